@@ -1,0 +1,78 @@
+"""The ``robobore`` command: ``robobore <stage> <verb>``.
+
+Each stage owns its commands in ``robobore/<stage>/cli.py`` and adds them here through a
+``register(groups)`` function, so the stages stay independent. Heavy imports (numba
+kernels) happen inside the commands, keeping ``robobore --help`` fast.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import typer
+
+from robobore import __version__
+
+app = typer.Typer(
+    name="robobore",
+    help="Robotic boring dynamics: robot stiffness, modal analysis, equivalent model, "
+    "cutting forces (mechanistic and explicit FE), stability and process studies.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+#: Command groups shared by the stages. ``groups["root"]`` is the top-level app, for
+#: top-level commands such as ``robobore lobes``.
+groups: dict[str, typer.Typer] = {
+    "root": app,
+    "robot": typer.Typer(help="Robot kinematics and stiffness.", no_args_is_help=True),
+    "identify": typer.Typer(help="Identify models from measurements.", no_args_is_help=True),
+    "model": typer.Typer(help="Build process models (equivalent model).", no_args_is_help=True),
+    "simulate": typer.Typer(help="Time-domain process simulation.", no_args_is_help=True),
+    "fe": typer.Typer(help="Explicit finite-element cutting simulation.", no_args_is_help=True),
+    "calibrate": typer.Typer(help="Calibrate models from simulations.", no_args_is_help=True),
+}
+
+#: Modules that contribute commands; each has ``register(groups)``.
+STAGE_CLIS = [
+    "robobore.robot.cli",
+    "robobore.modal.cli",
+    "robobore.dynamics.cli",
+    "robobore.cutting.fe.cli",
+    "robobore.study.cli",
+]
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(f"robobore {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version_callback, is_eager=True, help="Show the version."
+    ),
+) -> None:
+    """robobore command line."""
+
+
+def _build() -> None:
+    for mod in STAGE_CLIS:
+        importlib.import_module(mod).register(groups)
+    for name, sub in groups.items():
+        if name != "root" and sub.registered_commands:
+            app.add_typer(sub, name=name)
+
+
+_build()
+
+
+def main() -> None:  # console-script entry point
+    app()
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

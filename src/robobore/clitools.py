@@ -1,0 +1,140 @@
+"""Helpers shared by every CLI command: output as table or JSON, errors, progress bars.
+
+Stage CLIs (``robobore/<stage>/cli.py``) use these so every command behaves alike:
+a readable table by default, ``--json`` for machine-readable output on stdout, a rich
+progress bar on stderr for anything slow, and a one-line error (exit code 2) for bad input.
+"""
+
+from __future__ import annotations
+
+import functools
+import sys
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from typing import Any, TypeVar
+
+import typer
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+from robobore.errors import RoboboreError
+from robobore.io.results import dumps_json
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+stdout = Console()
+stderr = Console(stderr=True)
+
+JSON_OPTION = typer.Option(False, "--json", help="Print machine-readable JSON on stdout.")
+
+
+def handle_errors(func: F) -> F:
+    """Turn a :class:`RoboboreError` into one clear line on stderr and exit code 2."""
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return func(*args, **kwargs)
+        except RoboboreError as exc:
+            stderr.print(f"[bold red]error:[/] {exc}", highlight=False, markup=True)
+            raise typer.Exit(code=2) from None
+
+    return wrapper  # type: ignore[return-value]
+
+
+def emit(result: dict[str, Any], as_json: bool, render: Callable[[dict[str, Any]], None]) -> None:
+    """Print ``result`` as JSON (``as_json``) or through ``render`` (tables)."""
+    if as_json:
+        sys.stdout.write(dumps_json(result) + "\n")
+        sys.stdout.flush()
+    else:
+        render(result)
+
+
+def kv_table(title: str, rows: Iterable[tuple[str, Any]]) -> Table:
+    """A two-column (quantity, value) rich table."""
+    t = Table(title=title, show_header=True, header_style="bold")
+    t.add_column("quantity")
+    t.add_column("value", justify="right")
+    for k, v in rows:
+        t.add_row(str(k), fmt(v))
+    return t
+
+
+def fmt(v: Any) -> str:
+    """Compact human formatting of numbers (4 significant digits) and other values."""
+    if v is None:
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if v == 0.0:
+            return "0"
+        a = abs(v)
+        if 1e-3 <= a < 1e6:
+            return f"{v:.4g}"
+        return f"{v:.4e}"
+    return str(v)
+
+
+@contextmanager
+def progress_bar(
+    description: str, total: int | None, enabled: bool = True
+) -> Iterator[Callable[[int], None]]:
+    """A rich progress bar on stderr; yields ``advance(n)``.
+
+    Disabled (a no-op) when ``enabled`` is false, e.g. under ``--json`` output to a pipe;
+    the bar goes to stderr so JSON on stdout stays clean either way.
+    """
+    if not enabled:
+        yield lambda n=1: None
+        return
+    prog = Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=stderr,
+        transient=True,
+    )
+    with prog:
+        task = prog.add_task(description, total=total)
+        yield lambda n=1: prog.advance(task, n)
+
+
+def parse_floats(text: str, n: int | None, option: str, unit: str) -> list[float]:
+    """Parse a comma-separated list of numbers given on the command line.
+
+    Raises a ConfigError naming the option, the value and the expected count and unit.
+    """
+    from robobore.errors import ConfigError
+
+    parts = [p.strip() for p in text.replace(";", ",").split(",") if p.strip()]
+    try:
+        vals = [float(p) for p in parts]
+    except ValueError:
+        raise ConfigError(
+            "not a list of numbers",
+            field=option,
+            value=text,
+            expected=f"{n or 'some'} comma-separated numbers in {unit}",
+        ) from None
+    if n is not None and len(vals) != n:
+        raise ConfigError(
+            f"expected {n} values, got {len(vals)}",
+            field=option,
+            value=text,
+            expected=f"{n} comma-separated numbers in {unit}",
+        )
+    return vals

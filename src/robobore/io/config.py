@@ -1,0 +1,66 @@
+"""Config files (TOML) and their validation into pydantic models.
+
+Human units live in the key names (``feed_mm_per_rev``); conversion to SI happens once,
+in the model that parses the file. Validation errors are turned into
+:class:`robobore.errors.ConfigError` naming the file, the dotted key, the value and what
+was expected.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from robobore.errors import ConfigError
+
+M = TypeVar("M", bound=BaseModel)
+
+
+def load_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file into a dict; a missing file or a syntax error is a ConfigError."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError("config file not found", file=str(p), expected="an existing TOML file")
+    try:
+        with p.open("rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"not valid TOML: {exc}", file=str(p)) from exc
+
+
+def _loc(err: dict[str, Any]) -> str:
+    return ".".join(str(x) for x in err.get("loc", ()))
+
+
+def validate_model(model: type[M], data: dict[str, Any], source: str | Path = "<config>") -> M:
+    """Validate ``data`` into ``model``; errors name the file and the dotted key.
+
+    All validation problems are listed in the message; the first one fills the
+    structured ``field``/``value`` attributes of the raised :class:`ConfigError`.
+    """
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        errs = exc.errors()
+        lines = []
+        for e in errs:
+            msg = e.get("msg", "invalid")
+            inp = e.get("input")
+            shown = "" if isinstance(inp, dict) else f" (got {inp!r})"
+            lines.append(f"[{_loc(e)}] {msg}{shown}")
+        first = errs[0] if errs else {}
+        first_in = first.get("input")
+        raise ConfigError(
+            "; ".join(lines),
+            file=str(source),
+            field=_loc(first) or None,
+            value=None if isinstance(first_in, dict) else first_in,
+        ) from None
+
+
+def load_config(model: type[M], path: str | Path) -> M:
+    """Read and validate a TOML config file in one step."""
+    return validate_model(model, load_toml(path), source=path)

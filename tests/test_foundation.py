@@ -1,0 +1,76 @@
+"""Foundation: error messages, config validation, atomic writes, CLI wiring."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+from pydantic import BaseModel, Field
+from typer.testing import CliRunner
+
+from robobore.cli import app
+from robobore.errors import ConfigError, InputError
+from robobore.io.config import load_toml, validate_model
+from robobore.io.results import atomic_write_text, to_jsonable, write_json, write_netcdf
+
+
+def test_input_error_names_everything():
+    e = InputError("not a number", file="c.csv", row=3, field="q1_deg", value="abc",
+                   expected="a number in deg")
+    s = str(e)
+    for part in ("c.csv", "row 3", "q1_deg", "'abc'", "a number in deg"):
+        assert part in s
+
+
+class _Inner(BaseModel):
+    stiffness_N_per_m: float = Field(gt=0)
+
+
+class _Cfg(BaseModel):
+    inner: _Inner
+
+
+def test_validate_model_names_key_and_file():
+    with pytest.raises(ConfigError) as ei:
+        validate_model(_Cfg, {"inner": {"stiffness_N_per_m": -1.0}}, source="x.toml")
+    assert ei.value.field == "inner.stiffness_N_per_m"
+    assert "x.toml" in str(ei.value) and "-1.0" in str(ei.value)
+
+
+def test_load_toml_errors(tmp_path):
+    with pytest.raises(ConfigError, match="not found"):
+        load_toml(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[a\nb = ")
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        load_toml(bad)
+
+
+def test_atomic_write_leaves_no_temp(tmp_path):
+    p = atomic_write_text(tmp_path / "sub" / "a.txt", "hello")
+    assert p.read_text() == "hello"
+    assert [f.name for f in p.parent.iterdir()] == ["a.txt"]
+
+
+def test_json_and_netcdf_roundtrip(tmp_path):
+    obj = {"a": np.float64(1.5), "b": np.arange(3), "c": float("nan"), "d": np.bool_(True)}
+    assert to_jsonable(obj) == {"a": 1.5, "b": [0, 1, 2], "c": None, "d": True}
+    write_json(tmp_path / "r.json", obj)
+    assert json.loads((tmp_path / "r.json").read_text())["b"] == [0, 1, 2]
+    ds = xr.Dataset({"f": ("t", np.arange(4.0))})
+    ds["f"].attrs["units"] = "N"
+    write_netcdf(ds, tmp_path / "r.nc", config={"k": 1}, seed=7)
+    back = xr.open_dataset(tmp_path / "r.nc")
+    assert back.attrs["robobore_seed"] == 7
+    assert json.loads(back.attrs["robobore_config"]) == {"k": 1}
+    assert back["f"].attrs["units"] == "N"
+    back.close()
+
+
+def test_cli_version_and_help():
+    r = CliRunner().invoke(app, ["--version"])
+    assert r.exit_code == 0 and "robobore" in r.stdout
+    r = CliRunner().invoke(app, ["--help"])
+    assert r.exit_code == 0
