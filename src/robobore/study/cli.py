@@ -1,9 +1,146 @@
-"""CLI commands of this stage (registered by ``robobore.cli``)."""
+"""CLI commands of the study stage (registered by ``robobore.cli``).
+
+``robobore sweep CONFIG.toml`` and ``robobore compare MEASURED.csv RESULTS_DIR``.
+Dask, xarray and matplotlib are imported inside the commands.
+"""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+from typing import Any
+
 import typer
+
+from robobore.clitools import JSON_OPTION, emit, fmt, handle_errors, kv_table, stdout
+
+
+def _render_sweep(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    stdout.print(kv_table(f"sweep {res['name']}", [
+        ("results store", res["store"]),
+        ("mode", res["mode"]),
+        ("conditions", res["total"]),
+        ("already done (skipped)", res["skipped"]),
+        ("computed now", res["computed"]),
+        ("failed now", res["failed"]),
+        ("not done (failed or pending)", res["pending"]),
+        ("wall time, s", res["wall_time_s"]),
+        ("conditions/s", res["conditions_per_s"]),
+    ]))
+    if res["failures"]:
+        t = Table(title="failed conditions (see failed/<key>.json for tracebacks)",
+                  header_style="bold red")
+        for c in ("key", "condition", "error"):
+            t.add_column(c)
+        for f in res["failures"][:30]:
+            c = f["condition"]
+            t.add_row(f["key"], f"n={fmt(c['speed_rpm'])} f={fmt(c['feed_mm_per_rev'])} "
+                      f"ap={fmt(c['depth_of_cut_mm'])} P={fmt(c['pressure_MPa'])}",
+                      f["error"][:120])
+        stdout.print(t)
+
+
+def sweep_cmd(
+    config: Path = typer.Argument(..., help="Sweep config TOML (see docs/study.md)."),
+    scheduler: str | None = typer.Option(
+        None, "--scheduler", help="Address of a running Dask scheduler (tcp://host:port); "
+        "default: start a local cluster."),
+    workers: int | None = typer.Option(
+        None, "--workers", min=0, help="Local cluster workers (default: CPU count; "
+        "0 = run in this process without Dask)."),
+    threads: bool = typer.Option(
+        False, "--threads", help="Local workers as threads of this process, not processes."),
+    out: Path | None = typer.Option(
+        None, "--out", help="Results store folder (default: ./sweep-<name>)."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Run a sweep of cutting conditions (resumable: finished conditions are skipped).
+
+    Exit code 0 when every condition is done, 1 when some failed (they are listed, and
+    recorded with their traceback in the store; run the command again to retry them).
+    """
+    from robobore.study.sweep import plan_from_file, run_sweep
+
+    plan = plan_from_file(config)
+    if scheduler is not None and workers is not None:
+        from robobore.errors import ConfigError
+
+        raise ConfigError("give either --scheduler or --workers", field="--workers",
+                          value=workers, expected="no --workers with an external scheduler")
+    store = out if out is not None else Path(f"sweep-{plan.name}")
+    outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
+                        processes=not threads, progress=sys.stderr.isatty())
+    res = {"name": plan.name, "runner": plan.runner, **outcome.to_dict()}
+    emit(res, as_json, _render_sweep)
+    if outcome.pending:
+        raise typer.Exit(code=1)
+
+
+def _pct(v: float | None) -> str:
+    return "—" if v is None else f"{100.0 * v:.2f} %"
+
+
+def _render_compare(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    t = Table(title="measured vs simulated (relative error)", header_style="bold")
+    for c in ("row", "n [r/min]", "f [mm/r]", "ap [mm]", "P [MPa]", "group", "quantity",
+              "measured", "simulated", "rel. error"):
+        t.add_column(c, justify="right")
+    for r in res["conditions"]:
+        c = r["condition"]
+        for q, e in r["quantities"].items():
+            t.add_row(str(r["row"]), fmt(c["speed_rpm"]), fmt(c["feed_mm_per_rev"]),
+                      fmt(c["depth_of_cut_mm"]), fmt(c["pressure_MPa"]), r["group"], q,
+                      fmt(e["measured"]), fmt(e["simulated"]), _pct(e["rel_error"]))
+    stdout.print(t)
+    g = Table(title=f"relative error per group (groups from the {res['group_source']} "
+              "stable flag)", header_style="bold")
+    for c in ("group", "conditions", "values", "min", "max", "mean"):
+        g.add_column(c, justify="right")
+    for name, s in res["groups"].items():
+        g.add_row(name, str(s["n_conditions"]), str(s["n"]), _pct(s["min_rel_error"]),
+                  _pct(s["max_rel_error"]), _pct(s["mean_rel_error"]))
+    stdout.print(g)
+    a = res["agreement"]
+    stdout.print(kv_table("stable / vibratory agreement", [
+        ("conditions with both flags", a["n"]), ("agree", a["agree"]),
+        ("agreement rate", None if a["rate"] is None else f"{100 * a['rate']:.1f} %"),
+        ("measured stable, simulated vibratory", a["measured_stable_simulated_vibratory"]),
+        ("measured vibratory, simulated stable", a["measured_vibratory_simulated_stable"]),
+    ]))
+    if res["unmatched_measured"]:
+        rows = ", ".join(str(u["row"]) for u in res["unmatched_measured"])
+        stdout.print(f"[yellow]measured rows without a simulated condition:[/] {rows}")
+    for u in res["undefined"]:
+        stdout.print(f"[yellow]row {u['row']} {u['quantity']}:[/] {u['reason']}")
+
+
+def compare_cmd(
+    measured: Path = typer.Argument(..., help="Measured CSV (see docs/study.md for columns)."),
+    results: Path = typer.Argument(..., help="Results store folder written by 'robobore sweep'."),
+    report: Path | None = typer.Option(None, "--report", help="Also write an HTML report here."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Compare measurements with a sweep's results: relative errors, groups, agreement."""
+    from robobore.study.compare import compare_results
+
+    cmp = compare_results(measured, results)
+    res = cmp.to_dict()
+    res["measured"] = str(measured)
+    res["results"] = str(results)
+    if report is not None:
+        from robobore.study.plots import comparison_report
+
+        comparison_report(cmp, title=f"Comparison: {measured.name} vs {results.name}").write(report)
+        res["report"] = str(report)
+    emit(res, as_json, _render_compare)
 
 
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add this stage's commands to the shared command groups."""
+    root = groups["root"]
+    root.command("sweep")(handle_errors(sweep_cmd))
+    root.command("compare")(handle_errors(compare_cmd))

@@ -1,0 +1,356 @@
+"""Comparison of simulated results with measurements, per condition and quantity.
+
+Measured CSV contract (one row per condition, header first)::
+
+    speed_rpm,feed_mm_per_rev,depth_of_cut_mm,pressure_MPa,force_amplitude_x_N,...,stable
+    300,0.15,0.05,0,212.4,,,,true
+
+* required columns: ``speed_rpm`` (r/min, > 0), ``feed_mm_per_rev`` (mm, > 0),
+  ``depth_of_cut_mm`` (mm, > 0), ``pressure_MPa`` (MPa, >= 0);
+* at least one of ``force_amplitude_x_N``, ``force_amplitude_y_N``, ``force_amplitude_z_N``
+  (N, >= 0), ``feed_amplitude_um`` (um, >= 0), ``stable`` (true/false; 1/0 and yes/no are
+  accepted too);
+* optional ``posture`` (a posture name, matched against the simulated condition's);
+* an empty quantity cell means "not measured"; every other cell must parse. Anything else
+  (an unknown or repeated column, a non-numeric, negative or non-finite number, a bad
+  boolean, a row with the wrong number of cells, the same condition twice) raises
+  :class:`robobore.errors.DataError` naming the file, the row (data rows counted from 1 after
+  the header; blank lines count) and the column. Lines starting with ``#`` are comments.
+
+Relative error of a quantity: ``|simulated - measured| / |measured|`` (a fraction; the
+paper quotes it in %). A measured value of 0 has no relative error: that pair is listed in
+``undefined`` with the reason, never silently dropped. Conditions are split into stable and
+vibratory by the *measured* ``stable`` column when the CSV has it (as the paper does: the
+surface quality of the experiment decides), else by the simulated flag; for each group the
+minimum, maximum and mean relative error over all its quantities (and per quantity) are
+reported (the paper: 3.22-15.54 % stable, 5.61-22.56 % vibratory). The stable/vibratory
+agreement is the fraction of conditions where measured and simulated ``stable`` agree.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from robobore.errors import DataError
+from robobore.study.conditions import CONDITION_FIELDS, DEFAULT_POSTURE
+from robobore.study.summary import AMPLITUDE_QUANTITIES, SUMMARY_QUANTITIES, parse_bool
+
+_COND_UNITS = {
+    "speed_rpm": ("r/min", False),
+    "feed_mm_per_rev": ("mm", False),
+    "depth_of_cut_mm": ("mm", False),
+    "pressure_MPa": ("MPa", True),  # zero allowed
+}
+KNOWN_COLUMNS = (*CONDITION_FIELDS, "posture", *SUMMARY_QUANTITIES)
+
+
+def _match_key(cond: dict[str, Any], with_posture: bool) -> tuple[Any, ...]:
+    k: tuple[Any, ...] = tuple(float(f"{float(cond[f]):.9g}") for f in CONDITION_FIELDS)
+    if with_posture:
+        k = (*k, str(cond.get("posture", DEFAULT_POSTURE)))
+    return k
+
+
+@dataclass(frozen=True)
+class MeasuredRow:
+    """One measured condition: ``row`` (1-based data row), the condition, the values."""
+
+    row: int
+    condition: dict[str, Any]
+    values: dict[str, Any]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"row": self.row, "condition": self.condition, "values": self.values}
+
+
+@dataclass(frozen=True)
+class MeasuredTable:
+    """A validated measured CSV."""
+
+    source: str
+    columns: tuple[str, ...]
+    quantities: tuple[str, ...]
+    has_posture: bool
+    rows: tuple[MeasuredRow, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"source": self.source, "columns": list(self.columns),
+                "quantities": list(self.quantities), "rows": [r.to_dict() for r in self.rows]}
+
+
+def _parse_number(cell: str, *, source: str, row: int, col: str, unit: str,
+                  allow_zero: bool) -> float:
+    expected = f"a finite number {'>= 0' if allow_zero else '> 0'} in {unit}"
+    try:
+        v = float(cell)
+    except ValueError:
+        raise DataError("not a number", file=source, row=row, field=col, value=cell,
+                        expected=expected) from None
+    if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise DataError("number out of range", file=source, row=row, field=col, value=cell,
+                        expected=expected)
+    return v
+
+
+def parse_measured_csv(text: str, source: str = "<measured>") -> MeasuredTable:
+    """Parse and validate measured-CSV text (see module doc)."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    reader = csv.reader(io.StringIO(text))
+    header: list[str] | None = None
+    header_line = 0
+    rows: list[MeasuredRow] = []
+    seen: dict[tuple[Any, ...], int] = {}
+    for cells in reader:
+        line = reader.line_num
+        if not cells or all(not c.strip() for c in cells):
+            continue
+        if cells[0].lstrip().startswith("#"):
+            continue
+        if header is None:
+            header = [c.strip() for c in cells]
+            header_line = line
+            _check_header(header, source)
+            continue
+        row = line - header_line
+        if len(cells) != len(header):
+            raise DataError(f"row has {len(cells)} cells, the header has {len(header)}",
+                            file=source, row=row, expected=f"{len(header)} comma-separated cells")
+        rec = {h: c.strip() for h, c in zip(header, cells, strict=True)}
+        cond: dict[str, Any] = {}
+        for col in CONDITION_FIELDS:
+            unit, allow_zero = _COND_UNITS[col]
+            if rec[col] == "":
+                raise DataError("empty cell", file=source, row=row, field=col,
+                                expected=f"a number in {unit}")
+            cond[col] = _parse_number(rec[col], source=source, row=row, col=col, unit=unit,
+                                      allow_zero=allow_zero)
+        if "posture" in rec:
+            if rec["posture"] == "":
+                raise DataError("empty cell", file=source, row=row, field="posture",
+                                expected="a posture name")
+            cond["posture"] = rec["posture"]
+        values: dict[str, Any] = {}
+        for col, unit in AMPLITUDE_QUANTITIES.items():
+            if col in rec and rec[col] != "":
+                values[col] = _parse_number(rec[col], source=source, row=row, col=col,
+                                            unit=unit, allow_zero=True)
+        if "stable" in rec and rec["stable"] != "":
+            b = parse_bool(rec["stable"])
+            if b is None:
+                raise DataError("not a boolean", file=source, row=row, field="stable",
+                                value=rec["stable"], expected="true or false")
+            values["stable"] = b
+        key = _match_key(cond, "posture" in rec)
+        if key in seen:
+            raise DataError(f"the same condition as row {seen[key]}", file=source, row=row,
+                            field=",".join(CONDITION_FIELDS),
+                            expected="each condition once (average repeated measurements)")
+        seen[key] = row
+        rows.append(MeasuredRow(row=row, condition=cond, values=values))
+    if header is None:
+        raise DataError("no header line", file=source,
+                        expected=f"a header with columns {', '.join(CONDITION_FIELDS)}, ...")
+    if not rows:
+        raise DataError("no data rows", file=source, expected="at least one measured condition")
+    quantities = tuple(q for q in SUMMARY_QUANTITIES if q in header)
+    return MeasuredTable(source=source, columns=tuple(header), quantities=quantities,
+                         has_posture="posture" in header, rows=tuple(rows))
+
+
+def _check_header(header: list[str], source: str) -> None:
+    for i, h in enumerate(header):
+        if h == "":
+            raise DataError("empty column name", file=source, row=0, field=f"column {i + 1}",
+                            expected="a column name")
+        if h not in KNOWN_COLUMNS:
+            raise DataError("unknown column", file=source, field=h,
+                            expected=f"one of {', '.join(KNOWN_COLUMNS)}")
+        if header.count(h) > 1:
+            raise DataError("column appears twice", file=source, field=h,
+                            expected="each column once")
+    for col in CONDITION_FIELDS:
+        if col not in header:
+            raise DataError("missing column", file=source, field=col,
+                            expected=f"columns {', '.join(CONDITION_FIELDS)}")
+    if not any(q in header for q in SUMMARY_QUANTITIES):
+        raise DataError("no measured quantity column", file=source,
+                        expected=f"at least one of {', '.join(SUMMARY_QUANTITIES)}")
+
+
+def read_measured_csv(path: str | Path) -> MeasuredTable:
+    """Read and validate a measured CSV file (see module doc)."""
+    p = Path(path)
+    if not p.is_file():
+        raise DataError("file not found", file=str(p), expected="a measured-results CSV file")
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
+                        expected="a UTF-8 CSV file") from None
+    return parse_measured_csv(text, source=str(p))
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Result of :func:`compare` (all relative errors are fractions, not %)."""
+
+    rows: tuple[dict[str, Any], ...]
+    groups: dict[str, dict[str, Any]]
+    agreement: dict[str, Any]
+    group_source: str
+    unmatched_measured: tuple[dict[str, Any], ...] = field(default_factory=tuple)
+    undefined: tuple[dict[str, Any], ...] = field(default_factory=tuple)
+    quantities: tuple[str, ...] = field(default_factory=tuple)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "quantities": list(self.quantities), "group_source": self.group_source,
+            "groups": self.groups, "agreement": self.agreement, "conditions": list(self.rows),
+            "unmatched_measured": list(self.unmatched_measured), "undefined": list(self.undefined),
+        }
+
+    def table_rows(self) -> list[dict[str, Any]]:
+        """Flat rows (one per condition and amplitude quantity) for tables and CSV."""
+        out = []
+        for r in self.rows:
+            for q, e in r["quantities"].items():
+                out.append({**{f: r["condition"][f] for f in CONDITION_FIELDS},
+                            "group": r["group"], "quantity": q, "measured": e["measured"],
+                            "simulated": e["simulated"], "rel_error_pct":
+                            None if e["rel_error"] is None else 100.0 * e["rel_error"]})
+        return out
+
+
+def _stats(errors: list[float]) -> dict[str, Any]:
+    if not errors:
+        return {"n": 0, "min_rel_error": None, "max_rel_error": None, "mean_rel_error": None}
+    return {"n": len(errors), "min_rel_error": min(errors), "max_rel_error": max(errors),
+            "mean_rel_error": sum(errors) / len(errors)}
+
+
+def compare(measured: MeasuredTable,
+            simulated: Iterable[tuple[dict[str, Any], dict[str, Any]]]) -> Comparison:
+    """Compare measured rows with simulated ``(condition, summary)`` pairs.
+
+    Matching is on the four condition values (to 9 significant digits) and, when the CSV
+    has a ``posture`` column, the posture. Two simulated results for one measured condition
+    (e.g. two model configs in one store) are an error: compare one sweep at a time.
+    """
+    sims: dict[tuple[Any, ...], tuple[dict[str, Any], dict[str, Any]]] = {}
+    for cond, summ in simulated:
+        k = _match_key(cond, measured.has_posture)
+        if k in sims:
+            raise DataError(
+                "two simulated results for one condition "
+                f"({', '.join(f'{f}={cond[f]}' for f in CONDITION_FIELDS)}"
+                f"{'' if measured.has_posture else '; add a posture column to the CSV'})",
+                expected="one simulated result per condition (one sweep per results folder)",
+            )
+        sims[k] = (cond, summ)
+
+    use_measured_flag = "stable" in measured.quantities
+    rows: list[dict[str, Any]] = []
+    unmatched: list[dict[str, Any]] = []
+    undefined: list[dict[str, Any]] = []
+    per_group: dict[str, dict[str, list[float]]] = {"stable": {}, "vibratory": {}, "unknown": {}}
+    confusion = {"both_stable": 0, "both_vibratory": 0,
+                 "measured_stable_simulated_vibratory": 0,
+                 "measured_vibratory_simulated_stable": 0}
+    for m in measured.rows:
+        k = _match_key(m.condition, measured.has_posture)
+        if k not in sims:
+            unmatched.append({"row": m.row, "condition": m.condition})
+            continue
+        scond, ssum = sims[k]
+        ms, ss = m.values.get("stable"), ssum.get("stable")
+        flag = ms if use_measured_flag else ss
+        group = "unknown" if flag is None else ("stable" if flag else "vibratory")
+        qres: dict[str, Any] = {}
+        for q in AMPLITUDE_QUANTITIES:
+            if q not in m.values:
+                continue
+            mv, sv = m.values[q], ssum.get(q)
+            if sv is None:
+                undefined.append({"row": m.row, "quantity": q,
+                                  "reason": "the simulation does not give this quantity"})
+                qres[q] = {"measured": mv, "simulated": None, "rel_error": None}
+                continue
+            if mv == 0.0:
+                undefined.append({"row": m.row, "quantity": q,
+                                  "reason": "measured value is 0: relative error undefined"})
+                qres[q] = {"measured": mv, "simulated": sv, "rel_error": None}
+                continue
+            e = abs(sv - mv) / abs(mv)
+            qres[q] = {"measured": mv, "simulated": sv, "rel_error": e}
+            per_group[group].setdefault(q, []).append(e)
+        agree = None
+        if ms is not None and ss is not None:
+            agree = ms == ss
+            if ms and ss:
+                confusion["both_stable"] += 1
+            elif not ms and not ss:
+                confusion["both_vibratory"] += 1
+            elif ms:
+                confusion["measured_stable_simulated_vibratory"] += 1
+            else:
+                confusion["measured_vibratory_simulated_stable"] += 1
+        rows.append({"row": m.row, "condition": {**scond, **m.condition}, "group": group,
+                     "stable_measured": ms, "stable_simulated": ss, "stable_agree": agree,
+                     "quantities": qres})
+    if not rows:
+        raise DataError(
+            "no measured condition matches a simulated one", file=measured.source,
+            expected="rows whose speed_rpm, feed_mm_per_rev, depth_of_cut_mm, pressure_MPa "
+            "equal those of the sweep",
+        )
+    groups = {}
+    for g, qs in per_group.items():
+        if g == "unknown" and not qs:
+            continue
+        allv = [e for v in qs.values() for e in v]
+        groups[g] = {**_stats(allv),
+                     "n_conditions": sum(1 for r in rows if r["group"] == g),
+                     "per_quantity": {q: _stats(v) for q, v in qs.items()}}
+    n_cmp = sum(confusion.values())
+    agreement = {"n": n_cmp, "agree": confusion["both_stable"] + confusion["both_vibratory"],
+                 "rate": None if n_cmp == 0 else
+                 (confusion["both_stable"] + confusion["both_vibratory"]) / n_cmp,
+                 **confusion}
+    return Comparison(
+        rows=tuple(rows), groups=groups, agreement=agreement,
+        group_source="measured" if use_measured_flag else "simulated",
+        unmatched_measured=tuple(unmatched), undefined=tuple(undefined),
+        quantities=measured.quantities,
+    )
+
+
+def compare_results(measured_csv: str | Path, results_dir: str | Path) -> Comparison:
+    """Compare a measured CSV with every finished condition of a results store."""
+    from robobore.study.store import ResultsStore
+
+    table = read_measured_csv(measured_csv)
+    store = ResultsStore.open_existing(results_dir)
+    sims = [(r.condition, r.summary) for r in store.records()]
+    if not sims:
+        raise DataError("the results store has no finished condition", file=str(results_dir),
+                        expected="a folder with results written by 'robobore sweep'")
+    return compare(table, sims)
+
+
+__all__ = [
+    "KNOWN_COLUMNS",
+    "MeasuredRow",
+    "MeasuredTable",
+    "Comparison",
+    "parse_measured_csv",
+    "read_measured_csv",
+    "compare",
+    "compare_results",
+]

@@ -1,0 +1,331 @@
+"""Run a runner over many conditions with Dask, storing each result as it finishes.
+
+A *runner* is a picklable, importable function ``runner(condition: dict, context: dict)
+-> xarray.Dataset`` (condition: :class:`~robobore.study.conditions.Condition` as a dict;
+context: ``model`` (the model config), ``runner_options``, ``postures``, ``posture``
+(this condition's posture table or ``{}``), ``seed`` (this condition's seed), ``key``,
+``sweep``). It is named in the sweep config: a registered name (:data:`RUNNERS`) or
+``"package.module:function"``. Runners must be importable on the Dask workers.
+
+Execution (:func:`run_sweep`):
+
+* conditions already in the store are skipped; missing and failed ones are (re)computed;
+* a local Dask cluster (``workers`` processes, one thread each; or threads in this process
+  with ``processes=False``) is started unless a scheduler address is given, and closed at
+  the end; ``workers=0`` runs in this process without Dask (debugging, profiling);
+* results are collected with ``as_completed`` and written by the client at once, one
+  netCDF file per condition, atomically; a failing condition (runner exception, a result
+  that breaks the summary contract, a lost worker) is recorded with its error and
+  traceback and does not stop the others;
+* ``index.json`` is rewritten every few seconds and at the end, ``summary.csv`` at the end.
+
+Killing the process at any moment loses at most the conditions in flight; the next run
+recomputes exactly those.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import os
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from robobore.errors import ConfigError, DataError, RoboboreError
+from robobore.study.conditions import (
+    Condition,
+    SweepConfig,
+    condition_key,
+    condition_seed,
+)
+from robobore.study.store import ResultsStore, worker_label
+
+Runner = Callable[[dict[str, Any], dict[str, Any]], Any]
+
+#: Registered runner names -> "module:function". The real boring runner is added here when
+#: the process-dynamics stage provides it.
+RUNNERS: dict[str, str] = {
+    "demo": "robobore.study.demo:demo_runner",
+}
+
+
+def resolve_runner(spec: str) -> Runner:
+    """The runner function for a registered name or a ``"module:function"`` path."""
+    target = RUNNERS.get(spec, spec)
+    if ":" not in target:
+        raise ConfigError("unknown runner", field="sweep.runner", value=spec,
+                          expected=f"one of {sorted(RUNNERS)} or 'package.module:function'")
+    mod_name, _, attr = target.partition(":")
+    try:
+        mod = importlib.import_module(mod_name)
+        fn = getattr(mod, attr)
+    except (ImportError, AttributeError) as exc:
+        raise ConfigError(f"cannot import runner ({exc})", field="sweep.runner", value=spec,
+                          expected="an importable 'package.module:function'") from None
+    if not callable(fn):
+        raise ConfigError("runner is not callable", field="sweep.runner", value=spec,
+                          expected="a function runner(condition, context) -> xarray.Dataset")
+    return fn
+
+
+@dataclass(frozen=True)
+class SweepItem:
+    """One condition of a sweep with its key and its own context."""
+
+    key: str
+    condition: dict[str, Any]
+    context: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class SweepPlan:
+    """Everything needed to run a sweep: name, runner spec, items (in order)."""
+
+    name: str
+    runner: str
+    items: tuple[SweepItem, ...]
+    config: dict[str, Any]
+
+    @classmethod
+    def from_config(cls, cfg: SweepConfig, conditions: list[Condition]) -> SweepPlan:
+        items = []
+        for c in conditions:
+            posture = cfg.postures.get(c.posture, {})
+            key = condition_key(c, cfg.sweep.runner, cfg.model, posture)
+            ctx = {
+                "model": cfg.model, "runner_options": cfg.runner_options,
+                "postures": cfg.postures, "posture": posture,
+                "seed": condition_seed(cfg.sweep.seed, key), "key": key,
+                "sweep": cfg.sweep.name,
+            }
+            items.append(SweepItem(key=key, condition=c.to_dict(), context=ctx))
+        keys = [i.key for i in items]
+        if len(set(keys)) != len(keys):  # pragma: no cover - duplicates are caught earlier
+            raise ConfigError("two conditions have the same key", expected="distinct conditions")
+        return cls(
+            name=cfg.sweep.name, runner=cfg.sweep.runner, items=tuple(items),
+            config={"sweep": cfg.sweep.model_dump(), "model": cfg.model,
+                    "postures": cfg.postures},
+        )
+
+
+@dataclass(frozen=True)
+class SweepOutcome:
+    """What a sweep run did."""
+
+    store: Path
+    total: int
+    skipped: int  # already done before this run
+    computed: int  # finished in this run
+    failed: int  # failed in this run
+    pending: int  # still not done (failed or never run) after this run
+    wall_time_s: float
+    mode: str
+    failures: tuple[dict[str, Any], ...] = field(default_factory=tuple)
+
+    @property
+    def conditions_per_s(self) -> float:
+        n = self.computed + self.failed
+        return n / self.wall_time_s if self.wall_time_s > 0 and n else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "store": str(self.store), "total": self.total, "skipped": self.skipped,
+            "computed": self.computed, "failed": self.failed, "pending": self.pending,
+            "wall_time_s": self.wall_time_s, "conditions_per_s": self.conditions_per_s,
+            "mode": self.mode, "failures": list(self.failures),
+        }
+
+
+def execute(runner: Runner, condition: dict[str, Any], context: dict[str, Any]) -> dict[str, Any]:
+    """Run one condition (on a worker); never raises: returns ``ok`` and the dataset or the
+    error text and traceback."""
+    t0 = time.perf_counter()
+    try:
+        ds = runner(condition, context)
+        import xarray as xr
+
+        if not isinstance(ds, xr.Dataset):
+            raise TypeError(f"runner returned {type(ds).__name__}, expected xarray.Dataset")
+        return {"ok": True, "dataset": ds, "wall_time_s": time.perf_counter() - t0,
+                "worker": worker_label()}
+    except Exception as exc:  # recorded, the sweep goes on
+        return {"ok": False, "error": f"{type(exc).__name__}: {exc}",
+                "traceback": traceback.format_exc(), "wall_time_s": time.perf_counter() - t0,
+                "worker": worker_label()}
+
+
+def _default_workers() -> int:
+    return max(1, os.cpu_count() or 1)
+
+
+class _Recorder:
+    """Writes results/failures to the store and keeps the counts (client side)."""
+
+    def __init__(self, store: ResultsStore, plan: SweepPlan, advance: Callable[[int], None],
+                 index_every_s: float) -> None:
+        self.store, self.plan, self.advance = store, plan, advance
+        self.computed = 0
+        self.failures: list[dict[str, Any]] = []
+        self.index_every_s = index_every_s
+        self._last_index = time.monotonic()
+        self._pairs = [(i.key, i.condition) for i in plan.items]
+
+    def record(self, item: SweepItem, res: dict[str, Any]) -> None:
+        if res.get("ok"):
+            try:
+                self.store.write_result(
+                    item.key, item.condition, res["dataset"], runner=self.plan.runner,
+                    config={**self.plan.config, "runner_options":
+                            item.context.get("runner_options", {})},
+                    seed=item.context.get("seed"), wall_time_s=res.get("wall_time_s"),
+                    worker=res.get("worker"),
+                )
+                self.computed += 1
+            except DataError as exc:  # the result breaks the summary contract
+                self._fail(item, f"DataError: {exc}", traceback.format_exc(), res.get("worker"))
+        else:
+            self._fail(item, res["error"], res.get("traceback", ""), res.get("worker"))
+        self.advance(1)
+        now = time.monotonic()
+        if now - self._last_index >= self.index_every_s:
+            self.write_index()
+            self._last_index = now
+
+    def _fail(self, item: SweepItem, error: str, tb: str, worker: str | None) -> None:
+        self.store.write_failure(item.key, item.condition, error, tb, worker=worker)
+        self.failures.append({"key": item.key, "condition": item.condition, "error": error})
+
+    def write_index(self) -> dict[str, Any]:
+        return self.store.write_index(self.plan.name, self.plan.runner, self._pairs)
+
+
+def run_sweep(
+    plan: SweepPlan,
+    store: ResultsStore | str | Path,
+    *,
+    runner: Runner | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    processes: bool = True,
+    progress: bool = False,
+    index_every_s: float = 2.0,
+    connect_timeout_s: float = 15.0,
+) -> SweepOutcome:
+    """Run the pending conditions of ``plan`` and store each result as it finishes.
+
+    ``scheduler``: address of a running Dask scheduler (``tcp://host:port``); otherwise a
+    local cluster with ``workers`` workers (default: CPU count), processes or threads
+    (``processes``); ``workers=0`` (and no scheduler) runs serially in this process.
+    ``runner`` overrides the plan's runner spec (a picklable function).
+    """
+    from robobore.clitools import progress_bar
+
+    if not isinstance(store, ResultsStore):
+        store = ResultsStore(store)
+    store.cleanup_partial()
+    fn = runner if runner is not None else resolve_runner(plan.runner)
+    todo = [i for i in plan.items if not store.is_done(i.key)]
+    skipped = len(plan.items) - len(todo)
+    t0 = time.perf_counter()
+
+    if scheduler is not None:
+        mode = f"dask scheduler {scheduler}"
+    elif workers == 0:
+        mode = "serial (no Dask)"
+    else:
+        nw = workers or _default_workers()
+        mode = f"dask local cluster, {nw} {'process' if processes else 'thread'} worker(s)"
+
+    with progress_bar(f"sweep {plan.name}", total=len(todo), enabled=progress) as advance:
+        rec = _Recorder(store, plan, advance, index_every_s)
+        rec.write_index()
+        if todo:
+            if scheduler is None and workers == 0:
+                for item in todo:
+                    rec.record(item, execute(fn, item.condition, item.context))
+            else:
+                _run_dask(fn, todo, rec, scheduler=scheduler,
+                          workers=workers or _default_workers(), processes=processes,
+                          connect_timeout_s=connect_timeout_s)
+        index = rec.write_index()
+    store.write_summary_csv([i.key for i in plan.items])
+    return SweepOutcome(
+        store=store.root, total=len(plan.items), skipped=skipped, computed=rec.computed,
+        failed=len(rec.failures), pending=index["counts"]["failed"] + index["counts"]["pending"],
+        wall_time_s=time.perf_counter() - t0, mode=mode, failures=tuple(rec.failures),
+    )
+
+
+def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: str | None,
+              workers: int, processes: bool, connect_timeout_s: float) -> None:
+    from distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    client = None
+    try:
+        if scheduler is not None:
+            try:
+                client = Client(scheduler, timeout=f"{connect_timeout_s}s",
+                                set_as_default=False)
+            except (OSError, TimeoutError) as exc:
+                raise RoboboreError(
+                    f"cannot connect to the Dask scheduler at {scheduler!r} within "
+                    f"{connect_timeout_s:g} s ({exc}); expected a running scheduler, e.g. "
+                    "'dask scheduler' then 'dask worker ADDR'"
+                ) from None
+        else:
+            # processes: TCP on loopback only; threads: Dask's in-process transport
+            extra = {"host": "127.0.0.1"} if processes else {}
+            cluster = LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=processes,
+                dashboard_address=None, silence_logs=logging.ERROR, **extra,
+            )
+            client = Client(cluster, set_as_default=False)
+        by_future = {}
+        for item in todo:
+            fut = client.submit(execute, fn, item.condition, item.context, pure=False,
+                                key=f"robobore-{item.key}-{os.urandom(4).hex()}")
+            by_future[fut] = item
+        for fut in as_completed(list(by_future), loop=client.loop):
+            item = by_future.pop(fut)
+            if fut.status == "finished":
+                res = fut.result()
+            else:  # lost worker, cancelled, unpicklable result ...
+                exc = fut.exception()
+                tb = "".join(traceback.format_tb(fut.traceback())) if fut.traceback() else ""
+                res = {"ok": False, "error": f"{type(exc).__name__}: {exc}", "traceback": tb}
+            fut.release()
+            rec.record(item, res)
+    finally:
+        if client is not None:
+            client.close(timeout=10)
+        if cluster is not None:
+            cluster.close(timeout=10)
+
+
+def plan_from_file(path: str | Path) -> SweepPlan:
+    """Read a sweep config TOML into a :class:`SweepPlan` (validates the runner name too)."""
+    from robobore.study.conditions import load_sweep_config
+
+    cfg, conds = load_sweep_config(path)
+    plan = SweepPlan.from_config(cfg, conds)
+    resolve_runner(plan.runner)
+    return plan
+
+
+__all__ = [
+    "RUNNERS",
+    "Runner",
+    "SweepItem",
+    "SweepPlan",
+    "SweepOutcome",
+    "resolve_runner",
+    "execute",
+    "run_sweep",
+    "plan_from_file",
+]
