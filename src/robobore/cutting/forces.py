@@ -1,0 +1,321 @@
+"""Mechanistic edge-element force model for boring (Atabey, Lazoglu & Altintas 2003 type).
+
+Per edge element (``robobore.cutting.geometry.EdgeElements``), with local uncut chip
+thickness ``h``, chip width ``db`` and edge length ``dS``::
+
+    dFt = Ktc h db + Kte dS      tangential (against the cutting velocity of the insert)
+    dFf = Kfc h db + Kfe dS      thrust, normal to the local edge in the tool-profile plane
+                                 (the orthogonal-cutting "feed/thrust" force; along the feed
+                                 when the local approach angle is 90 deg)
+    dFl = Krc h db + Kre dS      lateral, along the local edge towards its leading end
+                                 (non-zero for inclined / oblique edges)
+
+The thrust acts along the local chip-thickness direction ``(-sin k, -cos k)`` in (feed, radial)
+coordinates, i.e. it is resolved by the local approach angle ``k`` into
+``feed = -dFf sin k + dFl cos k`` and ``radial = -dFf cos k - dFl sin k`` (forces ON THE TOOL,
+radial positive outwards). The rotating-frame totals ``(F_tangential, F_radial, F_feed)`` go to
+the boring frame (X horizontal, Y vertical, Z feed) with the bar's rotation angle ``theta``
+(from X towards Y; the insert moves along ``e_t = (-sin theta, cos theta, 0)``)::
+
+    F = -Ft e_t(theta) + Fr e_r(theta) + Fz e_z
+
+Coefficients (:class:`CuttingCoefficients`): shearing ``K*c`` in N/m^2, edge ``K*e`` in N/m.
+The TC4 default is fitted by code from the bundled measured orthogonal data (see
+``coefficients/README.md``); :func:`orthogonal_to_oblique` gives the classical
+orthogonal-to-oblique transformation (Armarego; Budak, Altintas & Armarego 1996; Altintas'
+textbook eq. 2.x) from shear stress, shear angle, friction angle, rake and inclination.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.geometry import BoringInsert, EdgeElements, edge_elements
+from robobore.errors import ConfigError
+
+COEFF_DIR = Path(__file__).with_name("coefficients")
+DUCOBU_FILE = COEFF_DIR / "ti64_orthogonal_cutting_forces.json"
+
+_KEYS = {"Ktc": "Ktc_N_per_m2", "Krc": "Krc_N_per_m2", "Kfc": "Kfc_N_per_m2",
+         "Kte": "Kte_N_per_m", "Kre": "Kre_N_per_m", "Kfe": "Kfe_N_per_m"}
+
+
+@dataclass(frozen=True)
+class CuttingCoefficients:
+    """Linear edge-force model coefficients (shearing N/m^2, edge N/m) and their source."""
+
+    Ktc: float
+    Krc: float
+    Kfc: float
+    Kte: float = 0.0
+    Kre: float = 0.0
+    Kfe: float = 0.0
+    provenance: str = "user"
+
+    def __post_init__(self) -> None:
+        for name in _KEYS:
+            v = getattr(self, name)
+            if not isinstance(v, int | float) or not math.isfinite(v):
+                raise ConfigError("not a finite number", field=_KEYS[name], value=v,
+                                  expected="a number in " + ("N/m^2" if name[-1] == "c"
+                                                             else "N/m"))
+        if self.Ktc <= 0:
+            raise ConfigError("tangential shearing coefficient must be positive",
+                              field="Ktc_N_per_m2", value=self.Ktc, expected="> 0 N/m^2")
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {_KEYS[k]: float(getattr(self, k)) for k in _KEYS}
+        d["provenance"] = self.provenance
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], source: str | None = None) -> CuttingCoefficients:
+        """From ``{"Ktc_N_per_m2": .., ..., "provenance": ..}`` (missing edge terms are 0)."""
+        vals: dict[str, Any] = {}
+        for short, key in _KEYS.items():
+            if key not in d:
+                if short in ("Ktc", "Kfc"):
+                    raise ConfigError("missing key", file=source, field=key,
+                                      expected="a number in N/m^2")
+                continue
+            try:
+                vals[short] = float(d[key])
+            except (TypeError, ValueError):
+                raise ConfigError("not a number", file=source, field=key, value=d[key],
+                                  expected="a number") from None
+        vals.setdefault("Krc", 0.0)
+        return cls(**vals, provenance=str(d.get("provenance", source or "user")))
+
+
+def load_coefficients(path: str | Path) -> CuttingCoefficients:
+    """Load a coefficient file (TOML or JSON, keys as :meth:`CuttingCoefficients.to_dict`)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError("coefficient file not found", file=str(p),
+                          expected="a TOML or JSON file")
+    try:
+        if p.suffix.lower() == ".json":
+            data = json.loads(p.read_text())
+        else:
+            with p.open("rb") as fh:
+                data = tomllib.load(fh)
+    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ConfigError(f"cannot parse: {exc}", file=str(p)) from None
+    if "coefficients" in data and isinstance(data["coefficients"], dict):
+        data = data["coefficients"]
+    return CuttingCoefficients.from_dict(data, source=str(p))
+
+
+# ---------------------------------------------------------------------------- fitting
+def fit_linear_edge_model(h_m: np.ndarray, force_N_per_m: np.ndarray) -> tuple[float, float]:
+    """Least-squares fit ``F = Ke + Kc h`` (per unit width); returns ``(Kc [N/m^2], Ke [N/m])``."""
+    h = np.asarray(h_m, float)
+    F = np.asarray(force_N_per_m, float)
+    A = np.column_stack([h, np.ones_like(h)])
+    (kc, ke), *_ = np.linalg.lstsq(A, F, rcond=None)
+    return float(kc), float(ke)
+
+
+@lru_cache(maxsize=1)
+def _ducobu() -> dict[str, Any]:
+    return json.loads(DUCOBU_FILE.read_text())
+
+
+def ducobu_fits() -> dict[float, dict[str, float]]:
+    """Per cutting speed [m/min]: fitted Ktc, Kte, Kfc, Kfe and chip ratio (bundled TC4 data)."""
+    data = _ducobu()["measured"]
+    hs = sorted(data["Fc"], key=float)
+    speeds = sorted(data["Fc"][hs[0]], key=float)
+    out = {}
+    for v in speeds:
+        h = np.array([float(x) * 1e-6 for x in hs])
+        fc = np.array([data["Fc"][x][v] for x in hs]) * 1e3  # N/mm -> N/m
+        ff = np.array([data["Ff"][x][v] for x in hs]) * 1e3
+        ktc, kte = fit_linear_edge_model(h, fc)
+        kfc, kfe = fit_linear_edge_model(h, ff)
+        rc = float(np.mean([data["chip_ratio"][x][v] for x in hs]))
+        out[float(v)] = {"Ktc": ktc, "Kte": kte, "Kfc": kfc, "Kfe": kfe, "chip_ratio": rc}
+    return out
+
+
+def ti64_coefficients(cutting_speed_m_per_min: float | None = 30.0) -> CuttingCoefficients:
+    """TC4 (Ti-6Al-4V) default coefficients from the bundled measured orthogonal data.
+
+    Linear interpolation of the per-speed fits in cutting speed; held constant outside the
+    measured range 5-30 m/min (said in the provenance). Rake 15 deg, inclination 0, so the
+    lateral coefficients are 0; use :func:`orthogonal_to_oblique` for an inclined insert.
+    """
+    fits = ducobu_fits()
+    v = np.array(sorted(fits))
+    vc = float(v[-1] if cutting_speed_m_per_min is None else cutting_speed_m_per_min)
+    note = ""
+    if vc < v[0] or vc > v[-1]:
+        note = f"; vc = {vc:.3g} m/min outside the measured {v[0]:g}-{v[-1]:g} m/min: held at edge"
+    vq = float(np.clip(vc, v[0], v[-1]))
+    vals = {k: float(np.interp(vq, v, [fits[s][k] for s in v]))
+            for k in ("Ktc", "Kte", "Kfc", "Kfe")}
+    prov = ("TC4: least-squares fit Fc = Kte + Ktc h, Ff = Kfe + Kfc h of measured orthogonal "
+            "forces (Ducobu et al., CIRP 2022; rake 15 deg, edge radius 20 um), "
+            f"interpolated at vc = {vq:.3g} m/min" + note)
+    return CuttingCoefficients(Ktc=vals["Ktc"], Krc=0.0, Kfc=vals["Kfc"], Kte=vals["Kte"],
+                               Kre=0.0, Kfe=vals["Kfe"], provenance=prov)
+
+
+@dataclass(frozen=True)
+class OrthogonalParameters:
+    """Orthogonal cutting parameters: shear stress [Pa], shear angle, friction angle, rake [rad]."""
+
+    shear_stress_Pa: float
+    shear_angle_rad: float
+    friction_angle_rad: float
+    rake_rad: float
+
+
+def orthogonal_parameters_from_data(Ktc: float, Kfc: float, chip_ratio: float,
+                                    rake_rad: float) -> OrthogonalParameters:
+    """Shear angle, friction angle and shear stress from orthogonal shearing coefficients.
+
+    ``chip_ratio`` = chip thickness / uncut chip thickness (> 1). Merchant/Armarego relations:
+    ``tan phi = r cos a / (1 - r sin a)`` with ``r = 1/chip_ratio``;
+    ``beta = a + atan(Kfc/Ktc)``; ``tau_s = (Ktc cos phi - Kfc sin phi) sin phi``.
+    """
+    r = 1.0 / chip_ratio
+    phi = math.atan2(r * math.cos(rake_rad), 1.0 - r * math.sin(rake_rad))
+    beta = rake_rad + math.atan2(Kfc, Ktc)
+    tau = (Ktc * math.cos(phi) - Kfc * math.sin(phi)) * math.sin(phi)
+    return OrthogonalParameters(tau, phi, beta, rake_rad)
+
+
+def orthogonal_to_oblique(shear_stress_Pa: float, shear_angle_rad: float,
+                          friction_angle_rad: float, rake_rad: float,
+                          inclination_rad: float = 0.0,
+                          chip_flow_angle_rad: float | None = None) -> tuple[float, float, float]:
+    """Orthogonal-to-oblique transformation: returns ``(Ktc, Kfc, Krc)`` in N/m^2.
+
+    Assumptions (Armarego & Whitfield; Budak, Altintas & Armarego 1996): normal shear angle =
+    orthogonal shear angle, normal rake = rake, chip flow angle = inclination (Stabler) unless
+    given, normal friction angle from ``tan beta_n = tan beta_a cos eta``::
+
+        Ktc = tau/sin(phi_n) (cos(bn-an) + tan i tan eta sin bn) / W
+        Kfc = tau/(sin(phi_n) cos i) sin(bn-an) / W
+        Krc = tau/sin(phi_n) (cos(bn-an) tan i - tan eta sin bn) / W
+        W = sqrt(cos^2(phi_n + bn - an) + tan^2 eta sin^2 bn)
+
+    Here Kfc is the thrust (normal to the edge) and Krc the lateral (along the edge) coefficient.
+    """
+    i = inclination_rad
+    eta = i if chip_flow_angle_rad is None else chip_flow_angle_rad
+    an = rake_rad
+    bn = math.atan(math.tan(friction_angle_rad) * math.cos(eta))
+    pn = shear_angle_rad
+    W = math.sqrt(math.cos(pn + bn - an) ** 2 + math.tan(eta) ** 2 * math.sin(bn) ** 2)
+    t = shear_stress_Pa / math.sin(pn)
+    ktc = t * (math.cos(bn - an) + math.tan(i) * math.tan(eta) * math.sin(bn)) / W
+    kfc = t / math.cos(i) * math.sin(bn - an) / W
+    krc = t * (math.cos(bn - an) * math.tan(i) - math.tan(eta) * math.sin(bn)) / W
+    return ktc, kfc, krc
+
+
+def ti64_oblique_coefficients(insert: BoringInsert,
+                              cutting_speed_m_per_min: float = 30.0) -> CuttingCoefficients:
+    """TC4 coefficients for an inclined insert via the orthogonal-to-oblique route.
+
+    Shear stress, shear angle and friction angle come from the bundled measured data
+    (:func:`orthogonal_parameters_from_data`, measured rake 15 deg); the friction angle is
+    shifted with the rake (beta - alpha kept, Merchant) to the insert's rake. Edge
+    coefficients are kept from the linear fit.
+    """
+    base = ti64_coefficients(cutting_speed_m_per_min)
+    fits = ducobu_fits()
+    v = np.array(sorted(fits))
+    vq = float(np.clip(cutting_speed_m_per_min, v[0], v[-1]))
+    rc = float(np.interp(vq, v, [fits[s]["chip_ratio"] for s in v]))
+    p = orthogonal_parameters_from_data(base.Ktc, base.Kfc, rc, math.radians(15.0))
+    a = math.radians(insert.rake_deg)
+    phi = p.shear_angle_rad + 0.5 * (a - p.rake_rad)
+    ktc, kfc, krc = orthogonal_to_oblique(p.shear_stress_Pa, phi, p.friction_angle_rad, a,
+                                          math.radians(insert.inclination_deg))
+    return CuttingCoefficients(ktc, krc, kfc, base.Kte, 0.0, base.Kfe,
+                               provenance=base.provenance + "; orthogonal-to-oblique with "
+                               f"tau_s = {p.shear_stress_Pa / 1e6:.0f} MPa, "
+                               f"beta = {math.degrees(p.friction_angle_rad):.1f} deg, "
+                               f"phi = {math.degrees(phi):.1f} deg")
+
+
+# ---------------------------------------------------------------------------- forces
+@dataclass(frozen=True)
+class ElementForces:
+    """Per-element local forces [N] (arrays of shape (n,)) and rotating-frame totals [N].
+
+    ``tangential``/``radial``/``feed`` totals are the force ON THE TOOL along
+    ``-e_t`` (i.e. opposite to the insert velocity, given as a positive magnitude), ``e_r``
+    (positive outwards) and ``e_z`` (positive along the feed).
+    """
+
+    dFt: np.ndarray
+    dFf: np.ndarray
+    dFl: np.ndarray
+    tangential: float
+    radial: float
+    feed: float
+
+
+def element_forces(el: EdgeElements, c: CuttingCoefficients) -> ElementForces:
+    """Edge-element forces and their rotating-frame sums (see module docstring)."""
+    dA = el.h * el.db
+    cut = el.h > 0
+    dS = np.where(cut, el.dS, 0.0)
+    dFt = c.Ktc * dA + c.Kte * dS
+    dFf = c.Kfc * dA + c.Kfe * dS
+    dFl = c.Krc * dA + c.Kre * dS
+    sk, ck = np.sin(el.kappa), np.cos(el.kappa)
+    feed = float(np.sum(-dFf * sk + dFl * ck))
+    radial = float(np.sum(-dFf * ck - dFl * sk))
+    return ElementForces(dFt, dFf, dFl, float(dFt.sum()), radial, feed)
+
+
+def rotating_to_boring(tangential: float, radial: float, feed: float,
+                       theta: np.ndarray) -> np.ndarray:
+    """Boring-frame force on the tool, shape (3, n_theta) [N], for bar angles ``theta`` [rad]."""
+    th = np.asarray(theta, float)
+    et = np.stack([-np.sin(th), np.cos(th), np.zeros_like(th)])
+    er = np.stack([np.cos(th), np.sin(th), np.zeros_like(th)])
+    ez = np.stack([np.zeros_like(th), np.zeros_like(th), np.ones_like(th)])
+    return -tangential * et + radial * er + feed * ez
+
+
+def boring_forces(insert: BoringInsert, depth_m: float, feed_per_rev_m: float,
+                  coefficients: CuttingCoefficients, n_theta: int = 360,
+                  n_elements: int = 40) -> dict[str, Any]:
+    """Static (rigid-tool) boring forces over one revolution.
+
+    Returns a dict with ``theta_rad`` (n,), ``force_N`` (3, n) in the boring frame (sum over
+    the inserts, equally spaced), rotating-frame totals per insert, chip area, and per-axis
+    mean and amplitude (half peak-to-peak).
+    """
+    fz = feed_per_rev_m / insert.n_inserts
+    el = edge_elements(insert, depth_m, fz, n_elements)
+    ef = element_forces(el, coefficients)
+    th = np.linspace(0.0, 2 * np.pi, n_theta, endpoint=False)
+    F = np.zeros((3, n_theta))
+    for p in range(insert.n_inserts):
+        F += rotating_to_boring(ef.tangential, ef.radial, ef.feed,
+                                th + 2 * np.pi * p / insert.n_inserts)
+    return {"theta_rad": th, "force_N": F, "tangential_N": ef.tangential,
+            "radial_N": ef.radial, "feed_N": ef.feed, "chip_area_m2": el.area,
+            "mean_N": F.mean(axis=1), "amplitude_N": 0.5 * (F.max(axis=1) - F.min(axis=1)),
+            "elements": el, "element_forces": ef}
+
+
+__all__ = ["CuttingCoefficients", "load_coefficients", "fit_linear_edge_model", "ducobu_fits",
+           "ti64_coefficients", "orthogonal_parameters_from_data", "orthogonal_to_oblique",
+           "ti64_oblique_coefficients", "ElementForces", "element_forces",
+           "rotating_to_boring", "boring_forces", "OrthogonalParameters"]

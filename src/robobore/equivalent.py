@@ -1,0 +1,409 @@
+"""Equivalent mass-spring-damper model of the robotic boring system (paper eq. 1-3).
+
+The robot + end-effector is replaced, in each direction of the boring frame (X horizontal,
+Y vertical, Z feed), by one mass-spring-damper unit::
+
+    m_d x_d'' + c_d x_d' + k_d x_d = F_d          d in {x, y, z}
+    m_d = k_d / omega_n,d^2                        (eq. 3 of the paper)
+    c_d = 2 zeta_d sqrt(k_d m_d)                   (from a modal damping ratio)
+    zeta_d = c_d / (2 sqrt(k_d m_d))               (from a given damping coefficient)
+
+Inputs are plain numbers or the JSON contracts of the other stages:
+
+* robot stiffness: ``{"directional_stiffness_N_per_m": {"x": .., "y": .., "z": ..}}``
+* modal analysis: ``{"modes": [{"frequency_Hz": .., "damping_ratio": .., "mpc": ..,
+  optional "direction": [3] or "x"/"y"/"z", optional "shape": [3]}]}``
+
+How modes are assigned to X, Y, Z (:meth:`EquivalentModel.from_stiffness_and_modes`):
+
+1. if every mode carries a ``direction`` (3-vector or axis letter) or a 3-component
+   ``shape``, each axis takes the lowest-frequency mode whose direction has its largest
+   absolute component on that axis (a mode can serve one axis only);
+2. otherwise the user's ``assignment`` mapping ``{"x": i, "y": j, "z": k}`` (0-based mode
+   indices) is used;
+3. default: mode 0 -> X, mode 1 -> Y, mode 2 -> Z.
+
+Principal directions: with equal masses in all directions (the paper's assumption) the
+uncoupled principal directions are the eigenvectors of the 3x3 stiffness matrix, i.e. a
+rotation of the frame (:func:`principal_frame`).
+
+Pressure foot (:class:`PressureFoot`): a documented, configurable ASSUMED contact model. The
+foot is pressed on the workpiece by a pneumatic piston: foot force ``F = p A``. It adds a normal
+contact stiffness along the foot normal (Hertz sphere-on-flat ``k_n = (6 F E*^2 R)^(1/3)``, or a
+user value), a friction-limited tangential stiffness ``k_t = mu F / delta_slip`` in the plane
+normal to it, and contact damping ``c = 2 zeta_c sqrt(k_add m)`` per direction. Defaults (piston
+diameter 50 mm, E* = 2 GPa pad, R = 0.1 m, mu = 0.3, delta_slip = 20 um, zeta_c = 0.05) are
+assumptions for illustration, not measured values; replace them with the cell's data.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from robobore.errors import ConfigError
+
+AXES = ("x", "y", "z")
+_AXIS_VEC = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def _positive(name: str, value: Any, unit: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError("not a number", field=name, value=value,
+                          expected=f"a positive number in {unit}") from None
+    if not math.isfinite(v) or v <= 0.0:
+        raise ConfigError("must be positive and finite", field=name, value=value,
+                          expected=f"a positive number in {unit}")
+    return v
+
+
+def _nonneg(name: str, value: Any, unit: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError("not a number", field=name, value=value,
+                          expected=f"a number >= 0 in {unit}") from None
+    if not math.isfinite(v) or v < 0.0:
+        raise ConfigError("must be >= 0 and finite", field=name, value=value,
+                          expected=f"a number >= 0 in {unit}")
+    return v
+
+
+@dataclass(frozen=True)
+class PressureFoot:
+    """Pressure-foot contact model (ASSUMED defaults, see module docstring).
+
+    Attributes are SI: ``pressure_Pa`` piston pressure, ``piston_area_m2`` piston area,
+    ``normal`` unit vector of the foot normal in the boring frame (default Z, the bore axis),
+    ``normal_stiffness_N_per_m`` user value of the contact stiffness (``None``: Hertz from
+    ``contact_modulus_Pa`` and ``contact_radius_m``), ``friction_coefficient``,
+    ``slip_displacement_m`` (tangential displacement at which the contact slides),
+    ``contact_damping_ratio`` (damping added per unit of added stiffness).
+    """
+
+    pressure_Pa: float = 0.3e6
+    piston_area_m2: float = math.pi * 0.025**2
+    normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    normal_stiffness_N_per_m: float | None = None
+    contact_modulus_Pa: float = 2.0e9
+    contact_radius_m: float = 0.1
+    friction_coefficient: float = 0.3
+    slip_displacement_m: float = 20e-6
+    contact_damping_ratio: float = 0.05
+
+    @property
+    def force_N(self) -> float:
+        """Foot force F = p A [N]."""
+        return self.pressure_Pa * self.piston_area_m2
+
+    def normal_stiffness(self) -> float:
+        """Normal contact stiffness [N/m]: user value or Hertz sphere-on-flat dF/d(delta)."""
+        if self.normal_stiffness_N_per_m is not None:
+            return float(self.normal_stiffness_N_per_m)
+        f = self.force_N
+        if f <= 0:
+            return 0.0
+        return (6.0 * f * self.contact_modulus_Pa**2 * self.contact_radius_m) ** (1.0 / 3.0)
+
+    def tangential_stiffness(self) -> float:
+        """Friction-limited tangential stiffness mu F / delta_slip [N/m]."""
+        return self.friction_coefficient * self.force_N / self.slip_displacement_m
+
+    def stiffness_matrix(self) -> np.ndarray:
+        """Added stiffness matrix (3, 3) [N/m] in the boring frame."""
+        n = np.asarray(self.normal, float)
+        n = n / np.linalg.norm(n)
+        nn = np.outer(n, n)
+        return self.normal_stiffness() * nn + self.tangential_stiffness() * (np.eye(3) - nn)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["normal"] = list(self.normal)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> PressureFoot:
+        d = dict(d)
+        if "normal" in d:
+            n = np.asarray(d["normal"], float)
+            if n.shape != (3,) or np.linalg.norm(n) < 1e-12:
+                raise ConfigError("foot normal must be a non-zero 3-vector", field="normal",
+                                  value=d["normal"], expected="[nx, ny, nz]")
+            d["normal"] = tuple(float(v) for v in n / np.linalg.norm(n))
+        for key in ("pressure_Pa", "piston_area_m2", "friction_coefficient",
+                    "contact_damping_ratio"):
+            if key in d:
+                _nonneg(key, d[key], "SI units")
+        for key in ("contact_modulus_Pa", "contact_radius_m", "slip_displacement_m"):
+            if key in d:
+                _positive(key, d[key], "SI units")
+        return cls(**d)
+
+
+@dataclass(frozen=True)
+class DirectionUnit:
+    """One mass-spring-damper unit: k [N/m], natural frequency [Hz], m [kg], c [N s/m], zeta."""
+
+    stiffness_N_per_m: float
+    frequency_Hz: float
+    mass_kg: float
+    damping_N_s_per_m: float
+    damping_ratio: float
+
+
+@dataclass(frozen=True)
+class EquivalentModel:
+    """Per-direction equivalent model of the robot at the tool point (boring frame).
+
+    ``stiffness_N_per_m``, ``frequency_Hz``, ``damping_ratio`` are dicts over the axes
+    ``x, y, z``. ``frame`` is the 3x3 rotation matrix whose columns are the directions of the
+    three units in the boring frame (identity: the units act along X, Y, Z). ``foot`` is the
+    pressure-foot model whose stiffness/damping has already been added (``None``: no foot).
+    ``notes`` records how the model was built (mode assignment, damping source).
+    """
+
+    stiffness_N_per_m: dict[str, float]
+    frequency_Hz: dict[str, float]
+    damping_ratio: dict[str, float]
+    frame: tuple[tuple[float, float, float], ...] = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0),
+                                                     (0.0, 0.0, 1.0))
+    foot: PressureFoot | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def build(
+        cls,
+        stiffness_N_per_m: dict[str, float],
+        frequency_Hz: dict[str, float],
+        damping_ratio: dict[str, float] | None = None,
+        damping_N_s_per_m: float | dict[str, float] | None = None,
+        frame: np.ndarray | None = None,
+        foot: PressureFoot | None = None,
+        notes: tuple[str, ...] = (),
+    ) -> EquivalentModel:
+        """Plain constructor from numbers.
+
+        Give either ``damping_ratio`` per axis or ``damping_N_s_per_m`` (one value for all
+        axes, like the paper's c = 23.7 N s/m, or per axis); the implied ratio is
+        ``zeta = c / (2 sqrt(k m))``. A pressure foot adds its stiffness along the unit
+        directions (diagonal of ``R^T K_foot R``) and contact damping, keeping each unit's mass.
+        """
+        k = {a: _positive(f"stiffness_N_per_m.{a}", stiffness_N_per_m.get(a), "N/m")
+             for a in AXES}
+        fn = {a: _positive(f"frequency_Hz.{a}", frequency_Hz.get(a), "Hz") for a in AXES}
+        m = {a: k[a] / (2 * math.pi * fn[a]) ** 2 for a in AXES}
+        notes = list(notes)
+        if damping_N_s_per_m is not None:
+            cd = (damping_N_s_per_m if isinstance(damping_N_s_per_m, dict)
+                  else dict.fromkeys(AXES, damping_N_s_per_m))
+            c = {a: _nonneg(f"damping_N_s_per_m.{a}", cd.get(a), "N s/m") for a in AXES}
+            z = {a: c[a] / (2.0 * math.sqrt(k[a] * m[a])) for a in AXES}
+            notes.append("damping from a given coefficient c; implied ratios "
+                         + ", ".join(f"{a}: {z[a]:.3e}" for a in AXES))
+        elif damping_ratio is not None:
+            z = {a: _nonneg(f"damping_ratio.{a}", damping_ratio.get(a), "(ratio)") for a in AXES}
+        else:
+            raise ConfigError("give damping ratios or a damping coefficient",
+                              field="damping", expected="damping_ratio or damping_N_s_per_m")
+        R = np.eye(3) if frame is None else np.asarray(frame, float)
+        if R.shape != (3, 3) or not np.allclose(R.T @ R, np.eye(3), atol=1e-6):
+            raise ConfigError("frame must be a 3x3 rotation matrix", field="frame",
+                              value=None if frame is None else np.asarray(frame).tolist(),
+                              expected="orthonormal columns")
+        if foot is not None:
+            kf = R.T @ foot.stiffness_matrix() @ R
+            for i, a in enumerate(AXES):
+                dk = float(kf[i, i])
+                c_old = 2 * z[a] * math.sqrt(k[a] * m[a])
+                c_add = 2 * foot.contact_damping_ratio * math.sqrt(max(dk, 0.0) * m[a])
+                k[a] = k[a] + dk
+                fn[a] = math.sqrt(k[a] / m[a]) / (2 * math.pi)
+                z[a] = (c_old + c_add) / (2 * math.sqrt(k[a] * m[a]))
+            notes.append(f"pressure foot added: F = {foot.force_N:.1f} N, "
+                         f"k_n = {foot.normal_stiffness():.3e} N/m, "
+                         f"k_t = {foot.tangential_stiffness():.3e} N/m (assumed contact model)")
+        return cls(stiffness_N_per_m=k, frequency_Hz=fn, damping_ratio=z,
+                   frame=tuple(tuple(float(v) for v in row) for row in R), foot=foot,
+                   notes=tuple(notes))
+
+    @classmethod
+    def from_stiffness_and_modes(
+        cls,
+        stiffness: dict[str, Any],
+        modes: dict[str, Any],
+        assignment: dict[str, int] | None = None,
+        damping_N_s_per_m: float | None = None,
+        foot: PressureFoot | None = None,
+    ) -> EquivalentModel:
+        """Build from the robot-stiffness and modal JSON contracts (see module docstring)."""
+        try:
+            ks = stiffness["directional_stiffness_N_per_m"]
+        except (KeyError, TypeError):
+            raise ConfigError("missing key", field="directional_stiffness_N_per_m",
+                              expected='{"x": .., "y": .., "z": ..} in N/m') from None
+        try:
+            ml = list(modes["modes"])
+        except (KeyError, TypeError):
+            raise ConfigError("missing key", field="modes",
+                              expected='a list of {"frequency_Hz", "damping_ratio"}') from None
+        if len(ml) < 1:
+            raise ConfigError("no modes given", field="modes", expected="at least one mode")
+        for i, md in enumerate(ml):
+            _positive(f"modes[{i}].frequency_Hz", md.get("frequency_Hz"), "Hz")
+            _nonneg(f"modes[{i}].damping_ratio", md.get("damping_ratio", 0.0), "(ratio)")
+        chosen, how = assign_modes(ml, assignment)
+        fn = {a: float(ml[chosen[a]]["frequency_Hz"]) for a in AXES}
+        zr = {a: float(ml[chosen[a]].get("damping_ratio", 0.0)) for a in AXES}
+        notes = (how + ": " + ", ".join(f"{a} <- mode {chosen[a]} ({fn[a]:.4g} Hz)"
+                                        for a in AXES),)
+        return cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
+                         damping_N_s_per_m=damping_N_s_per_m, foot=foot, notes=notes)
+
+    # ------------------------------------------------------------------ derived
+    def unit(self, axis: str) -> DirectionUnit:
+        k = self.stiffness_N_per_m[axis]
+        fn = self.frequency_Hz[axis]
+        m = k / (2 * math.pi * fn) ** 2
+        z = self.damping_ratio[axis]
+        return DirectionUnit(k, fn, m, 2 * z * math.sqrt(k * m), z)
+
+    @property
+    def mass_kg(self) -> dict[str, float]:
+        return {a: self.unit(a).mass_kg for a in AXES}
+
+    @property
+    def damping_N_s_per_m(self) -> dict[str, float]:
+        return {a: self.unit(a).damping_N_s_per_m for a in AXES}
+
+    def directions(self) -> np.ndarray:
+        """Unit directions of the three units in the boring frame, shape (3, 3) rows = x, y, z."""
+        return np.asarray(self.frame, float).T
+
+    def tool_point_modes(self) -> list[dict[str, Any]]:
+        """The model as general tool-point modes (the ``[structure] modes`` contract)."""
+        D = self.directions()
+        return [{"frequency_Hz": self.frequency_Hz[a], "damping_ratio": self.damping_ratio[a],
+                 "stiffness_N_per_m": self.stiffness_N_per_m[a],
+                 "direction": [float(v) for v in D[i]]} for i, a in enumerate(AXES)]
+
+    def table(self) -> list[dict[str, Any]]:
+        """Per-direction rows: axis, k, f_n, m, c, zeta."""
+        rows = []
+        for a in AXES:
+            u = self.unit(a)
+            rows.append({"axis": a, "stiffness_N_per_m": u.stiffness_N_per_m,
+                         "frequency_Hz": u.frequency_Hz, "mass_kg": u.mass_kg,
+                         "damping_N_s_per_m": u.damping_N_s_per_m,
+                         "damping_ratio": u.damping_ratio})
+        return rows
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"stiffness_N_per_m": dict(self.stiffness_N_per_m),
+                "frequency_Hz": dict(self.frequency_Hz),
+                "damping_ratio": dict(self.damping_ratio),
+                "mass_kg": self.mass_kg, "damping_N_s_per_m": self.damping_N_s_per_m,
+                "frame": [list(r) for r in self.frame],
+                "foot": None if self.foot is None else self.foot.to_dict(),
+                "notes": list(self.notes)}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> EquivalentModel:
+        """Inverse of :meth:`to_dict` (the foot is already included in k, f, zeta)."""
+        for key in ("stiffness_N_per_m", "frequency_Hz", "damping_ratio"):
+            if key not in d:
+                raise ConfigError("missing key", field=key, expected="a dict over x, y, z")
+        k = {a: _positive(f"stiffness_N_per_m.{a}", d["stiffness_N_per_m"].get(a), "N/m")
+             for a in AXES}
+        f = {a: _positive(f"frequency_Hz.{a}", d["frequency_Hz"].get(a), "Hz") for a in AXES}
+        z = {a: _nonneg(f"damping_ratio.{a}", d["damping_ratio"].get(a), "(ratio)")
+             for a in AXES}
+        frame = d.get("frame", np.eye(3).tolist())
+        foot = None if d.get("foot") is None else PressureFoot.from_dict(d["foot"])
+        return cls(k, f, z, tuple(tuple(float(v) for v in r) for r in frame), foot,
+                   tuple(d.get("notes", ())))
+
+
+def _mode_direction(md: dict[str, Any]) -> np.ndarray | None:
+    d = md.get("direction", md.get("shape"))
+    if d is None:
+        return None
+    if isinstance(d, str):
+        if d.lower() not in _AXIS_VEC:
+            raise ConfigError("unknown axis", field="direction", value=d, expected="x, y or z")
+        return np.asarray(_AXIS_VEC[d.lower()])
+    v = np.abs(np.asarray(d, dtype=complex)).astype(float).ravel()
+    if v.shape != (3,) or not np.isfinite(v).all() or v.max() <= 0:
+        return None
+    return v
+
+
+def assign_modes(modes: list[dict[str, Any]],
+                 assignment: dict[str, int] | None = None) -> tuple[dict[str, int], str]:
+    """Choose the mode index for each axis (rules in the module docstring).
+
+    Returns ``({"x": i, "y": j, "z": k}, how)``.
+    """
+    dirs = [_mode_direction(md) for md in modes]
+    if all(d is not None for d in dirs) and len(modes) >= 3:
+        order = sorted(range(len(modes)), key=lambda i: modes[i]["frequency_Hz"])
+        chosen: dict[str, int] = {}
+        used: set[int] = set()
+        for ax_i, a in enumerate(AXES):
+            for i in order:
+                if i in used:
+                    continue
+                if int(np.argmax(dirs[i])) == ax_i:
+                    chosen[a] = i
+                    used.add(i)
+                    break
+        if len(chosen) == 3:
+            return chosen, "assigned by mode direction"
+    if assignment is not None:
+        out = {}
+        for a in AXES:
+            if a not in assignment:
+                raise ConfigError("assignment misses an axis", field=f"assignment.{a}",
+                                  expected="a 0-based mode index")
+            i = int(assignment[a])
+            if not 0 <= i < len(modes):
+                raise ConfigError("mode index out of range", field=f"assignment.{a}", value=i,
+                                  expected=f"0 .. {len(modes) - 1}")
+            out[a] = i
+        return out, "assigned by user mapping"
+    if len(modes) < 3:
+        raise ConfigError("need 3 modes (or an assignment) for X, Y, Z", field="modes",
+                          value=len(modes), expected="3 or more modes")
+    return {"x": 0, "y": 1, "z": 2}, "default assignment (mode i -> axis i)"
+
+
+def principal_frame(stiffness_matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Principal (uncoupled) directions of a symmetric 3x3 stiffness matrix [N/m].
+
+    With equal masses in all directions the uncoupling transformation is a rotation of the
+    frame (paper, after eq. 3). Returns ``(k_principal (3,), R (3, 3))`` with
+    ``K = R diag(k) R^T``, ``R`` a proper rotation (det +1) whose columns are the principal
+    directions in the input frame, sorted by ascending stiffness.
+    """
+    K = np.asarray(stiffness_matrix, float)
+    if K.shape != (3, 3) or not np.all(np.isfinite(K)):
+        raise ConfigError("stiffness matrix must be a finite 3x3 array", field="stiffness_matrix",
+                          expected="3x3 in N/m")
+    if not np.allclose(K, K.T, rtol=1e-6, atol=1e-9 * np.abs(K).max()):
+        raise ConfigError("stiffness matrix must be symmetric", field="stiffness_matrix")
+    w, V = np.linalg.eigh(0.5 * (K + K.T))
+    if w.min() <= 0:
+        raise ConfigError("stiffness matrix must be positive definite", field="stiffness_matrix",
+                          value=float(w.min()), expected="all eigenvalues > 0 N/m")
+    if np.linalg.det(V) < 0:
+        V[:, 2] *= -1
+    return w, V
+
+
+__all__ = ["EquivalentModel", "PressureFoot", "DirectionUnit", "assign_modes",
+           "principal_frame", "AXES"]
