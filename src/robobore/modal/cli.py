@@ -1,9 +1,201 @@
-"""CLI commands of this stage (registered by ``robobore.cli``)."""
+"""CLI commands of this stage (registered by ``robobore.cli``).
+
+* ``robobore identify modes INPUT|--example [--band-hz LO HI] [--modes N] [--max-order N]
+  [--plot DIR] [--json]``: FRFs (from time records if needed) -> CMIF -> pLSCF ->
+  stabilisation -> automatic modes -> LSFD.
+* ``robobore identify virtual-hammer-test OUT.uff [--noise ...] [--seed ...]``: write a
+  SYNTHETIC hammer test (UFF 58 time records + 164 units) with its ground truth.
+"""
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
+from typing import Any
+
 import typer
+
+from robobore.clitools import JSON_OPTION, emit, handle_errors, parse_floats, progress_bar
+
+
+def _render_modes(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    from robobore.clitools import fmt, stdout
+
+    t = Table(title=f"Modes ({res['source'] or 'data'}, band {res['band_Hz'][0]:.4g}-"
+              f"{res['band_Hz'][1]:.4g} Hz, orders up to {res['max_order']})",
+              header_style="bold")
+    for c in ("#", "frequency (Hz)", "damping (%)", "MPC", "direction", "orders stable",
+              "CMIF support"):
+        t.add_column(c, justify="right")
+    for k, m in enumerate(res["modes"]):
+        t.add_row(str(k + 1), f"{m['frequency_Hz']:.4f}", f"{100 * m['damping_ratio']:.3f}",
+                  f"{m['mpc']:.3f}", m["dominant_input"], str(m["cluster_size"]),
+                  fmt(m["cmif_support"]))
+    stdout.print(t)
+    st = res["stabilisation"]
+    stdout.print(f"poles: {st['n_poles']} over orders {st['orders'][0]}-{st['orders'][1]}; "
+                 f"status counts {st['status_counts']}; CMIF peaks (Hz): "
+                 + ", ".join(f"{f:.3g}" for f in st["cmif_peaks_Hz"]))
+    fit = res["fit_percent"]
+    if fit:
+        import numpy as np
+
+        stdout.print(f"LSFD fit: min {np.min(fit):.2f} %, mean {np.mean(fit):.2f} % over "
+                     f"{np.size(fit)} FRFs")
+    for w in res.get("warnings", []):
+        stdout.print(f"[yellow]warning:[/] {w}")
+    for p in res.get("plots", []):
+        stdout.print(f"plot: {p}")
+
+
+@handle_errors
+def modes_cmd(
+    input_file: Path | None = typer.Argument(
+        None, help="UFF file (58 time records or FRFs, 164 units) or NPZ FRF file."),
+    example: bool = typer.Option(False, "--example",
+                                 help="Use the bundled SYNTHETIC robot hammer test."),
+    band_hz: tuple[float, float] | None = typer.Option(
+        None, "--band-hz", help="Analysis band LO HI in Hz (default: all lines)."),
+    modes: int | None = typer.Option(None, "--modes", help="Number of modes to keep."),
+    approx_hz: str | None = typer.Option(
+        None, "--approx-hz", help="Approximate mode frequencies, comma-separated, Hz."),
+    max_order: int = typer.Option(40, "--max-order", help="Highest pLSCF model order."),
+    estimator: str = typer.Option("H1", "--estimator", help="FRF estimator: H1, H2, Hv."),
+    exp_window_tau_s: float | None = typer.Option(
+        None, "--exp-window-tau-s", help="Exponential window time constant, s (corrected)."),
+    drop_flagged: bool = typer.Option(False, "--drop-flagged",
+                                      help="Leave out double hits and overloads."),
+    frf_type: str | None = typer.Option(
+        None, "--frf-type", help="FRF type of a UFF FRF file if its records do not say."),
+    plot: Path | None = typer.Option(None, "--plot", help="Write PNG plots to this folder."),
+    out: Path | None = typer.Option(None, "--out", help="Write the result JSON to this file."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
+    from robobore.errors import ConfigError
+    from robobore.io.results import write_json
+    from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
+    from robobore.modal.frf import DoubleHitWarning, FRFData, estimate_frf
+    from robobore.modal.identify import identify_modes
+    from robobore.modal.io import load_input
+
+    if example == (input_file is not None):
+        raise ConfigError("give either INPUT or --example", field="INPUT", value=input_file,
+                          expected="a UFF/NPZ file path or the --example flag")
+    if example:
+        input_file = example_path()
+        if band_hz is None:
+            band_hz = EXAMPLE_BAND_HZ
+    approx = parse_floats(approx_hz, None, "--approx-hz", "Hz") if approx_hz else None
+    warn_list: list[str] = []
+    with progress_bar("modal analysis", 3, enabled=not as_json) as advance:
+        data = load_input(input_file, frf_type)
+        advance(1)
+        hits = None
+        if not isinstance(data, FRFData):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", DoubleHitWarning)
+                est = estimate_frf(data, estimator=estimator, exp_window_tau_s=exp_window_tau_s,
+                                   drop_flagged=drop_flagged)
+            warn_list += [str(w.message) for w in caught]
+            data, hits = est.frf, est
+        elif exp_window_tau_s is not None:
+            raise ConfigError("--exp-window-tau-s applies to time records only",
+                              field="--exp-window-tau-s", value=exp_window_tau_s,
+                              expected="no window option for FRF input")
+        an = identify_modes(data, band_Hz=band_hz, n_modes=modes, approx_Hz=approx,
+                            max_order=max_order)
+        advance(1)
+        res = an.result.to_dict()
+        res["source"] = str(input_file)
+        res["synthetic"] = bool(example)
+        if hits is not None:
+            res["hits"] = hits.to_dict()
+        res["warnings"] = warn_list
+        if plot is not None:
+            from robobore.modal.plots import plot_all
+
+            res["plots"] = [str(p) for p in plot_all(an, plot)]
+        advance(1)
+    if out is not None:
+        write_json(out, res)
+    emit(res, as_json, _render_modes)
+
+
+@handle_errors
+def virtual_test_cmd(
+    out: Path = typer.Argument(..., help="Output UFF file (time records, UFF 58 + 164)."),
+    example: bool = typer.Option(False, "--example",
+                                 help="Regenerate the bundled example exactly (its settings)."),
+    noise: float = typer.Option(0.01, "--noise",
+                                help="Noise std as a fraction of channel RMS (force, response)."),
+    hits: int = typer.Option(5, "--hits", help="Hits per hammer direction."),
+    directions: str = typer.Option("x,y,z", "--directions",
+                                   help="Hammer directions at the tool point (subset of x,y,z)."),
+    sample_rate_hz: float = typer.Option(256.0, "--sample-rate-hz", help="Sampling rate, Hz."),
+    duration_s: float = typer.Option(6.0, "--duration-s", help="Record length, s."),
+    tip: str = typer.Option("soft", "--tip", help="Hammer tip: soft, medium, hard."),
+    double_hit: list[str] = typer.Option([], "--double-hit",
+                                         help="Make hit I,H (1-based) a double hit."),
+    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Write a SYNTHETIC impact-hammer test of the robot boring truth model."""
+    from robobore.clitools import kv_table, stdout
+    from robobore.errors import ConfigError
+    from robobore.io.results import write_json
+    from robobore.modal.example import (
+        EXAMPLE_INPUT_DOFS,
+        EXAMPLE_OUTPUT_DOFS,
+        EXAMPLE_SETTINGS,
+        make_example,
+    )
+    from robobore.modal.io import write_uff_time
+    from robobore.modal.virtual import robot_boring_truth, simulate_hammer_test
+
+    truth = robot_boring_truth()
+    if example:
+        make_example(out)
+        settings: dict[str, Any] = dict(EXAMPLE_SETTINGS)
+    else:
+        dirs = [d.strip().lower() for d in directions.split(",") if d.strip()]
+        if not dirs or any(d not in ("x", "y", "z") for d in dirs) or len(set(dirs)) < len(dirs):
+            raise ConfigError("bad hammer directions", field="--directions", value=directions,
+                              expected="distinct values among x, y, z, comma-separated")
+        rows = ["xyz".index(d) for d in dirs]
+        truth = truth.with_inputs(rows)
+        dh = []
+        for s in double_hit:
+            v = parse_floats(s, 2, "--double-hit", "(input, hit) 1-based indices")
+            dh.append((int(v[0]) - 1, int(v[1]) - 1))
+        if not 0 <= noise < 1:
+            raise ConfigError("noise must be a fraction in [0, 1)", field="--noise", value=noise,
+                              expected="e.g. 0.01 for 1 % of RMS")
+        settings = {"n_hits": hits, "sample_rate_Hz": sample_rate_hz, "duration_s": duration_s,
+                    "tip": tip, "noise_force": noise, "noise_response": noise, "seed": seed,
+                    "double_hits": dh}
+        rec = simulate_hammer_test(truth, **settings)
+        write_uff_time(rec, out, [EXAMPLE_INPUT_DOFS[r] for r in rows], EXAMPLE_OUTPUT_DOFS,
+                       "SYNTHETIC robobore virtual hammer test")
+    truth_path = Path(str(out) + ".truth.json")
+    info = {"file": str(out), "truth_file": str(truth_path), "synthetic": True,
+            "settings": settings, "truth": truth.to_dict()}
+    write_json(truth_path, info)
+    if as_json:
+        emit(info, True, lambda r: None)
+    else:
+        stdout.print(kv_table("SYNTHETIC virtual hammer test", [
+            ("file", str(out)), ("ground truth", str(truth_path)),
+            ("modes (Hz)", ", ".join(f"{f:g}" for f in truth.frequencies_Hz)),
+            ("damping ratios", ", ".join(f"{z:g}" for z in truth.damping_ratios)),
+            ("hammer inputs", ", ".join(truth.input_names)),
+            ("hits per input", settings["n_hits"]), ("noise (fraction of RMS)",
+                                                      settings["noise_response"])]))
 
 
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add this stage's commands to the shared command groups."""
+    groups["identify"].command("modes")(modes_cmd)
+    groups["identify"].command("virtual-hammer-test")(virtual_test_cmd)

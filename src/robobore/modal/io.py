@@ -1,0 +1,350 @@
+"""Modal-analysis files: UFF 58 (time records, FRFs) and 164 (units) via pyuff; NPZ; JSON.
+
+UFF conventions used (and expected when reading)
+------------------------------------------------
+* Dataset 58, ``func_type`` 1 (time response): one record per channel and hit. The force
+  channel has ordinate specific data type 13 (excitation force); responses 12
+  (acceleration), 11 (velocity) or 8 (displacement). ``ref_node/ref_dir`` = the hammer point
+  and direction of that hit; ``rsp_node/rsp_dir`` = the channel; ``load_case_id`` = the hit
+  number (1-based). Channel names go in ``id2``. Sampling from ``abscissa_inc`` (s).
+* Dataset 58, ``func_type`` 4 (FRF): complex data over frequency (Hz), one record per
+  (output, input) pair; the FRF type comes from the ordinate specific data type (12
+  accelerance, 11 mobility, 8 receptance) unless given.
+* Dataset 164: unit factors; values are converted to SI on reading (SI = value / factor,
+  as the UFF 164 definition says), and written as SI (units code 1, factors 1).
+
+NPZ contract: ``frequency_Hz (n_f,)``, ``frf`` complex ``(n_outputs, n_inputs, n_f)``,
+``frf_type`` (accelerance | mobility | receptance); optional ``coherence``,
+``output_names``, ``input_names``.
+"""
+
+from __future__ import annotations
+
+import io as _io
+import os
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robobore.errors import DataError
+from robobore.io.results import atomic_write_bytes
+from robobore.modal.frf import FRFData, HammerRecords, check_frf_type
+
+SPEC_FORCE = 13
+SPEC_BY_QUANTITY = {"acceleration": 12, "velocity": 11, "displacement": 8}
+QUANTITY_BY_SPEC = {v: k for k, v in SPEC_BY_QUANTITY.items()}
+FRF_TYPE_BY_SPEC = {12: "accelerance", 11: "mobility", 8: "receptance"}
+SPEC_BY_FRF_TYPE = {v: k for k, v in FRF_TYPE_BY_SPEC.items()}
+_DIRS = {"x": 1, "y": 2, "z": 3}
+
+
+def default_dofs(names: tuple[str, ...], start_node: int = 1) -> list[tuple[int, int]]:
+    """(node, direction) per channel name: ``<point>_<x|y|z>`` groups by point, else node
+    per channel with direction 1 (+X)."""
+    nodes: dict[str, int] = {}
+    out = []
+    for k, nm in enumerate(names):
+        m = re.match(r"^(.*)[_\-]([xyzXYZ])$", nm)
+        if m:
+            pt = m.group(1)
+            if pt not in nodes:
+                nodes[pt] = start_node + len(nodes)
+            out.append((nodes[pt], _DIRS[m.group(2).lower()]))
+        else:
+            out.append((start_node + 100 + k, 1))
+    return out
+
+
+def _uff_sets(path: Path, need: int = 58) -> list[dict[str, Any]]:
+    import pyuff
+
+    p = Path(path)
+    if not p.is_file():
+        raise DataError("file not found", file=str(p), expected="a UFF (.uff/.unv) file")
+    try:
+        uff = pyuff.UFF(str(p))
+        types = list(uff.get_set_types())
+    except Exception as exc:  # pyuff raises plain Exceptions for unreadable files
+        raise DataError(f"not a readable UFF file ({exc})", file=str(p),
+                        expected="a universal file with dataset 58 records") from None
+    if need not in [int(t) for t in types]:
+        raise DataError(f"UFF file has no dataset {need}", file=str(p),
+                        value=f"datasets {sorted({int(t) for t in types})}",
+                        expected="dataset 58 (function at nodal DOF: time records or FRFs)")
+    try:
+        sets = uff.read_sets()
+    except Exception as exc:
+        raise DataError(f"UFF file could not be parsed ({exc})", file=str(p),
+                        expected="valid dataset 58 records") from None
+    return [sets] if isinstance(sets, dict) else list(sets)
+
+
+def _unit_factors(sets: list[dict[str, Any]]) -> tuple[float, float]:
+    for s in sets:
+        if int(s.get("type", 0)) == 164:
+            return float(s.get("length", 1.0) or 1.0), float(s.get("force", 1.0) or 1.0)
+    return 1.0, 1.0
+
+
+def read_uff(path: str | Path, frf_type: str | None = None) -> HammerRecords | FRFData:
+    """Read UFF 58 time records (-> HammerRecords) or FRFs (-> FRFData), in SI units."""
+    p = str(path)
+    sets = _uff_sets(Path(path))
+    lf, ff = _unit_factors(sets)
+    s58 = [s for s in sets if int(s.get("type", 0)) == 58]
+    ftypes = {int(s.get("func_type", 0)) for s in s58}
+    if 1 in ftypes:
+        return _read_time(p, [s for s in s58 if int(s["func_type"]) == 1], lf, ff)
+    if 4 in ftypes:
+        return _read_frf(p, [s for s in s58 if int(s["func_type"]) == 4], lf, ff, frf_type)
+    raise DataError("UFF file has neither time records nor FRFs", file=p, field="func_type",
+                    value=sorted(ftypes), expected="dataset 58 func_type 1 (time) or 4 (FRF)")
+
+
+def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> HammerRecords:
+    forces = [r for r in recs if int(r.get("ordinate_spec_data_type", 0)) == SPEC_FORCE]
+    resps = [r for r in recs if int(r.get("ordinate_spec_data_type", 0)) != SPEC_FORCE]
+    if not forces:
+        raise DataError("time records have no force channel", file=p,
+                        field="ordinate_spec_data_type",
+                        expected="one record per hit with specific data type 13 (force)")
+    if not resps:
+        raise DataError("time records have no response channel", file=p,
+                        field="ordinate_spec_data_type",
+                        expected="response records (12 acceleration, 11 velocity, 8 disp.)")
+    qty = {int(r.get("ordinate_spec_data_type", 0)) for r in resps}
+    if len(qty) != 1 or next(iter(qty)) not in QUANTITY_BY_SPEC:
+        raise DataError("response records mix or lack quantities", file=p,
+                        field="ordinate_spec_data_type", value=sorted(qty),
+                        expected="all 12 (acceleration), all 11 (velocity) or all 8 (disp.)")
+    quantity = QUANTITY_BY_SPEC[next(iter(qty))]
+    inputs = sorted({(int(r["ref_node"]), int(r["ref_dir"])) for r in forces})
+    outputs = sorted({(int(r["rsp_node"]), int(r["rsp_dir"])) for r in resps})
+    hits = sorted({int(r.get("load_case_id", 0)) for r in forces})
+    n = len(forces[0]["data"])
+    dt = float(forces[0]["abscissa_inc"])
+    if not dt > 0:
+        raise DataError("abscissa increment must be > 0", file=p, field="abscissa_inc",
+                        value=dt, expected="sampling interval in s")
+    for r in recs:
+        if len(r["data"]) != n or not np.isclose(float(r["abscissa_inc"]), dt):
+            raise DataError("time records differ in length or sampling", file=p,
+                            field=f"record {r.get('id2', '')}",
+                            value=(len(r["data"]), float(r["abscissa_inc"])),
+                            expected=f"{n} samples at dt = {dt:g} s like the first record")
+    ni, nh, no = len(inputs), len(hits), len(outputs)
+    force = np.full((ni, nh, n), np.nan)
+    resp = np.full((ni, nh, no, n), np.nan)
+    in_names = [""] * ni
+    out_names = [""] * no
+    acc_scale = 1.0 / lf  # length-based quantities
+    for r in forces:
+        i = inputs.index((int(r["ref_node"]), int(r["ref_dir"])))
+        h = hits.index(int(r.get("load_case_id", 0)))
+        force[i, h] = np.asarray(r["data"], float) / ff
+        nm = str(r.get("id2", "")).strip()
+        in_names[i] = nm if nm and nm != "NONE" else f"n{inputs[i][0]}d{inputs[i][1]}"
+    for r in resps:
+        key = (int(r["ref_node"]), int(r["ref_dir"]))
+        if key not in inputs:
+            raise DataError("response record refers to an input without force record", file=p,
+                            field="ref_node/ref_dir", value=key,
+                            expected=f"one of the hammer DOFs {inputs}")
+        i = inputs.index(key)
+        h = hits.index(int(r.get("load_case_id", 0))) if int(r.get("load_case_id", 0)) in \
+            hits else -1
+        if h < 0:
+            raise DataError("response record of a hit without force record", file=p,
+                            field="load_case_id", value=int(r.get("load_case_id", 0)),
+                            expected=f"one of the hits {hits}")
+        o = outputs.index((int(r["rsp_node"]), int(r["rsp_dir"])))
+        resp[i, h, o] = np.asarray(r["data"], float) * acc_scale
+        nm = str(r.get("id2", "")).strip()
+        out_names[o] = nm if nm and nm != "NONE" else f"n{outputs[o][0]}d{outputs[o][1]}"
+    missing = np.argwhere(np.isnan(force[:, :, 0]))
+    if missing.size:
+        i, h = missing[0]
+        raise DataError("missing force record", file=p, field=f"input {in_names[i] or i}",
+                        value=f"hit {hits[h]}", expected="a force record for every hit")
+    missing = np.argwhere(np.isnan(resp[:, :, :, 0]))
+    if missing.size:
+        i, h, o = missing[0]
+        raise DataError("missing response record", file=p,
+                        field=f"output n{outputs[o][0]}d{outputs[o][1]}",
+                        value=f"input {in_names[i]}, hit {hits[h]}",
+                        expected="every response channel recorded for every hit")
+    return HammerRecords(1.0 / dt, force, resp, quantity, tuple(out_names), tuple(in_names),
+                         source=p, meta={"input_dofs": inputs, "output_dofs": outputs})
+
+
+def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
+              frf_type: str | None) -> FRFData:
+    outputs = sorted({(int(r["rsp_node"]), int(r["rsp_dir"])) for r in recs})
+    inputs = sorted({(int(r["ref_node"]), int(r["ref_dir"])) for r in recs})
+    x = np.asarray(recs[0]["x"], float)
+    if frf_type is None:
+        specs = {int(r.get("ordinate_spec_data_type", 0)) for r in recs}
+        if len(specs) != 1 or next(iter(specs)) not in FRF_TYPE_BY_SPEC:
+            raise DataError("cannot tell the FRF type from the UFF records", file=p,
+                            field="ordinate_spec_data_type", value=sorted(specs),
+                            expected="12, 11 or 8 in every record, or give --frf-type")
+        frf_type = FRF_TYPE_BY_SPEC[next(iter(specs))]
+    frf_type = check_frf_type(frf_type, file=p)
+    H = np.full((len(outputs), len(inputs), x.size), np.nan + 0j)
+    for r in recs:
+        xr = np.asarray(r["x"], float)
+        if xr.size != x.size or not np.allclose(xr, x):
+            raise DataError("FRF records have different frequency axes", file=p,
+                            field=f"record {r.get('id2', '')}", value=xr.size,
+                            expected=f"{x.size} lines from {x[0]:g} Hz like the first record")
+        o = outputs.index((int(r["rsp_node"]), int(r["rsp_dir"])))
+        i = inputs.index((int(r["ref_node"]), int(r["ref_dir"])))
+        H[o, i] = np.asarray(r["data"], complex) * ff / lf
+    miss = np.argwhere(np.isnan(H[:, :, 0].real))
+    if miss.size:
+        o, i = miss[0]
+        raise DataError("FRF matrix is incomplete", file=p,
+                        field=f"output n{outputs[o][0]}d{outputs[o][1]}",
+                        value=f"input n{inputs[i][0]}d{inputs[i][1]}",
+                        expected="one FRF record per (output, input) pair")
+    on = tuple(f"n{n}d{d}" for n, d in outputs)
+    inn = tuple(f"n{n}d{d}" for n, d in inputs)
+    return FRFData(x, H, frf_type, None, on, inn, source=p)
+
+
+def _units_set() -> dict[str, Any]:
+    return {"type": 164, "units_code": 1, "units_description": "SI - meter newton",
+            "temp_mode": 2, "length": 1.0, "force": 1.0, "temp": 1.0, "temp_offset": 273.15}
+
+
+def _write_sets(path: str | Path, sets: list[dict[str, Any]]) -> Path:
+    """Write datasets through pyuff into a temporary file, then rename (atomic)."""
+    import pyuff
+
+    dest = Path(path)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    tmp = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")
+    try:
+        tmp.unlink(missing_ok=True)
+        uff = pyuff.UFF(str(tmp))
+        uff.write_sets(sets, mode="overwrite", force_double=True)
+        os.replace(tmp, dest)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return dest
+
+
+def write_uff_time(records: HammerRecords, path: str | Path,
+                   input_dofs: list[tuple[int, int]] | None = None,
+                   output_dofs: list[tuple[int, int]] | None = None,
+                   description: str = "") -> Path:
+    """Write time records as UFF 58 (binary 58b, float64: pyuff writes binary data in
+    double precision only) + 164 (SI units)."""
+    out_d = output_dofs or default_dofs(records.output_names)
+    in_d = input_dofs or default_dofs(records.input_names)
+    dt = 1.0 / records.sample_rate_Hz
+    x = np.arange(records.n_samples) * dt
+    odt = 4
+    spec = SPEC_BY_QUANTITY[records.response_quantity]
+    sets: list[dict[str, Any]] = [_units_set()]
+    desc = (description or "robobore hammer test")[:80]
+
+    def rec(data: np.ndarray, name: str, rsp: tuple[int, int], ref: tuple[int, int],
+            hit: int, sp: int) -> dict[str, Any]:
+        d = dict(
+            type=58, binary=1, id1=desc, id2=name[:80], id3=f"hit {hit}", id4="robobore.modal",
+            id5="NONE", func_type=1, ver_num=0, load_case_id=hit, rsp_ent_name=name[:10],
+            rsp_node=rsp[0], rsp_dir=rsp[1], ref_ent_name="hammer", ref_node=ref[0],
+            ref_dir=ref[1], ord_data_type=odt, num_pts=x.size, abscissa_spacing=1,
+            abscissa_min=0.0, abscissa_inc=dt, abscissa_spec_data_type=17,
+            abscissa_axis_units_lab="s", ordinate_spec_data_type=sp,
+            ordinate_axis_units_lab="N" if sp == SPEC_FORCE else "m/s^2",
+            orddenom_spec_data_type=0, z_axis_spec_data_type=0,
+            data=np.asarray(data, float), x=x)
+        return d
+
+    for i in range(records.n_inputs):
+        for h in range(records.n_hits):
+            if not records.valid[i, h]:
+                continue
+            sets.append(rec(records.force[i, h], records.input_names[i], in_d[i], in_d[i],
+                            h + 1, SPEC_FORCE))
+            for o in range(records.n_outputs):
+                sets.append(rec(records.response[i, h, o], records.output_names[o], out_d[o],
+                                in_d[i], h + 1, spec))
+    return _write_sets(path, sets)
+
+
+def write_uff_frf(data: FRFData, path: str | Path,
+                  input_dofs: list[tuple[int, int]] | None = None,
+                  output_dofs: list[tuple[int, int]] | None = None,
+                  description: str = "") -> Path:
+    """Write an FRF matrix as UFF 58 (func_type 4, complex) + 164 (SI)."""
+    out_d = output_dofs or default_dofs(data.output_names)
+    in_d = input_dofs or default_dofs(data.input_names)
+    sets: list[dict[str, Any]] = [_units_set()]
+    for i in range(data.n_inputs):
+        for o in range(data.n_outputs):
+            sets.append(dict(
+                type=58, binary=1, id1=(description or "robobore FRF")[:80],
+                id2=f"{data.output_names[o]}/{data.input_names[i]}"[:80], id3="NONE",
+                id4="robobore.modal", id5="NONE", func_type=4, ver_num=0, load_case_id=0,
+                rsp_ent_name="rsp", rsp_node=out_d[o][0], rsp_dir=out_d[o][1],
+                ref_ent_name="ref", ref_node=in_d[i][0], ref_dir=in_d[i][1], ord_data_type=6,
+                num_pts=data.frequency_Hz.size, abscissa_spacing=0,
+                abscissa_spec_data_type=18, abscissa_axis_units_lab="Hz",
+                ordinate_spec_data_type=SPEC_BY_FRF_TYPE[data.frf_type],
+                orddenom_spec_data_type=SPEC_FORCE, z_axis_spec_data_type=0,
+                data=data.frf[o, i].astype(complex), x=data.frequency_Hz))
+    return _write_sets(path, sets)
+
+
+def load_npz(path: str | Path) -> FRFData:
+    """Read the NPZ contract (see module docstring)."""
+    p = Path(path)
+    if not p.is_file():
+        raise DataError("file not found", file=str(p), expected="an .npz file")
+    try:
+        z = np.load(p, allow_pickle=False)
+    except Exception as exc:
+        raise DataError(f"not a readable NPZ file ({exc})", file=str(p),
+                        expected="numpy .npz with frequency_Hz, frf, frf_type") from None
+    with z:
+        for key in ("frequency_Hz", "frf", "frf_type"):
+            if key not in z.files:
+                raise DataError("NPZ file lacks a required array", file=str(p), field=key,
+                                value=sorted(z.files),
+                                expected="arrays frequency_Hz (Hz), frf (complex), frf_type")
+        names = {k: tuple(str(v) for v in z[k]) for k in ("output_names", "input_names")
+                 if k in z.files}
+        coh = z["coherence"] if "coherence" in z.files else None
+        return FRFData(z["frequency_Hz"], z["frf"], str(z["frf_type"]), coh,
+                       names.get("output_names", ()), names.get("input_names", ()),
+                       source=str(p))
+
+
+def save_npz(data: FRFData, path: str | Path) -> Path:
+    """Write FRFs in the NPZ contract (atomically)."""
+    buf = _io.BytesIO()
+    arrays: dict[str, Any] = {"frequency_Hz": data.frequency_Hz, "frf": data.frf,
+                              "frf_type": np.array(data.frf_type),
+                              "output_names": np.array(data.output_names),
+                              "input_names": np.array(data.input_names)}
+    if data.coherence is not None:
+        arrays["coherence"] = data.coherence
+    np.savez_compressed(buf, **arrays)
+    return atomic_write_bytes(path, buf.getvalue())
+
+
+def load_input(path: str | Path, frf_type: str | None = None) -> HammerRecords | FRFData:
+    """Read a UFF (.uff/.unv) or NPZ file by extension (UFF if not .npz)."""
+    p = Path(path)
+    if p.suffix.lower() == ".npz":
+        return load_npz(p)
+    return read_uff(p, frf_type)
+
+
+__all__ = ["read_uff", "write_uff_time", "write_uff_frf", "load_npz", "save_npz",
+           "load_input", "default_dofs"]
