@@ -244,18 +244,25 @@ def deflect(
     """Joint deflection ``dq`` (rad) solving ``diag(k) dq = J(q + dq)^T [F; 0]``.
 
     The force ``F`` (world frame, N, fixed direction: a dead load) acts at a point fixed in
-    the flange frame, ``J`` is the geometric Jacobian at that point. Fixed-point iteration
-    (converges because the geometric stiffness is tiny compared with ``k``).
+    the flange frame, ``J`` is the geometric Jacobian at that point. Newton iteration with
+    the exact tangent ``diag(k) - K_G`` (K_G from the analytic dJ/dq, Chen & Kao 2000).
     """
+    from robobore.errors import NumericalError
+    from robobore.robot.stiffness import geometric_stiffness
+
     W = np.concatenate([np.asarray(force_N, float), np.zeros(3)])
+    k = np.asarray(k, float)
     dq = np.zeros(robot.n_joints)
     for _ in range(max_iter):
         _, J = fk_jacobian(robot, q_rad + dq, point_flange_m)
-        new = (J.T @ W) / k
-        if np.max(np.abs(new - dq)) < tol_rad:
-            return new
-        dq = new
-    return dq
+        r = k * dq - J.T @ W
+        step = np.linalg.solve(np.diag(k) - geometric_stiffness(robot, q_rad + dq, W,
+                                                                point_flange_m), r)
+        dq = dq - step
+        if np.max(np.abs(step)) < tol_rad:
+            return dq
+    raise NumericalError("joint-spring equilibrium did not converge (load too large for the "
+                         "joint stiffnesses?)")
 
 
 def simulate_clean(spec: CampaignSpec) -> dict[str, Any]:
@@ -291,7 +298,7 @@ def simulate_clean(spec: CampaignSpec) -> dict[str, Any]:
             d = np.asarray(spec.force_directions[p], float)
             d = d / np.linalg.norm(d)
         for s in range(S):
-            F = mags[s] * d
+            F = mags[s] * d + 0.0  # no negative zeros in the CSV
             force[p, s] = F
             dq = np.zeros(robot.n_joints) if mags[s] == 0 else deflect(robot, q[p], k, F, lp_f)
             dq_all[p, s] = dq

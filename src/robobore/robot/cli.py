@@ -1,9 +1,484 @@
-"""CLI commands of this stage (registered by ``robobore.cli``)."""
+"""CLI commands of the robot stage (registered by ``robobore.cli``).
+
+``robobore robot list|fk|stiffness|campaign`` and ``robobore identify stiffness``.
+Heavy imports (numba kernels, scipy) happen inside the commands.
+"""
 
 from __future__ import annotations
 
+import json
+import math
+from pathlib import Path
+from typing import Any
+
 import typer
+
+from robobore.clitools import (
+    JSON_OPTION,
+    emit,
+    fmt,
+    handle_errors,
+    kv_table,
+    parse_floats,
+    stdout,
+)
+
+DEFAULT_ROBOT = "irb6600-175-2.55"
+EXAMPLE_CAMPAIGN = ("data", "campaign_irb6600", "campaign.csv")
+
+ROBOT_OPT = typer.Option(
+    None, "--robot", help="Robot library name (see `robobore robot list`) or a robot TOML path."
+)
+ROBOT_FILE_OPT = typer.Option(
+    None, "--robot-file", help="A robot TOML file (D-H data); overrides --robot."
+)
+TCP_OPT = typer.Option(
+    None, "--tcp-m", help="Tool point in the flange frame, 'x,y,z' in m (default: flange)."
+)
+FRAME_OPT = typer.Option(
+    "tool", "--frame",
+    help="Process frame for k_xx, k_yy, k_zz: tool (flange axes; z = spindle = feed), base, "
+    "or boring (Z = tool z, X horizontal, Y = Z x X).",
+)
+
+
+def _robot(robot: str | None, robot_file: Path | None, default: str | None = DEFAULT_ROBOT):
+    from robobore.errors import ConfigError
+    from robobore.robot.kinematics import get_robot, load_robot_file
+
+    if robot_file is not None:
+        return load_robot_file(robot_file)
+    if robot is None:
+        if default is None:
+            raise ConfigError("no robot given", field="--robot",
+                              expected="a robot library name or --robot-file PATH")
+        robot = default
+    return get_robot(robot)
+
+
+def _tcp(tcp: str | None) -> list[float] | None:
+    return None if tcp is None else parse_floats(tcp, 3, "--tcp-m", "m")
+
+
+def _frame(frame: str, frame_rotation: str | None) -> Any:
+    import numpy as np
+
+    from robobore.errors import ConfigError
+    from robobore.robot.stiffness import FRAMES
+
+    if frame_rotation is not None:
+        return np.asarray(parse_floats(frame_rotation, 9, "--frame-rotation", "-"),
+                          float).reshape(3, 3)
+    if frame not in FRAMES:
+        raise ConfigError("unknown frame", field="--frame", value=frame,
+                          expected=f"one of {list(FRAMES)}")
+    return frame
+
+
+def _q(robot, joints_deg: str):
+    import numpy as np
+
+    from robobore.robot.kinematics import check_joint_limits
+
+    q = np.radians(parse_floats(joints_deg, robot.n_joints, "--joints-deg", "deg"))
+    try:
+        check_joint_limits(robot, q)
+    except Exception as exc:  # re-label with the CLI option
+        from robobore.errors import ConfigError, InputError
+
+        if isinstance(exc, InputError):
+            raise ConfigError(exc.message, field=f"--joints-deg ({exc.field})", value=exc.value,
+                              expected=exc.expected) from None
+        raise
+    return q
+
+
+def _matrix_table(title: str, M, row_labels, col_labels):
+    from rich.table import Table
+
+    t = Table(title=title, header_style="bold")
+    t.add_column("")
+    for c in col_labels:
+        t.add_column(c, justify="right")
+    for lab, row in zip(row_labels, M, strict=True):
+        t.add_row(lab, *[f"{float(v):.4e}" for v in row])
+    return t
+
+
+# --- robot list -----------------------------------------------------------------------------
+
+
+@handle_errors
+def list_cmd(as_json: bool = JSON_OPTION) -> None:
+    """List the robots in the library (built-in and ROBOBORE_ROBOT_PATH folders)."""
+    from robobore.robot.kinematics import available_robots, load_robot_file
+
+    out = {}
+    for name, path in available_robots().items():
+        r = load_robot_file(path)
+        out[name] = {"file": str(path), "joints": r.n_joints, "description": r.description}
+
+    def render(res: dict[str, Any]) -> None:
+        stdout.print(kv_table("robot library", [(k, v["description"]) for k, v in res.items()]))
+
+    emit({"robots": out}, as_json, lambda r: render(r["robots"]))
+
+
+# --- robot fk -------------------------------------------------------------------------------
+
+
+@handle_errors
+def fk_cmd(
+    joints_deg: str = typer.Option(..., "--joints-deg", help="q1,...,q6 in deg."),
+    robot: str = ROBOT_OPT,
+    robot_file: Path = ROBOT_FILE_OPT,
+    tcp_m: str = TCP_OPT,
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Forward kinematics and geometric Jacobian at one posture."""
+    import numpy as np
+
+    from robobore.robot.kinematics import fk_jacobian
+    from robobore.robot.stiffness import process_frame
+
+    rb = _robot(robot, robot_file)
+    q = _q(rb, joints_deg)
+    T, J = fk_jacobian(rb, q, _tcp(tcp_m))
+    res = {
+        "robot": rb.name,
+        "joints_deg": np.degrees(q).tolist(),
+        "tcp_m": _tcp(tcp_m) or [0.0, 0.0, 0.0],
+        "position_m": T[:3, 3].tolist(),
+        "rotation": T[:3, :3].tolist(),
+        "jacobian": J.tolist(),
+        "jacobian_condition": float(np.linalg.cond(J)),
+    }
+    try:
+        res["R_world_boring"] = process_frame(T[:3, :3], "boring").tolist()
+    except Exception:  # vertical feed axis: no boring frame
+        res["R_world_boring"] = None
+
+    def render(r: dict[str, Any]) -> None:
+        p = r["position_m"]
+        stdout.print(kv_table(f"forward kinematics — {r['robot']}", [
+            ("x (m)", p[0]), ("y (m)", p[1]), ("z (m)", p[2]),
+            ("tool z-axis (feed)", ", ".join(f"{v[2]:.4f}" for v in r["rotation"])),
+            ("cond(J)", r["jacobian_condition"]),
+        ]))
+        stdout.print(_matrix_table("rotation (world <- tool)", r["rotation"], "xyz",
+                                   ["x_tool", "y_tool", "z_tool"]))
+        stdout.print(_matrix_table("geometric Jacobian (m/rad; rad/rad)", r["jacobian"],
+                                   ["vx", "vy", "vz", "wx", "wy", "wz"],
+                                   [f"q{i + 1}" for i in range(len(r["joints_deg"]))]))
+
+    emit(res, as_json, render)
+
+
+# --- robot stiffness ------------------------------------------------------------------------
+
+
+def _joint_stiffness(text: str | None, file: Path | None, n: int):
+    from robobore.errors import ConfigError, InputError
+    from robobore.robot.stiffness import JointStiffness
+
+    if file is not None:
+        p = Path(file)
+        if not p.is_file():
+            raise ConfigError("file not found", file=str(p),
+                              expected="a JSON file from `robobore identify stiffness --json`")
+        try:
+            data = json.loads(p.read_text())
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"not valid JSON: {exc}", file=str(p)) from None
+        try:
+            js = JointStiffness.from_dict(data)
+        except InputError as exc:
+            raise ConfigError(exc.message, file=str(p), field=exc.field, value=exc.value,
+                              expected=exc.expected) from None
+        return js
+    if text is None:
+        raise ConfigError("no joint stiffness given", field="--joint-stiffness-Nm-per-rad",
+                          expected=f"{n} comma-separated values in N m/rad, or "
+                          "--joint-stiffness-file")
+    vals = parse_floats(text, n, "--joint-stiffness-Nm-per-rad", "N m/rad")
+    if any(not (v > 0 and math.isfinite(v)) for v in vals):
+        raise ConfigError("joint stiffnesses must be positive",
+                          field="--joint-stiffness-Nm-per-rad", value=text,
+                          expected=f"{n} positive values in N m/rad")
+    return vals
+
+
+@handle_errors
+def stiffness_cmd(
+    joints_deg: str = typer.Option(..., "--joints-deg", help="q1,...,q6 in deg."),
+    joint_stiffness: str = typer.Option(
+        None, "--joint-stiffness-Nm-per-rad", help="k1,...,k6 in N m/rad."),
+    joint_stiffness_file: Path = typer.Option(
+        None, "--joint-stiffness-file",
+        help="JSON from `robobore identify stiffness --json` (instead of the list)."),
+    robot: str = ROBOT_OPT,
+    robot_file: Path = ROBOT_FILE_OPT,
+    tcp_m: str = TCP_OPT,
+    frame: str = FRAME_OPT,
+    frame_rotation: str = typer.Option(
+        None, "--frame-rotation",
+        help="User process frame: R_world_process as 9 numbers, row-major (columns = axes)."),
+    wrench: str = typer.Option(
+        None, "--wrench-N-Nm",
+        help="External wrench on the tool 'Fx,Fy,Fz,Mx,My,Mz' (N, N m about the tool point, "
+        "world frame): adds the complementary stiffness under load (CCT, Chen & Kao 2000)."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Cartesian, directional and principal stiffness of the robot at one posture."""
+    import numpy as np
+
+    from robobore.robot.stiffness import stiffness_at
+
+    rb = _robot(robot, robot_file)
+    q = _q(rb, joints_deg)
+    k = _joint_stiffness(joint_stiffness, joint_stiffness_file, rb.n_joints)
+    W = None if wrench is None else parse_floats(wrench, 6, "--wrench-N-Nm", "N and N m")
+    res = stiffness_at(rb, q, k, frame=_frame(frame, frame_rotation), tcp_m=_tcp(tcp_m),
+                       wrench=W).to_dict()
+    res = {"robot": rb.name, "joints_deg": np.degrees(q).tolist(), **res}
+
+    def render(r: dict[str, Any]) -> None:
+        d, b = r["directional_stiffness_N_per_m"], r["directional_stiffness_base_N_per_m"]
+        rows = [(f"k_{a}{a} ({r['frame']} frame) N/m", d[a]) for a in "xyz"]
+        rows += [(f"k_{a}{a} (base frame) N/m", b[a]) for a in "xyz"]
+        rows += [(f"principal k{i + 1} N/m", v)
+                 for i, v in enumerate(r["principal_stiffness_N_per_m"])]
+        rows += [("cond(J)", r["jacobian_condition"])]
+        stdout.print(kv_table(f"stiffness — {r['robot']} at "
+                              f"{', '.join(f'{v:g}' for v in r['joints_deg'])} deg", rows))
+        lab = ["x", "y", "z", "rx", "ry", "rz"]
+        stdout.print(_matrix_table("Cartesian stiffness K (N/m, N/rad; N m/m, N m/rad)",
+                                   r["cartesian_stiffness"], lab, lab))
+        if r.get("complementary_stiffness") is not None:
+            stdout.print(_matrix_table("complementary stiffness under load K_C (CCT)",
+                                       r["complementary_stiffness"], lab, lab))
+
+    emit(res, as_json, render)
+
+
+# --- robot campaign -------------------------------------------------------------------------
+
+
+@handle_errors
+def campaign_cmd(
+    out: Path = typer.Argument(..., help="Campaign CSV to write (contract layout)."),
+    robot: str = ROBOT_OPT,
+    robot_file: Path = ROBOT_FILE_OPT,
+    joint_stiffness: str = typer.Option(
+        None, "--joint-stiffness-Nm-per-rad",
+        help="TRUE k1..k6 (N m/rad); default: the documented IRB 6600 assumption."),
+    postures_deg: str = typer.Option(
+        None, "--postures-deg", help="'q1,..,q6; q1,..,q6; ...' deg (default: paper posture "
+        "+ 5 spread postures)."),
+    force_directions: str = typer.Option(
+        None, "--force-directions", help="'x,y,z; ...' one world-frame direction per posture."),
+    load_levels_N: str = typer.Option(
+        "0,250,500,750,1000", "--load-levels-N", help="Force per load step, N (step 0 = 0)."),
+    pressures_MPa: str = typer.Option(
+        None, "--pressures-MPa",
+        help="Pressure-foot mode (paper): e.g. '0,0.3,0.4,0.5,0.6'; force = P x piston area "
+        "along -tool z at the foot (joints 4-6 then NOT identifiable)."),
+    piston_area_m2: float = typer.Option(1.0e-3 / 0.6, "--piston-area-m2",
+                                         help="Pressure-foot piston area, m^2."),
+    load_point_m: str = typer.Option(
+        None, "--load-point-m", help="Load point in the flange frame 'x,y,z', m (lever arm; "
+        "default 0.25,0,0.30; pressure foot 0,0,0.35)."),
+    reflectors_m: str = typer.Option(
+        None, "--reflectors-m", help="Reflectors in the flange frame 'x,y,z; ...' m (>= 3)."),
+    sigma_um: float = typer.Option(
+        None, "--sigma-um", help="Tracker noise, 1-sigma per coordinate, um (default: AT901 "
+        "model, half of MPE = 15 um + 6 um/m)."),
+    tracker_position_m: str = typer.Option(
+        "3.5,-3.0,1.0", "--tracker-position-m", help="Tracker position (world), m."),
+    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Generate a SYNTHETIC laser-tracker stiffness campaign (virtual experiment)."""
+    from robobore.robot import campaign as cm
+    from robobore.robot.campaign_io import write_campaign
+
+    rb = _robot(robot, robot_file)
+    kw: dict[str, Any] = {"robot": str(robot_file) if robot_file else rb.name, "seed": seed}
+    if joint_stiffness is not None:
+        kw["joint_stiffness_Nm_per_rad"] = tuple(_joint_stiffness(joint_stiffness, None,
+                                                                  rb.n_joints))
+    if postures_deg is not None:
+        kw["postures_deg"] = tuple(tuple(parse_floats(p, rb.n_joints, "--postures-deg", "deg"))
+                                   for p in postures_deg.split(";") if p.strip())
+    if force_directions is not None:
+        kw["force_directions"] = cm.parse_vectors(force_directions, "--force-directions", "-")
+    if load_point_m is not None:
+        kw["load_point_flange_m"] = tuple(parse_floats(load_point_m, 3, "--load-point-m", "m"))
+    if reflectors_m is not None:
+        kw["reflectors_flange_m"] = cm.parse_vectors(reflectors_m, "--reflectors-m", "m")
+    kw["noise"] = cm.TrackerNoise(
+        sigma_m=None if sigma_um is None else sigma_um * 1e-6,
+        tracker_position_m=tuple(parse_floats(tracker_position_m, 3, "--tracker-position-m",
+                                              "m")))
+    if pressures_MPa is not None:
+        kw["pressures_MPa"] = tuple(parse_floats(pressures_MPa, None, "--pressures-MPa", "MPa"))
+        kw["piston_area_m2"] = piston_area_m2
+        spec = cm.pressure_foot_spec(**kw)
+    else:
+        kw["load_levels_N"] = tuple(parse_floats(load_levels_N, None, "--load-levels-N", "N"))
+        spec = cm.CampaignSpec(**kw)
+    camp = cm.simulate_campaign(spec)
+    write_campaign(camp, out)
+    res = {
+        "file": str(out),
+        "synthetic": True,
+        "rows": camp.n_rows,
+        "postures": len(camp.postures()),
+        "load_steps": int(camp.load_step.max()) + 1,
+        "true_joint_stiffness_Nm_per_rad": list(spec.joint_stiffness_Nm_per_rad),
+        "spec": spec.to_dict(),
+    }
+
+    def render(r: dict[str, Any]) -> None:
+        stdout.print(kv_table("virtual campaign (SYNTHETIC)", [
+            ("file", r["file"]), ("rows", r["rows"]), ("postures", r["postures"]),
+            ("load steps per posture", r["load_steps"]),
+            ("true k (N m/rad)",
+             ", ".join(f"{v:.3g}" for v in r["true_joint_stiffness_Nm_per_rad"])),
+            ("seed", r["spec"]["seed"]),
+        ]))
+
+    emit(res, as_json, render)
+
+
+# --- identify stiffness ---------------------------------------------------------------------
+
+
+def example_campaign_path() -> Path:
+    """Path of the bundled SYNTHETIC example campaign CSV."""
+    from importlib import resources
+
+    return Path(str(resources.files("robobore").joinpath(*EXAMPLE_CAMPAIGN)))
+
+
+@handle_errors
+def identify_stiffness_cmd(
+    campaign: Path = typer.Argument(None, help="Campaign CSV (contract layout)."),
+    example: bool = typer.Option(False, "--example",
+                                 help="Use the bundled SYNTHETIC IRB 6600 campaign."),
+    robot: str = ROBOT_OPT,
+    robot_file: Path = ROBOT_FILE_OPT,
+    sigma_um: float = typer.Option(
+        None, "--sigma-um", help="Known tracker noise (1-sigma per coordinate, um); default: "
+        "estimated from the weighted residuals."),
+    cond_limit: float = typer.Option(1e6, "--cond-limit",
+                                     help="Largest accepted scaled condition number."),
+    tcp_m: str = TCP_OPT,
+    frame: str = FRAME_OPT,
+    plot: Path = typer.Option(None, "--plot", help="Write PNG plots to this folder."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Identify joint stiffnesses from a laser-tracker campaign (weighted NNLS)."""
+    from robobore.errors import ConfigError
+    from robobore.robot.campaign_io import read_campaign
+    from robobore.robot.identify import identify_joint_stiffness
+
+    if example:
+        if campaign is not None:
+            raise ConfigError("give either a campaign file or --example, not both",
+                              field="--example")
+        path = example_campaign_path()
+        rb = _robot(robot, robot_file, default=DEFAULT_ROBOT)
+    else:
+        if campaign is None:
+            raise ConfigError("no campaign file given", field="CAMPAIGN",
+                              expected="a campaign CSV path, or --example")
+        path = campaign
+        rb = _robot(robot, robot_file, default=None)
+    camp = read_campaign(path, robot=rb)
+    res = identify_joint_stiffness(camp, rb, sigma_m=None if sigma_um is None else
+                                   sigma_um * 1e-6, cond_limit=cond_limit,
+                                   frame=_frame(frame, None), tcp_m=_tcp(tcp_m))
+    d = res.to_dict()
+    d["synthetic"] = bool(example or res.synthetic)
+    if example:
+        d["example"] = "bundled SYNTHETIC campaign (virtual experiment, documented ground truth)"
+    if plot is not None:
+        d["plots"] = _plot_identification(d, Path(plot))
+    emit(d, as_json, _render_identification)
+
+
+def _render_identification(r: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    title = "joint stiffness identification"
+    if r.get("synthetic"):
+        title += " — SYNTHETIC data"
+    t = Table(title=title, header_style="bold")
+    for c in ("joint", "k (N m/rad)", "std", "95 % low", "95 % high", "status"):
+        t.add_column(c, justify="right" if c not in ("status",) else "left")
+    for i, k in enumerate(r["joint_stiffness_Nm_per_rad"]):
+        t.add_row(str(i + 1), fmt(k), fmt(r["joint_stiffness_std_Nm_per_rad"][i]),
+                  fmt(r["joint_stiffness_ci95_low_Nm_per_rad"][i]),
+                  fmt(r["joint_stiffness_ci95_high_Nm_per_rad"][i]), r["joint_status"][i])
+    stdout.print(t)
+    obs = r["observability"]
+    stdout.print(kv_table("fit and observability", [
+        ("equations / dof", f"{r['n_equations']} / {r['dof']}"),
+        ("cond (column-scaled regressor)", obs["condition_number_scaled"]),
+        ("residual rms translation (um)", r["residual_rms_translation_m"] * 1e6),
+        ("residual rms rotation (urad)", r["residual_rms_rotation_rad"] * 1e6),
+        ("tracker sigma estimated from residuals (um)",
+         None if r["noise_sigma_estimated_m"] is None else r["noise_sigma_estimated_m"] * 1e6),
+        ("chi2/dof with the given sigma", r["chi2_per_dof"]),
+    ]))
+    d = r["directional_stiffness_N_per_m"]
+    lo, hi = (r["directional_stiffness_ci95_low_N_per_m"],
+              r["directional_stiffness_ci95_high_N_per_m"])
+    q = ", ".join(f"{v:g}" for v in r["directional_posture_deg"])
+    stdout.print(kv_table(
+        f"directional stiffness at the first (boring) posture ({q} deg), "
+        f"{r['directional_frame']} frame, TCP {r['directional_tcp_m']} m",
+        [(f"k_{a}{a} N/m [95 %]",
+          "—" if d[a] is None else f"{fmt(d[a])}  [{fmt(lo[a])}, {fmt(hi[a])}]")
+         for a in "xyz"]))
+
+
+def _plot_identification(r: dict[str, Any], folder: Path) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    folder.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    k = [np.nan if v is None else v for v in r["joint_stiffness_Nm_per_rad"]]
+    lo = [np.nan if v is None else v for v in r["joint_stiffness_ci95_low_Nm_per_rad"]]
+    hi = [np.nan if v is None else v for v in r["joint_stiffness_ci95_high_Nm_per_rad"]]
+    x = np.arange(1, len(k) + 1)
+    k, lo, hi = map(np.asarray, (k, lo, hi))
+    ax[0].errorbar(x, k, yerr=[k - lo, hi - k], fmt="o", capsize=4)
+    ax[0].set_yscale("log")
+    ax[0].set_xlabel("joint")
+    ax[0].set_ylabel("k (N m/rad), 95 % interval")
+    ax[0].set_title("identified joint stiffness" + (" (SYNTHETIC)" if r.get("synthetic") else ""))
+    res = r["residuals"]
+    ax[1].bar(np.arange(len(res)), [e["translation_residual_m"] * 1e6 for e in res])
+    ax[1].set_xlabel("measurement (posture, load step)")
+    ax[1].set_ylabel("translation residual (um)")
+    ax[1].set_title("per-measurement residuals")
+    fig.tight_layout()
+    p = folder / "identify_stiffness.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    return [str(p)]
 
 
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add this stage's commands to the shared command groups."""
+    groups["robot"].command("list")(list_cmd)
+    groups["robot"].command("fk")(fk_cmd)
+    groups["robot"].command("stiffness")(stiffness_cmd)
+    groups["robot"].command("campaign")(campaign_cmd)
+    groups["identify"].command("stiffness")(identify_stiffness_cmd)

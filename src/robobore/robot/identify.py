@@ -188,6 +188,7 @@ class _Solution:
     cov_c: np.ndarray  # (B, n, n), zeros outside active
     resid_w: np.ndarray  # (B, N_eq) whitened residuals
     resid: np.ndarray  # (B, N_eq) physical residuals
+    chi2_dof: np.ndarray  # (B,) weighted residual variance (sigma^2 if unknown, else chi2/dof)
 
 
 def _solve(d: _Design, y: np.ndarray, cond_limit: float) -> _Solution:
@@ -234,10 +235,8 @@ def _solve(d: _Design, y: np.ndarray, cond_limit: float) -> _Solution:
     cz = np.where(np.isnan(c), 0.0, c)
     resid_w = yw - cz @ Aw.T
     resid = y - cz @ d.A.T
-    if d.known_sigma is None:
-        s2 = np.sum(resid_w ** 2, axis=1) / dof
-    else:
-        s2 = np.ones(B)
+    chi2_dof = np.sum(resid_w ** 2, axis=1) / dof
+    s2 = chi2_dof if d.known_sigma is None else np.ones(B)
     G = np.linalg.inv(As.T @ As)  # scaled
     cov_act = G / np.outer(norms[idx], norms[idx])
     cov = np.zeros((B, n, n))
@@ -245,7 +244,7 @@ def _solve(d: _Design, y: np.ndarray, cond_limit: float) -> _Solution:
     se = np.sqrt(np.einsum("bii->bi", cov))
     se[:, ~active] = np.nan
     return _Solution(c, se, active, status, s2, dof, cond_all, cond_act, rel, cov, resid_w,
-                     resid)
+                     resid, chi2_dof)
 
 
 @dataclass(frozen=True)
@@ -260,7 +259,8 @@ class StiffnessIdentification:
     column_norm_relative: tuple[float, ...]
     dof: int
     n_equations: int
-    residual_scale: float
+    noise_sigma_estimated_m: float | None
+    chi2_per_dof: float | None
     residual_rms_translation_m: float
     residual_rms_rotation_rad: float
     residuals: tuple[dict[str, Any], ...]
@@ -292,7 +292,8 @@ class StiffnessIdentification:
             },
             "n_equations": self.n_equations,
             "dof": self.dof,
-            "residual_scale": self.residual_scale,
+            "noise_sigma_estimated_m": self.noise_sigma_estimated_m,
+            "chi2_per_dof": self.chi2_per_dof,
             "sigma_known_m": self.sigma_known_m,
             "residual_rms_translation_m": self.residual_rms_translation_m,
             "residual_rms_rotation_rad": self.residual_rms_rotation_rad,
@@ -416,7 +417,9 @@ def identify_joint_stiffness(
         column_norm_relative=tuple(float(x) for x in sol.col_norm_rel),
         dof=sol.dof,
         n_equations=int(d.A.shape[0]),
-        residual_scale=float(math.sqrt(sol.s2[0])),
+        noise_sigma_estimated_m=None if sigma_m is not None else float(
+            math.sqrt(sol.chi2_dof[0])),
+        chi2_per_dof=None if sigma_m is None else float(sol.chi2_dof[0]),
         residual_rms_translation_m=rt,
         residual_rms_rotation_rad=rr_,
         residuals=tuple(res),
