@@ -1,0 +1,163 @@
+"""Linear cutting-process description shared by the time-domain simulation and the lobes.
+
+The process is a set of cutting "elements" (the edge elements of a boring insert, or one
+element for the general single-point case), each described in a basis ``B(theta)`` whose rows
+are three unit vectors of the boring frame:
+
+* boring bar (``rotating=True``): ``B = (e_t, e_r, e_z)`` with ``e_t = (-sin t, cos t, 0)`` the
+  velocity direction of the insert, ``e_r = (cos t, sin t, 0)`` outward radial and ``e_z`` the
+  feed (bore axis); ``theta`` is the bar angle from X towards Y;
+* single-point cutting with fixed directions (``rotating=False``): ``B = I`` (X, Y, Z).
+
+For element ``e`` at depth of cut ``a`` (per unit depth widths ``w_e``, edge lengths ``s_e``)::
+
+    h_e  = p h0_e - n_e . B (r(t) - mu r_s)        (p: passes since the surface at this angle
+                                                    was cut; r_s: tool displacement then)
+    F    = B^T sum_e [ shear_e h_e w_e a g + edge_e s_e a g ]     if h_e > 0, else 0
+    g    = max(0, 1 + dd . B r / a)                 (depth modulation against the pre-bore
+                                                    surface; dd = 0 for the general case)
+
+``n_e`` (chip normal: a tool displacement along it REDUCES the chip), ``shear_e`` [N/m^2] and
+``edge_e`` [N/m] are basis coordinates; forces are ON THE TOOL; ``mu`` is the overlap factor
+(1: full regeneration). The general contract (``[process]`` of the TOML) is one element with
+``n = chip_normal``, ``shear = K u`` (``u = force_direction``), ``h0 = feed``, ``w = 1``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.forces import CuttingCoefficients
+from robobore.cutting.geometry import BoringInsert, edge_elements
+
+
+@dataclass(frozen=True)
+class CuttingProcess:
+    """Structure-of-arrays process model (see module docstring). Shapes: (E,), (E, 3), (3,)."""
+
+    rotating: bool
+    n_inserts: int
+    h0: np.ndarray
+    width_per_depth: np.ndarray
+    edge_per_depth: np.ndarray
+    normal: np.ndarray
+    shear: np.ndarray
+    edge: np.ndarray
+    depth_direction: np.ndarray
+    overlap: float = 1.0
+    feed_per_rev_m: float = 0.0
+    reference_depth_m: float | None = None
+    label: str = ""
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.h0.size)
+
+    def basis(self, theta: np.ndarray) -> np.ndarray:
+        """Basis matrices, shape (n, 3, 3): rows are the basis vectors in the boring frame."""
+        th = np.atleast_1d(np.asarray(theta, float))
+        B = np.zeros((th.size, 3, 3))
+        if self.rotating:
+            c, s = np.cos(th), np.sin(th)
+            B[:, 0, 0], B[:, 0, 1] = -s, c
+            B[:, 1, 0], B[:, 1, 1] = c, s
+            B[:, 2, 2] = 1.0
+        else:
+            B[:] = np.eye(3)
+        return B
+
+    def directional_matrix(self, theta: np.ndarray) -> np.ndarray:
+        """Regenerative directional matrix per unit depth [N/m^2], shape (n, 3, 3).
+
+        Linearised about the nominal chip, all inserts summed (insert ``p`` at
+        ``theta + 2 pi p / N``): ``dF = -a A(theta) (r(t) - mu r(t - tau))``,
+        ``A = sum_p B_p^T [sum_e w_e shear_e n_e^T] B_p``.
+        """
+        th = np.atleast_1d(np.asarray(theta, float))
+        core = np.einsum("e,ei,ej->ij", self.width_per_depth, self.shear, self.normal)
+        A = np.zeros((th.size, 3, 3))
+        for p in range(self.n_inserts):
+            B = self.basis(th + 2 * np.pi * p / self.n_inserts)
+            A += np.einsum("nki,kl,nlj->nij", B, core, B)
+        return A
+
+    def mean_directional_matrix(self, n_theta: int = 720) -> np.ndarray:
+        """Zero-order (revolution-averaged) directional matrix [N/m^2], shape (3, 3)."""
+        if not self.rotating:
+            return self.directional_matrix(np.zeros(1))[0]
+        th = np.linspace(0, 2 * np.pi, n_theta, endpoint=False)
+        return self.directional_matrix(th).mean(axis=0)
+
+    def process_stiffness(self, theta: np.ndarray) -> np.ndarray:
+        """Non-regenerative stiffness from depth modulation [N/m], shape (n, 3, 3).
+
+        ``dF = P(theta) r`` with ``P = sum_p B_p^T [sum_e w_e h0_e shear_e] dd^T B_p`` (it does
+        not scale with depth: the width change is the displacement itself)."""
+        th = np.atleast_1d(np.asarray(theta, float))
+        vec = np.einsum("e,e,ei->i", self.width_per_depth, self.h0, self.shear)
+        core = np.outer(vec, self.depth_direction)
+        P = np.zeros((th.size, 3, 3))
+        if not np.any(self.depth_direction):
+            return P
+        for p in range(self.n_inserts):
+            B = self.basis(th + 2 * np.pi * p / self.n_inserts)
+            P += np.einsum("nki,kl,nlj->nij", B, core, B)
+        return P
+
+    def to_dict(self) -> dict[str, Any]:
+        return {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                for k, v in self.__dict__.items()}
+
+
+def single_point_process(cutting_coefficient_N_per_m2: float, force_direction: np.ndarray,
+                         chip_normal: np.ndarray, feed_per_rev_m: float,
+                         n_inserts: int = 1, overlap: float = 1.0) -> CuttingProcess:
+    """The general single-point contract: ``F = K a h u`` with ``h = f - n . (r - mu r_s)``."""
+    u = np.asarray(force_direction, float)
+    n = np.asarray(chip_normal, float)
+    return CuttingProcess(
+        rotating=False, n_inserts=int(n_inserts), h0=np.array([feed_per_rev_m / n_inserts]),
+        width_per_depth=np.ones(1), edge_per_depth=np.zeros(1), normal=n[None, :],
+        shear=(cutting_coefficient_N_per_m2 * u)[None, :], edge=np.zeros((1, 3)),
+        depth_direction=np.zeros(3), overlap=float(overlap), feed_per_rev_m=feed_per_rev_m,
+        reference_depth_m=None, label="single-point (fixed directions)")
+
+
+def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, depth_m: float,
+                   feed_per_rev_m: float, n_elements: int = 24, overlap: float = 1.0,
+                   depth_modulation: bool = True) -> CuttingProcess:
+    """Rotating boring bar: edge elements of ``insert`` at depth ``depth_m`` (see
+    :mod:`robobore.cutting.geometry`) with the mechanistic force model
+    (:mod:`robobore.cutting.forces`). Element widths scale linearly with the simulated depth
+    (uniform stretch of the engaged edge: exact on a straight edge, an approximation when the
+    depth differs much from ``depth_m`` on the nose)."""
+    fz = feed_per_rev_m / insert.n_inserts
+    el = edge_elements(insert, depth_m, fz, n_elements)
+    sk, ck = np.sin(el.kappa), np.cos(el.kappa)
+    c = coefficients
+    # basis coordinates (t, r, z); tangential force on the tool is -Ft e_t
+    normal = np.column_stack([np.zeros_like(sk), -ck, -sk])
+    shear = np.column_stack([-c.Ktc * np.ones_like(sk), -c.Kfc * ck - c.Krc * sk,
+                             -c.Kfc * sk + c.Krc * ck])
+    edge = np.column_stack([-c.Kte * np.ones_like(sk), -c.Kfe * ck - c.Kre * sk,
+                            -c.Kfe * sk + c.Kre * ck])
+    # h0: the element's nominal thickness; per unit depth widths
+    return CuttingProcess(
+        rotating=True, n_inserts=insert.n_inserts, h0=el.h.copy(),
+        width_per_depth=el.db / depth_m, edge_per_depth=el.dS / depth_m, normal=normal,
+        shear=shear, edge=edge,
+        depth_direction=np.array([0.0, 1.0, 0.0]) if depth_modulation else np.zeros(3),
+        overlap=float(overlap), feed_per_rev_m=feed_per_rev_m, reference_depth_m=depth_m,
+        label=f"boring bar, {insert.n_inserts} insert(s), nose {insert.nose_radius_m * 1e3:g} mm, "
+              f"kappa_r {insert.approach_angle_deg:g} deg")
+
+
+def tooth_period(speed_rpm: float, n_inserts: int) -> float:
+    """Delay between successive inserts [s]: 60 / (N n)."""
+    return 60.0 / (n_inserts * speed_rpm)
+
+
+__all__ = ["CuttingProcess", "single_point_process", "boring_process", "tooth_period"]

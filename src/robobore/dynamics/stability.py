@@ -1,0 +1,464 @@
+"""Stability of single-point cutting / boring: lobes, semi-discretisation, mode coupling.
+
+Linearised dynamics (see :mod:`robobore.dynamics.process`): for depth of cut ``a`` and delay
+``tau = 60 / (N n)``::
+
+    M q'' + C q' + K q = D^T [ -a A(t) (r(t) - mu r(t - tau)) + P(t) r(t) ],   r = D q
+
+Frequency domain, zero-order (Altintas' oriented transfer function; Altintas & Budak 1995 for
+the averaged directional matrix): with ``A0`` the revolution-averaged directional matrix, the
+characteristic equation is ``det(I + a (1 - mu e^{-i w tau}) G(iw) A0) = 0``. With ``lambda(w)``
+an eigenvalue of ``G(iw) A0`` (for one mode and ``A0 = K u n^T``: ``lambda = K n^T G u``) and
+``mu = 1``::
+
+    a_lim = -1 / (2 Re lambda),   eps = 3 pi + 2 arg(lambda)  (mod 2 pi),
+    n = 60 w / (N (eps + 2 pi k)),   k = 0, 1, 2, ...
+
+(for ``mu < 1`` the phase condition is solved on the circle ``1 - mu e^{-i eps}``). The
+non-regenerative depth-modulation stiffness ``P`` is NOT in the frequency-domain solution (it
+does not scale with depth); semi-discretisation includes it.
+
+Semi-discretisation (Insperger & Stepan 2002, 2004; first-order interpolation of the delayed
+term, Insperger, Stepan & Turi 2008): the delay is split into ``r`` steps, the ODE is solved
+exactly over each step with the delayed state linearly interpolated; the monodromy matrix over
+one delay is the product of the step matrices; stable iff its spectral radius < 1.
+
+Mode coupling (Tlusty & Polacek 1963; for robots Pan et al. 2006): the non-delayed system
+``M q'' + C q' + (K + a D^T A0 D - D^T P D) q = 0`` (chip thickness driven by the current
+displacement, no regeneration); unstable when an eigenvalue has a positive real part (with
+damping) or, undamped, when two eigenfrequencies coalesce and become complex (Pan's
+criterion).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numba as nb
+import numpy as np
+from scipy.linalg import expm
+
+from robobore.dynamics.process import CuttingProcess
+from robobore.dynamics.structure import ToolPointStructure
+
+
+# --------------------------------------------------------------------------- frequency domain
+def frequency_grid(structure: ToolPointStructure, n_global: int = 6000,
+                   n_local: int = 2000) -> np.ndarray:
+    """Chatter-frequency grid [rad/s]: log-spaced over 0.2-5 x the mode range, dense near modes."""
+    f = structure.frequency_Hz
+    z = np.maximum(structure.damping_ratio, 1e-4)
+    parts = [np.geomspace(0.2 * f.min(), 5.0 * f.max(), n_global)]
+    for fj, zj in zip(f, z, strict=True):
+        parts.append(fj * (1 + zj * np.linspace(-40, 40, n_local)))
+    g = np.unique(np.concatenate(parts))
+    return 2 * np.pi * g[g > 0]
+
+
+def oriented_eigenvalues(structure: ToolPointStructure, A0: np.ndarray,
+                         omega: np.ndarray) -> np.ndarray:
+    """Eigenvalues of ``G(iw) A0`` (dimensionless per unit depth x depth), shape (n_branch, n_w).
+
+    Rank-one ``A0`` (the single-point contract) has a single non-zero eigenvalue, the trace.
+    Otherwise the three eigenvalues are tracked across frequency by nearest-neighbour matching.
+    """
+    G = structure.frf(omega)  # (3,3,nw)
+    M = np.einsum("oiw,ij->woj", G, A0)
+    sv = np.linalg.svd(A0, compute_uv=False)
+    if sv[1] <= 1e-12 * sv[0]:
+        return np.trace(M, axis1=1, axis2=2)[None, :]
+    ev = np.linalg.eigvals(M)  # (nw, 3)
+    out = np.empty_like(ev)
+    out[0] = ev[0]
+    perms = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
+    for i in range(1, ev.shape[0]):
+        best, cost = None, np.inf
+        for p in perms:
+            c = np.abs(ev[i, list(p)] - out[i - 1]).sum()
+            if c < cost:
+                best, cost = p, c
+        out[i] = ev[i, list(best)]
+    return out.T
+
+
+def lobe_branches(lam: np.ndarray, overlap: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Critical depth ``b`` and phase ``eps`` [rad] per branch and frequency.
+
+    ``lam``: (n_branch, n_w). Returns ``(b, eps)`` of shape (n_branch * roots, n_w) with
+    ``b = inf`` where no positive real depth satisfies the characteristic equation.
+    """
+    mu = float(overlap)
+    psi = np.angle(lam)
+    mag = np.abs(lam)
+    theta = np.angle(np.exp(1j * (np.pi - psi)))
+    ct = np.cos(theta)
+    bs, es = [], []
+    if mu >= 1.0 - 1e-12:
+        rho = 2 * ct
+        roots = [rho]
+    else:
+        disc = ct**2 - (1 - mu**2)
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        roots = [ct + sq, ct - sq]
+    for rho in roots:
+        ok = np.isfinite(rho) & (rho > 1e-12) & (mag > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            b = np.where(ok, 1.0 / (rho * mag), np.inf)
+            w = 1 - rho * np.exp(1j * theta)
+            eps = np.mod(-np.angle(w), 2 * np.pi)
+        bs.append(b)
+        es.append(np.where(ok, eps, np.nan))
+    return np.concatenate(bs), np.concatenate(es)
+
+
+@nb.njit(cache=True, parallel=True)
+def _envelope(speeds_rpm, n_inserts, omega, b, eps, out_b, out_w):  # pragma: no cover - numba
+    """Lower envelope of the lobes at each speed (parallel over speeds).
+
+    For speed n, delay tau = 60/(N n); along each branch the phase ``w tau - eps(w)`` crosses
+    2 pi k (k >= 0) where a lobe passes this speed; ``b`` is interpolated linearly there.
+    """
+    nbr, nw = b.shape
+    for s in nb.prange(speeds_rpm.size):
+        tau = 60.0 / (n_inserts * speeds_rpm[s])
+        best = np.inf
+        wbest = np.nan
+        for k in range(nbr):
+            for i in range(nw - 1):
+                b0 = b[k, i]
+                b1 = b[k, i + 1]
+                if not (b0 < np.inf and b1 < np.inf):
+                    continue
+                e0 = eps[k, i]
+                e1 = eps[k, i + 1]
+                if abs(e1 - e0) > np.pi:
+                    continue
+                p0 = (omega[i] * tau - e0) / (2 * np.pi)
+                p1 = (omega[i + 1] * tau - e1) / (2 * np.pi)
+                lo = min(p0, p1)
+                hi = max(p0, p1)
+                j = math.ceil(lo)
+                if j < 0:
+                    j = 0
+                while j <= hi:
+                    if p1 != p0:
+                        t = (j - p0) / (p1 - p0)
+                    else:
+                        t = 0.0
+                    bb = b0 + t * (b1 - b0)
+                    if bb < best:
+                        best = bb
+                        wbest = omega[i] + t * (omega[i + 1] - omega[i])
+                    j += 1
+        out_b[s] = best
+        out_w[s] = wbest
+
+
+@nb.njit(cache=True)
+def _mode_coupling_line(omega, lam, out):  # pragma: no cover - numba
+    """mu = 0: b where lambda crosses the negative real axis (speed independent)."""
+    best = np.inf
+    wb = np.nan
+    for i in range(lam.size - 1):
+        a0 = lam[i].imag
+        a1 = lam[i + 1].imag
+        if a0 == 0.0 or a0 * a1 < 0:
+            t = a0 / (a0 - a1) if a1 != a0 else 0.0
+            re = lam[i].real + t * (lam[i + 1].real - lam[i].real)
+            if re < 0 and -1.0 / re < best:
+                best = -1.0 / re
+                wb = omega[i] + t * (omega[i + 1] - omega[i])
+    out[0] = best
+    out[1] = wb
+
+
+@dataclass(frozen=True)
+class LobeResult:
+    """Stability lobes: ``speed_rpm`` (n,), ``critical_depth_m`` (n,), ``chatter_frequency_Hz``
+    (n,), ``absolute_limit_m`` and its frequency; ``method``; per-lobe curves (optional)."""
+
+    speed_rpm: np.ndarray
+    critical_depth_m: np.ndarray
+    chatter_frequency_Hz: np.ndarray
+    absolute_limit_m: float
+    absolute_limit_frequency_Hz: float
+    method: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"method": self.method, "speed_rpm": self.speed_rpm,
+                "critical_depth_mm": self.critical_depth_m * 1e3,
+                "absolute_limit_mm": self.absolute_limit_m * 1e3,
+                "absolute_limit_frequency_Hz": self.absolute_limit_frequency_Hz,
+                "chatter_frequency_Hz": self.chatter_frequency_Hz}
+
+
+def _refine_min(omega: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """Minimum of b(w) on the grid refined by a parabola through the 3 nearest points."""
+    i = int(np.nanargmin(b))
+    if 0 < i < b.size - 1 and np.all(np.isfinite(b[i - 1:i + 2])):
+        x = omega[i - 1:i + 2]
+        y = b[i - 1:i + 2]
+        c = np.polyfit(x - x[1], y, 2)
+        if c[0] > 0:
+            xm = -c[1] / (2 * c[0])
+            if abs(xm) <= max(abs(x[0] - x[1]), abs(x[2] - x[1])):
+                return float(np.polyval(c, xm)), float(x[1] + xm)
+    return float(b[i]), float(omega[i])
+
+
+def lobes_frequency_domain(structure: ToolPointStructure, process: CuttingProcess,
+                           speed_rpm: np.ndarray, omega: np.ndarray | None = None) -> LobeResult:
+    """Zero-order frequency-domain lobes at the given spindle speeds (any number of modes)."""
+    speeds = np.asarray(speed_rpm, float)
+    w = frequency_grid(structure) if omega is None else np.asarray(omega, float)
+    A0 = process.mean_directional_matrix()
+    lam = oriented_eigenvalues(structure, A0, w)
+    mu = process.overlap
+    if mu <= 1e-9:
+        best = np.full(lam.shape[0], np.inf)
+        wb = np.full(lam.shape[0], np.nan)
+        tmp = np.empty(2)
+        for k in range(lam.shape[0]):
+            _mode_coupling_line(w, lam[k], tmp)
+            best[k], wb[k] = tmp
+        k = int(np.argmin(best))
+        return LobeResult(speeds, np.full(speeds.size, best[k]),
+                          np.full(speeds.size, wb[k] / (2 * np.pi)), float(best[k]),
+                          float(wb[k] / (2 * np.pi)), "frequency (mu = 0: no regeneration)")
+    b, eps = lobe_branches(lam, mu)
+    out_b = np.empty(speeds.size)
+    out_w = np.empty(speeds.size)
+    _envelope(speeds, int(process.n_inserts), w, b, np.nan_to_num(eps, nan=0.0), out_b, out_w)
+    bmin = np.min(b, axis=0)
+    alim, walim = _refine_min(w, np.where(np.isfinite(bmin), bmin, np.nan)) if np.any(
+        np.isfinite(bmin)) else (np.inf, np.nan)
+    return LobeResult(speeds, out_b, out_w / (2 * np.pi), alim, walim / (2 * np.pi),
+                      "frequency")
+
+
+def lobe_curves(structure: ToolPointStructure, process: CuttingProcess, n_lobes: int = 10,
+                omega: np.ndarray | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Individual lobes (speed_rpm, depth_m) for k = 0 .. n_lobes-1 (for plots)."""
+    w = frequency_grid(structure) if omega is None else omega
+    lam = oriented_eigenvalues(structure, process.mean_directional_matrix(), w)
+    b, eps = lobe_branches(lam, max(process.overlap, 1e-6))
+    out = []
+    for br in range(b.shape[0]):
+        ok = np.isfinite(b[br])
+        for k in range(n_lobes):
+            n = 60 * w[ok] / (process.n_inserts * (eps[br, ok] + 2 * np.pi * k))
+            out.append((n, b[br, ok]))
+    return out
+
+
+# --------------------------------------------------------------------------- semi-discretisation
+def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Phi = e^{L dt}, Gamma0 = int e^{L(dt-s)} ds, Gamma1 = int e^{L(dt-s)} s ds (Van Loan)."""
+    n = Lc.shape[0]
+    H = np.zeros((3 * n, 3 * n))
+    H[:n, :n] = Lc
+    H[:n, n:2 * n] = np.eye(n)
+    H[n:2 * n, 2 * n:] = np.eye(n)
+    E = expm(H * dt)
+    return E[:n, :n], E[:n, n:2 * n], E[:n, 2 * n:]
+
+
+def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: np.ndarray,
+                include_process_stiffness: bool = True):
+    D = structure.directions  # (m,3)
+    minv = 1.0 / structure.modal_mass
+    A = process.directional_matrix(theta)  # (n,3,3)
+    W = minv[None, :, None] * np.einsum("jo,noi,ki->njk", D, A, D)
+    if include_process_stiffness:
+        P = process.process_stiffness(theta)
+        Pm = minv[None, :, None] * np.einsum("jo,noi,ki->njk", D, P, D)
+    else:
+        Pm = np.zeros_like(W)
+    return W, Pm
+
+
+def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingProcess,
+                              speed_rpm: float, depth_m: float, steps: int = 40,
+                              include_process_stiffness: bool = True) -> float:
+    """Spectral radius of the semi-discretised monodromy matrix over one delay (< 1: stable)."""
+    m = structure.n_modes
+    tau = 60.0 / (process.n_inserts * speed_rpm)
+    dt = tau / steps
+    om = structure.omega
+    base = np.zeros((2 * m, 2 * m))
+    base[:m, m:] = np.eye(m)
+    base[m:, :m] = -np.diag(om**2)
+    base[m:, m:] = -np.diag(2 * structure.damping_ratio * om)
+    constant = (not process.rotating) or process.n_inserts == 0
+    n_th = 1 if constant else steps
+    # coefficient angle at the middle of each step (delay = one insert pitch)
+    theta = (np.arange(n_th) + 0.5) * dt * 2 * np.pi * speed_rpm / 60.0
+    W, Pm = _modal_mats(structure, process, theta, include_process_stiffness)
+    mu = process.overlap
+    n = 2 * m + steps * m
+    mono = np.eye(n)
+    for i in range(n_th):
+        L = base.copy()
+        L[m:, :m] += -depth_m * W[i] + Pm[i]
+        Phi, G0, G1 = _step_matrices(L, dt)
+        Rq = np.zeros((2 * m, m))
+        Rq[m:, :] = mu * depth_m * W[i]
+        P1 = (G1 / dt) @ Rq             # multiplies q_{i-r+1}
+        P0 = (G0 - G1 / dt) @ Rq        # multiplies q_{i-r}
+        Gs = np.zeros((n, n))
+        Gs[:2 * m, :2 * m] = Phi
+        # delayed states: register holds q_{i-1} .. q_{i-r} at rows 2m + (k-1) m
+        last = 2 * m + (steps - 1) * m
+        Gs[:2 * m, last:last + m] += P0
+        if steps == 1:
+            Gs[:2 * m, :m] += P1
+        else:
+            prev = 2 * m + (steps - 2) * m
+            Gs[:2 * m, prev:prev + m] += P1
+        # shift register: new q_{i} -> slot 1, slot k -> slot k+1
+        Gs[2 * m:3 * m, :m] = np.eye(m)
+        for k in range(1, steps):
+            Gs[2 * m + k * m:2 * m + (k + 1) * m, 2 * m + (k - 1) * m:2 * m + k * m] = np.eye(m)
+        if constant:
+            ev = np.linalg.eigvals(Gs)
+            return float(np.max(np.abs(ev)) ** steps)
+        mono = Gs @ mono
+    return float(np.max(np.abs(np.linalg.eigvals(mono))))
+
+
+def critical_depth_semidiscretization(structure: ToolPointStructure, process: CuttingProcess,
+                                      speed_rpm: float, depth_hi_m: float = 0.05,
+                                      steps: int = 40, tol: float = 1e-4,
+                                      include_process_stiffness: bool = True) -> float:
+    """Critical depth [m] at one speed by bisection on the monodromy spectral radius.
+
+    Returns ``inf`` if stable up to ``depth_hi_m`` and 0 if unstable at vanishing depth (e.g.
+    a depth-independent process-stiffness instability)."""
+
+    def rho(b: float) -> float:
+        return monodromy_spectral_radius(structure, process, speed_rpm, b, steps,
+                                         include_process_stiffness)
+
+    if rho(depth_hi_m * 1e-6) >= 1.0:
+        return 0.0
+    lo, hi = 0.0, depth_hi_m * 1e-3
+    while rho(hi) < 1.0:
+        lo = hi
+        hi *= 2.0
+        if hi > depth_hi_m:
+            if rho(depth_hi_m) < 1.0:
+                return math.inf
+            hi = depth_hi_m
+            break
+    while (hi - lo) > tol * hi:
+        mid = 0.5 * (lo + hi)
+        if rho(mid) < 1.0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def lobes_semidiscretization(structure: ToolPointStructure, process: CuttingProcess,
+                             speed_rpm: np.ndarray, steps: int = 40,
+                             depth_hi_m: float = 0.05, progress=None) -> LobeResult:
+    """Critical depth at each speed by semi-discretisation (slower; for cross-checks)."""
+    speeds = np.asarray(speed_rpm, float)
+    out = np.empty(speeds.size)
+    for i, n in enumerate(speeds):
+        out[i] = critical_depth_semidiscretization(structure, process, float(n), depth_hi_m,
+                                                   steps)
+        if progress is not None:
+            progress(1)
+    fin = out[np.isfinite(out)]
+    alim = float(fin.min()) if fin.size else math.inf
+    return LobeResult(speeds, out, np.full(speeds.size, np.nan), alim, math.nan,
+                      "semi-discretization")
+
+
+# --------------------------------------------------------------------------- mode coupling
+@dataclass(frozen=True)
+class ModeCoupling:
+    """Mode-coupling analysis at one depth: eigenfrequencies [Hz], growth rates [1/s]."""
+
+    depth_m: float
+    unstable: bool
+    undamped_coalescence: bool
+    frequencies_Hz: np.ndarray
+    growth_rate_per_s: np.ndarray
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def mode_coupling(structure: ToolPointStructure, process: CuttingProcess,
+                  depth_m: float) -> ModeCoupling:
+    """Tlusty/Pan mode-coupling criterion at depth ``depth_m`` (no regeneration)."""
+    m = structure.n_modes
+    D = structure.directions
+    minv = 1.0 / structure.modal_mass
+    A0 = process.mean_directional_matrix()
+    P0 = process.process_stiffness(np.linspace(0, 2 * np.pi, 720, endpoint=False)).mean(
+        axis=0)
+    Km = np.diag(structure.omega**2) + minv[:, None] * (D @ (depth_m * A0 - P0) @ D.T)
+    L = np.zeros((2 * m, 2 * m))
+    L[:m, m:] = np.eye(m)
+    L[m:, :m] = -Km
+    L[m:, m:] = -np.diag(2 * structure.damping_ratio * structure.omega)
+    ev = np.linalg.eigvals(L)
+    ev_u = np.linalg.eigvals(Km)
+    coal = bool(np.any(np.abs(ev_u.imag) > 1e-9 * np.abs(ev_u).max()) or np.any(ev_u.real < 0))
+    up = ev[ev.imag >= 0]
+    return ModeCoupling(float(depth_m), bool(np.max(ev.real) > 0), coal,
+                        np.abs(up.imag) / (2 * np.pi), up.real)
+
+
+def mode_coupling_limit(structure: ToolPointStructure, process: CuttingProcess,
+                        depth_hi_m: float = 0.05, damped: bool = True) -> float:
+    """Smallest depth [m] at which the mode-coupling criterion flags instability (inf: none)."""
+
+    def bad(b: float) -> bool:
+        mc = mode_coupling(structure, process, b)
+        return mc.unstable if damped else mc.undamped_coalescence
+
+    grid = np.geomspace(depth_hi_m * 1e-7, depth_hi_m, 120)
+    flags = [bad(b) for b in grid]
+    if flags[0]:
+        return 0.0
+    if not any(flags):
+        return math.inf
+    i = flags.index(True)
+    lo, hi = grid[i - 1], grid[i]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if bad(mid):
+            hi = mid
+        else:
+            lo = mid
+    return 0.5 * (lo + hi)
+
+
+def sdof_absolute_limit(k: float, zeta: float, K: float, cos_factor: float) -> float:
+    """Closed-form SDOF absolute limit 2 k zeta (1 + zeta) / (K cos_factor) [m] (Tlusty)."""
+    return 2 * k * zeta * (1 + zeta) / (K * cos_factor)
+
+
+def sdof_pocket_speeds(f_n: float, zeta: float, n_inserts: int, lobes: int) -> np.ndarray:
+    """Speeds [rpm] of the lobe minima (pockets) of a SDOF system, closed form.
+
+    The minimum of ``-1/(2 Re G)`` is at ``r^2 = 1 + 2 zeta`` where the phase gives
+    ``eps = pi + 2 atan(r)``; lobe ``k`` passes there at ``n = 60 w_c / (N (eps + 2 pi k))``.
+    """
+    r = math.sqrt(1 + 2 * zeta)
+    wc = 2 * math.pi * f_n * r
+    eps = math.pi + 2 * math.atan(r)
+    k = np.arange(lobes)
+    return 60 * wc / (n_inserts * (eps + 2 * np.pi * k))
+
+
+__all__ = ["LobeResult", "frequency_grid", "oriented_eigenvalues", "lobe_branches",
+           "lobes_frequency_domain", "lobe_curves", "monodromy_spectral_radius",
+           "critical_depth_semidiscretization", "lobes_semidiscretization", "ModeCoupling",
+           "mode_coupling", "mode_coupling_limit", "sdof_absolute_limit", "sdof_pocket_speeds"]
