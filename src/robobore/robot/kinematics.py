@@ -358,6 +358,16 @@ def _fk_jac_kernel(q, d, a, alpha, off, base, tcp, T_out, J_out, Z, O):  # pragm
             J_out[k, 5, i] = zz
 
 
+#: Same kernel compiled without threads: for a few postures the parallel launch costs more
+#: than the work (milliseconds on a loaded machine vs microseconds).
+_fk_jac_kernel_serial = njit(cache=True)(_fk_jac_kernel.py_func)
+PARALLEL_MIN_POSTURES = 256
+
+
+def _kernel(n: int):
+    return _fk_jac_kernel if n >= PARALLEL_MIN_POSTURES else _fk_jac_kernel_serial
+
+
 def _prep(robot: Robot, q_rad: Any, tcp_m: Any) -> tuple[np.ndarray, bool, np.ndarray]:
     q = np.asarray(q_rad, dtype=np.float64)
     single = q.ndim == 1
@@ -395,7 +405,7 @@ def fk_jacobian(
     J = np.empty((n, 6, nj))
     Z = np.empty((n, nj + 1, 3))
     O = np.empty((n, nj + 1, 3))
-    _fk_jac_kernel(q, d, a, al, off, np.ascontiguousarray(robot.base), tcp, T, J, Z, O)
+    _kernel(n)(q, d, a, al, off, np.ascontiguousarray(robot.base), tcp, T, J, Z, O)
     if single:
         return T[0], J[0]
     return T, J
@@ -424,7 +434,7 @@ def joint_frames(robot: Robot, q_rad: np.ndarray) -> tuple[np.ndarray, np.ndarra
     J = np.empty((1, 6, nj))
     Z = np.empty((1, nj + 1, 3))
     O = np.empty((1, nj + 1, 3))
-    _fk_jac_kernel(q[:1], d, a, al, off, np.ascontiguousarray(robot.base), tcp, T, J, Z, O)
+    _fk_jac_kernel_serial(q[:1], d, a, al, off, np.ascontiguousarray(robot.base), tcp, T, J, Z, O)
     return Z[0], O[0]
 
 
@@ -444,17 +454,17 @@ def jacobian_derivative(robot: Robot, q_rad: Any, tcp_m: Any = None) -> np.ndarr
     T = fk(robot, q, tcp_m)
     p = T[:3, 3]
     nj = robot.n_joints
+    zi = Z[:nj, None, :]  # joint i (axis of derivative), broadcast over j
+    zj = Z[None, :nj, :]
+    oi = O[:nj, None, :]
+    oj = O[None, :nj, :]
+    dzj = np.cross(zi, zj)  # (i, j, 3)
+    lower = np.cross(dzj, p - oj) + np.cross(zj, np.cross(zi, p - oj))  # i < j
+    upper = np.cross(zj, np.cross(zi, p - oi))  # i >= j
+    before = (np.arange(nj)[:, None] < np.arange(nj)[None, :])[..., None]
     dJ = np.zeros((nj, 6, nj))
-    for i in range(nj):
-        zi, oi = Z[i], O[i]
-        for j in range(nj):
-            zj, oj = Z[j], O[j]
-            if i < j:
-                dzj = np.cross(zi, zj)
-                dJ[i, :3, j] = np.cross(dzj, p - oj) + np.cross(zj, np.cross(zi, p - oj))
-                dJ[i, 3:, j] = dzj
-            else:
-                dJ[i, :3, j] = np.cross(zj, np.cross(zi, p - oi))
+    dJ[:, :3, :] = np.swapaxes(np.where(before, lower, upper), 1, 2)
+    dJ[:, 3:, :] = np.swapaxes(np.where(before, dzj, 0.0), 1, 2)
     return dJ
 
 
