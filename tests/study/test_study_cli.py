@@ -1,0 +1,53 @@
+"""`robobore sweep`: JSON output, resume, exit codes, clear errors."""
+
+from __future__ import annotations
+
+import json
+
+from conftest import write_sweep_toml
+from typer.testing import CliRunner
+
+from robobore.cli import app
+
+
+def test_sweep_json_then_resume(tmp_path, sweep_toml):
+    r = CliRunner()
+    args = ["sweep", str(sweep_toml), "--out", str(tmp_path / "s"), "--workers", "0", "--json"]
+    res = r.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.stdout)
+    assert (d["total"], d["computed"], d["skipped"], d["failed"]) == (12, 12, 0, 0)
+    assert d["runner"] == "demo" and d["mode"] == "serial (no Dask)"
+    d2 = json.loads(r.invoke(app, args).stdout)
+    assert (d2["computed"], d2["skipped"]) == (0, 12)
+    res = r.invoke(app, args[:-1])  # table output
+    assert res.exit_code == 0 and "already done" in res.output
+
+
+def test_sweep_with_failures_exits_1_and_lists_them(tmp_path):
+    cfg = write_sweep_toml(tmp_path / "c.toml", runner_options="fail_speeds_rpm = [600]")
+    res = CliRunner().invoke(app, ["sweep", str(cfg), "--out", str(tmp_path / "s"),
+                                   "--workers", "1", "--threads"])
+    assert res.exit_code == 1
+    text = " ".join(res.output.split())
+    assert "failed conditions" in text and "asked to fail at 600" in text
+
+
+def test_sweep_bad_inputs_are_one_line_errors(tmp_path, sweep_toml):
+    r = CliRunner()
+    res = r.invoke(app, ["sweep", str(tmp_path / "none.toml")])
+    assert res.exit_code == 2 and "config file not found" in res.output
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[sweep]\nrunner = "nope"\n[grid]\nspeed_rpm = [300]\n'
+                   'feed_mm_per_rev = [0.1]\ndepth_of_cut_mm = [0.1]\n')
+    res = r.invoke(app, ["sweep", str(bad)])
+    assert res.exit_code == 2 and "unknown runner" in " ".join(res.output.split())
+    res = r.invoke(app, ["sweep", str(sweep_toml), "--scheduler", "tcp://127.0.0.1:9",
+                         "--workers", "2"])
+    assert res.exit_code == 2 and "either --scheduler or --workers" in " ".join(
+        res.output.split())
+    notstore = tmp_path / "notstore"
+    notstore.mkdir()
+    (notstore / "x.txt").write_text("mine")
+    res = r.invoke(app, ["sweep", str(sweep_toml), "--out", str(notstore), "--workers", "0"])
+    assert res.exit_code == 2 and "not a results store" in " ".join(res.output.split())
