@@ -95,7 +95,37 @@ def main() -> None:
     cb = simulate_campaign(big)
     t = timeit(lambda: identify_joint_stiffness(cb, rb), repeat=2)
     print(f"identification, 60 postures x 5 steps ({cb.n_rows} rows): {t * 1e3:.1f} ms")
+    acceptance_figures()
     print(f"load average: {os.getloadavg()}")
+
+
+def acceptance_figures() -> None:
+    """Issue-2 acceptance campaign (6 postures x 4 levels to 1 kN, lever arm, sigma 5 um):
+    errors and 95 % coverage over 100 seeded repeats (the test asserts the limits)."""
+    from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD as KT
+    from robobore.robot.campaign import PAPER_POSTURE_DEG
+    from robobore.robot.stiffness import directional_stiffness_xyz, process_frame
+
+    spec = CampaignSpec(load_levels_N=(0.0, 1000.0 / 3, 2000.0 / 3, 1000.0),
+                        noise=TrackerNoise(sigma_m=5e-6), seed=11)
+    camp, clean = simulate_campaign(spec), simulate_clean(spec)
+    kt = np.asarray(KT)
+    out = identify_batch(camp, "irb6600-175-2.55", noisy_batch(clean, 100,
+                                                               np.random.default_rng(2026)))
+    err = np.abs(out["k"] / kt - 1)
+    cover = ((out["ci_low"] <= kt) & (kt <= out["ci_high"])).mean(axis=0)
+    rb = get_robot("irb6600-175-2.55")
+    q = np.radians(PAPER_POSTURE_DEG)
+    T, J = fk_jacobian(rb, q)
+    g = (process_frame(T[:3, :3], "tool").T @ J[:3]) ** 2
+    kd = 1.0 / (out["c"] @ g.T)
+    kd_true = np.array(list(directional_stiffness_xyz(rb, q, kt).values()))
+    print("acceptance campaign, 100 repeats:")
+    print(f"  worst |k err| % per joint : {np.round(100 * err.max(axis=0), 2)}")
+    print(f"  rms |k err| % per joint   : {np.round(100 * np.sqrt((err ** 2).mean(axis=0)), 2)}")
+    kd_err = np.abs(kd / kd_true - 1).max(axis=0)
+    print(f"  worst k_xx,k_yy,k_zz err %: {np.round(100 * kd_err, 2)}")
+    print(f"  95 % coverage per joint   : {cover}")
 
 
 if __name__ == "__main__":

@@ -203,7 +203,7 @@ def _solve(d: _Design, y: np.ndarray, cond_limit: float) -> _Solution:
     status = ["identified"] * n
     active = rel > STRUCTURAL_ZERO
     for i in np.flatnonzero(~active):
-        status[i] = "unidentifiable: no torque at this joint in any test"
+        status[i] = "unidentifiable: not loaded (no torque in any test)"
     if not active.any():
         raise IdentificationError("no joint is loaded by the campaign's forces")
 
@@ -221,8 +221,7 @@ def _solve(d: _Design, y: np.ndarray, cond_limit: float) -> _Solution:
         idx = np.flatnonzero(active)
         j = int(idx[np.argmax(np.abs(v))])
         active[j] = False
-        status[j] = (f"unidentifiable: its column is (nearly) a combination of the others "
-                     f"(scaled condition number {cond_act:.3g} > {cond_limit:.3g})")
+        status[j] = f"unidentifiable: combination of the others (cond {cond_act:.3g})"
     idx = np.flatnonzero(active)
     As = Aw[:, idx] / norms[idx]
     B = y.shape[0]
@@ -365,13 +364,12 @@ def identify_joint_stiffness(
         if not sol.active[i]:
             kk.append(None)
         elif not c[i] > 0:
-            status[i] = ("unidentifiable: compliance at the non-negativity bound (joint stiffer "
-                         "than this campaign can resolve)")
+            status[i] = "unidentifiable: compliance at bound 0 (too stiff to resolve)"
             kk.append(None)
         else:
             kk.append(float(k[i]))
             if not np.isfinite(hi[i]):
-                status[i] = "weakly determined: 95 % interval unbounded above"
+                status[i] = "weak: 95 % interval unbounded above"
 
     def _opt(a: np.ndarray, ok: list[bool]) -> tuple[float | None, ...]:
         return tuple(float(a[i]) if ok[i] and np.isfinite(a[i]) else None
