@@ -31,6 +31,8 @@ vectors.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -38,6 +40,22 @@ import numpy as np
 
 from robobore.errors import IdentificationError, InputError
 from robobore.modal.frf import FRFData
+
+
+@contextmanager
+def single_thread_blas() -> Iterator[None]:
+    """Run the many small LAPACK calls (solves, eigenvalues of <= 200x200 matrices) on one
+    BLAS thread. Multi-threaded OpenBLAS gains nothing at these sizes and, on a loaded
+    machine, its spinning threads made the pLSCF order loop 10x slower (measured:
+    0.77 s single-threaded vs 8.6 s threaded at load 8 on 2 cores). Uses threadpoolctl when
+    it is installed, else does nothing."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - optional
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
 
 
 @dataclass(frozen=True)
@@ -233,9 +251,10 @@ def plscf(data: FRFData, band_Hz: tuple[float, float] | None = None, max_order: 
     Ts = 1.0 / (2.0 * f_hi)
     w = _weights(d.frf, weighting)
     scale = np.max(np.abs(d.frf)) or 1.0
-    r, s, t = normal_equation_lags(f, d.frf / scale, max_order, f_hi, w)
-    R, S, T = _blocks(r, s, t, max_order)
-    sets = solve_orders(R, S, T, np.arange(min_order, max_order + 1), l, Ts)
+    with single_thread_blas():
+        r, s, t = normal_equation_lags(f, d.frf / scale, max_order, f_hi, w)
+        R, S, T = _blocks(r, s, t, max_order)
+        sets = solve_orders(R, S, T, np.arange(min_order, max_order + 1), l, Ts)
     tau = data.exp_window_tau_s
     shift = 0.0 if tau is None else 1.0 / tau
     if shift:

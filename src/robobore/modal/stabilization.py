@@ -204,6 +204,7 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
         return SelectedPole(lam, diagram.participation[k].copy(), fm, zm, int(n_ord),
                             float(np.std(fd) / fm), float(np.std(zd) / zm))
 
+    need = max(2, int(np.ceil(min_fraction * n_orders)))
     if approx_Hz:
         chosen = []
         for fa in approx_Hz:
@@ -211,7 +212,10 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
             if not cand:
                 raise IdentificationError(
                     f"no stable pole cluster within {100 * search_tol:g} % of {fa:g} Hz")
-            best = max(cand, key=lambda c: (c[0], -abs(c[1] - fa)))
+            # the nearest well-supported cluster; if none is, the best-supported one
+            strong = [c for c in cand if c[0] >= need]
+            best = (min(strong, key=lambda c: abs(c[1] - fa)) if strong
+                    else max(cand, key=lambda c: (c[0], -abs(c[1] - fa))))
             chosen.append(best)
     elif n_modes is not None:
         chosen = clusters[:n_modes]
@@ -220,7 +224,6 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
                 f"asked for {n_modes} modes but the diagram has only {len(chosen)} stable "
                 "pole clusters: raise --max-order or check the band")
     else:
-        need = max(2, int(np.ceil(min_fraction * n_orders)))
         chosen = [c for c in clusters if c[0] >= need]
         if not chosen:
             raise IdentificationError(
