@@ -27,15 +27,17 @@ def test_fk_json_contract():
     assert np.asarray(d["rotation"]).shape == (3, 3)
 
 
-def test_stiffness_json_contract():
+def test_stiffness_json_contract(tmp_path):
     d = _json(["robot", "stiffness", "--robot", "irb6600-175-2.55", "--joints-deg", PAPER,
                "--joint-stiffness-Nm-per-rad", K, "--json"])
     assert set(d["directional_stiffness_N_per_m"]) == {"x", "y", "z"}
     assert np.asarray(d["cartesian_stiffness"]).shape == (6, 6)
     d2 = _json(["robot", "stiffness", "--joints-deg", PAPER, "--joint-stiffness-Nm-per-rad", K,
-                "--wrench-N-Nm", "0,0,-1000,0,0,0", "--frame", "boring", "--json"])
+                "--wrench-N-Nm", "0,0,-1000,0,0,0", "--frame", "boring", "--json",
+                "--plot", str(tmp_path)])
     assert np.asarray(d2["complementary_stiffness"]).shape == (6, 6)
     assert d2["frame"] == "boring"
+    assert (tmp_path / "directional_stiffness.png").is_file()
 
 
 def test_identify_example_is_synthetic_and_complete():

@@ -141,3 +141,24 @@ def test_condition_limit_marks_joint_unidentifiable(accept):
     assert "combination of the others" in res.joint.status[i]
     assert res.condition_number_identified <= 1.5
 
+
+
+def test_outlier_measurement_is_flagged_and_principal_stiffness(accept):
+    """A load step whose three reflectors all read 150 um off (e.g. a tracker re-set) is
+    flagged 'suspect' (chi2, 6 dof, 99.9 %); the clean steps are not (at most a stray one)."""
+    camp, _ = accept
+    xyz = camp.xyz_m.copy()
+    rows = [i for i in range(camp.n_rows) if camp.posture[i] == "3" and camp.load_step[i] == 2]
+    xyz[rows] += np.array([150e-6, -100e-6, 50e-6])
+    from dataclasses import replace
+
+    res = identify_joint_stiffness(replace(camp, xyz_m=xyz), ROBOT)
+    flagged = [(e["posture"], e["load_step"]) for e in res.residuals if e["suspect"]]
+    assert ("3", 2) in flagged and len(flagged) <= 2
+    clean = identify_joint_stiffness(camp, ROBOT).to_dict()
+    kp = np.asarray(clean["principal_stiffness_N_per_m"])
+    from robobore.robot.stiffness import compliance_matrix, principal_stiffness
+
+    _, J = fk_jacobian(get_robot(ROBOT), np.radians(PAPER_POSTURE_DEG))
+    kp_true, _ = principal_stiffness(compliance_matrix(J, K_TRUE))
+    assert np.allclose(np.sort(kp), np.sort(kp_true), rtol=0.03)

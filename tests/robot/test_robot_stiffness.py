@@ -155,3 +155,15 @@ def test_bad_stiffness_and_singular_posture(rb):
 def test_rotation_vector_small_angle_consistency(rb):
     R = fk(rb, PAPER_Q + 1e-7)[:3, :3] @ fk(rb, PAPER_Q)[:3, :3].T
     assert np.linalg.norm(rotation_vector(R)) < 1e-6
+
+
+def test_directional_map_matches_single_posture(rb):
+    from robobore.robot.stiffness import directional_stiffness_map
+
+    rng = np.random.default_rng(5)
+    Q = PAPER_Q + rng.normal(scale=0.2, size=(5, 6))
+    for frame in ("tool", "base", "boring"):
+        M = directional_stiffness_map(rb, Q, K_TRUE, frame=frame, tcp_m=[0, 0, 0.3])
+        for i in range(5):
+            d = directional_stiffness_xyz(rb, Q[i], K_TRUE, frame=frame, tcp_m=[0, 0, 0.3])
+            assert np.allclose(M[i], [d["x"], d["y"], d["z"]], rtol=1e-12)

@@ -101,7 +101,7 @@ def _matrix_table(title: str, M, row_labels, col_labels):
     for c in col_labels:
         t.add_column(c, justify="right")
     for lab, row in zip(row_labels, M, strict=True):
-        t.add_row(lab, *[f"{float(v):.4e}" for v in row])
+        t.add_row(lab, *[f"{float(v):.3g}" for v in row])
     return t
 
 
@@ -227,6 +227,8 @@ def stiffness_cmd(
         None, "--wrench-N-Nm",
         help="External wrench on the tool 'Fx,Fy,Fz,Mx,My,Mz' (N, N m about the tool point, "
         "world frame): adds the complementary stiffness under load (CCT, Chen & Kao 2000)."),
+    plot: Path = typer.Option(None, "--plot", help="Write a polar plot of the directional "
+                              "stiffness in the process planes (PNG) to this folder."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Cartesian, directional and principal stiffness of the robot at one posture."""
@@ -241,6 +243,8 @@ def stiffness_cmd(
     res = stiffness_at(rb, q, k, frame=_frame(frame, frame_rotation), tcp_m=_tcp(tcp_m),
                        wrench=W).to_dict()
     res = {"robot": rb.name, "joints_deg": np.degrees(q).tolist(), **res}
+    if plot is not None:
+        res["plots"] = _plot_stiffness(res, Path(plot))
 
     def render(r: dict[str, Any]) -> None:
         d, b = r["directional_stiffness_N_per_m"], r["directional_stiffness_base_N_per_m"]
@@ -259,6 +263,34 @@ def stiffness_cmd(
                                        r["complementary_stiffness"], lab, lab))
 
     emit(res, as_json, render)
+
+
+def _plot_stiffness(r: dict[str, Any], folder: Path) -> list[str]:
+    """Polar plots of k_u = 1/(u^T C_tt u) for u in the process XY, XZ and YZ planes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    C = np.asarray(r["compliance"])[:3, :3]
+    R = np.asarray(r["R_world_process"])
+    phi = np.linspace(0, 2 * np.pi, 361)
+    fig, axs = plt.subplots(1, 3, subplot_kw={"projection": "polar"}, figsize=(13, 4.4))
+    for ax, (a, b) in zip(axs, ((0, 1), (0, 2), (1, 2)), strict=True):
+        U = np.outer(np.cos(phi), R[:, a]) + np.outer(np.sin(phi), R[:, b])
+        k = 1.0 / np.einsum("ni,ij,nj->n", U, C, U)
+        ax.plot(phi, k / 1e6)
+        ax.set_title(f"{'XYZ'[a]}{'XYZ'[b]} plane ({r['frame']} frame), k in N/um",
+                     fontsize=9)
+    fig.suptitle(f"directional stiffness, {r['robot']} at "
+                 f"{', '.join(f'{v:g}' for v in r['joints_deg'])} deg")
+    fig.tight_layout()
+    folder.mkdir(parents=True, exist_ok=True)
+    p = folder / "directional_stiffness.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    return [str(p)]
 
 
 # --- robot campaign -------------------------------------------------------------------------

@@ -45,6 +45,9 @@ from robobore.robot.kinematics import check_joint_limits, fk_jacobian, get_robot
 from robobore.robot.stiffness import JointStiffness, process_frame
 
 STRUCTURAL_ZERO = 1e-8  # column norm relative to the largest: "no excitation"
+#: chi-square (6 dof) 99.9 % quantile: a measurement whose whitened residual exceeds it is
+#: flagged ``suspect`` (a reflector knocked in its nest, a wrong force reading ...).
+SUSPECT_CHI2_6DOF = 22.458
 
 
 def kabsch(P0: np.ndarray, P1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -393,13 +396,15 @@ def identify_joint_stiffness(
     r = sol.resid[0].reshape(-1, 6)
     rw = sol.resid_w[0].reshape(-1, 6)
     for (p, st, ref, ids, row), rr, rrw in zip(d.meas, r, rw, strict=True):
+        nres = np.linalg.norm(rrw) / math.sqrt(6 * sol.s2[0])
         _, _, fit_rms = kabsch(campaign.xyz_m[ref], campaign.xyz_m[ids])
         res.append({
             "posture": d.labels[p], "load_step": st, "first_row": row,
             "translation_residual_m": float(np.linalg.norm(rr[:3])),
             "rotation_residual_rad": float(np.linalg.norm(rr[3:])),
-            "normalised_residual": float(np.linalg.norm(rrw) / math.sqrt(6 * sol.s2[0])),
+            "normalised_residual": float(nres),
             "rigid_fit_rms_m": float(fit_rms),
+            "suspect": bool(nres ** 2 * 6 > SUSPECT_CHI2_6DOF),
         })
     rt = math.sqrt(float(np.mean(r[:, :3] ** 2)))
     rr_ = math.sqrt(float(np.mean(r[:, 3:] ** 2)))
@@ -455,7 +460,18 @@ def directional_with_interval(
         vals[name] = 1.0 / s
         los[name] = 1.0 / (s + tq * se)
         his[name] = 1.0 / (s - tq * se) if s - tq * se > 0 else None
+    Jv = J[:3]
+    if np.any(np.sum(Jv[:, ~usable] ** 2, axis=0) > 1e-12 * np.sum(Jv ** 2, axis=0).max()):
+        kp, V = None, None
+    else:
+        Ctt = (Jv * cz) @ Jv.T
+        lam, Vm = np.linalg.eigh(0.5 * (Ctt + Ctt.T))
+        if np.linalg.det(Vm) < 0:
+            Vm[:, 2] *= -1.0
+        kp, V = (1.0 / lam).tolist(), Vm.tolist()
     return {
+        "principal_stiffness_N_per_m": kp,
+        "principal_directions_world": V,
         "directional_stiffness_N_per_m": vals,
         "directional_stiffness_ci95_low_N_per_m": los,
         "directional_stiffness_ci95_high_N_per_m": his,

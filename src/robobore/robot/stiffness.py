@@ -211,6 +211,35 @@ def directional_stiffness_xyz(
     return out
 
 
+def directional_stiffness_map(
+    robot: Robot | str,
+    Q_rad: Any,
+    k_Nm_per_rad: Any,
+    *,
+    frame: str = "tool",
+    tcp_m: Any = None,
+) -> np.ndarray:
+    """Directional stiffness k_xx, k_yy, k_zz [N/m] for many postures at once, (n, 3).
+
+    ``Q_rad`` (n, n_joints); ``frame`` "tool", "base" or "boring" (per posture). Vectorised
+    (one numba FK/Jacobian call), for workspace maps and posture optimisation.
+    """
+    robot = get_robot(robot)
+    k = _k_array(k_Nm_per_rad, robot.n_joints)
+    T, J = fk_jacobian(robot, np.atleast_2d(np.asarray(Q_rad, float)), tcp_m)
+    if frame == "base":
+        R = np.broadcast_to(np.eye(3), T[:, :3, :3].shape)
+    elif frame == "tool":
+        R = T[:, :3, :3]
+    elif frame == "boring":
+        R = np.stack([process_frame(t[:3, :3], "boring") for t in T])
+    else:
+        raise ConfigError("unknown frame", field="frame", value=frame,
+                          expected=f"one of {FRAMES}")
+    G = np.einsum("nia,nij->naj", R, J[:, :3, :]) ** 2  # (n, 3 axes, joints)
+    return 1.0 / np.einsum("naj,j->na", G, 1.0 / k)
+
+
 @dataclass(frozen=True)
 class StiffnessResult:
     """Stiffness of a robot at one posture (what ``robobore robot stiffness`` prints)."""
@@ -373,6 +402,7 @@ __all__ = [
     "principal_stiffness",
     "process_frame",
     "directional_stiffness_xyz",
+    "directional_stiffness_map",
     "stiffness_at",
     "StiffnessResult",
     "JointStiffness",
