@@ -170,6 +170,8 @@ def test_frfdata_bad_input_messages():
     with pytest.raises(InputError, match="outside the data") as e:
         d.band(20.0, 30.0)
     assert "[1, 10] Hz" in str(e.value)
+    with pytest.raises(InputError, match="extends beyond the data"):
+        d.band(5.0, 12.0)
     with pytest.raises(InputError, match="LO < HI"):
         d.band(5.0, 2.0)
     with pytest.raises(InputError, match="fewer than 8"):

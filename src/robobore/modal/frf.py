@@ -181,8 +181,10 @@ class FRFData:
         if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
             raise InputError("frequency band must have LO < HI", field="band_Hz",
                              value=(lo, hi), expected="LO < HI in Hz")
-        if lo >= f[-1] or hi <= f[0]:
-            raise InputError("frequency band is outside the data", field="band_Hz",
+        tol = 0.5 * float(np.min(np.diff(f)))
+        if lo < f[0] - tol or hi > f[-1] + tol:
+            what = "is outside" if (lo >= f[-1] or hi <= f[0]) else "extends beyond"
+            raise InputError(f"frequency band {what} the data", field="band_Hz",
                              value=(lo, hi),
                              expected=f"a band inside [{f[0]:g}, {f[-1]:g}] Hz")
         m = (f >= lo) & (f <= hi)
