@@ -21,6 +21,11 @@ def _json(args):
     return json.loads(r.stdout)
 
 
+def test_robot_list():
+    d = _json(["robot", "list", "--json"])
+    assert d["robots"]["irb6600-175-2.55"]["joints"] == 6
+
+
 def test_fk_json_contract():
     d = _json(["robot", "fk", "--robot", "irb6600-175-2.55", "--joints-deg", PAPER, "--json"])
     assert np.allclose(d["position_m"], [1.073, -1.441, 0.489], atol=1e-3)

@@ -137,8 +137,9 @@ def test_bad_robot_file_names_key(tmp_path):
     f.write_text('name = "b"\nd_m = [0.1, 0.2]\na_m = [0]\nalpha_deg = [0, 0]\n'
                  'theta_offset_deg = [0, 0]\nlower_limit_deg = [-1, -1]\n'
                  'upper_limit_deg = [1, 1]\n')
-    with pytest.raises(ConfigError, match="a_m"):
+    with pytest.raises(ConfigError, match="a_m") as ei:
         load_robot_file(f)
+    assert "bad.toml" in str(ei.value)
 
 
 @settings(max_examples=60, deadline=None)

@@ -102,7 +102,7 @@ class _Design:
     # (posture, step, reference rows, rows, first row) per loaded step
     meas: list[tuple[int, int, list[int], list[int], int]]
     A: np.ndarray  # (N_eq, n) physical regressor
-    whiten: np.ndarray  # (N_eq, N_eq) block-diagonal inverse Cholesky factor
+    whiten: list[np.ndarray]  # per posture: inverse Cholesky factor (6S x 6S) of its block
     ref_point: np.ndarray  # (P, 3)
     J: np.ndarray  # (P, 6, n) at the reference point
     force: np.ndarray  # (M, 3)
@@ -153,17 +153,11 @@ def _build_design(c: Campaign, robot, sigma_m: float | None) -> _Design:
                                   "identify (every posture needs load steps > 0)")
     A = np.concatenate(A_blocks, axis=0)
     N = A.shape[0]
-    Wh = np.zeros((N, N))
-    o = 0
-    for B in W_blocks:
-        k = B.shape[0]
-        Wh[o:o + k, o:o + k] = B
-        o += k
     if N < n + 1:
         raise IdentificationError(
             f"{c.source}: too few equations: {N} (6 per loaded step) for {n} joint "
             f"compliances; at least {n + 1} are needed (more postures / load steps)")
-    return _Design(labels, q, meas, A, Wh, ref_point, J, np.asarray(forces), steps, sigma_m)
+    return _Design(labels, q, meas, A, W_blocks, ref_point, J, np.asarray(forces), steps, sigma_m)
 
 
 def _screws(c: Campaign, d: _Design, xyz: np.ndarray) -> np.ndarray:
@@ -175,6 +169,17 @@ def _screws(c: Campaign, d: _Design, xyz: np.ndarray) -> np.ndarray:
         dp = np.einsum("bij,j->bi", R, c0) + t - c0
         out.append(np.concatenate([dp, rotation_vector(R)], axis=-1))
     return np.stack(out, axis=1).reshape(xyz.shape[0], -1)
+
+
+def _whiten(d: _Design, X: np.ndarray) -> np.ndarray:
+    """Apply the block-diagonal whitening to the last axis of X (..., N_eq)."""
+    out = np.empty_like(X)
+    o = 0
+    for B in d.whiten:
+        k = B.shape[0]
+        out[..., o:o + k] = X[..., o:o + k] @ B.T
+        o += k
+    return out
 
 
 @dataclass
@@ -196,8 +201,8 @@ class _Solution:
 
 def _solve(d: _Design, y: np.ndarray, cond_limit: float) -> _Solution:
     n = d.A.shape[1]
-    Aw = d.whiten @ d.A
-    yw = y @ d.whiten.T
+    Aw = _whiten(d, d.A.T).T
+    yw = _whiten(d, y)
     if d.known_sigma is not None:
         Aw = Aw / d.known_sigma
         yw = yw / d.known_sigma

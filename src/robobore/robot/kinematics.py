@@ -126,6 +126,14 @@ class Robot:
         from robobore.io.config import validate_model
 
         m = validate_model(_RobotFile, data, source=source)
+        try:
+            return cls._from_model(m)
+        except ConfigError as exc:
+            raise ConfigError(exc.message, file=source, field=exc.field, value=exc.value,
+                              expected=exc.expected) from None
+
+    @classmethod
+    def _from_model(cls, m: _RobotFile) -> Robot:
         return cls(
             name=m.name,
             d_m=tuple(m.d_m),
