@@ -474,6 +474,11 @@ def _render_identification(r: dict[str, Any]) -> None:
         [(f"k_{a}{a} N/m [95 %]",
           "—" if d[a] is None else f"{fmt(d[a])}  [{fmt(lo[a])}, {fmt(hi[a])}]")
          for a in "xyz"]))
+    byf = r.get("directional_stiffness_by_frame_N_per_m") or {}
+    if byf.get("boring") is not None and r["directional_frame"] != "boring":
+        b = byf["boring"]
+        stdout.print("boring frame (X horizontal, Y vertical, Z feed = tool z): "
+                     f"k_XX {fmt(b['x'])}, k_YY {fmt(b['y'])}, k_ZZ {fmt(b['z'])} N/m")
 
 
 def _plot_identification(r: dict[str, Any], folder: Path) -> list[str]:

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from scipy import optimize, stats
 
-from robobore.errors import IdentificationError
+from robobore.errors import IdentificationError, InputError
 from robobore.robot.campaign import Campaign
 from robobore.robot.campaign_io import validate_campaign
 from robobore.robot.kinematics import check_joint_limits, fk_jacobian, get_robot, rotation_vector
@@ -416,6 +416,15 @@ def identify_joint_stiffness(
     directional = directional_with_interval(robot, d.q_rad[0], c, sol.cov_c[0], sol.active, tq,
                                             frame=frame, tcp_m=tcp_m)
     directional["directional_posture_deg"] = np.degrees(d.q_rad[0]).tolist()
+    by_frame = {}
+    for fr in ("tool", "boring", "base"):
+        try:
+            by_frame[fr] = directional_with_interval(
+                robot, d.q_rad[0], c, sol.cov_c[0], sol.active, tq, frame=fr, tcp_m=tcp_m
+            )["directional_stiffness_N_per_m"]
+        except InputError:  # boring frame undefined for a vertical feed axis
+            by_frame[fr] = None
+    directional["directional_stiffness_by_frame_N_per_m"] = by_frame
     return StiffnessIdentification(
         joint=js,
         compliance_rad_per_Nm=_opt(c, ok),
