@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import stats
 from scipy.spatial.transform import Rotation
 
@@ -17,8 +19,8 @@ from robobore.robot.campaign import (
     simulate_campaign,
     simulate_clean,
 )
-from robobore.robot.identify import identify_batch, identify_joint_stiffness, kabsch
-from robobore.robot.kinematics import fk_jacobian, get_robot
+from robobore.robot.identify import identify_batch, identify_joint_stiffness, kabsch, screw_map
+from robobore.robot.kinematics import fk_jacobian, get_robot, rotation_vector
 from robobore.robot.stiffness import directional_stiffness_xyz, process_frame
 
 ROBOT = "irb6600-175-2.55"
@@ -162,3 +164,44 @@ def test_outlier_measurement_is_flagged_and_principal_stiffness(accept):
     _, J = fk_jacobian(get_robot(ROBOT), np.radians(PAPER_POSTURE_DEG))
     kp_true, _ = principal_stiffness(compliance_matrix(J, K_TRUE))
     assert np.allclose(np.sort(kp), np.sort(kp_true), rtol=0.03)
+
+
+def test_posture_without_loaded_step_is_reported(accept):
+    camp, _ = accept
+    from dataclasses import replace
+
+    keep = np.array([not (camp.posture[i] == "4" and camp.load_step[i] > 0)
+                     for i in range(camp.n_rows)])
+    sub = replace(camp, posture=tuple(np.asarray(camp.posture)[keep]),
+                  load_step=camp.load_step[keep], q_deg=camp.q_deg[keep],
+                  force_N=camp.force_N[keep], load_point_m=camp.load_point_m[keep],
+                  reflector=tuple(np.asarray(camp.reflector)[keep]), xyz_m=camp.xyz_m[keep])
+    res = identify_joint_stiffness(sub, ROBOT)
+    assert any("'4'" in n and "not used" in n for n in res.notes)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3),
+       st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3),
+       st.integers(3, 6), st.integers(0, 10_000))
+def test_kabsch_property_and_small_motion_map(rotvec, t, m, seed):
+    """Kabsch recovers any proper rigid motion of >= 3 non-collinear points exactly (Horn 1987),
+    and the linearised map L (screw_map) matches it for small motions to second order."""
+    pts = np.random.default_rng(seed).normal(scale=0.2, size=(m, 3))
+    if np.linalg.svd(pts - pts.mean(0), compute_uv=False)[1] < 1e-3:
+        return
+    rv = np.asarray(rotvec)
+    if np.linalg.norm(rv) >= np.pi:
+        rv = rv / np.linalg.norm(rv) * 3.0
+    R = Rotation.from_rotvec(rv).as_matrix()
+    R_f, t_f, rms = kabsch(pts, pts @ R.T + np.asarray(t))
+    assert np.allclose(R_f, R, atol=1e-9) and np.allclose(t_f, t, atol=1e-9) and rms < 1e-9
+    small = rv * 1e-5
+    dt = np.asarray(t) * 1e-5
+    moved = pts @ Rotation.from_rotvec(small).as_matrix().T + dt
+    ref = pts[0] + 0.05
+    L = screw_map(pts, ref)
+    screw = L @ (moved - pts).ravel()
+    R_s, t_s, _ = kabsch(pts, moved)
+    exact = np.concatenate([R_s @ ref + t_s - ref, rotation_vector(R_s)])
+    assert np.allclose(screw, exact, atol=1e-8)

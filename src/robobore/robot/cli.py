@@ -474,6 +474,14 @@ def _render_identification(r: dict[str, Any]) -> None:
         [(f"k_{a}{a} N/m [95 %]",
           "—" if d[a] is None else f"{fmt(d[a])}  [{fmt(lo[a])}, {fmt(hi[a])}]")
          for a in "xyz"]))
+    for note in r.get("notes", []):
+        stdout.print(f"[yellow]note:[/] {note}")
+    sus = [e for e in r.get("residuals", []) if e.get("suspect")]
+    for e in sus:
+        stdout.print(f"[yellow]suspect measurement:[/] posture {e['posture']}, load step "
+                     f"{e['load_step']} (row {e['first_row']}): normalised residual "
+                     f"{e['normalised_residual']:.2f}, reflector fit rms "
+                     f"{e['rigid_fit_rms_m'] * 1e6:.1f} um")
     byf = r.get("directional_stiffness_by_frame_N_per_m") or {}
     if byf.get("boring") is not None and r["directional_frame"] != "boring":
         b = byf["boring"]

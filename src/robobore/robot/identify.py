@@ -108,6 +108,7 @@ class _Design:
     force: np.ndarray  # (M, 3)
     step_of: list[int]
     known_sigma: float | None
+    unused_postures: list[str]  # postures with only the unloaded step (reported, not used)
 
 
 def _build_design(c: Campaign, robot, sigma_m: float | None) -> _Design:
@@ -124,6 +125,7 @@ def _build_design(c: Campaign, robot, sigma_m: float | None) -> _Design:
     T, J = fk_jacobian(robot, q)  # reference point: flange origin
     ref_point = T[:, :3, 3]
     meas = []
+    unused: list[str] = []
     A_blocks = []
     W_blocks = []
     forces = []
@@ -132,6 +134,7 @@ def _build_design(c: Campaign, robot, sigma_m: float | None) -> _Design:
         ref = sorted(rows_of[(lab, 0)], key=lambda i: c.reflector[i])
         loaded_steps = sorted(st for (lb, st) in rows_of if lb == lab and st > 0)
         if not loaded_steps:
+            unused.append(lab)
             continue
         L = screw_map(c.xyz_m[ref], ref_point[p])
         M = L @ L.T  # unit per-coordinate variance
@@ -157,7 +160,8 @@ def _build_design(c: Campaign, robot, sigma_m: float | None) -> _Design:
         raise IdentificationError(
             f"{c.source}: too few equations: {N} (6 per loaded step) for {n} joint "
             f"compliances; at least {n + 1} are needed (more postures / load steps)")
-    return _Design(labels, q, meas, A, W_blocks, ref_point, J, np.asarray(forces), steps, sigma_m)
+    return _Design(labels, q, meas, A, W_blocks, ref_point, J, np.asarray(forces), steps, sigma_m,
+                   unused)
 
 
 def _screws(c: Campaign, d: _Design, xyz: np.ndarray) -> np.ndarray:
@@ -275,6 +279,7 @@ class StiffnessIdentification:
     directional: dict[str, Any] = field(default_factory=dict)
     source: str = ""
     synthetic: bool = False
+    notes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         j = self.joint.to_dict()
@@ -305,6 +310,7 @@ class StiffnessIdentification:
             "residual_rms_translation_m": self.residual_rms_translation_m,
             "residual_rms_rotation_rad": self.residual_rms_rotation_rad,
             "residuals": list(self.residuals),
+            "notes": list(self.notes),
         })
         return out
 
@@ -444,6 +450,8 @@ def identify_joint_stiffness(
         directional=directional,
         source=campaign.source,
         synthetic=synthetic,
+        notes=tuple(f"posture {lab!r} has no loaded step: it was not used" for lab in
+                    d.unused_postures),
     )
 
 
