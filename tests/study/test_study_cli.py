@@ -25,12 +25,16 @@ def test_sweep_json_then_resume(tmp_path, sweep_toml):
 
 
 def test_sweep_with_failures_exits_1_and_lists_them(tmp_path):
-    cfg = write_sweep_toml(tmp_path / "c.toml", runner_options="fail_speeds_rpm = [600]")
+    cfg = write_sweep_toml(tmp_path / "c.toml", speeds=(300, 600), feeds=(0.1,),
+                           runner_options="fail_speeds_rpm = [600]")
     res = CliRunner().invoke(app, ["sweep", str(cfg), "--out", str(tmp_path / "s"),
-                                   "--workers", "1", "--threads"])
+                                   "--workers", "1", "--threads",
+                                   "--report", str(tmp_path / "r.html")])
     assert res.exit_code == 1
     text = " ".join(res.output.split())
     assert "failed conditions" in text and "asked to fail at 600" in text
+    html = (tmp_path / "r.html").read_text()
+    assert "Failed conditions" in html and html.count("data:image/png;base64,") == 1
 
 
 def test_sweep_bad_inputs_are_one_line_errors(tmp_path, sweep_toml):

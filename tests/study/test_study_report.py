@@ -128,12 +128,16 @@ def test_browser_check_detects_broken_and_external_content(tmp_path):
     assert "inline svg 1" in text
 
 
-def test_comparison_report_opens_in_headless_chromium(tmp_path):
-    """The report that `robobore compare --report` writes, in the browser."""
+def test_comparison_and_sweep_reports_open_in_headless_chromium(tmp_path):
+    """The reports that `robobore compare --report` and `robobore sweep --report` write."""
     _browser_or_skip()
-    from robobore.study.browser import check_html_in_browser
+    from conftest import write_sweep_toml
+
+    from robobore.study.browser import check_html_files_in_browser
     from robobore.study.compare import compare, parse_measured_csv
-    from robobore.study.plots import comparison_report
+    from robobore.study.plots import comparison_report, sweep_report
+    from robobore.study.store import ResultsStore
+    from robobore.study.sweep import plan_from_file, run_sweep
 
     head = "speed_rpm,feed_mm_per_rev,depth_of_cut_mm,pressure_MPa"
     t = parse_measured_csv(f"{head},force_amplitude_x_N,feed_amplitude_um,stable\n"
@@ -144,6 +148,20 @@ def test_comparison_report_opens_in_headless_chromium(tmp_path):
             ({"speed_rpm": 400, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.2,
               "pressure_MPa": 0}, {"force_amplitude_x_N": 250.0, "feed_amplitude_um": 70.0,
                                    "stable": True})]
-    p = comparison_report(compare(t, sims)).write(tmp_path / "cmp.html")
-    res = check_html_in_browser(p)
-    assert res.problems == () and res.images == 1
+    cmp_html = comparison_report(compare(t, sims)).write(tmp_path / "cmp.html")
+
+    plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(300, 600), feeds=(0.1,),
+                                           depths=(0.05, 0.3), pressures=(0.0, 0.3),
+                                           runner_options="fail_speeds_rpm = [600]"))
+    run_sweep(plan, tmp_path / "s", workers=0)
+    rep = sweep_report(ResultsStore(tmp_path / "s"), [i.key for i in plan.items])
+    sweep_html = rep.write(tmp_path / "sweep.html")
+    text = sweep_html.read_text()
+    assert "Failed conditions" in text and "asked to fail at 600" in text
+    assert "DEMO runner" in text
+    # 2 stability maps (P = 0 and 0.3 MPa) + 1 trend figure per amplitude quantity (4)
+    assert text.count("data:image/png;base64,") == 6
+
+    res_cmp, res_sweep = check_html_files_in_browser([cmp_html, sweep_html])
+    assert res_cmp.problems == () and res_cmp.images == 1
+    assert res_sweep.problems == () and res_sweep.images == 6

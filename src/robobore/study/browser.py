@@ -83,17 +83,22 @@ return Array.from(document.querySelectorAll('svg')).filter(s => !s.parentElement
 
 def check_html_in_browser(path: str | Path, timeout_s: float = 60.0) -> BrowserCheck:
     """Open ``path`` in headless Chromium and return what failed to load (see module doc)."""
+    return check_html_files_in_browser([path], timeout_s)[0]
+
+
+def check_html_files_in_browser(paths: list[str | Path], timeout_s: float = 60.0
+                                ) -> list[BrowserCheck]:
+    """Like :func:`check_html_in_browser` for several files, one browser for all."""
     why = browser_available()
     if why:
         raise BrowserUnavailable(why)
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
-    from selenium.webdriver.support.ui import WebDriverWait
 
-    p = Path(path).resolve()
-    if not p.is_file():
-        raise RoboboreError(f"report not found: {p}")
-    url = p.as_uri()
+    files = [Path(p).resolve() for p in paths]
+    for p in files:
+        if not p.is_file():
+            raise RoboboreError(f"report not found: {p}")
     profile = tempfile.mkdtemp(prefix="robobore-chromium-")
     opts = webdriver.ChromeOptions()
     opts.binary_location = CHROMIUM
@@ -106,22 +111,29 @@ def check_html_in_browser(path: str | Path, timeout_s: float = 60.0) -> BrowserC
         driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=opts)
         driver.set_page_load_timeout(timeout_s)
         driver.set_script_timeout(timeout_s)
-        driver.get_log("performance")  # drop what the browser loaded for itself at start-up
-        driver.get(url)
-        WebDriverWait(driver, timeout_s).until(
-            lambda d: d.execute_script("return document.readyState") == "complete")
-        # images decode asynchronously: wait until every one reports complete
-        WebDriverWait(driver, timeout_s).until(
-            lambda d: all(c for c, *_ in d.execute_script(_JS_IMAGES)))
-        images = driver.execute_script(_JS_IMAGES)
-        svgs = driver.execute_script(_JS_SVGS)
-        title = driver.title
-        console = driver.get_log("browser")
-        perf = driver.get_log("performance")
+        return [_check_page(driver, p.as_uri(), timeout_s) for p in files]
     finally:
         if driver is not None:
             driver.quit()
         shutil.rmtree(profile, ignore_errors=True)
+
+
+def _check_page(driver: Any, url: str, timeout_s: float) -> BrowserCheck:
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    driver.get_log("performance")  # drop earlier events (browser start-up, previous page)
+    driver.get_log("browser")
+    driver.get(url)
+    WebDriverWait(driver, timeout_s).until(
+        lambda d: d.execute_script("return document.readyState") == "complete")
+    # images decode asynchronously: wait until every one reports complete
+    WebDriverWait(driver, timeout_s).until(
+        lambda d: all(c for c, *_ in d.execute_script(_JS_IMAGES)))
+    images = driver.execute_script(_JS_IMAGES)
+    svgs = driver.execute_script(_JS_SVGS)
+    title = driver.title
+    console = driver.get_log("browser")
+    perf = driver.get_log("performance")
 
     problems: list[str] = []
     for i, (complete, w, h, alt, src) in enumerate(images):
@@ -167,4 +179,4 @@ def check_html_in_browser(path: str | Path, timeout_s: float = 60.0) -> BrowserC
 
 
 __all__ = ["BrowserCheck", "BrowserUnavailable", "browser_available", "check_html_in_browser",
-           "CHROMIUM_FLAGS"]
+           "check_html_files_in_browser", "CHROMIUM_FLAGS"]

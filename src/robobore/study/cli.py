@@ -54,6 +54,8 @@ def sweep_cmd(
         False, "--threads", help="Local workers as threads of this process, not processes."),
     out: Path | None = typer.Option(
         None, "--out", help="Results store folder (default: ./sweep-<name>)."),
+    report: Path | None = typer.Option(
+        None, "--report", help="Also write a self-contained HTML report of the sweep here."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Run a sweep of cutting conditions (resumable: finished conditions are skipped).
@@ -73,6 +75,13 @@ def sweep_cmd(
     outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
                         processes=not threads, progress=sys.stderr.isatty())
     res = {"name": plan.name, "runner": plan.runner, **outcome.to_dict()}
+    if report is not None:
+        from robobore.study.plots import sweep_report
+        from robobore.study.store import ResultsStore
+
+        sweep_report(ResultsStore(store), [i.key for i in plan.items],
+                     title=f"Sweep {plan.name}").write(report)
+        res["report"] = str(report)
     emit(res, as_json, _render_sweep)
     if outcome.pending:
         raise typer.Exit(code=1)

@@ -1,8 +1,17 @@
 """Figures and report sections of the study stage (matplotlib, Agg backend).
 
-:func:`parity_figure` plots simulated against measured amplitudes, stable conditions as
-small black dots and vibratory ones as larger red markers (the paper's Fig. 10 convention);
-:func:`comparison_report` builds the HTML report of ``robobore compare --report``.
+Stable conditions are drawn as small black dots and vibratory ones as larger red markers
+(the paper's Fig. 10 convention).
+
+* :func:`parity_figure`: simulated against measured amplitudes;
+* :func:`trend_figure`: a summary quantity against one factor (speed, feed, depth of cut),
+  one line per foot pressure (the paper's Figs. 9 and 10);
+* :func:`stability_map_figure`: depth of cut against speed, stable/vibratory marked (the
+  swept conditions to overlay on a stability lobe diagram);
+* :func:`comparison_report` and :func:`sweep_report`: the HTML reports of
+  ``robobore compare --report`` and ``robobore sweep --report``.
+
+``records`` are ``(condition, summary)`` pairs, e.g. from ``ResultsStore.records()``.
 """
 
 from __future__ import annotations
@@ -112,4 +121,171 @@ def comparison_report(cmp: Comparison, title: str = "Comparison with measurement
     return rep
 
 
-__all__ = ["parity_figure", "comparison_report"]
+FACTOR_LABEL = {
+    "speed_rpm": "rotational speed n [r/min]",
+    "feed_mm_per_rev": "feed f [mm/r]",
+    "depth_of_cut_mm": "depth of cut ap [mm]",
+    "pressure_MPa": "foot pressure P [MPa]",
+}
+
+
+SERIES_LABEL = {
+    "speed_rpm": "n = {:g} r/min",
+    "feed_mm_per_rev": "f = {:g} mm/r",
+    "depth_of_cut_mm": "ap = {:g} mm",
+    "pressure_MPa": "P = {:g} MPa",
+}
+
+
+def _matches(cond: dict[str, Any], fixed: dict[str, Any] | None) -> bool:
+    return not fixed or all(abs(float(cond[k]) - float(v)) <= 1e-9 * max(1.0, abs(float(v)))
+                            for k, v in fixed.items())
+
+
+def trend_figure(records: list[tuple[dict[str, Any], dict[str, Any]]], x: str,
+                 quantity: str, series: str = "pressure_MPa",
+                 fixed: dict[str, Any] | None = None, ax: Any = None) -> Any:
+    """``quantity`` against factor ``x``, one line per value of ``series``.
+
+    ``fixed`` keeps only the conditions with those factor values (a one-factor-at-a-time
+    cut through a grid); otherwise each line goes through the mean over the other factors
+    at each ``x`` (a main-effect plot) and every condition is drawn as a marker.
+    Returns the figure.
+    """
+    plt = _pyplot()
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(5.2, 3.6))
+    else:
+        fig = ax.figure
+    rows = [(c, s) for c, s in records if _matches(c, fixed) and s.get(quantity) is not None]
+    levels = sorted({float(c[series]) for c, _ in rows})
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, lv in enumerate(levels):
+        pts = [(float(c[x]), float(s[quantity]), s.get("stable"))
+               for c, s in rows if float(c[series]) == lv]
+        xs = sorted({p[0] for p in pts})
+        means = [sum(p[1] for p in pts if p[0] == xv) / sum(1 for p in pts if p[0] == xv)
+                 for xv in xs]
+        ax.plot(xs, means, "-", color=colours[i % len(colours)], lw=1.3,
+                label=SERIES_LABEL.get(series, series + " = {:g}").format(lv))
+        st = [p for p in pts if p[2] is not False]
+        vib = [p for p in pts if p[2] is False]
+        if st:
+            ax.scatter([p[0] for p in st], [p[1] for p in st], s=12, c="k", zorder=3)
+        if vib:
+            ax.scatter([p[0] for p in vib], [p[1] for p in vib], s=40, c="tab:red",
+                       marker="D", zorder=3)
+    ax.scatter([], [], s=12, c="k", label="stable")
+    ax.scatter([], [], s=40, c="tab:red", marker="D", label="vibratory")
+    ax.set_xlabel(FACTOR_LABEL.get(x, x))
+    ax.set_ylabel(_LABEL.get(quantity, quantity))
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def stability_map_figure(records: list[tuple[dict[str, Any], dict[str, Any]]],
+                         pressure_MPa: float | None = None, ax: Any = None) -> Any:
+    """Depth of cut against speed for the swept conditions, stable/vibratory marked
+    (conditions with the given foot pressure, or all). Returns the figure; overlay a
+    stability lobe diagram on ``fig.axes[0]``."""
+    plt = _pyplot()
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(5.6, 3.6))
+    else:
+        fig = ax.figure
+    fixed = None if pressure_MPa is None else {"pressure_MPa": pressure_MPa}
+    rows = [(c, s) for c, s in records if _matches(c, fixed)]
+    groups = {
+        "stable": ([c for c, s in rows if s.get("stable") is True], dict(s=14, c="k")),
+        "vibratory": ([c for c, s in rows if s.get("stable") is False],
+                      dict(s=44, c="tab:red", marker="D")),
+        "not classified": ([c for c, s in rows if s.get("stable") is None],
+                           dict(s=20, c="tab:blue", marker="s")),
+    }
+    for name, (cs, style) in groups.items():
+        if cs:
+            ax.scatter([c["speed_rpm"] for c in cs], [c["depth_of_cut_mm"] for c in cs],
+                       label=name, zorder=3, **style)
+    ax.set_xlabel(FACTOR_LABEL["speed_rpm"])
+    ax.set_ylabel(FACTOR_LABEL["depth_of_cut_mm"])
+    if pressure_MPa is not None:
+        ax.set_title(f"P = {pressure_MPa:g} MPa", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def sweep_report(store: Any, keys: list[str] | None = None, title: str = "Sweep results",
+                 max_rows: int = 300) -> Report:
+    """An HTML report of a sweep: counts, failures, stability maps, trends, summary table.
+
+    ``store``: a :class:`robobore.study.store.ResultsStore`; ``keys``: the sweep's
+    conditions (default: every finished condition in the store).
+    """
+    from robobore.study.conditions import CONDITION_FIELDS
+
+    plt = _pyplot()
+    recs = list(store.records(keys))
+    records = [(r.condition, r.summary) for r in recs]
+    rep = Report(title, subtitle=f"Results store: {store.root}")
+    rep.add_section("Overview")
+    n_keys = len(keys) if keys is not None else len(recs)
+    failed = [k for k in (keys or []) if store.status(k) == "failed"]
+    runners = sorted({r.runner or "?" for r in recs})
+    rep.add_key_values({"conditions": n_keys, "finished": len(recs), "failed": len(failed),
+                        "runner": ", ".join(runners),
+                        "stable": sum(1 for _, s in records if s.get("stable") is True),
+                        "vibratory": sum(1 for _, s in records if s.get("stable") is False)},
+                       caption="Sweep status")
+    if any("demo" == r for r in runners):
+        rep.add_note("These results come from the DEMO runner (single-DOF regenerative toy), "
+                     "not from the boring model.")
+    if failed:
+        rows = []
+        for k in failed:
+            f = store.failure(k) or {}
+            rows.append({"key": k, **{c: f.get("condition", {}).get(c)
+                                      for c in CONDITION_FIELDS},
+                         "error": f.get("error", "")[:200]})
+        rep.add_table(rows, caption="Failed conditions")
+    if not records:
+        rep.add_text("No finished condition.")
+        return rep
+    pressures = sorted({float(c["pressure_MPa"]) for c, _ in records})
+    if any(s.get("stable") is not None for _, s in records):
+        rep.add_section("Stable and vibratory conditions")
+        for p in pressures:
+            fig = stability_map_figure(records, p)
+            rep.add_figure(fig, f"Swept conditions at P = {p:g} MPa: small black dots stable, "
+                           "red diamonds vibratory.")
+            plt.close(fig)
+    quantities = [q for q in AMPLITUDE_QUANTITIES
+                  if any(s.get(q) is not None for _, s in records)]
+    factors = [f for f in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm")
+               if len({float(c[f]) for c, _ in records}) > 1]
+    if quantities and factors:
+        rep.add_section("Trends")
+        rep.add_text("Each line is the mean over the other factors at each level (main "
+                     "effect); every condition is drawn as a marker.")
+        for q in quantities:
+            fig, axes = plt.subplots(1, len(factors), figsize=(4.6 * len(factors), 3.5),
+                                     squeeze=False)
+            for ax, f in zip(axes[0], factors, strict=True):
+                trend_figure(records, f, q, ax=ax)
+            fig.tight_layout()
+            rep.add_figure(fig, f"{_LABEL.get(q, q)} against the cutting conditions.")
+            plt.close(fig)
+    rep.add_section("All conditions")
+    rep.add_table([{**{f: c[f] for f in CONDITION_FIELDS}, "posture": c.get("posture"),
+                    **{q: s.get(q) for q in (*AMPLITUDE_QUANTITIES, "stable")}}
+                   for c, s in records], caption="Summary per condition", max_rows=max_rows)
+    return rep
+
+
+__all__ = [
+    "parity_figure", "trend_figure", "stability_map_figure", "comparison_report",
+    "sweep_report",
+]
