@@ -152,3 +152,23 @@ def test_rotation_vector_matches_scipy(axis, angle):
     rv = a / np.linalg.norm(a) * angle
     R = Rotation.from_rotvec(rv).as_matrix()
     assert np.allclose(rotation_vector(R), rv, atol=1e-9)
+
+
+def test_inverse_kinematics_round_trip(rb):
+    """IK (damped least squares) from a nearby start reaches the FK pose of a known posture
+    to 1e-10 m / rad, and an unreachable target raises NumericalError."""
+    from robobore.errors import NumericalError
+    from robobore.robot.kinematics import inverse_kinematics
+
+    rng = np.random.default_rng(3)
+    q_true = np.radians(PAPER_Q_DEG)
+    tcp = [0.1, 0.0, 0.35]
+    T = fk(rb, q_true, tcp)
+    q = inverse_kinematics(rb, T, q_true + rng.normal(scale=0.05, size=6), tcp)
+    T2 = fk(rb, q, tcp)
+    assert np.abs(T2[:3, 3] - T[:3, 3]).max() < 1e-10
+    assert np.linalg.norm(rotation_vector(T2[:3, :3] @ T[:3, :3].T)) < 1e-10
+    far = T.copy()
+    far[:3, 3] = [10.0, 0.0, 0.0]
+    with pytest.raises(NumericalError):
+        inverse_kinematics(rb, far, q_true, tcp, max_iter=50)

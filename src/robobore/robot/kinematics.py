@@ -506,4 +506,39 @@ __all__ = [
     "joint_frames",
     "jacobian_derivative",
     "rotation_vector",
+    "inverse_kinematics",
 ]
+
+
+def inverse_kinematics(
+    robot: Robot,
+    T_target: np.ndarray,
+    q0_rad: Any,
+    tcp_m: Any = None,
+    *,
+    tol: float = 1e-11,
+    max_iter: int = 100,
+    damping: float = 1e-6,
+) -> np.ndarray:
+    """Joint angles (rad) that put the tool frame at ``T_target`` (4x4), starting from ``q0``.
+
+    Damped least squares Newton on the geometric Jacobian (Wampler 1986; Buss 2004): error
+    ``e = [p_t - p; log(R_t R^T)]``, ``dq = J^T (J J^T + lambda^2 I)^-1 e``. Converges to the
+    solution in the branch of ``q0`` (local method: use continuation for scans). Raises
+    NumericalError when it does not converge (target out of reach or singular).
+    """
+    from robobore.errors import NumericalError
+
+    q = np.asarray(q0_rad, float).reshape(robot.n_joints).copy()
+    Tt = np.asarray(T_target, float)
+    for _ in range(max_iter):
+        T, J = fk_jacobian(robot, q, tcp_m)
+        e = np.concatenate([Tt[:3, 3] - T[:3, 3], rotation_vector(Tt[:3, :3] @ T[:3, :3].T)])
+        if np.max(np.abs(e)) < tol:
+            return q
+        JJt = J @ J.T + damping ** 2 * np.eye(6)
+        q = q + J.T @ np.linalg.solve(JJt, e)
+    raise NumericalError(
+        f"inverse kinematics did not converge (residual {np.max(np.abs(e)):.3e}); the target "
+        "may be out of reach or at a singularity"
+    )
