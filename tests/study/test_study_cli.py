@@ -34,7 +34,8 @@ def test_sweep_with_failures_exits_1_and_lists_them(tmp_path):
     text = " ".join(res.output.split())
     assert "failed conditions" in text and "asked to fail at 600" in text
     html = (tmp_path / "r.html").read_text()
-    assert "Failed conditions" in html and html.count("data:image/png;base64,") == 1
+    # 1 stability map (P = 0) + 4 trend figures (depth of cut is the only varied factor left)
+    assert "Failed conditions" in html and html.count("data:image/png;base64,") == 5
 
 
 def test_sweep_bad_inputs_are_one_line_errors(tmp_path, sweep_toml):
