@@ -156,3 +156,25 @@ def test_sweep_on_a_separately_started_scheduler(tmp_path):
     finally:
         for p in reversed(procs):
             _stop(p)
+
+
+class _FakeFuture:
+    def __init__(self, status, exc=None):
+        self.status, self._exc = status, exc
+
+    def exception(self):
+        if self.status == "cancelled":
+            raise RuntimeError("cancelled future")
+        return self._exc
+
+    def traceback(self):
+        return None
+
+
+def test_unfinished_dask_tasks_become_readable_failures():
+    from robobore.study.sweep import _dask_failure
+
+    r = _dask_failure(_FakeFuture("error", ValueError("KilledWorker-like")))
+    assert r == {"ok": False, "error": "ValueError: KilledWorker-like", "traceback": ""}
+    assert "RuntimeError: cancelled future" in _dask_failure(_FakeFuture("cancelled"))["error"]
+    assert "without a result" in _dask_failure(_FakeFuture("lost"))["error"]

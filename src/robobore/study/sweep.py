@@ -295,10 +295,8 @@ def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: s
             item = by_future.pop(fut)
             if fut.status == "finished":
                 res = fut.result()
-            else:  # lost worker, cancelled, unpicklable result ...
-                exc = fut.exception()
-                tb = "".join(traceback.format_tb(fut.traceback())) if fut.traceback() else ""
-                res = {"ok": False, "error": f"{type(exc).__name__}: {exc}", "traceback": tb}
+            else:  # lost worker (KilledWorker), cancelled, unpicklable result ...
+                res = _dask_failure(fut)
             fut.release()
             rec.record(item, res)
     finally:
@@ -306,6 +304,24 @@ def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: s
             client.close(timeout=10)
         if cluster is not None:
             cluster.close(timeout=10)
+
+
+def _dask_failure(fut: Any) -> dict[str, Any]:
+    """Failure record of a Dask future that did not finish (never raises)."""
+    exc, tb = None, ""
+    try:
+        if fut.status == "error":
+            exc = fut.exception()
+            t = fut.traceback()
+            tb = "".join(traceback.format_tb(t)) if t is not None else ""
+    except Exception as e:  # cancelled futures raise on inspection
+        exc = e
+    if exc is None:
+        err = (f"Dask task ended as '{fut.status}' without a result (its worker was probably "
+               "lost while it was queued there); run the sweep again to retry it")
+    else:
+        err = f"{type(exc).__name__}: {exc}"
+    return {"ok": False, "error": err, "traceback": tb}
 
 
 def plan_from_file(path: str | Path) -> SweepPlan:
