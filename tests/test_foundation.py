@@ -52,6 +52,7 @@ def test_atomic_write_leaves_no_temp(tmp_path):
     p = atomic_write_text(tmp_path / "sub" / "a.txt", "hello")
     assert p.read_text() == "hello"
     assert [f.name for f in p.parent.iterdir()] == ["a.txt"]
+    assert p.stat().st_mode & 0o044 == 0o044  # readable by others under the usual umask 022
 
 
 def test_json_and_netcdf_roundtrip(tmp_path):

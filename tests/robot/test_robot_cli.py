@@ -55,7 +55,7 @@ def test_identify_example_is_synthetic_and_complete():
     assert len(d["joint_stiffness_std_Nm_per_rad"]) == 6
     assert set(d["directional_stiffness_N_per_m"]) == {"x", "y", "z"}
     byf = d["directional_stiffness_by_frame_N_per_m"]
-    assert byf["tool"] == d["directional_stiffness_N_per_m"]
+    assert byf["boring"] == d["directional_stiffness_N_per_m"]  # default frame: boring
     # at the paper's posture tool x is vertical and tool y horizontal: boring X = tool y
     assert byf["boring"]["x"] == pytest.approx(byf["tool"]["y"], rel=0.02)
     assert byf["boring"]["z"] == pytest.approx(byf["tool"]["z"], rel=1e-9)

@@ -15,10 +15,22 @@ from typing import Any
 import numpy as np
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def _tmp_path(dest: Path) -> Path:
+    """A temporary file beside ``dest`` with the permissions a plain ``open`` would give.
+
+    ``mkstemp`` creates files with mode 0600; results are ordinary user files, so the mode is
+    set from the umask (typically 0644) before the rename.
+    """
     dest.parent.mkdir(parents=True, exist_ok=True)
     fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
     os.close(fd)
+    os.chmod(name, 0o666 & ~_umask())
     return Path(name)
 
 

@@ -36,9 +36,9 @@ TCP_OPT = typer.Option(
     None, "--tcp-m", help="Tool point in the flange frame, 'x,y,z' in m (default: flange)."
 )
 FRAME_OPT = typer.Option(
-    "tool", "--frame",
-    help="Process frame for k_xx, k_yy, k_zz: tool (flange axes; z = spindle = feed), base, "
-    "or boring (Z = tool z, X horizontal, Y = Z x X).",
+    "boring", "--frame",
+    help="Process frame for k_xx, k_yy, k_zz: boring (the paper's frame: Z = tool z = feed, "
+    "X horizontal, Y = Z x X, vertical), tool (flange axes), or base.",
 )
 
 

@@ -354,7 +354,7 @@ def identify_joint_stiffness(
     *,
     sigma_m: float | None = None,
     cond_limit: float = 1e6,
-    frame: str | np.ndarray = "tool",
+    frame: str | np.ndarray = "boring",
     tcp_m: Any = None,
 ) -> StiffnessIdentification:
     """Identify the joint stiffnesses of ``robot`` from ``campaign`` (see module docstring).
@@ -457,7 +457,7 @@ def identify_joint_stiffness(
 
 def directional_with_interval(
     robot: Any, q_rad: np.ndarray, c: np.ndarray, cov_c: np.ndarray, active: np.ndarray,
-    tq: float, *, frame: str | np.ndarray = "tool", tcp_m: Any = None,
+    tq: float, *, frame: str | np.ndarray = "boring", tcp_m: Any = None,
 ) -> dict[str, Any]:
     """Directional stiffness {x, y, z} [N/m] with 95 % intervals from the compliance fit.
 

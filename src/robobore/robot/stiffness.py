@@ -135,7 +135,7 @@ def principal_stiffness(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def process_frame(
-    R_world_tool: np.ndarray, frame: str | np.ndarray = "tool", *, vertical: Any = (0, 0, 1)
+    R_world_tool: np.ndarray, frame: str | np.ndarray = "boring", *, vertical: Any = (0, 0, 1)
 ) -> np.ndarray:
     """Rotation ``R_world_process`` (columns: process X, Y, Z in the world frame).
 
@@ -173,7 +173,7 @@ def directional_stiffness_xyz(
     q_rad: Any,
     joint_stiffness: Any,
     *,
-    frame: str | np.ndarray = "tool",
+    frame: str | np.ndarray = "boring",
     tcp_m: Any = None,
 ) -> dict[str, float]:
     """Directional stiffness ``{"x", "y", "z"}`` [N/m] along the process-frame axes.
@@ -268,7 +268,7 @@ def stiffness_at(
     q_rad: Any,
     k_Nm_per_rad: Any,
     *,
-    frame: str | np.ndarray = "tool",
+    frame: str | np.ndarray = "boring",
     tcp_m: Any = None,
     wrench: Any = None,
 ) -> StiffnessResult:
