@@ -176,5 +176,5 @@ def test_unfinished_dask_tasks_become_readable_failures():
 
     r = _dask_failure(_FakeFuture("error", ValueError("KilledWorker-like")))
     assert r == {"ok": False, "error": "ValueError: KilledWorker-like", "traceback": ""}
-    assert "RuntimeError: cancelled future" in _dask_failure(_FakeFuture("cancelled"))["error"]
+    assert "ended as 'cancelled'" in _dask_failure(_FakeFuture("cancelled"))["error"]
     assert "without a result" in _dask_failure(_FakeFuture("lost"))["error"]
