@@ -50,6 +50,7 @@ def test_uff_frf_round_trip_and_npz(tmp_path, small_records):
     d = estimate_frf(small_records).frf.band(1.0, 60.0)
     back = read_uff(write_uff_frf(d, tmp_path / "f.uff"))
     assert isinstance(back, FRFData) and back.frf_type == "accelerance"
+    assert back.output_names == d.output_names and back.input_names == d.input_names
     np.testing.assert_allclose(back.frf, d.frf, rtol=1e-12)
     np.testing.assert_allclose(back.frequency_Hz, d.frequency_Hz, rtol=1e-12)
     n = load_input(save_npz(d, tmp_path / "f.npz"))
@@ -96,6 +97,19 @@ def test_uff_bad_files(tmp_path, small_records):
     del sets[3]
     with pytest.raises(DataError, match="missing response record"):
         read_uff(_write_sets(tmp_path / "hole.uff", sets))
+    # a whole hit missing for one input (force + responses): that hit is marked invalid
+    sets = pyuff.UFF(str(p)).read_sets()
+    n_ch = 1 + small_records.n_outputs
+    hit2_x = sets[1 + n_ch: 1 + 2 * n_ch]
+    assert all(s["load_case_id"] == 2 and s["ref_dir"] == 1 for s in hit2_x)
+    rec = read_uff(_write_sets(tmp_path / "fewer.uff", sets[: 1 + n_ch] + sets[1 + 2 * n_ch:]))
+    assert rec.valid.tolist() == [[True, False], [True, True]]
+    assert estimate_frf(rec).n_averages.tolist() == [1, 2]
+    # a response whose hit has no force record
+    sets = pyuff.UFF(str(p)).read_sets()
+    del sets[1 + n_ch]
+    with pytest.raises(DataError, match="without force record"):
+        read_uff(_write_sets(tmp_path / "orphan.uff", sets))
 
 
 def test_npz_bad_files(tmp_path):

@@ -163,11 +163,20 @@ def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> Hamm
         resp[i, h, o] = np.asarray(r["data"], float) * acc_scale
         nm = str(r.get("id2", "")).strip()
         out_names[o] = nm if nm and nm != "NONE" else f"n{outputs[o][0]}d{outputs[o][1]}"
-    missing = np.argwhere(np.isnan(force[:, :, 0]))
-    if missing.size:
-        i, h = missing[0]
-        raise DataError("missing force record", file=p, field=f"input {in_names[i] or i}",
-                        value=f"hit {hits[h]}", expected="a force record for every hit")
+    # inputs may have different numbers of hits (hit numbers are per file): a hit without
+    # force record for one input is marked invalid, not an error
+    valid = ~np.isnan(force[:, :, 0])
+    for i in range(ni):
+        if not valid[i].any():  # pragma: no cover - inputs come from force records
+            raise DataError("no force record for an input", file=p, field=f"input {i}")
+    orphan = np.argwhere(~valid[:, :, None] & ~np.isnan(resp[:, :, :, 0]))
+    if orphan.size:
+        i, h, _ = orphan[0]
+        raise DataError("response record of a hit without force record", file=p,
+                        field=f"input {in_names[i]}", value=f"hit {hits[h]}",
+                        expected="a force record (specific data type 13) for every hit")
+    force[~valid] = 0.0
+    resp[~valid] = 0.0
     missing = np.argwhere(np.isnan(resp[:, :, :, 0]))
     if missing.size:
         i, h, o = missing[0]
@@ -176,7 +185,8 @@ def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> Hamm
                         value=f"input {in_names[i]}, hit {hits[h]}",
                         expected="every response channel recorded for every hit")
     return HammerRecords(1.0 / dt, force, resp, quantity, tuple(out_names), tuple(in_names),
-                         source=p, meta={"input_dofs": inputs, "output_dofs": outputs})
+                         valid=valid, source=p,
+                         meta={"input_dofs": inputs, "output_dofs": outputs, "hits": hits})
 
 
 def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
@@ -209,9 +219,17 @@ def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
                         field=f"output n{outputs[o][0]}d{outputs[o][1]}",
                         value=f"input n{inputs[i][0]}d{inputs[i][1]}",
                         expected="one FRF record per (output, input) pair")
-    on = tuple(f"n{n}d{d}" for n, d in outputs)
-    inn = tuple(f"n{n}d{d}" for n, d in inputs)
-    return FRFData(x, H, frf_type, None, on, inn, source=p)
+    on = [f"n{n}d{d}" for n, d in outputs]
+    inn = [f"n{n}d{d}" for n, d in inputs]
+    for r in recs:  # channel names written as "output/input" in id2 (write_uff_frf)
+        parts = str(r.get("id2", "")).strip().split("/")
+        if len(parts) == 2 and all(parts):
+            on[outputs.index((int(r["rsp_node"]), int(r["rsp_dir"])))] = parts[0]
+            inn[inputs.index((int(r["ref_node"]), int(r["ref_dir"])))] = parts[1]
+    if len(set(on)) < len(on) or len(set(inn)) < len(inn):
+        on = [f"n{n}d{d}" for n, d in outputs]
+        inn = [f"n{n}d{d}" for n, d in inputs]
+    return FRFData(x, H, frf_type, None, tuple(on), tuple(inn), source=p)
 
 
 def _units_set() -> dict[str, Any]:
