@@ -56,3 +56,19 @@ def test_sweep_bad_inputs_are_one_line_errors(tmp_path, sweep_toml):
     (notstore / "x.txt").write_text("mine")
     res = r.invoke(app, ["sweep", str(sweep_toml), "--out", str(notstore), "--workers", "0"])
     assert res.exit_code == 2 and "not a results store" in " ".join(res.output.split())
+
+
+def test_sweep_status_computes_nothing(tmp_path):
+    cfg = write_sweep_toml(tmp_path / "c.toml", speeds=(300, 600), feeds=(0.1,),
+                           runner_options="fail_speeds_rpm = [600]")
+    r = CliRunner()
+    base = ["sweep", str(cfg), "--out", str(tmp_path / "s")]
+    d = json.loads(r.invoke(app, [*base, "--status", "--json"]).stdout)
+    assert (d["total"], d["done"], d["failed"], d["pending"]) == (4, 0, 0, 4)
+    assert not (tmp_path / "s").exists()
+    assert r.invoke(app, [*base, "--workers", "0"]).exit_code == 1
+    d = json.loads(r.invoke(app, [*base, "--status", "--json"]).stdout)
+    assert (d["done"], d["failed"], d["pending"]) == (2, 2, 0)
+    assert "asked to fail" in d["failures"][0]["error"] and d["failures"][0]["attempts"] == 1
+    res = r.invoke(app, [*base, "--status"])
+    assert res.exit_code == 0 and "status only" in res.output

@@ -248,3 +248,28 @@ def test_cli_compare_bad_csv_is_one_line_exit_2(tmp_path, sweep_toml):
     text = " ".join(res.output.split())  # rich wraps long lines
     assert "m.csv, row 1, field 'depth_of_cut_mm': not a number (got 'x')" in text
     assert "in mm" in text and "Traceback" not in text
+
+
+def test_synthetic_measurements_round_trip_through_the_comparison(tmp_path):
+    """Virtual experiment with known noise: the comparison recovers it (ground truth:
+    measured = simulated x (1 + e), |e| <= 3 * 0.05, so rel. error = |e| / (1 + e))."""
+    import numpy as np
+
+    from robobore.study.synthetic import synthetic_measured_csv
+
+    rng = np.random.default_rng(5)
+    sims = [_sim(float(n), 0.1 * f, 0.05 * a, 0.0, force_amplitude_x_N=float(rng.uniform(50, 500)),
+                 feed_amplitude_um=float(rng.uniform(1, 50)), stable=bool(a < 3))
+            for n in (200, 400, 600) for f in (1, 2, 3) for a in (1, 2, 4, 6)]
+    p = synthetic_measured_csv(sims, tmp_path / "m.csv", rel_noise=0.05, seed=1)
+    assert p.read_text().startswith("# SYNTHETIC")
+    c = compare(read_measured_csv(p), sims)
+    errs = [e["rel_error"] for r in c.rows for e in r["quantities"].values()]
+    assert len(errs) == 2 * len(sims)
+    assert max(errs) <= 0.15 / 0.85 + 1e-12  # |e| <= 0.15 -> |e|/(1+e) <= 0.15/0.85
+    assert 0.02 < float(np.mean(errs)) < 0.06  # E|e|/(1+e) ~ 0.05*sqrt(2/pi) ~ 0.04
+    assert c.agreement["rate"] == 1.0  # no flips asked
+    again = synthetic_measured_csv(sims, tmp_path / "m2.csv", rel_noise=0.05, seed=1)
+    assert again.read_text() == p.read_text()  # deterministic for a seed
+    flipped = synthetic_measured_csv(sims, tmp_path / "m3.csv", flip_stable=1.0, seed=1)
+    assert compare(read_measured_csv(flipped), sims).agreement["rate"] == 0.0

@@ -165,3 +165,20 @@ def test_comparison_and_sweep_reports_open_in_headless_chromium(tmp_path):
     res_cmp, res_sweep = check_html_files_in_browser([cmp_html, sweep_html])
     assert res_cmp.problems == () and res_cmp.images == 1
     assert res_sweep.problems == () and res_sweep.images == 6
+
+
+def test_missing_browser_is_reported_not_ignored(monkeypatch, tmp_path):
+    """Without chromium the check raises BrowserUnavailable with the reason, and the tests
+    above fail (unless ROBOBORE_SKIP_BROWSER=1): nothing passes silently."""
+    import robobore.study.browser as br
+
+    monkeypatch.setattr(br, "CHROMIUM", str(tmp_path / "no-chromium"))
+    assert "no-chromium not found" in br.browser_available()
+    with pytest.raises(br.BrowserUnavailable, match="chromium-driver"):
+        br.check_html_in_browser(tmp_path / "x.html")
+    monkeypatch.delenv("ROBOBORE_SKIP_BROWSER", raising=False)
+    with pytest.raises(pytest.fail.Exception, match="cannot run"):
+        _browser_or_skip()
+    monkeypatch.setenv("ROBOBORE_SKIP_BROWSER", "1")
+    with pytest.raises(pytest.skip.Exception, match="ROBOBORE_SKIP_BROWSER"):
+        _browser_or_skip()

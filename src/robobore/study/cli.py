@@ -56,6 +56,8 @@ def sweep_cmd(
         None, "--out", help="Results store folder (default: ./sweep-<name>)."),
     report: Path | None = typer.Option(
         None, "--report", help="Also write a self-contained HTML report of the sweep here."),
+    status: bool = typer.Option(
+        False, "--status", help="Only show what is done / failed / pending; compute nothing."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Run a sweep of cutting conditions (resumable: finished conditions are skipped).
@@ -72,6 +74,9 @@ def sweep_cmd(
         raise ConfigError("give either --scheduler or --workers", field="--workers",
                           value=workers, expected="no --workers with an external scheduler")
     store = out if out is not None else Path(f"sweep-{plan.name}")
+    if status:
+        _status(plan, store, as_json)
+        return
     outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
                         processes=not threads, progress=sys.stderr.isatty())
     res = {"name": plan.name, "runner": plan.runner, **outcome.to_dict()}
@@ -85,6 +90,37 @@ def sweep_cmd(
     emit(res, as_json, _render_sweep)
     if outcome.pending:
         raise typer.Exit(code=1)
+
+
+def _status(plan: Any, store_dir: Path, as_json: bool) -> None:
+    from robobore.study.store import ResultsStore
+
+    if not (store_dir / "store.json").is_file():
+        counts = {"done": 0, "failed": 0, "pending": len(plan.items)}
+        failures: list[dict[str, Any]] = []
+    else:
+        st = ResultsStore(store_dir)
+        counts = {"done": 0, "failed": 0, "pending": 0}
+        failures = []
+        for i in plan.items:
+            s = st.status(i.key)
+            counts[s] += 1
+            if s == "failed":
+                rec = st.failure(i.key) or {}
+                failures.append({"key": i.key, "condition": i.condition,
+                                 "error": rec.get("error", ""),
+                                 "attempts": rec.get("attempts", 0)})
+    res = {"name": plan.name, "store": str(store_dir), "total": len(plan.items), **counts,
+           "failures": failures}
+
+    def render(r: dict[str, Any]) -> None:
+        stdout.print(kv_table(f"sweep {r['name']} (status only)", [
+            ("results store", r["store"]), ("conditions", r["total"]), ("done", r["done"]),
+            ("failed", r["failed"]), ("pending", r["pending"])]))
+        for f in r["failures"][:30]:
+            stdout.print(f"[red]failed[/] {f['key']} ({f['attempts']}x): {f['error'][:120]}")
+
+    emit(res, as_json, render)
 
 
 def _pct(v: float | None) -> str:
