@@ -84,12 +84,19 @@ def _bad_summary(condition, context):
     return xr.Dataset({"feed_amplitude_um": ((), -3.0)})
 
 
+def _unstorable(condition, context):
+    return xr.Dataset({"stable": ((), True)}, attrs={"nested": {"not": "netCDF"}})
+
+
 def test_bad_runner_results_become_failures(tmp_path):
     plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(300,), feeds=(0.1,)))
     out = run_sweep(plan, tmp_path / "a", workers=0, runner=_not_a_dataset)
     assert out.failed == 2 and "expected xarray.Dataset" in out.failures[0]["error"]
     out = run_sweep(plan, tmp_path / "b", workers=0, runner=_bad_summary)
     assert out.failed == 2 and "feed_amplitude_um" in out.failures[0]["error"]
+    out = run_sweep(plan, tmp_path / "c", workers=0, runner=_unstorable)
+    assert out.failed == 2 and out.failures[0]["error"].startswith("TypeError")
+    assert not list((tmp_path / "c" / "results").iterdir())  # no half file either
     assert execute(_not_a_dataset, {}, {})["ok"] is False
 
 

@@ -186,8 +186,11 @@ class _Recorder:
                     worker=res.get("worker"),
                 )
                 self.computed += 1
-            except DataError as exc:  # the result breaks the summary contract
-                self._fail(item, f"DataError: {exc}", traceback.format_exc(), res.get("worker"))
+            except (DataError, TypeError, ValueError) as exc:
+                # the result breaks the summary contract or cannot be stored as netCDF
+                # (e.g. a dict-valued attribute): a failure of this condition, not the sweep
+                self._fail(item, f"{type(exc).__name__}: {exc}", traceback.format_exc(),
+                           res.get("worker"))
         else:
             self._fail(item, res["error"], res.get("traceback", ""), res.get("worker"))
         self.advance(1)
