@@ -55,6 +55,9 @@ def test_uff_frf_round_trip_and_npz(tmp_path, small_records):
     np.testing.assert_allclose(back.frequency_Hz, d.frequency_Hz, rtol=1e-12)
     n = load_input(save_npz(d, tmp_path / "f.npz"))
     np.testing.assert_array_equal(n.frf, d.frf)
+    assert d.input_dofs == () and len(back.input_dofs) == 2  # UFF records carry DOFs
+    n2 = load_npz(save_npz(back, tmp_path / "g.npz"))
+    assert n2.input_dofs == back.input_dofs and n2.output_dofs == back.output_dofs
     assert n.output_names == d.output_names and n.coherence is not None
 
 
@@ -170,6 +173,11 @@ def test_cli_example_json_meets_truth(tmp_path):
     np.testing.assert_array_less(np.abs(f / truth.frequencies_Hz - 1), 0.005)
     np.testing.assert_array_less(np.abs(z / truth.damping_ratios - 1), 0.10)
     assert {"mpc", "direction", "mode_shape"} <= set(res["modes"][0])
+    # driving points known from the UFF DOFs: effective modal masses 1/phi^2 of the truth
+    # (README table), within 2 % (2 % noise in the example)
+    for k, (inp, phi) in enumerate([("hammer_x", 0.18), ("hammer_y", 0.16),
+                                    ("hammer_z", 0.14)]):
+        assert res["modes"][k]["modal_mass_kg"][inp] == pytest.approx(1 / phi**2, rel=0.02)
     assert res["stabilisation"]["n_poles"] > 0
     pngs = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
     assert "stabilisation.png" in pngs and "cmif.png" in pngs and len(pngs) == 5

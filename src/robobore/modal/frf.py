@@ -32,7 +32,7 @@ Conventions
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -136,6 +136,8 @@ class FRFData:
     input_names: tuple[str, ...] = ()
     exp_window_tau_s: float | None = None
     source: str | None = None
+    output_dofs: tuple[tuple[int, int], ...] = ()
+    input_dofs: tuple[tuple[int, int], ...] = ()
 
     def __post_init__(self) -> None:
         f = check_frequencies(self.frequency_Hz, file=self.source)
@@ -160,6 +162,13 @@ class FRFData:
                             expected=f"{no} output names and {ni} input names")
         object.__setattr__(self, "output_names", on)
         object.__setattr__(self, "input_names", inn)
+        for name, dofs, n in (("output_dofs", self.output_dofs, no),
+                              ("input_dofs", self.input_dofs, ni)):
+            t = tuple((int(a), int(b)) for a, b in dofs)
+            if t and len(t) != n:
+                raise DataError("DOF list does not match the FRF shape", file=self.source,
+                                field=name, value=len(t), expected=f"{n} (node, direction) pairs")
+            object.__setattr__(self, name, t)
         if self.exp_window_tau_s is not None and not (self.exp_window_tau_s > 0):
             raise InputError("exponential window time constant must be > 0",
                              field="exp_window_tau_s", value=self.exp_window_tau_s,
@@ -172,6 +181,14 @@ class FRFData:
     @property
     def n_inputs(self) -> int:
         return self.frf.shape[1]
+
+    def driving_points(self) -> list[tuple[int, int]]:
+        """``(output_index, input_index)`` pairs measured at the same node and direction
+        (from the DOFs; empty when the DOFs are unknown)."""
+        if not self.output_dofs or not self.input_dofs:
+            return []
+        return [(self.output_dofs.index(d), j) for j, d in enumerate(self.input_dofs)
+                if d in self.output_dofs]
 
     def band(self, lo_Hz: float | None, hi_Hz: float | None) -> FRFData:
         """The lines in ``[lo_Hz, hi_Hz]``; raises InputError when the band is outside."""
@@ -192,15 +209,13 @@ class FRFData:
             raise InputError("frequency band holds fewer than 8 frequency lines",
                              field="band_Hz", value=(lo, hi),
                              expected=f"a wider band (line spacing {np.median(np.diff(f)):g} Hz)")
-        return FRFData(f[m], self.frf[:, :, m], self.frf_type,
-                       None if self.coherence is None else self.coherence[:, :, m],
-                       self.output_names, self.input_names, self.exp_window_tau_s, self.source)
+        return replace(self, frequency_Hz=f[m], frf=self.frf[:, :, m],
+                       coherence=None if self.coherence is None else self.coherence[:, :, m])
 
     def as_type(self, frf_type: str) -> FRFData:
         """Convert between accelerance / mobility / receptance (H_acc = (jw)^2 H_rec)."""
         h = convert_frf(self.frf, self.frequency_Hz, self.frf_type, frf_type)
-        return FRFData(self.frequency_Hz, h, frf_type, self.coherence, self.output_names,
-                       self.input_names, self.exp_window_tau_s, self.source)
+        return replace(self, frf=h, frf_type=frf_type)
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {
@@ -209,6 +224,8 @@ class FRFData:
             "frf_type": self.frf_type,
             "output_names": list(self.output_names), "input_names": list(self.input_names),
             "exp_window_tau_s": self.exp_window_tau_s,
+            "output_dofs": [list(d) for d in self.output_dofs],
+            "input_dofs": [list(d) for d in self.input_dofs],
         }
         if self.coherence is not None:
             d["coherence"] = self.coherence.tolist()
@@ -221,7 +238,9 @@ class FRFData:
                    d.get("frf_type", "accelerance"),
                    None if d.get("coherence") is None else np.asarray(d["coherence"]),
                    tuple(d.get("output_names", ())), tuple(d.get("input_names", ())),
-                   d.get("exp_window_tau_s"))
+                   d.get("exp_window_tau_s"), None,
+                   tuple(tuple(x) for x in d.get("output_dofs", ())),
+                   tuple(tuple(x) for x in d.get("input_dofs", ())))
 
 
 def convert_frf(frf: np.ndarray, frequency_Hz: np.ndarray, from_type: str,
@@ -562,7 +581,9 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
     coh = np.nan_to_num(np.clip(coh, 0.0, 1.0), nan=0.0)
     ftype = RESPONSE_QUANTITIES[records.response_quantity]
     data = FRFData(freq, h, ftype, coh, records.output_names, records.input_names,
-                   exp_window_tau_s, records.source)
+                   exp_window_tau_s, records.source,
+                   tuple(records.meta.get("output_dofs", ())),
+                   tuple(records.meta.get("input_dofs", ())))
     return FRFEstimate(data, tuple(checks), used)
 
 

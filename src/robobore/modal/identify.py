@@ -61,7 +61,10 @@ class Mode:
     n_inputs)`` complex receptance residues (m/N/s); dominant_input: name of the input whose
     residues are largest; direction: its axis letter ``x``/``y``/``z`` when the input name
     ends in one (``hammer_x`` -> ``x``; the equivalent-model stage assigns modes to axes by
-    it), else None; input_weights: the share of each input in the residue norm (sums to 1).
+    it), else None; input_weights: the share of each input in the residue norm (sums to 1);
+    modal_mass_kg: effective modal mass per input name at its driving point (when the DOFs
+    tell which output is measured at the hammer point and direction; mass-line not reached
+    or out-of-phase residues give no entry).
     """
 
     frequency_Hz: float
@@ -75,6 +78,7 @@ class Mode:
     input_weights: tuple[float, ...] = ()
     cluster_size: int = 0
     cmif_support: float = 0.0
+    modal_mass_kg: dict[str, float] = field(default_factory=dict)
 
     @property
     def pole(self) -> complex:
@@ -101,6 +105,9 @@ class Mode:
                 "dominant_input": self.dominant_input,
                 "input_weights": list(self.input_weights), "cluster_size": self.cluster_size,
                 "cmif_support": self.cmif_support,
+                "modal_mass_kg": dict(self.modal_mass_kg),
+                "modal_stiffness_N_per_m": {k: v * (2 * np.pi * self.frequency_Hz) ** 2
+                                            for k, v in self.modal_mass_kg.items()},
                 "mode_shape": _cplx_list(self.mode_shape),
                 "participation": _cplx_list(self.participation),
                 "residues": _cplx_list(self.residues)}
@@ -112,7 +119,9 @@ class Mode:
                    str(d.get("dominant_input", "")), d.get("direction"),
                    tuple(float(v) for v in d.get("input_weights", ())),
                    int(d.get("cluster_size", 0)),
-                   float(d.get("cmif_support", 0.0)))
+                   float(d.get("cmif_support", 0.0)),
+                   {str(k): float(v) for k, v in (d.get("modal_mass_kg") or {}).items()
+                    if v is not None})
 
 
 @dataclass(frozen=True)
@@ -214,10 +223,14 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
         share = np.linalg.norm(R, axis=0)
         share = share / (share.sum() or 1.0)
         dom = d.input_names[int(np.argmax(share))]
+        mode = Mode(s.frequency_Hz, s.damping_ratio, 0.0, np.zeros(0), s.participation, R, dom)
+        masses = {d.input_names[j]: mode.driving_point_mass_kg(o, j)
+                  for o, j in d.driving_points()}
         modes.append(Mode(s.frequency_Hz, s.damping_ratio, mpc(fit.mode_shapes[:, k]),
                           normalise_shape(fit.mode_shapes[:, k]), s.participation, R,
                           dom, _axis_of(dom), tuple(float(v) for v in share), s.cluster_size,
-                          float(cm.at(s.frequency_Hz)[0] / c1.max())))
+                          float(cm.at(s.frequency_Hz)[0] / c1.max()),
+                          {k: v for k, v in masses.items() if np.isfinite(v)}))
     summary = diag.summary()
     summary["selected"] = [{"frequency_Hz": s.frequency_Hz, "damping_ratio": s.damping_ratio,
                             "orders_stable": s.cluster_size,

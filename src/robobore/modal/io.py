@@ -15,7 +15,8 @@ UFF conventions used (and expected when reading)
 
 NPZ contract: ``frequency_Hz (n_f,)``, ``frf`` complex ``(n_outputs, n_inputs, n_f)``,
 ``frf_type`` (accelerance | mobility | receptance); optional ``coherence``,
-``output_names``, ``input_names``.
+``output_names``, ``input_names``, ``output_dofs``/``input_dofs`` (int ``(n, 2)``: node,
+direction; outputs and inputs with the same DOF are driving points).
 """
 
 from __future__ import annotations
@@ -229,7 +230,8 @@ def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
     if len(set(on)) < len(on) or len(set(inn)) < len(inn):
         on = [f"n{n}d{d}" for n, d in outputs]
         inn = [f"n{n}d{d}" for n, d in inputs]
-    return FRFData(x, H, frf_type, None, tuple(on), tuple(inn), source=p)
+    return FRFData(x, H, frf_type, None, tuple(on), tuple(inn), source=p,
+                   output_dofs=tuple(outputs), input_dofs=tuple(inputs))
 
 
 def _units_set() -> dict[str, Any]:
@@ -338,9 +340,18 @@ def load_npz(path: str | Path) -> FRFData:
         names = {k: tuple(str(v) for v in z[k]) for k in ("output_names", "input_names")
                  if k in z.files}
         coh = z["coherence"] if "coherence" in z.files else None
+        dofs = {}
+        for k in ("output_dofs", "input_dofs"):
+            if k in z.files:
+                a = np.asarray(z[k])
+                if a.ndim != 2 or a.shape[1:] != (2,) or not np.issubdtype(a.dtype, np.integer):
+                    raise DataError("DOF array has the wrong shape or type", file=str(p),
+                                    field=k, value=f"shape {a.shape}, {a.dtype}",
+                                    expected="integers of shape (n, 2): node, direction")
+                dofs[k] = tuple((int(u), int(v)) for u, v in a)
         return FRFData(z["frequency_Hz"], z["frf"], str(z["frf_type"]), coh,
                        names.get("output_names", ()), names.get("input_names", ()),
-                       source=str(p))
+                       source=str(p), **dofs)
 
 
 def save_npz(data: FRFData, path: str | Path) -> Path:
@@ -352,6 +363,9 @@ def save_npz(data: FRFData, path: str | Path) -> Path:
                               "input_names": np.array(data.input_names)}
     if data.coherence is not None:
         arrays["coherence"] = data.coherence
+    if data.output_dofs and data.input_dofs:
+        arrays["output_dofs"] = np.array(data.output_dofs, dtype=np.int64)
+        arrays["input_dofs"] = np.array(data.input_dofs, dtype=np.int64)
     np.savez_compressed(buf, **arrays)
     return atomic_write_bytes(path, buf.getvalue())
 
