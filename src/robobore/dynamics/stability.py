@@ -39,20 +39,30 @@ from typing import Any
 import numba as nb
 import numpy as np
 from scipy.linalg import expm
+from scipy.optimize import brentq
 
 from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.structure import ToolPointStructure
+from robobore.errors import ConfigError
+
+try:  # a single BLAS thread: the many mid-size eigenproblems are slower multi-threaded
+    from threadpoolctl import threadpool_limits as _limits
+except ImportError:  # pragma: no cover - optional
+    from contextlib import nullcontext as _null
+
+    def _limits(*_a, **_k):  # type: ignore[no-redef]
+        return _null()
 
 
 # --------------------------------------------------------------------------- frequency domain
 def frequency_grid(structure: ToolPointStructure, n_global: int = 6000,
-                   n_local: int = 2000) -> np.ndarray:
+                   n_local: int = 4000) -> np.ndarray:
     """Chatter-frequency grid [rad/s]: log-spaced over 0.2-5 x the mode range, dense near modes."""
     f = structure.frequency_Hz
     z = np.maximum(structure.damping_ratio, 1e-4)
     parts = [np.geomspace(0.2 * f.min(), 5.0 * f.max(), n_global)]
     for fj, zj in zip(f, z, strict=True):
-        parts.append(fj * (1 + zj * np.linspace(-40, 40, n_local)))
+        parts.append(fj * (1 + zj * np.linspace(-30, 30, n_local)))
     g = np.unique(np.concatenate(parts))
     return 2 * np.pi * g[g > 0]
 
@@ -216,6 +226,10 @@ def lobes_frequency_domain(structure: ToolPointStructure, process: CuttingProces
     A0 = process.mean_directional_matrix()
     lam = oriented_eigenvalues(structure, A0, w)
     mu = process.overlap
+    if 1e-9 < mu < 1.0 - 1e-9:
+        raise ConfigError("the frequency-domain lobes support overlap 1 (full regeneration) or "
+                          "0 (mode coupling only)", field="process.overlap_factor", value=mu,
+                          expected="1.0 or 0.0, or use the semi-discretization method")
     if mu <= 1e-9:
         best = np.full(lam.shape[0], np.inf)
         wb = np.full(lam.shape[0], np.nan)
@@ -280,9 +294,18 @@ def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: n
 
 
 def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingProcess,
-                              speed_rpm: float, depth_m: float, steps: int = 40,
+                              speed_rpm: float, depth_m: float, steps: int = 0,
                               include_process_stiffness: bool = True) -> float:
-    """Spectral radius of the semi-discretised monodromy matrix over one delay (< 1: stable)."""
+    """Spectral radius of the semi-discretised monodromy matrix over one delay (< 1: stable).
+
+    ``steps`` per delay (0: :func:`auto_steps`)."""
+    steps = steps or auto_steps(structure, process, speed_rpm)
+    with _limits(1):
+        return _monodromy(structure, process, speed_rpm, depth_m, steps,
+                          include_process_stiffness)
+
+
+def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness):
     m = structure.n_modes
     tau = 60.0 / (process.n_inserts * speed_rpm)
     dt = tau / steps
@@ -328,14 +351,25 @@ def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingPro
     return float(np.max(np.abs(np.linalg.eigvals(mono))))
 
 
+def auto_steps(structure: ToolPointStructure, process: CuttingProcess, speed_rpm: float,
+               per_cycle: int = 20, lo: int = 30, hi: int = 400) -> int:
+    """Semi-discretisation steps per delay: ``per_cycle`` steps per period of the highest mode."""
+    tau = 60.0 / (process.n_inserts * speed_rpm)
+    return int(min(hi, max(lo, math.ceil(per_cycle * structure.frequency_Hz.max() * tau))))
+
+
 def critical_depth_semidiscretization(structure: ToolPointStructure, process: CuttingProcess,
-                                      speed_rpm: float, depth_hi_m: float = 0.05,
-                                      steps: int = 40, tol: float = 1e-4,
-                                      include_process_stiffness: bool = True) -> float:
+                                      speed_rpm: float, depth_hi_m: float = 1.0,
+                                      steps: int = 0, tol: float = 1e-4,
+                                      include_process_stiffness: bool = True,
+                                      depth_guess_m: float | None = None) -> float:
     """Critical depth [m] at one speed by bisection on the monodromy spectral radius.
 
-    Returns ``inf`` if stable up to ``depth_hi_m`` and 0 if unstable at vanishing depth (e.g.
-    a depth-independent process-stiffness instability)."""
+    ``steps`` per delay (0: :func:`auto_steps`); ``depth_guess_m`` (e.g. the frequency-domain
+    value) narrows the bracket; Brent's method on ``log(rho)`` finds the root. Returns ``inf``
+    if stable up to ``depth_hi_m`` and 0 if unstable at vanishing depth (e.g. a depth-independent
+    process-stiffness instability)."""
+    steps = steps or auto_steps(structure, process, speed_rpm)
 
     def rho(b: float) -> float:
         return monodromy_spectral_radius(structure, process, speed_rpm, b, steps,
@@ -343,33 +377,36 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
 
     if rho(depth_hi_m * 1e-6) >= 1.0:
         return 0.0
-    lo, hi = 0.0, depth_hi_m * 1e-3
+    # march up in depth (x1.25) to the FIRST unstable depth, then Brent on log(rho)
+    start = depth_hi_m * 1e-5
+    if depth_guess_m is not None and depth_hi_m * 1e-5 < depth_guess_m < depth_hi_m:
+        start = 0.6 * depth_guess_m
+        while rho(start) >= 1.0 and start > depth_hi_m * 1e-5:
+            start *= 0.6
+    lo = start
+    hi = start * 1.25
     while rho(hi) < 1.0:
         lo = hi
-        hi *= 2.0
+        hi *= 1.25
         if hi > depth_hi_m:
-            if rho(depth_hi_m) < 1.0:
-                return math.inf
-            hi = depth_hi_m
-            break
-    while (hi - lo) > tol * hi:
-        mid = 0.5 * (lo + hi)
-        if rho(mid) < 1.0:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+            return math.inf
+    return float(brentq(lambda b: math.log(rho(b)), lo, hi, rtol=tol))
 
 
 def lobes_semidiscretization(structure: ToolPointStructure, process: CuttingProcess,
-                             speed_rpm: np.ndarray, steps: int = 40,
-                             depth_hi_m: float = 0.05, progress=None) -> LobeResult:
-    """Critical depth at each speed by semi-discretisation (slower; for cross-checks)."""
+                             speed_rpm: np.ndarray, steps: int = 0,
+                             depth_hi_m: float = 1.0, progress=None,
+                             guesses_m: np.ndarray | None = None) -> LobeResult:
+    """Critical depth at each speed by semi-discretisation (slower; for cross-checks).
+
+    ``guesses_m`` (e.g. frequency-domain depths) only narrow the root bracket."""
     speeds = np.asarray(speed_rpm, float)
     out = np.empty(speeds.size)
     for i, n in enumerate(speeds):
-        out[i] = critical_depth_semidiscretization(structure, process, float(n), depth_hi_m,
-                                                   steps)
+        g = None if guesses_m is None else float(guesses_m[i])
+        out[i] = critical_depth_semidiscretization(
+            structure, process, float(n), depth_hi_m, steps,
+            depth_guess_m=g if g is not None and math.isfinite(g) else None)
         if progress is not None:
             progress(1)
     fin = out[np.isfinite(out)]
@@ -460,5 +497,6 @@ def sdof_pocket_speeds(f_n: float, zeta: float, n_inserts: int, lobes: int) -> n
 
 __all__ = ["LobeResult", "frequency_grid", "oriented_eigenvalues", "lobe_branches",
            "lobes_frequency_domain", "lobe_curves", "monodromy_spectral_radius",
-           "critical_depth_semidiscretization", "lobes_semidiscretization", "ModeCoupling",
+           "critical_depth_semidiscretization", "lobes_semidiscretization", "auto_steps",
+           "ModeCoupling",
            "mode_coupling", "mode_coupling_limit", "sdof_absolute_limit", "sdof_pocket_speeds"]

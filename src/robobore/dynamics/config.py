@@ -1,0 +1,315 @@
+"""TOML configuration of the process stage (``robobore lobes``, ``robobore simulate boring``).
+
+Two kinds of file are accepted.
+
+General single-point cutting (the contract)::
+
+    [structure]   # tool-point modes, boring frame: x horizontal, y vertical, z feed
+    modes = [ { frequency_Hz = 250.0, damping_ratio = 0.012, stiffness_N_per_m = 2.26e8,
+                direction = [0.866, 0.5, 0.0] } ]
+    [process]
+    cutting_coefficient_N_per_m2 = 1.0e9
+    force_direction = [1.0, 0.0, 0.0]
+    chip_normal = [1.0, 0.0, 0.0]
+    feed_mm_per_rev = 0.1
+    # optional: overlap_factor = 1.0, n_inserts = 1
+    [speed_rpm]
+    min = 2000.0
+    max = 14000.0
+    count = 601
+
+Boring (rotating bar): instead of ``[process]`` give ``[insert]``, ``[bore]``, ``[cutting]``
+and optionally ``[coefficients]``; instead of (or besides) ``[structure]`` an ``[equivalent]``
+section (per-direction stiffness, frequency and damping, optional ``[equivalent.pressure_foot]``).
+Optional ``[simulation]`` (revolutions, samples per revolution, roughness tolerance).
+Human units are in the key names and converted to SI here, once.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from robobore.errors import ConfigError
+from robobore.io.config import load_toml, validate_model
+
+
+def _unit(v: list[float], tol: float = 0.01) -> list[float]:
+    if len(v) != 3 or not all(math.isfinite(x) for x in v):
+        raise ValueError("must be 3 finite numbers (a unit vector)")
+    n = math.sqrt(sum(x * x for x in v))
+    if n < 1e-9:
+        raise ValueError("zero-length direction; expected a unit vector")
+    if abs(n - 1.0) > tol:
+        raise ValueError(f"length {n:.4f} is more than 1% off unit length; expected |d| = 1")
+    return [x / n for x in v]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class ModeCfg(_Strict):
+    frequency_Hz: float = Field(gt=0, le=1e6)
+    damping_ratio: float = Field(ge=0, lt=1)
+    stiffness_N_per_m: float = Field(gt=0, le=1e12)
+    direction: list[float]
+
+    @field_validator("direction")
+    @classmethod
+    def _dir(cls, v: list[float]) -> list[float]:
+        return _unit(v)
+
+
+class StructureCfg(_Strict):
+    modes: list[ModeCfg] = Field(min_length=1)
+
+
+class XYZ(_Strict):
+    x: float
+    y: float
+    z: float
+
+
+class PressureFootCfg(_Strict):
+    pressure_MPa: float = Field(0.3, ge=0, le=10)
+    piston_diameter_mm: float = Field(50.0, gt=0, le=1000)
+    normal: list[float] = [0.0, 0.0, 1.0]
+    normal_stiffness_N_per_m: float | None = Field(None, gt=0)
+    contact_modulus_GPa: float = Field(2.0, gt=0)
+    contact_radius_mm: float = Field(100.0, gt=0)
+    friction_coefficient: float = Field(0.3, ge=0, le=2)
+    slip_displacement_um: float = Field(20.0, gt=0)
+    contact_damping_ratio: float = Field(0.05, ge=0, lt=1)
+
+    @field_validator("normal")
+    @classmethod
+    def _dir(cls, v: list[float]) -> list[float]:
+        return _unit(v)
+
+    def to_foot(self):
+        from robobore.equivalent import PressureFoot
+
+        return PressureFoot(
+            pressure_Pa=self.pressure_MPa * 1e6,
+            piston_area_m2=math.pi * (self.piston_diameter_mm * 1e-3 / 2) ** 2,
+            normal=tuple(self.normal), normal_stiffness_N_per_m=self.normal_stiffness_N_per_m,
+            contact_modulus_Pa=self.contact_modulus_GPa * 1e9,
+            contact_radius_m=self.contact_radius_mm * 1e-3,
+            friction_coefficient=self.friction_coefficient,
+            slip_displacement_m=self.slip_displacement_um * 1e-6,
+            contact_damping_ratio=self.contact_damping_ratio)
+
+
+class EquivalentCfg(_Strict):
+    stiffness_N_per_m: XYZ
+    frequency_Hz: XYZ
+    damping_ratio: XYZ | None = None
+    damping_N_s_per_m: float | None = Field(None, ge=0)
+    pressure_foot: PressureFootCfg | None = None
+    note: str = ""
+
+    @field_validator("stiffness_N_per_m", "frequency_Hz")
+    @classmethod
+    def _pos(cls, v: XYZ) -> XYZ:
+        for a in "xyz":
+            if not (getattr(v, a) > 0 and math.isfinite(getattr(v, a))):
+                raise ValueError(f"component {a} must be positive")
+        return v
+
+    @model_validator(mode="after")
+    def _damping(self):
+        if (self.damping_ratio is None) == (self.damping_N_s_per_m is None):
+            raise ValueError("give exactly one of damping_ratio or damping_N_s_per_m")
+        return self
+
+    def to_model(self):
+        from robobore.equivalent import EquivalentModel
+
+        return EquivalentModel.build(
+            self.stiffness_N_per_m.model_dump(), self.frequency_Hz.model_dump(),
+            damping_ratio=None if self.damping_ratio is None else self.damping_ratio.model_dump(),
+            damping_N_s_per_m=self.damping_N_s_per_m,
+            foot=None if self.pressure_foot is None else self.pressure_foot.to_foot(),
+            notes=(self.note,) if self.note else ())
+
+
+class ProcessCfg(_Strict):
+    cutting_coefficient_N_per_m2: float = Field(gt=0, le=1e12)
+    force_direction: list[float]
+    chip_normal: list[float]
+    feed_mm_per_rev: float = Field(gt=0, le=10)
+    overlap_factor: float = Field(1.0, ge=0, le=1)
+    n_inserts: int = Field(1, ge=1, le=12)
+
+    @field_validator("force_direction", "chip_normal")
+    @classmethod
+    def _dir(cls, v: list[float]) -> list[float]:
+        return _unit(v)
+
+
+class SpeedCfg(_Strict):
+    min: float = Field(gt=0, le=100000)
+    max: float = Field(gt=0, le=100000)
+    count: int = Field(gt=1, le=100000)
+
+    @model_validator(mode="after")
+    def _order(self):
+        if self.max <= self.min:
+            raise ValueError("max must be larger than min (r/min)")
+        return self
+
+
+class InsertCfg(_Strict):
+    nose_radius_mm: float = Field(0.4, gt=0, le=10)
+    approach_angle_deg: float = Field(90.0, gt=0, le=90)
+    end_edge_angle_deg: float = Field(5.0, gt=0, lt=90)
+    rake_deg: float = Field(7.0, ge=-30, le=30)
+    inclination_deg: float = Field(0.0, ge=-30, le=30)
+    clearance_deg: float = Field(7.0, ge=0, le=30)
+    edge_radius_um: float = Field(20.0, ge=0, le=200)
+    n_inserts: int = Field(1, ge=1, le=12)
+
+    def to_insert(self):
+        from robobore.cutting.geometry import BoringInsert
+
+        return BoringInsert(self.nose_radius_mm * 1e-3, self.approach_angle_deg,
+                            self.end_edge_angle_deg, self.rake_deg, self.inclination_deg,
+                            self.clearance_deg, self.edge_radius_um * 1e-6, self.n_inserts)
+
+
+class BoreCfg(_Strict):
+    diameter_mm: float = Field(gt=1, le=2000)
+
+
+class CuttingCfg(_Strict):
+    speed_rpm: float = Field(gt=0, le=100000)
+    feed_mm_per_rev: float = Field(gt=0, le=5)
+    depth_mm: float = Field(gt=0, le=50)
+    overlap_factor: float = Field(1.0, ge=0, le=1)
+    depth_modulation: bool = True
+
+
+class CoefficientsCfg(_Strict):
+    material: str | None = None
+    file: str | None = None
+    oblique: bool = False
+    Ktc_N_per_m2: float | None = None
+    Krc_N_per_m2: float | None = None
+    Kfc_N_per_m2: float | None = None
+    Kte_N_per_m: float | None = None
+    Kre_N_per_m: float | None = None
+    Kfe_N_per_m: float | None = None
+    provenance: str = "config file"
+
+    @model_validator(mode="after")
+    def _one(self):
+        given = [self.material is not None, self.file is not None, self.Ktc_N_per_m2 is not None]
+        if sum(given) != 1:
+            raise ValueError("give exactly one of material, file or Ktc_N_per_m2 (+ others)")
+        if self.material is not None and self.material.upper() not in ("TC4", "TI6AL4V",
+                                                                         "TI-6AL-4V"):
+            raise ValueError("unknown material; expected TC4")
+        return self
+
+
+class SimulationCfg(_Strict):
+    revolutions: int = Field(150, ge=1, le=20000)
+    samples_per_rev: int = Field(0, ge=0, le=200000)
+    ra_tolerance_um: float | None = Field(None, gt=0)
+
+
+class DynamicsConfig(_Strict):
+    structure: StructureCfg | None = None
+    equivalent: EquivalentCfg | None = None
+    process: ProcessCfg | None = None
+    insert: InsertCfg | None = None
+    bore: BoreCfg | None = None
+    cutting: CuttingCfg | None = None
+    coefficients: CoefficientsCfg | None = None
+    speed_rpm: SpeedCfg | None = None
+    simulation: SimulationCfg = SimulationCfg()
+
+    @model_validator(mode="after")
+    def _sections(self):
+        if self.structure is None and self.equivalent is None:
+            raise ValueError("missing section [structure] (tool-point modes) or [equivalent]")
+        if self.process is None:
+            missing = [k for k in ("insert", "bore", "cutting") if getattr(self, k) is None]
+            if missing:
+                raise ValueError("missing section [process] (single-point cutting) or the "
+                                 "boring sections [" + "], [".join(missing) + "]")
+        return self
+
+    @property
+    def is_boring(self) -> bool:
+        return self.process is None
+
+
+def load_dynamics_config(path: str | Path) -> tuple[DynamicsConfig, dict[str, Any]]:
+    """Read and validate a config file; returns the model and the raw dict (for provenance)."""
+    raw = load_toml(path)
+    cfg = validate_model(DynamicsConfig, raw, source=path)
+    return cfg, raw
+
+
+def build_structure(cfg: DynamicsConfig, source: str | None = None):
+    """Tool-point structure: ``[structure]`` modes plus the ``[equivalent]`` units (if both)."""
+    from robobore.dynamics.structure import ToolPointStructure
+
+    modes: list[dict[str, Any]] = []
+    if cfg.equivalent is not None:
+        modes += cfg.equivalent.to_model().tool_point_modes()
+    if cfg.structure is not None:
+        modes += [m.model_dump() for m in cfg.structure.modes]
+    return ToolPointStructure.from_modes(modes, file=source)
+
+
+def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
+    from robobore.cutting import forces
+
+    c = cfg.coefficients
+    vc = None
+    if cfg.bore is not None and cfg.cutting is not None:
+        vc = math.pi * cfg.bore.diameter_mm * 1e-3 * cfg.cutting.speed_rpm
+    if c is None or c.material is not None:
+        if c is not None and c.oblique:
+            return forces.ti64_oblique_coefficients(cfg.insert.to_insert(),
+                                                    30.0 if vc is None else vc)
+        return forces.ti64_coefficients(vc)
+    if c.file is not None:
+        p = Path(c.file)
+        if not p.is_absolute() and source is not None:
+            p = Path(source).parent / p
+        return forces.load_coefficients(p)
+    d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
+    d["provenance"] = c.provenance
+    return forces.CuttingCoefficients.from_dict(d, source=source)
+
+
+def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float | None = None):
+    """Process model: the ``[process]`` contract or the boring bar from insert + cutting."""
+    from robobore.dynamics.process import boring_process, single_point_process
+
+    if cfg.process is not None:
+        p = cfg.process
+        return single_point_process(p.cutting_coefficient_N_per_m2, p.force_direction,
+                                    p.chip_normal, p.feed_mm_per_rev * 1e-3, p.n_inserts,
+                                    p.overlap_factor)
+    ins = cfg.insert.to_insert()
+    cut = cfg.cutting
+    if ins.nose_radius_m * 2 >= cfg.bore.diameter_mm * 1e-3:
+        raise ConfigError("nose radius too large for the bore", file=source,
+                          field="insert.nose_radius_mm", value=cfg.insert.nose_radius_mm,
+                          expected=f"< bore radius {cfg.bore.diameter_mm / 2} mm")
+    return boring_process(ins, build_coefficients(cfg, source),
+                          cut.depth_mm * 1e-3 if depth_m is None else depth_m,
+                          cut.feed_mm_per_rev * 1e-3, overlap=cut.overlap_factor,
+                          depth_modulation=cut.depth_modulation)
+
+
+__all__ = ["DynamicsConfig", "load_dynamics_config", "build_structure", "build_process",
+           "build_coefficients"]
