@@ -105,3 +105,24 @@ def test_summary_json_round_trip():
     assert summary_from_json(js) == flat
     with pytest.raises(DataError, match="stable"):
         summary_from_json({"stable": "perhaps"})
+
+
+def test_a_store_is_used_by_one_sweep_at_a_time(tmp_path):
+    import subprocess
+    import sys
+
+    from robobore.errors import RoboboreError
+
+    st = ResultsStore(tmp_path)
+    with st.lock():
+        with pytest.raises(RoboboreError, match="in use by another sweep"):
+            with ResultsStore(tmp_path).lock():
+                pass
+        # another process is refused too, and is told who holds the store
+        code = ("from robobore.study.store import ResultsStore\n"
+                f"with ResultsStore({str(tmp_path)!r}).lock(): pass\n")
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           timeout=60)
+        assert r.returncode != 0 and "in use by another sweep (pid" in r.stderr
+    with ResultsStore(tmp_path).lock():  # released
+        pass

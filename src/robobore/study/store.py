@@ -27,12 +27,13 @@ import json
 import os
 import socket
 from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from robobore.errors import DataError
+from robobore.errors import DataError, RoboboreError
 from robobore.io.results import atomic_write_text, write_json, write_netcdf
 from robobore.study.conditions import CONDITION_FIELDS
 from robobore.study.summary import SUMMARY_QUANTITIES, summarise, summary_attrs
@@ -103,6 +104,37 @@ class ResultsStore:
             raise DataError("not a robobore results store (no store.json)", file=str(p),
                             expected="a folder written by 'robobore sweep'")
         return cls(p)
+
+    # --- exclusive use ----------------------------------------------------------------
+    @contextmanager
+    def lock(self) -> Iterator[None]:
+        """Hold the store for one sweep: a second sweep on the same store (from any
+        process on this machine) gets a clear error instead of racing on the files. The
+        lock is an ``flock`` on ``.lock``, released by the OS when the process dies, so a
+        killed sweep never leaves the store locked. (No-op where ``fcntl`` is missing.)"""
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - Windows
+            yield
+            return
+        fh = (self.root / ".lock").open("a+")
+        try:
+            try:
+                fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                fh.seek(0)
+                who = fh.read().strip() or "another process"
+                raise RoboboreError(
+                    f"results store {self.root} is in use by another sweep ({who}); wait for "
+                    "it to finish or use another --out folder"
+                ) from None
+            fh.seek(0)
+            fh.truncate()
+            fh.write(f"pid {os.getpid()} on {socket.gethostname()} since {_now()}\n")
+            fh.flush()
+            yield
+        finally:
+            fh.close()  # releases the lock
 
     # --- paths and status -------------------------------------------------------------
     def result_path(self, key: str) -> Path:

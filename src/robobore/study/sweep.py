@@ -224,14 +224,24 @@ def run_sweep(
     ``scheduler``: address of a running Dask scheduler (``tcp://host:port``); otherwise a
     local cluster with ``workers`` workers (default: CPU count), processes or threads
     (``processes``); ``workers=0`` (and no scheduler) runs serially in this process.
-    ``runner`` overrides the plan's runner spec (a picklable function).
+    ``runner`` overrides the plan's runner spec (a picklable function). The store is
+    locked for the duration (:meth:`ResultsStore.lock`).
     """
-    from robobore.clitools import progress_bar
-
     if not isinstance(store, ResultsStore):
         store = ResultsStore(store)
-    store.cleanup_partial()
     fn = runner if runner is not None else resolve_runner(plan.runner)
+    with store.lock():
+        return _run_locked(plan, store, fn, scheduler=scheduler, workers=workers,
+                           processes=processes, progress=progress, index_every_s=index_every_s,
+                           connect_timeout_s=connect_timeout_s)
+
+
+def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: str | None,
+                workers: int | None, processes: bool, progress: bool, index_every_s: float,
+                connect_timeout_s: float) -> SweepOutcome:
+    from robobore.clitools import progress_bar
+
+    store.cleanup_partial()  # safe: the lock says no other sweep is writing here
     todo = [i for i in plan.items if not store.is_done(i.key)]
     skipped = len(plan.items) - len(todo)
     t0 = time.perf_counter()
@@ -284,9 +294,11 @@ def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: s
         else:
             # processes: TCP on loopback only; threads: Dask's in-process transport
             extra = {"host": "127.0.0.1"} if processes else {}
+            # the scheduler's HTTP server always starts; a random loopback port avoids
+            # clashes with other clusters (the default 8787) and exposes nothing
             cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=processes,
-                dashboard_address=None, silence_logs=logging.ERROR, **extra,
+                dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR, **extra,
             )
             client = Client(cluster, set_as_default=False)
         by_future = {}
