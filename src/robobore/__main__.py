@@ -1,0 +1,5 @@
+"""``python -m robobore``: the same as the ``robobore`` command."""
+
+from robobore.cli import main
+
+main()
