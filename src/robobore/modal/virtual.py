@@ -33,13 +33,32 @@ from robobore.modal.frf import FRFData, HammerRecords
 TIP_WIDTH_S = {"soft": 8e-3, "medium": 4e-3, "hard": 1.5e-3}
 
 
+def _as_shape(v: Any) -> np.ndarray:
+    """Real or complex shape array; complex entries may come as ``{"re", "im"}`` dicts."""
+    a = np.asarray(v, dtype=object) if not isinstance(v, np.ndarray) else v
+    if a.dtype == object:
+        a = np.vectorize(lambda x: complex(x["re"], x["im"]) if isinstance(x, dict)
+                         else complex(x), otypes=[complex])(a)
+    if np.iscomplexobj(a):
+        a = a.astype(complex)
+        return a.real.copy() if not np.any(a.imag) else a
+    return a.astype(float)
+
+
+def _shape_list(a: np.ndarray) -> Any:
+    if np.iscomplexobj(a):
+        return [[{"re": float(z.real), "im": float(z.imag)} for z in row] for row in a]
+    return a.tolist()
+
+
 @dataclass(frozen=True)
 class ModalTruth:
     """Ground-truth modal model of a virtual structure (SYNTHETIC).
 
     frequencies_Hz, damping_ratios: ``(n_modes,)`` undamped natural frequencies (Hz) and
     viscous damping ratios. phi_out ``(n_outputs, n_modes)``, phi_in ``(n_inputs, n_modes)``:
-    mass-normalised mode-shape values (1/sqrt(kg)).
+    mass-normalised mode-shape values (1/sqrt(kg)); complex shapes give non-proportionally
+    damped (complex) modes with receptance residues ``phi_o phi_j / (2 j w_d)``.
     """
 
     frequencies_Hz: np.ndarray
@@ -53,8 +72,8 @@ class ModalTruth:
     def __post_init__(self) -> None:
         f = np.asarray(self.frequencies_Hz, float)
         z = np.asarray(self.damping_ratios, float)
-        po = np.atleast_2d(np.asarray(self.phi_out, float))
-        pi = np.atleast_2d(np.asarray(self.phi_in, float))
+        po = np.atleast_2d(_as_shape(self.phi_out))
+        pi = np.atleast_2d(_as_shape(self.phi_in))
         nm = f.size
         if z.shape != (nm,) or po.shape[1] != nm or pi.shape[1] != nm:
             raise InputError("modal truth shapes do not agree", field="phi_out/phi_in",
@@ -76,6 +95,11 @@ class ModalTruth:
     def n_modes(self) -> int:
         return self.frequencies_Hz.size
 
+    @property
+    def is_complex(self) -> bool:
+        """Complex (non-proportionally damped) mode shapes."""
+        return bool(np.iscomplexobj(self.phi_out) or np.iscomplexobj(self.phi_in))
+
     def poles(self) -> np.ndarray:
         """``(n_modes,)`` complex poles (rad/s), positive imaginary part."""
         wn = 2 * np.pi * self.frequencies_Hz
@@ -85,9 +109,19 @@ class ModalTruth:
     def frf(self, frequency_Hz: np.ndarray, frf_type: str = "accelerance") -> np.ndarray:
         """Exact FRF ``(n_outputs, n_inputs, n_f)``."""
         w = 2 * np.pi * np.asarray(frequency_Hz, float)
-        wn = 2 * np.pi * self.frequencies_Hz
-        den = wn[:, None] ** 2 - w[None, :] ** 2 + 2j * (self.damping_ratios * wn)[:, None] * w
-        h = np.einsum("or,jr,rk->ojk", self.phi_out, self.phi_in, 1.0 / den)
+        if not self.is_complex:
+            wn = 2 * np.pi * self.frequencies_Hz
+            den = (wn[:, None] ** 2 - w[None, :] ** 2
+                   + 2j * (self.damping_ratios * wn)[:, None] * w)
+            h = np.einsum("or,jr,rk->ojk", self.phi_out, self.phi_in, 1.0 / den)
+        else:
+            # pole-residue form, residue phi_o phi_j / (2 j w_d) (equal to the real-mode
+            # expression above when the shapes are real)
+            lam = self.poles()
+            R = np.einsum("or,jr->ojr", self.phi_out, self.phi_in) / (2j * lam.imag)
+            jw = 1j * w[None, :]
+            h = (np.einsum("ojr,rk->ojk", R, 1.0 / (jw - lam[:, None]))
+                 + np.einsum("ojr,rk->ojk", R.conj(), 1.0 / (jw - lam.conj()[:, None])))
         p = {"receptance": 0, "mobility": 1, "accelerance": 2}[frf_type]
         return h * (1j * w) ** p
 
@@ -104,14 +138,14 @@ class ModalTruth:
     def to_dict(self) -> dict[str, Any]:
         return {"frequencies_Hz": self.frequencies_Hz.tolist(),
                 "damping_ratios": self.damping_ratios.tolist(),
-                "phi_out": self.phi_out.tolist(), "phi_in": self.phi_in.tolist(),
+                "phi_out": _shape_list(self.phi_out), "phi_in": _shape_list(self.phi_in),
                 "output_names": list(self.output_names), "input_names": list(self.input_names),
                 "description": self.description}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> ModalTruth:
         return cls(np.asarray(d["frequencies_Hz"]), np.asarray(d["damping_ratios"]),
-                   np.asarray(d["phi_out"]), np.asarray(d["phi_in"]),
+                   _as_shape(d["phi_out"]), _as_shape(d["phi_in"]),
                    tuple(d.get("output_names", ())), tuple(d.get("input_names", ())),
                    d.get("description", ""))
 
