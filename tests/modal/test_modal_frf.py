@@ -14,6 +14,7 @@ from robobore.modal.frf import (
     DoubleHitWarning,
     FRFData,
     HammerRecords,
+    LeakageWarning,
     check_frequencies,
     check_hit,
     convert_frf,
@@ -82,6 +83,8 @@ def test_exponential_window_damping_correction():
                        np.array([[0.2, 0.1], [0.1, -0.15]]), np.array([[0.2, 0.1]]))
     rec = simulate_hammer_test(truth, n_hits=5, duration_s=2.0, noise_force=0.005,
                                noise_response=0.005, seed=4)
+    with pytest.warns(LeakageWarning, match="has not decayed"):
+        assert estimate_frf(rec).decay_ratio[0] > 0.2
     tau = 0.5
     d = estimate_frf(rec, exp_window_tau_s=tau).frf
     assert d.exp_window_tau_s == tau
@@ -121,7 +124,8 @@ def test_double_hit_and_overload_are_detected_and_dropped():
     clean = simulate_hammer_test(truth, n_hits=2, seed=6, noise_force=0.05, noise_response=0.05)
     with warnings.catch_warnings():
         warnings.simplefilter("error", DoubleHitWarning)
-        estimate_frf(clean)
+        warnings.simplefilter("error", LeakageWarning)  # 8 s records: decayed, no warning
+        assert estimate_frf(clean).decay_ratio.max() < 0.1
 
 
 def test_check_hit_hand_made():

@@ -77,7 +77,7 @@ def modes_cmd(
     from robobore.errors import ConfigError
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
-    from robobore.modal.frf import DoubleHitWarning, FRFData, estimate_frf
+    from robobore.modal.frf import DoubleHitWarning, FRFData, LeakageWarning, estimate_frf
     from robobore.modal.identify import identify_modes
     from robobore.modal.io import load_input
 
@@ -97,6 +97,7 @@ def modes_cmd(
         if not isinstance(data, FRFData):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", DoubleHitWarning)
+                warnings.simplefilter("always", LeakageWarning)
                 est = estimate_frf(data, estimator=estimator, exp_window_tau_s=exp_window_tau_s,
                                    drop_flagged=drop_flagged)
             warn_list += [str(w.message) for w in caught]

@@ -480,16 +480,43 @@ class FRFEstimate:
     frf: FRFData
     hits: tuple[HitCheck, ...]
     n_averages: np.ndarray  # (n_inputs,) hits used per input
+    decay_ratio: np.ndarray | None = None  # (n_inputs,) median over hits, record_decay_ratio
 
     def to_dict(self) -> dict[str, Any]:
-        return {"hits": [h.to_dict() for h in self.hits],
-                "n_averages": self.n_averages.tolist()}
+        d: dict[str, Any] = {"hits": [h.to_dict() for h in self.hits],
+                             "n_averages": self.n_averages.tolist()}
+        if self.decay_ratio is not None:
+            d["decay_ratio"] = self.decay_ratio.tolist()
+        return d
+
+
+class LeakageWarning(UserWarning):
+    """The response has not decayed by the end of the record (leakage)."""
+
+
+def record_decay_ratio(response: np.ndarray, t_peak: int) -> float:
+    """RMS of the last 10 % of a record over the RMS of the 10 % after the hammer peak,
+    worst channel; ``response`` ``(n_outputs, n_samples)``. The noise floor, estimated from
+    the pre-trigger samples (when there are >= 8), is removed in power from the tail, so the
+    ratio is ~0 when the response has died out and large when the free decay was truncated
+    (leakage)."""
+    n = response.shape[-1]
+    m = max(4, n // 10)
+    head = response[:, t_peak: t_peak + m]
+    tail = response[:, n - m:]
+    h2 = np.mean(head**2, axis=-1)
+    t2 = np.mean(tail**2, axis=-1)
+    pre = t_peak - 4  # leave out the samples next to the pulse
+    if pre >= 8:
+        t2 = np.maximum(t2 - np.mean(response[:, :pre] ** 2, axis=-1), 0.0)
+    return float(np.max(np.sqrt(t2 / np.where(h2 > 0, h2, np.inf))))
 
 
 def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
                  exp_window_tau_s: float | None = None, use_force_window: bool = True,
                  force_window_s: float | None = None, drop_flagged: bool = False,
-                 double_hit_threshold: float = 0.1) -> FRFEstimate:
+                 double_hit_threshold: float = 0.1,
+                 leakage_threshold: float = 0.1) -> FRFEstimate:
     """Average FRFs and coherence over the hits of every input.
 
     Parameters
@@ -502,6 +529,8 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
     use_force_window, force_window_s: force window (see :func:`force_window`).
     drop_flagged: leave out hits flagged as double hits/overloads (a warning is issued
         either way).
+    leakage_threshold: warn (LeakageWarning) when, without exponential window, the median
+        over the hits of :func:`record_decay_ratio` exceeds this value.
 
     Returns
     -------
@@ -522,6 +551,8 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
     saa = np.zeros((no, ni, nf))
     checks: list[HitCheck] = []
     used = np.zeros(ni, int)
+    decay = np.zeros(ni)
+    ratios: list[float] = []
     for i in range(ni):
         for h in range(nh):
             f = records.force[i, h]
@@ -553,6 +584,15 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
             sfa[:, i] += np.conj(F)[None, :] * A
             saa[:, i] += np.abs(A) ** 2
             used[i] += 1
+            ratios.append(record_decay_ratio(r, int(np.argmax(np.abs(f)))))
+        decay[i] = float(np.median(ratios)) if ratios else 0.0
+        ratios.clear()
+        if exp_window_tau_s is None and decay[i] > leakage_threshold:
+            warnings.warn(
+                f"input {records.input_names[i]}: the response has not decayed by the end of "
+                f"the record (end/start RMS {decay[i]:.2f}): leakage biases damping; use an "
+                f"exponential window, e.g. tau = {n / fs / 4:.3g} s (--exp-window-tau-s)",
+                LeakageWarning, stacklevel=2)
         if used[i] == 0:
             raise DataError("no valid hit left for an input", file=records.source,
                             field=f"input {records.input_names[i]}",
@@ -584,11 +624,12 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
                    exp_window_tau_s, records.source,
                    tuple(records.meta.get("output_dofs", ())),
                    tuple(records.meta.get("input_dofs", ())))
-    return FRFEstimate(data, tuple(checks), used)
+    return FRFEstimate(data, tuple(checks), used, decay)
 
 
 __all__ = [
     "FRF_TYPES", "FRF_UNITS", "FRFData", "HammerRecords", "HitCheck", "FRFEstimate",
-    "DoubleHitWarning", "estimate_frf", "convert_frf", "check_hit", "force_window",
+    "DoubleHitWarning", "LeakageWarning", "record_decay_ratio", "estimate_frf", "convert_frf",
+    "check_hit", "force_window",
     "exponential_window", "check_frequencies", "check_frf_array",
 ]
