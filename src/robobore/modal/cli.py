@@ -26,12 +26,13 @@ def _render_modes(res: dict[str, Any]) -> None:
     t = Table(title=f"Modes ({res['source'] or 'data'}, band {res['band_Hz'][0]:.4g}-"
               f"{res['band_Hz'][1]:.4g} Hz, orders up to {res['max_order']})",
               header_style="bold")
-    for c in ("#", "frequency (Hz)", "damping (%)", "MPC", "direction", "orders stable",
-              "CMIF support"):
+    for c in ("#", "frequency (Hz)", "damping (%)", "MPC", "dominant input",
+              "modal mass there (kg)", "orders stable", "CMIF support"):
         t.add_column(c, justify="right")
     for k, m in enumerate(res["modes"]):
+        mass = m.get("modal_mass_kg", {}).get(m["dominant_input"])
         t.add_row(str(k + 1), f"{m['frequency_Hz']:.4f}", f"{100 * m['damping_ratio']:.3f}",
-                  f"{m['mpc']:.3f}", m["dominant_input"], str(m["cluster_size"]),
+                  f"{m['mpc']:.3f}", m["dominant_input"], fmt(mass), str(m["cluster_size"]),
                   fmt(m["cmif_support"]))
     stdout.print(t)
     st = res["stabilisation"]
