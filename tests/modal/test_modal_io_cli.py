@@ -194,7 +194,7 @@ def test_cli_virtual_test_then_modes_table(tmp_path):
     r = runner.invoke(app, ["identify", "modes", str(out), "--band-hz", "3", "60",
                             "--modes", "5", "--drop-flagged", "--out", str(tmp_path / "m.json")])
     assert r.exit_code == 0, r.output
-    assert "double hit" in " ".join(r.stdout.split()) and "frequency" in r.stdout
+    assert "double hit" in " ".join(r.stdout.split()) and "f (Hz)" in r.stdout
     res = json.loads((tmp_path / "m.json").read_text())
     assert res["hits"]["n_averages"] == [2, 3]
     assert len(res["modes"]) == 5

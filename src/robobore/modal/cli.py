@@ -26,8 +26,9 @@ def _render_modes(res: dict[str, Any]) -> None:
     t = Table(title=f"Modes ({res['source'] or 'data'}, band {res['band_Hz'][0]:.4g}-"
               f"{res['band_Hz'][1]:.4g} Hz, orders up to {res['max_order']})",
               header_style="bold")
-    for c in ("#", "frequency (Hz)", "damping (%)", "MPC", "dominant input",
-              "modal mass there (kg)", "orders stable", "CMIF support"):
+    # dominant input: hammer input with the largest residues; m_eff: effective modal mass
+    # at that input's driving point; orders: pLSCF orders where the mode is stable
+    for c in ("#", "f (Hz)", "zeta (%)", "MPC", "input", "m_eff (kg)", "orders", "CMIF"):
         t.add_column(c, justify="right")
     for k, m in enumerate(res["modes"]):
         mass = m.get("modal_mass_kg", {}).get(m["dominant_input"])
