@@ -75,3 +75,27 @@ def test_cli_version_and_help():
     assert r.exit_code == 0 and "robobore" in r.stdout
     r = CliRunner().invoke(app, ["--help"])
     assert r.exit_code == 0
+
+
+def test_installed_package_has_every_data_file():
+    """Every non-Python file in the source tree ships with the installed package (the tests
+    may run against a wheel install, as in CI; a file left out of package-data breaks users)."""
+    from pathlib import Path
+
+    import robobore
+
+    src = Path(__file__).resolve().parents[1] / "src" / "robobore"
+    if not src.is_dir():
+        pytest.skip("no source tree beside the tests")
+    installed = Path(robobore.__file__).resolve().parent
+    skip_parts = {"__pycache__"}
+    missing = []
+    for f in src.rglob("*"):
+        if f.is_dir() or f.suffix in {".py", ".pyc", ".nbi", ".nbc"}:
+            continue
+        rel = f.relative_to(src)
+        if skip_parts & set(rel.parts) or rel.name.startswith("."):
+            continue
+        if not (installed / rel).is_file():
+            missing.append(str(rel))
+    assert not missing, f"not installed (add to package-data in pyproject.toml): {missing}"
