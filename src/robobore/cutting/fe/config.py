@@ -1,0 +1,169 @@
+"""The FE orthogonal-cutting config (TOML) as a pydantic model, with documented defaults.
+
+Human units in the key names (um, mm, m/min, deg, MPa); :meth:`FEConfig.si` gives SI values.
+Only the contract keys are required (see ``examples/fe_orthogonal.toml``); every other key
+has the default documented on its field.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from robobore.errors import ConfigError
+from robobore.io.config import load_toml, validate_model
+
+#: Coulomb friction coefficient vs cutting speed [m/min] for Ti6Al4V on uncoated WC
+#: (Rech et al. 2013, as used by Ducobu, Pantale et al. 2022; see
+#: ../shared/data/ti64_orthogonal_cutting_forces.json). Used when ``contact.friction`` is
+#: "table": linear interpolation, constant beyond the ends.
+FRICTION_TABLE_VC_M_MIN = np.array([5.0, 7.5, 10.0, 20.0, 30.0, 40.0])
+FRICTION_TABLE_MU = np.array([0.24, 0.22, 0.21, 0.19, 0.18, 0.17])
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class MaterialSection(_Strict):
+    #: bundled material name (e.g. "TC4") or a path to a material TOML file
+    name: str = "TC4"
+
+
+class ToolSection(_Strict):
+    rake_deg: float = Field(ge=-30.0, le=40.0, description="rake angle, -30..40 deg")
+    clearance_deg: float = Field(gt=0.0, le=30.0, description="clearance angle, 0..30 deg")
+    edge_radius_um: float = Field(ge=0.0, le=200.0, description="cutting-edge radius, um")
+
+
+class CutSection(_Strict):
+    uncut_chip_thickness_um: float = Field(gt=0.0, le=2000.0)
+    cutting_speed_m_per_min: float = Field(gt=0.0, le=2000.0)
+    length_mm: float = Field(gt=0.0, le=50.0, description="length of cut simulated, mm")
+    #: width of cut [mm]; 2D results are per unit width, totals (tool support) use it
+    width_mm: float = Field(default=1.0, gt=0.0)
+
+
+class ContactSection(_Strict):
+    #: Coulomb coefficient, or "table" for the Rech et al. 2013 mu(vc) table
+    friction: float | Literal["table"] = "table"
+    #: cap on the contact shear stress [MPa] (Ducobu/Pantale model input: 576 MPa)
+    shear_limit_MPa: float = Field(default=576.0, gt=0.0)
+    #: penalty factor: normal stiffness = factor * nodal mass / dt^2 (0 < factor <= 0.5)
+    penalty_factor: float = Field(default=0.1, gt=0.0, le=0.5)
+
+    @field_validator("friction")
+    @classmethod
+    def _mu(cls, v: Any) -> Any:
+        if isinstance(v, float) and not (0.0 <= v <= 2.0):
+            raise ValueError("friction coefficient must be within 0..2")
+        return v
+
+
+class MeshSection(_Strict):
+    #: element size in the cutting zone and chip layer [um]; at most h/3
+    element_size_um: float = Field(gt=0.0)
+    #: depth of the fine zone below the cut line, in uncut chip thicknesses
+    fine_depth_factor: float = Field(default=1.0, ge=0.2, le=10.0)
+    #: total workpiece height below the free surface, in uncut chip thicknesses
+    height_factor: float = Field(default=5.0, ge=2.0, le=50.0)
+    #: growth ratio of element size outside the fine zone (1 = uniform)
+    grading: float = Field(default=1.25, ge=1.0, le=2.0)
+    #: uncut material left ahead of the tool at the end of the cut [mm]
+    ahead_mm: float = Field(default=0.3, gt=0.0, le=20.0)
+
+
+class SolverSection(_Strict):
+    #: density factor applied to the inertial (not the thermal) mass: time step grows by
+    #: sqrt(mass_scaling); 1 = none
+    mass_scaling: float = Field(default=1.0, ge=1.0, le=1e6)
+    #: fraction of the stable time step (element length / dilatational wave speed)
+    cfl: float = Field(default=0.8, gt=0.0, le=1.0)
+    #: Flanagan-Belytschko hourglass control coefficients (viscous, stiffness)
+    hourglass_viscous: float = Field(default=0.05, ge=0.0, le=0.5)
+    hourglass_stiffness: float = Field(default=0.05, ge=0.0, le=0.5)
+    #: bulk viscosity (linear, quadratic), active in compression
+    bulk_viscosity_linear: float = Field(default=0.06, ge=0.0, le=1.0)
+    bulk_viscosity_quadratic: float = Field(default=1.2, ge=0.0, le=4.0)
+    #: where elements erode when JC damage reaches 1: "layer" (separation layer along the
+    #: cut line), "everywhere", or "none"
+    erosion: Literal["layer", "everywhere", "none"] = "layer"
+    #: erode an element whose area ratio A/A0 or corner Jacobian falls below this (numerical
+    #: safety against inverted elements; counted and reported separately); 0 disables
+    distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
+    #: heat conduction between elements (explicit, finite-volume); false = adiabatic
+    conduction: bool = False
+    #: number of force/tool samples over the whole run
+    n_samples: int = Field(default=400, ge=10, le=100000)
+    #: steps per compiled chunk between progress updates
+    chunk_steps: int = Field(default=2000, ge=10, le=10**7)
+    #: fraction of the cut (from its end) averaged for the steady-state values
+    steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
+    #: stop with NumericalError when |energy error| exceeds this after 10 % of the cut
+    energy_error_limit: float = Field(default=0.5, gt=0.0)
+
+
+class ToolSupport(_Strict):
+    """Spring/damper/mass holding the tool to its guide point; (x, y) pairs or one value."""
+
+    stiffness_N_per_m: float | list[float]
+    damping_N_s_per_m: float | list[float]
+    mass_kg: float | list[float]
+
+    @field_validator("stiffness_N_per_m", "damping_N_s_per_m", "mass_kg")
+    @classmethod
+    def _pair(cls, v: Any) -> Any:
+        vals = [v, v] if isinstance(v, float | int) else list(v)
+        if len(vals) != 2:
+            raise ValueError("give one value or [x, y]")
+        if any(x < 0 for x in vals):
+            raise ValueError("must be >= 0")
+        return [float(x) for x in vals]
+
+    @model_validator(mode="after")
+    def _pos(self) -> ToolSupport:
+        if any(m <= 0 for m in self.mass_kg):  # type: ignore[union-attr]
+            raise ValueError("mass_kg must be > 0")
+        return self
+
+
+class FEConfig(_Strict):
+    material: MaterialSection = MaterialSection()
+    tool: ToolSection
+    cut: CutSection
+    contact: ContactSection = ContactSection()
+    mesh: MeshSection
+    solver: SolverSection = SolverSection()
+    tool_support: ToolSupport | None = None
+
+    def friction_coefficient(self) -> float:
+        """Coulomb coefficient used (the value given, or the table at the cutting speed)."""
+        if self.contact.friction == "table":
+            return float(np.interp(self.cut.cutting_speed_m_per_min,
+                                   FRICTION_TABLE_VC_M_MIN, FRICTION_TABLE_MU))
+        return float(self.contact.friction)
+
+
+def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
+    """Cross-field checks (element size vs chip thickness)."""
+    h = cfg.cut.uncut_chip_thickness_um
+    le = cfg.mesh.element_size_um
+    if le > h / 3.0 + 1e-12:
+        raise ConfigError("element too large for the chip thickness", file=source,
+                          field="mesh.element_size_um", value=le,
+                          expected=f"an element size in um at most uncut_chip_thickness_um/3 "
+                          f"= {h / 3.0:.4g} um")
+    return cfg
+
+
+def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
+    """Validate a config dict (as read from TOML)."""
+    return check_config(validate_model(FEConfig, data, source=source or "<config>"), source)
+
+
+def load_fe_config(path: str | Path) -> FEConfig:
+    """Read and validate an FE config TOML file."""
+    return parse_config(load_toml(path), str(path))

@@ -1,0 +1,448 @@
+"""Numba kernels of the explicit plane-strain cutting engine (SI units, per unit width).
+
+Element: 4-node quadrilateral, one-point (centroid) integration -- no volumetric locking in
+isochoric plastic flow -- with Flanagan-Belytschko (1981) hourglass control, viscous plus
+stiffness (the stiffness part stored per element and co-rotated with the element spin).
+Stress update: hypoelastic, Jaumann rate, Johnson-Cook radial return
+(:func:`robobore.material.johnson_cook.radial_return`), adiabatic heating with the
+Taylor-Quinney factor, Johnson-Cook damage, bulk viscosity (von Neumann-Richtmyer linear +
+quadratic, in compression). Time integration: central difference, lumped mass.
+
+Reference: Flanagan D.P., Belytschko T. (1981), "A uniform strain hexahedron and quadrilateral
+with orthogonal hourglass control", IJNME 17, 679-706; Belytschko, Liu, Moran (2000),
+*Nonlinear Finite Elements for Continua and Structures*, ch. 6 (explicit, stable step,
+energy balance).
+
+Layout of the small state arrays (indices are module constants):
+``prm`` float64 parameters, ``tool`` float64 tool state, ``en`` float64 energy accumulators,
+``ist`` int64 counters/status, ``hist`` (n_samples, N_HIST) time-averaged histories.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit, prange
+
+from robobore.cutting.fe.physics import contact_force, radial_return, tool_gap, tool_support_step
+from robobore.material import johnson_cook as jc
+
+# --- prm indices (float parameters)
+P_CFL, P_MS, P_HGV, P_HGS, P_BV1, P_BV2, P_DIST = 0, 1, 2, 3, 4, 5, 6
+P_MU, P_TAU, P_PEN, P_R = 7, 8, 9, 10
+P_NRX, P_NRY, P_NFX, P_NFY = 11, 12, 13, 14
+P_VC, P_KX, P_KY, P_CX, P_CY, P_MX, P_MY, P_WIDTH = 15, 16, 17, 18, 19, 20, 21, 22
+P_SAMPLE_DT, P_DTMIN, P_TEND, P_EROSION, P_SUPPORT = 23, 24, 25, 26, 27
+N_PRM = 28
+# erosion modes
+ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
+# --- tool state: guide x, y; displacement u, v; velocity of displacement; force
+T_GX, T_GY, T_UX, T_UY, T_VUX, T_VUY, T_FX, T_FY = 0, 1, 2, 3, 4, 5, 6, 7
+N_TOOL = 8
+# --- energies
+E_EXT, E_KIN, E_INT, E_PLAST, E_HG, E_FRIC, E_NODEWORK, E_ERODED, E_EROKE = range(9)
+N_EN = 9
+# --- int state
+I_STEP, I_SAMPLE, I_STATUS, I_ERODED_DAMAGE, I_ERODED_DIST, I_BADELEM = 0, 1, 2, 3, 4, 5
+N_IST = 6
+STATUS_OK, STATUS_NONFINITE, STATUS_DT_COLLAPSE, STATUS_DONE, STATUS_INVERTED = 0, 1, 2, 3, 4
+STATUS_NO_ELEMENTS = 5
+# --- history columns (time averages over each sample interval)
+H_T, H_FX, H_FY, H_UX, H_UY, H_TIP_X, H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT = range(12)
+H_EERO, H_NCONT = 12, 13
+N_HIST = 14
+
+
+@njit(parallel=True, cache=True)
+def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp,
+                   dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
+                   erosion):
+    """Stress update and element nodal forces at the new configuration.
+
+    Writes ``fex``/``fey`` (n_elem, 4) internal nodal forces [N/m], ``dte`` (n_elem,) the
+    element stable step [s], ``ie`` internal energy per element [J/m] (cumulative),
+    ``plast`` plastic work per element [J/m], ``hge`` hourglass work [J/m]. Erodes
+    elements (``alive`` = 0 damage, -1 distortion).
+    """
+    ne = conn.shape[0]
+    E = mat[jc.E_MOD]
+    nu = mat[jc.NU]
+    G = E / (2.0 * (1.0 + nu))
+    K = E / (3.0 * (1.0 - 2.0 * nu))
+    rho_s = mat[jc.RHO] * prm[P_MS]
+    rcp = mat[jc.RHO] * mat[jc.CP]
+    beta = mat[jc.BETA_TQ]
+    a_, b_, n_, c_, m_ = mat[jc.A], mat[jc.B], mat[jc.N], mat[jc.C], mat[jc.M]
+    e0, tr_, tm_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT]
+    hgv = prm[P_HGV]
+    hgs = prm[P_HGS]
+    bv1 = prm[P_BV1]
+    bv2 = prm[P_BV2]
+    dlim = prm[P_DIST]
+    for e in prange(ne):
+        if alive[e] != 1:
+            for k in range(4):
+                fex[e, k] = 0.0
+                fey[e, k] = 0.0
+            dte[e] = 1e30
+            continue
+        i1 = conn[e, 0]
+        i2 = conn[e, 1]
+        i3 = conn[e, 2]
+        i4 = conn[e, 3]
+        x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
+        y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
+        A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
+        # corner Jacobians (2x twice the corner triangle area); all > 0 for a convex quad
+        c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
+        c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
+        c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
+        c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
+        cmin = min(min(c1, c2), min(c3, c4))
+        if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
+            # inverted (-2: an error unless the distortion limit caught it) or distorted (-1)
+            alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
+            for k in range(4):
+                fex[e, k] = 0.0
+                fey[e, k] = 0.0
+            dte[e] = 1e30
+            continue
+        inv2a = 0.5 / A
+        bx1 = (y2 - y4) * inv2a
+        bx2 = (y3 - y1) * inv2a
+        bx3 = (y4 - y2) * inv2a
+        bx4 = (y1 - y3) * inv2a
+        by1 = (x4 - x2) * inv2a
+        by2 = (x1 - x3) * inv2a
+        by3 = (x2 - x4) * inv2a
+        by4 = (x3 - x1) * inv2a
+        u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
+        w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
+        dvxdx = u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
+        dvxdy = u1 * by1 + u2 * by2 + u3 * by3 + u4 * by4
+        dvydx = w1 * bx1 + w2 * bx2 + w3 * bx3 + w4 * bx4
+        dvydy = w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4
+        dxx = dvxdx
+        dyy = dvydy
+        dxy = 0.5 * (dvxdy + dvydx)
+        spin = 0.5 * (dvxdy - dvydx)
+        trd = dxx + dyy
+        # old total stress (for the midpoint stress power)
+        p_old = pres[e]
+        oxx = sdx[e] - p_old
+        oyy = sdy[e] - p_old
+        oxy = sdxy[e]
+        # Jaumann rotation of the deviatoric stress (zz unaffected in plane strain)
+        sx = sdx[e]
+        sy = sdy[e]
+        sxy = sdxy[e]
+        rs = dt * spin
+        sx_r = sx + 2.0 * rs * sxy
+        sy_r = sy - 2.0 * rs * sxy
+        sxy_r = sxy + rs * (sy - sx)
+        # elastic trial
+        tr3 = trd * dt / 3.0
+        tx = sx_r + 2.0 * G * (dxx * dt - tr3)
+        ty = sy_r + 2.0 * G * (dyy * dt - tr3)
+        tz = sdz[e] + 2.0 * G * (-tr3)
+        txy = sxy_r + 2.0 * G * dxy * dt
+        p_new = p_old - K * trd * dt
+        nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
+                                                       G, a_, b_, n_, c_, m_, e0, tr_, tm_)
+        if dep > 0.0:
+            eps_p[e] += dep
+            rate[e] = dep / dt
+            wp = syld * dep
+            plast[e] += wp * A
+            temp[e] += beta * wp / rcp
+            q = syld
+            if q > 0.0:
+                triax = -p_new / q
+            else:
+                triax = 0.0
+            dmg[e] += jc.jc_damage_increment(dep, triax, dep / dt, temp[e], mat[jc.D1],
+                                             mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
+                                             e0, tr_, tm_)
+        else:
+            rate[e] = 0.0
+        sdx[e] = nsx
+        sdy[e] = nsy
+        sdz[e] = nsz
+        sdxy[e] = nsxy
+        pres[e] = p_new
+        # bulk viscosity (compression only) and stable step
+        rho_c = rho_s * area0[e] / A
+        c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
+        bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
+                + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
+        le = 1.0 / math.sqrt(bsum)
+        qbv = 0.0
+        qrate = 0.0
+        if trd < 0.0:
+            qrate = bv1 * c + bv2 * le * (-trd)
+            qbv = rho_c * le * qrate * (-trd)
+        dte[e] = le / (qrate + math.sqrt(qrate * qrate + c * c))
+        fxx = nsx - p_new - qbv
+        fyy = nsy - p_new - qbv
+        # stress power (midpoint) -> internal energy
+        ie[e] += A * dt * (0.5 * (oxx + fxx) * dxx + 0.5 * (oyy + fyy) * dyy
+                           + (oxy + nsxy) * dxy)
+        # hourglass (Flanagan-Belytschko): gamma vectors for h = (1, -1, 1, -1)
+        hx = x1 - x2 + x3 - x4
+        hy = y1 - y2 + y3 - y4
+        g1 = 0.25 * (1.0 - hx * bx1 - hy * by1)
+        g2 = 0.25 * (-1.0 - hx * bx2 - hy * by2)
+        g3 = 0.25 * (1.0 - hx * bx3 - hy * by3)
+        g4 = 0.25 * (-1.0 - hx * bx4 - hy * by4)
+        qx = g1 * u1 + g2 * u2 + g3 * u3 + g4 * u4
+        qy = g1 * w1 + g2 * w2 + g3 * w3 + g4 * w4
+        # stiffness part: stored, co-rotated, rate-form
+        hsx = qhx[e]
+        hsy = qhy[e]
+        hsx, hsy = hsx + rs * hsy, hsy - rs * hsx
+        kh = hgs * G * A * bsum
+        hsx += dt * kh * qx
+        hsy += dt * kh * qy
+        qhx[e] = hsx
+        qhy[e] = hsy
+        cv = 2.0 * hgv * rho_c * c * math.sqrt(A)
+        Qx = hsx + cv * qx
+        Qy = hsy + cv * qy
+        hge[e] += dt * (Qx * qx + Qy * qy)
+        fex[e, 0] = A * (fxx * bx1 + nsxy * by1) + Qx * g1
+        fex[e, 1] = A * (fxx * bx2 + nsxy * by2) + Qx * g2
+        fex[e, 2] = A * (fxx * bx3 + nsxy * by3) + Qx * g3
+        fex[e, 3] = A * (fxx * bx4 + nsxy * by4) + Qx * g4
+        fey[e, 0] = A * (nsxy * bx1 + fyy * by1) + Qy * g1
+        fey[e, 1] = A * (nsxy * bx2 + fyy * by2) + Qy * g2
+        fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
+        fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
+        # erosion by Johnson-Cook damage
+        if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+            alive[e] = 0
+
+
+@njit(parallel=True, cache=True)
+def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
+                cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx, tool_vy,
+                prm, dt):
+    """Gather element forces, add tool contact, advance velocities and positions.
+
+    Contact uses positions at step n and velocities at n-1/2; ``cfx``/``cfy`` receive the
+    contact force on each node [N/m]; ``fric`` (cumulative) the frictional dissipation,
+    ``pen`` the current penalty energy, ``nwork`` (cumulative) the contact work on the node
+    [J/m]. Nodes left without a live element are retired (velocity zeroed, their kinetic
+    energy booked in ``ero_ke``).
+    """
+    nn = x.shape[0]
+    r = prm[P_R]
+    nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
+    mu, tau, pf = prm[P_MU], prm[P_TAU], prm[P_PEN]
+    for n in prange(nn):
+        cfx[n] = 0.0
+        cfy[n] = 0.0
+        pen[n] = 0.0
+        if ndead[n]:
+            continue
+        fx = 0.0
+        fy = 0.0
+        nlive = 0
+        asum = 0.0
+        for k in range(ptr[n], ptr[n + 1]):
+            e = nel[k]
+            if alive[e] == 1:
+                c = ncorner[k]
+                fx -= fex[e, c]
+                fy -= fey[e, c]
+                nlive += 1
+                asum += area0[e]
+        if nlive == 0:
+            ndead[n] = 1
+            ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
+            vx[n] = 0.0
+            vy[n] = 0.0
+            continue
+        if fixed[n]:
+            vx[n] = 0.0
+            vy[n] = 0.0
+            continue
+        m = mass[n]
+        gap, gnx, gny = tool_gap(x[n], y[n], tool_cx, tool_cy, nrx, nry, nfx, nfy, r)
+        fcx = 0.0
+        fcy = 0.0
+        ft = 0.0
+        vt0 = 0.0
+        if gap < 0.0:
+            vrx = vx[n] - tool_vx
+            vry = vy[n] - tool_vy
+            trib = math.sqrt(asum / nlive)
+            fcx, fcy, fn, ft = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf, dt)
+            vt0 = -vrx * gny + vry * gnx
+            pen[n] = 0.5 * fn * (-gap)
+        cfx[n] = fcx
+        cfy[n] = fcy
+        ox = vx[n]
+        oy = vy[n]
+        nvx = ox + dt * (fx + fcx) / m
+        nvy = oy + dt * (fy + fcy) / m
+        vx[n] = nvx
+        vy[n] = nvy
+        x[n] += dt * nvx
+        y[n] += dt * nvy
+        if gap < 0.0:
+            nwork[n] += dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
+            vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
+            fric[n] -= dt * ft * 0.5 * (vt0 + vt1)
+
+
+@njit(cache=True)
+def _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
+    ke = 0.0
+    for n in range(mass.shape[0]):
+        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
+    si = 0.0
+    sp = 0.0
+    sh = 0.0
+    se = 0.0
+    for e in range(ie.shape[0]):
+        si += ie[e]
+        sp += plast[e]
+        sh += hge[e]
+        if alive[e] != 1:
+            se += ie[e]
+    sf = 0.0
+    spn = 0.0
+    sek = 0.0
+    sw = 0.0
+    for n in range(mass.shape[0]):
+        sf += fric[n]
+        spn += pen[n]
+        sek += ero_ke[n]
+        sw += nwork[n]
+    en[E_KIN] = ke
+    en[E_INT] = si
+    en[E_PLAST] = sp
+    en[E_HG] = sh
+    en[E_FRIC] = sf + spn
+    en[E_NODEWORK] = sw
+    en[E_ERODED] = se + sek
+    en[E_EROKE] = sek
+
+
+@njit(cache=True)
+def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
+              sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
+              dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
+              en, ist, clock, hacc, hist):
+    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
+
+    ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
+    sample interval). Stops early with ``ist[I_STATUS]`` = STATUS_DONE at ``prm[P_TEND]``,
+    STATUS_NONFINITE or STATUS_DT_COLLAPSE. Returns the number of steps taken.
+    """
+    erosion = int(prm[P_EROSION])
+    support = prm[P_SUPPORT] > 0.5
+    vc = prm[P_VC]
+    width = prm[P_WIDTH]
+    cfl = prm[P_CFL]
+    nn = x.shape[0]
+    ne = conn.shape[0]
+    taken = 0
+    for _s in range(n_steps):
+        dt = clock[1]
+        t = clock[0]
+        cx = tool[T_GX] + tool[T_UX]
+        cy = tool[T_GY] + tool[T_UY]
+        tvx = -vc + tool[T_VUX]
+        tvy = tool[T_VUY]
+        node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
+                    cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy, prm, dt)
+        fwx = 0.0
+        fwy = 0.0
+        ncont = 0
+        for n in range(nn):
+            if cfx[n] != 0.0 or cfy[n] != 0.0:
+                fwx += cfx[n]
+                fwy += cfy[n]
+                ncont += 1
+        # force on the tool = - force on the workpiece [N/m]
+        tool[T_FX] = -fwx
+        tool[T_FY] = -fwy
+        if support:
+            ux, vux = tool_support_step(tool[T_UX], tool[T_VUX], -fwx * width, prm[P_KX],
+                                        prm[P_CX], prm[P_MX], dt)
+            uy, vuy = tool_support_step(tool[T_UY], tool[T_VUY], -fwy * width, prm[P_KY],
+                                        prm[P_CY], prm[P_MY], dt)
+            tool[T_UX] = ux
+            tool[T_VUX] = vux
+            tool[T_UY] = uy
+            tool[T_VUY] = vuy
+        tool[T_GX] -= vc * dt
+        tvx_new = -vc + tool[T_VUX]
+        tvy_new = tool[T_VUY]
+        en[E_EXT] += dt * (fwx * 0.5 * (tvx + tvx_new) + fwy * 0.5 * (tvy + tvy_new))
+        element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                       temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
+                       prm, dt, erosion)
+        dtmin = 1e30
+        for e in range(ne):
+            if dte[e] < dtmin:
+                dtmin = dte[e]
+            if alive[e] == -2:
+                ist[I_BADELEM] = e
+                ist[I_STATUS] = STATUS_INVERTED
+        if ist[I_STATUS] == STATUS_INVERTED:
+            return taken + 1
+        if dtmin >= 1e30:
+            ist[I_STATUS] = STATUS_NO_ELEMENTS
+            return taken + 1
+        new_dt = cfl * dtmin
+        t += dt
+        clock[0] = t
+        taken += 1
+        ist[I_STEP] += 1
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(new_dt)):
+            ist[I_STATUS] = STATUS_NONFINITE
+            return taken
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = STATUS_DT_COLLAPSE
+            clock[1] = new_dt
+            return taken
+        clock[1] = new_dt
+        # time-averaged histories
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_NCONT] += dt * ncont
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            if not math.isfinite(en[E_KIN]):
+                ist[I_STATUS] = STATUS_NONFINITE
+                return taken
+            hist[k, H_T] = t
+            hist[k, H_FX] = hacc[H_FX] / ta
+            hist[k, H_FY] = hacc[H_FY] / ta
+            hist[k, H_UX] = hacc[H_UX] / ta
+            hist[k, H_UY] = hacc[H_UY] / ta
+            hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
+            hist[k, H_EKIN] = en[E_KIN]
+            hist[k, H_EINT] = en[E_INT]
+            hist[k, H_EPL] = en[E_PLAST]
+            hist[k, H_EHG] = en[E_HG]
+            hist[k, H_EFRIC] = en[E_FRIC]
+            hist[k, H_EEXT] = en[E_EXT]
+            hist[k, H_EERO] = en[E_ERODED]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = STATUS_DONE
+            _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            return taken
+    return taken

@@ -1,0 +1,147 @@
+"""Graded structured quad mesh of the orthogonal-cutting workpiece (SI units).
+
+Frame: x along the workpiece (the tool moves towards -x), y up; the free surface is y = 0,
+the tool's lowest point (cut line) is at y = -h. Layout from top to bottom:
+
+* chip layer, 0 > y > -h + le/2, uniform rows of about ``le`` (element size);
+* the separation layer, one row of height ``le`` centred on the cut line y = -h;
+* a fine zone of ``fine_depth_factor * h`` below it, uniform ``le``;
+* rows growing geometrically (ratio ``grading``) down to y = -height_factor * h.
+
+Columns are uniform (``le``) over the cut and ``3 h`` beyond its end, then grow
+geometrically towards the fixed back end x = 0. Nodes on x = 0 and on the bottom are fixed.
+Elements are numbered row by row, nodes counter-clockwise (n1..n4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def _graded(length: float, h0: float, ratio: float) -> np.ndarray:
+    """Element sizes (first = h0, growing by ``ratio``) that fill ``length`` exactly."""
+    sizes: list[float] = []
+    total = 0.0
+    s = h0
+    while total + s < length - 1e-12 * length:
+        sizes.append(s)
+        total += s
+        s *= ratio
+    rest = length - total
+    if sizes and rest < 0.5 * sizes[-1]:
+        sizes[-1] += rest
+    else:
+        sizes.append(rest)
+    return np.array(sizes)
+
+
+@dataclass(frozen=True)
+class CuttingMesh:
+    """Quad mesh: ``nodes`` (n_nodes, 2) [m], ``conn`` (n_elem, 4) counter-clockwise.
+
+    ``layer`` (n_elem,) bool: separation-layer elements; ``chip`` (n_elem,) bool: elements
+    of the uncut chip layer; ``fixed`` (n_nodes,) bool: nodes held in x and y;
+    ``surface`` (n_nodes,) bool: nodes on the initial free surface y = 0.
+    ``node_elems_ptr``/``node_elems`` (CSR) and ``node_corner`` list the elements (and the
+    node's local corner 0..3) around each node.
+    """
+
+    nodes: np.ndarray
+    conn: np.ndarray
+    layer: np.ndarray
+    chip: np.ndarray
+    fixed: np.ndarray
+    surface: np.ndarray
+    node_elems_ptr: np.ndarray
+    node_elems: np.ndarray
+    node_corner: np.ndarray
+    length: float
+    height: float
+    y_cut: float
+    element_size: float
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.conn.shape[0])
+
+
+def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
+               fine_depth_factor: float = 1.0, height_factor: float = 5.0,
+               grading: float = 1.25) -> CuttingMesh:
+    """Graded mesh for uncut chip thickness ``h`` [m], element size ``le`` [m], cut length [m].
+
+    The workpiece spans x in [0, ahead + cut_length]; the cut runs from the right end to
+    x = ahead.
+    """
+    n_chip = max(1, int(round((h - 0.5 * le) / le)))
+    y_rows = [0.0]
+    top_chip = -(h - 0.5 * le)
+    y_rows += list(np.linspace(0.0, top_chip, n_chip + 1)[1:])
+    y_rows.append(-h - 0.5 * le)  # separation layer
+    layer_row = n_chip  # row index from the top
+    fine_depth = fine_depth_factor * h
+    n_fine = max(1, int(round(fine_depth / le)))
+    y0 = y_rows[-1]
+    y_rows += [y0 - le * (i + 1) for i in range(n_fine)]
+    depth_rest = height_factor * h - (-y_rows[-1])
+    if depth_rest > 0.25 * le:
+        ys = np.cumsum(_graded(depth_rest, le * grading, grading))
+        y_rows += list(y_rows[-1] - ys)
+    y_top_down = np.array(y_rows)
+    yc = y_top_down[::-1].copy()  # bottom -> top
+    n_ey = len(yc) - 1
+    layer_e_row = n_ey - 1 - layer_row
+    chip_rows = set(range(n_ey - n_chip, n_ey))
+
+    total = ahead + cut_length
+    fine_start = max(0.0, ahead - 3.0 * h)
+    n_fx = max(1, int(round((total - fine_start) / le)))
+    x_fine = np.linspace(fine_start, total, n_fx + 1)
+    if fine_start > 0.25 * le:
+        xs = np.cumsum(_graded(fine_start, le * grading, grading))
+        x_left = fine_start - xs
+        x_left[-1] = 0.0
+        xc = np.concatenate([x_left[::-1], x_fine])
+    else:
+        x_fine[0] = 0.0
+        xc = x_fine
+    n_ex = len(xc) - 1
+
+    X, Y = np.meshgrid(xc, yc)  # (ny, nx)
+    nodes = np.column_stack([X.ravel(), Y.ravel()])
+    nxn = n_ex + 1
+    conn = np.empty((n_ex * n_ey, 4), dtype=np.int64)
+    layer = np.zeros(n_ex * n_ey, dtype=bool)
+    chip = np.zeros(n_ex * n_ey, dtype=bool)
+    e = 0
+    for j in range(n_ey):
+        for i in range(n_ex):
+            n1 = j * nxn + i
+            conn[e] = (n1, n1 + 1, n1 + 1 + nxn, n1 + nxn)
+            layer[e] = j == layer_e_row
+            chip[e] = j in chip_rows
+            e += 1
+    fixed = (np.abs(nodes[:, 0]) < 1e-15) | (np.abs(nodes[:, 1] - yc[0]) < 1e-15)
+    surface = np.abs(nodes[:, 1]) < 1e-15
+    n_nodes = nodes.shape[0]
+    counts = np.bincount(conn.ravel(), minlength=n_nodes)
+    ptr = np.zeros(n_nodes + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum(counts)
+    ne = np.empty(ptr[-1], dtype=np.int64)
+    nc = np.empty(ptr[-1], dtype=np.int64)
+    fill = ptr[:-1].copy()
+    for el in range(conn.shape[0]):
+        for k in range(4):
+            n = conn[el, k]
+            ne[fill[n]] = el
+            nc[fill[n]] = k
+            fill[n] += 1
+    return CuttingMesh(nodes=nodes, conn=conn, layer=layer, chip=chip, fixed=fixed,
+                       surface=surface, node_elems_ptr=ptr, node_elems=ne, node_corner=nc,
+                       length=total, height=-yc[0], y_cut=-h, element_size=le)

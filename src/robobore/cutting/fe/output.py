@@ -1,0 +1,216 @@
+"""Results of an FE cutting run: steady-state values, chip geometry, Dataset, VTK, PNG.
+
+Forces are on the tool, per unit width, reported in N/mm (cutting force Fc along the
+cutting speed, feed force Ff normal to the machined surface, both positive when the
+workpiece pushes the tool back / up).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.fe import kernels as K
+
+
+@dataclass(frozen=True)
+class ChipGeometry:
+    """Chip thickness [m] measured on the deformed chip and the derived quantities."""
+
+    thickness: float
+    uncut_thickness: float
+    ratio: float
+    shear_angle_deg: float
+    n_points: int
+    ratio_velocity: float
+
+
+def shear_angle_deg(chip_ratio: float, rake_rad: float) -> float:
+    """Merchant shear angle tan(phi) = cos(rake) / (r_c - sin(rake)), in degrees."""
+    return math.degrees(math.atan2(math.cos(rake_rad), chip_ratio - math.sin(rake_rad)))
+
+
+def _point_polyline_distance(px: np.ndarray, py: np.ndarray, lx: np.ndarray,
+                             ly: np.ndarray) -> np.ndarray:
+    """Distance of each point to the polyline through (lx, ly) (ordered)."""
+    ax, ay = lx[:-1], ly[:-1]
+    bx, by = lx[1:], ly[1:]
+    dx, dy = bx - ax, by - ay
+    ll = np.maximum(dx * dx + dy * dy, 1e-300)
+    t = np.clip(((px[:, None] - ax) * dx + (py[:, None] - ay) * dy) / ll, 0.0, 1.0)
+    qx = ax + t * dx
+    qy = ay + t * dy
+    d = np.hypot(px[:, None] - qx, py[:, None] - qy)
+    return d.min(axis=1)
+
+
+def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
+    """Chip thickness from the deformed mesh.
+
+    Outer chip surface: nodes that started on the free surface (y0 = 0); inner surface: the
+    nodes that started on the top of the separation layer (y0 = -h + le/2), i.e. the chip's
+    underside once the layer has eroded. Only chip material that has risen above the
+    free surface by more than h and lies at least 1.5 h along the rake from the edge is used
+    (formed chip, outside the primary shear zone). Thickness = median distance of the outer
+    nodes to the inner polyline; the ratio refers to the chip layer of the mesh,
+    h - le/2 (the upper half of the eroded separation layer is part of the uncut chip but
+    its mass is deleted). A second ratio from continuity, vc / chip speed, is also given.
+    """
+    le = mesh.element_size
+    y_inner0 = -h + 0.5 * le
+    x, y = st.x, st.y
+    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
+    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    trx, try_ = math.sin(rake), math.cos(rake)
+    alive_n = ~st.ndead
+    s_along = (x - cx) * trx + (y - cy) * try_
+    formed = alive_n & (y > h) & (s_along > 1.5 * h) & (st.x0 > cx)
+    outer = formed & (np.abs(st.y0) < 1e-12)
+    inner_all = alive_n & (np.abs(st.y0 - y_inner0) < 1e-9 * max(h, 1e-9)) & (st.x0 > cx)
+    h_chip0 = h - 0.5 * le
+    if outer.sum() < 2 or inner_all.sum() < 2:
+        return ChipGeometry(math.nan, h_chip0, math.nan, math.nan, int(outer.sum()), math.nan)
+    order = np.argsort(st.x0[inner_all])
+    lx = x[inner_all][order]
+    ly = y[inner_all][order]
+    d = _point_polyline_distance(x[outer], y[outer], lx, ly)
+    tc = float(np.median(d))
+    # continuity: chip speed relative to the tool (plane strain, incompressible)
+    tvx = -vc + st.tool[K.T_VUX]
+    tvy = st.tool[K.T_VUY]
+    chip_nodes = formed & (st.y0 > y_inner0 - 1e-12)
+    if chip_nodes.sum() > 0:
+        vrel = np.hypot(st.vx[chip_nodes] - tvx, st.vy[chip_nodes] - tvy)
+        r_v = vc / float(np.median(vrel)) if np.median(vrel) > 0 else math.nan
+    else:
+        r_v = math.nan
+    ratio = tc / h_chip0
+    return ChipGeometry(tc, h_chip0, ratio, shear_angle_deg(ratio, rake), int(outer.sum()),
+                        r_v)
+
+
+@dataclass
+class FEResult:
+    """Outcome of an orthogonal-cutting run (SI inside; summary keys in human units)."""
+
+    summary: dict[str, Any]
+    history: dict[str, np.ndarray]
+    config: dict[str, Any]
+    final: dict[str, np.ndarray] = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.summary)
+
+
+def steady_window(t: np.ndarray, t_start: float, t_end: float) -> np.ndarray:
+    """Boolean mask of the samples inside [t_start, t_end]."""
+    return (t >= t_start) & (t <= t_end)
+
+
+def to_dataset(res: FEResult):
+    """xarray Dataset: histories on the ``time`` axis, summary values as attributes."""
+    import xarray as xr
+
+    hist = res.history
+    t = hist["time_s"]
+    units = {
+        "cutting_force_N_per_mm": "N/mm", "feed_force_N_per_mm": "N/mm",
+        "tool_dx_um": "um", "tool_dy_um": "um", "tool_tip_x_mm": "mm",
+        "energy_external_J_per_m": "J/m", "energy_kinetic_J_per_m": "J/m",
+        "energy_internal_J_per_m": "J/m", "energy_plastic_J_per_m": "J/m",
+        "energy_hourglass_J_per_m": "J/m", "energy_contact_J_per_m": "J/m",
+        "energy_eroded_J_per_m": "J/m", "contact_nodes": "1",
+    }
+    data = {k: ("time", np.asarray(v), {"units": units.get(k, "")})
+            for k, v in hist.items() if k != "time_s"}
+    ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"})})
+    for k, v in res.summary.items():
+        if isinstance(v, bool):
+            ds.attrs[k] = int(v)
+        elif isinstance(v, int | float | str):
+            ds.attrs[k] = v
+    return ds
+
+
+def write_vtk(res: FEResult, path: str | Path) -> Path:
+    """Deformed mesh with element fields (VTK unstructured grid, via meshio)."""
+    import meshio
+
+    f = res.final
+    live = f["alive"] == 1
+    pts = np.column_stack([f["x"], f["y"], np.zeros_like(f["x"])])
+    cells = [("quad", f["conn"][live])]
+    cd = {k: [f[k][live]] for k in ("eps_p", "temperature_K", "damage", "von_mises_Pa",
+                                     "pressure_Pa")}
+    mesh = meshio.Mesh(pts, cells, cell_data=cd)
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    tmp = p.with_suffix(".tmp.vtu")
+    mesh.write(tmp)
+    tmp.replace(p)
+    return p
+
+
+def plot_chip(res: FEResult, path: str | Path, field_name: str = "temperature_K",
+              window_mm: float | None = None) -> Path:
+    """PNG of the chip region coloured by an element field, with the tool outline."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+
+    f = res.final
+    live = f["alive"] == 1
+    conn = f["conn"][live]
+    verts = np.stack([f["x"][conn] * 1e3, f["y"][conn] * 1e3], axis=-1)
+    vals = f[field_name][live]
+    fig, ax = plt.subplots(figsize=(8, 5), dpi=120)
+    pc = PolyCollection(verts, array=vals, cmap="inferno", edgecolors="face", linewidths=0.1)
+    ax.add_collection(pc)
+    fig.colorbar(pc, ax=ax, label=field_name)
+    tx, ty = f["tool_outline"]
+    ax.fill(tx * 1e3, ty * 1e3, color="0.6", alpha=0.8, lw=0.5, ec="k")
+    cx = float(f["tool_center"][0]) * 1e3
+    w = window_mm if window_mm is not None else 0.5
+    h = float(res.summary["uncut_chip_thickness_um"]) * 1e-3
+    ax.set_xlim(cx - 0.5 * w, cx + 0.5 * w)
+    ax.set_ylim(-3.5 * h, 0.6 * w)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    s = res.summary
+    ax.set_title(f"Fc = {s['cutting_force_N_per_mm']:.1f} N/mm, "
+                 f"Ff = {s['feed_force_N_per_mm']:.1f} N/mm, chip ratio = "
+                 f"{s['chip_ratio']:.2f}")
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    tmp = p.with_name(p.stem + ".tmp.png")
+    fig.savefig(tmp)
+    plt.close(fig)
+    tmp.replace(p)
+    return p
+
+
+def tool_outline(cx: float, cy: float, r: float, rake: float, clearance: float,
+                 size: float) -> tuple[np.ndarray, np.ndarray]:
+    """Polygon of the tool (rake face, edge arc, flank) of extent ``size`` [m]."""
+    nr = np.array([-math.cos(rake), math.sin(rake)])
+    nf = np.array([math.sin(clearance), -math.cos(clearance)])
+    a0 = math.atan2(nr[1], nr[0])
+    a1 = math.atan2(nf[1], nf[0])
+    if a1 > a0:
+        a1 -= 2 * math.pi
+    ang = np.linspace(a0, a1, 30)
+    arc = np.column_stack([cx + r * np.cos(ang), cy + r * np.sin(ang)])
+    tr = np.array([nr[1], -nr[0]])
+    tf = np.array([-nf[1], nf[0]])
+    top = arc[0] + size * tr
+    back = arc[-1] + size * tf
+    corner = back + size * tr
+    poly = np.vstack([top[None], arc, back[None], corner[None]])
+    return poly[:, 0], poly[:, 1]

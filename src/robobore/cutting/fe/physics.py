@@ -1,0 +1,104 @@
+"""Scalar physics of the FE cutting engine, in one module (CPU now, GPU later).
+
+Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` versions:
+
+* Johnson-Cook flow stress, failure strain, damage increment and radial return -- re-exported
+  from :mod:`robobore.material.johnson_cook`;
+* :func:`tool_gap_py` -- signed distance of a point to the analytic rigid tool (rake face,
+  edge-radius arc, flank with clearance) and the outward normal;
+* :func:`contact_force_py` -- penalty normal force, Coulomb friction with a shear-stress cap;
+* :func:`tool_support_step_py` -- one central-difference step of a mass on a spring/damper.
+
+All take and return floats and allocate nothing (device-function ready; see
+:func:`robobore.material.johnson_cook.rebind`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from robobore.material.johnson_cook import (  # noqa: F401  (re-exports)
+    jc_damage_increment,
+    jc_damage_increment_py,
+    jc_failure_strain,
+    jc_failure_strain_py,
+    jc_flow_stress,
+    jc_flow_stress_py,
+    radial_return,
+    radial_return_py,
+    rebind,
+)
+
+
+def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
+    """Signed gap of point (px, py) to the rigid tool and the tool's outward normal.
+
+    The tool is the set of points within ``r`` (edge radius) of the wedge with apex at the
+    edge centre (cx, cy) bounded by the rake face (outward unit normal (nrx, nry)) and the
+    flank face (outward unit normal (nfx, nfy)). The rake face runs from the edge up along
+    t_r = (nry, -nrx); the flank runs from the edge back along t_f = (-nfy, nfx).
+
+    Returns ``(gap, nx, ny)``: gap > 0 outside (distance to the surface), gap < 0 inside
+    (penetration depth); (nx, ny) the outward normal of the closest surface point [m].
+    """
+    dx = px - cx
+    dy = py - cy
+    sr = dx * nrx + dy * nry
+    sf = dx * nfx + dy * nfy
+    if sr <= 0.0 and sf <= 0.0:
+        if sr >= sf:
+            return sr - r, nrx, nry
+        return sf - r, nfx, nfy
+    if sr > 0.0 and (dx * nry - dy * nrx) >= 0.0:
+        return sr - r, nrx, nry
+    if sf > 0.0 and (-dx * nfy + dy * nfx) >= 0.0:
+        return sf - r, nfx, nfy
+    d = math.sqrt(dx * dx + dy * dy)
+    return d - r, dx / d, dy / d
+
+
+def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt):
+    """Contact force on a node touching the rigid tool [N per m of width].
+
+    Normal: penalty ``Fn = pen_factor * mass / dt**2 * (-gap)`` (mass-proportional penalty,
+    stable for ``pen_factor`` << 1 and independent of mass scaling: penetration under a force
+    F is F dt^2 / (pen_factor m)). Tangential: the force that would stop the relative
+    sliding velocity in one step, limited by Coulomb ``mu * Fn`` and by the shear-stress cap
+    ``tau_max * trib_len`` (the node's tributary contact length). (vrx, vry) is the node's
+    velocity relative to the tool [m/s]; mass the node's (scaled) mass [kg/m].
+
+    Returns ``(fx, fy, fn, ft)`` with fn >= 0 and ft the signed tangential component along
+    t = (-ny, nx). Zero for gap >= 0.
+    """
+    if gap >= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    fn = pen_factor * mass / (dt * dt) * (-gap)
+    tx = -ny
+    ty = nx
+    vt = vrx * tx + vry * ty
+    fstick = mass * abs(vt) / dt
+    fcap = mu * fn
+    if tau_max * trib_len < fcap:
+        fcap = tau_max * trib_len
+    fmag = fstick if fstick < fcap else fcap
+    ft = -fmag if vt > 0.0 else fmag
+    return fn * nx + ft * tx, fn * ny + ft * ty, fn, ft
+
+
+def tool_support_step_py(u, v, force, k, c, m, dt):
+    """One central-difference step of m u'' + c u' + k u = force.
+
+    ``u`` is the displacement at step n, ``v`` the velocity at n-1/2; returns
+    ``(u_next, v_half_next)``. The damping term uses the average of v at n-1/2 and n+1/2
+    (unconditionally stable in c); the spring is explicit (stable for dt < 2 sqrt(m/k)).
+    """
+    h = 0.5 * c * dt / m
+    vn = (v * (1.0 - h) + dt * (force - k * u) / m) / (1.0 + h)
+    return u + dt * vn, vn
+
+
+tool_gap = njit(cache=True)(tool_gap_py)
+contact_force = njit(cache=True)(contact_force_py)
+tool_support_step = njit(cache=True)(tool_support_step_py)

@@ -1,0 +1,445 @@
+"""Explicit solver: state arrays, the chunked central-difference loop, instability checks.
+
+:class:`FEState` holds every array of a model (structure of arrays); :func:`make_state`
+builds one from any quad mesh (used by the cutting model and by the element/bar tests);
+:func:`advance` runs the compiled loop in chunks (progress between chunks) and turns a
+non-finite state or a collapsing time step into :class:`robobore.errors.NumericalError`.
+:func:`simulate_orthogonal` sets up and runs the orthogonal-cutting model from a config.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.config import FEConfig
+from robobore.cutting.fe.mesh import CuttingMesh, build_mesh
+from robobore.errors import ConfigError, NumericalError
+from robobore.material import Material, load_material
+
+
+@dataclass
+class FEState:
+    """All arrays of an explicit model (SI, per unit width). Shapes: nodes (n,), elements (e,)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    mass: np.ndarray
+    fixed: np.ndarray
+    ptr: np.ndarray
+    nel: np.ndarray
+    ncorner: np.ndarray
+    conn: np.ndarray
+    layer: np.ndarray
+    alive: np.ndarray
+    sdx: np.ndarray
+    sdy: np.ndarray
+    sdz: np.ndarray
+    sdxy: np.ndarray
+    pres: np.ndarray
+    eps_p: np.ndarray
+    temp: np.ndarray
+    dmg: np.ndarray
+    qhx: np.ndarray
+    qhy: np.ndarray
+    area0: np.ndarray
+    ie: np.ndarray
+    hge: np.ndarray
+    fex: np.ndarray
+    fey: np.ndarray
+    dte: np.ndarray
+    plast: np.ndarray
+    rate: np.ndarray
+    cfx: np.ndarray
+    cfy: np.ndarray
+    fric: np.ndarray
+    pen: np.ndarray
+    ndead: np.ndarray
+    ero_ke: np.ndarray
+    nwork: np.ndarray
+    mat: np.ndarray
+    prm: np.ndarray
+    tool: np.ndarray
+    en: np.ndarray
+    ist: np.ndarray
+    clock: np.ndarray
+    hacc: np.ndarray
+    hist: np.ndarray
+    x0: np.ndarray = field(default=None)  # type: ignore[assignment]
+    y0: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def kernel_args(self) -> tuple:
+        return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
+                self.ncorner, self.conn, self.layer, self.alive, self.sdx, self.sdy, self.sdz,
+                self.sdxy, self.pres, self.eps_p, self.temp, self.dmg, self.qhx, self.qhy,
+                self.area0, self.ie, self.hge, self.fex, self.fey, self.dte, self.plast,
+                self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
+                self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
+                self.hacc, self.hist)
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.conn.shape[0])
+
+    @property
+    def time(self) -> float:
+        return float(self.clock[0])
+
+
+def default_prm() -> np.ndarray:
+    """Parameter vector with neutral values (no tool contact, no support, no erosion)."""
+    p = np.zeros(K.N_PRM)
+    p[K.P_CFL] = 0.8
+    p[K.P_MS] = 1.0
+    p[K.P_HGV] = 0.05
+    p[K.P_HGS] = 0.05
+    p[K.P_BV1] = 0.06
+    p[K.P_BV2] = 1.2
+    p[K.P_DIST] = 0.0
+    p[K.P_PEN] = 0.1
+    p[K.P_TAU] = 1e30
+    p[K.P_R] = 0.0
+    # tool far away: rake normal (-1, 0), flank normal (0, -1)
+    p[K.P_NRX], p[K.P_NRY], p[K.P_NFX], p[K.P_NFY] = -1.0, 0.0, 0.0, -1.0
+    p[K.P_WIDTH] = 1.0
+    p[K.P_SAMPLE_DT] = 1e30
+    p[K.P_TEND] = 1e30
+    p[K.P_EROSION] = K.ERODE_NONE
+    return p
+
+
+def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
+               prm: np.ndarray | None = None, layer: np.ndarray | None = None,
+               n_samples: int = 1, tool_center: tuple[float, float] = (1e3, 1e3)
+               ) -> FEState:
+    """State for a quad mesh ``nodes`` (n, 2) [m], ``conn`` (e, 4) counter-clockwise.
+
+    Lumped nodal masses from the (mass-scaled) density; stresses zero; temperature at
+    T_room. The tool starts with its edge centre at ``tool_center`` [m].
+    """
+    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+    conn = np.ascontiguousarray(conn, dtype=np.int64)
+    n = nodes.shape[0]
+    ne = conn.shape[0]
+    prm = default_prm() if prm is None else prm.astype(np.float64)
+    mat = material.to_array()
+    xs = nodes[:, 0].copy()
+    ys = nodes[:, 1].copy()
+    xe = xs[conn]
+    ye = ys[conn]
+    area = 0.5 * ((xe[:, 2] - xe[:, 0]) * (ye[:, 3] - ye[:, 1])
+                  + (xe[:, 1] - xe[:, 3]) * (ye[:, 2] - ye[:, 0]))
+    if np.any(area <= 0):
+        bad = int(np.argmin(area))
+        raise ConfigError("mesh has an element with non-positive area (nodes must be "
+                          "counter-clockwise)", field="conn", value=bad)
+    mass = np.zeros(n)
+    np.add.at(mass, conn.ravel(), np.repeat(area * material.rho * prm[K.P_MS] / 4.0, 4))
+    counts = np.bincount(conn.ravel(), minlength=n)
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum(counts)
+    nel = np.empty(ptr[-1], dtype=np.int64)
+    nco = np.empty(ptr[-1], dtype=np.int64)
+    fill = ptr[:-1].copy()
+    flat = conn.ravel()
+    order = np.argsort(flat, kind="stable")
+    nel[:] = order // 4
+    nco[:] = order % 4
+    del fill
+    tool = np.zeros(K.N_TOOL)
+    tool[K.T_GX], tool[K.T_GY] = tool_center
+    z = np.zeros
+    st = FEState(
+        x=xs, y=ys, vx=z(n), vy=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.bool_),
+        ptr=ptr, nel=nel, ncorner=nco, conn=conn,
+        layer=np.zeros(ne, np.bool_) if layer is None else np.asarray(layer, np.bool_),
+        alive=np.ones(ne, np.int64), sdx=z(ne), sdy=z(ne), sdz=z(ne), sdxy=z(ne), pres=z(ne),
+        eps_p=z(ne), temp=np.full(ne, material.T_room), dmg=z(ne), qhx=z(ne), qhy=z(ne),
+        area0=area.copy(), ie=z(ne), hge=z(ne), fex=z((ne, 4)), fey=z((ne, 4)),
+        dte=z(ne), plast=z(ne), rate=z(ne), cfx=z(n), cfy=z(n), fric=z(n), pen=z(n),
+        ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
+        en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
+        hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy())
+    init_forces(st)
+    return st
+
+
+def init_forces(st: FEState) -> float:
+    """Element forces and stable step of the current configuration (no stress update)."""
+    K.element_update(st.conn, st.x, st.y, st.vx * 0.0, st.vy * 0.0, st.alive, st.layer,
+                     st.sdx.copy(), st.sdy.copy(), st.sdz.copy(), st.sdxy.copy(),
+                     st.pres.copy(), st.eps_p.copy(), st.temp.copy(), st.dmg.copy(),
+                     st.qhx.copy(), st.qhy.copy(), st.area0, st.ie.copy(), st.hge.copy(),
+                     st.fex, st.fey, st.dte, st.plast.copy(), st.rate.copy(), st.mat, st.prm,
+                     1e-30, K.ERODE_NONE)
+    dt = st.prm[K.P_CFL] * float(np.min(st.dte))
+    st.clock[1] = dt
+    if st.prm[K.P_DTMIN] <= 0:
+        st.prm[K.P_DTMIN] = 1e-3 * dt
+    return dt
+
+
+_STATUS_TEXT = {
+    K.STATUS_NONFINITE: "non-finite forces, velocities or time step",
+    K.STATUS_DT_COLLAPSE: "stable time step collapsed below 1/1000 of the initial one "
+                          "(an element inverted or was crushed)",
+    K.STATUS_INVERTED: "an element turned inside out (negative area)",
+    K.STATUS_NO_ELEMENTS: "no element left (all eroded or inverted)",
+}
+
+
+def advance(st: FEState, t_end: float, *, chunk_steps: int = 2000,
+            progress: Callable[[float], None] | None = None,
+            check: Callable[[FEState], None] | None = None) -> int:
+    """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
+
+    ``progress(fraction_done)`` is called between chunks; ``check(state)`` too (it may raise).
+    Raises NumericalError (with step, time and cause) on instability.
+    """
+    st.prm[K.P_TEND] = t_end
+    st.ist[K.I_STATUS] = K.STATUS_OK
+    total = 0
+    t_start = st.time
+    while True:
+        taken = K.run_chunk(chunk_steps, *st.kernel_args())
+        total += int(taken)
+        status = int(st.ist[K.I_STATUS])
+        if status in _STATUS_TEXT:
+            raise NumericalError(
+                f"simulation unstable at step {int(st.ist[K.I_STEP])}, time "
+                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
+                + (f" (element {int(st.ist[K.I_BADELEM])})"
+                   if status == K.STATUS_INVERTED else "")
+                + "; try a smaller solver.cfl, a "
+                "larger mesh.element_size_um or less mass scaling")
+        if progress is not None:
+            span = max(t_end - t_start, 1e-300)
+            progress(min(1.0, (st.time - t_start) / span))
+        if check is not None:
+            check(st)
+        if status == K.STATUS_DONE or st.time >= t_end:
+            return total
+
+
+# ----------------------------------------------------------------- orthogonal cutting model
+
+
+@dataclass
+class CuttingSetup:
+    """Everything derived from a config before the run."""
+
+    cfg: FEConfig
+    material: Material
+    mesh: CuttingMesh
+    state: FEState
+    h: float
+    vc: float
+    rake: float
+    t_end: float
+    t_contact: float
+    mu: float
+
+
+def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
+    """Build mesh, tool and state for the orthogonal-cutting model of ``cfg``."""
+    mat = load_material(cfg.material.name, source=source)
+    h = cfg.cut.uncut_chip_thickness_um * 1e-6
+    le = cfg.mesh.element_size_um * 1e-6
+    L = cfg.cut.length_mm * 1e-3
+    vc = cfg.cut.cutting_speed_m_per_min / 60.0
+    r = cfg.tool.edge_radius_um * 1e-6
+    rake = math.radians(cfg.tool.rake_deg)
+    clr = math.radians(cfg.tool.clearance_deg)
+    mesh = build_mesh(h, le, L, ahead=cfg.mesh.ahead_mm * 1e-3,
+                      fine_depth_factor=cfg.mesh.fine_depth_factor,
+                      height_factor=cfg.mesh.height_factor, grading=cfg.mesh.grading)
+    s = cfg.solver
+    p = default_prm()
+    p[K.P_CFL] = s.cfl
+    p[K.P_MS] = s.mass_scaling
+    p[K.P_HGV] = s.hourglass_viscous
+    p[K.P_HGS] = s.hourglass_stiffness
+    p[K.P_BV1] = s.bulk_viscosity_linear
+    p[K.P_BV2] = s.bulk_viscosity_quadratic
+    p[K.P_DIST] = s.distortion_limit
+    mu = cfg.friction_coefficient()
+    p[K.P_MU] = mu
+    p[K.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
+    p[K.P_PEN] = cfg.contact.penalty_factor
+    p[K.P_R] = r
+    p[K.P_NRX], p[K.P_NRY] = -math.cos(rake), math.sin(rake)
+    p[K.P_NFX], p[K.P_NFY] = math.sin(clr), -math.cos(clr)
+    p[K.P_VC] = vc
+    p[K.P_WIDTH] = cfg.cut.width_mm * 1e-3
+    p[K.P_EROSION] = {"none": K.ERODE_NONE, "layer": K.ERODE_LAYER,
+                      "everywhere": K.ERODE_ALL}[s.erosion]
+    gap0 = 0.5 * le
+    cx0 = mesh.length + r + gap0
+    cy0 = -h + r
+    t_contact = gap0 / vc
+    t_end = (L + r + gap0) / vc
+    p[K.P_SAMPLE_DT] = t_end / s.n_samples
+    ts = cfg.tool_support
+    if ts is not None:
+        p[K.P_SUPPORT] = 1.0
+        p[K.P_KX], p[K.P_KY] = ts.stiffness_N_per_m  # type: ignore[misc]
+        p[K.P_CX], p[K.P_CY] = ts.damping_N_s_per_m  # type: ignore[misc]
+        p[K.P_MX], p[K.P_MY] = ts.mass_kg  # type: ignore[misc]
+    st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, layer=mesh.layer,
+                    n_samples=s.n_samples, tool_center=(cx0, cy0))
+    if ts is not None:
+        dt = st.clock[1]
+        for i, (k, m) in enumerate(zip(ts.stiffness_N_per_m, ts.mass_kg, strict=True)):  # type: ignore[arg-type]
+            if dt * math.sqrt(k / m) > 0.5:
+                raise ConfigError("tool support too stiff for the explicit time step",
+                                  source, field=f"tool_support.stiffness_N_per_m[{i}]",
+                                  value=k, expected=f"k < {0.25 * m / dt**2:.3g} N/m for "
+                                  f"mass {m} kg and time step {dt:.3g} s")
+    return CuttingSetup(cfg=cfg, material=mat, mesh=mesh, state=st, h=h, vc=vc, rake=rake,
+                        t_end=t_end, t_contact=t_contact, mu=mu)
+
+
+def energy_error(en: np.ndarray) -> float:
+    """|E_ext - (kinetic + internal + hourglass + contact + eroded kinetic)| / scale.
+
+    Internal includes elastic, plastic and bulk-viscous work (and the internal energy of
+    eroded elements); contact is frictional dissipation plus the current penalty energy.
+    """
+    parts = en[K.E_KIN] + en[K.E_INT] + en[K.E_HG] + en[K.E_FRIC] + en[K.E_EROKE]
+    scale = max(abs(en[K.E_EXT]), abs(parts), 1e-300)
+    return float(abs(en[K.E_EXT] - parts) / scale)
+
+
+def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None = None):
+    """Run the cutting model to the end; returns (wall time [s], steps taken)."""
+    st = setup.state
+    limit = setup.cfg.solver.energy_error_limit
+
+    def check(s: FEState) -> None:
+        if s.time > setup.t_contact + 0.1 * (setup.t_end - setup.t_contact):
+            err = energy_error(s.en)
+            if err > limit:
+                raise NumericalError(
+                    f"energy balance lost at step {int(s.ist[K.I_STEP])}, time {s.time:.6g} s:"
+                    f" error {err:.3g} > solver.energy_error_limit {limit}")
+
+    t0 = time.perf_counter()
+    steps = advance(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
+                    progress=progress, check=check)
+    return time.perf_counter() - t0, steps
+
+
+def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
+    from robobore.cutting.fe.output import tool_outline
+
+    st = setup.state
+    cfg = setup.cfg
+    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
+    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    sxx, syy, szz, sxy = st.sdx, st.sdy, st.sdz, st.sdxy
+    vm = np.sqrt(1.5 * (sxx**2 + syy**2 + szz**2 + 2 * sxy**2))
+    ox, oy = tool_outline(cx, cy, cfg.tool.edge_radius_um * 1e-6, setup.rake,
+                          math.radians(cfg.tool.clearance_deg), 4 * setup.h)
+    return {"x": st.x.copy(), "y": st.y.copy(), "x0": st.x0.copy(), "y0": st.y0.copy(),
+            "conn": st.conn.copy(), "alive": st.alive.copy(), "eps_p": st.eps_p.copy(),
+            "temperature_K": st.temp.copy(), "damage": st.dmg.copy(), "von_mises_Pa": vm,
+            "pressure_Pa": st.pres.copy(), "tool_outline": np.array([ox, oy]),
+            "tool_center": np.array([cx, cy])}
+
+
+def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
+                        progress: Callable[[float], None] | None = None):
+    """Set up and run the orthogonal-cutting model; returns an :class:`FEResult`."""
+    from robobore.cutting.fe.output import FEResult, measure_chip, steady_window
+
+    setup = setup_orthogonal(cfg, source)
+    st = setup.state
+    dt0 = float(st.clock[1])
+    wall, steps = run_orthogonal(setup, progress)
+    hist = st.hist
+    ok = np.isfinite(hist[:, K.H_T])
+    hh = hist[ok]
+    t = hh[:, K.H_T]
+    L = cfg.cut.length_mm * 1e-3
+    frac = cfg.solver.steady_window_fraction
+    t0w = setup.t_end - frac * L / setup.vc
+    win = steady_window(t, t0w, setup.t_end + 1e-12)
+    fc = hh[:, K.H_FX] * 1e-3
+    ff = hh[:, K.H_FY] * 1e-3
+    x_tip_start = setup.mesh.length
+    cut_pos_mm = (x_tip_start - hh[:, K.H_TIP_X] + cfg.tool.edge_radius_um * 1e-6) * 1e3
+    chip = measure_chip(st, setup.mesh, setup.h, setup.rake, setup.vc)
+    en = st.en
+    n_el = st.n_elements
+    summary: dict[str, Any] = {
+        "cutting_force_N_per_mm": float(np.mean(fc[win])),
+        "feed_force_N_per_mm": float(np.mean(ff[win])),
+        "cutting_force_std_N_per_mm": float(np.std(fc[win])),
+        "feed_force_std_N_per_mm": float(np.std(ff[win])),
+        "averaging_window_mm": [float(cut_pos_mm[win][0]) if win.any() else math.nan,
+                                float(cut_pos_mm[win][-1]) if win.any() else math.nan],
+        "chip_ratio": chip.ratio,
+        "chip_ratio_continuity": chip.ratio_velocity,
+        "chip_thickness_um": chip.thickness * 1e6,
+        "shear_angle_deg": chip.shear_angle_deg,
+        "peak_temperature_K": float(np.max(st.temp[st.alive == 1])),
+        "energy_error": energy_error(en),
+        "wall_time_s": wall,
+        "element_updates_per_s": n_el * steps / max(wall, 1e-12),
+        "steps": int(steps),
+        "time_step_s": dt0,
+        "n_elements": n_el,
+        "n_nodes": int(st.x.shape[0]),
+        "friction_coefficient": setup.mu,
+        "uncut_chip_thickness_um": cfg.cut.uncut_chip_thickness_um,
+        "cutting_speed_m_per_min": cfg.cut.cutting_speed_m_per_min,
+        "eroded_damage": int(np.sum(st.alive == 0)),
+        "eroded_distortion": int(np.sum(st.alive == -1)),
+        "energy_external_J_per_m": float(en[K.E_EXT]),
+        "energy_plastic_J_per_m": float(en[K.E_PLAST]),
+        "energy_hourglass_J_per_m": float(en[K.E_HG]),
+        "energy_contact_J_per_m": float(en[K.E_FRIC]),
+        "energy_kinetic_J_per_m": float(en[K.E_KIN]),
+        "energy_internal_J_per_m": float(en[K.E_INT]),
+        "hourglass_fraction": float(en[K.E_HG] / max(en[K.E_INT], 1e-300)),
+    }
+    if cfg.tool_support is not None:
+        kx, ky = cfg.tool_support.stiffness_N_per_m  # type: ignore[misc]
+        w = cfg.cut.width_mm
+        dx = hh[:, K.H_UX] * 1e6
+        dy = hh[:, K.H_UY] * 1e6
+        summary.update({
+            "tool_dx_mean_um": float(np.mean(dx[win])),
+            "tool_dy_mean_um": float(np.mean(dy[win])),
+            "tool_dx_std_um": float(np.std(dx[win])),
+            "tool_dy_std_um": float(np.std(dy[win])),
+            "tool_dx_static_um": summary["cutting_force_N_per_mm"] * w / kx * 1e6,
+            "tool_dy_static_um": summary["feed_force_N_per_mm"] * w / ky * 1e6,
+        })
+    history = {
+        "time_s": t,
+        "cut_length_mm": cut_pos_mm,
+        "cutting_force_N_per_mm": fc,
+        "feed_force_N_per_mm": ff,
+        "tool_dx_um": hh[:, K.H_UX] * 1e6,
+        "tool_dy_um": hh[:, K.H_UY] * 1e6,
+        "tool_tip_x_mm": hh[:, K.H_TIP_X] * 1e3,
+        "contact_nodes": hh[:, K.H_NCONT],
+        "energy_external_J_per_m": hh[:, K.H_EEXT],
+        "energy_kinetic_J_per_m": hh[:, K.H_EKIN],
+        "energy_internal_J_per_m": hh[:, K.H_EINT],
+        "energy_plastic_J_per_m": hh[:, K.H_EPL],
+        "energy_hourglass_J_per_m": hh[:, K.H_EHG],
+        "energy_contact_J_per_m": hh[:, K.H_EFRIC],
+        "energy_eroded_J_per_m": hh[:, K.H_EERO],
+    }
+    return FEResult(summary=summary, history=history, config=cfg.model_dump(),
+                    final=_final_fields(setup))

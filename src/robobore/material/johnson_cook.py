@@ -1,0 +1,177 @@
+"""Johnson-Cook plasticity and damage as scalar functions (SI units).
+
+Every function here takes and returns plain floats and allocates nothing, so the same source
+can be compiled for the CPU (``numba.njit``) and later for a GPU
+(``numba.cuda.jit(device=True)``). The plain-Python originals keep the ``_py`` suffix; the
+compiled versions (``njit(cache=True)``) drop it. A ``_py`` function that needs another one
+calls the compiled name (e.g. ``radial_return_py`` calls ``jc_flow_stress``); a device port
+rebinds those globals with :func:`rebind`.
+
+References
+----------
+Johnson G.R., Cook W.H. (1983), "A constitutive model and data for metals subjected to large
+strains, high strain rates and high temperatures", 7th Int. Symp. Ballistics, 541-547.
+Johnson G.R., Cook W.H. (1985), "Fracture characteristics of three metals subjected to
+various strains, strain rates, temperatures and pressures", Eng. Fract. Mech. 21, 31-48.
+Simo J.C., Hughes T.J.R. (1998), *Computational Inelasticity*, Springer, sec. 3.3 (radial
+return) -- the consistency equation solved here is their (3.3.10) with a rate- and
+temperature-dependent yield stress.
+"""
+
+from __future__ import annotations
+
+import math
+import types
+
+from numba import njit
+
+#: Indices of the Johnson-Cook parameters in the flat material array ``mat`` used by kernels.
+A, B, N, C, M, EPS0, TROOM, TMELT = 0, 1, 2, 3, 4, 5, 6, 7
+D1, D2, D3, D4, D5 = 8, 9, 10, 11, 12
+E_MOD, NU, RHO, CP, KCOND, BETA_TQ = 13, 14, 15, 16, 17, 18
+N_MAT = 19
+
+
+def homologous_temperature_py(T, Troom, Tmelt):
+    """T* = (T - Troom)/(Tmelt - Troom), clipped to [0, 1]."""
+    ts = (T - Troom) / (Tmelt - Troom)
+    if ts < 0.0:
+        return 0.0
+    if ts > 1.0:
+        return 1.0
+    return ts
+
+
+def jc_flow_stress_py(eps_p, eps_rate, T, a, b, n, c, m, eps0, Troom, Tmelt):
+    """Johnson-Cook flow stress [Pa].
+
+    sigma_y = (A + B eps_p^n) (1 + C ln(max(eps_rate/eps0, 1))) (1 - T*^m).
+    The rate term is clipped at eps_rate = eps0 (no strengthening below the reference rate,
+    and no logarithm of zero); T* is clipped to [0, 1].
+    """
+    ep = eps_p if eps_p > 0.0 else 0.0
+    hard = a + b * ep**n
+    r = eps_rate / eps0
+    rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
+    ts = homologous_temperature(T, Troom, Tmelt)
+    therm = 1.0 - ts**m
+    return hard * rate * therm
+
+
+def jc_failure_strain_py(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt):
+    """Johnson-Cook (1985) equivalent plastic strain at failure.
+
+    eps_f = (D1 + D2 exp(D3 sigma*)) (1 + D4 ln(max(eps_rate/eps0, 1))) (1 + D5 T*),
+    sigma* = mean stress / von Mises stress (triaxiality). Floored at 1e-3 so that the
+    damage increment stays finite where the fit goes negative (high triaxiality).
+    """
+    r = eps_rate / eps0
+    rate = 1.0 + d4 * math.log(r) if r > 1.0 else 1.0
+    ts = homologous_temperature(T, Troom, Tmelt)
+    ef = (d1 + d2 * math.exp(d3 * triax)) * rate * (1.0 + d5 * ts)
+    if ef < 1e-3:
+        ef = 1e-3
+    return ef
+
+
+def jc_damage_increment_py(deps_p, triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt):
+    """Damage increment dD = d(eps_p) / eps_f (Johnson-Cook 1985, linear accumulation)."""
+    if deps_p <= 0.0:
+        return 0.0
+    return deps_p / jc_failure_strain(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt)
+
+
+def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
+    """Radial return of a trial deviatoric stress onto the Johnson-Cook yield surface.
+
+    Parameters
+    ----------
+    sxx, syy, szz, sxy:
+        Trial *deviatoric* stress components [Pa] (plane strain: xz = yz = 0).
+    eps_p:
+        Equivalent plastic strain at the start of the increment [-].
+    T:
+        Temperature [K] (held fixed over the increment, explicit coupling).
+    dt:
+        Time increment [s]; the plastic strain rate is d(eps_p)/dt.
+    G:
+        Shear modulus [Pa].
+
+    Returns
+    -------
+    (sxx, syy, szz, sxy, deps_p, sigma_y):
+        Returned deviatoric stress, plastic strain increment, flow stress at the end.
+
+    The scalar consistency equation q_trial - 3 G d - sigma_y(eps_p + d, d/dt, T) = 0 is
+    solved by Newton's method safeguarded by bisection on [0, q_trial/(3G)]; f is strictly
+    decreasing in d, so the root is unique.
+    """
+    q = math.sqrt(1.5 * (sxx * sxx + syy * syy + szz * szz + 2.0 * sxy * sxy))
+    sy0 = jc_flow_stress(eps_p, 0.0, T, a, b, n, c, m, eps0, Troom, Tmelt)
+    if q <= sy0:
+        return sxx, syy, szz, sxy, 0.0, sy0
+    lo = 0.0
+    hi = q / (3.0 * G)
+    d = (q - sy0) / (3.0 * G)
+    sy = sy0
+    for _ in range(60):
+        sy = jc_flow_stress(eps_p + d, d / dt, T, a, b, n, c, m, eps0, Troom, Tmelt)
+        f = q - 3.0 * G * d - sy
+        if f > 0.0:
+            lo = d
+        else:
+            hi = d
+        # derivative of sigma_y wrt d (hardening + rate), analytic
+        ep = eps_p + d
+        hard = a + b * ep**n
+        r = d / (dt * eps0)
+        rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
+        ts = homologous_temperature(T, Troom, Tmelt)
+        therm = 1.0 - ts**m
+        dhard = n * b * ep ** (n - 1.0) if ep > 1e-12 else 1e12 * b
+        drate = c / d if r > 1.0 else 0.0
+        dsy = (dhard * rate + hard * drate) * therm
+        fp = -3.0 * G - dsy
+        dn = d - f / fp
+        if not (dn > lo and dn < hi):
+            dn = 0.5 * (lo + hi)
+        if abs(dn - d) <= 1e-14 + 1e-12 * d:
+            d = dn
+            break
+        d = dn
+    sy = jc_flow_stress(eps_p + d, d / dt, T, a, b, n, c, m, eps0, Troom, Tmelt)
+    scale = sy / q
+    return sxx * scale, syy * scale, szz * scale, sxy * scale, d, sy
+
+
+homologous_temperature = njit(cache=True)(homologous_temperature_py)
+jc_flow_stress = njit(cache=True)(jc_flow_stress_py)
+jc_failure_strain = njit(cache=True)(jc_failure_strain_py)
+jc_damage_increment = njit(cache=True)(jc_damage_increment_py)
+radial_return = njit(cache=True)(radial_return_py)
+
+
+def rebind(func, **names):
+    """Copy of a ``_py`` function whose global names are replaced (for device ports).
+
+    Example: ``rebind(radial_return_py, jc_flow_stress=flow_dev,
+    homologous_temperature=th_dev)`` before wrapping with ``numba.cuda.jit(device=True)``.
+    """
+    g = dict(func.__globals__)
+    g.update(names)
+    return types.FunctionType(func.__code__, g, func.__name__, func.__defaults__, func.__closure__)
+
+
+__all__ = [
+    "homologous_temperature_py",
+    "jc_flow_stress_py",
+    "jc_failure_strain_py",
+    "jc_damage_increment_py",
+    "radial_return_py",
+    "homologous_temperature",
+    "jc_flow_stress",
+    "jc_failure_strain",
+    "jc_damage_increment",
+    "radial_return",
+    "rebind",
+]

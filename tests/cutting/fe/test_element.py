@@ -1,0 +1,140 @@
+"""Element kernel: one-element flow curves, elastic bar wave speed and energy conservation.
+
+References: Belytschko, Liu, Moran (2000), *Nonlinear Finite Elements*, sec. 6.3 (explicit
+central difference: a lumped-mass elastic model conserves energy to O(dt^2)); bar wave speed
+c = sqrt(E' / rho) for a thin plane-strain strip, E' = E / (1 - nu^2) (Graff, *Wave Motion in
+Elastic Solids*, 1975, sec. 8.1, long-wave limit), fundamental period of a fixed-free bar
+T = 4 L / c.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import elastic_tc4, strip_mesh
+
+from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.errors import NumericalError
+from robobore.material import load_material
+
+TC4 = load_material("TC4")
+
+
+def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, size=10e-6):
+    """Prescribe a homogeneous velocity field v(x) on one square element; returns history."""
+    nodes = np.array([[0, 0], [size, 0], [size, size], [0, size]], float)
+    conn = np.array([[0, 1, 2, 3]])
+    prm = default_prm()
+    prm[K.P_HGS] = 0.0
+    prm[K.P_HGV] = 0.0
+    prm[K.P_BV1] = 0.0
+    prm[K.P_BV2] = 0.0
+    st = make_state(nodes, conn, np.zeros(4, bool), TC4, prm=prm)
+    out = []
+    for _ in range(n_steps):
+        vx, vy = velocity(st.x, st.y)
+        st.vx[:] = vx
+        st.vy[:] = vy
+        st.x += dt * vx
+        st.y += dt * vy
+        K.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx, st.sdy,
+                         st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy,
+                         st.area0, st.ie, st.hge, st.fex, st.fey, st.dte, st.plast, st.rate,
+                         st.mat, st.prm, dt, K.ERODE_NONE)
+        q = math.sqrt(1.5 * (st.sdx[0] ** 2 + st.sdy[0] ** 2 + st.sdz[0] ** 2
+                             + 2 * st.sdxy[0] ** 2))
+        out.append((total_strain_measure(st), q, st.eps_p[0], st.rate[0], st.temp[0],
+                    st.sdxy[0], st.pres[0]))
+    return np.array(out), st
+
+
+def test_simple_shear_follows_flow_curve():
+    """Simple shear v_x = g y: von Mises stress equals sigma_JC(eps_p, rate, T) once yielded;
+    eps_p -> gamma/sqrt(3) minus the elastic part; adiabatic heating = 0.9 W_p / (rho cp)."""
+    g = 2.0e4  # 1/s
+    h, st = _drive_one_element(lambda x, y: (g * y, 0.0 * y), lambda s: 0.0, n_steps=5000)
+    gamma = g * 2e-9 * np.arange(1, 5001)
+    q, ep, rate, T = h[:, 1], h[:, 2], h[:, 3], h[:, 4]
+    plastic = ep > 0.05
+    assert plastic.sum() > 1000
+    # the return uses the temperature at the start of the increment (explicit coupling)
+    t_start = np.r_[293.0, T[:-1]]
+    flow = np.array([TC4.flow_stress(e, r, t) for e, r, t in zip(ep, rate, t_start,
+                                                                 strict=True)])
+    np.testing.assert_allclose(q[plastic], flow[plastic], rtol=1e-6)
+    # total equivalent strain gamma/sqrt(3) = eps_p + elastic part q/(3G) (small-strain split)
+    np.testing.assert_allclose(ep[plastic] + q[plastic] / (3 * TC4.G), gamma[plastic] / math.sqrt(3),
+                               rtol=0.02)
+    # equivalent plastic rate = g / sqrt(3)
+    assert np.median(rate[plastic]) == pytest.approx(g / math.sqrt(3), rel=0.01)
+    # Taylor-Quinney heating: dT = 0.9 * plastic work / (rho cp)
+    wp = st.plast[0] / st.area0[0]
+    assert T[-1] - 293.0 == pytest.approx(0.9 * wp / (TC4.rho * TC4.cp), rel=0.02)
+
+
+def test_plane_strain_extension_follows_flow_curve():
+    """Isochoric plane-strain extension v = (-e x, e y): eps_p rate = 2 e / sqrt(3)."""
+    e = 1.0e4
+    h, st = _drive_one_element(lambda x, y: (-e * x, e * y), lambda s: 0.0, n_steps=4000)
+    q, ep, rate, T = h[:, 1], h[:, 2], h[:, 3], h[:, 4]
+    plastic = ep > 0.02
+    assert plastic.sum() > 500
+    t_start = np.r_[293.0, T[:-1]]
+    flow = np.array([TC4.flow_stress(a, r, t) for a, r, t in zip(ep, rate, t_start,
+                                                                 strict=True)])
+    np.testing.assert_allclose(q[plastic], flow[plastic], rtol=1e-6)
+    assert np.median(rate[plastic]) == pytest.approx(2 * e / math.sqrt(3), rel=0.01)
+    # isochoric: pressure stays ~0 (no volumetric strain, no locking)
+    assert np.max(np.abs(h[:, 6])) < 1e-3 * np.max(q)
+
+
+def _bar(nx=200, ny=1, length=2e-3, thickness=1e-5, v0=0.5):
+    nodes, conn = strip_mesh(nx, ny, length, thickness)
+    fixed = nodes[:, 0] < 1e-15
+    prm = default_prm()
+    prm[K.P_HGV] = 0.0
+    prm[K.P_BV1] = 0.0
+    prm[K.P_BV2] = 0.0
+    prm[K.P_SAMPLE_DT] = 2e-8
+    mat = elastic_tc4()
+    st = make_state(nodes, conn, fixed, mat, prm=prm, n_samples=20000)
+    st.vx[:] = v0 * np.sin(0.5 * math.pi * st.x / length)
+    st.vx[fixed] = 0.0
+    return st, mat, length
+
+
+def test_elastic_bar_period_and_energy():
+    st, mat, L = _bar()
+    tip = np.argmax(st.x + st.y)
+    E1 = mat.E / (1 - mat.nu**2)
+    c = math.sqrt(E1 / mat.rho)
+    T = 4 * L / c
+    xs, ts = [], []
+    ke0 = 0.5 * np.sum(st.mass * st.vx**2)
+    energies = []
+    n_chunks = 60
+    for k in range(n_chunks):
+        advance(st, (k + 1) * 1.5 * T / n_chunks, chunk_steps=10**7)
+        xs.append(st.x[tip] - st.x0[tip])
+        ts.append(st.time)
+    h = st.hist[np.isfinite(st.hist[:, K.H_T])]
+    energies = h[:, K.H_EKIN] + h[:, K.H_EINT] + h[:, K.H_EHG]
+    # energy conserved to 0.5 % (central difference, no viscosity)
+    assert np.max(np.abs(energies - ke0)) / ke0 < 5e-3
+    # period from the first zero crossing of the tip displacement after its maximum (T/2)
+    xs = np.array(xs)
+    ts = np.array(ts)
+    i = np.argmax(xs < 0)
+    t_zero = ts[i - 1] + (ts[i] - ts[i - 1]) * xs[i - 1] / (xs[i - 1] - xs[i])
+    assert t_zero == pytest.approx(T / 2, rel=0.02)
+
+
+def test_instability_is_reported_not_nan():
+    st, mat, L = _bar(nx=20, length=2e-4)
+    st.prm[K.P_CFL] = 3.0  # far above the stable step
+    st.clock[1] *= 3.0 / 0.8
+    with pytest.raises(NumericalError, match="step .* time"):
+        advance(st, 1e-5, chunk_steps=500)

@@ -1,0 +1,130 @@
+"""Johnson-Cook flow stress, damage and radial return against closed forms.
+
+Reference: Johnson & Cook (1983, 1985); radial return: Simo & Hughes (1998) sec. 3.3 -- for
+linear isotropic hardening the plastic multiplier is closed-form,
+d(eps_p) = (q_trial - sigma_y0) / (3 G + H)   (their eq. 3.3.11 in von Mises form).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from robobore.errors import ConfigError
+from robobore.material import bundled_materials, load_material
+from robobore.material import johnson_cook as jc
+
+TC4 = load_material("TC4")
+
+
+def _jc_hand(ep, rate, T):
+    m = TC4
+    ts = min(max((T - m.T_room) / (m.T_melt - m.T_room), 0.0), 1.0)
+    r = 1.0 + m.C * math.log(rate / m.eps_dot0) if rate > m.eps_dot0 else 1.0
+    return (m.A + m.B * ep**m.n) * r * (1.0 - ts**m.m)
+
+
+def test_tc4_library_values():
+    m = TC4
+    assert m.A == pytest.approx(997.9e6) and m.B == pytest.approx(653.1e6)
+    assert (m.n, m.C, m.m, m.eps_dot0) == (0.45, 0.0198, 0.7, 1.0)
+    assert (m.T_room, m.T_melt) == (293.0, 1873.0)
+    assert (m.D1, m.D2, m.D3, m.D4, m.D5) == (-0.09, 0.25, -0.5, 0.014, 3.87)
+    assert m.E == pytest.approx(113.8e9) and m.nu == 0.34 and m.rho == 4430.0
+    assert (m.cp, m.k, m.taylor_quinney) == (531.0, 6.3, 0.9)
+    assert "TC4" in bundled_materials()
+
+
+@pytest.mark.parametrize("ep,rate,T", [(0.0, 0.5, 293.0), (0.1, 1e3, 500.0), (1.0, 1e5, 900.0),
+                                       (2.5, 1e6, 1500.0), (0.3, 10.0, 2000.0)])
+def test_flow_stress_closed_form(ep, rate, T):
+    assert TC4.flow_stress(ep, rate, T) == pytest.approx(_jc_hand(ep, rate, T), rel=1e-12)
+    assert jc.jc_flow_stress_py(ep, rate, T, TC4.A, TC4.B, TC4.n, TC4.C, TC4.m, 1.0, 293.0,
+                                1873.0) == pytest.approx(_jc_hand(ep, rate, T), rel=1e-12)
+
+
+def test_failure_strain_closed_form():
+    # JC 1985: eps_f = (D1 + D2 exp(D3 s*)) (1 + D4 ln rate*) (1 + D5 T*)
+    s, rate, T = -0.4, 100.0, 600.0
+    ts = (T - 293.0) / (1873.0 - 293.0)
+    hand = (-0.09 + 0.25 * math.exp(-0.5 * s)) * (1 + 0.014 * math.log(rate)) * (1 + 3.87 * ts)
+    assert TC4.failure_strain(s, rate, T) == pytest.approx(hand, rel=1e-12)
+    d = jc.jc_damage_increment(0.01, s, rate, T, TC4.D1, TC4.D2, TC4.D3, TC4.D4, TC4.D5,
+                               1.0, 293.0, 1873.0)
+    assert d == pytest.approx(0.01 / hand, rel=1e-12)
+
+
+def _trial(q, direction=(2.0, -1.0, -1.0, 0.5)):
+    s = np.array(direction, float)
+    s[:3] -= s[:3].mean()
+    qs = math.sqrt(1.5 * (s[0] ** 2 + s[1] ** 2 + s[2] ** 2 + 2 * s[3] ** 2))
+    return s * q / qs
+
+
+def test_radial_return_linear_hardening_closed_form():
+    """n = 1, C = 0, T = Troom: d = (q - A) / (3G + B) exactly."""
+    G = TC4.G
+    q = 3.0e9
+    s = _trial(q)
+    out = jc.radial_return(*s, 0.0, 293.0, 1e-8, G, 1e9, 5e9, 1.0, 0.0, 0.7, 1.0, 293.0,
+                           1873.0)
+    d_exact = (q - 1e9) / (3 * G + 5e9)
+    assert out[4] == pytest.approx(d_exact, rel=1e-10)
+    assert out[5] == pytest.approx(1e9 + 5e9 * d_exact, rel=1e-10)
+
+
+@settings(max_examples=60, deadline=None)
+@given(q=st.floats(1.1e9, 2e10), ep=st.floats(0.0, 3.0), T=st.floats(293.0, 1700.0),
+       dt=st.floats(1e-10, 1e-5))
+def test_radial_return_consistency(q, ep, T, dt):
+    """Returned stress lies on the JC surface at the solved rate and keeps its direction."""
+    m = TC4
+    s = _trial(q)
+    sy0 = m.flow_stress(ep, 0.0, T)
+    sx, sy, sz, sxy, d, syld = jc.radial_return(*s, ep, T, dt, m.G, m.A, m.B, m.n, m.C, m.m,
+                                                1.0, 293.0, 1873.0)
+    qn = math.sqrt(1.5 * (sx * sx + sy * sy + sz * sz + 2 * sxy * sxy))
+    if q <= sy0:
+        assert d == 0.0
+        return
+    assert d > 0
+    assert syld == pytest.approx(_jc_hand(ep + d, d / dt, T), rel=1e-9)
+    assert qn == pytest.approx(syld, rel=1e-9)
+    assert q - 3 * m.G * d == pytest.approx(qn, rel=1e-8, abs=1e-3)
+    np.testing.assert_allclose(np.array([sx, sy, sz, sxy]) / qn, s / q, rtol=1e-9, atol=1e-12)
+
+
+def test_elastic_state_unchanged():
+    s = _trial(0.5e9)
+    out = jc.radial_return(*s, 0.0, 293.0, 1e-8, TC4.G, TC4.A, TC4.B, TC4.n, TC4.C, TC4.m, 1.0,
+                           293.0, 1873.0)
+    np.testing.assert_allclose(out[:4], s)
+    assert out[4] == 0.0
+
+
+def test_user_material_file(tmp_path):
+    txt = (tmp_path / "x.toml")
+    src = (load_material.__globals__["resources"].files("robobore.material") / "library"
+           / "tc4.toml").read_text()
+    txt.write_text(src.replace('name = "TC4"', 'name = "MINE"').replace("A_MPa = 997.9",
+                                                                        "A_MPa = 500.0"))
+    m = load_material(str(txt))
+    assert m.name == "MINE" and m.A == pytest.approx(500e6)
+
+
+def test_unknown_material_is_clear():
+    with pytest.raises(ConfigError, match="unknown material.*'NOPE'.*TC4"):
+        load_material("NOPE", source="cfg.toml")
+
+
+def test_bad_material_file(tmp_path):
+    f = tmp_path / "bad.toml"
+    src = (load_material.__globals__["resources"].files("robobore.material") / "library"
+           / "tc4.toml").read_text()
+    f.write_text(src.replace("E_GPa = 113.8", "E_GPa = -1.0"))
+    with pytest.raises(ConfigError, match="elastic.E_GPa"):
+        load_material(str(f))
