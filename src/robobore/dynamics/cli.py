@@ -1,9 +1,295 @@
-"""CLI commands of this stage (registered by ``robobore.cli``)."""
+"""CLI commands of the process stage: ``robobore lobes``, ``robobore simulate boring``,
+``robobore model equivalent`` (registered by ``robobore.cli``)."""
 
 from __future__ import annotations
 
+import json
+import math
+from pathlib import Path
+from typing import Any
+
 import typer
+
+from robobore.clitools import (
+    JSON_OPTION,
+    emit,
+    fmt,
+    handle_errors,
+    kv_table,
+    parse_floats,
+    progress_bar,
+    stdout,
+)
+from robobore.errors import ConfigError
+
+
+def _read_json(path: Path, what: str) -> dict[str, Any]:
+    if not path.is_file():
+        raise ConfigError(f"{what} file not found", file=str(path), expected="a JSON file")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"not valid JSON: {exc}", file=str(path)) from None
+
+
+# ----------------------------------------------------------------------------- lobes
+@handle_errors
+def lobes_cmd(
+    config: Path = typer.Argument(..., help="TOML config ([structure]/[equivalent] + "
+                                            "[process] or boring sections, [speed_rpm])."),
+    method: str = typer.Option("frequency", "--method",
+                               help="frequency (zero-order, fast) or semidiscretization."),
+    plot: Path | None = typer.Option(None, "--plot", help="Write lobes.png into this folder."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Stability lobes: critical depth of cut vs spindle speed."""
+    import numpy as np
+
+    from robobore.dynamics import stability
+    from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+
+    cfg, _ = load_dynamics_config(config)
+    src = str(config)
+    st = build_structure(cfg, src)
+    pr = build_process(cfg, src)
+    sp = cfg.speed_rpm
+    speeds = (np.linspace(100.0, 3000.0, 300) if sp is None
+              else np.linspace(sp.min, sp.max, sp.count))
+    if method not in ("frequency", "semidiscretization"):
+        raise ConfigError("unknown method", field="--method", value=method,
+                          expected="frequency or semidiscretization")
+    notes = []
+    if method == "frequency":
+        res = stability.lobes_frequency_domain(st, pr, speeds)
+        if pr.rotating:
+            notes.append("rotating boring bar: zero-order (revolution-averaged) directions; "
+                         "the depth-modulation stiffness is not in the frequency-domain "
+                         "solution -- cross-check with --method semidiscretization")
+    else:
+        fd = None
+        if pr.overlap in (0.0, 1.0):
+            fd = stability.lobes_frequency_domain(st, pr, speeds).critical_depth_m
+        with progress_bar("semi-discretisation", speeds.size, not as_json) as adv:
+            res = stability.lobes_semidiscretization(st, pr, speeds, progress=adv,
+                                                     guesses_m=fd)
+    mc = stability.mode_coupling_limit(st, pr)
+    out = res.to_dict()
+    out["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
+    out["process"] = pr.label
+    if pr.reference_depth_m is not None:
+        notes.append(f"boring process linearised at depth {pr.reference_depth_m * 1e3:g} mm "
+                     "(engaged edge stretched with depth)")
+    out["notes"] = notes
+    if plot is not None:
+        curves = stability.lobe_curves(st, pr, 12) if method == "frequency" else None
+        out["plot"] = str(stability_plot(res, plot, curves, pr.label))
+
+    def render(r: dict[str, Any]) -> None:
+        d = np.asarray(res.critical_depth_m) * 1e3
+        i = int(np.nanargmin(np.where(np.isfinite(d), d, np.nan))) if np.isfinite(d).any() else 0
+        j = int(np.nanargmax(np.where(np.isfinite(d), d, np.nan))) if np.isfinite(d).any() else 0
+        rows = [("method", res.method), ("process", pr.label),
+                ("speeds (r/min)", f"{speeds[0]:g} .. {speeds[-1]:g} ({speeds.size})"),
+                ("absolute limit (mm)", r["absolute_limit_mm"]),
+                ("lowest critical depth (mm) at r/min", f"{fmt(d[i])} at {speeds[i]:.0f}"),
+                ("best pocket (mm) at r/min", f"{fmt(d[j])} at {speeds[j]:.0f}"),
+                ("mode-coupling limit (mm)", r["mode_coupling_limit_mm"])]
+        if "plot" in r:
+            rows.append(("plot", r["plot"]))
+        stdout.print(kv_table("stability lobes", rows))
+        for n in notes:
+            stdout.print(f"[dim]note: {n}[/]")
+
+    emit(out, as_json, render)
+
+
+def stability_plot(res, plot_dir: Path, curves, label: str) -> Path:
+    from robobore.dynamics.plots import plot_lobes
+
+    return plot_lobes(res, plot_dir, curves, title=f"stability lobes -- {label}")
+
+
+# ----------------------------------------------------------------------------- simulate
+@handle_errors
+def simulate_boring_cmd(
+    config: Path = typer.Argument(..., help="TOML config (as for `robobore lobes`)."),
+    speed_rpm: float | None = typer.Option(None, "--speed-rpm",
+                                           help="Spindle speed [r/min] (default [cutting])."),
+    depth_mm: float | None = typer.Option(None, "--depth-mm",
+                                          help="Depth of cut [mm] (default [cutting])."),
+    revolutions: int | None = typer.Option(None, "--revolutions",
+                                           help="Revolutions (default [simulation], 150)."),
+    samples_per_rev: int | None = typer.Option(None, "--samples-per-rev",
+                                               help="Samples per revolution (default auto)."),
+    out: Path | None = typer.Option(None, "--out", help="Write the Dataset to this .nc file."),
+    plot: Path | None = typer.Option(None, "--plot", help="Write PNG plots into this folder."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Time-domain boring simulation with regeneration; stable / vibratory verdict."""
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+    from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
+    from robobore.io.results import write_netcdf
+
+    cfg, raw = load_dynamics_config(config)
+    src = str(config)
+    if speed_rpm is None:
+        if cfg.cutting is None:
+            raise ConfigError("no spindle speed", field="--speed-rpm",
+                              expected="--speed-rpm N (r/min) or a [cutting] section")
+        speed_rpm = cfg.cutting.speed_rpm
+    if depth_mm is None:
+        if cfg.cutting is None:
+            raise ConfigError("no depth of cut", field="--depth-mm",
+                              expected="--depth-mm A (mm) or a [cutting] section")
+        depth_mm = cfg.cutting.depth_mm
+    if not (math.isfinite(speed_rpm) and 1.0 <= speed_rpm <= 100000.0):
+        raise ConfigError("spindle speed out of range", field="--speed-rpm", value=speed_rpm,
+                          expected="1 .. 100000 r/min")
+    if not (math.isfinite(depth_mm) and 0.0 < depth_mm <= 50.0):
+        raise ConfigError("depth of cut out of range", field="--depth-mm", value=depth_mm,
+                          expected="0 < depth <= 50 mm")
+    revs = revolutions if revolutions is not None else cfg.simulation.revolutions
+    nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
+    st = build_structure(cfg, src)
+    pr = build_process(cfg, src, depth_m=depth_mm * 1e-3 if cfg.is_boring else None)
+    settings = SimulationSettings(float(speed_rpm), depth_mm * 1e-3, int(revs), int(nspr))
+    with progress_bar("simulating", None, not as_json):
+        ds = simulate(st, pr, settings, cfg.insert.to_insert() if cfg.is_boring else None)
+    tol = cfg.simulation.ra_tolerance_um
+    verdict = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
+    s = summarize(ds)
+    result = {
+        "stable": verdict.stable,
+        "chatter_frequency_Hz": verdict.chatter_frequency_Hz,
+        "vibration_growth": verdict.vibration_growth,
+        "force_mean_N": s["force_mean_N"],
+        "force_amplitude_N": s["force_amplitude_N"],
+        "feed_amplitude_um": s["feed_amplitude_m"] * 1e6,
+        "nonharmonic_energy_ratio": verdict.nonharmonic_energy_ratio,
+        "roughness_Ra_um": ds.attrs["Ra_m"] * 1e6,
+        "roughness_Rz_um": ds.attrs["Rz_m"] * 1e6,
+        "tool_left_cut_fraction": verdict.tool_left_cut_fraction,
+        "reasons": list(verdict.reasons),
+        "speed_rpm": speed_rpm, "depth_mm": depth_mm, "revolutions": int(revs),
+        "samples_per_rev": int(ds.attrs["samples_per_rev"]), "process": pr.label,
+    }
+    if out is not None:
+        if out.suffix != ".nc":
+            raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
+                              expected="a path ending in .nc")
+        write_netcdf(ds, out, config=raw)
+        result["out"] = str(out)
+    if plot is not None:
+        from robobore.dynamics.plots import plot_simulation
+
+        result["plots"] = [str(p) for p in plot_simulation(ds, plot)]
+
+    def render(r: dict[str, Any]) -> None:
+        rows = [("verdict", "stable" if r["stable"] else "VIBRATORY"),
+                ("chatter frequency (Hz)", r["chatter_frequency_Hz"]),
+                ("vibration growth", r["vibration_growth"]),
+                *[(f"mean force {a} (N)", r["force_mean_N"][a]) for a in "xyz"],
+                *[(f"force amplitude {a} (N)", r["force_amplitude_N"][a]) for a in "xyz"],
+                ("feed amplitude (um)", r["feed_amplitude_um"]),
+                ("Ra / Rz (um)", f"{fmt(r['roughness_Ra_um'])} / {fmt(r['roughness_Rz_um'])}"),
+                ("samples per revolution", r["samples_per_rev"])]
+        for why in r["reasons"]:
+            rows.append(("reason", why))
+        stdout.print(kv_table(f"boring simulation, n = {speed_rpm:g} r/min, "
+                              f"a = {depth_mm:g} mm", rows))
+
+    emit(result, as_json, render)
+
+
+# ----------------------------------------------------------------------------- equivalent
+@handle_errors
+def equivalent_cmd(
+    stiffness_N_per_m: str | None = typer.Option(
+        None, "--stiffness-N-per-m", help="Directional stiffness x,y,z [N/m]."),
+    stiffness_file: Path | None = typer.Option(
+        None, "--stiffness-file", help='JSON {"directional_stiffness_N_per_m": {x,y,z}}.'),
+    modes_file: Path | None = typer.Option(
+        None, "--modes-file", help='JSON {"modes": [{"frequency_Hz", "damping_ratio", ...}]}.'),
+    frequencies_Hz: str | None = typer.Option(
+        None, "--frequencies-Hz", help="Natural frequencies x,y,z [Hz] (instead of a file)."),
+    damping_ratios: str | None = typer.Option(
+        None, "--damping-ratios", help="Damping ratios x,y,z (with --frequencies-Hz)."),
+    assign: str | None = typer.Option(
+        None, "--assign", help="Mode indices for x,y,z, e.g. 0,2,1 (0-based)."),
+    damping_N_s_per_m: float | None = typer.Option(
+        None, "--damping-N-s-per-m", help="Given damping coefficient (the paper: 23.7)."),
+    foot_pressure_MPa: float | None = typer.Option(
+        None, "--foot-pressure-MPa", help="Add the pressure foot at this pressure [MPa]."),
+    foot_piston_diameter_mm: float = typer.Option(
+        50.0, "--foot-piston-diameter-mm", help="Piston diameter [mm] (assumed default 50)."),
+    foot_normal_stiffness_N_per_m: float | None = typer.Option(
+        None, "--foot-normal-stiffness-N-per-m", help="Contact stiffness (default Hertz)."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Equivalent per-direction mass-spring-damper model (m = k / wn^2; c or zeta)."""
+    from robobore.equivalent import EquivalentModel, PressureFoot
+
+    if (stiffness_N_per_m is None) == (stiffness_file is None):
+        raise ConfigError("give exactly one stiffness source", field="--stiffness-N-per-m",
+                          expected="--stiffness-N-per-m x,y,z or --stiffness-file FILE.json")
+    if stiffness_file is not None:
+        stiff = _read_json(stiffness_file, "stiffness")
+    else:
+        k = parse_floats(stiffness_N_per_m, 3, "--stiffness-N-per-m", "N/m")
+        stiff = {"directional_stiffness_N_per_m": dict(zip("xyz", k, strict=True))}
+    if modes_file is not None:
+        modes = _read_json(modes_file, "modes")
+    elif frequencies_Hz is not None:
+        f = parse_floats(frequencies_Hz, 3, "--frequencies-Hz", "Hz")
+        z = (parse_floats(damping_ratios, 3, "--damping-ratios", "(ratio)")
+             if damping_ratios is not None else [0.0] * 3)
+        if damping_ratios is None and damping_N_s_per_m is None:
+            raise ConfigError("no damping given", field="--damping-ratios",
+                              expected="--damping-ratios x,y,z or --damping-N-s-per-m C")
+        modes = {"modes": [{"frequency_Hz": a, "damping_ratio": b}
+                           for a, b in zip(f, z, strict=True)]}
+    else:
+        raise ConfigError("no modes given", field="--modes-file",
+                          expected="--modes-file FILE.json or --frequencies-Hz x,y,z")
+    assignment = None
+    if assign is not None:
+        idx = parse_floats(assign, 3, "--assign", "0-based mode indices")
+        assignment = {a: int(i) for a, i in zip("xyz", idx, strict=True)}
+    foot = None
+    if foot_pressure_MPa is not None:
+        if not 0 <= foot_pressure_MPa <= 10:
+            raise ConfigError("out of range", field="--foot-pressure-MPa",
+                              value=foot_pressure_MPa, expected="0 .. 10 MPa")
+        foot = PressureFoot(pressure_Pa=foot_pressure_MPa * 1e6,
+                            piston_area_m2=math.pi * (foot_piston_diameter_mm * 1e-3 / 2) ** 2,
+                            normal_stiffness_N_per_m=foot_normal_stiffness_N_per_m)
+    em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
+                                                  damping_N_s_per_m=damping_N_s_per_m,
+                                                  foot=foot)
+    result = em.to_dict()
+    result["table"] = em.table()
+    result["tool_point_modes"] = em.tool_point_modes()
+
+    def render(r: dict[str, Any]) -> None:
+        from rich.table import Table
+
+        t = Table(title="equivalent model (boring frame)", header_style="bold")
+        for h in ("axis", "k (N/m)", "f_n (Hz)", "m (kg)", "c (N s/m)", "zeta"):
+            t.add_column(h, justify="right")
+        for row in r["table"]:
+            t.add_row(row["axis"], fmt(row["stiffness_N_per_m"]), fmt(row["frequency_Hz"]),
+                      fmt(row["mass_kg"]), fmt(row["damping_N_s_per_m"]),
+                      fmt(row["damping_ratio"]))
+        stdout.print(t)
+        for n in r["notes"]:
+            stdout.print(f"[dim]note: {n}[/]")
+
+    emit(result, as_json, render)
 
 
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add this stage's commands to the shared command groups."""
+    groups["root"].command("lobes")(lobes_cmd)
+    groups["simulate"].command("boring")(simulate_boring_cmd)
+    groups["model"].command("equivalent")(equivalent_cmd)

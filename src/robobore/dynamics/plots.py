@@ -1,0 +1,105 @@
+"""Plots of the process stage (matplotlib, Agg backend, PNG files)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_lobes(result, out_dir: str | Path, curves=None, title: str = "") -> Path:
+    """Lobe diagram: critical depth [mm] vs spindle speed [r/min] (+ individual lobes)."""
+    plt = _plt()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    s = result.speed_rpm
+    d = result.critical_depth_m * 1e3
+    finite = np.isfinite(d)
+    top = np.nanmax(d[finite]) * 1.2 if finite.any() else 1.0
+    if np.isfinite(result.absolute_limit_m) and result.absolute_limit_m > 0:
+        top = min(top, 8.0 * result.absolute_limit_m * 1e3)
+    if curves:
+        for n, b in curves:
+            ok = (n >= s.min()) & (n <= s.max())
+            ax.plot(n[ok], b[ok] * 1e3, color="0.8", lw=0.6)
+    ax.fill_between(s, np.where(finite, d, top), top, color="tab:red", alpha=0.12,
+                    label="unstable")
+    ax.plot(s, np.where(finite, d, np.nan), color="tab:blue", lw=1.5,
+            label=f"critical depth ({result.method})")
+    if np.isfinite(result.absolute_limit_m):
+        ax.axhline(result.absolute_limit_m * 1e3, color="k", ls="--", lw=0.8,
+                   label=f"absolute limit {result.absolute_limit_m * 1e3:.4g} mm")
+    ax.set_ylim(0, top)
+    ax.set_xlim(s.min(), s.max())
+    ax.set_xlabel("spindle speed [r/min]")
+    ax.set_ylabel("depth of cut [mm]")
+    ax.set_title(title or "stability lobes")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    path = out / "lobes.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
+    """Forces, displacements, feed amplitude, surface profile and spectrum of a simulation."""
+    plt = _plt()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    t = ds["time"].values
+    paths = []
+    fig, axs = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    for i, a in enumerate("xyz"):
+        axs[0].plot(t, ds["force"].values[:, i], lw=0.6, label=f"F{a}")
+        axs[1].plot(t, ds["displacement"].values[:, i] * 1e6, lw=0.6, label=a)
+    axs[0].set_ylabel("force on tool [N]")
+    axs[1].set_ylabel("displacement [um]")
+    axs[2].plot(t, ds["rotational_acceleration"].values[:, 0], lw=0.5, color="tab:purple")
+    axs[2].set_ylabel("rotational acc. [m/s^2]")
+    axs[2].set_xlabel("time [s]")
+    for a in axs[:2]:
+        a.legend(fontsize=8, loc="upper right")
+    fig.suptitle(f"n = {ds.attrs['speed_rpm']:.0f} r/min, a = {ds.attrs['depth_m'] * 1e3:.4g} mm")
+    fig.tight_layout()
+    p = out / "simulation_signals.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    paths.append(p)
+
+    fig, axs = plt.subplots(1, 2, figsize=(10, 3.8))
+    z = ds["surface_z"].values
+    h = ds["surface_profile"].values
+    axs[0].plot((z - z[0]) * 1e3, (h - np.nanmean(h)) * 1e6, lw=0.8)
+    axs[0].set_xlabel("position along the feed [mm]")
+    axs[0].set_ylabel("surface height [um]")
+    axs[0].set_title(f"Ra = {ds.attrs['Ra_m'] * 1e6:.3g} um, Rz = {ds.attrs['Rz_m'] * 1e6:.3g} um")
+    X = ds["displacement"].values
+    n0 = int(0.7 * X.shape[0])
+    x = X[n0:] - X[n0:].mean(axis=0)
+    P = (np.abs(np.fft.rfft(x * np.hanning(x.shape[0])[:, None], axis=0)) ** 2).sum(axis=1)
+    f = np.fft.rfftfreq(x.shape[0], float(ds.attrs["dt_s"]))
+    axs[1].semilogy(f, P + 1e-300, lw=0.7)
+    fmax = max(5 * float(ds.attrs["speed_rpm"]) / 60 * int(ds.attrs["n_inserts"]), 1.0)
+    axs[1].set_xlim(0, fmax)
+    axs[1].set_xlabel("frequency [Hz]")
+    axs[1].set_ylabel("displacement PSD [a.u.]")
+    fig.tight_layout()
+    p = out / "simulation_surface_spectrum.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    paths.append(p)
+    return paths
+
+
+__all__ = ["plot_lobes", "plot_simulation"]
