@@ -236,12 +236,12 @@ class DynamicsConfig(_Strict):
     @model_validator(mode="after")
     def _sections(self):
         if self.structure is None and self.equivalent is None:
-            raise ValueError("missing section [structure] (tool-point modes) or [equivalent]")
+            raise ValueError("missing section 'structure' (tool-point modes) or 'equivalent'")
         if self.process is None:
             missing = [k for k in ("insert", "bore", "cutting") if getattr(self, k) is None]
             if missing:
-                raise ValueError("missing section [process] (single-point cutting) or the "
-                                 "boring sections [" + "], [".join(missing) + "]")
+                raise ValueError("missing section 'process' (single-point cutting) or the "
+                                 "boring section(s) " + ", ".join(f"'{m}'" for m in missing))
         return self
 
     @property

@@ -1,0 +1,130 @@
+# ruff: noqa: E501  (the contract TOML is quoted verbatim from the issue)
+"""Config contract and CLI: the contract TOML is accepted; bad configs name the key."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from robobore.cli import app
+
+EX = Path(__file__).resolve().parents[2] / "examples"
+runner = CliRunner()
+
+CONTRACT = """
+[structure]   # tool-point modes, boring frame: x horizontal, y vertical, z feed
+modes = [ { frequency_Hz = 250.0, damping_ratio = 0.012, stiffness_N_per_m = 2.26e8, direction = [0.866, 0.5, 0.0] } ]
+[process]
+cutting_coefficient_N_per_m2 = 1.0e9   # force magnitude per unit chip area (depth x chip thickness)
+force_direction = [1.0, 0.0, 0.0]      # unit vector of the cutting force on the tool
+chip_normal = [1.0, 0.0, 0.0]          # tool displacement along this changes the chip thickness
+feed_mm_per_rev = 0.1
+[speed_rpm]
+min = 2000.0
+max = 14000.0
+count = 601
+"""
+
+
+def _write(tmp_path, text, name="c.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_lobes_contract_json(tmp_path):
+    p = _write(tmp_path, CONTRACT)
+    r = runner.invoke(app, ["lobes", str(p), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert len(d["speed_rpm"]) == 601 and len(d["critical_depth_mm"]) == 601
+    assert len(d["chatter_frequency_Hz"]) == 601
+    ref = 2 * 2.26e8 * 0.012 * 1.012 / (1e9 * (0.866**2 / (0.866**2 + 0.25))) * 1e3
+    assert d["absolute_limit_mm"] == pytest.approx(ref, rel=5e-3)
+
+
+def test_simulate_contract_json_and_netcdf(tmp_path):
+    p = _write(tmp_path, CONTRACT)
+    nc = tmp_path / "out.nc"
+    r = runner.invoke(app, ["simulate", "boring", str(p), "--speed-rpm", "9500", "--depth-mm",
+                            "5", "--revolutions", "60", "--json", "--out", str(nc)])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    for k in ("stable", "chatter_frequency_Hz", "vibration_growth", "force_mean_N",
+              "force_amplitude_N", "feed_amplitude_um"):
+        assert k in d
+    assert d["stable"] is True and d["chatter_frequency_Hz"] is None
+    assert set(d["force_mean_N"]) == {"x", "y", "z"}
+    # force = K a h u: 1e9 * 5e-3 * 1e-4 = 500 N along x at steady state
+    assert d["force_mean_N"]["x"] == pytest.approx(500.0, rel=0.02)
+    import xarray as xr
+
+    with xr.open_dataset(nc) as ds:
+        assert ds["force"].attrs["units"] == "N" and "robobore_config" in ds.attrs
+
+
+def test_boring_example_runs(tmp_path):
+    r = runner.invoke(app, ["simulate", "boring", str(EX / "boring_paper.toml"), "--json",
+                            "--revolutions", "20"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert 5.0 < d["force_amplitude_N"]["x"] < 100.0  # tens of newtons (paper condition)
+    r = runner.invoke(app, ["lobes", str(EX / "boring_paper.toml"), "--json", "--plot",
+                            str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "lobes.png").is_file()
+
+
+def test_model_equivalent_command():
+    r = runner.invoke(app, ["model", "equivalent", "--stiffness-N-per-m", "1.2e6,0.9e6,1.5e6",
+                            "--frequencies-Hz", "6.9,16.8,24.6", "--damping-N-s-per-m", "23.7",
+                            "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    m = 1.2e6 / (2 * math.pi * 6.9) ** 2
+    assert d["mass_kg"]["x"] == pytest.approx(m)
+    assert d["damping_ratio"]["x"] == pytest.approx(23.7 / (2 * math.sqrt(1.2e6 * m)))
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ("stiffness_N_per_m = 2.26e8", "stiffness_N_per_m = -2.26e8", "structure.modes.0.stiffness"),
+    ("direction = [0.866, 0.5, 0.0]", "direction = [0.0, 0.0, 0.0]", "structure.modes.0.direction"),
+    ("direction = [0.866, 0.5, 0.0]", "direction = [0.88, 0.5, 0.0]",
+     "structure.modes.0.direction"),
+    ("force_direction = [1.0, 0.0, 0.0]", "force_direction = [0.0, 0.0, 0.0]",
+     "process.force_direction"),
+    ("count = 601", "count = 0", "speed_rpm.count"),
+    ("min = 2000.0", "min = -5.0", "speed_rpm.min"),
+    ("feed_mm_per_rev = 0.1", "feed_mm_per_rev = 0.1\nfeed_typo = 1", "process.feed_typo"),
+])
+def test_bad_config_names_key(tmp_path, old, new, key):
+    p = _write(tmp_path, CONTRACT.replace(old, new))
+    r = runner.invoke(app, ["lobes", str(p), "--json"])
+    assert r.exit_code == 2
+    assert key in r.output and "c.toml" in r.output
+
+
+def test_missing_sections(tmp_path):
+    text = CONTRACT.split("[process]")[0]
+    p = _write(tmp_path, text)
+    r = runner.invoke(app, ["lobes", str(p)])
+    assert r.exit_code == 2 and "missing section 'process'" in r.output
+    assert "'insert', 'bore', 'cutting'" in r.output
+    p = _write(tmp_path, "[process]" + CONTRACT.split("[process]")[1])
+    r = runner.invoke(app, ["lobes", str(p)])
+    assert r.exit_code == 2 and "'structure'" in r.output
+
+
+@pytest.mark.parametrize("opt, val, key", [("--speed-rpm", "0", "--speed-rpm"),
+                                           ("--depth-mm", "-1", "--depth-mm"),
+                                           ("--depth-mm", "80", "--depth-mm")])
+def test_out_of_range_options(tmp_path, opt, val, key):
+    p = _write(tmp_path, CONTRACT)
+    args = ["simulate", "boring", str(p), "--speed-rpm", "5000", "--depth-mm", "1"]
+    args[args.index(opt) + 1] = val
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2 and key in r.output

@@ -1,0 +1,120 @@
+"""Time-domain simulation against the lobes, mode coupling, static forces, surface."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from robobore.cutting.forces import CuttingCoefficients, boring_forces
+from robobore.cutting.geometry import BoringInsert
+from robobore.dynamics.chatter import classify
+from robobore.dynamics.process import boring_process
+from robobore.dynamics.stability import (
+    lobes_frequency_domain,
+    mode_coupling,
+    mode_coupling_limit,
+    sdof_pocket_speeds,
+)
+from robobore.dynamics.structure import ToolPointStructure
+from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
+
+
+@pytest.mark.parametrize("speed", ["pocket", 9500.0])
+def test_time_domain_agrees_with_lobes(sdof, contract_process, speed):
+    """At a lobe-minimum (pocket) speed and at a speed on the flank, 0.9 x the
+    frequency-domain critical depth decays and 1.1 x grows over 150 revolutions."""
+    n = sdof_pocket_speeds(250.0, 0.012, 1, 3)[1] if speed == "pocket" else speed
+    b = lobes_frequency_domain(sdof, contract_process, np.array([n])).critical_depth_m[0]
+    lo = classify(simulate(sdof, contract_process, SimulationSettings(n, 0.9 * b, 150)))
+    hi = classify(simulate(sdof, contract_process, SimulationSettings(n, 1.1 * b, 150)))
+    assert lo.stable and lo.vibration_growth < 0.5
+    assert not hi.stable and hi.vibration_growth > 2.0
+    assert hi.chatter_frequency_Hz == pytest.approx(255.0, abs=8.0)
+
+
+def test_tool_leaves_cut_and_vibration_saturates(sdof, contract_process):
+    """Well above the limit the tool jumps out of the cut (h <= 0: no force, surface kept), so
+    the chatter amplitude stays bounded (nonlinear saturation) instead of growing forever."""
+    n = 9500.0
+    b = lobes_frequency_domain(sdof, contract_process, np.array([n])).critical_depth_m[0]
+    ds = simulate(sdof, contract_process, SimulationSettings(n, 1.5 * b, 400))
+    v = classify(ds)
+    assert not v.stable and v.tool_left_cut_fraction > 0.05
+    x = ds["displacement"].values[:, 0]
+    Ns = ds.attrs["samples_per_rev"]
+    late = np.abs(x[-50 * Ns:]).max()
+    mid = np.abs(x[-150 * Ns:-100 * Ns]).max()
+    assert late < 1.5 * mid  # saturated, not exponential
+
+
+def test_mode_coupling_case(coupling_case):
+    """Two orthogonal close modes, force between them (Pan et al. 2006): at 60 um and 2500
+    r/min each mode alone is regeneratively stable (classical per-mode lobes), the
+    mode-coupling criterion flags instability, and the simulation grows at a frequency between
+    the two modes; at 15 um all agree it is stable."""
+    st, pr = coupling_case()
+    n, b = 2500.0, 60e-6
+    per_mode = [lobes_frequency_domain(ToolPointStructure.from_modes([m]), pr,
+                                       np.array([n])).critical_depth_m[0] for m in st.modes()]
+    assert min(per_mode) > b  # regeneration of each mode alone: stable
+    assert mode_coupling(st, pr, b).unstable and mode_coupling_limit(st, pr) < b
+    v = classify(simulate(st, pr, SimulationSettings(n, b, 150)))
+    assert not v.stable and v.vibration_growth > 2
+    assert 19.5 < v.chatter_frequency_Hz < 21.5
+    assert not mode_coupling(st, pr, 15e-6).unstable
+    assert classify(simulate(st, pr, SimulationSettings(n, 15e-6, 150))).stable
+
+
+def _rigid():
+    return ToolPointStructure.from_modes([
+        {"frequency_Hz": 3000.0, "damping_ratio": 0.05, "stiffness_N_per_m": 1e12,
+         "direction": d} for d in ([1, 0, 0], [0, 1, 0], [0, 0, 1])])
+
+
+def test_rigid_boring_reproduces_static_forces():
+    """On a (nearly) rigid structure the simulated boring forces equal the static mechanistic
+    model: rotating force of amplitude sqrt(Ft^2 + Fr^2) in X and Y, constant feed force (1 %)."""
+    ins = BoringInsert(nose_radius_m=0.4e-3)
+    c = CuttingCoefficients(Ktc=1.6e9, Krc=0.0, Kfc=0.3e9, Kte=2e4, Kfe=4e4)
+    ap, f = 0.3e-3, 0.15e-3
+    pr = boring_process(ins, c, ap, f, n_elements=30)
+    ds = simulate(_rigid(), pr, SimulationSettings(300.0, ap, 6, samples_per_rev=720), ins)
+    s = summarize(ds)
+    ref = boring_forces(ins, ap, f, c, n_elements=30)
+    amp = math.hypot(ref["tangential_N"], ref["radial_N"])
+    assert s["force_amplitude_N"]["x"] == pytest.approx(amp, rel=0.01)
+    assert s["force_amplitude_N"]["y"] == pytest.approx(amp, rel=0.01)
+    assert s["force_mean_N"]["z"] == pytest.approx(ref["feed_N"], rel=0.01)
+    assert ds["force"].attrs["units"] == "N" and ds["displacement"].attrs["units"] == "m"
+
+
+def test_surface_roughness_of_round_nose():
+    """Rigid tool, feed inside the nose arc: Ra = f^2 / (18 sqrt(3) r) = 0.0321 f^2 / r and
+    Rz = f^2 / (8 r) (circular-arc feed marks, e.g. Shaw, Metal Cutting Principles). 3 %."""
+    ins = BoringInsert(nose_radius_m=0.8e-3, end_edge_angle_deg=30.0)
+    c = CuttingCoefficients(Ktc=1.6e9, Krc=0.0, Kfc=0.3e9)
+    f = 0.2e-3
+    pr = boring_process(ins, c, 0.5e-3, f)
+    ds = simulate(_rigid(), pr, SimulationSettings(300.0, 0.5e-3, 50, 360), ins)
+    assert ds.attrs["Ra_m"] == pytest.approx(f**2 / (18 * math.sqrt(3) * 0.8e-3), rel=0.03)
+    assert ds.attrs["Rz_m"] == pytest.approx(f**2 / (8 * 0.8e-3), rel=0.03)
+
+
+def test_two_inserts_halve_the_lobe_speeds(sdof):
+    """Delay 1/(N n): two inserts cutting at once (fixed force direction) see the delay of one
+    insert at twice the speed and twice the force per depth: b_2(n) = b_1(2 n) / 2 (exact);
+    the simulation (surface regenerated insert by insert) agrees at 0.9 / 1.1 x."""
+    from robobore.dynamics.process import single_point_process
+
+    p1 = single_point_process(1e9, [1, 0, 0], [1, 0, 0], 1e-4, n_inserts=1)
+    p2 = single_point_process(1e9, [1, 0, 0], [1, 0, 0], 1e-4, n_inserts=2)
+    s = np.array([4000.0, 6000.0, 8000.0])
+    a = lobes_frequency_domain(sdof, p1, 2 * s).critical_depth_m
+    b = lobes_frequency_domain(sdof, p2, s).critical_depth_m
+    assert np.allclose(a, 2 * b, rtol=1e-9)
+    n = 4332.0  # half of the second pocket speed: 2 inserts at 0.9 x limit decay
+    lim = lobes_frequency_domain(sdof, p2, np.array([n])).critical_depth_m[0]
+    assert classify(simulate(sdof, p2, SimulationSettings(n, 0.9 * lim, 150))).stable
+    assert not classify(simulate(sdof, p2, SimulationSettings(n, 1.1 * lim, 150))).stable
