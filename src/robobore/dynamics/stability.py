@@ -322,6 +322,8 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
     mu = process.overlap
     n = 2 * m + steps * m
     mono = np.eye(n)
+    last = 2 * m + (steps - 1) * m
+    prev = 2 * m + (steps - 2) * m if steps > 1 else 0  # q_{i-r+1} (= q_i when r = 1)
     for i in range(n_th):
         L = base.copy()
         L[m:, :m] += -depth_m * W[i] + Pm[i]
@@ -330,24 +332,23 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
         Rq[m:, :] = mu * depth_m * W[i]
         P1 = (G1 / dt) @ Rq             # multiplies q_{i-r+1}
         P0 = (G0 - G1 / dt) @ Rq        # multiplies q_{i-r}
-        Gs = np.zeros((n, n))
-        Gs[:2 * m, :2 * m] = Phi
-        # delayed states: register holds q_{i-1} .. q_{i-r} at rows 2m + (k-1) m
-        last = 2 * m + (steps - 1) * m
-        Gs[:2 * m, last:last + m] += P0
-        if steps == 1:
-            Gs[:2 * m, :m] += P1
-        else:
-            prev = 2 * m + (steps - 2) * m
-            Gs[:2 * m, prev:prev + m] += P1
-        # shift register: new q_{i} -> slot 1, slot k -> slot k+1
-        Gs[2 * m:3 * m, :m] = np.eye(m)
-        for k in range(1, steps):
-            Gs[2 * m + k * m:2 * m + (k + 1) * m, 2 * m + (k - 1) * m:2 * m + k * m] = np.eye(m)
         if constant:
+            # step matrix z_{i+1} = G z_i, z = [x_i, q_{i-1}, ..., q_{i-r}]
+            Gs = np.zeros((n, n))
+            Gs[:2 * m, :2 * m] = Phi
+            Gs[:2 * m, last:last + m] += P0
+            Gs[:2 * m, prev:prev + m] += P1
+            Gs[2 * m:3 * m, :m] = np.eye(m)  # shift register: q_i -> slot 1, k -> k + 1
+            for k in range(1, steps):
+                Gs[2 * m + k * m:2 * m + (k + 1) * m,
+                   2 * m + (k - 1) * m:2 * m + k * m] = np.eye(m)
             ev = np.linalg.eigvals(Gs)
             return float(np.max(np.abs(ev)) ** steps)
-        mono = Gs @ mono
+        # periodic: apply the sparse step matrix to the monodromy product (O(m n^2) per step)
+        top = Phi @ mono[:2 * m] + P0 @ mono[last:last + m] + P1 @ mono[prev:prev + m]
+        mono[3 * m:] = mono[2 * m:n - m].copy()
+        mono[2 * m:3 * m] = mono[:m]
+        mono[:2 * m] = top
     return float(np.max(np.abs(np.linalg.eigvals(mono))))
 
 
