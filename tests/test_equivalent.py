@@ -103,3 +103,22 @@ def test_bad_mode_names_key():
     with pytest.raises(ConfigError) as ei:
         EquivalentModel.from_stiffness_and_modes(STIFF, {"modes": [{"frequency_Hz": -2}] * 3})
     assert ei.value.field == "modes[0].frequency_Hz"
+
+
+def test_principal_frame_from_stiffness_matrix():
+    """Equal masses: the units act along the stiffness-matrix eigenvectors (a frame rotation);
+    a mode whose direction lies along the softest principal axis is assigned to it."""
+    c, s_ = np.cos(np.radians(30)), np.sin(np.radians(30))
+    R = np.array([[c, -s_, 0], [s_, c, 0], [0, 0, 1.0]])
+    K = R @ np.diag([1e6, 2e6, 3e6]) @ R.T
+    modes = {"modes": [
+        {"frequency_Hz": 30.0, "damping_ratio": 0.02, "direction": [0.0, 0.0, 1.0]},
+        {"frequency_Hz": 12.0, "damping_ratio": 0.03, "direction": list(R[:, 0])},
+        {"frequency_Hz": 20.0, "damping_ratio": 0.04, "direction": list(R[:, 1])},
+    ]}
+    em = EquivalentModel.from_stiffness_and_modes({"stiffness_matrix_N_per_m": K.tolist()}, modes)
+    assert em.stiffness_N_per_m["x"] == pytest.approx(1e6)
+    assert em.frequency_Hz == {"x": 12.0, "y": 20.0, "z": 30.0}
+    D = em.directions()
+    assert abs(D[0] @ R[:, 0]) == pytest.approx(1.0)
+    assert np.allclose(em.tool_point_modes()[0]["direction"], D[0])

@@ -241,12 +241,23 @@ class EquivalentModel:
         damping_N_s_per_m: float | None = None,
         foot: PressureFoot | None = None,
     ) -> EquivalentModel:
-        """Build from the robot-stiffness and modal JSON contracts (see module docstring)."""
-        try:
-            ks = stiffness["directional_stiffness_N_per_m"]
-        except (KeyError, TypeError):
-            raise ConfigError("missing key", field="directional_stiffness_N_per_m",
-                              expected='{"x": .., "y": .., "z": ..} in N/m') from None
+        """Build from the robot-stiffness and modal JSON contracts (see module docstring).
+
+        If ``stiffness`` carries a full ``"stiffness_matrix_N_per_m"`` (3x3, boring frame),
+        the units act along its principal directions (:func:`principal_frame`, equal-mass
+        assumption of the paper) with the principal stiffnesses, and mode directions are
+        compared with those principal axes.
+        """
+        R = None
+        if isinstance(stiffness, dict) and "stiffness_matrix_N_per_m" in stiffness:
+            kp, R = principal_frame(np.asarray(stiffness["stiffness_matrix_N_per_m"], float))
+            ks = dict(zip(AXES, (float(v) for v in kp), strict=True))
+        else:
+            try:
+                ks = stiffness["directional_stiffness_N_per_m"]
+            except (KeyError, TypeError):
+                raise ConfigError("missing key", field="directional_stiffness_N_per_m",
+                                  expected='{"x": .., "y": .., "z": ..} in N/m') from None
         try:
             ml = list(modes["modes"])
         except (KeyError, TypeError):
@@ -257,13 +268,22 @@ class EquivalentModel:
         for i, md in enumerate(ml):
             _positive(f"modes[{i}].frequency_Hz", md.get("frequency_Hz"), "Hz")
             _nonneg(f"modes[{i}].damping_ratio", md.get("damping_ratio", 0.0), "(ratio)")
+        if R is not None:  # compare mode directions with the principal axes
+            ml = [dict(md) for md in ml]
+            for md in ml:
+                d = _mode_direction(md, signed=True)
+                if d is not None:
+                    md["direction"] = list(np.abs(R.T @ d))
+                    md.pop("shape", None)
         chosen, how = assign_modes(ml, assignment)
         fn = {a: float(ml[chosen[a]]["frequency_Hz"]) for a in AXES}
         zr = {a: float(ml[chosen[a]].get("damping_ratio", 0.0)) for a in AXES}
         notes = (how + ": " + ", ".join(f"{a} <- mode {chosen[a]} ({fn[a]:.4g} Hz)"
                                         for a in AXES),)
+        if R is not None:
+            notes = notes + ("units along the principal directions of the stiffness matrix",)
         return cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
-                         damping_N_s_per_m=damping_N_s_per_m, foot=foot, notes=notes)
+                         damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot, notes=notes)
 
     # ------------------------------------------------------------------ derived
     def unit(self, axis: str) -> DirectionUnit:
@@ -329,7 +349,9 @@ class EquivalentModel:
                    tuple(d.get("notes", ())))
 
 
-def _mode_direction(md: dict[str, Any]) -> np.ndarray | None:
+def _mode_direction(md: dict[str, Any], signed: bool = False) -> np.ndarray | None:
+    """Mode direction (3,): absolute components, or (``signed``) the real shape after
+    removing the phase of its largest component."""
     d = md.get("direction", md.get("shape"))
     if d is None:
         return None
@@ -337,9 +359,13 @@ def _mode_direction(md: dict[str, Any]) -> np.ndarray | None:
         if d.lower() not in _AXIS_VEC:
             raise ConfigError("unknown axis", field="direction", value=d, expected="x, y or z")
         return np.asarray(_AXIS_VEC[d.lower()])
-    v = np.abs(np.asarray(d, dtype=complex)).astype(float).ravel()
-    if v.shape != (3,) or not np.isfinite(v).all() or v.max() <= 0:
+    c = np.asarray(d, dtype=complex).ravel()
+    v = np.abs(c)
+    if c.shape != (3,) or not np.isfinite(v).all() or v.max() <= 0:
         return None
+    if signed:
+        ph = c[int(np.argmax(v))] / v.max()
+        return np.real(c / ph)
     return v
 
 
