@@ -81,35 +81,31 @@ def jc_damage_increment_py(deps_p, triax, eps_rate, T, d1, d2, d3, d4, d5, eps0,
     return deps_p / jc_failure_strain(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt)
 
 
-def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
-    """Radial return of a trial deviatoric stress onto the Johnson-Cook yield surface.
+def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
+    """Scalar Johnson-Cook return mapping: plastic strain increment and flow stress.
 
     Parameters
     ----------
-    sxx, syy, szz, sxy:
-        Trial *deviatoric* stress components [Pa] (plane strain: xz = yz = 0).
-    eps_p:
-        Equivalent plastic strain at the start of the increment [-].
-    T:
-        Temperature [K] (held fixed over the increment, explicit coupling).
-    dt:
-        Time increment [s]; the plastic strain rate is d(eps_p)/dt.
-    G:
-        Shear modulus [Pa].
+    q:
+        von Mises equivalent of the trial deviatoric stress, sqrt(3/2 s:s) [Pa].
+    eps_p, T, dt, G:
+        Equivalent plastic strain at the start of the increment [-], temperature [K] (held
+        fixed over the increment), time increment [s], shear modulus [Pa].
 
     Returns
     -------
-    (sxx, syy, szz, sxy, deps_p, sigma_y):
-        Returned deviatoric stress, plastic strain increment, flow stress at the end.
+    (deps_p, sigma_y):
+        Plastic strain increment (0.0 when the trial state is elastic) and the flow stress
+        at the end of the increment [Pa]. A caller scales its trial deviator by
+        ``sigma_y / q`` when ``deps_p > 0`` (radial return, any dimension).
 
-    The scalar consistency equation q_trial - 3 G d - sigma_y(eps_p + d, d/dt, T) = 0 is
-    solved by Newton's method safeguarded by bisection on [0, q_trial/(3G)]; f is strictly
-    decreasing in d, so the root is unique.
+    The scalar consistency equation q - 3 G d - sigma_y(eps_p + d, d/dt, T) = 0 is solved by
+    Newton's method safeguarded by bisection on [0, q/(3G)]; f is strictly decreasing in d,
+    so the root is unique.
     """
-    q = math.sqrt(1.5 * (sxx * sxx + syy * syy + szz * szz + 2.0 * sxy * sxy))
     sy0 = jc_flow_stress(eps_p, 0.0, T, a, b, n, c, m, eps0, Troom, Tmelt)
     if q <= sy0:
-        return sxx, syy, szz, sxy, 0.0, sy0
+        return 0.0, sy0
     lo = 0.0
     hi = q / (3.0 * G)
     d = (q - sy0) / (3.0 * G)
@@ -140,6 +136,36 @@ def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, T
             break
         d = dn
     sy = jc_flow_stress(eps_p + d, d / dt, T, a, b, n, c, m, eps0, Troom, Tmelt)
+    return d, sy
+
+
+def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
+    """Radial return of a trial deviatoric stress onto the Johnson-Cook yield surface.
+
+    Parameters
+    ----------
+    sxx, syy, szz, sxy:
+        Trial *deviatoric* stress components [Pa] (plane strain: xz = yz = 0).
+    eps_p:
+        Equivalent plastic strain at the start of the increment [-].
+    T:
+        Temperature [K] (held fixed over the increment, explicit coupling).
+    dt:
+        Time increment [s]; the plastic strain rate is d(eps_p)/dt.
+    G:
+        Shear modulus [Pa].
+
+    Returns
+    -------
+    (sxx, syy, szz, sxy, deps_p, sigma_y):
+        Returned deviatoric stress, plastic strain increment, flow stress at the end.
+
+    The scalar solve is :func:`jc_return_py` (shared with the 3D engine).
+    """
+    q = math.sqrt(1.5 * (sxx * sxx + syy * syy + szz * szz + 2.0 * sxy * sxy))
+    d, sy = jc_return(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt)
+    if d <= 0.0:
+        return sxx, syy, szz, sxy, 0.0, sy
     scale = sy / q
     return sxx * scale, syy * scale, szz * scale, sxy * scale, d, sy
 
@@ -148,14 +174,17 @@ homologous_temperature = njit(cache=True)(homologous_temperature_py)
 jc_flow_stress = njit(cache=True)(jc_flow_stress_py)
 jc_failure_strain = njit(cache=True)(jc_failure_strain_py)
 jc_damage_increment = njit(cache=True)(jc_damage_increment_py)
+jc_return = njit(cache=True)(jc_return_py)
 radial_return = njit(cache=True)(radial_return_py)
 
 
 def rebind(func, **names):
     """Copy of a ``_py`` function whose global names are replaced (for device ports).
 
-    Example: ``rebind(radial_return_py, jc_flow_stress=flow_dev,
-    homologous_temperature=th_dev)`` before wrapping with ``numba.cuda.jit(device=True)``.
+    Example: ``rebind(jc_return_py, jc_flow_stress=flow_dev, homologous_temperature=th_dev)``
+    then ``rebind(radial_return_py, jc_return=return_dev)``; likewise
+    ``rebind(jc_flow_stress_py, homologous_temperature=th_dev)``, each wrapped with
+    ``numba.cuda.jit(device=True)``.
     """
     g = dict(func.__globals__)
     g.update(names)
@@ -168,6 +197,8 @@ __all__ = [
     "jc_failure_strain_py",
     "jc_damage_increment_py",
     "radial_return_py",
+    "jc_return_py",
+    "jc_return",
     "homologous_temperature",
     "jc_flow_stress",
     "jc_failure_strain",
