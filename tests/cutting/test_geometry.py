@@ -56,12 +56,13 @@ def test_depth_inside_nose_uses_arc_only():
     f=st.floats(0.02e-3, 0.4e-3),
 )
 def test_area_properties(r, kappa, kend, ap, f):
-    """Properties: A = ap f - scallop (exact identity, 1e-3); A <= ap f; elements sum to A
-    (0.5 %, quadrature); local thickness never exceeds the feed; all widths positive."""
+    """Properties: A = ap f - scallop (exact identity, 1e-3, when the cusp lies below the
+    pre-bore surface); A <= ap f (1e-4, quadrature); elements sum to A (0.5 %, two
+    independent quadratures); local thickness never exceeds the feed; widths positive."""
     ins = BoringInsert(nose_radius_m=r, approach_angle_deg=kappa, end_edge_angle_deg=kend)
     A = chip_area(ins, ap, f)
     S = scallop_area(ins, f)
-    assert A <= ap * f * (1 + 1e-9)
+    assert A <= ap * f * (1 + 1e-4)  # quadrature error at the kappa = 90 deg corner ~ 4e-5
     z = np.linspace(-f, 0.0, 4001)
     cusp = np.max(np.minimum(ins.drop(z), ins.drop(z + f)))
     if cusp <= ap:  # the whole cusp lies below the pre-bore surface

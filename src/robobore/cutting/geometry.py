@@ -199,9 +199,21 @@ def chip_area(insert: BoringInsert, depth_m: float, feed_m: float, n_grid: int =
     _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
     _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
     z_hi = _lead_end(insert, depth_m)
-    z = np.linspace(-feed_m, z_hi, n_grid)
-    g = np.maximum(_prev_surface_drop(insert, z, feed_m, depth_m) - insert.drop(z), 0.0)
-    return float(np.trapezoid(g, z))
+    r = insert.nose_radius_m
+    s_maj, s_min = r * math.sin(insert.kappa), r * math.sin(insert.kappa_end)
+    # piecewise over the profile's corners (the integrand jumps at s_maj - f when kappa = 90)
+    cuts = [-feed_m, z_hi]
+    for b in (-s_min, s_maj, -s_min - feed_m, s_maj - feed_m, 0.0, -feed_m / 2):
+        if -feed_m < b < z_hi:
+            cuts.append(b)
+    cuts = sorted(set(cuts))
+    n_seg = max(200, n_grid // len(cuts))
+    total = 0.0
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        z = np.linspace(np.nextafter(a, b), np.nextafter(b, a), n_seg)
+        g = np.maximum(_prev_surface_drop(insert, z, feed_m, depth_m) - insert.drop(z), 0.0)
+        total += float(np.trapezoid(g, z))
+    return total
 
 
 def scallop_area(insert: BoringInsert, feed_m: float, n_grid: int = 20001) -> float:
