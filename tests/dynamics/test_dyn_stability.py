@@ -96,3 +96,27 @@ def test_partial_overlap_needs_semidiscretization(sdof):
     pr = single_point_process(1e9, [1, 0, 0], [1, 0, 0], 1e-4, overlap=0.5)
     with pytest.raises(ConfigError, match="overlap"):
         lobes_frequency_domain(sdof, pr, np.array([5000.0]))
+
+
+def test_undamped_mode_coupling_closed_form():
+    """Two orthogonal modes of equal mass along x and y, force u and chip normal n in the plane
+    (Tlusty; Pan et al. 2006): K + p u n^T has complex eigenvalues when
+    (k1 - k2 + p a)^2 + 4 p^2 c < 0, a = ux nx - uy ny, c = ux uy nx ny; the smallest positive
+    root p* gives the depth p*/K. The eigen criterion matches it to 1e-6."""
+    k1, k2, m = 1.0e6, 1.1e6, 50.0
+    f = [np.sqrt(k / m) / (2 * np.pi) for k in (k1, k2)]
+    st = ToolPointStructure.from_modes([
+        {"frequency_Hz": f[0], "damping_ratio": 0.0, "stiffness_N_per_m": k1,
+         "direction": [1, 0, 0]},
+        {"frequency_Hz": f[1], "damping_ratio": 0.0, "stiffness_N_per_m": k2,
+         "direction": [0, 1, 0]}])
+    b_, a_ = np.radians(70.0), np.radians(-25.0)
+    u = np.array([np.cos(b_), np.sin(b_), 0.0])
+    n = np.array([np.cos(a_), np.sin(a_), 0.0])
+    K = 2e9
+    pr = single_point_process(K, u, n, 1e-4)
+    a = u[0] * n[0] - u[1] * n[1]
+    c = u[0] * u[1] * n[0] * n[1]
+    roots = np.roots([a * a + 4 * c, 2 * (k1 - k2) * a, (k1 - k2) ** 2])
+    p = min(r.real for r in roots if abs(r.imag) < 1e-9 and r.real > 0)
+    assert mode_coupling_limit(st, pr, damped=False) == pytest.approx(p / K, rel=1e-6)
