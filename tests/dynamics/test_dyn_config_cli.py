@@ -128,3 +128,18 @@ def test_out_of_range_options(tmp_path, opt, val, key):
     args[args.index(opt) + 1] = val
     r = runner.invoke(app, args)
     assert r.exit_code == 2 and key in r.output
+
+
+def test_api_run_boring_overrides():
+    """One-call API: condition overrides (feed, foot pressure) act as documented."""
+    from robobore.dynamics.api import lobes, run_boring
+
+    ex = EX / "boring_paper.toml"
+    base = run_boring(ex, revolutions=20)
+    more_feed = run_boring(ex, feed_mm_per_rev=0.3, revolutions=20)
+    foot = run_boring(ex, pressure_MPa=0.3, revolutions=20)
+    assert more_feed["force_amplitude_N"]["x"] > base["force_amplitude_N"]["x"]
+    assert foot["feed_amplitude_um"] < base["feed_amplitude_um"]
+    assert base["speed_rpm"] == 300.0 and base["depth_mm"] == 0.05
+    d = lobes(EX / "lobes_single_point.toml")
+    assert len(d["critical_depth_mm"]) == 601

@@ -126,58 +126,33 @@ def simulate_boring_cmd(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Time-domain boring simulation with regeneration; stable / vibratory verdict."""
-    from robobore.dynamics.chatter import classify
-    from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
-    from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
+    from robobore.dynamics.api import run_boring
+    from robobore.dynamics.config import load_dynamics_config
     from robobore.io.results import write_netcdf
 
     cfg, raw = load_dynamics_config(config)
-    src = str(config)
-    if speed_rpm is None:
-        if cfg.cutting is None:
-            raise ConfigError("no spindle speed", field="--speed-rpm",
-                              expected="--speed-rpm N (r/min) or a [cutting] section")
-        speed_rpm = cfg.cutting.speed_rpm
-    if depth_mm is None:
-        if cfg.cutting is None:
-            raise ConfigError("no depth of cut", field="--depth-mm",
-                              expected="--depth-mm A (mm) or a [cutting] section")
-        depth_mm = cfg.cutting.depth_mm
-    if not (math.isfinite(speed_rpm) and 1.0 <= speed_rpm <= 100000.0):
+    if speed_rpm is None and cfg.cutting is None:
+        raise ConfigError("no spindle speed", field="--speed-rpm",
+                          expected="--speed-rpm N (r/min) or a [cutting] section")
+    if depth_mm is None and cfg.cutting is None:
+        raise ConfigError("no depth of cut", field="--depth-mm",
+                          expected="--depth-mm A (mm) or a [cutting] section")
+    if speed_rpm is not None and not (math.isfinite(speed_rpm) and 1.0 <= speed_rpm <= 1e5):
         raise ConfigError("spindle speed out of range", field="--speed-rpm", value=speed_rpm,
                           expected="1 .. 100000 r/min")
-    if not (math.isfinite(depth_mm) and 0.0 < depth_mm <= 50.0):
+    if depth_mm is not None and not (math.isfinite(depth_mm) and 0.0 < depth_mm <= 50.0):
         raise ConfigError("depth of cut out of range", field="--depth-mm", value=depth_mm,
                           expected="0 < depth <= 50 mm")
-    revs = revolutions if revolutions is not None else cfg.simulation.revolutions
-    nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
-    st = build_structure(cfg, src)
-    pr = build_process(cfg, src, depth_m=depth_mm * 1e-3 if cfg.is_boring else None)
-    settings = SimulationSettings(float(speed_rpm), depth_mm * 1e-3, int(revs), int(nspr))
+    if out is not None and out.suffix != ".nc":
+        raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
+                          expected="a path ending in .nc")
     with progress_bar("simulating", None, not as_json):
-        ds = simulate(st, pr, settings, cfg.insert.to_insert() if cfg.is_boring else None)
-    tol = cfg.simulation.ra_tolerance_um
-    verdict = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
-    s = summarize(ds)
-    result = {
-        "stable": verdict.stable,
-        "chatter_frequency_Hz": verdict.chatter_frequency_Hz,
-        "vibration_growth": verdict.vibration_growth,
-        "force_mean_N": s["force_mean_N"],
-        "force_amplitude_N": s["force_amplitude_N"],
-        "feed_amplitude_um": s["feed_amplitude_m"] * 1e6,
-        "nonharmonic_energy_ratio": verdict.nonharmonic_energy_ratio,
-        "roughness_Ra_um": ds.attrs["Ra_m"] * 1e6,
-        "roughness_Rz_um": ds.attrs["Rz_m"] * 1e6,
-        "tool_left_cut_fraction": verdict.tool_left_cut_fraction,
-        "reasons": list(verdict.reasons),
-        "speed_rpm": speed_rpm, "depth_mm": depth_mm, "revolutions": int(revs),
-        "samples_per_rev": int(ds.attrs["samples_per_rev"]), "process": pr.label,
-    }
+        result = run_boring(cfg, speed_rpm, depth_mm, revolutions=revolutions,
+                            samples_per_rev=samples_per_rev, return_dataset=True)
+    ds = result.pop("dataset")
+    result.pop("config")
+    speed_rpm, depth_mm = result["speed_rpm"], result["depth_mm"]
     if out is not None:
-        if out.suffix != ".nc":
-            raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
-                              expected="a path ending in .nc")
         write_netcdf(ds, out, config=raw)
         result["out"] = str(out)
     if plot is not None:

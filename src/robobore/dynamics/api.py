@@ -1,0 +1,141 @@
+"""One-call entry points of the process stage for other stages (sweeps, reports).
+
+:func:`run_boring` simulates one cutting condition from a config (path, dict or validated
+:class:`~robobore.dynamics.config.DynamicsConfig`) and returns the same JSON-ready summary as
+``robobore simulate boring --json``; :func:`lobes` returns the ``robobore lobes --json``
+contents. Conditions given as arguments override the config (speed, depth, feed, foot
+pressure), so a sweep needs only one config file.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from robobore.dynamics.config import (
+    DynamicsConfig,
+    PressureFootCfg,
+    build_process,
+    build_structure,
+    load_dynamics_config,
+)
+from robobore.errors import ConfigError
+from robobore.io.config import validate_model
+
+
+def _config(config: str | Path | dict[str, Any] | DynamicsConfig
+            ) -> tuple[DynamicsConfig, dict[str, Any], str | None]:
+    if isinstance(config, DynamicsConfig):
+        return config.model_copy(deep=True), config.model_dump(), None
+    if isinstance(config, dict):
+        return validate_model(DynamicsConfig, config), config, None
+    cfg, raw = load_dynamics_config(config)
+    return cfg, raw, str(config)
+
+
+def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
+               speed_rpm: float | None = None, depth_mm: float | None = None,
+               feed_mm_per_rev: float | None = None, pressure_MPa: float | None = None,
+               revolutions: int | None = None, samples_per_rev: int | None = None,
+               return_dataset: bool = False) -> dict[str, Any]:
+    """Simulate one condition; returns the summary dict (and ``"dataset"`` if asked).
+
+    ``pressure_MPa`` (boring configs with an ``[equivalent]`` section) replaces the pressure
+    foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
+    """
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
+
+    cfg, raw, src = _config(config)
+    if cfg.cutting is not None:
+        upd = {}
+        if speed_rpm is not None:
+            upd["speed_rpm"] = speed_rpm
+        if depth_mm is not None:
+            upd["depth_mm"] = depth_mm
+        if feed_mm_per_rev is not None:
+            upd["feed_mm_per_rev"] = feed_mm_per_rev
+        cfg.cutting = cfg.cutting.model_copy(update=upd)
+    elif feed_mm_per_rev is not None and cfg.process is not None:
+        cfg.process = cfg.process.model_copy(update={"feed_mm_per_rev": feed_mm_per_rev})
+    if pressure_MPa is not None:
+        if cfg.equivalent is None:
+            raise ConfigError("a foot pressure needs an [equivalent] section", file=src,
+                              field="pressure_MPa", value=pressure_MPa)
+        foot = cfg.equivalent.pressure_foot or PressureFootCfg()
+        cfg.equivalent = cfg.equivalent.model_copy(update={
+            "pressure_foot": None if pressure_MPa == 0 else foot.model_copy(
+                update={"pressure_MPa": float(pressure_MPa)})})
+    n = speed_rpm if speed_rpm is not None else (cfg.cutting.speed_rpm if cfg.cutting else None)
+    a = depth_mm if depth_mm is not None else (cfg.cutting.depth_mm if cfg.cutting else None)
+    if n is None:
+        raise ConfigError("no spindle speed", file=src, field="speed_rpm",
+                          expected="a speed in r/min or a [cutting] section")
+    if a is None:
+        raise ConfigError("no depth of cut", file=src, field="depth_mm",
+                          expected="a depth in mm or a [cutting] section")
+    if not (math.isfinite(n) and 1.0 <= n <= 100000.0):
+        raise ConfigError("spindle speed out of range", file=src, field="speed_rpm", value=n,
+                          expected="1 .. 100000 r/min")
+    if not (math.isfinite(a) and 0.0 < a <= 50.0):
+        raise ConfigError("depth of cut out of range", file=src, field="depth_mm", value=a,
+                          expected="0 < depth <= 50 mm")
+    revs = revolutions if revolutions is not None else cfg.simulation.revolutions
+    nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
+    st = build_structure(cfg, src)
+    pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None)
+    ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
+                  cfg.insert.to_insert() if cfg.is_boring else None)
+    tol = cfg.simulation.ra_tolerance_um
+    v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
+    s = summarize(ds)
+    out: dict[str, Any] = {
+        "stable": v.stable,
+        "chatter_frequency_Hz": v.chatter_frequency_Hz,
+        "vibration_growth": v.vibration_growth,
+        "force_mean_N": s["force_mean_N"],
+        "force_amplitude_N": s["force_amplitude_N"],
+        "feed_amplitude_um": s["feed_amplitude_m"] * 1e6,
+        "nonharmonic_energy_ratio": v.nonharmonic_energy_ratio,
+        "roughness_Ra_um": ds.attrs["Ra_m"] * 1e6,
+        "roughness_Rz_um": ds.attrs["Rz_m"] * 1e6,
+        "tool_left_cut_fraction": v.tool_left_cut_fraction,
+        "reasons": list(v.reasons),
+        "speed_rpm": float(n), "depth_mm": float(a), "revolutions": int(revs),
+        "samples_per_rev": int(ds.attrs["samples_per_rev"]), "process": pr.label,
+        "model": "robobore.dynamics time-domain boring (regenerative, mechanistic forces)",
+    }
+    if return_dataset:
+        out["dataset"] = ds
+        out["config"] = raw
+    return out
+
+
+def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
+          method: str = "frequency") -> dict[str, Any]:
+    """Lobes of a config (``robobore lobes --json`` contents, without notes)."""
+    import numpy as np
+
+    from robobore.dynamics import stability
+
+    cfg, _, src = _config(config)
+    st = build_structure(cfg, src)
+    pr = build_process(cfg, src)
+    sp = cfg.speed_rpm
+    speeds = (np.linspace(100.0, 3000.0, 300) if sp is None
+              else np.linspace(sp.min, sp.max, sp.count))
+    if method == "frequency":
+        res = stability.lobes_frequency_domain(st, pr, speeds)
+    elif method == "semidiscretization":
+        res = stability.lobes_semidiscretization(st, pr, speeds)
+    else:
+        raise ConfigError("unknown method", field="method", value=method,
+                          expected="frequency or semidiscretization")
+    d = res.to_dict()
+    mc = stability.mode_coupling_limit(st, pr)
+    d["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
+    return d
+
+
+__all__ = ["run_boring", "lobes"]
