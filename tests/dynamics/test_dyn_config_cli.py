@@ -143,3 +143,23 @@ def test_api_run_boring_overrides():
     assert base["speed_rpm"] == 300.0 and base["depth_mm"] == 0.05
     d = lobes(EX / "lobes_single_point.toml")
     assert len(d["critical_depth_mm"]) == 601
+
+
+def test_model_equivalent_from_json_files(tmp_path):
+    """The robot-stiffness and modal JSON contracts, a user assignment and the foot."""
+    s = tmp_path / "stiff.json"
+    s.write_text(json.dumps({"directional_stiffness_N_per_m": {"x": 1e6, "y": 2e6, "z": 3e6}}))
+    m = tmp_path / "modes.json"
+    m.write_text(json.dumps({"modes": [
+        {"frequency_Hz": f, "damping_ratio": z, "mpc": 0.9}
+        for f, z in zip([6.9, 16.8, 24.6, 25.34, 47.5], [0.035, 0.028, 0.02, 0.022, 0.05],
+                        strict=True)]}))
+    r = runner.invoke(app, ["model", "equivalent", "--stiffness-file", str(s), "--modes-file",
+                            str(m), "--assign", "0,2,4", "--foot-pressure-MPa", "0.3", "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["damping_ratio"]["x"] > 0.035  # the foot adds contact damping
+    assert d["frequency_Hz"]["z"] > 47.5 and "user mapping" in d["notes"][0]
+    r = runner.invoke(app, ["model", "equivalent", "--stiffness-file", str(s), "--modes-file",
+                            str(m), "--assign", "0,2,9"])
+    assert r.exit_code == 2 and "assignment.z" in r.output
