@@ -151,3 +151,18 @@ def test_pressure_foot_suppresses_vibration():
         freqs.append(st.frequency_Hz)
     assert amps[1] < 0.1 * amps[0]
     assert np.all(freqs[1] > freqs[0])
+
+
+def test_zoh_discretisation_matches_matrix_exponential(sdof):
+    """Closed-form ZOH step = expm of the augmented state matrix (Van Loan), to 1e-10."""
+    from scipy.linalg import expm
+
+    from robobore.dynamics.timedomain import modal_zoh
+
+    dt = 1.3e-4
+    Phi, Gam = modal_zoh(sdof, dt)
+    w, z, m = sdof.omega[0], sdof.damping_ratio[0], sdof.modal_mass[0]
+    H = np.array([[0, 1, 0], [-w * w, -2 * z * w, 1 / m], [0, 0, 0]])
+    E = expm(H * dt)
+    assert np.allclose(Phi[0], E[:2, :2], rtol=1e-10, atol=1e-14)
+    assert np.allclose(Gam[0], E[:2, 2], rtol=1e-10, atol=1e-20)

@@ -33,7 +33,6 @@ from typing import Any
 import numba as nb
 import numpy as np
 import xarray as xr
-from scipy.linalg import expm
 
 from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.structure import ToolPointStructure
@@ -43,28 +42,29 @@ from robobore.errors import ConfigError, NumericalError
 def modal_zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Exact ZOH discretisation per mode: ``x+ = Phi x + Gam f`` with ``x = (q, q')``.
 
-    Returns ``Phi`` (m, 2, 2) and ``Gam`` (m, 2) for a unit modal force [N] (``f = d_j . F``).
+    Returns ``Phi`` (m, 2, 2) and ``Gam`` (m, 2) for a unit modal force [N] (``f = d_j . F``):
+    closed-form exponential of the underdamped oscillator, ``Gam = A^-1 (Phi - I) B``.
     """
     m = structure.n_modes
     Phi = np.empty((m, 2, 2))
     Gam = np.empty((m, 2))
     for j in range(m):
-        w = structure.omega[j]
-        z = structure.damping_ratio[j]
-        H = np.zeros((3, 3))
-        H[0, 1] = 1.0
-        H[1, 0] = -w * w
-        H[1, 1] = -2 * z * w
-        H[1, 2] = 1.0 / structure.modal_mass[j]
-        E = expm(H * dt)
-        Phi[j] = E[:2, :2]
-        Gam[j] = E[:2, 2]
+        w = float(structure.omega[j])
+        z = float(structure.damping_ratio[j])
+        wd = w * math.sqrt(1.0 - z * z)  # 0 <= zeta < 1 is validated
+        e = math.exp(-z * w * dt)
+        c, sn = math.cos(wd * dt), math.sin(wd * dt)
+        P = e * np.array([[c + z * w / wd * sn, sn / wd],
+                          [-w * w / wd * sn, c - z * w / wd * sn]])
+        Ainv = np.array([[-2 * z / w, -1 / (w * w)], [1.0, 0.0]])
+        Phi[j] = P
+        Gam[j] = Ainv @ (P - np.eye(2)) @ np.array([0.0, 1.0 / structure.modal_mass[j]])
     return Phi, Gam
 
 
 @nb.njit(cache=True)
 def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, nrm, shr, edg, dd,
-                     inv_depth, mu, q, qd, sr, tlast, F_out, X_out, Q_out, Qd_out,
+                     inv_depth, mu, om, zeta, minv, q, qd, sr, tlast, F_out, X_out, A_out,
                      area_out):  # pragma: no cover - compiled
     m = D.shape[0]
     E = h0.shape[0]
@@ -125,14 +125,22 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, nrm, shr, ed
         X_out[i, 0] = rx
         X_out[i, 1] = ry
         X_out[i, 2] = rz
+        ax = 0.0
+        ay = 0.0
+        az = 0.0
         for j in range(m):
             fm = D[j, 0] * fx + D[j, 1] * fy + D[j, 2] * fz
-            Q_out[i, j] = q[j]
-            Qd_out[i, j] = qd[j]
+            qdd = fm * minv[j] - 2.0 * zeta[j] * om[j] * qd[j] - om[j] * om[j] * q[j]
+            ax += D[j, 0] * qdd
+            ay += D[j, 1] * qdd
+            az += D[j, 2] * qdd
             qn = Phi[j, 0, 0] * q[j] + Phi[j, 0, 1] * qd[j] + Gam[j, 0] * fm
             qdn = Phi[j, 1, 0] * q[j] + Phi[j, 1, 1] * qd[j] + Gam[j, 1] * fm
             q[j] = qn
             qd[j] = qdn
+        A_out[i, 0] = ax
+        A_out[i, 1] = ay
+        A_out[i, 2] = az
 
 
 @dataclass(frozen=True)
@@ -196,20 +204,15 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     tlast = np.full(Ns, -spp, dtype=np.int64)
     F = np.empty((n_steps, 3))
     X = np.empty((n_steps, 3))
-    Q = np.empty((n_steps, m))
-    Qd = np.empty((n_steps, m))
+    acc = np.empty((n_steps, 3))
     area = np.empty((n_steps, N))
     _simulate_kernel(n_steps, Ns, N, Phi, Gam, np.ascontiguousarray(structure.directions),
                      basis, process.h0, w, ds, process.normal, process.shear, process.edge,
-                     process.depth_direction, inv_depth, process.overlap, q, qd, sr, tlast,
-                     F, X, Q, Qd, area)
+                     process.depth_direction, inv_depth, process.overlap, structure.omega,
+                     structure.damping_ratio, 1.0 / structure.modal_mass, q, qd, sr, tlast,
+                     F, X, acc, area)
     if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
         raise NumericalError("the simulation produced non-finite values (unstable integration)")
-    # accelerations from the modal equations
-    om = structure.omega
-    fm = F @ structure.directions.T
-    qdd = fm / structure.modal_mass - 2 * structure.damping_ratio * om * Qd - om**2 * Q
-    acc = qdd @ structure.directions
     t = np.arange(n_steps) * dt
     th_all = 2 * np.pi * (np.arange(n_steps) % Ns) / Ns
     a_r = acc[:, 0] * np.cos(th_all) + acc[:, 1] * np.sin(th_all)
