@@ -1,0 +1,511 @@
+"""Numba kernels of the 3D explicit engine (hexahedra, SI units, forces in N).
+
+Reuses the 2D engine's scalar physics unchanged: the Johnson-Cook return mapping and damage
+(:mod:`robobore.material.johnson_cook`), the 2D wedge signed distance
+(:func:`robobore.cutting.fe.physics.tool_gap`, applied in the local normal section of the
+insert edge) and the spring-damper step (:func:`robobore.cutting.fe.physics.tool_support_step`).
+New scalar functions, written in the same device-ready style (``_py`` original + ``njit``):
+
+* :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
+  approach and end-edge angles, rake, clearance, edge radius and inclination;
+* :func:`contact_force3_py` -- the 2D contact law (:func:`physics.contact_force_py`: mass-
+  proportional penalty, Coulomb friction, shear-stress cap) with a tangential *vector*;
+* :func:`hex_node_py` -- gather, contact and central-difference update of one node.
+
+Energy indices, status codes and the energy-balance definition are the 2D engine's
+(:mod:`robobore.cutting.fe.kernels`), so :func:`robobore.cutting.fe.solver.energy_error`
+applies to both.
+
+Frames: the kernels work in the *local* frame of the insert at the start of the run
+(x along the cutting velocity, y normal to the bore wall pointing out of the material,
+towards the bore axis, z along the feed). The tool support integrates in the *boring*
+frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
+``theta(t) = theta0 + vc t / R``; see :mod:`robobore.cutting.fe.boring3d`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit, prange
+
+from robobore.cutting.fe.hex8 import (
+    ERODE_ALL,
+    ERODE_LAYER,
+    ERODE_NONE,
+    N_PRM,
+    P_BV1,
+    P_BV2,
+    P_CFL,
+    P_CLR,
+    P_CX,
+    P_CY,
+    P_CZ,
+    P_DIST,
+    P_DT_ERODE,
+    P_DTMIN,
+    P_EROSION,
+    P_HGS,
+    P_HGV,
+    P_KAPPA,
+    P_KEND,
+    P_KX,
+    P_KY,
+    P_KZ,
+    P_MS,
+    P_MU,
+    P_MX,
+    P_MY,
+    P_MZ,
+    P_PEN,
+    P_RADIUS,
+    P_RAKE,
+    P_RE,
+    P_RN,
+    P_SAMPLE_DT,
+    P_SUPPORT,
+    P_TANI,
+    P_TAU,
+    P_TEND,
+    P_THETA0,
+    P_TOOL,
+    P_VC,
+    P_VF,
+    hex_element,
+)
+from robobore.cutting.fe.kernels import (
+    E_ERODED,
+    E_EROKE,
+    E_EXT,
+    E_FRIC,
+    E_HG,
+    E_INT,
+    E_KIN,
+    E_NODEWORK,
+    E_PLAST,
+    I_BADELEM,
+    I_SAMPLE,
+    I_STATUS,
+    I_STEP,
+    N_EN,
+    N_IST,
+    STATUS_DONE,
+    STATUS_DT_COLLAPSE,
+    STATUS_INVERTED,
+    STATUS_NO_ELEMENTS,
+    STATUS_NONFINITE,
+    STATUS_OK,
+)
+from robobore.cutting.fe.physics import tool_gap, tool_support_step
+
+__all__ = [
+    "N_PRM", "P_CFL", "P_MS", "P_HGV", "P_HGS", "P_BV1", "P_BV2", "P_DIST", "P_DT_ERODE",
+    "P_DTMIN", "P_MU", "P_TAU", "P_PEN", "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR",
+    "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF", "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY",
+    "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY", "P_MZ", "P_THETA0", "P_SAMPLE_DT",
+    "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN", "N_IST", "STATUS_OK",
+    "insert_gap3_py", "insert_gap3", "contact_force3_py", "contact_force3", "hex_node_py",
+    "hex_node", "element_update3", "node_update3", "run_chunk3",
+]
+
+# --- fixed-dof bit mask (velocity component held at its current value)
+FIX_X, FIX_Y, FIX_Z = 1, 2, 4
+# --- tool state: guide (tip reference) position, local frame [m]; support displacement and
+# velocity in the boring frame [m, m/s]; force on the tool, local frame [N]; bar angle [rad]
+T_GX, T_GY, T_GZ, T_UX, T_UY, T_UZ, T_VX, T_VY, T_VZ = 0, 1, 2, 3, 4, 5, 6, 7, 8
+T_FX, T_FY, T_FZ, T_THETA = 9, 10, 11, 12
+N_TOOL = 13
+# --- history columns (time averages over each sample interval; energies at its end)
+H_T, H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ, H_TIPX, H_THETA = 0, 1, 2, 3, 4, 5, 6, 7, 8
+H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO, H_NCONT = 9, 10, 11, 12, 13, 14, 15, 16
+N_HIST = 17
+
+
+def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
+    """Signed distance of a point to the boring insert and the insert's outward normal.
+
+    ``(px, py, pz)`` [m] is the point relative to the insert's tip reference (the lowest point
+    of the nose, on the cutting edge) in the local frame (x cutting direction, y out of the
+    workpiece, z feed). The edge profile in the y-z plane is the nose arc of radius ``rn``
+    (centre at y = rn, z = 0) spanning local approach angles -kend..kappa, continued by the
+    major edge (approach angle ``kappa`` to the feed axis) and the minor (end) edge (angle
+    ``kend``). In every normal section of the edge the insert is the 2D wedge of the 2D
+    engine (:func:`physics.tool_gap_py`: normal rake ``rake``, clearance ``clr``, edge radius
+    ``re`` [rad, m]); the wedge apex runs along the profile offset by ``re`` into the tool.
+    The inclination enters as ``x -> x - tani * s`` with ``s`` the arc length along the edge
+    from the tip (small-angle model). Exact for points in a normal section; near the surface
+    (where contact acts) the error is second order in the distance.
+
+    Returns ``(gap, nx, ny, nz)``: gap > 0 outside, < 0 penetration depth [m]; unit normal.
+    """
+    ra = rn - re
+    qz = pz
+    qy = py - rn
+    psi = math.atan2(qz, -qy)
+    if psi > kappa:
+        mz = math.sin(kappa)
+        my = -math.cos(kappa)
+        s = (qz - ra * mz) * mz + (qy - ra * my) * my
+        arc = rn * kappa - (qz - ra * mz) * my + (qy - ra * my) * mz
+    elif psi < -kend:
+        mz = -math.sin(kend)
+        my = -math.cos(kend)
+        s = (qz - ra * mz) * mz + (qy - ra * my) * my
+        arc = -rn * kend - ((qz - ra * mz) * my - (qy - ra * my) * mz)
+    else:
+        d = math.sqrt(qz * qz + qy * qy)
+        if d < 1e-300:
+            d = 1e-300
+        mz = qz / d
+        my = qy / d
+        s = d - ra
+        arc = rn * psi
+    u = px - tani * arc
+    # 2D wedge of the 2D engine, mirrored (it cuts along -x): apex at the origin
+    gap, n2x, n2y = tool_gap(-u, -s, 0.0, 0.0, -math.cos(rake), math.sin(rake),
+                             math.sin(clr), -math.cos(clr), re)
+    # local "up" (into the tool, normal to the edge in the profile plane) is -m
+    return gap, -n2x, -n2y * my, -n2y * mz
+
+
+def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_max, pen_factor,
+                      dt):
+    """Contact force on a node touching the rigid insert [N] (3D form of the 2D law).
+
+    Normal: penalty ``Fn = pen_factor * mass / dt^2 * (-gap)`` (as
+    :func:`physics.contact_force_py`). Tangential: the force that stops the relative sliding
+    velocity (vector ``v_r - (v_r.n) n``) in one step, limited by Coulomb ``mu Fn`` and by the
+    shear cap ``tau_max * trib_area`` (the node's tributary contact area [m^2]), opposite
+    to the sliding direction. ``(vrx, vry, vrz)`` node velocity relative to the tool [m/s].
+
+    Returns ``(fx, fy, fz, fn, ft, tx, ty, tz)``: force, normal magnitude, tangential
+    magnitude and the unit sliding direction (zero vector when not sliding).
+    """
+    if gap >= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    fn = pen_factor * mass / (dt * dt) * (-gap)
+    vn = vrx * nx + vry * ny + vrz * nz
+    vtx = vrx - vn * nx
+    vty = vry - vn * ny
+    vtz = vrz - vn * nz
+    vt = math.sqrt(vtx * vtx + vty * vty + vtz * vtz)
+    if vt <= 0.0:
+        return fn * nx, fn * ny, fn * nz, fn, 0.0, 0.0, 0.0, 0.0
+    tx = vtx / vt
+    ty = vty / vt
+    tz = vtz / vt
+    fstick = mass * vt / dt
+    fcap = mu * fn
+    if tau_max * trib_area < fcap:
+        fcap = tau_max * trib_area
+    ft = fstick if fstick < fcap else fcap
+    return (fn * nx - ft * tx, fn * ny - ft * ty, fn * nz - ft * tz, fn, ft, tx, ty, tz)
+
+
+insert_gap3 = njit(cache=True)(insert_gap3_py)
+contact_force3 = njit(cache=True)(contact_force3_py)
+
+
+def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
+                fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt):
+    """Gather element forces on node ``n``, add insert contact, advance v and x (one node).
+
+    Contact uses positions at step n and velocities at n-1/2 (as the 2D engine). ``cf[n]``
+    receives the contact force on the node [N]; ``fric`` (cumulative) frictional dissipation,
+    ``pen`` the current penalty energy, ``nwork`` (cumulative) the contact work [J]. A node
+    left without a live element is retired (its kinetic energy booked in ``ero_ke``).
+    ``fixed[n]`` bit mask (1 x, 2 y, 4 z): that velocity component is held (prescribed).
+    ``(cx, cy, cz)`` tool tip reference, ``(tvx, tvy, tvz)`` tool velocity (local frame).
+    """
+    cf[n, 0] = 0.0
+    cf[n, 1] = 0.0
+    cf[n, 2] = 0.0
+    pen[n] = 0.0
+    if ndead[n]:
+        return
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    nlive = 0
+    vsum = 0.0
+    for k in range(ptr[n], ptr[n + 1]):
+        e = nel[k]
+        if alive[e] == 1:
+            c3 = 3 * ncorner[k]
+            fx -= fe[e, c3]
+            fy -= fe[e, c3 + 1]
+            fz -= fe[e, c3 + 2]
+            nlive += 1
+            vsum += vol0[e]
+    if nlive == 0:
+        ndead[n] = 1
+        ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n] + vz[n] * vz[n])
+        vx[n] = 0.0
+        vy[n] = 0.0
+        vz[n] = 0.0
+        return
+    m = mass[n]
+    fcx = 0.0
+    fcy = 0.0
+    fcz = 0.0
+    ft = 0.0
+    vt0 = 0.0
+    tx = 0.0
+    ty = 0.0
+    tz = 0.0
+    gap = 1.0
+    px = x[n] - cx
+    # cheap bound: a node ahead of the rounded edge and of a non-negative-rake face is free
+    if prm[P_TOOL] > 0.5 and not (px > prm[P_RE] and prm[P_RAKE] >= 0.0 and prm[P_TANI] == 0.0):
+        gap, gnx, gny, gnz = insert_gap3(px, y[n] - cy, z[n] - cz, prm[P_RN],
+                                         prm[P_KAPPA], prm[P_KEND], prm[P_RAKE], prm[P_CLR],
+                                         prm[P_RE], prm[P_TANI])
+        if gap < 0.0:
+            vrx = vx[n] - tvx
+            vry = vy[n] - tvy
+            vrz = vz[n] - tvz
+            trib = (vsum / nlive) ** (2.0 / 3.0)
+            fcx, fcy, fcz, fn, ft, tx, ty, tz = contact_force3(
+                gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, prm[P_MU], prm[P_TAU], prm[P_PEN],
+                dt)
+            vt0 = vrx * tx + vry * ty + vrz * tz
+            pen[n] = 0.5 * fn * (-gap)
+    cf[n, 0] = fcx
+    cf[n, 1] = fcy
+    cf[n, 2] = fcz
+    ox = vx[n]
+    oy = vy[n]
+    oz = vz[n]
+    fb = fixed[n]
+    nvx = ox if (fb & 1) else ox + dt * (fx + fcx) / m
+    nvy = oy if (fb & 2) else oy + dt * (fy + fcy) / m
+    nvz = oz if (fb & 4) else oz + dt * (fz + fcz) / m
+    vx[n] = nvx
+    vy[n] = nvy
+    vz[n] = nvz
+    x[n] += dt * nvx
+    y[n] += dt * nvy
+    z[n] += dt * nvz
+    if gap < 0.0:
+        nwork[n] += dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy)
+                          + fcz * 0.5 * (oz + nvz))
+        vt1 = (nvx - tvx) * tx + (nvy - tvy) * ty + (nvz - tvz) * tz
+        fric[n] += dt * ft * 0.5 * (vt0 + vt1)
+
+
+hex_node = njit(cache=True)(hex_node_py)
+
+
+@njit(parallel=True, cache=True)
+def element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
+                    ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
+    """:func:`hex8.hex_element_py` over all elements (parallel)."""
+    for e in prange(conn.shape[0]):
+        hex_element(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
+                    vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+
+
+@njit(parallel=True, cache=True)
+def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
+                 pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt):
+    """:func:`hex_node_py` over all nodes (parallel)."""
+    for n in prange(x.shape[0]):
+        hex_node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
+                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+
+
+@njit(cache=True)
+def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
+    """Totals of the energy accumulators into ``en`` (2D engine's indices) [J]."""
+    ke = 0.0
+    sf = 0.0
+    spn = 0.0
+    sek = 0.0
+    sw = 0.0
+    for n in range(mass.shape[0]):
+        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n] + vz[n] * vz[n])
+        sf += fric[n]
+        spn += pen[n]
+        sek += ero_ke[n]
+        sw += nwork[n]
+    si = 0.0
+    sp = 0.0
+    sh = 0.0
+    se = 0.0
+    for e in range(ie.shape[0]):
+        si += ie[e]
+        sp += plast[e]
+        sh += hge[e]
+        if alive[e] != 1:
+            se += ie[e]
+    en[E_KIN] = ke
+    en[E_INT] = si
+    en[E_PLAST] = sp
+    en[E_HG] = sh
+    en[E_FRIC] = sf + spn
+    en[E_NODEWORK] = sw
+    en[E_ERODED] = se + sek
+    en[E_EROKE] = sek
+
+
+def tool_kinematics_py(tool, prm):
+    """Tool tip position and velocity in the local frame from the tool state.
+
+    The support displacement/velocity (boring frame) is rotated into the local frame of the
+    run with the current bar angle: e_x = e_t = (-sin th, cos th, 0), e_y = -e_r, e_z = Z.
+    Returns ``(cx, cy, cz, vx, vy, vz)`` [m, m/s].
+    """
+    th = tool[T_THETA]
+    s = math.sin(th)
+    c = math.cos(th)
+    ux = -s * tool[T_UX] + c * tool[T_UY]
+    uy = -c * tool[T_UX] - s * tool[T_UY]
+    wx = -s * tool[T_VX] + c * tool[T_VY]
+    wy = -c * tool[T_VX] - s * tool[T_VY]
+    return (tool[T_GX] + ux, tool[T_GY] + uy, tool[T_GZ] + tool[T_UZ], prm[P_VC] + wx, wy,
+            prm[P_VF] + tool[T_VZ])
+
+
+tool_kinematics = njit(cache=True)(tool_kinematics_py)
+
+
+def tool_step_py(tool, prm, fwx, fwy, fwz, dt):
+    """Advance the tool one step given the contact force ON THE WORKPIECE (local) [N].
+
+    Stores the force on the tool (local), steps the three boring-frame spring-damper units
+    (:func:`physics.tool_support_step_py`; force rotated with the bar angle), moves the guide
+    (cutting speed along x, feed speed along z) and the bar angle. Returns the work done on
+    the workpiece during the step [J] (tool velocity averaged over the step).
+    """
+    cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
+    tool[T_FX] = -fwx
+    tool[T_FY] = -fwy
+    tool[T_FZ] = -fwz
+    if prm[P_SUPPORT] > 0.5:
+        th = tool[T_THETA]
+        s = math.sin(th)
+        c = math.cos(th)
+        FX = -s * (-fwx) - c * (-fwy)
+        FY = c * (-fwx) - s * (-fwy)
+        ux, vux = tool_support_step(tool[T_UX], tool[T_VX], FX, prm[P_KX], prm[P_CX],
+                                    prm[P_MX], dt)
+        uy, vuy = tool_support_step(tool[T_UY], tool[T_VY], FY, prm[P_KY], prm[P_CY],
+                                    prm[P_MY], dt)
+        uz, vuz = tool_support_step(tool[T_UZ], tool[T_VZ], -fwz, prm[P_KZ], prm[P_CZ],
+                                    prm[P_MZ], dt)
+        tool[T_UX] = ux
+        tool[T_VX] = vux
+        tool[T_UY] = uy
+        tool[T_VY] = vuy
+        tool[T_UZ] = uz
+        tool[T_VZ] = vuz
+    tool[T_GX] += prm[P_VC] * dt
+    tool[T_GZ] += prm[P_VF] * dt
+    if prm[P_RADIUS] > 0.0:
+        tool[T_THETA] += prm[P_VC] * dt / prm[P_RADIUS]
+    cx2, cy2, cz2, tvx2, tvy2, tvz2 = tool_kinematics(tool, prm)
+    return dt * (fwx * 0.5 * (tvx + tvx2) + fwy * 0.5 * (tvy + tvy2) + fwz * 0.5 * (tvz + tvz2))
+
+
+tool_step = njit(cache=True)(tool_step_py)
+
+
+@njit(cache=True)
+def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
+               sd, pres, eps_p, temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
+               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist):
+    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
+
+    ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
+    STATUS_DONE at ``prm[P_TEND]``, or an instability status. Returns the steps taken.
+    """
+    erosion = int(prm[P_EROSION])
+    nn = x.shape[0]
+    ne = conn.shape[0]
+    taken = 0
+    for _s in range(n_steps):
+        dt = clock[1]
+        t = clock[0]
+        cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
+        node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
+                     fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+        fwx = 0.0
+        fwy = 0.0
+        fwz = 0.0
+        ncont = 0
+        for n in range(nn):
+            if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
+                fwx += cf[n, 0]
+                fwy += cf[n, 1]
+                fwz += cf[n, 2]
+                ncont += 1
+        en[E_EXT] += tool_step(tool, prm, fwx, fwy, fwz, dt)
+        element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
+                        vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+        dtmin = 1e30
+        for e in range(ne):
+            if dte[e] < dtmin:
+                dtmin = dte[e]
+            if alive[e] == -2:
+                ist[I_BADELEM] = e
+                ist[I_STATUS] = STATUS_INVERTED
+        taken += 1
+        ist[I_STEP] += 1
+        t += dt
+        clock[0] = t
+        if ist[I_STATUS] == STATUS_INVERTED:
+            return taken
+        if dtmin >= 1e30:
+            ist[I_STATUS] = STATUS_NO_ELEMENTS
+            return taken
+        new_dt = prm[P_CFL] * dtmin
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(fwz)
+                and math.isfinite(new_dt)):
+            ist[I_STATUS] = STATUS_NONFINITE
+            return taken
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = STATUS_DT_COLLAPSE
+            clock[1] = new_dt
+            return taken
+        clock[1] = new_dt
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_FZ] += dt * tool[T_FZ]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_UZ] += dt * tool[T_UZ]
+        hacc[H_NCONT] += dt * ncont
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            if not math.isfinite(en[E_KIN]):
+                ist[I_STATUS] = STATUS_NONFINITE
+                return taken
+            hist[k, H_T] = t
+            for j in (H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ, H_NCONT):
+                hist[k, j] = hacc[j] / ta
+            hist[k, H_TIPX] = tool[T_GX]
+            hist[k, H_THETA] = tool[T_THETA]
+            hist[k, H_EKIN] = en[E_KIN]
+            hist[k, H_EINT] = en[E_INT]
+            hist[k, H_EPL] = en[E_PLAST]
+            hist[k, H_EHG] = en[E_HG]
+            hist[k, H_EFRIC] = en[E_FRIC]
+            hist[k, H_EEXT] = en[E_EXT]
+            hist[k, H_EERO] = en[E_ERODED]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = STATUS_DONE
+            sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            return taken
+    sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+    return taken
+
+
+_UNUSED = (ERODE_LAYER, P_BV1, P_BV2, P_DIST, P_DT_ERODE, P_HGS, P_HGV, P_MS, ERODE_ALL, ERODE_NONE,
+           STATUS_OK, STATUS_DONE, N_EN, N_IST)
