@@ -94,10 +94,13 @@ class CuttingProcess:
     def process_stiffness(self, theta: np.ndarray) -> np.ndarray:
         """Non-regenerative stiffness from depth modulation [N/m], shape (n, 3, 3).
 
-        ``dF = P(theta) r`` with ``P = sum_p B_p^T [sum_e w_e h0_e shear_e] dd^T B_p`` (it does
-        not scale with depth: the width change is the displacement itself)."""
+        ``dF = P(theta) r`` with
+        ``P = sum_p B_p^T [sum_e (w_e h0_e shear_e + s_e edge_e)] dd^T B_p`` (per unit depth
+        widths ``w_e`` and edge lengths ``s_e``; it does not scale with depth: the width
+        change is the displacement itself)."""
         th = np.atleast_1d(np.asarray(theta, float))
-        vec = np.einsum("e,e,ei->i", self.width_per_depth, self.h0, self.shear)
+        vec = (np.einsum("e,e,ei->i", self.width_per_depth, self.h0, self.shear)
+               + np.einsum("e,ei->i", self.edge_per_depth, self.edge))
         core = np.outer(vec, self.depth_direction)
         P = np.zeros((th.size, 3, 3))
         if not np.any(self.depth_direction):
@@ -128,14 +131,25 @@ def single_point_process(cutting_coefficient_N_per_m2: float, force_direction: n
 
 def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, depth_m: float,
                    feed_per_rev_m: float, n_elements: int = 24, overlap: float = 1.0,
-                   depth_modulation: bool = True) -> CuttingProcess:
+                   depth_modulation: bool = True,
+                   min_chip_thickness_m: float | None = None) -> CuttingProcess:
     """Rotating boring bar: edge elements of ``insert`` at depth ``depth_m`` (see
     :mod:`robobore.cutting.geometry`) with the mechanistic force model
     (:mod:`robobore.cutting.forces`). Element widths scale linearly with the simulated depth
     (uniform stretch of the engaged edge: exact on a straight edge, an approximation when the
-    depth differs much from ``depth_m`` on the nose)."""
+    depth differs much from ``depth_m`` on the nose).
+
+    Minimum chip thickness: elements whose nominal uncut chip thickness is below
+    ``min_chip_thickness_m`` (default 0.25 x the edge radius; the minimum chip thickness is
+    about 0.2-0.4 edge radii, Liu, DeVor & Kapoor 2006) plough rather than cut: they keep their
+    edge (ploughing) force but carry no shearing force and no regeneration. Near the nose tip
+    the nominal thickness tends to zero, and a linear model that kept those elements fully
+    engaged would overstate the regenerative gain (the time domain drops them as soon as the
+    tool vibrates)."""
     fz = feed_per_rev_m / insert.n_inserts
     el = edge_elements(insert, depth_m, fz, n_elements)
+    hmin = 0.25 * insert.edge_radius_m if min_chip_thickness_m is None else min_chip_thickness_m
+    shearing = el.h >= hmin
     sk, ck = np.sin(el.kappa), np.cos(el.kappa)
     c = coefficients
     # basis coordinates (t, r, z); tangential force on the tool is -Ft e_t
@@ -147,7 +161,8 @@ def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dept
     # h0: the element's nominal thickness; per unit depth widths
     return CuttingProcess(
         rotating=True, n_inserts=insert.n_inserts, h0=el.h.copy(),
-        width_per_depth=el.db / depth_m, edge_per_depth=el.dS / depth_m, normal=normal,
+        width_per_depth=el.db / depth_m * shearing, edge_per_depth=el.dS / depth_m,
+        normal=normal,
         shear=shear, edge=edge,
         depth_direction=np.array([0.0, 1.0, 0.0]) if depth_modulation else np.zeros(3),
         overlap=float(overlap), feed_per_rev_m=feed_per_rev_m, reference_depth_m=depth_m,
