@@ -69,19 +69,24 @@ class CuttingProcess:
             B[:] = np.eye(3)
         return B
 
-    def directional_matrix(self, theta: np.ndarray) -> np.ndarray:
+    def directional_matrix(self, theta: np.ndarray,
+                           insert_weights: np.ndarray | None = None) -> np.ndarray:
         """Regenerative directional matrix per unit depth [N/m^2], shape (n, 3, 3).
 
         Linearised about the nominal chip, all inserts summed (insert ``p`` at
         ``theta + 2 pi p / N``): ``dF = -a A(theta) (r(t) - mu r(t - tau))``,
-        ``A = sum_p B_p^T [sum_e w_e shear_e n_e^T] B_p``.
+        ``A = sum_p g_p B_p^T [sum_e w_e shear_e n_e^T] B_p`` with optional per-insert weights
+        ``g_p`` (shape (n, N); e.g. the actual/nominal depth ratio along a deflected path).
         """
         th = np.atleast_1d(np.asarray(theta, float))
         core = np.einsum("e,ei,ej->ij", self.width_per_depth, self.shear, self.normal)
         A = np.zeros((th.size, 3, 3))
         for p in range(self.n_inserts):
             B = self.basis(th + 2 * np.pi * p / self.n_inserts)
-            A += np.einsum("nki,kl,nlj->nij", B, core, B)
+            Ap = np.einsum("nki,kl,nlj->nij", B, core, B)
+            if insert_weights is not None:
+                Ap = Ap * insert_weights[:, p, None, None]
+            A += Ap
         return A
 
     def mean_directional_matrix(self, n_theta: int = 720) -> np.ndarray:

@@ -279,11 +279,35 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
     return E[:n, :n], E[:n, n:2 * n], E[:n, 2 * n:]
 
 
+def deflected_depth_weights(structure: ToolPointStructure, process: CuttingProcess,
+                            speed_rpm: float, theta: np.ndarray) -> np.ndarray | None:
+    """Actual/nominal depth of each insert along the steady deflected path, shape (n, N).
+
+    The radial deflection under the nominal force scales with the depth, so the ratio
+    ``1 + e_r . r_p / a`` does not depend on it. ``None`` for fixed-direction processes or
+    without depth modulation (no such effect)."""
+    if not process.rotating or not np.any(process.depth_direction):
+        return None
+    from robobore.dynamics.timedomain import forced_response
+
+    Ns = 720
+    rp = forced_response(structure, process, speed_rpm, 1.0, Ns)  # per unit depth, (Ns,3)
+    ang = 2 * np.pi * np.arange(rp.shape[0]) / rp.shape[0]
+    th = np.mod(np.atleast_1d(theta), 2 * np.pi)
+    r = np.column_stack([np.interp(th, ang, rp[:, k], period=2 * np.pi) for k in range(3)])
+    N = process.n_inserts
+    w = np.empty((th.size, N))
+    for p in range(N):
+        B = process.basis(th + 2 * np.pi * p / N)  # (n,3,3)
+        w[:, p] = 1.0 + np.einsum("k,nki,ni->n", process.depth_direction, B, r)
+    return np.clip(w, 0.0, None)
+
+
 def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: np.ndarray,
-                include_process_stiffness: bool = True):
+                include_process_stiffness: bool = True, insert_weights=None):
     D = structure.directions  # (m,3)
     minv = 1.0 / structure.modal_mass
-    A = process.directional_matrix(theta)  # (n,3,3)
+    A = process.directional_matrix(theta, insert_weights)  # (n,3,3)
     W = minv[None, :, None] * np.einsum("jo,noi,ki->njk", D, A, D)
     if include_process_stiffness:
         P = process.process_stiffness(theta)
@@ -295,17 +319,22 @@ def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: n
 
 def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingProcess,
                               speed_rpm: float, depth_m: float, steps: int = 0,
-                              include_process_stiffness: bool = True) -> float:
+                              include_process_stiffness: bool = True,
+                              about_deflected: bool = True) -> float:
     """Spectral radius of the semi-discretised monodromy matrix over one delay (< 1: stable).
 
-    ``steps`` per delay (0: :func:`auto_steps`)."""
+    ``steps`` per delay (0: :func:`auto_steps`). ``about_deflected``: for the rotating bar
+    with depth modulation, linearise about the steady deflected path (each insert's actual
+    depth along the forced response, :func:`deflected_depth_weights`) rather than the
+    undeflected nominal cut."""
     steps = steps or auto_steps(structure, process, speed_rpm)
     with _limits(1):
         return _monodromy(structure, process, speed_rpm, depth_m, steps,
-                          include_process_stiffness)
+                          include_process_stiffness, about_deflected)
 
 
-def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness):
+def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
+               about_deflected=True):
     m = structure.n_modes
     tau = 60.0 / (process.n_inserts * speed_rpm)
     dt = tau / steps
@@ -318,7 +347,9 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
     n_th = 1 if constant else steps
     # coefficient angle at the middle of each step (delay = one insert pitch)
     theta = (np.arange(n_th) + 0.5) * dt * 2 * np.pi * speed_rpm / 60.0
-    W, Pm = _modal_mats(structure, process, theta, include_process_stiffness)
+    wts = (deflected_depth_weights(structure, process, speed_rpm, theta)
+           if about_deflected else None)
+    W, Pm = _modal_mats(structure, process, theta, include_process_stiffness, wts)
     mu = process.overlap
     n = 2 * m + steps * m
     mono = np.eye(n)
@@ -363,7 +394,8 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
                                       speed_rpm: float, depth_hi_m: float = 1.0,
                                       steps: int = 0, tol: float = 1e-4,
                                       include_process_stiffness: bool = True,
-                                      depth_guess_m: float | None = None) -> float:
+                                      depth_guess_m: float | None = None,
+                                      about_deflected: bool = True) -> float:
     """Critical depth [m] at one speed by bisection on the monodromy spectral radius.
 
     ``steps`` per delay (0: :func:`auto_steps`); ``depth_guess_m`` (e.g. the frequency-domain
@@ -374,7 +406,7 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
 
     def rho(b: float) -> float:
         return monodromy_spectral_radius(structure, process, speed_rpm, b, steps,
-                                         include_process_stiffness)
+                                         include_process_stiffness, about_deflected)
 
     if rho(depth_hi_m * 1e-6) >= 1.0:
         return 0.0
@@ -499,5 +531,6 @@ def sdof_pocket_speeds(f_n: float, zeta: float, n_inserts: int, lobes: int) -> n
 __all__ = ["LobeResult", "frequency_grid", "oriented_eigenvalues", "lobe_branches",
            "lobes_frequency_domain", "lobe_curves", "monodromy_spectral_radius",
            "critical_depth_semidiscretization", "lobes_semidiscretization", "auto_steps",
+           "deflected_depth_weights",
            "ModeCoupling",
            "mode_coupling", "mode_coupling_limit", "sdof_absolute_limit", "sdof_pocket_speeds"]

@@ -258,7 +258,16 @@ def _periodic_state(structure, process, Ns, depth_m, speed_rpm):
     r_t = q_t @ structure.directions  # (Ns, 3)
     spp = Ns // int(process.n_inserts)
     sr = r_t[np.arange(Ns) % spp]
-    return q0, qd0, np.ascontiguousarray(sr)
+    return q0, qd0, np.ascontiguousarray(sr), r_t
+
+
+def forced_response(structure: ToolPointStructure, process: CuttingProcess, speed_rpm: float,
+                    depth_m: float, samples_per_rev: int = 720) -> np.ndarray:
+    """Steady tool-point displacement [m] under the nominal cutting force over one revolution,
+    shape (samples_per_rev, 3), at bar angles ``2 pi i / samples_per_rev``."""
+    N = int(process.n_inserts)
+    Ns = int(math.ceil(samples_per_rev / N) * N)
+    return _periodic_state(structure, process, Ns, depth_m, speed_rpm)[3]
 
 
 def simulate(structure: ToolPointStructure, process: CuttingProcess,
@@ -285,7 +294,7 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     m = structure.n_modes
     spp = Ns // N
     if settings.start == "periodic":
-        q, qd, sr = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
+        q, qd, sr, _ = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
         pert = settings.perturbation_m
         if pert is None:
             pert = 0.01 * float(np.max(process.h0))
@@ -403,5 +412,5 @@ def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, 
 
 
 __all__ = ["simulate", "SimulationSettings", "modal_zoh", "auto_samples_per_rev",
-           "periodic_start",
+           "periodic_start", "forced_response",
            "surface_profile", "summarize"]
