@@ -99,3 +99,26 @@ def test_installed_package_has_every_data_file():
         if not (installed / rel).is_file():
             missing.append(str(rel))
     assert not missing, f"not installed (add to package-data in pyproject.toml): {missing}"
+
+
+def test_cli_error_keeps_square_brackets():
+    """Rich markup must not eat '[process]' or '[mm]' from error messages and tables."""
+    import typer
+
+    from robobore.clitools import handle_errors, kv_table
+
+    demo = typer.Typer()
+
+    @demo.command()
+    @handle_errors
+    def boom() -> None:
+        raise ConfigError("missing section", field="[process]", expected="depth in [mm]")
+
+    r = CliRunner().invoke(demo, [])
+    assert r.exit_code == 2
+    assert "[process]" in r.output and "[mm]" in r.output
+    from rich.console import Console
+
+    con = Console(record=True, width=80)
+    con.print(kv_table("t", [("depth [mm]", 1.0)]))
+    assert "depth [mm]" in con.export_text()

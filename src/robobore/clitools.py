@@ -15,6 +15,7 @@ from typing import Any, TypeVar
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -44,7 +45,7 @@ def handle_errors(func: F) -> F:
         try:
             return func(*args, **kwargs)
         except RoboboreError as exc:
-            stderr.print(f"[bold red]error:[/] {exc}", highlight=False, markup=True)
+            stderr.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, markup=True)
             raise typer.Exit(code=2) from None
 
     return wrapper  # type: ignore[return-value]
@@ -65,7 +66,7 @@ def kv_table(title: str, rows: Iterable[tuple[str, Any]]) -> Table:
     t.add_column("quantity")
     t.add_column("value", justify="right")
     for k, v in rows:
-        t.add_row(str(k), fmt(v))
+        t.add_row(escape(str(k)), escape(fmt(v)))
     return t
 
 
