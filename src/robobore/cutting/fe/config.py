@@ -72,6 +72,12 @@ class MeshSection(_Strict):
     height_factor: float = Field(default=5.0, ge=2.0, le=50.0)
     #: growth ratio of element size outside the fine zone (1 = uniform)
     grading: float = Field(default=1.25, ge=1.0, le=2.0)
+    #: position of the one-element separation layer: "above_cut_line" (its bottom on the
+    #: tool's lowest point: everything below is ploughed under the edge and rubs the flank)
+    #: "centred" (centred on the cut line: half of it lies below the tool) or
+    #: "below_cut_line" (its top on the cut line: the chip layer is the full h and the
+    #: layer is the material crushed under the edge)
+    separation_layer: Literal["above_cut_line", "centred", "below_cut_line"] = "centred"
     #: uncut material left ahead of the tool at the end of the cut [mm]
     ahead_mm: float = Field(default=0.3, gt=0.0, le=20.0)
 
@@ -94,8 +100,14 @@ class SolverSection(_Strict):
     #: erode an element whose area ratio A/A0 or corner Jacobian falls below this (numerical
     #: safety against inverted elements; counted and reported separately); 0 disables
     distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
-    #: heat conduction between elements (explicit, finite-volume); false = adiabatic
-    conduction: bool = False
+    #: steps between chip rezoning passes (Laplacian smoothing + donor-cell remap of the
+    #: chip layer, see robobore.cutting.fe.rezone); 0 = pure Lagrangian
+    rezone_interval: int = Field(default=0, ge=0, le=10**6)
+    #: relaxation of each smoothing pass (fraction of the move towards the neighbour mean)
+    rezone_relaxation: float = Field(default=0.3, gt=0.0, le=1.0)
+    #: erode an element whose stable time step falls below this fraction of the initial
+    #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
+    erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
     #: number of force/tool samples over the whole run
     n_samples: int = Field(default=400, ge=10, le=100000)
     #: steps per compiled chunk between progress updates

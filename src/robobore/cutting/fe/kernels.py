@@ -25,6 +25,7 @@ import math
 from numba import njit, prange
 
 from robobore.cutting.fe.physics import contact_force, radial_return, tool_gap, tool_support_step
+from robobore.cutting.fe.rezone import rezone
 from robobore.material import johnson_cook as jc
 
 # --- prm indices (float parameters)
@@ -33,7 +34,8 @@ P_MU, P_TAU, P_PEN, P_R = 7, 8, 9, 10
 P_NRX, P_NRY, P_NFX, P_NFY = 11, 12, 13, 14
 P_VC, P_KX, P_KY, P_CX, P_CY, P_MX, P_MY, P_WIDTH = 15, 16, 17, 18, 19, 20, 21, 22
 P_SAMPLE_DT, P_DTMIN, P_TEND, P_EROSION, P_SUPPORT = 23, 24, 25, 26, 27
-N_PRM = 28
+P_RZ_EVERY, P_RZ_OMEGA, P_RZ_MAXMOVE, P_DT_ERODE = 28, 29, 30, 31
+N_PRM = 32
 # erosion modes
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 # --- tool state: guide x, y; displacement u, v; velocity of displacement; force
@@ -79,6 +81,7 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
     bv1 = prm[P_BV1]
     bv2 = prm[P_BV2]
     dlim = prm[P_DIST]
+    dt_erode = prm[P_DT_ERODE]
     for e in prange(ne):
         if alive[e] != 1:
             for k in range(4):
@@ -182,6 +185,10 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
             qrate = bv1 * c + bv2 * le * (-trd)
             qbv = rho_c * le * qrate * (-trd)
         dte[e] = le / (qrate + math.sqrt(qrate * qrate + c * c))
+        if dte[e] < dt_erode:
+            # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
+            # element whose stable step fell below the floor is deleted
+            alive[e] = -1
         fxx = nsx - p_new - qbv
         fyy = nsy - p_new - qbv
         # stress power (midpoint) -> internal energy
@@ -333,7 +340,7 @@ def _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork,
 def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
-              en, ist, clock, hacc, hist):
+              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -345,6 +352,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     vc = prm[P_VC]
     width = prm[P_WIDTH]
     cfl = prm[P_CFL]
+    rz_every = int(prm[P_RZ_EVERY])
+    rho_s = mat[jc.RHO] * prm[P_MS]
     nn = x.shape[0]
     ne = conn.shape[0]
     taken = 0
@@ -381,6 +390,10 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         tvx_new = -vc + tool[T_VUX]
         tvy_new = tool[T_VUY]
         en[E_EXT] += dt * (fwx * 0.5 * (tvx + tvx_new) + fwy * 0.5 * (tvy + tvy_new))
+        if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
+            rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
+                   sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
+                   prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE])
         element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
                        temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
                        prm, dt, erosion)

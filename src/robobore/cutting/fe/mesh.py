@@ -3,8 +3,9 @@
 Frame: x along the workpiece (the tool moves towards -x), y up; the free surface is y = 0,
 the tool's lowest point (cut line) is at y = -h. Layout from top to bottom:
 
-* chip layer, 0 > y > -h + le/2, uniform rows of about ``le`` (element size);
-* the separation layer, one row of height ``le`` centred on the cut line y = -h;
+* chip layer, 0 > y > -h + f le, uniform rows of about ``le`` (element size);
+* the separation layer, one row of height ``le`` from -h + f le down to -h - (1 - f) le
+  (f = ``layer_offset``: 1 puts the layer just above the cut line, 0.5 centres it on it);
 * a fine zone of ``fine_depth_factor * h`` below it, uniform ``le``;
 * rows growing geometrically (ratio ``grading``) down to y = -height_factor * h.
 
@@ -61,6 +62,7 @@ class CuttingMesh:
     height: float
     y_cut: float
     element_size: float
+    layer_top: float
 
     @property
     def n_nodes(self) -> int:
@@ -73,17 +75,18 @@ class CuttingMesh:
 
 def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
                fine_depth_factor: float = 1.0, height_factor: float = 5.0,
-               grading: float = 1.25) -> CuttingMesh:
+               grading: float = 1.25, layer_offset: float = 0.5) -> CuttingMesh:
     """Graded mesh for uncut chip thickness ``h`` [m], element size ``le`` [m], cut length [m].
 
     The workpiece spans x in [0, ahead + cut_length]; the cut runs from the right end to
-    x = ahead.
+    x = ahead. ``layer_offset`` places the separation layer: its top is at
+    y = -h + layer_offset * le (1: the layer lies just above the cut line, 0.5: centred on it).
     """
-    n_chip = max(1, int(round((h - 0.5 * le) / le)))
+    top_chip = -(h - layer_offset * le)
+    n_chip = max(1, int(round(-top_chip / le)))
     y_rows = [0.0]
-    top_chip = -(h - 0.5 * le)
     y_rows += list(np.linspace(0.0, top_chip, n_chip + 1)[1:])
-    y_rows.append(-h - 0.5 * le)  # separation layer
+    y_rows.append(top_chip - le)  # separation layer
     layer_row = n_chip  # row index from the top
     fine_depth = fine_depth_factor * h
     n_fine = max(1, int(round(fine_depth / le)))
@@ -144,4 +147,5 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
             fill[n] += 1
     return CuttingMesh(nodes=nodes, conn=conn, layer=layer, chip=chip, fixed=fixed,
                        surface=surface, node_elems_ptr=ptr, node_elems=ne, node_corner=nc,
-                       length=total, height=-yc[0], y_cut=-h, element_size=le)
+                       length=total, height=-yc[0], y_cut=-h, element_size=le,
+                       layer_top=top_chip)

@@ -26,7 +26,6 @@ class ChipGeometry:
     ratio: float
     shear_angle_deg: float
     n_points: int
-    ratio_velocity: float
 
 
 def shear_angle_deg(chip_ratio: float, rake_rad: float) -> float:
@@ -51,46 +50,54 @@ def _point_polyline_distance(px: np.ndarray, py: np.ndarray, lx: np.ndarray,
 def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     """Chip thickness from the deformed mesh.
 
-    Outer chip surface: nodes that started on the free surface (y0 = 0); inner surface: the
-    nodes that started on the top of the separation layer (y0 = -h + le/2), i.e. the chip's
-    underside once the layer has eroded. Only chip material that has risen above the
-    free surface by more than h and lies at least 1.5 h along the rake from the edge is used
-    (formed chip, outside the primary shear zone). Thickness = median distance of the outer
-    nodes to the inner polyline; the ratio refers to the chip layer of the mesh,
-    h - le/2 (the upper half of the eroded separation layer is part of the uncut chip but
-    its mass is deleted). A second ratio from continuity, vc / chip speed, is also given.
+    The chip is the material of the chip layer (rows above the separation layer) that has
+    passed the tool. Outer surface: nodes that started on the free surface (y0 = 0). Inner
+    surface: in every original node column, the lowest node still attached to a live
+    element (the chip underside after the separation layer -- and any chip element
+    deleted by time-step erosion -- is gone). Only formed chip is used: above the free
+    surface by more than h and at least 1.5 h along the rake from the edge. For each outer
+    node, thickness = distance to the inner polyline, and the ratio divides it by the
+    original thickness of the surviving material of that column (0 - y0 of the inner node);
+    the reported ratio is the median.
     """
     le = mesh.element_size
-    y_inner0 = -h + 0.5 * le
+    y_inner0 = mesh.layer_top
     x, y = st.x, st.y
     cx = st.tool[K.T_GX] + st.tool[K.T_UX]
     cy = st.tool[K.T_GY] + st.tool[K.T_UY]
     trx, try_ = math.sin(rake), math.cos(rake)
     alive_n = ~st.ndead
     s_along = (x - cx) * trx + (y - cy) * try_
-    formed = alive_n & (y > h) & (s_along > 1.5 * h) & (st.x0 > cx)
-    outer = formed & (np.abs(st.y0) < 1e-12)
-    inner_all = alive_n & (np.abs(st.y0 - y_inner0) < 1e-9 * max(h, 1e-9)) & (st.x0 > cx)
-    h_chip0 = h - 0.5 * le
-    if outer.sum() < 2 or inner_all.sum() < 2:
-        return ChipGeometry(math.nan, h_chip0, math.nan, math.nan, int(outer.sum()), math.nan)
-    order = np.argsort(st.x0[inner_all])
-    lx = x[inner_all][order]
-    ly = y[inner_all][order]
+    passed = alive_n & (st.x0 > cx) & (st.y0 > y_inner0 - 1e-3 * le)
+    formed = passed & (y > h) & (s_along > 1.5 * h)
+    outer = formed & (np.abs(st.y0) < 1e-3 * le)
+    h_chip0 = -mesh.layer_top
+    nan = ChipGeometry(math.nan, h_chip0, math.nan, math.nan, int(outer.sum()))
+    if outer.sum() < 2:
+        return nan
+    # inner surface: lowest live node of each passed column
+    cols = np.unique(st.x0[passed])
+    ix, iy, iy0, kept = [], [], [], []
+    for c in cols:
+        sel = np.where(passed & (np.abs(st.x0 - c) < 1e-3 * le))[0]
+        j = sel[np.argmin(st.y0[sel])]
+        if st.y0[j] < -0.5 * le:
+            ix.append(x[j])
+            iy.append(y[j])
+            iy0.append(st.y0[j])
+            kept.append(c)
+    if len(ix) < 2:
+        return nan
+    lx, ly, ly0 = np.array(ix), np.array(iy), np.array(iy0)
     d = _point_polyline_distance(x[outer], y[outer], lx, ly)
+    # original thickness of the surviving material near each outer node's column
+    near = np.argmin(np.abs(st.x0[outer][:, None] - np.array(kept)[None, :]), axis=1)
+    t0 = -ly0[near]
+    ratios = d / t0
     tc = float(np.median(d))
-    # continuity: chip speed relative to the tool (plane strain, incompressible)
-    tvx = -vc + st.tool[K.T_VUX]
-    tvy = st.tool[K.T_VUY]
-    chip_nodes = formed & (st.y0 > y_inner0 - 1e-12)
-    if chip_nodes.sum() > 0:
-        vrel = np.hypot(st.vx[chip_nodes] - tvx, st.vy[chip_nodes] - tvy)
-        r_v = vc / float(np.median(vrel)) if np.median(vrel) > 0 else math.nan
-    else:
-        r_v = math.nan
-    ratio = tc / h_chip0
-    return ChipGeometry(tc, h_chip0, ratio, shear_angle_deg(ratio, rake), int(outer.sum()),
-                        r_v)
+    ratio = float(np.median(ratios))
+    return ChipGeometry(tc, float(np.median(t0)), ratio, shear_angle_deg(ratio, rake),
+                        int(outer.sum()))
 
 
 @dataclass
@@ -203,8 +210,8 @@ def tool_outline(cx: float, cy: float, r: float, rake: float, clearance: float,
     nf = np.array([math.sin(clearance), -math.cos(clearance)])
     a0 = math.atan2(nr[1], nr[0])
     a1 = math.atan2(nf[1], nf[0])
-    if a1 > a0:
-        a1 -= 2 * math.pi
+    if a1 < a0:  # the edge arc runs from the rake normal round the bottom to the flank normal
+        a1 += 2 * math.pi
     ang = np.linspace(a0, a1, 30)
     arc = np.column_stack([cx + r * np.cos(ang), cy + r * np.sin(ang)])
     tr = np.array([nr[1], -nr[0]])

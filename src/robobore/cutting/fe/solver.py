@@ -20,6 +20,7 @@ import numpy as np
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config import FEConfig
 from robobore.cutting.fe.mesh import CuttingMesh, build_mesh
+from robobore.cutting.fe.rezone import N_RZ_FIELDS, edge_neighbours, smoothing_stencil
 from robobore.errors import ConfigError, NumericalError
 from robobore.material import Material, load_material
 
@@ -73,6 +74,12 @@ class FEState:
     clock: np.ndarray
     hacc: np.ndarray
     hist: np.ndarray
+    enbr: np.ndarray = field(default=None)  # type: ignore[assignment]
+    snodes: np.ndarray = field(default=None)  # type: ignore[assignment]
+    snbr: np.ndarray = field(default=None)  # type: ignore[assignment]
+    xn: np.ndarray = field(default=None)  # type: ignore[assignment]
+    yn: np.ndarray = field(default=None)  # type: ignore[assignment]
+    buf: np.ndarray = field(default=None)  # type: ignore[assignment]
     x0: np.ndarray = field(default=None)  # type: ignore[assignment]
     y0: np.ndarray = field(default=None)  # type: ignore[assignment]
 
@@ -83,7 +90,8 @@ class FEState:
                 self.area0, self.ie, self.hge, self.fex, self.fey, self.dte, self.plast,
                 self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
-                self.hacc, self.hist)
+                self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
+                self.buf)
 
     @property
     def n_elements(self) -> int:
@@ -167,7 +175,9 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         dte=z(ne), plast=z(ne), rate=z(ne), cfx=z(n), cfy=z(n), fric=z(n), pen=z(n),
         ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
         en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
-        hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy())
+        hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
+        enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64),
+        snbr=np.zeros((0, 4), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)))
     init_forces(st)
     return st
 
@@ -184,6 +194,8 @@ def init_forces(st: FEState) -> float:
     st.clock[1] = dt
     if st.prm[K.P_DTMIN] <= 0:
         st.prm[K.P_DTMIN] = 1e-3 * dt
+    if st.prm[K.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
+        st.prm[K.P_DT_ERODE] = -st.prm[K.P_DT_ERODE] * float(np.min(st.dte))
     return dt
 
 
@@ -260,7 +272,10 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     clr = math.radians(cfg.tool.clearance_deg)
     mesh = build_mesh(h, le, L, ahead=cfg.mesh.ahead_mm * 1e-3,
                       fine_depth_factor=cfg.mesh.fine_depth_factor,
-                      height_factor=cfg.mesh.height_factor, grading=cfg.mesh.grading)
+                      height_factor=cfg.mesh.height_factor, grading=cfg.mesh.grading,
+                      layer_offset={"above_cut_line": 1.0, "centred": 0.5,
+                                    "below_cut_line": 0.0}[
+                          cfg.mesh.separation_layer])
     s = cfg.solver
     p = default_prm()
     p[K.P_CFL] = s.cfl
@@ -293,8 +308,14 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_KX], p[K.P_KY] = ts.stiffness_N_per_m  # type: ignore[misc]
         p[K.P_CX], p[K.P_CY] = ts.damping_N_s_per_m  # type: ignore[misc]
         p[K.P_MX], p[K.P_MY] = ts.mass_kg  # type: ignore[misc]
+    p[K.P_RZ_EVERY] = s.rezone_interval
+    p[K.P_RZ_OMEGA] = s.rezone_relaxation
+    p[K.P_RZ_MAXMOVE] = 0.2
+    p[K.P_DT_ERODE] = -s.erode_time_step_fraction
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, layer=mesh.layer,
                     n_samples=s.n_samples, tool_center=(cx0, cy0))
+    if s.rezone_interval > 0:
+        st.snodes, st.snbr = smoothing_stencil(mesh)
     if ts is not None:
         dt = st.clock[1]
         for i, (k, m) in enumerate(zip(ts.stiffness_N_per_m, ts.mass_kg, strict=True)):  # type: ignore[arg-type]
@@ -387,7 +408,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "averaging_window_mm": [float(cut_pos_mm[win][0]) if win.any() else math.nan,
                                 float(cut_pos_mm[win][-1]) if win.any() else math.nan],
         "chip_ratio": chip.ratio,
-        "chip_ratio_continuity": chip.ratio_velocity,
+        "chip_ratio_points": chip.n_points,
         "chip_thickness_um": chip.thickness * 1e6,
         "shear_angle_deg": chip.shear_angle_deg,
         "peak_temperature_K": float(np.max(st.temp[st.alive == 1])),
@@ -403,6 +424,9 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "cutting_speed_m_per_min": cfg.cut.cutting_speed_m_per_min,
         "eroded_damage": int(np.sum(st.alive == 0)),
         "eroded_distortion": int(np.sum(st.alive == -1)),
+        "eroded_chip_mass_fraction": float(
+            np.sum(st.area0[(st.alive != 1) & setup.mesh.chip])
+            / max(np.sum(st.area0[setup.mesh.chip]), 1e-300)),
         "energy_external_J_per_m": float(en[K.E_EXT]),
         "energy_plastic_J_per_m": float(en[K.E_PLAST]),
         "energy_hourglass_J_per_m": float(en[K.E_HG]),

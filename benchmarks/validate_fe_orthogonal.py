@@ -1,0 +1,100 @@
+"""Validate the FE orthogonal-cutting engine against the 9 measured Ti6Al4V points.
+
+Reference: ../shared/data/ti64_orthogonal_cutting_forces.json (Ducobu, Pantale et al., CIRP
+2022; forces per mm of width, chip ratio). Acceptance of issue 5: |Fc error| <= 10 %,
+|Ff error| <= 35 %, chip ratio within the measured value +-30 %.
+
+The friction coefficient comes from the source's Coulomb-vs-speed table (Rech et al. 2013)
+through ``contact.friction = "table"``; nothing is fitted to these points.
+
+Usage::
+
+    python benchmarks/validate_fe_orthogonal.py [--length-mm 1.0] [--element-um 10]
+        [--data PATH] [--json OUT.json] [--points 60:30,40:5]
+
+Prints a table (measured, simulated, error, pass) and the run times.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.solver import simulate_orthogonal
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / \
+    "ti64_orthogonal_cutting_forces.json"
+
+
+def config(h_um: float, vc: float, length_mm: float, le_um: float, extra=None) -> dict:
+    d = {
+        "material": {"name": "TC4"},
+        "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
+        "cut": {"uncut_chip_thickness_um": h_um, "cutting_speed_m_per_min": vc,
+                "length_mm": length_mm, "width_mm": 1.0},
+        "contact": {"friction": "table", "shear_limit_MPa": 576.0},
+        "mesh": {"element_size_um": le_um},
+        "solver": {"mass_scaling": 100.0},
+    }
+    for k, v in (extra or {}).items():
+        d.setdefault(k, {}).update(v)
+    return d
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--length-mm", type=float, default=1.0)
+    ap.add_argument("--element-um", type=float, default=10.0)
+    ap.add_argument("--data", type=Path, default=Path(os.environ.get("ROBOBORE_TI64_DATA", DATA)))
+    ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--points", type=str, default="", help="h_um:vc list, e.g. 60:30,40:5")
+    args = ap.parse_args()
+    ref = json.loads(args.data.read_text())["measured"]
+    pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
+    if args.points:
+        pts = [tuple(float(x) for x in p.split(":")) for p in args.points.split(",")]
+    rows = []
+    print(f"# FE orthogonal validation: length {args.length_mm} mm, element "
+          f"{args.element_um} um, load {os.getloadavg()[0]:.1f}")
+    hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
+           f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} | {'E err':>6} {'wall s':>6}")
+    print(hdr)
+    for h, vc in pts:
+        hk = f"{h:g}"
+        vk = f"{vc:g}"
+        t0 = time.perf_counter()
+        cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3)))
+        res = simulate_orthogonal(cfg)
+        s = res.summary
+        fc_m, ff_m, r_m = ref["Fc"][hk][vk], ref["Ff"][hk][vk], ref["chip_ratio"][hk][vk]
+        efc = 100 * (s["cutting_force_N_per_mm"] - fc_m) / fc_m
+        eff = 100 * (s["feed_force_N_per_mm"] - ff_m) / ff_m
+        ok = (abs(efc) <= 10, abs(eff) <= 35,
+              abs(s["chip_ratio"] - r_m) <= 0.3 * r_m if s["chip_ratio"] == s["chip_ratio"]
+              else False)
+        row = dict(h_um=h, vc_m_per_min=vc, Fc_meas=fc_m, Fc_sim=s["cutting_force_N_per_mm"],
+                   Fc_err_pct=efc, Ff_meas=ff_m, Ff_sim=s["feed_force_N_per_mm"],
+                   Ff_err_pct=eff, chip_ratio_meas=r_m, chip_ratio_sim=s["chip_ratio"],
+                   energy_error=s["energy_error"], wall_s=time.perf_counter() - t0,
+                   pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
+                   friction=s["friction_coefficient"])
+        rows.append(row)
+        print(f"{h:5.0f} {vc:4.0f} | {fc_m:7.1f} {row['Fc_sim']:7.1f} {efc:6.1f} | {ff_m:7.1f} "
+              f"{row['Ff_sim']:7.1f} {eff:6.1f} | {r_m:6.2f} {row['chip_ratio_sim']:6.2f} | "
+              f"{row['energy_error']:6.3f} {row['wall_s']:6.0f}  "
+              f"{'Fc ok' if ok[0] else 'Fc FAIL'} {'Ff ok' if ok[1] else 'Ff FAIL'} "
+              f"{'r ok' if ok[2] else 'r FAIL'}", flush=True)
+    n = len(rows)
+    print(f"# passed: Fc {sum(r['pass_Fc'] for r in rows)}/{n}, Ff "
+          f"{sum(r['pass_Ff'] for r in rows)}/{n}, chip ratio {sum(r['pass_chip'] for r in rows)}"
+          f"/{n}")
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()

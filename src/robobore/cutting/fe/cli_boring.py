@@ -1,0 +1,107 @@
+"""``robobore fe boring CONFIG.toml [--json] [--vtk DIR] [--device cpu|gpu] [--coefficients F]``.
+
+Registered by :func:`register_boring` (called from the FE stage's ``register``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from robobore.clitools import JSON_OPTION, emit, handle_errors, kv_table, progress_bar, stdout
+
+_ROWS = [
+    ("force_rotating_N", "force on the tool, rotating frame (tangential, radial, feed) [N]"),
+    ("force_mean_N", "boring frame X, Y, Z: mean over a revolution [N]"),
+    ("force_amplitude_N", "boring frame X, Y, Z: amplitude over a revolution [N]"),
+    ("force_at_run_angle_N", "boring frame X, Y, Z at the simulated bar angle [N]"),
+    ("feed_amplitude_um", "feed-direction (Z) tool amplitude [um]"),
+    ("tool_dz_mean_um", "tool Z deflection, mean [um]"),
+    ("tool_dz_static_um", "feed force / kZ [um]"),
+    ("averaging_window_mm", "averaging window [mm of cut]"),
+    ("chip_area_mm2", "chip area (ap f - scallop) [mm^2]"),
+    ("chip_max_height_um", "chip height above the pre-bore surface [um]"),
+    ("peak_temperature_K", "peak temperature [K]"),
+    ("energy_error", "energy balance error"),
+    ("hourglass_fraction", "hourglass / internal energy"),
+    ("eroded_damage", "elements eroded (damage)"),
+    ("eroded_distortion", "elements eroded (distortion/time step)"),
+    ("n_elements", "elements"),
+    ("steps", "time steps"),
+    ("wall_time_s", "wall time [s]"),
+    ("element_updates_per_s", "element updates per second"),
+    ("device", "device"),
+]
+
+
+def boring_cmd(
+    config: Path = typer.Argument(..., help="3D FE boring config (TOML)."),
+    as_json: bool = JSON_OPTION,
+    vtk: Path | None = typer.Option(None, "--vtk", help="Write initial/final meshes (VTU) here."),
+    device: str = typer.Option("cpu", "--device", help="cpu (default) or gpu (numba-cuda)."),
+    coefficients: Path | None = typer.Option(
+        None, "--coefficients",
+        help="Compare with the mechanistic model using this coefficients file "
+             "(default: the bundled TC4 coefficients)."),
+) -> None:
+    """Explicit 3D FE simulation of boring: insert with nose radius on the bore wall with the
+    previous revolution's feed marks, held by the 3-direction equivalent model."""
+    run_boring_cli(config, as_json, vtk, device, coefficients)
+
+
+@handle_errors
+def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
+    from robobore.cutting.fe.boring3d import (
+        compare_with_mechanistic,
+        load_boring_config,
+        simulate_boring,
+        write_vtk,
+    )
+    from robobore.errors import ConfigError
+
+    if device not in ("cpu", "gpu"):
+        raise ConfigError("unknown device", field="--device", value=device,
+                          expected="cpu or gpu")
+    if device == "gpu":
+        from robobore.cutting.fe.gpu import require_gpu
+
+        require_gpu()
+    cfg = load_boring_config(config)
+    total = 1000
+    with progress_bar("FE boring (3D)", total, enabled=not as_json) as advance:
+        done = [0]
+
+        def prog(frac: float) -> None:
+            n = int(frac * total)
+            if n > done[0]:
+                advance(n - done[0])
+                done[0] = n
+
+        res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
+    result = dict(res.summary)
+    result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients)
+    if vtk is not None:
+        result["files"] = {"vtk": [str(p) for p in write_vtk(res, vtk)]}
+
+    def render(r: dict) -> None:
+        rows = []
+        for k, label in _ROWS:
+            v = r.get(k)
+            if isinstance(v, dict):
+                v = ", ".join(f"{x:.4g}" if isinstance(x, float) else str(x) for x in v.values())
+            rows.append((label, v))
+        stdout.print(kv_table("FE boring (3D)", rows))
+        mc = r["mechanistic_comparison"]
+        stdout.print(kv_table("FE vs mechanistic model", [
+            (f"{c}: FE / model [N], difference",
+             f"{mc[c]['fe_N']:.3g} / {mc[c]['model_N']:.3g}, "
+             f"{100 * mc[c]['relative_difference']:+.1f} %")
+            for c in ("tangential", "radial", "feed")]))
+
+    emit(result, as_json, render)
+
+
+def register_boring(groups: dict[str, typer.Typer]) -> None:
+    """Add ``robobore fe boring`` to the "fe" group."""
+    groups["fe"].command("boring")(boring_cmd)

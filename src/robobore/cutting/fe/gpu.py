@@ -1,0 +1,287 @@
+"""GPU backend of the 3D explicit engine (numba-cuda), built from the SAME scalar physics.
+
+The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
+(:func:`hex8.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
+and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
+:mod:`robobore.cutting.fe.physics`), re-bound to device versions with
+:func:`robobore.material.johnson_cook.rebind` and compiled with
+``numba.cuda.jit(device=True)``. One time step is four kernel launches: nodes (contact
+forces summed with atomics), the tool (one thread), elements (stable step by atomic min),
+and the step end (one thread: time, status, time-averaged histories). The loop stays on the
+device; the host only checks the status between chunks.
+
+Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``, i.e.
+``numba-cuda``). Importing this module never needs either; :func:`require_gpu` raises a
+clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
+the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine.
+
+Limits: per-sample energy histories are not recorded on the GPU (the final energy totals
+are computed on the host from the copied-back state); the 2D engine has no GPU port yet.
+"""
+
+from __future__ import annotations
+
+import functools
+import math  # noqa: F401  (math.isfinite inside the kernels)
+import os
+from collections.abc import Callable
+
+import numpy as np
+
+from robobore.errors import ConfigError, NumericalError
+
+__all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled"]
+
+_THREADS = 128
+# reduction slots on the device
+R_DTMIN, R_BAD, R_FX, R_FY, R_FZ, R_NC = 0, 1, 2, 3, 4, 5
+N_RED = 6
+
+
+def simulator_enabled() -> bool:
+    """True when numba's CUDA simulator is switched on (NUMBA_ENABLE_CUDASIM=1)."""
+    return os.environ.get("NUMBA_ENABLE_CUDASIM", "0") == "1"
+
+
+def cuda_available() -> bool:
+    """True when a CUDA device (or the simulator) can run the kernels."""
+    try:
+        from numba import cuda
+    except Exception:  # pragma: no cover - numba without a CUDA target
+        return False
+    try:
+        return bool(cuda.is_available())
+    except Exception:  # pragma: no cover
+        return False
+
+
+def require_gpu() -> None:
+    """Raise a clear ConfigError unless a CUDA GPU (or the simulator) is usable."""
+    if not cuda_available():
+        raise ConfigError(
+            "no usable NVIDIA GPU: numba could not find a CUDA device or driver",
+            field="--device", value="gpu",
+            expected="an NVIDIA GPU with its driver and numba-cuda installed "
+                     "(pip install 'robobore[gpu]'), or --device cpu")
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels():
+    """Compile (lazily, once) the device functions and kernels."""
+    from numba import cuda
+
+    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.hex8 import hex_element_py
+    from robobore.cutting.fe.physics import tool_gap_py, tool_support_step_py
+    from robobore.material import johnson_cook as jc
+
+    dev = cuda.jit(device=True)
+    th = dev(jc.homologous_temperature_py)
+    flow = dev(jc.rebind(jc.jc_flow_stress_py, homologous_temperature=th))
+    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
+    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
+    ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
+    elem = dev(jc.rebind(hex_element_py, jc_return=ret, jc_damage_increment=dmg))
+    tg = dev(tool_gap_py)
+    gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg))
+    cf3 = dev(K3.contact_force3_py)
+    node = dev(jc.rebind(K3.hex_node_py, insert_gap3=gap3, contact_force3=cf3))
+    sup = dev(tool_support_step_py)
+    kin = dev(K3.tool_kinematics_py)
+    tstep = dev(jc.rebind(K3.tool_step_py, tool_kinematics=kin, tool_support_step=sup))
+
+    I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K3.I_STATUS, K3.I_STEP, K3.I_SAMPLE, K3.I_BADELEM
+    ST_OK, ST_DONE, ST_INV = K3.STATUS_OK, K3.STATUS_DONE, K3.STATUS_INVERTED
+    ST_NOEL, ST_NONF, ST_DTC = K3.STATUS_NO_ELEMENTS, K3.STATUS_NONFINITE, K3.STATUS_DT_COLLAPSE
+    P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K3.P_CFL, K3.P_DTMIN, K3.P_TEND, K3.P_SAMPLE_DT
+    T_FX, T_FY, T_FZ, T_UX, T_UY, T_UZ = K3.T_FX, K3.T_FY, K3.T_FZ, K3.T_UX, K3.T_UY, K3.T_UZ
+    T_GX, T_THETA, E_EXT = K3.T_GX, K3.T_THETA, K3.E_EXT
+    H_T, H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ = (K3.H_T, K3.H_FX, K3.H_FY, K3.H_FZ, K3.H_UX,
+                                               K3.H_UY, K3.H_UZ)
+    H_NCONT, H_TIPX, H_THETA, H_EEXT = K3.H_NCONT, K3.H_TIPX, K3.H_THETA, K3.H_EEXT
+
+    @cuda.jit
+    def k_nodes(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
+                pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
+        node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
+             pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1])
+        if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
+            cuda.atomic.add(red, R_FX, cf[n, 0])
+            cuda.atomic.add(red, R_FY, cf[n, 1])
+            cuda.atomic.add(red, R_FZ, cf[n, 2])
+            cuda.atomic.add(red, R_NC, 1.0)
+
+    @cuda.jit
+    def k_tool(tool, prm, en, clock, ist, red):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        en[E_EXT] += tstep(tool, prm, red[R_FX], red[R_FY], red[R_FZ], clock[1])
+        red[R_DTMIN] = 1e30
+        red[R_BAD] = -1.0
+
+    @cuda.jit
+    def k_elems(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dm, qh, vol0,
+                ie, hge, fe, dte, plast, rate, mat, prm, clock, erosion, ist, red):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        elem(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dm, qh, vol0,
+             ie, hge, fe, dte, plast, rate, mat, prm, clock[1], erosion)
+        cuda.atomic.min(red, R_DTMIN, dte[e])
+        if alive[e] == -2:
+            red[R_BAD] = e
+
+    @cuda.jit
+    def k_finish(tool, prm, clock, ist, hacc, hist, en, red):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        dt = clock[1]
+        t = clock[0] + dt
+        clock[0] = t
+        ist[I_STEP] += 1
+        fwx = red[R_FX]
+        fwy = red[R_FY]
+        fwz = red[R_FZ]
+        nc = red[R_NC]
+        red[R_FX] = 0.0
+        red[R_FY] = 0.0
+        red[R_FZ] = 0.0
+        red[R_NC] = 0.0
+        if red[R_BAD] >= 0.0:
+            ist[I_BADELEM] = int(red[R_BAD])
+            ist[I_STATUS] = ST_INV
+            return
+        if red[R_DTMIN] >= 1e30:
+            ist[I_STATUS] = ST_NOEL
+            return
+        new_dt = prm[P_CFL] * red[R_DTMIN]
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(fwz)
+                and math.isfinite(new_dt)):
+            ist[I_STATUS] = ST_NONF
+            return
+        clock[1] = new_dt
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = ST_DTC
+            return
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_FZ] += dt * tool[T_FZ]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_UZ] += dt * tool[T_UZ]
+        hacc[H_NCONT] += dt * nc
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            hist[k, H_T] = t
+            hist[k, H_FX] = hacc[H_FX] / ta
+            hist[k, H_FY] = hacc[H_FY] / ta
+            hist[k, H_FZ] = hacc[H_FZ] / ta
+            hist[k, H_UX] = hacc[H_UX] / ta
+            hist[k, H_UY] = hacc[H_UY] / ta
+            hist[k, H_UZ] = hacc[H_UZ] / ta
+            hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            hist[k, H_TIPX] = tool[T_GX]
+            hist[k, H_THETA] = tool[T_THETA]
+            hist[k, H_EEXT] = en[E_EXT]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = ST_DONE
+
+    return k_nodes, k_tool, k_elems, k_finish
+
+
+#: arrays of FEState3 that the kernels change (copied back to the host)
+_MUTABLE = ("x", "y", "z", "vx", "vy", "vz", "alive", "sd", "pres", "eps_p", "temp", "dmg",
+            "qh", "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
+            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist")
+
+
+def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
+                 progress: Callable[[float], None] | None = None,
+                 check: Callable[[object], None] | None = None) -> int:
+    """GPU counterpart of :func:`robobore.cutting.fe.solver3d.advance3` (same contract).
+
+    Copies the state to the device, runs chunks of ``chunk_steps`` steps, copies the state
+    back after each chunk (for ``check``/``progress``) and at the end, and computes the
+    energy totals on the host. Raises NumericalError on instability, ConfigError when no
+    GPU is usable.
+    """
+    from numba import cuda
+
+    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.solver import _STATUS_TEXT
+
+    require_gpu()
+    k_nodes, k_tool, k_elems, k_finish = _kernels()
+    st.prm[K3.P_TEND] = t_end
+    st.ist[K3.I_STATUS] = K3.STATUS_OK
+    d = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name)))
+         for name in ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel",
+                      "ncorner", "conn", "alive", "layer", "sd", "pres", "eps_p", "temp",
+                      "dmg", "qh", "vol0", "ie", "hge", "fe", "dte", "plast", "rate", "cf",
+                      "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en",
+                      "ist", "clock", "hacc", "hist")}
+    red = np.zeros(N_RED)
+    red[R_DTMIN] = 1e30
+    red[R_BAD] = -1.0
+    dred = cuda.to_device(red)
+    nn = st.x.shape[0]
+    ne = st.conn.shape[0]
+    gn = (nn + _THREADS - 1) // _THREADS
+    ge = (ne + _THREADS - 1) // _THREADS
+    erosion = int(st.prm[K3.P_EROSION])
+    t_start = st.time
+    step0 = int(st.ist[K3.I_STEP])
+    g = d
+    while True:
+        for _ in range(chunk_steps):
+            k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
+                                  g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
+                                  g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
+                                  g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
+                                  g["ist"], dred)
+            k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+            k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
+                                  g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],
+                                  g["temp"], g["dmg"], g["qh"], g["vol0"], g["ie"], g["hge"],
+                                  g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
+                                  g["clock"], erosion, g["ist"], dred)
+            k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
+                           g["en"], dred)
+        for name in ("ist", "clock"):
+            getattr(st, name)[...] = g[name].copy_to_host()
+        status = int(st.ist[K3.I_STATUS])
+        if status in _STATUS_TEXT or status == K3.STATUS_DONE or check is not None:
+            _copy_back(st, g)
+        if status in _STATUS_TEXT:
+            raise NumericalError(
+                f"3D simulation (GPU) unstable at step {int(st.ist[K3.I_STEP])}, time "
+                f"{st.time:.6g} s: {_STATUS_TEXT[status]}; try a smaller solver.cfl, a "
+                "larger mesh.element_size_um or less mass scaling")
+        if progress is not None:
+            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
+        if check is not None:
+            check(st)
+        if status == K3.STATUS_DONE or st.time >= t_end:
+            _copy_back(st, g)
+            return int(st.ist[K3.I_STEP]) - step0
+
+
+def _copy_back(st, g) -> None:
+    from robobore.cutting.fe import kernels3d as K3
+
+    for name in _MUTABLE:
+        getattr(st, name)[...] = g[name].copy_to_host()
+    ext = float(st.en[K3.E_EXT])
+    K3.sum_energies3(st.mass, st.vx, st.vy, st.vz, st.ie, st.plast, st.hge, st.alive, st.fric,
+                     st.pen, st.ero_ke, st.nwork, st.en)
+    st.en[K3.E_EXT] = ext
