@@ -65,10 +65,18 @@ def require_gpu() -> None:
                      "(pip install 'robobore[gpu]'), or --device cpu")
 
 
+#: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
+#: substitute its own inside the kernels)
+cuda = None
+
+
 @functools.lru_cache(maxsize=1)
 def _kernels():
     """Compile (lazily, once) the device functions and kernels."""
-    from numba import cuda
+    global cuda
+    from numba import cuda as _cuda
+
+    cuda = _cuda
 
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.hex8 import hex_element_py
@@ -215,8 +223,6 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     energy totals on the host. Raises NumericalError on instability, ConfigError when no
     GPU is usable.
     """
-    from numba import cuda
-
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.solver import _STATUS_TEXT
 

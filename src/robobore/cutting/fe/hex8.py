@@ -65,7 +65,10 @@ P_RN, P_KAPPA, P_KEND, P_RAKE, P_CLR, P_RE, P_TANI, P_TOOL = 12, 13, 14, 15, 16,
 P_VC, P_VF, P_RADIUS, P_SUPPORT = 20, 21, 22, 23
 P_KX, P_KY, P_KZ, P_CX, P_CY, P_CZ, P_MX, P_MY, P_MZ = 24, 25, 26, 27, 28, 29, 30, 31, 32
 P_THETA0, P_SAMPLE_DT, P_TEND, P_EROSION = 33, 34, 35, 36
-N_PRM = 37
+# 1: parallel element/node loops (prange), 0: serial (better for small meshes or a loaded
+# machine, where every parallel region's barrier waits for a descheduled thread)
+P_PARALLEL = 37
+N_PRM = 38
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 
 

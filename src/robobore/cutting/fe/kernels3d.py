@@ -57,6 +57,7 @@ from robobore.cutting.fe.hex8 import (
     P_MX,
     P_MY,
     P_MZ,
+    P_PARALLEL,
     P_PEN,
     P_RADIUS,
     P_RAKE,
@@ -103,7 +104,8 @@ __all__ = [
     "P_DTMIN", "P_MU", "P_TAU", "P_PEN", "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR",
     "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF", "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY",
     "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY", "P_MZ", "P_THETA0", "P_SAMPLE_DT",
-    "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN", "N_IST", "STATUS_OK",
+    "P_TEND", "P_EROSION", "P_PARALLEL", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN",
+    "N_IST", "STATUS_OK",
     "insert_gap3_py", "insert_gap3", "contact_force3_py", "contact_force3", "hex_node_py",
     "hex_node", "element_update3", "node_update3", "run_chunk3",
 ]
@@ -315,6 +317,24 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
 
 
 @njit(cache=True)
+def element_update3_serial(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg,
+                           qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
+    """:func:`hex8.hex_element_py` over all elements (one thread)."""
+    for e in range(conn.shape[0]):
+        hex_element(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
+                    vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+
+
+@njit(cache=True)
+def node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
+                        cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt):
+    """:func:`hex_node_py` over all nodes (one thread)."""
+    for n in range(x.shape[0]):
+        hex_node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
+                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+
+
+@njit(cache=True)
 def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
     """Totals of the energy accumulators into ``en`` (2D engine's indices) [J]."""
     ke = 0.0
@@ -420,6 +440,7 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
     STATUS_DONE at ``prm[P_TEND]``, or an instability status. Returns the steps taken.
     """
     erosion = int(prm[P_EROSION])
+    par = prm[P_PARALLEL] > 0.5
     nn = x.shape[0]
     ne = conn.shape[0]
     taken = 0
@@ -427,8 +448,13 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
         dt = clock[1]
         t = clock[0]
         cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
-        node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
-                     fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+        if par:
+            node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
+                         cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+        else:
+            node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
+                                fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx,
+                                tvy, tvz, dt)
         fwx = 0.0
         fwy = 0.0
         fwz = 0.0
@@ -440,8 +466,13 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
                 fwz += cf[n, 2]
                 ncont += 1
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, fwz, dt)
-        element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
-                        vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+        if par:
+            element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg,
+                            qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+        else:
+            element_update3_serial(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p,
+                                   temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm,
+                                   dt, erosion)
         dtmin = 1e30
         for e in range(ne):
             if dte[e] < dtmin:
