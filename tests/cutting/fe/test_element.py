@@ -66,8 +66,8 @@ def test_simple_shear_follows_flow_curve():
                                                                  strict=True)])
     np.testing.assert_allclose(q[plastic], flow[plastic], rtol=1e-6)
     # total equivalent strain gamma/sqrt(3) = eps_p + elastic part q/(3G) (small-strain split)
-    np.testing.assert_allclose(ep[plastic] + q[plastic] / (3 * TC4.G), gamma[plastic] / math.sqrt(3),
-                               rtol=0.02)
+    np.testing.assert_allclose(ep[plastic] + q[plastic] / (3 * TC4.G),
+                               gamma[plastic] / math.sqrt(3), rtol=0.02)
     # equivalent plastic rate = g / sqrt(3)
     assert np.median(rate[plastic]) == pytest.approx(g / math.sqrt(3), rel=0.01)
     # Taylor-Quinney heating: dT = 0.9 * plastic work / (rho cp)
