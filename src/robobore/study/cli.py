@@ -189,3 +189,111 @@ def register(groups: dict[str, typer.Typer]) -> None:
     root = groups["root"]
     root.command("sweep")(handle_errors(sweep_cmd))
     root.command("compare")(handle_errors(compare_cmd))
+    register_main(groups)
+
+
+# --- robobore paper / robobore calibrate forces (issue 6 main job) ------------------------
+
+
+def _render_paper(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    stdout.print(kv_table("robobore paper" + (" (SYNTHETIC example data)"
+                                              if res.get("synthetic_inputs") else ""), [
+        ("report", res["report"]),
+        ("conditions", res["conditions"]),
+        ("computed", res["computed"]),
+        ("stable", res["stable"]),
+        ("vibratory", res["vibratory"]),
+        ("failed", len(res["failed"])),
+        ("force coefficients", res.get("coefficients_mode")),
+        ("wall time, s", res["wall_time_s"]),
+    ]))
+    cmp = res.get("comparison")
+    if cmp:
+        t = Table(title="relative error vs measured (SYNTHETIC)", header_style="bold")
+        for c in ("group", "conditions", "min", "max", "mean"):
+            t.add_column(c, justify="right")
+        for name, s in cmp["groups"].items():
+            t.add_row(name, str(s.get("n_conditions")), _pct(s.get("min_rel_error")),
+                      _pct(s.get("max_rel_error")), _pct(s.get("mean_rel_error")))
+        stdout.print(t)
+    t = Table(title="the paper's findings, checked on our results", header_style="bold")
+    for c in ("paper's finding", "our result", "agrees"):
+        t.add_column(c)
+    for c in res["qualitative_checks"]:
+        t.add_row(c["finding"], c["ours"], {True: "yes", False: "[red]NO[/]", None: "n/a"}[
+            c["agrees"]])
+    stdout.print(t)
+
+
+def paper_cmd(
+    config: Path | None = typer.Argument(
+        None, help="Paper study config TOML (default: the bundled SYNTHETIC example)."),
+    out: Path = typer.Option(Path("paper-results"), "--out", help="Output folder."),
+    fast: bool = typer.Option(False, "--fast", help="Use the stored FE-calibrated "
+                              "coefficients instead of running the FE calibration."),
+    workers: int = typer.Option(2, "--workers", min=0, help="Dask worker processes for the "
+                                "sweep and FE processes (0 = serial, no Dask)."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """The paper's whole study: identify, model, calibrate, sweep, compare, report."""
+    from robobore.study.paper import run_paper
+
+    res = run_paper(config, out, fast=fast, workers=workers,
+                    progress=sys.stderr.isatty() and not as_json)
+    emit(res, as_json, _render_paper)
+
+
+def _render_calibration(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    from robobore.cutting.calibrate import predicted_forces
+
+    t = Table(title=f"virtual orthogonal tests ({res['material']}, FE 2D)", header_style="bold")
+    for c in ("h [um]", "vc [m/min]", "Fc FE [N/mm]", "Fc fit", "err", "Ff FE [N/mm]",
+              "Ff fit", "err"):
+        t.add_column(c, justify="right")
+    for p in predicted_forces(res):
+        t.add_row(fmt(p["h_um"]), fmt(p["vc_m_per_min"]), fmt(p["Fc_fe"] * 1e-3),
+                  fmt(p["Fc_fit"] * 1e-3), _pct(p["Fc_rel_error"]), fmt(p["Ff_fe"] * 1e-3),
+                  fmt(p["Ff_fit"] * 1e-3), _pct(p["Ff_rel_error"]))
+    stdout.print(t)
+    c, se = res["coefficients"], res["standard_errors"]
+    stdout.print(kv_table("fitted coefficients (± standard error)", [
+        (k, f"{fmt(c[k])} ± {fmt(se.get(k))}" if se.get(k) is not None else fmt(c[k]))
+        for k in ("Ktc_N_per_m2", "Kte_N_per_m", "Kfc_N_per_m2", "Kfe_N_per_m",
+                  "Krc_N_per_m2", "Kre_N_per_m")] + [
+        ("FE points from cache", res.get("fe_cached_points")),
+        ("file", res.get("file", "(not written; use --out)")),
+        ("wall time, s", res.get("wall_time_s"))]))
+    for w in res.get("warnings", []):
+        stdout.print(f"[yellow]warning:[/] {w}")
+
+
+def calibrate_forces_cmd(
+    config: Path | None = typer.Argument(
+        None, help="TOML with a [calibration] table (+ [insert], [material]); default: the "
+        "bundled paper example."),
+    out: Path | None = typer.Option(None, "--out", help="Write the coefficients file (JSON)."),
+    workers: int = typer.Option(2, "--workers", min=1, help="FE runs in parallel (processes)."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """FE-calibrated mechanistic coefficients: 2D FE over h x vc, least-squares fit."""
+    from robobore.clitools import progress_bar
+    from robobore.cutting.calibrate import calibrate_forces, load_calibration_config
+    from robobore.study.paper import example_config_path
+
+    path = config if config is not None else example_config_path()
+    cfg = load_calibration_config(path)
+    n = len(cfg.uncut_chip_thickness_um) * len(cfg.cutting_speed_m_per_min)
+    with progress_bar("FE virtual cutting tests", total=n,
+                      enabled=sys.stderr.isatty() and not as_json) as advance:
+        res = calibrate_forces(cfg, out=out, workers=workers, progress=advance)
+    res["config"] = str(path)
+    emit(res, as_json, _render_calibration)
+
+
+def register_main(groups: dict[str, typer.Typer]) -> None:
+    groups["root"].command("paper")(handle_errors(paper_cmd))
+    groups["calibrate"].command("forces")(handle_errors(calibrate_forces_cmd))

@@ -50,6 +50,7 @@ Runner = Callable[[dict[str, Any], dict[str, Any]], Any]
 #: the process-dynamics stage provides it.
 RUNNERS: dict[str, str] = {
     "demo": "robobore.study.demo:demo_runner",
+    "boring": "robobore.study.runners:boring_runner",
 }
 
 

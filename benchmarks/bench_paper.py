@@ -1,0 +1,73 @@
+"""Wall time of the main job: ``robobore paper --fast`` and ``robobore paper`` (cold cache).
+
+Issue 6 acceptance: from a fresh install the README's first command finishes the report in
+under 10 minutes on 2 cores with a cold cache, and under 2 minutes with ``--fast``.
+
+Usage::
+
+    python benchmarks/bench_paper.py [--mode fast|cold|both] [--workers 2] [--keep DIR]
+
+Each mode runs the real command (``python -m robobore paper``) in a subprocess with a fresh
+output folder and (cold) a fresh, empty ``ROBOBORE_CACHE_DIR`` and numba cache is NOT
+cleared (a fresh install compiles the numba kernels on first use: run once in a fresh venv
+for that figure). Prints the wall time, the per-stage timings from ``paper_summary.json``
+and the load average (the machine is shared: timings are noisy).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def run(mode: str, workers: int, keep: Path | None) -> dict:
+    tmp = Path(tempfile.mkdtemp(prefix=f"bench-paper-{mode}-"))
+    out = (keep / mode) if keep else tmp / "out"
+    env = dict(os.environ)
+    env["ROBOBORE_CACHE_DIR"] = str(tmp / "cache")  # cold: empty FE cache
+    cmd = [sys.executable, "-m", "robobore", "paper", "--out", str(out), "--json",
+           "--workers", str(workers)]
+    if mode == "fast":
+        cmd.append("--fast")
+    load0 = os.getloadavg()
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    load1 = os.getloadavg()
+    if p.returncode != 0:
+        print(p.stderr[-3000:], file=sys.stderr)
+        raise SystemExit(f"robobore paper ({mode}) failed with exit code {p.returncode}")
+    res = json.loads(p.stdout)
+    return {"mode": mode, "wall_s": wall, "conditions": res["conditions"],
+            "computed": res["computed"], "stable": res["stable"],
+            "vibratory": res["vibratory"], "timings_s": res.get("timings_s"),
+            "load_before": load0, "load_after": load1}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mode", choices=("fast", "cold", "both"), default="both")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--keep", type=Path, default=None, help="keep outputs under this folder")
+    a = ap.parse_args()
+    modes = ("fast", "cold") if a.mode == "both" else (a.mode,)
+    print(f"# robobore paper wall time, {os.cpu_count()} CPUs, workers {a.workers}")
+    for m in modes:
+        r = run(m, a.workers, a.keep)
+        per_min = 60.0 * r["computed"] / r["wall_s"]
+        print(f"{m:>5}: {r['wall_s']:7.1f} s wall, {r['computed']}/{r['conditions']} conditions "
+              f"({per_min:.1f} conditions/min end to end), stable {r['stable']}, "
+              f"vibratory {r['vibratory']}, load {r['load_before'][0]:.1f} -> "
+              f"{r['load_after'][0]:.1f}")
+        print("       stages: " + ", ".join(f"{k} {v:.1f} s"
+                                            for k, v in (r["timings_s"] or {}).items()))
+
+
+if __name__ == "__main__":
+    main()

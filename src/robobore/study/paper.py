@@ -1,0 +1,725 @@
+"""``robobore paper``: the paper's whole study in one command (the project's main job).
+
+Pipeline (:func:`run_paper`), on the bundled SYNTHETIC example data by default
+(``robobore/data/paper_example/paper.toml``):
+
+1. joint stiffness from the laser-tracker campaign (``robot.identify``) and the directional
+   stiffness at the paper's posture in the boring frame (X horizontal, Y vertical, Z feed);
+2. the five best-supported modes of the hammer test (``modal.identify``);
+3. the equivalent model (``equivalent``: k from 1, f_n and zeta from 2, m = k / w_n^2, modes
+   assigned to X, Y, Z by their direction) without and with the pressure foot;
+4. the force model: FE-calibrated coefficients (``cutting.calibrate``; ``fast``: the stored
+   file of the example, made by the same command);
+5. the sweep of the paper's kind of conditions (one factor at a time around the paper's
+   Fig. 7 condition) for the robot at P = 0 and 0.3 MPa and for a stiff machine tool, on Dask
+   with a resumable results store under ``OUT/sweep``;
+6. stability lobes (robot without and with the foot) at the base feed;
+7. comparison with the (SYNTHETIC) measured CSV and the paper's qualitative checks;
+8. the report (``paper_report``), ``results.nc`` and ``paper_summary.json`` in OUT.
+
+The config file (TOML) is documented in ``docs/paper.md`` and in the bundled example.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from robobore.dynamics.config import BoreCfg, InsertCfg, PressureFootCfg
+from robobore.errors import ConfigError
+
+RUNNER = "boring"
+PAPER_DAMPING_N_S_PER_M = 23.7  # the paper's equivalent damping coefficient
+
+
+def example_dir() -> Path:
+    """Folder of the bundled example (config, coefficients, SYNTHETIC measured CSV)."""
+    return Path(str(resources.files("robobore") / "data" / "paper_example"))
+
+
+def example_config_path() -> Path:
+    return example_dir() / "paper.toml"
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class XYZ(_Strict):
+    x: float = Field(gt=0)
+    y: float = Field(gt=0)
+    z: float = Field(gt=0)
+
+
+class StudySection(_Strict):
+    name: str = "paper"
+    title: str = "Robotic boring of TC4: the paper's study"
+    revolutions: int = Field(60, ge=10, le=5000)
+    ra_tolerance_um: float = Field(1.6, gt=0)
+    samples_per_rev_stored: int = Field(120, ge=8, le=100000)
+    speed_rpm: list[float] = Field(default_factory=lambda: [200.0, 300.0, 400.0, 500.0, 600.0,
+                                                             800.0, 1000.0])
+    feed_mm_per_rev: list[float] = Field(default_factory=lambda: [0.1, 0.125, 0.15, 0.2, 0.3,
+                                                                   0.4, 0.5])
+    depth_of_cut_mm: list[float] = Field(default_factory=lambda: [0.05, 0.1, 0.15, 0.2, 0.25,
+                                                                   0.3])
+    pressure_MPa: list[float] = Field(default_factory=lambda: [0.0, 0.3])
+    base: dict[str, float] = Field(default_factory=lambda: {
+        "speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.05})
+    design: Literal["ofat", "grid"] = "ofat"
+    machine_tool: bool = True
+
+
+class RobotSection(_Strict):
+    name: str = "irb6600-175-2.55"
+    campaign: str | None = None  # None: bundled SYNTHETIC campaign
+    posture_deg: list[float] = Field(
+        default_factory=lambda: [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95])
+    tcp_m: list[float] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+class ModalSection(_Strict):
+    file: str | None = None  # None: bundled SYNTHETIC hammer test
+    band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0])
+    n_modes: int = Field(5, ge=3, le=50)
+    max_order: int = Field(40, ge=4, le=200)
+
+
+class MachineToolSection(_Strict):
+    note: str = ""
+    stiffness_N_per_m: XYZ
+    frequency_Hz: XYZ
+    damping_ratio: XYZ
+
+
+class LobesSection(_Strict):
+    speed_min_rpm: float = Field(150.0, gt=0)
+    speed_max_rpm: float = Field(1100.0, gt=0)
+    count: int = Field(200, ge=10, le=5000)
+    method: Literal["frequency", "semidiscretization"] = "frequency"
+
+
+class MaterialSection(_Strict):
+    name: str = "TC4"
+
+
+class CoefficientsSection(_Strict):
+    file: str  # stored FE-calibrated coefficients (used by --fast)
+
+
+class MeasuredSection(_Strict):
+    file: str | None = None
+    truth_note: str = ""
+
+
+class PaperConfig(_Strict):
+    study: StudySection = StudySection()
+    robot: RobotSection = RobotSection()
+    modal: ModalSection = ModalSection()
+    insert: InsertCfg = InsertCfg()
+    bore: BoreCfg
+    material: MaterialSection = MaterialSection()
+    pressure_foot: PressureFootCfg = PressureFootCfg()
+    machine_tool: MachineToolSection
+    calibration: dict[str, Any]
+    coefficients: CoefficientsSection
+    measured: MeasuredSection = MeasuredSection()
+    lobes: LobesSection = LobesSection()
+
+
+def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict[str, Any], Path]:
+    """Read and validate a paper config; returns the model, the raw dict and its path."""
+    from robobore.io.config import load_toml, validate_model
+
+    p = Path(path) if path is not None else example_config_path()
+    raw = load_toml(p)
+    cfg = validate_model(PaperConfig, raw, source=p)
+    for name in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm"):
+        lv = getattr(cfg.study, name)
+        if not lv or any(not (math.isfinite(v) and v > 0) for v in lv):
+            raise ConfigError("levels must be positive numbers", file=str(p),
+                              field=f"study.{name}", value=lv,
+                              expected="a non-empty list of positive values")
+        if name not in cfg.study.base:
+            raise ConfigError("missing base value", file=str(p), field=f"study.base.{name}",
+                              expected="the base condition of the one-factor-at-a-time design")
+    if any(v < 0 for v in cfg.study.pressure_MPa) or not cfg.study.pressure_MPa:
+        raise ConfigError("bad foot pressures", file=str(p), field="study.pressure_MPa",
+                          value=cfg.study.pressure_MPa, expected="a list of values >= 0 MPa")
+    if cfg.lobes.speed_max_rpm <= cfg.lobes.speed_min_rpm:
+        raise ConfigError("lobe speed range empty", file=str(p), field="lobes.speed_max_rpm",
+                          value=cfg.lobes.speed_max_rpm,
+                          expected=f"> speed_min_rpm = {cfg.lobes.speed_min_rpm} r/min")
+    return cfg, raw, p
+
+
+def _resolve(base: Path, name: str | None) -> Path | None:
+    if name is None:
+        return None
+    q = Path(name)
+    return q if q.is_absolute() else base.parent / q
+
+
+# ----------------------------------------------------------------------------- stages
+def identify_stiffness(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
+    """Joint stiffness from the campaign + directional stiffness at the configured posture."""
+    from robobore.robot.campaign_io import read_campaign
+    from robobore.robot.identify import identify_joint_stiffness
+    from robobore.robot.kinematics import get_robot
+    from robobore.robot.stiffness import directional_stiffness_xyz
+
+    robot = get_robot(cfg.robot.name)
+    camp_path = _resolve(cfg_path, cfg.robot.campaign)
+    synthetic = camp_path is None
+    if camp_path is None:
+        camp_path = Path(str(resources.files("robobore") / "data" / "campaign_irb6600"
+                             / "campaign.csv"))
+    camp = read_campaign(camp_path, robot=robot)
+    res = identify_joint_stiffness(camp, robot)
+    d = res.to_dict()
+    if len(cfg.robot.posture_deg) != len(d["joint_stiffness_Nm_per_rad"]):
+        raise ConfigError("posture needs one angle per joint", field="robot.posture_deg",
+                          value=cfg.robot.posture_deg,
+                          expected=f"{len(d['joint_stiffness_Nm_per_rad'])} angles in deg")
+    k = np.asarray([math.inf if v is None else v for v in d["joint_stiffness_Nm_per_rad"]])
+    q = np.radians(cfg.robot.posture_deg)
+    ku = directional_stiffness_xyz(robot, q, k, frame="boring", tcp_m=cfg.robot.tcp_m)
+    d.pop("residuals", None)
+    return {"identification": d, "directional_stiffness_N_per_m": ku,
+            "posture_deg": list(cfg.robot.posture_deg), "tcp_m": list(cfg.robot.tcp_m),
+            "campaign": str(camp_path), "synthetic": synthetic, "robot": cfg.robot.name}
+
+
+def identify_modes(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
+    """The ``n_modes`` best-supported modes of the hammer test (modal JSON contract)."""
+    from robobore.modal.example import example_path
+    from robobore.modal.frf import FRFData, estimate_frf
+    from robobore.modal.identify import identify_modes as _identify
+    from robobore.modal.io import load_input
+
+    path = _resolve(cfg_path, cfg.modal.file)
+    synthetic = path is None
+    path = example_path() if path is None else path
+    data = load_input(path, None)
+    if not isinstance(data, FRFData):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            data = estimate_frf(data).frf
+    band = tuple(cfg.modal.band_Hz)
+    an = _identify(data, band_Hz=(float(band[0]), float(band[1])), n_modes=cfg.modal.n_modes,
+                   max_order=cfg.modal.max_order)
+    d = an.result.to_dict()
+    keep = ("frequency_Hz", "damping_ratio", "mpc", "direction", "modal_mass_kg",
+            "modal_stiffness_N_per_m", "cluster_size", "shape")
+    modes = [{k: m[k] for k in keep if k in m} for m in d["modes"]]
+    return {"modes": modes, "source": str(path), "synthetic": synthetic,
+            "fit_percent": d.get("fit_percent")}
+
+
+def build_equivalent(stiffness: dict[str, Any], modes: dict[str, Any],
+                     foot: PressureFootCfg) -> dict[str, Any]:
+    """Equivalent models without / with the foot, and what the paper's c would imply."""
+    from robobore.equivalent import EquivalentModel
+
+    st = {"directional_stiffness_N_per_m": stiffness["directional_stiffness_N_per_m"]}
+    md = {"modes": [{k: v for k, v in m.items() if k in ("frequency_Hz", "damping_ratio",
+                                                           "direction", "mpc")}
+                    for m in modes["modes"]]}
+    bare = EquivalentModel.from_stiffness_and_modes(st, md)
+    with_foot = EquivalentModel.from_stiffness_and_modes(st, md, foot=foot.to_foot())
+    paper_c = EquivalentModel.from_stiffness_and_modes(
+        st, md, damping_N_s_per_m=PAPER_DAMPING_N_S_PER_M)
+    return {"without_foot": bare, "with_foot": with_foot, "paper_c": paper_c,
+            "pressure_MPa": foot.pressure_MPa}
+
+
+def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fast: bool,
+                      workers: int, progress: Any = None) -> dict[str, Any]:
+    """The coefficients file content: stored (``fast``) or freshly FE-calibrated (cached FE)."""
+    from robobore.cutting.calibrate import calibrate_forces, calibration_from_mapping
+
+    if fast:
+        p = _resolve(cfg_path, cfg.coefficients.file)
+        assert p is not None
+        if not p.is_file():
+            raise ConfigError("stored coefficients file not found", file=str(cfg_path),
+                              field="coefficients.file", value=str(p),
+                              expected="a JSON file written by 'robobore calibrate forces'")
+        data = json.loads(p.read_text())
+        data["file"] = str(p)
+        data["mode"] = "stored (--fast)"
+        return data
+    ccfg = calibration_from_mapping(
+        {"calibration": raw.get("calibration", {}), "insert": raw.get("insert", {}),
+         "material": raw.get("material", {})}, source=str(cfg_path))
+    data = calibrate_forces(ccfg, workers=workers, progress=progress)
+    data["mode"] = "FE calibration (cached FE results reused)"
+    return data
+
+
+def dynamics_model(cfg: PaperConfig, eq: Any, coeffs: dict[str, Any],
+                   system: str) -> dict[str, Any]:
+    """The ``[model]`` of the boring runner for the robot (equivalent, no foot; the foot is
+    set per condition) or the machine tool."""
+    dyn: dict[str, Any] = {
+        "insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
+        "coefficients": dict(coeffs["coefficients"]),
+        "simulation": {"revolutions": cfg.study.revolutions,
+                       "ra_tolerance_um": cfg.study.ra_tolerance_um},
+    }
+    if system == "robot":
+        m = eq["without_foot"]
+        dyn["equivalent"] = {
+            "stiffness_N_per_m": dict(m.stiffness_N_per_m),
+            "frequency_Hz": dict(m.frequency_Hz), "damping_ratio": dict(m.damping_ratio),
+            "pressure_foot": cfg.pressure_foot.model_dump(),
+            "note": "identified from the example campaign and hammer test",
+        }
+    else:
+        mt = cfg.machine_tool
+        dirs = {"x": [1.0, 0.0, 0.0], "y": [0.0, 1.0, 0.0], "z": [0.0, 0.0, 1.0]}
+        dyn["structure"] = {"modes": [
+            {"frequency_Hz": getattr(mt.frequency_Hz, a),
+             "damping_ratio": getattr(mt.damping_ratio, a),
+             "stiffness_N_per_m": getattr(mt.stiffness_N_per_m, a), "direction": dirs[a]}
+            for a in "xyz"]}
+    return {"system": system, "dynamics": dyn}
+
+
+def study_conditions(cfg: PaperConfig) -> list[dict[str, Any]]:
+    """Conditions (human units) of the study: OFAT around ``study.base`` or the full grid,
+    per foot pressure (robot). Ordered, without duplicates."""
+    import itertools
+
+    s = cfg.study
+    names = ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm")
+    combos: list[tuple[float, ...]] = []
+    if s.design == "grid":
+        combos = list(itertools.product(*(getattr(s, n) for n in names)))
+    else:
+        for vary in names:
+            for v in getattr(s, vary):
+                c = {n: float(s.base[n]) for n in names}
+                c[vary] = float(v)
+                combos.append(tuple(c[n] for n in names))
+    out, seen = [], set()
+    for p in s.pressure_MPa:
+        for combo in combos:
+            t = (*combo, float(p))
+            if t in seen:
+                continue
+            seen.add(t)
+            out.append({**dict(zip(names, combo, strict=True)), "pressure_MPa": float(p),
+                        "posture": "paper"})
+    return out
+
+
+def build_plan(cfg: PaperConfig, robot_model: dict[str, Any],
+               mt_model: dict[str, Any] | None) -> tuple[Any, list[dict[str, Any]]]:
+    """One sweep plan holding the robot and machine-tool conditions (distinct keys)."""
+    from robobore.study.conditions import Condition, condition_key, condition_seed
+    from robobore.study.sweep import SweepItem, SweepPlan
+
+    posture = {"joints_deg": list(cfg.robot.posture_deg)}
+    opts = {"samples_per_rev_stored": cfg.study.samples_per_rev_stored}
+    items, meta = [], []
+    conds = study_conditions(cfg)
+    runs = [("robot", robot_model, c) for c in conds]
+    if mt_model is not None:
+        runs += [("machine_tool", mt_model, c) for c in conds if c["pressure_MPa"] == 0.0]
+    for system, model, c in runs:
+        cond = Condition.from_dict(c)
+        key = condition_key(cond, RUNNER, model, posture)
+        ctx = {"model": model, "runner_options": opts, "postures": {"paper": posture},
+               "posture": posture, "seed": condition_seed(0, key), "key": key,
+               "sweep": cfg.study.name}
+        items.append(SweepItem(key=key, condition=cond.to_dict(), context=ctx))
+        meta.append({"key": key, "system": system, **cond.to_dict()})
+    plan = SweepPlan(name=cfg.study.name, runner=RUNNER, items=tuple(items),
+                     config={"sweep": {"name": cfg.study.name, "runner": RUNNER},
+                             "model": {"robot": robot_model, "machine_tool": mt_model},
+                             "postures": {"paper": posture}})
+    return plan, meta
+
+
+def compute_lobes(cfg: PaperConfig, robot_model: dict[str, Any]) -> dict[str, Any]:
+    """Stability lobes (robot without / with the foot) at the base feed."""
+    from robobore.dynamics.api import lobes
+
+    out = {}
+    for label, p in (("P = 0", 0.0), (f"P = {cfg.pressure_foot.pressure_MPa:g} MPa",
+                                      cfg.pressure_foot.pressure_MPa)):
+        dyn = json.loads(json.dumps(robot_model["dynamics"]))
+        if p == 0.0:
+            dyn["equivalent"].pop("pressure_foot", None)
+        dyn["cutting"] = {"speed_rpm": float(cfg.study.base["speed_rpm"]),
+                          "feed_mm_per_rev": float(cfg.study.base["feed_mm_per_rev"]),
+                          "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
+        dyn["speed_rpm"] = {"min": cfg.lobes.speed_min_rpm, "max": cfg.lobes.speed_max_rpm,
+                            "count": cfg.lobes.count}
+        d = lobes(dyn, method=cfg.lobes.method)
+        out[label] = {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
+                      for k, v in d.items()}
+    return out
+
+
+# ----------------------------------------------------------------------------- checks
+def _rank_corr(x: list[float], y: list[float]) -> float | None:
+    if len(x) < 3:
+        return None
+    rx = np.argsort(np.argsort(x)).astype(float)
+    ry = np.argsort(np.argsort(y)).astype(float)
+    if rx.std() == 0 or ry.std() == 0:
+        return None
+    return float(np.corrcoef(rx, ry)[0, 1])
+
+
+def series(rows: list[dict[str, Any]], cfg: PaperConfig, vary: str, system: str,
+           pressure: float) -> list[dict[str, Any]]:
+    """Rows of the one-factor series ``vary`` (others at the base), sorted by ``vary``."""
+    base = cfg.study.base
+    others = [n for n in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm") if n != vary]
+    sel = [r for r in rows if r["system"] == system and r["pressure_MPa"] == pressure
+           and all(math.isclose(r[o], base[o]) for o in others) and r.get("summary")]
+    return sorted(sel, key=lambda r: r[vary])
+
+
+def qualitative_checks(rows: list[dict[str, Any]], cfg: PaperConfig) -> list[dict[str, Any]]:
+    """The paper's qualitative findings, checked on our results (computed, never assumed).
+
+    Each check: ``finding`` (the paper's), ``ours`` (what our results show), ``agrees``.
+    """
+    out: list[dict[str, Any]] = []
+    p_foot = cfg.pressure_foot.pressure_MPa
+    paper_onset = {"speed_rpm": 500.0, "feed_mm_per_rev": 0.2, "depth_of_cut_mm": 0.1}
+    names = {"speed_rpm": ("spindle speed", "r/min"), "feed_mm_per_rev": ("feed", "mm/r"),
+             "depth_of_cut_mm": ("depth of cut", "mm")}
+    for vary in ("depth_of_cut_mm", "feed_mm_per_rev"):
+        s = series(rows, cfg, vary, "robot", 0.0)
+        x = [r[vary] for r in s]
+        fa = [r["summary"].get("feed_amplitude_um", math.nan) for r in s]
+        fx = [r["summary"].get("force_amplitude_x_N", math.nan) for r in s]
+        rho_a, rho_f = _rank_corr(x, fa), _rank_corr(x, fx)
+        ok = rho_a is not None and rho_f is not None and rho_a > 0.5 and rho_f > 0.5
+        out.append({
+            "finding": f"vibration grows with {names[vary][0]} (paper, robot without foot)",
+            "ours": (f"rank correlation with {names[vary][0]}: feed amplitude "
+                     f"{_f(rho_a)}, X force amplitude {_f(rho_f)} ({len(s)} levels)"),
+            "agrees": bool(ok) if rho_a is not None else None})
+    for vary in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm"):
+        s = series(rows, cfg, vary, "robot", 0.0)
+        vib = [r[vary] for r in s if r["summary"].get("stable") is False]
+        onset = min(vib) if vib else None
+        name, unit = names[vary]
+        po = paper_onset[vary]
+        levels = [r[vary] for r in s]
+        if onset is None:
+            ours = f"no vibratory level of {name} in {_lv(levels)} {unit}"
+            agrees = False
+        else:
+            above = [r for r in s if r[vary] >= onset]
+            mono = all(r["summary"].get("stable") is False for r in above)
+            ours = (f"first vibratory {name}: {onset:g} {unit}"
+                    + ("" if mono else " (not vibratory at every higher level)"))
+            # agreement: our onset falls between the level below the paper's and the paper's
+            below = [v for v in levels if v < po]
+            lo = max(below) if below else -math.inf
+            agrees = lo < onset <= po * 1.0000001 and mono
+        out.append({"finding": f"vibratory from {name} >= {po:g} {unit} (paper, onset)",
+                    "ours": ours, "agrees": agrees})
+    pairs = []
+    by = {(r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]): r for r in rows
+          if r["system"] == "robot" and r["pressure_MPa"] == 0.0 and r.get("summary")}
+    for r in rows:
+        if r["system"] == "robot" and r["pressure_MPa"] == p_foot and r.get("summary"):
+            b = by.get((r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]))
+            if b is not None:
+                pairs.append((b["summary"], r["summary"]))
+    if pairs:
+        lower = sum(1 for a, b in pairs
+                    if b.get("feed_amplitude_um", 0) < a.get("feed_amplitude_um", 0))
+        lower_f = sum(1 for a, b in pairs
+                      if b.get("force_amplitude_x_N", 0) < a.get("force_amplitude_x_N", 0))
+        ratio = [b["feed_amplitude_um"] / a["feed_amplitude_um"] for a, b in pairs
+                 if a.get("feed_amplitude_um", 0) > 0]
+        med = float(np.median(ratio)) if ratio else None
+        out.append({"finding": f"the pressure foot ({p_foot:g} MPa) reduces the feed "
+                               "(vibration) amplitude",
+                    "ours": (f"feed amplitude lower with the foot in {lower}/{len(pairs)} "
+                             f"conditions (median ratio with/without {_f(med)})"),
+                    "agrees": lower >= 0.8 * len(pairs)})
+        out.append({"finding": f"the pressure foot ({p_foot:g} MPa) reduces the cutting-force "
+                               "amplitude",
+                    "ours": f"X force amplitude lower with the foot in {lower_f}/{len(pairs)} "
+                            "conditions",
+                    "agrees": lower_f >= 0.8 * len(pairs)})
+        vib0 = sum(1 for a, _ in pairs if a.get("stable") is False)
+        vib1 = sum(1 for _, b in pairs if b.get("stable") is False)
+        out.append({"finding": "the pressure foot suppresses vibration (fewer vibratory cuts)",
+                    "ours": f"vibratory: {vib0} without the foot, {vib1} with it "
+                            f"(of {len(pairs)})",
+                    "agrees": vib1 <= vib0})
+    mt = {(r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]): r for r in rows
+          if r["system"] == "machine_tool" and r.get("summary")}
+    if mt:
+        n = lower = 0
+        for k, r in mt.items():
+            b = by.get(k)
+            if b is None:
+                continue
+            n += 1
+            lower += r["summary"]["feed_amplitude_um"] <= b["summary"]["feed_amplitude_um"]
+        vib = sum(1 for r in mt.values() if r["summary"].get("stable") is False)
+        out.append({"finding": "a (stiff) machine tool vibrates less than the robot",
+                    "ours": f"machine tool feed amplitude <= robot's in {lower}/{n} conditions; "
+                            f"machine tool vibratory in {vib}/{len(mt)}",
+                    "agrees": lower >= 0.8 * n if n else None})
+    return out
+
+
+def _f(v: float | None) -> str:
+    return "n/a" if v is None or not math.isfinite(v) else f"{v:.2f}"
+
+
+def _lv(levels: list[float]) -> str:
+    return ", ".join(f"{v:g}" for v in levels)
+
+
+# ----------------------------------------------------------------------------- outputs
+def results_dataset(rows: list[dict[str, Any]]) -> Any:
+    """All conditions and their summaries as one Dataset (dimension ``condition``)."""
+    import xarray as xr
+
+    n = len(rows)
+    def col(f, dtype=float):  # noqa: E306
+        return np.array([f(r) for r in rows], dtype=dtype)
+
+    def sv(name: str) -> np.ndarray:
+        return col(lambda r: (r.get("summary") or {}).get(name, math.nan))
+
+    ds = xr.Dataset({
+        "speed_rpm": ("condition", col(lambda r: r["speed_rpm"])),
+        "feed_mm_per_rev": ("condition", col(lambda r: r["feed_mm_per_rev"])),
+        "depth_of_cut_mm": ("condition", col(lambda r: r["depth_of_cut_mm"])),
+        "pressure_MPa": ("condition", col(lambda r: r["pressure_MPa"])),
+        "system": ("condition", np.array([r["system"] for r in rows], dtype=object)),
+        "key": ("condition", np.array([r["key"] for r in rows], dtype=object)),
+        "force_amplitude_x_N": ("condition", sv("force_amplitude_x_N")),
+        "force_amplitude_y_N": ("condition", sv("force_amplitude_y_N")),
+        "force_amplitude_z_N": ("condition", sv("force_amplitude_z_N")),
+        "feed_amplitude_um": ("condition", sv("feed_amplitude_um")),
+        "stable": ("condition", col(lambda r: {True: 1, False: 0}.get(
+            (r.get("summary") or {}).get("stable"), -1), np.int8)),
+        "done": ("condition", col(lambda r: 1 if r.get("summary") else 0, np.int8)),
+    }, coords={"condition": np.arange(n)})
+    ds["stable"].attrs["meaning"] = "1 stable, 0 vibratory, -1 not computed"
+    for q, u in (("force_amplitude_x_N", "N"), ("feed_amplitude_um", "um")):
+        ds[q].attrs["units"] = u
+    return ds
+
+
+def run_paper(config: str | Path | None = None, out: str | Path = "paper-results", *,
+              fast: bool = False, workers: int | None = None, progress: bool = False,
+              browser_check: bool = False) -> dict[str, Any]:
+    """Run the whole study (see module doc); returns the JSON summary (also written)."""
+    from robobore import __version__
+    from robobore.clitools import progress_bar
+    from robobore.io.results import write_json, write_netcdf
+    from robobore.study.compare import compare, read_measured_csv
+    from robobore.study.paper_report import build_report
+    from robobore.study.store import ResultsStore
+    from robobore.study.sweep import run_sweep
+
+    t0 = time.perf_counter()
+    cfg, raw, cfg_path = load_paper_config(config)
+    outdir = Path(out)
+    outdir.mkdir(parents=True, exist_ok=True)
+    nw = workers if workers is not None else 2
+    timings: dict[str, float] = {}
+
+    def lap(name: str, t: float) -> None:
+        timings[name] = time.perf_counter() - t
+
+    # successive bars (rich allows one live display at a time; the sweep has its own)
+    with progress_bar("identify robot and modes", total=2, enabled=progress) as advance:
+        t = time.perf_counter()
+        stiff = identify_stiffness(cfg, cfg_path)
+        lap("stiffness", t)
+        advance(1)
+        t = time.perf_counter()
+        modes = identify_modes(cfg, cfg_path)
+        lap("modes", t)
+        advance(1)
+    eq = build_equivalent(stiff, modes, cfg.pressure_foot)
+    t = time.perf_counter()
+    n_fe = (len(cfg.calibration.get("uncut_chip_thickness_um", []))
+            * len(cfg.calibration.get("cutting_speed_m_per_min", [])))
+    with progress_bar("FE force calibration", total=n_fe, enabled=progress and not fast
+                      ) as advance:
+        coeffs = load_or_calibrate(cfg, raw, cfg_path, fast, max(nw, 1), progress=advance)
+    lap("force_calibration", t)
+    write_json(outdir / "coefficients.json", {k: v for k, v in coeffs.items()
+                                              if k not in ("file",)})
+    robot_model = dynamics_model(cfg, eq, coeffs, "robot")
+    mt_model = dynamics_model(cfg, eq, coeffs, "machine_tool") if cfg.study.machine_tool \
+        else None
+    plan, meta = build_plan(cfg, robot_model, mt_model)
+    t = time.perf_counter()
+    store = ResultsStore(outdir / "sweep")
+    outcome = run_sweep(plan, store, workers=nw, processes=nw > 0, progress=progress)
+    lap("sweep", t)
+    rows = []
+    for m in meta:
+        r = dict(m)
+        if store.is_done(m["key"]):
+            r["summary"] = store.read_record(m["key"]).summary
+        else:
+            r["summary"] = None
+            f = store.failure(m["key"]) or {}
+            r["error"] = f.get("error", "not computed")
+        rows.append(r)
+    with progress_bar("lobes, comparison, report", total=3, enabled=progress) as advance:
+        t = time.perf_counter()
+        lob = compute_lobes(cfg, robot_model)
+        lap("lobes", t)
+        advance(1)
+        cmp = None
+        mpath = _resolve(cfg_path, cfg.measured.file)
+        if mpath is not None:
+            table = read_measured_csv(mpath)
+            sims = [({k: r[k] for k in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm",
+                                        "pressure_MPa", "posture")}, r["summary"])
+                    for r in rows if r["system"] == "robot" and r["summary"]]
+            cmp = compare(table, sims)
+        checks = qualitative_checks(rows, cfg)
+        advance(1)
+        t = time.perf_counter()
+        ds = results_dataset(rows)
+        write_netcdf(ds, outdir / "results.nc", config=raw)
+        eq_json = {k: (v.to_dict() if hasattr(v, "to_dict") else v) for k, v in eq.items()}
+        write_json(outdir / "equivalent_model.json", eq_json)
+        done = [r for r in rows if r["summary"]]
+        n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
+        n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
+        summary: dict[str, Any] = {
+            "report": str(outdir / "report.html"),
+            "conditions": len(rows), "computed": len(done),
+            "failed": [{"key": r["key"], "system": r["system"],
+                        "condition": {k: r[k] for k in ("speed_rpm", "feed_mm_per_rev",
+                                                        "depth_of_cut_mm", "pressure_MPa")},
+                        "error": r.get("error")} for r in rows if not r["summary"]],
+            "stable": n_stable, "vibratory": n_vib,
+            "fast": fast, "workers": nw, "synthetic_inputs": True,
+            "config": str(cfg_path), "out": str(outdir),
+            "sweep": outcome.to_dict(),
+            "directional_stiffness_N_per_m": stiff["directional_stiffness_N_per_m"],
+            "modes_Hz": [m["frequency_Hz"] for m in modes["modes"]],
+            "equivalent_model": {"without_foot": eq["without_foot"].table(),
+                                 "with_foot": eq["with_foot"].table()},
+            "coefficients": coeffs["coefficients"],
+            "coefficients_mode": coeffs.get("mode"),
+            "comparison": None if cmp is None else {"groups": cmp.groups,
+                                                    "agreement": cmp.agreement},
+            "qualitative_checks": checks,
+            "robobore_version": __version__,
+        }
+        rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
+                           rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,
+                           summary=summary)
+        rep.write(outdir / "report.html")
+        lap("report", t)
+        if browser_check:
+            from robobore.study.browser import check_html_in_browser
+
+            chk = check_html_in_browser(outdir / "report.html")
+            summary["browser_check"] = {"ok": chk.ok}
+        timings["total"] = time.perf_counter() - t0
+        summary["timings_s"] = timings
+        summary["wall_time_s"] = timings["total"]
+        write_json(outdir / "paper_summary.json", summary)
+        advance(1)
+    return summary
+
+
+# ----------------------------------------------------------------------------- example data
+#: Ground truth of the SYNTHETIC measured CSV (see data/paper_example/README.md): the
+#: boring model with the TRUE robot (the campaign's assumed joint stiffness, the hammer
+#: test's true modes) and the MEASURED TC4 coefficients (Ducobu et al. 2022 fit, not the FE
+#: calibration), plus 8 % truncated Gaussian noise on every amplitude (seed 2026).
+MEASURED_NOISE = 0.08
+MEASURED_SEED = 2026
+
+
+def truth_robot_model(cfg: PaperConfig) -> dict[str, Any]:
+    """The 'real' robot of the SYNTHETIC measurements (documented ground truth)."""
+    from robobore.modal.virtual import robot_boring_truth
+    from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
+    from robobore.robot.kinematics import get_robot
+    from robobore.robot.stiffness import directional_stiffness_xyz
+
+    robot = get_robot(cfg.robot.name)
+    k = directional_stiffness_xyz(robot, np.radians(cfg.robot.posture_deg),
+                                  np.asarray(IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD),
+                                  frame="boring", tcp_m=cfg.robot.tcp_m)
+    tr = robot_boring_truth()
+    f = [float(v) for v in tr.frequencies_Hz]
+    z = [float(v) for v in tr.damping_ratios]
+    return {"system": "robot", "dynamics": {
+        "equivalent": {"stiffness_N_per_m": dict(k),
+                       "frequency_Hz": {"x": f[0], "y": f[1], "z": f[2]},
+                       "damping_ratio": {"x": z[0], "y": z[1], "z": z[2]},
+                       "pressure_foot": cfg.pressure_foot.model_dump(),
+                       "note": "SYNTHETIC ground truth"},
+        "insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
+        "coefficients": {"material": "TC4"},
+        "simulation": {"revolutions": cfg.study.revolutions,
+                       "ra_tolerance_um": cfg.study.ra_tolerance_um}}}
+
+
+def make_synthetic_measured(config: str | Path | None, path: str | Path) -> Path:
+    """Write the SYNTHETIC measured CSV of the robot conditions of ``config``.
+
+    Conditions whose ground-truth simulation fails (a :class:`RoboboreError`, e.g. a
+    non-finite integration) cannot be 'measured': they are left out and listed in a
+    ``#`` comment line of the file.
+    """
+    from robobore.errors import RoboboreError
+    from robobore.io.results import atomic_write_text
+    from robobore.study.runners import boring_runner
+    from robobore.study.summary import summarise
+    from robobore.study.synthetic import synthetic_measured_csv
+
+    cfg, _, _ = load_paper_config(config)
+    model = truth_robot_model(cfg)
+    recs, missing = [], []
+    for c in study_conditions(cfg):
+        try:
+            ds = boring_runner(c, {"model": model,
+                                   "runner_options": {"samples_per_rev_stored": 8}})
+        except RoboboreError as exc:
+            missing.append(f"n={c['speed_rpm']:g} f={c['feed_mm_per_rev']:g} "
+                           f"ap={c['depth_of_cut_mm']:g} P={c['pressure_MPa']:g} ({exc})")
+            continue
+        recs.append((c, summarise(ds)))
+    p = synthetic_measured_csv(recs, path, rel_noise=MEASURED_NOISE, seed=MEASURED_SEED)
+    if missing:
+        text = Path(p).read_text()
+        head, _, rest = text.partition("\n")
+        note = ("# not measured (the ground-truth simulation failed): " + "; ".join(missing))
+        atomic_write_text(p, head + "\n" + note + "\n" + rest)
+    return Path(p)
+
+
+__all__ = ["PaperConfig", "load_paper_config", "run_paper", "example_config_path",
+           "example_dir", "identify_stiffness", "identify_modes", "build_equivalent",
+           "dynamics_model", "study_conditions", "build_plan", "qualitative_checks",
+           "make_synthetic_measured", "truth_robot_model", "results_dataset"]

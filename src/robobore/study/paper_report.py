@@ -1,0 +1,458 @@
+"""Figures and the self-contained HTML report of ``robobore paper``.
+
+:func:`build_report` returns a :class:`robobore.study.report.Report` with: inputs (SYNTHETIC
+labels), the stiffness and mode tables, the equivalent model (with / without the foot, and
+what the paper's c = 23.7 N s/m implies), the FE calibration (points, fit, coefficients),
+figures like the paper's (force over half a revolution; feed amplitude over time; force and
+feed amplitude against speed, feed and depth for robot and machine tool with stable /
+vibratory marked; force and rotational acceleration as vibration develops; machined
+surface stable vs vibratory; lobes with the swept conditions), the comparison with the
+measured CSV, and the qualitative checks against the paper (disagreements stated).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robobore.study.report import Report
+
+_SYS_STYLE = {("robot", 0.0): ("robot, no foot", "tab:blue"),
+              ("machine_tool", 0.0): ("machine tool (stiff, assumed)", "tab:green")}
+_FACTORS = (("speed_rpm", "spindle speed n [r/min]"), ("feed_mm_per_rev", "feed f [mm/r]"),
+            ("depth_of_cut_mm", "depth of cut ap [mm]"))
+
+
+def _plt() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _label(system: str, p: float) -> tuple[str, str]:
+    if (system, p) in _SYS_STYLE:
+        return _SYS_STYLE[(system, p)]
+    return f"robot, foot {p:g} MPa", "tab:orange"
+
+
+def _base_key(rows: list[dict[str, Any]], base: dict[str, float], system: str,
+              p: float) -> dict[str, Any] | None:
+    for r in rows:
+        if (r["system"] == system and r["pressure_MPa"] == p and r.get("summary")
+                and all(math.isclose(r[k], base[k]) for k in base)):
+            return r
+    return None
+
+
+def fig_force_half_rev(ds: Any, title: str) -> Any:
+    """Force components over the last half revolution (paper Fig. 7 kind)."""
+    plt = _plt()
+    ns = int(ds.attrs["samples_per_rev"]) // int(ds.attrs.get("stored_time_stride", 1))
+    F = np.asarray(ds["force"].values, float)
+    n = F.shape[0]
+    half = max(2, ns // 2)
+    seg = F[n - half:]
+    ang = np.linspace(0.0, 180.0, seg.shape[0], endpoint=False)
+    fig, ax = plt.subplots(figsize=(6.0, 3.4))
+    for i, (lab, c) in enumerate((("X horizontal", "tab:blue"), ("Y vertical", "tab:orange"),
+                                  ("Z feed", "tab:green"))):
+        ax.plot(ang, seg[:, i], color=c, label=lab)
+    ax.set_xlabel("bar rotation over the last half revolution [deg]")
+    ax.set_ylabel("force on the tool [N]")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def fig_feed_amplitude_time(items: list[tuple[str, Any]]) -> Any:
+    """Feed-direction (Z) displacement over time (paper Fig. 8 kind)."""
+    plt = _plt()
+    fig, axes = plt.subplots(len(items), 1, figsize=(6.4, 1.9 * len(items) + 0.6),
+                             squeeze=False, sharex=False)
+    for ax, (lab, ds) in zip(axes[:, 0], items, strict=True):
+        z = np.asarray(ds["displacement"].values, float)[:, 2] * 1e6
+        t = np.asarray(ds["time"].values, float)
+        ax.plot(t, z, lw=0.6, color="tab:blue")
+        ax.set_ylabel("Z [um]")
+        ax.set_title(lab, fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.tight_layout()
+    return fig
+
+
+def fig_trends(rows: list[dict[str, Any]], base: dict[str, float]) -> Any:
+    """Average force amplitude and feed amplitude vs speed, feed, depth (paper Figs. 9-10)."""
+    plt = _plt()
+    fig, axes = plt.subplots(2, 3, figsize=(13.0, 6.6))
+    groups = sorted({(r["system"], r["pressure_MPa"]) for r in rows})
+    for j, (f, flab) in enumerate(_FACTORS):
+        others = [k for k, _ in _FACTORS if k != f]
+        for i, (q, qlab) in enumerate((("force", "mean XY force amplitude [N]"),
+                                       ("feed_amplitude_um", "feed amplitude [um]"))):
+            ax = axes[i, j]
+            for g in groups:
+                lab, col = _label(*g)
+                sel = sorted([r for r in rows if (r["system"], r["pressure_MPa"]) == g
+                              and r.get("summary")
+                              and all(math.isclose(r[o], base[o]) for o in others)],
+                             key=lambda r: r[f])
+                if not sel:
+                    continue
+                x = [r[f] for r in sel]
+                if q == "force":
+                    y = [0.5 * (r["summary"]["force_amplitude_x_N"]
+                                + r["summary"]["force_amplitude_y_N"]) for r in sel]
+                else:
+                    y = [r["summary"]["feed_amplitude_um"] for r in sel]
+                ax.plot(x, y, "-", color=col, lw=1.2, label=lab)
+                st = [(a, b) for a, b, r in zip(x, y, sel, strict=True)
+                      if r["summary"].get("stable") is not False]
+                vb = [(a, b) for a, b, r in zip(x, y, sel, strict=True)
+                      if r["summary"].get("stable") is False]
+                if st:
+                    ax.scatter(*zip(*st, strict=True), s=12, c="k", zorder=3)
+                if vb:
+                    ax.scatter(*zip(*vb, strict=True), s=40, c="tab:red", marker="D", zorder=3)
+            ax.set_xlabel(flab)
+            ax.set_ylabel(qlab)
+            if q == "feed_amplitude_um":
+                ax.set_yscale("symlog", linthresh=0.01)
+            ax.grid(alpha=0.3)
+    axes[0, 0].scatter([], [], s=12, c="k", label="stable")
+    axes[0, 0].scatter([], [], s=40, c="tab:red", marker="D", label="vibratory")
+    axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def fig_vibration_develops(ds: Any, title: str) -> Any:
+    """Force and rotational acceleration over time for a vibratory cut (paper Fig. 11)."""
+    plt = _plt()
+    t = np.asarray(ds["time"].values, float)
+    F = np.asarray(ds["force"].values, float)
+    fig, axes = plt.subplots(2, 1, figsize=(6.6, 4.6), sharex=True)
+    for i, lab in enumerate(("X", "Y", "Z")):
+        axes[0].plot(t, F[:, i], lw=0.6, label=lab)
+    axes[0].set_ylabel("force [N]")
+    axes[0].legend(fontsize=7, ncol=3)
+    axes[0].set_title(title, fontsize=9)
+    if "rotational_acceleration" in ds:
+        A = np.asarray(ds["rotational_acceleration"].values, float)
+        names = [str(v) for v in ds["rot_axis"].values] if "rot_axis" in ds.coords else \
+            ["radial", "tangential"]
+        for i in range(A.shape[1]):
+            axes[1].plot(t, A[:, i], lw=0.6, label=names[i])
+        axes[1].legend(fontsize=7)
+    axes[1].set_ylabel("rotational acceleration [m/s^2]")
+    axes[1].set_xlabel("time [s]")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def fig_surface(items: list[tuple[str, Any]]) -> Any:
+    """Machined-surface profile along the bore axis, stable vs vibratory (paper Fig. 12)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.6, 3.2))
+    for lab, ds in items:
+        z = np.asarray(ds["surface_z"].values, float) * 1e3
+        r = np.asarray(ds["surface_profile"].values, float) * 1e6
+        ax.plot(z - z[0], r - np.mean(r), lw=0.8,
+                label=f"{lab}: Ra {float(ds['roughness_Ra_um']):.2f} um")
+    ax.set_xlabel("position along the bore axis [mm]")
+    ax.set_ylabel("surface height (mean removed) [um]")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def fig_lobes(lobes: dict[str, Any], rows: list[dict[str, Any]], base: dict[str, float]) -> Any:
+    """Stability lobes (critical depth vs speed) with the swept conditions at the base feed."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.8, 4.0))
+    cols = ["tab:blue", "tab:orange"]
+    ymax = 0.0
+    for (lab, d), c in zip(lobes.items(), cols, strict=False):
+        n = np.asarray(d["speed_rpm"], float)
+        a = np.asarray(d["critical_depth_mm"], float)
+        ax.plot(n, a, color=c, lw=1.2, label=f"lobes, robot {lab} ({d.get('method', '')})")
+        fin = a[np.isfinite(a)]
+        if fin.size:
+            ymax = max(ymax, float(np.percentile(fin, 90)))
+    pts = [r for r in rows if r["system"] == "robot" and r.get("summary")
+           and math.isclose(r["feed_mm_per_rev"], base["feed_mm_per_rev"])]
+    for p, mk in ((0.0, "o"),):
+        sel = [r for r in pts if r["pressure_MPa"] == p]
+        st = [r for r in sel if r["summary"].get("stable") is True]
+        vb = [r for r in sel if r["summary"].get("stable") is False]
+        if st:
+            ax.scatter([r["speed_rpm"] for r in st], [r["depth_of_cut_mm"] for r in st],
+                       c="k", s=16, marker=mk, zorder=3, label="swept, stable (no foot)")
+        if vb:
+            ax.scatter([r["speed_rpm"] for r in vb], [r["depth_of_cut_mm"] for r in vb],
+                       c="tab:red", s=44, marker="D", zorder=3,
+                       label="swept, vibratory (no foot)")
+    dmax = max([r["depth_of_cut_mm"] for r in pts] + [0.0])
+    ax.set_ylim(0, max(ymax, 1.3 * dmax, 1e-3))
+    ax.set_xlabel("spindle speed n [r/min]")
+    ax.set_ylabel("critical depth of cut [mm]")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def _eq_rows(eq: dict[str, Any]) -> list[dict[str, Any]]:
+    out = []
+    for label, key in (("without foot", "without_foot"),
+                       (f"with foot ({eq['pressure_MPa']:g} MPa)", "with_foot"),
+                       ("paper's c = 23.7 N s/m", "paper_c")):
+        for r in eq[key].table():
+            out.append({"model": label, "axis": r["axis"].upper(),
+                        "k [N/um]": r["stiffness_N_per_m"] * 1e-6,
+                        "f_n [Hz]": r["frequency_Hz"], "m [kg]": r["mass_kg"],
+                        "c [N s/m]": r["damping_N_s_per_m"], "zeta": r["damping_ratio"]})
+    return out
+
+
+def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict[str, Any],
+                 eq: dict[str, Any], coeffs: dict[str, Any], rows: list[dict[str, Any]],
+                 store: Any, lobes: dict[str, Any], cmp: Any, checks: list[dict[str, Any]],
+                 summary: dict[str, Any]) -> Report:
+    """The paper report (see module doc)."""
+    plt = _plt()
+    base = {k: float(v) for k, v in cfg.study.base.items()}
+    syn = stiff.get("synthetic") or modes.get("synthetic")
+    rep = Report(cfg.study.title, subtitle=("SYNTHETIC example data: every measurement in "
+                                            "this report is a virtual experiment"
+                                            if syn else f"config {cfg_path}"))
+    rep.add_section("Summary")
+    rep.add_key_values({
+        "config": str(cfg_path),
+        "conditions simulated": f"{summary['computed']} of {summary['conditions']}",
+        "stable / vibratory": f"{summary['stable']} / {summary['vibratory']}",
+        "force coefficients": summary.get("coefficients_mode"),
+        "robobore version": summary.get("robobore_version"),
+    }, caption="Run")
+    if summary["failed"]:
+        rep.add_note(f"{len(summary['failed'])} condition(s) FAILED in the simulation and are "
+                     "missing from the figures and checks (see the table below).")
+        rep.add_table([{"system": f["system"], **f["condition"], "error": (f["error"] or "")[:160]}
+                       for f in summary["failed"]], caption="Failed conditions")
+    dis = [c for c in checks if c["agrees"] is False]
+    if dis:
+        rep.add_note("Our model DISAGREES with the paper on: "
+                     + "; ".join(c["finding"] for c in dis) + " (details in 'Paper's "
+                     "findings').")
+
+    # ---------------------------------------------------------------- robot
+    rep.add_section("Robot stiffness")
+    ide = stiff["identification"]
+    rep.add_text(f"Joint stiffness identified from the laser-tracker campaign {stiff['campaign']}"
+                 + (" (SYNTHETIC)" if stiff["synthetic"] else "") + f" for {stiff['robot']}; "
+                 "directional stiffness at the paper's posture "
+                 f"{', '.join(f'{v:g}' for v in stiff['posture_deg'])} deg in the boring frame "
+                 "(X horizontal, Y vertical, Z feed).")
+    rep.add_table([{"joint": i + 1, "k [N m/rad]": k,
+                    "std": ide["joint_stiffness_std_Nm_per_rad"][i],
+                    "95 % low": ide["joint_stiffness_ci95_low_Nm_per_rad"][i],
+                    "95 % high": ide["joint_stiffness_ci95_high_Nm_per_rad"][i],
+                    "status": ide["joint_status"][i]}
+                   for i, k in enumerate(ide["joint_stiffness_Nm_per_rad"])],
+                  caption="Identified joint stiffness")
+    ku = stiff["directional_stiffness_N_per_m"]
+    rep.add_table([{"direction": a.upper(), "k [N/um]": ku[a] * 1e-6} for a in "xyz"],
+                  caption="Directional stiffness at the boring posture (boring frame)")
+
+    rep.add_section("Modes")
+    rep.add_text(f"The {len(modes['modes'])} best-supported modes of the hammer test "
+                 f"{modes['source']}" + (" (SYNTHETIC)" if modes["synthetic"] else "")
+                 + " (pLSCF + LSFD, automatic selection).")
+    rep.add_table([{"mode": i + 1, "f [Hz]": m["frequency_Hz"], "zeta [%]":
+                    100 * m["damping_ratio"], "MPC": m.get("mpc"),
+                    "direction": m.get("direction")} for i, m in enumerate(modes["modes"])],
+                  caption="Identified modes")
+
+    rep.add_section("Equivalent model")
+    rep.add_text("Paper eq. 1-3: per direction k from the robot stiffness, f_n and zeta from the "
+                 "mode assigned to that direction (by its direction), m = k / w_n^2, "
+                 "c = 2 zeta sqrt(k m). The pressure foot is an ASSUMED contact model "
+                 "(docs/process.md). The last block uses the paper's c = 23.7 N s/m instead of "
+                 "the identified damping.")
+    rep.add_table(_eq_rows(eq), caption="Equivalent model per direction")
+    zp = eq["paper_c"].damping_ratio
+    rep.add_note("With c = 23.7 N s/m the implied damping ratios are "
+                 + ", ".join(f"{a.upper()}: {zp[a]:.2e}" for a in "xyz")
+                 + ", i.e. practically undamped, far below the identified modal damping "
+                 + ", ".join(f"{100 * eq['without_foot'].damping_ratio[a]:.1f} %" for a in "xyz")
+                 + ". The simulations use the identified damping.")
+
+    # ---------------------------------------------------------------- forces
+    rep.add_section("Force model (FE-calibrated)")
+    c = coeffs["coefficients"]
+    rep.add_text(f"Coefficients: {coeffs.get('mode')}. {c.get('provenance', '')}")
+    se = coeffs.get("standard_errors", {})
+    rep.add_table([{"coefficient": k, "value": c[k], "standard error": se.get(k)}
+                   for k in ("Ktc_N_per_m2", "Kte_N_per_m", "Kfc_N_per_m2", "Kfe_N_per_m",
+                             "Krc_N_per_m2", "Kre_N_per_m")],
+                  caption="Mechanistic coefficients used by the boring model")
+    if coeffs.get("fe_points"):
+        from robobore.cutting.calibrate import predicted_forces
+
+        rep.add_table([{"h [um]": p["h_um"], "vc [m/min]": p["vc_m_per_min"],
+                        "Fc FE [N/mm]": p["Fc_fe"] * 1e-3, "Fc fit [N/mm]": p["Fc_fit"] * 1e-3,
+                        "Fc err [%]": 100 * p["Fc_rel_error"],
+                        "Ff FE [N/mm]": p["Ff_fe"] * 1e-3, "Ff fit [N/mm]": p["Ff_fit"] * 1e-3,
+                        "Ff err [%]": 100 * p["Ff_rel_error"]}
+                       for p in predicted_forces(coeffs)],
+                      caption="Virtual orthogonal cutting tests (2D FE) and the fit")
+        for w in coeffs.get("warnings", []):
+            rep.add_note("Calibration warning: " + w + ".")
+        rep.add_note("The 2D FE engine under-predicts the measured TC4 forces (about -20 % "
+                     "cutting, -75 % feed force, see docs/fe.md); the FE-calibrated "
+                     "coefficients inherit that bias.")
+
+    # ---------------------------------------------------------------- figures
+    rep.add_section("Simulated boring: forces and vibration")
+    rb = _base_key(rows, base, "robot", 0.0)
+    if rb is not None:
+        ds = store.load(rb["key"])
+        fig = fig_force_half_rev(ds, f"robot, no foot, n = {base['speed_rpm']:g} r/min, "
+                                     f"f = {base['feed_mm_per_rev']:g} mm/r, "
+                                     f"ap = {base['depth_of_cut_mm']:g} mm")
+        rep.add_figure(fig, "Force components over half a revolution at the base condition "
+                       "(paper Fig. 7 kind): X and Y rotate with the bar, Z (feed) is nearly "
+                       "constant.")
+        plt.close(fig)
+    items = []
+    for g in sorted({(r["system"], r["pressure_MPa"]) for r in rows}):
+        r = _base_key(rows, base, *g)
+        if r is not None:
+            items.append((_label(*g)[0] + " (base condition)", store.load(r["key"])))
+    robot0 = [r for r in rows if r["system"] == "robot" and r["pressure_MPa"] == 0.0
+              and r.get("summary")]
+    vib = [r for r in robot0 if r["summary"].get("stable") is False]
+    worst = max(vib, key=lambda r: r["summary"]["feed_amplitude_um"]) if vib else None
+    if worst is not None:
+        items.append((f"robot, no foot, vibratory: n = {worst['speed_rpm']:g}, "
+                      f"f = {worst['feed_mm_per_rev']:g}, ap = {worst['depth_of_cut_mm']:g}",
+                      store.load(worst["key"])))
+    if items:
+        fig = fig_feed_amplitude_time(items)
+        rep.add_figure(fig, "Feed-direction (Z) displacement of the tool over time (paper Fig. "
+                       "8 kind).")
+        plt.close(fig)
+    fig = fig_trends(rows, base)
+    rep.add_figure(fig, "Average force amplitude (mean of X and Y) and feed amplitude against "
+                   "speed, feed and depth of cut, one factor at a time around the base "
+                   "condition (paper Figs. 9-10 kind); black dots stable, red diamonds "
+                   "vibratory.")
+    plt.close(fig)
+    if worst is not None:
+        ds = store.load(worst["key"])
+        fig = fig_vibration_develops(ds, f"robot, no foot, n = {worst['speed_rpm']:g} r/min, "
+                                         f"f = {worst['feed_mm_per_rev']:g} mm/r, "
+                                         f"ap = {worst['depth_of_cut_mm']:g} mm (vibratory)")
+        rep.add_figure(fig, "Force and rotational acceleration as the vibration develops "
+                       f"(paper Fig. 11 kind). Classification: {ds.attrs.get('reasons', '')}.")
+        plt.close(fig)
+    st = [r for r in robot0 if r["summary"].get("stable") is True]
+    surf = []
+    if rb is not None and rb["summary"].get("stable") is True:
+        surf.append(("stable (base)", store.load(rb["key"])))
+    elif st:
+        surf.append(("stable", store.load(st[0]["key"])))
+    if worst is not None:
+        surf.append(("vibratory", store.load(worst["key"])))
+    if surf:
+        fig = fig_surface(surf)
+        rep.add_figure(fig, "Machined surface along the bore axis, stable vs vibratory "
+                       "(paper Fig. 12 kind).")
+        plt.close(fig)
+    if lobes:
+        fig = fig_lobes(lobes, rows, base)
+        rep.add_figure(fig, "Stability lobe diagram of the robot at the base feed, with the "
+                       "swept conditions (speed and depth series). The lobes are the linear "
+                       "regenerative limit; the time-domain classification also flags "
+                       "roughness above the tolerance and forced resonance, so points can be "
+                       "vibratory below the lobes.")
+        plt.close(fig)
+
+    # ---------------------------------------------------------------- comparison
+    rep.add_section("Comparison with the measurements")
+    if cmp is None:
+        rep.add_text("No measured CSV configured.")
+    else:
+        rep.add_text("Measured: " + str(cfg.measured.file) + (" (SYNTHETIC: " +
+                     cfg.measured.truth_note + ")" if cfg.measured.truth_note else "")
+                     + ". The paper reports 3.22-15.54 % (stable) and 5.61-22.56 % "
+                     "(vibratory) relative errors.")
+        g = []
+        for name, s in cmp.groups.items():
+            g.append({"group": name, "conditions": s.get("n_conditions"), "values": s.get("n"),
+                      "min [%]": None if s.get("min_rel_error") is None
+                      else 100 * s["min_rel_error"],
+                      "max [%]": None if s.get("max_rel_error") is None
+                      else 100 * s["max_rel_error"],
+                      "mean [%]": None if s.get("mean_rel_error") is None
+                      else 100 * s["mean_rel_error"]})
+        rep.add_table(g, caption=f"Relative error per group (groups from the "
+                      f"{cmp.group_source} stable flag)")
+        a = cmp.agreement
+        rep.add_key_values({"conditions with both flags": a.get("n"),
+                            "agree": a.get("agree"),
+                            "agreement rate": None if a.get("rate") is None
+                            else f"{100 * a['rate']:.1f} %",
+                            "measured stable, simulated vibratory":
+                                a.get("measured_stable_simulated_vibratory"),
+                            "measured vibratory, simulated stable":
+                                a.get("measured_vibratory_simulated_stable")},
+                           caption="Stable / vibratory agreement")
+        from robobore.study.plots import parity_figure
+
+        fig = parity_figure(cmp)
+        rep.add_figure(fig, "Simulated against measured (SYNTHETIC) amplitudes.")
+        plt.close(fig)
+        rep.add_table(cmp.table_rows(), caption="Per condition and quantity", max_rows=400)
+
+    # ---------------------------------------------------------------- checks
+    rep.add_section("Paper's findings")
+    rep.add_text("Each qualitative finding of the paper is checked on our results (computed "
+                 "from the sweep, not written by hand).")
+    rep.add_table([{"paper's finding": c["finding"], "our result": c["ours"],
+                    "agrees": {True: "yes", False: "NO", None: "n/a"}[c["agrees"]]}
+                   for c in checks], caption="Qualitative checks")
+    for c in checks:
+        if c["agrees"] is False:
+            rep.add_note(f"Disagreement: the paper finds '{c['finding']}'; our model gives "
+                         f"{c['ours']}.")
+
+    rep.add_section("All conditions")
+    rep.add_table([{"system": r["system"], "n [r/min]": r["speed_rpm"],
+                    "f [mm/r]": r["feed_mm_per_rev"], "ap [mm]": r["depth_of_cut_mm"],
+                    "P [MPa]": r["pressure_MPa"],
+                    "Fx amp [N]": (r["summary"] or {}).get("force_amplitude_x_N"),
+                    "Fy amp [N]": (r["summary"] or {}).get("force_amplitude_y_N"),
+                    "Fz amp [N]": (r["summary"] or {}).get("force_amplitude_z_N"),
+                    "feed amp [um]": (r["summary"] or {}).get("feed_amplitude_um"),
+                    "stable": (r["summary"] or {}).get("stable", "FAILED")}
+                   for r in rows], caption="Summary per condition")
+    rep.add_text("Files: results.nc (all conditions), sweep/results/<key>.nc (one condition "
+                 "each, time histories decimated), paper_summary.json, equivalent_model.json, "
+                 "coefficients.json.")
+    return rep
+
+
+__all__ = ["build_report", "fig_force_half_rev", "fig_feed_amplitude_time", "fig_trends",
+           "fig_vibration_develops", "fig_surface", "fig_lobes"]

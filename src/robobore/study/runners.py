@@ -1,0 +1,123 @@
+"""The real boring runner of sweeps: one cutting condition through ``dynamics.api.run_boring``.
+
+``boring_runner(condition, context) -> xarray.Dataset`` (registered as ``"boring"`` in
+:data:`robobore.study.sweep.RUNNERS`). ``context["model"]`` (hashed into every condition's
+key) holds:
+
+* ``system``: ``"robot"`` (the equivalent model of the robot, ``[equivalent]`` section; the
+  condition's ``pressure_MPa`` sets the pressure foot, 0 = no foot) or ``"machine_tool"``
+  (a stiff machine tool given as ``[structure] modes``; the condition's pressure must be 0);
+* ``dynamics``: the process-stage config (``robobore simulate boring`` contract, see
+  ``docs/process.md``) without the cutting condition: ``equivalent`` or ``structure``,
+  ``insert``, ``bore``, ``coefficients`` (put the coefficient VALUES inline, so that the key
+  changes when they change), ``simulation``.
+
+``context["runner_options"]`` (not hashed): ``samples_per_rev_stored`` (default 120): the
+time series are decimated to about this many samples per revolution and stored as float32
+(the full-rate simulation is summarised before decimation, so the summary is exact).
+
+The Dataset carries the summary contract of :mod:`robobore.study.summary` as 0-d
+variables (``force_amplitude_{x,y,z}_N``, ``feed_amplitude_um``, ``stable`` as int8 0/1),
+the force / displacement / rotational-acceleration histories (boring frame), the feed
+amplitude per revolution, the machined-surface profile, and in the attributes the
+classification (reasons, vibration growth, chatter frequency, Ra, Rz, mean forces).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from robobore.errors import ConfigError
+
+SYSTEMS = ("robot", "machine_tool")
+
+
+def _dynamics_config(condition: dict[str, Any], model: dict[str, Any]) -> dict[str, Any]:
+    system = model.get("system", "robot")
+    if system not in SYSTEMS:
+        raise ConfigError("unknown system", field="model.system", value=system,
+                          expected=f"one of {SYSTEMS}")
+    dyn = model.get("dynamics")
+    if not isinstance(dyn, dict):
+        raise ConfigError("missing model table", field="model.dynamics",
+                          expected="the process-stage config (insert, bore, coefficients, ...)")
+    cfg = json.loads(json.dumps(dyn))  # deep copy, plain types
+    cfg["cutting"] = {"speed_rpm": float(condition["speed_rpm"]),
+                      "feed_mm_per_rev": float(condition["feed_mm_per_rev"]),
+                      "depth_mm": float(condition["depth_of_cut_mm"])}
+    if system == "robot":
+        if "equivalent" not in cfg:
+            raise ConfigError("a robot needs the equivalent model",
+                              field="model.dynamics.equivalent",
+                              expected="stiffness_N_per_m, frequency_Hz, damping_ratio per axis")
+    else:
+        if float(condition.get("pressure_MPa", 0.0)) != 0.0:
+            raise ConfigError("a pressure foot applies to the robot only",
+                              field="condition.pressure_MPa", value=condition["pressure_MPa"],
+                              expected="0 MPa for the machine tool")
+        if "structure" not in cfg:
+            raise ConfigError("a machine tool needs its modes", field="model.dynamics.structure",
+                              expected="[structure] modes (frequency_Hz, damping_ratio, "
+                              "stiffness_N_per_m, direction)")
+        cfg.pop("equivalent", None)
+    return cfg
+
+
+def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
+    """Simulate one boring condition; returns the Dataset described in the module doc."""
+    import numpy as np
+    import xarray as xr
+
+    from robobore.dynamics.api import run_boring
+
+    model = context.get("model", {})
+    opts = context.get("runner_options", {}) or {}
+    cfg = _dynamics_config(condition, model)
+    system = model.get("system", "robot")
+    r = run_boring(cfg, speed_rpm=float(condition["speed_rpm"]),
+                   depth_mm=float(condition["depth_of_cut_mm"]),
+                   feed_mm_per_rev=float(condition["feed_mm_per_rev"]),
+                   pressure_MPa=(float(condition.get("pressure_MPa", 0.0))
+                                 if system == "robot" else None),
+                   return_dataset=True)
+    full = r.pop("dataset")
+    r.pop("config", None)
+    ns = int(full.attrs["samples_per_rev"])
+    keep = int(opts.get("samples_per_rev_stored", 120))
+    stride = max(1, ns // max(keep, 1))
+    t_idx = slice(None, None, stride)
+    data_vars: dict[str, Any] = {}
+    for name in ("force", "displacement", "rotational_acceleration"):
+        if name in full:
+            data_vars[name] = full[name].isel(time=t_idx).astype(np.float32)
+    for name in ("feed_amplitude", "surface_profile"):
+        if name in full:
+            data_vars[name] = full[name]
+    ds = xr.Dataset(data_vars)
+    fa = r["force_amplitude_N"]
+    for ax in "xyz":
+        ds[f"force_amplitude_{ax}_N"] = xr.DataArray(float(fa[ax]))
+        ds[f"force_mean_{ax}_N"] = xr.DataArray(float(r["force_mean_N"][ax]))
+    ds["feed_amplitude_um"] = xr.DataArray(float(r["feed_amplitude_um"]))
+    ds["stable"] = xr.DataArray(np.int8(1 if r["stable"] else 0))
+    ds["roughness_Ra_um"] = xr.DataArray(float(r["roughness_Ra_um"]))
+    ds["roughness_Rz_um"] = xr.DataArray(float(r["roughness_Rz_um"]))
+    ds["vibration_growth"] = xr.DataArray(float(r["vibration_growth"]))
+    attrs = {k: v for k, v in full.attrs.items() if isinstance(v, str | int | float)}
+    attrs.update({
+        "system": system,
+        "stored_time_stride": int(stride),
+        "reasons": "; ".join(r["reasons"]) if r["reasons"] else "",
+        "chatter_frequency_Hz": (float(r["chatter_frequency_Hz"])
+                                 if r["chatter_frequency_Hz"] is not None else -1.0),
+        "nonharmonic_energy_ratio": float(r["nonharmonic_energy_ratio"]),
+        "tool_left_cut_fraction": float(r["tool_left_cut_fraction"]),
+        "model": r["model"],
+        "coefficients_provenance": str(cfg.get("coefficients", {}).get("provenance", "")),
+    })
+    ds.attrs = attrs
+    return ds
+
+
+__all__ = ["boring_runner", "SYSTEMS"]

@@ -1,0 +1,280 @@
+"""``robobore paper`` (the main job), the boring runner and the paper report.
+
+The full study (54 conditions) is measured by ``benchmarks/bench_paper.py``; here the
+pipeline runs with ``--fast`` on a reduced one-factor-at-a-time set (2 levels per factor)
+so that the test stays within the suite's budget.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robobore.errors import ConfigError
+from robobore.study import paper as pp
+from robobore.study.runners import boring_runner
+from robobore.study.summary import summarise
+
+EX = pp.example_dir()
+
+
+def _small_config(tmp_path: Path, extra: str = "", drop: tuple[str, ...] = ()) -> Path:
+    """The bundled example with 2 levels per factor, absolute data paths, fewer lobes."""
+    text = (EX / "paper.toml").read_text()
+    lines = []
+    for ln in text.splitlines():
+        key = ln.split("=")[0].strip()
+        if key == "speed_rpm" and ln.startswith("speed_rpm = ["):
+            ln = "speed_rpm = [300.0, 800.0]"
+        elif key == "feed_mm_per_rev" and ln.startswith("feed_mm_per_rev = ["):
+            ln = "feed_mm_per_rev = [0.15, 0.3]"
+        elif key == "depth_of_cut_mm" and ln.startswith("depth_of_cut_mm = ["):
+            ln = "depth_of_cut_mm = [0.05, 0.2]"
+        elif key == "revolutions":
+            ln = "revolutions = 40"
+        elif key == "count":
+            ln = "count = 40"
+        elif key == "file" and "tc4_fe" in ln:
+            ln = f'file = "{EX / "tc4_fe_coefficients.json"}"'
+        elif key == "file" and "measured" in ln:
+            ln = f'file = "{EX / "measured_synthetic.csv"}"'
+        if key in drop:
+            continue
+        lines.append(ln)
+    p = tmp_path / "paper_small.toml"
+    p.write_text("\n".join(lines) + "\n" + extra)
+    return p
+
+
+def _dyn_model(coeffs: dict, system: str = "machine_tool", k: float = 1e10) -> dict:
+    cfg, _, _ = pp.load_paper_config()
+    dyn = {"insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
+           "coefficients": coeffs, "simulation": {"revolutions": 30}}
+    dirs = {"x": [1.0, 0, 0], "y": [0, 1.0, 0], "z": [0, 0, 1.0]}
+    dyn["structure"] = {"modes": [{"frequency_Hz": 400.0, "damping_ratio": 0.05,
+                                   "stiffness_N_per_m": k, "direction": dirs[a]}
+                                  for a in "xyz"]}
+    return {"system": system, "dynamics": dyn}
+
+
+def test_boring_runner_uses_the_coefficients():
+    """The FE-calibrated coefficients are USED: on a (practically) rigid structure the runner's
+    force amplitudes equal the static mechanistic forces of ``cutting.forces.boring_forces``
+    with the same coefficients (within 1 %, the time-domain sampling of the max/min), and
+    doubling every coefficient doubles them (within 1 %)."""
+    from robobore.cutting.forces import boring_forces, load_coefficients
+
+    stored = json.loads((EX / "tc4_fe_coefficients.json").read_text())["coefficients"]
+    cond = {"speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.1,
+            "pressure_MPa": 0.0, "posture": "paper"}
+    ds = boring_runner(cond, {"model": _dyn_model(stored)})
+    s = summarise(ds)
+    cfg, _, _ = pp.load_paper_config()
+    ref = boring_forces(cfg.insert.to_insert(), 0.1e-3, 0.15e-3,
+                        load_coefficients(EX / "tc4_fe_coefficients.json"))
+    for i, ax in enumerate("xy"):
+        assert s[f"force_amplitude_{ax}_N"] == pytest.approx(ref["amplitude_N"][i], rel=0.01)
+    assert s["stable"] is True
+    assert "FE-calibrated" in ds.attrs["coefficients_provenance"]
+    doubled = {k: (2 * v if k.startswith("K") else v) for k, v in stored.items()}
+    s2 = summarise(boring_runner(cond, {"model": _dyn_model(doubled)}))
+    assert s2["force_amplitude_x_N"] == pytest.approx(2 * s["force_amplitude_x_N"], rel=0.01)
+
+
+def test_boring_runner_dataset_contract():
+    """Summary contract as 0-d variables, decimated float32 histories, classification attrs."""
+    stored = json.loads((EX / "tc4_fe_coefficients.json").read_text())["coefficients"]
+    cond = {"speed_rpm": 600.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.05,
+            "pressure_MPa": 0.0, "posture": "paper"}
+    ds = boring_runner(cond, {"model": _dyn_model(stored, k=5e7),
+                              "runner_options": {"samples_per_rev_stored": 50}})
+    for q in ("force_amplitude_x_N", "force_amplitude_y_N", "force_amplitude_z_N",
+              "feed_amplitude_um", "stable"):
+        assert ds[q].ndim == 0
+    assert ds["force"].dtype == np.float32
+    assert ds.sizes["time"] <= 30 * 60 + 1
+    assert ds.sizes["revolution"] == 30
+    assert ds.attrs["system"] == "machine_tool"
+
+
+def test_boring_runner_bad_model():
+    cond = {"speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.05,
+            "pressure_MPa": 0.3, "posture": "paper"}
+    with pytest.raises(ConfigError, match="pressure foot applies to the robot only"):
+        boring_runner(cond, {"model": _dyn_model({"material": "TC4"})})
+    with pytest.raises(ConfigError, match="model.system"):
+        boring_runner(cond, {"model": {"system": "lathe", "dynamics": {}}})
+
+
+def test_boring_runner_is_registered():
+    from robobore.study.sweep import resolve_runner
+
+    assert resolve_runner("boring") is boring_runner
+
+
+def test_study_conditions_of_the_example():
+    """OFAT around the base: 7 speeds + 7 feeds + 6 depths - 2 repeats of the base = 18 per
+    pressure (the levels of docs/study.md), 36 for the robot."""
+    cfg, _, _ = pp.load_paper_config()
+    conds = pp.study_conditions(cfg)
+    assert len(conds) == 36
+    assert {c["pressure_MPa"] for c in conds} == {0.0, 0.3}
+    assert len({(c["speed_rpm"], c["feed_mm_per_rev"], c["depth_of_cut_mm"],
+                 c["pressure_MPa"]) for c in conds}) == 36
+
+
+def test_bad_paper_config(tmp_path):
+    p = _small_config(tmp_path, extra="\n[unknown]\nx = 1\n")
+    with pytest.raises(ConfigError) as e:
+        pp.load_paper_config(p)
+    assert "unknown" in str(e.value)
+    p2 = tmp_path / "b.toml"
+    p2.write_text((EX / "paper.toml").read_text().replace("diameter_mm = 40.0",
+                                                          "diameter_mm = -4.0"))
+    with pytest.raises(ConfigError) as e:
+        pp.load_paper_config(p2)
+    assert "bore.diameter_mm" in str(e.value)
+
+
+def _rows(depth_amp, feed_amp, foot_factor):
+    """Synthetic result rows for the checks: the base is n=300, f=0.15, ap=0.05."""
+    rows = []
+    for p, fac in ((0.0, 1.0), (0.3, foot_factor)):
+        for ap, a in zip((0.05, 0.1, 0.2, 0.3), depth_amp, strict=True):
+            rows.append({"system": "robot", "pressure_MPa": p, "speed_rpm": 300.0,
+                         "feed_mm_per_rev": 0.15, "depth_of_cut_mm": ap, "key": f"d{ap}{p}",
+                         "summary": {"feed_amplitude_um": a * fac, "force_amplitude_x_N":
+                                     10 * a * fac, "stable": a < 1.0}})
+        for f, a in zip((0.1, 0.2, 0.3), feed_amp, strict=True):
+            rows.append({"system": "robot", "pressure_MPa": p, "speed_rpm": 300.0,
+                         "feed_mm_per_rev": f, "depth_of_cut_mm": 0.05, "key": f"f{f}{p}",
+                         "summary": {"feed_amplitude_um": a * fac, "force_amplitude_x_N":
+                                     10 * a * fac, "stable": a < 1.0}})
+    return rows
+
+
+def test_qualitative_checks_are_computed_not_assumed():
+    """Same checker, two data sets: paper-like results agree, reversed trends and a foot
+    that amplifies vibration are reported as disagreements."""
+    cfg, _, _ = pp.load_paper_config()
+    good = {c["finding"]: c["agrees"]
+            for c in pp.qualitative_checks(_rows([0.2, 1.5, 3, 6], [0.1, 1.2, 2], 0.1), cfg)}
+    bad = {c["finding"]: c["agrees"]
+           for c in pp.qualitative_checks(_rows([6, 3, 1.5, 0.2], [2, 1.2, 0.1], 3.0), cfg)}
+    grow_d = "vibration grows with depth of cut (paper, robot without foot)"
+    grow_f = "vibration grows with feed (paper, robot without foot)"
+    foot = "the pressure foot (0.3 MPa) reduces the feed (vibration) amplitude"
+    assert good[grow_d] and good[grow_f] and good[foot]
+    assert bad[grow_d] is False and bad[grow_f] is False and bad[foot] is False
+    # the onset check: paper-like onset at ap = 0.1 mm agrees, at 0.05 mm (base) it does not
+    onset = "vibratory from depth of cut >= 0.1 mm (paper, onset)"
+    assert good[onset] is True and bad[onset] is False
+
+
+def _browser_or_skip():
+    from robobore.study.browser import browser_available
+
+    why = browser_available()
+    if why is None:
+        return
+    if os.environ.get("ROBOBORE_SKIP_BROWSER") == "1":
+        pytest.skip(f"ROBOBORE_SKIP_BROWSER=1 and no browser: {why}")
+    pytest.fail(f"headless Chromium test cannot run: {why}")
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("paper")
+    cfg = _small_config(tmp)
+    out = tmp / "out"
+    res = pp.run_paper(cfg, out, fast=True, workers=0)
+    return res, out, cfg
+
+
+def test_paper_fast_small_run_outputs(small_run):
+    """The main job end to end (--fast, reduced set): JSON contract, files, every condition
+    simulated once and recorded, comparison and checks present."""
+    res, out, _ = small_run
+    # OFAT 2 levels per factor: 4 distinct conditions per pressure, 2 pressures + tool
+    assert res["conditions"] == 12
+    assert res["computed"] + len(res["failed"]) == 12
+    assert res["stable"] + res["vibratory"] == res["computed"]
+    assert Path(res["report"]).is_file() and res["wall_time_s"] > 0
+    for f in ("results.nc", "paper_summary.json", "coefficients.json",
+              "equivalent_model.json", "sweep/index.json"):
+        assert (out / f).is_file(), f
+    import xarray as xr
+
+    with xr.open_dataset(out / "results.nc") as ds:
+        assert ds.sizes["condition"] == 12
+        assert int((ds["system"] == "machine_tool").sum()) == 4
+    s = json.loads((out / "paper_summary.json").read_text())
+    assert s["coefficients_mode"] == "stored (--fast)"
+    assert s["comparison"]["groups"]
+    assert any("pressure foot" in c["finding"] for c in s["qualitative_checks"])
+    eq = s["equivalent_model"]
+    # the foot stiffens every direction (assumed contact model adds stiffness)
+    for a, b in zip(eq["without_foot"], eq["with_foot"], strict=True):
+        assert b["stiffness_N_per_m"] > a["stiffness_N_per_m"]
+        assert a["mass_kg"] == pytest.approx(
+            a["stiffness_N_per_m"] / (2 * math.pi * a["frequency_Hz"]) ** 2, rel=1e-9)
+    html = Path(res["report"]).read_text()
+    for word in ("SYNTHETIC", "Equivalent model", "23.7", "Stability lobe", "Qualitative checks",
+                 "3.22-15.54"):
+        assert word in html, word
+
+
+def test_paper_report_opens_in_headless_chromium(small_run):
+    """Issue 6 acceptance: the paper report loads with no console error and every figure."""
+    _browser_or_skip()
+    from robobore.study.browser import check_html_in_browser
+
+    res, _, _ = small_run
+    chk = check_html_in_browser(res["report"])
+    assert chk.problems == ()
+    assert chk.images >= 6
+
+
+def test_fast_needs_the_stored_file(tmp_path):
+    p = _small_config(tmp_path)
+    p.write_text(p.read_text().replace(str(EX / "tc4_fe_coefficients.json"),
+                                       str(tmp_path / "missing.json")))
+    with pytest.raises(ConfigError, match="coefficients"):
+        pp.run_paper(p, tmp_path / "o", fast=True, workers=0)
+
+
+def test_cli_paper_json_and_resume(tmp_path, small_run):
+    """``robobore paper CONFIG --fast --json`` prints only JSON with the contract keys; run
+    again on the same OUT it recomputes nothing (the sweep store is resumable)."""
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+
+    _, out, cfg = small_run
+    r = CliRunner().invoke(app, ["paper", str(cfg), "--out", str(out), "--fast", "--json",
+                                 "--workers", "0"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    for k in ("report", "conditions", "stable", "vibratory", "wall_time_s"):
+        assert k in d
+    res, _, _ = small_run
+    assert d["sweep"]["computed"] == 0
+    assert d["sweep"]["skipped"] == res["computed"]
+    assert (d["stable"], d["vibratory"]) == (res["stable"], res["vibratory"])
+
+
+def test_synthetic_measured_is_reproducible(tmp_path):
+    """The SYNTHETIC measured CSV is made by package code, deterministically (seeded)."""
+    cfg = _small_config(tmp_path, drop=())
+    text = cfg.read_text().replace("pressure_MPa = [0.0, 0.3]", "pressure_MPa = [0.3]")
+    cfg.write_text(text)
+    a = pp.make_synthetic_measured(cfg, tmp_path / "a.csv").read_text()
+    b = pp.make_synthetic_measured(cfg, tmp_path / "b.csv").read_text()
+    assert a == b
+    assert a.startswith("# SYNTHETIC")
+    assert len([ln for ln in a.splitlines() if ln and not ln.startswith("#")]) == 1 + 4
