@@ -20,18 +20,23 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help texts are plain: units in brackets ("[mm]") stay visible
 )
 
 #: Command groups shared by the stages. ``groups["root"]`` is the top-level app, for
 #: top-level commands such as ``robobore lobes``.
+def _group(help: str) -> typer.Typer:
+    return typer.Typer(help=help, no_args_is_help=True, rich_markup_mode=None)
+
+
 groups: dict[str, typer.Typer] = {
     "root": app,
-    "robot": typer.Typer(help="Robot kinematics and stiffness.", no_args_is_help=True),
-    "identify": typer.Typer(help="Identify models from measurements.", no_args_is_help=True),
-    "model": typer.Typer(help="Build process models (equivalent model).", no_args_is_help=True),
-    "simulate": typer.Typer(help="Time-domain process simulation.", no_args_is_help=True),
-    "fe": typer.Typer(help="Explicit finite-element cutting simulation.", no_args_is_help=True),
-    "calibrate": typer.Typer(help="Calibrate models from simulations.", no_args_is_help=True),
+    "robot": _group("Robot kinematics and stiffness."),
+    "identify": _group("Identify models from measurements."),
+    "model": _group("Build process models (equivalent model)."),
+    "simulate": _group("Time-domain process simulation."),
+    "fe": _group("Explicit finite-element cutting simulation."),
+    "calibrate": _group("Calibrate models from simulations."),
 }
 
 #: Modules that contribute commands; each has ``register(groups)``.

@@ -79,6 +79,20 @@ def test_boring_example_runs(tmp_path):
     assert (tmp_path / "lobes.png").is_file()
 
 
+def test_simulate_feed_and_pressure_options():
+    """--feed-mm-per-rev overrides the config's feed (the mean feed force and the chip grow with
+    it); --pressure-MPa switches the foot; bad values are refused naming the option."""
+    base = ["simulate", "boring", str(EX / "boring_paper.toml"), "--json", "--revolutions", "10"]
+    d1 = json.loads(runner.invoke(app, base + ["--feed-mm-per-rev", "0.1"]).stdout)
+    d2 = json.loads(runner.invoke(app, base + ["--feed-mm-per-rev", "0.2"]).stdout)
+    assert d2["force_amplitude_N"]["x"] > 1.2 * d1["force_amplitude_N"]["x"]
+    r = runner.invoke(app, base + ["--pressure-MPa", "0.3"])
+    assert r.exit_code == 0, r.output
+    for opt, val in (("--feed-mm-per-rev", "0"), ("--pressure-MPa", "-1")):
+        r = runner.invoke(app, base + [opt, val])
+        assert r.exit_code == 2 and opt in r.output
+
+
 def test_model_equivalent_command():
     r = runner.invoke(app, ["model", "equivalent", "--stiffness-N-per-m", "1.2e6,0.9e6,1.5e6",
                             "--frequencies-Hz", "6.9,16.8,24.6", "--damping-N-s-per-m", "23.7",

@@ -49,6 +49,42 @@ def test_tool_leaves_cut_and_vibration_saturates(sdof, contract_process):
     assert late < 1.5 * mid  # saturated, not exponential
 
 
+def test_diverging_cut_stops_flagged_not_nan(sdof, contract_process):
+    """A growing cut whose tool-point displacement passes the divergence limit stops at the
+    last whole revolution, is flagged ``diverged`` and classified vibratory; outputs stay
+    finite (no NaN, no exception). The limit here is set low (2 x the nominal chip) so that the
+    1.1 x critical-depth case of the contract example reaches it; without the limit the same
+    run completes all revolutions (checked: it saturates far below any overflow)."""
+    n = sdof_pocket_speeds(250.0, 0.012, 1, 3)[1]
+    b = lobes_frequency_domain(sdof, contract_process, np.array([n])).critical_depth_m[0]
+    free = simulate(sdof, contract_process, SimulationSettings(n, 1.5 * b, 150))
+    assert not free.attrs["diverged"] and free.attrs["revolutions"] == 150
+    xmax = np.abs(free["displacement"].values).max()
+    lim = 0.5 * xmax
+    ds = simulate(sdof, contract_process,
+                  SimulationSettings(n, 1.5 * b, 150, divergence_limit_m=lim))
+    assert ds.attrs["diverged"] == 1
+    revs = ds.attrs["revolutions"]
+    assert 1 <= revs < 150
+    assert ds["displacement"].shape[0] == revs * ds.attrs["samples_per_rev"]
+    assert np.all(np.isfinite(ds["displacement"].values))
+    assert ds.attrs["diverged_at_s"] >= revs * 60.0 / n
+    v = classify(ds)
+    assert not v.stable and any("diverged" in r for r in v.reasons)
+
+
+def test_divergence_in_first_revolution_is_a_clear_error(sdof, contract_process):
+    from robobore.errors import ConfigError, NumericalError
+
+    n = 9500.0
+    b = lobes_frequency_domain(sdof, contract_process, np.array([n])).critical_depth_m[0]
+    with pytest.raises(NumericalError, match="first revolution"):
+        simulate(sdof, contract_process,
+                 SimulationSettings(n, b, 10, divergence_limit_m=1e-12))
+    with pytest.raises(ConfigError, match="divergence"):
+        simulate(sdof, contract_process, SimulationSettings(n, b, 10, divergence_limit_m=0.0))
+
+
 def test_mode_coupling_case(coupling_case):
     """Two orthogonal close modes, force between them (Pan et al. 2006): at 60 um and 2500
     r/min each mode alone is regeneratively stable (classical per-mode lobes), the

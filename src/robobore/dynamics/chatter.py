@@ -85,7 +85,8 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
              tail_fraction: float = 0.3) -> ChatterVerdict:
     """Stable / vibratory verdict from a simulation Dataset (:func:`simulate`).
 
-    Vibratory if the regenerative envelope grows (``vibration_growth > growth_limit``) or the
+    Vibratory if the run diverged (see :class:`~robobore.dynamics.timedomain.SimulationSettings`),
+    the regenerative envelope grows (``vibration_growth > growth_limit``) or the
     surface roughness exceeds ``ra_tolerance_m``. The chatter frequency is reported (largest
     peak away from the tooth-passing harmonics in the last ``tail_fraction`` of the run) when
     vibratory, ``None`` when stable.
@@ -104,6 +105,10 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
     area = ds["chip_area"].values
     left = float(np.mean(area[n0:] <= 0))
     reasons = []
+    if int(ds.attrs.get("diverged", 0)):
+        reasons.append(f"vibration diverged: tool-point displacement above "
+                       f"{float(ds.attrs['divergence_limit_m']) * 1e3:.3g} mm at "
+                       f"t = {float(ds.attrs['diverged_at_s']):.4g} s")
     if not math.isfinite(g) or g > growth_limit:
         reasons.append(f"vibration envelope grows (x{g:.3g})")
     if not r_ok:

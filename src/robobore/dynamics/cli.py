@@ -117,6 +117,11 @@ def simulate_boring_cmd(
                                            help="Spindle speed [r/min] (default [cutting])."),
     depth_mm: float | None = typer.Option(None, "--depth-mm",
                                           help="Depth of cut [mm] (default [cutting])."),
+    feed_mm_per_rev: float | None = typer.Option(
+        None, "--feed-mm-per-rev", help="Feed [mm/r] (default [cutting] or [process])."),
+    pressure_MPa: float | None = typer.Option(
+        None, "--pressure-MPa",
+        help="Pressure-foot pressure [MPa] (boring configs with [equivalent]; 0 = no foot)."),
     revolutions: int | None = typer.Option(None, "--revolutions",
                                            help="Revolutions (default [simulation], 150)."),
     samples_per_rev: int | None = typer.Option(None, "--samples-per-rev",
@@ -143,11 +148,20 @@ def simulate_boring_cmd(
     if depth_mm is not None and not (math.isfinite(depth_mm) and 0.0 < depth_mm <= 50.0):
         raise ConfigError("depth of cut out of range", field="--depth-mm", value=depth_mm,
                           expected="0 < depth <= 50 mm")
+    if feed_mm_per_rev is not None and not (
+            math.isfinite(feed_mm_per_rev) and 0.0 < feed_mm_per_rev <= 10.0):
+        raise ConfigError("feed out of range", field="--feed-mm-per-rev", value=feed_mm_per_rev,
+                          expected="0 < feed <= 10 mm/r")
+    if pressure_MPa is not None and not (math.isfinite(pressure_MPa) and 0.0 <= pressure_MPa
+                                         <= 10.0):
+        raise ConfigError("pressure out of range", field="--pressure-MPa", value=pressure_MPa,
+                          expected="0 .. 10 MPa")
     if out is not None and out.suffix != ".nc":
         raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
                           expected="a path ending in .nc")
     with progress_bar("simulating", None, not as_json):
-        result = run_boring(cfg, speed_rpm, depth_mm, revolutions=revolutions,
+        result = run_boring(cfg, speed_rpm, depth_mm, feed_mm_per_rev=feed_mm_per_rev,
+                            pressure_MPa=pressure_MPa, revolutions=revolutions,
                             samples_per_rev=samples_per_rev, return_dataset=True)
     ds = result.pop("dataset")
     result.pop("config")

@@ -71,7 +71,9 @@ def modal_zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.
 @nb.njit(cache=True)
 def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, nrm, shr, edg, dd,
                      inv_depth, mu, om, zeta, minv, half_dt, q, qd, sr, tlast, F_out, X_out,
-                     A_out, area_out):  # pragma: no cover - compiled
+                     A_out, area_out, limit):  # pragma: no cover - compiled
+    """Integrate ``n_steps``; returns the number of steps done (fewer when the tool-point
+    displacement leaves ``[-limit, limit]`` or is not finite: a diverging cut)."""
     m = D.shape[0]
     E = h0.shape[0]
     spp = Ns // N
@@ -168,6 +170,9 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, nrm, shr, ed
         A_out[i, 0] = ax
         A_out[i, 1] = ay
         A_out[i, 2] = az
+        if not (abs(px) <= limit and abs(py) <= limit and abs(pz) <= limit):
+            return i + 1
+    return n_steps
 
 
 @dataclass(frozen=True)
@@ -179,6 +184,11 @@ class SimulationSettings:
     mode (default 1 % of the largest nominal chip thickness), so that ``vibration_growth``
     measures the growth of that perturbation; ``"rest"`` starts from zero displacement with the
     nominal chip (the tool is loaded suddenly).
+
+    ``divergence_limit_m``: the run stops when the tool-point displacement exceeds this
+    (default 2 mm, tens of times any depth of cut or feed of boring): the linear cutting model
+    means nothing beyond it (the insert would break or the bar hit the wall). The Dataset is
+    then cut at the last whole revolution and flagged ``diverged``; the cut is vibratory.
     """
 
     speed_rpm: float
@@ -187,6 +197,7 @@ class SimulationSettings:
     samples_per_rev: int = 0
     start: str = "periodic"
     perturbation_m: float | None = None
+    divergence_limit_m: float = 2e-3
 
     def check(self) -> None:
         if not (math.isfinite(self.speed_rpm) and 1.0 <= self.speed_rpm <= 100000.0):
@@ -201,6 +212,9 @@ class SimulationSettings:
         if self.start not in ("periodic", "rest"):
             raise ConfigError("unknown start", field="start", value=self.start,
                               expected="periodic or rest")
+        if not (math.isfinite(self.divergence_limit_m) and self.divergence_limit_m > 0.0):
+            raise ConfigError("divergence limit must be positive", field="divergence_limit_m",
+                              value=self.divergence_limit_m, expected="a length > 0 in m")
         if self.samples_per_rev and not 8 <= self.samples_per_rev <= 200000:
             raise ConfigError("samples per revolution out of range", field="samples_per_rev",
                               value=self.samples_per_rev, expected="8 .. 200000")
@@ -308,18 +322,30 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     X = np.empty((n_steps, 3))
     acc = np.empty((n_steps, 3))
     area = np.empty((n_steps, N))
-    _simulate_kernel(n_steps, Ns, N, Phi, Gam, np.ascontiguousarray(structure.directions),
-                     basis, process.h0, w, ds, process.normal, process.shear, process.edge,
-                     process.depth_direction, inv_depth, process.overlap, structure.omega,
-                     structure.damping_ratio, 1.0 / structure.modal_mass, 0.5 * dt, q, qd,
-                     sr, tlast, F, X, acc, area)
+    n_done = _simulate_kernel(n_steps, Ns, N, Phi, Gam,
+                              np.ascontiguousarray(structure.directions), basis, process.h0, w,
+                              ds, process.normal, process.shear, process.edge,
+                              process.depth_direction, inv_depth, process.overlap,
+                              structure.omega, structure.damping_ratio,
+                              1.0 / structure.modal_mass, 0.5 * dt, q, qd, sr, tlast, F, X, acc,
+                              area, float(settings.divergence_limit_m))
+    diverged = n_done < n_steps
+    revs = int(settings.revolutions)
+    if diverged:
+        revs = n_done // Ns  # keep the whole revolutions before the divergence
+        if revs < 1:
+            raise NumericalError(
+                f"the tool-point displacement exceeded {settings.divergence_limit_m * 1e3:.3g} mm"
+                f" within the first revolution (t = {n_done * dt:.4g} s): the cut diverges at "
+                "once; check the structure (stiffness, mass) and the cutting coefficients")
+        n_steps = revs * Ns
+        F, X, acc, area = F[:n_steps], X[:n_steps], acc[:n_steps], area[:n_steps]
     if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
         raise NumericalError("the simulation produced non-finite values (unstable integration)")
     t = np.arange(n_steps) * dt
     th_all = 2 * np.pi * (np.arange(n_steps) % Ns) / Ns
     a_r = acc[:, 0] * np.cos(th_all) + acc[:, 1] * np.sin(th_all)
     a_t = -acc[:, 0] * np.sin(th_all) + acc[:, 1] * np.cos(th_all)
-    revs = int(settings.revolutions)
     zr = X[:, 2].reshape(revs, Ns)
     feed_amp = 0.5 * (zr.max(axis=1) - zr.min(axis=1))
     ds_out = xr.Dataset(
@@ -343,6 +369,9 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
         attrs={"speed_rpm": settings.speed_rpm, "depth_m": a, "revolutions": revs,
                "samples_per_rev": Ns, "n_inserts": N, "dt_s": dt, "overlap": process.overlap,
                "feed_per_rev_m": process.feed_per_rev_m, "process": process.label,
+               "diverged": int(diverged), "revolutions_requested": int(settings.revolutions),
+               "diverged_at_s": n_done * dt if diverged else math.nan,
+               "divergence_limit_m": float(settings.divergence_limit_m),
                "frame": "boring frame: x horizontal, y vertical, z feed (bore axis)"},
     )
     prof_z, prof_r, ra, rz = surface_profile(X, area, Ns, N, process, insert_profile)
