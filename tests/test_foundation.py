@@ -122,3 +122,17 @@ def test_cli_error_keeps_square_brackets():
     con = Console(record=True, width=80)
     con.print(kv_table("t", [("depth [mm]", 1.0)]))
     assert "depth [mm]" in con.export_text()
+
+
+@pytest.mark.parametrize("cmd", [
+    ["robot", "fk"], ["robot", "stiffness"], ["robot", "campaign"],
+    ["identify", "stiffness"], ["identify", "modes"],
+    ["model", "equivalent"], ["simulate", "boring"], ["lobes"],
+    ["fe", "orthogonal"], ["fe", "boring"],
+    ["calibrate", "forces"], ["sweep"], ["compare"], ["paper"],
+])
+def test_every_contract_command_is_reachable(cmd):
+    """The commands the issues' contracts name exist on the one `robobore` app."""
+    r = CliRunner().invoke(app, [*cmd, "--help"])
+    assert r.exit_code == 0, r.output
+    assert "--json" in r.output

@@ -1,4 +1,5 @@
-"""CLI commands of this stage (registered by ``robobore.cli``): ``robobore fe orthogonal``."""
+"""CLI commands of the FE stage (registered by ``robobore.cli``): ``robobore fe orthogonal``
+and, from :mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
 
 from __future__ import annotations
 
@@ -109,4 +110,7 @@ def _plot_forces(res, path: Path) -> Path:
 
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add this stage's commands to the shared command groups."""
+    from robobore.cutting.fe.cli_boring import register_boring
+
     groups["fe"].command("orthogonal")(orthogonal_cmd)
+    register_boring(groups)
