@@ -103,8 +103,9 @@ def test_bad_runner_results_become_failures(tmp_path):
 def test_runner_resolution_errors():
     assert callable(resolve_runner("demo"))
     assert callable(resolve_runner("robobore.study.demo:demo_runner"))
+    assert callable(resolve_runner("boring"))  # the real boring runner (study.runners)
     with pytest.raises(ConfigError, match="unknown runner"):
-        resolve_runner("boring")
+        resolve_runner("no-such-runner")
     with pytest.raises(ConfigError, match="cannot import"):
         resolve_runner("robobore.nope:run")
 
