@@ -208,6 +208,41 @@ _STATUS_TEXT = {
 }
 
 
+def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: int, *,
+                 chunk_steps: int, label: str, hint: str,
+                 progress: Callable[[float], None] | None = None,
+                 check: Callable[[Any], None] | None = None) -> int:
+    """Run a compiled chunk loop (2D ``run_chunk`` or 3D ``run_chunk3``) until ``t_end`` [s].
+
+    Shared by :func:`advance` and :func:`~robobore.cutting.fe.solver3d.advance3`: ``st`` has
+    ``prm``, ``ist``, ``time`` and ``kernel_args()``; ``p_tend`` is the index of the end time in
+    that engine's ``prm``. ``progress(fraction_done)`` and ``check(state)`` (may raise) are
+    called between chunks. Raises NumericalError (``label``, step, time, cause, ``hint``) on
+    instability; returns the number of steps taken.
+    """
+    st.prm[p_tend] = t_end
+    st.ist[K.I_STATUS] = K.STATUS_OK
+    total = 0
+    t_start = st.time
+    while True:
+        taken = run_chunk(chunk_steps, *st.kernel_args())
+        total += int(taken)
+        status = int(st.ist[K.I_STATUS])
+        if status in _STATUS_TEXT:
+            raise NumericalError(
+                f"{label} unstable at step {int(st.ist[K.I_STEP])}, time "
+                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
+                + (f" (element {int(st.ist[K.I_BADELEM])})"
+                   if status == K.STATUS_INVERTED else "")
+                + f"; try {hint}")
+        if progress is not None:
+            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
+        if check is not None:
+            check(st)
+        if status == K.STATUS_DONE or st.time >= t_end:
+            return total
+
+
 def advance(st: FEState, t_end: float, *, chunk_steps: int = 2000,
             progress: Callable[[float], None] | None = None,
             check: Callable[[FEState], None] | None = None) -> int:
@@ -216,29 +251,10 @@ def advance(st: FEState, t_end: float, *, chunk_steps: int = 2000,
     ``progress(fraction_done)`` is called between chunks; ``check(state)`` too (it may raise).
     Raises NumericalError (with step, time and cause) on instability.
     """
-    st.prm[K.P_TEND] = t_end
-    st.ist[K.I_STATUS] = K.STATUS_OK
-    total = 0
-    t_start = st.time
-    while True:
-        taken = K.run_chunk(chunk_steps, *st.kernel_args())
-        total += int(taken)
-        status = int(st.ist[K.I_STATUS])
-        if status in _STATUS_TEXT:
-            raise NumericalError(
-                f"simulation unstable at step {int(st.ist[K.I_STEP])}, time "
-                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
-                + (f" (element {int(st.ist[K.I_BADELEM])})"
-                   if status == K.STATUS_INVERTED else "")
-                + "; try a smaller solver.cfl, a "
-                "larger mesh.element_size_um or less mass scaling")
-        if progress is not None:
-            span = max(t_end - t_start, 1e-300)
-            progress(min(1.0, (st.time - t_start) / span))
-        if check is not None:
-            check(st)
-        if status == K.STATUS_DONE or st.time >= t_end:
-            return total
+    return drive_chunks(st, t_end, K.run_chunk, K.P_TEND, chunk_steps=chunk_steps,
+                        label="simulation",
+                        hint="a smaller solver.cfl, a larger mesh.element_size_um or less "
+                        "mass scaling", progress=progress, check=check)
 
 
 # ----------------------------------------------------------------- orthogonal cutting model

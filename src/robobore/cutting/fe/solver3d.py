@@ -15,8 +15,8 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.solver import _STATUS_TEXT, energy_error
-from robobore.errors import ConfigError, NumericalError
+from robobore.cutting.fe.solver import drive_chunks, energy_error
+from robobore.errors import ConfigError
 from robobore.material import Material
 
 __all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "advance3", "energy_error",
@@ -215,28 +215,11 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
     """
-    st.prm[K3.P_TEND] = t_end
-    st.ist[K3.I_STATUS] = K3.STATUS_OK
-    total = 0
-    t_start = st.time
-    while True:
-        taken = K3.run_chunk3(chunk_steps, *st.kernel_args())
-        total += int(taken)
-        status = int(st.ist[K3.I_STATUS])
-        if status in _STATUS_TEXT:
-            raise NumericalError(
-                f"3D simulation unstable at step {int(st.ist[K3.I_STEP])}, time "
-                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
-                + (f" (element {int(st.ist[K3.I_BADELEM])})"
-                   if status == K3.STATUS_INVERTED else "")
-                + "; try a smaller solver.cfl, a larger mesh.element_size_um, less mass "
-                "scaling or a softer contact.penalty_factor")
-        if progress is not None:
-            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
-        if check is not None:
-            check(st)
-        if status == K3.STATUS_DONE or st.time >= t_end:
-            return total
+    return drive_chunks(st, t_end, K3.run_chunk3, K3.P_TEND, chunk_steps=chunk_steps,
+                        label="3D simulation",
+                        hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "
+                        "scaling or a softer contact.penalty_factor",
+                        progress=progress, check=check)
 
 
 def box_mesh(nx: int, ny: int, nz: int, lx: float, ly: float, lz: float,
