@@ -55,6 +55,10 @@ def main() -> None:
     ap.add_argument("--data", type=Path, default=Path(os.environ.get("ROBOBORE_TI64_DATA", DATA)))
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--points", type=str, default="", help="h_um:vc list, e.g. 60:30,40:5")
+    ap.add_argument("--separation", choices=["node_split", "erosion_layer"], default=None,
+                    help="mesh.separation (default: the engine's default)")
+    ap.add_argument("--separation-height-um", type=float, default=None,
+                    help="mesh.separation_height_um (default: the engine's default)")
     args = ap.parse_args()
     ref = json.loads(args.data.read_text())["measured"]
     pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
@@ -62,7 +66,8 @@ def main() -> None:
         pts = [tuple(float(x) for x in p.split(":")) for p in args.points.split(",")]
     rows = []
     print(f"# FE orthogonal validation: length {args.length_mm} mm, element "
-          f"{args.element_um} um, load {os.getloadavg()[0]:.1f}")
+          f"{args.element_um} um, separation {args.separation or 'default'} "
+          f"(height {args.separation_height_um} um), load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} | {'E err':>6} {'wall s':>6}")
     print(hdr)
@@ -70,7 +75,13 @@ def main() -> None:
         hk = f"{h:g}"
         vk = f"{vc:g}"
         t0 = time.perf_counter()
-        cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3)))
+        mesh = {}
+        if args.separation is not None:
+            mesh["separation"] = args.separation
+        if args.separation_height_um is not None:
+            mesh["separation_height_um"] = args.separation_height_um
+        cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3),
+                                  {"mesh": mesh} if mesh else None))
         res = simulate_orthogonal(cfg)
         s = res.summary
         fc_m, ff_m, r_m = ref["Fc"][hk][vk], ref["Ff"][hk][vk], ref["chip_ratio"][hk][vk]

@@ -33,6 +33,7 @@ provenance (material, insert, FE settings, grid, version, FE forces, fit residua
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -63,6 +64,9 @@ class FESettings(_Strict):
     shear_limit_MPa: float = Field(576.0, gt=0)
     clearance_deg: float = Field(7.0, gt=0, le=30)
     steady_window_fraction: float = Field(0.5, gt=0, le=1)
+    #: the engine's mesh.separation and mesh.separation_height_um (docs/fe.md)
+    separation: Literal["node_split", "erosion_layer"] = "erosion_layer"
+    separation_height_um: float | None = Field(None, ge=0)
 
 
 class CalibrationConfig(_Strict):
@@ -139,7 +143,9 @@ def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> 
                 "cutting_speed_m_per_min": float(vc_m_per_min),
                 "length_mm": fe.length_mm, "width_mm": 1.0},
         "contact": {"friction": fe.friction, "shear_limit_MPa": fe.shear_limit_MPa},
-        "mesh": {"element_size_um": fe.element_size_um},
+        "mesh": {"element_size_um": fe.element_size_um, "separation": fe.separation,
+                 **({} if fe.separation_height_um is None
+                    else {"separation_height_um": fe.separation_height_um})},
         "solver": {"mass_scaling": fe.mass_scaling,
                    "steady_window_fraction": fe.steady_window_fraction},
     }
@@ -178,6 +184,13 @@ def fe_cache_inputs(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     return {"fe_config": parse_config(fe_cfg).model_dump(mode="json")}
 
 
+def _limit_numba_threads(n: int) -> None:
+    """Process-pool initializer: at most ``n`` numba threads in this worker."""
+    import numba
+
+    numba.set_num_threads(max(1, min(n, numba.config.NUMBA_NUM_THREADS)))
+
+
 def run_grid(cfg: CalibrationConfig, *, cache: Any | None = None, workers: int = 1,
              progress: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
     """FE forces at every grid point (cached). Returns one record per point (h-major order):
@@ -213,7 +226,12 @@ def run_grid(cfg: CalibrationConfig, *, cache: Any | None = None, workers: int =
             progress(1)
 
     if todo and workers > 1 and len(todo) > 1:
-        with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as ex:
+        nproc = min(workers, len(todo))
+        # each worker gets its share of the cores for numba's parallel loops: oversubscribed
+        # numba threads slow the FE kernels 5-20x (docs/fe.md)
+        threads = max(1, (os.cpu_count() or 1) // nproc)
+        with ProcessPoolExecutor(max_workers=nproc, initializer=_limit_numba_threads,
+                                 initargs=(threads,)) as ex:
             futs = {ex.submit(run_fe_point, cfgs[i]): i for i in todo}
             for f in as_completed(futs):
                 store(futs[f], f.result())

@@ -78,6 +78,14 @@ class MeshSection(_Strict):
     #: "below_cut_line" (its top on the cut line: the chip layer is the full h and the
     #: layer is the material crushed under the edge)
     separation_layer: Literal["above_cut_line", "centred", "below_cut_line"] = "centred"
+    #: how chip and workpiece part: "node_split" (doubled nodes along a parting line, tied
+    #: until the tool edge reaches them) or "erosion_layer" (a one-element layer eroded by
+    #: Johnson-Cook damage, placed by ``separation_layer``)
+    separation: Literal["node_split", "erosion_layer"] = "erosion_layer"
+    #: height of the parting line (node_split) -- or of the erosion layer's bottom, when
+    #: given -- above the tool's lowest point [um]: the material below it (the stagnation
+    #: zone) is ploughed under the edge radius instead of leaving with the chip
+    separation_height_um: float | None = Field(default=None, ge=0.0)
     #: uncut material left ahead of the tool at the end of the cut [mm]
     ahead_mm: float = Field(default=0.3, gt=0.0, le=20.0)
 
@@ -97,6 +105,10 @@ class SolverSection(_Strict):
     #: where elements erode when JC damage reaches 1: "layer" (separation layer along the
     #: cut line), "everywhere", or "none"
     erosion: Literal["layer", "everywhere", "none"] = "layer"
+    #: when given, a separation-layer element whose damage reached 1 erodes only once one of
+    #: its nodes is within this distance [um] of the tool surface (the material separates
+    #: at the cutting edge, not ahead of it); None: erode wherever the damage reaches 1
+    separation_gate_um: float | None = Field(default=None, ge=0.0)
     #: erode an element whose area ratio A/A0 or corner Jacobian falls below this (numerical
     #: safety against inverted elements; counted and reported separately); 0 disables
     distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
@@ -108,6 +120,11 @@ class SolverSection(_Strict):
     #: erode an element whose stable time step falls below this fraction of the initial
     #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
     erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
+    #: heat conduction between workpiece elements (finite volumes on the deformed mesh,
+    #: explicit, every ``conduction_interval`` steps); the tool and free surfaces are
+    #: adiabatic. False: adiabatic heating only
+    heat_conduction: bool = False
+    conduction_interval: int = Field(default=10, ge=1, le=10000)
     #: number of force/tool samples over the whole run
     n_samples: int = Field(default=400, ge=10, le=100000)
     #: steps per compiled chunk between progress updates
@@ -168,6 +185,12 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           field="mesh.element_size_um", value=le,
                           expected=f"an element size in um at most uncut_chip_thickness_um/3 "
                           f"= {h / 3.0:.4g} um")
+    sh = cfg.mesh.separation_height_um
+    if sh is not None and sh > h - le + 1e-12:
+        raise ConfigError("separation line too high for the chip thickness", file=source,
+                          field="mesh.separation_height_um", value=sh,
+                          expected=f"a height in um at most uncut_chip_thickness_um - "
+                          f"element_size_um = {h - le:.4g} um (one element row of chip)")
     return cfg
 
 

@@ -35,7 +35,13 @@ P_NRX, P_NRY, P_NFX, P_NFY = 11, 12, 13, 14
 P_VC, P_KX, P_KY, P_CX, P_CY, P_MX, P_MY, P_WIDTH = 15, 16, 17, 18, 19, 20, 21, 22
 P_SAMPLE_DT, P_DTMIN, P_TEND, P_EROSION, P_SUPPORT = 23, 24, 25, 26, 27
 P_RZ_EVERY, P_RZ_OMEGA, P_RZ_MAXMOVE, P_DT_ERODE = 28, 29, 30, 31
-N_PRM = 32
+#: separation gate [m] (a layer element erodes only with a node within this distance of the
+#: tool surface; < 0: no gate) and the current tool edge centre (set every step)
+P_GATE, P_TCX, P_TCY = 32, 33, 34
+#: heat conduction: steps between conduction updates (0: adiabatic), time accumulated since
+#: the last one [s]
+P_COND_EVERY, P_COND_ACC = 35, 36
+N_PRM = 37
 # erosion modes
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 # --- tool state: guide x, y; displacement u, v; velocity of displacement; force
@@ -224,15 +230,27 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
         fey[e, 1] = A * (nsxy * bx2 + fyy * by2) + Qy * g2
         fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
         fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
-        # erosion by Johnson-Cook damage
+        # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
         if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
-            alive[e] = 0
+            gate = prm[P_GATE]
+            if gate < 0.0 or not layer[e]:
+                alive[e] = 0
+            else:
+                gmin = 1e30
+                for k in range(4):
+                    nk = conn[e, k]
+                    g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
+                                           prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
+                    if g < gmin:
+                        gmin = g
+                if gmin <= gate:
+                    alive[e] = 0
 
 
 @njit(parallel=True, cache=True)
 def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
                 cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx, tool_vy,
-                prm, dt):
+                prm, dt, twin, tied):
     """Gather element forces, add tool contact, advance velocities and positions.
 
     Contact uses positions at step n and velocities at n-1/2; ``cfx``/``cfy`` receive the
@@ -240,29 +258,53 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
     ``pen`` the current penalty energy, ``nwork`` (cumulative) the contact work on the node
     [J/m]. Nodes left without a live element are retired (velocity zeroed, their kinetic
     energy booked in ``ero_ke``).
+
+    Node splitting: a node with ``twin[n] >= 0`` and ``tied[n]`` moves with its twin as one
+    node (forces and masses of both, summed in a fixed order so that both copies stay
+    bitwise identical; the contact force is shared half and half). The pair is released
+    (``tied`` = 0) when it comes within ``prm[P_GATE]`` of the tool surface: the material
+    separates where it meets the cutting edge.
     """
     nn = x.shape[0]
     r = prm[P_R]
     nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
     mu, tau, pf = prm[P_MU], prm[P_TAU], prm[P_PEN]
+    gate = prm[P_GATE]
     for n in prange(nn):
         cfx[n] = 0.0
         cfy[n] = 0.0
         pen[n] = 0.0
         if ndead[n]:
             continue
+        tw = twin[n]
+        pair = tw >= 0 and tied[n] != 0
+        # node ids as int64 (the prange index is unsigned: mixing would give floats)
+        na = ptr[0] * 0 + n
+        nb = na - na - 1
+        share = 1.0
+        if pair:
+            nself = twin[tw]
+            na = min(nself, tw)
+            nb = max(nself, tw)
+            share = 0.5
         fx = 0.0
         fy = 0.0
         nlive = 0
         asum = 0.0
-        for k in range(ptr[n], ptr[n + 1]):
-            e = nel[k]
-            if alive[e] == 1:
-                c = ncorner[k]
-                fx -= fex[e, c]
-                fy -= fey[e, c]
-                nlive += 1
-                asum += area0[e]
+        m = 0.0
+        for j in range(2):
+            nk = na if j == 0 else nb
+            if nk < 0:
+                continue
+            m += mass[nk]
+            for k in range(ptr[nk], ptr[nk + 1]):
+                e = nel[k]
+                if alive[e] == 1:
+                    c = ncorner[k]
+                    fx -= fex[e, c]
+                    fy -= fey[e, c]
+                    nlive += 1
+                    asum += area0[e]
         if nlive == 0:
             ndead[n] = 1
             ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
@@ -273,8 +315,9 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
             vx[n] = 0.0
             vy[n] = 0.0
             continue
-        m = mass[n]
         gap, gnx, gny = tool_gap(x[n], y[n], tool_cx, tool_cy, nrx, nry, nfx, nfy, r)
+        if pair and gap <= gate:
+            tied[n] = 0
         fcx = 0.0
         fcy = 0.0
         ft = 0.0
@@ -285,9 +328,9 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
             trib = math.sqrt(asum / nlive)
             fcx, fcy, fn, ft = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf, dt)
             vt0 = -vrx * gny + vry * gnx
-            pen[n] = 0.5 * fn * (-gap)
-        cfx[n] = fcx
-        cfy[n] = fcy
+            pen[n] = share * 0.5 * fn * (-gap)
+        cfx[n] = share * fcx
+        cfy[n] = share * fcy
         ox = vx[n]
         oy = vy[n]
         nvx = ox + dt * (fx + fcx) / m
@@ -297,9 +340,56 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
         x[n] += dt * nvx
         y[n] += dt * nvy
         if gap < 0.0:
-            nwork[n] += dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
+            nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
             vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
-            fric[n] -= dt * ft * 0.5 * (vt0 + vt1)
+            fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
+
+
+@njit(parallel=True, cache=True)
+def conduct(conn, x, y, alive, enbr, temp, tbuf, kcond, rcp, dt_th):
+    """Explicit heat conduction between live elements over ``dt_th`` [s] (finite volumes).
+
+    Element temperatures are cell values on the current (deformed) mesh; across each edge
+    shared by two live elements flows ``G (T_nb - T_e)`` with the two-point conductance
+    ``G = k L_edge / d_centroids * dt_th`` [J/K per m of width]. ``G`` is capped at a quarter
+    of the smaller of the two heat capacities ``rho cp A`` (stability of the explicit update
+    for any element shape; symmetric, so heat is conserved exactly). Eroded elements and
+    free surfaces are adiabatic (so is the tool). ``tbuf`` (n_elem,) is scratch.
+    """
+    ne = conn.shape[0]
+    for e in prange(ne):
+        tbuf[e] = temp[e]
+        if alive[e] != 1:
+            continue
+        i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
+        ax = 0.25 * (x[i1] + x[i2] + x[i3] + x[i4])
+        ay = 0.25 * (y[i1] + y[i2] + y[i3] + y[i4])
+        ae = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+        ce = rcp * ae
+        dq = 0.0
+        for k in range(4):
+            nb = enbr[e, k]
+            if nb < 0 or alive[nb] != 1:
+                continue
+            j1, j2, j3, j4 = conn[nb, 0], conn[nb, 1], conn[nb, 2], conn[nb, 3]
+            bx = 0.25 * (x[j1] + x[j2] + x[j3] + x[j4])
+            by = 0.25 * (y[j1] + y[j2] + y[j3] + y[j4])
+            an = 0.5 * ((x[j3] - x[j1]) * (y[j4] - y[j2]) + (x[j2] - x[j4]) * (y[j3] - y[j1]))
+            na = conn[e, k]
+            nb2 = conn[e, (k + 1) % 4]
+            ledge = math.sqrt((x[nb2] - x[na]) ** 2 + (y[nb2] - y[na]) ** 2)
+            d = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+            if d <= 0.0 or ae <= 0.0 or an <= 0.0:
+                continue
+            g = kcond * ledge / d * dt_th
+            gmax = 0.25 * rcp * min(ae, an)
+            if g > gmax:
+                g = gmax
+            dq += g * (temp[nb] - temp[e])
+        if ce > 0.0:
+            tbuf[e] = temp[e] + dq / ce
+    for e in prange(ne):
+        temp[e] = tbuf[e]
 
 
 @njit(cache=True)
@@ -340,7 +430,7 @@ def _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork,
 def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
-              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf):
+              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -365,7 +455,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         tvx = -vc + tool[T_VUX]
         tvy = tool[T_VUY]
         node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
-                    cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy, prm, dt)
+                    cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy, prm, dt,
+                    twin, tied)
         fwx = 0.0
         fwy = 0.0
         ncont = 0
@@ -394,9 +485,18 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
             rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
                    sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
                    prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE])
+        prm[P_TCX] = tool[T_GX] + tool[T_UX]
+        prm[P_TCY] = tool[T_GY] + tool[T_UY]
         element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
                        temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
                        prm, dt, erosion)
+        cond_every = int(prm[P_COND_EVERY])
+        if cond_every > 0:
+            prm[P_COND_ACC] += dt
+            if ist[I_STEP] % cond_every == 0:
+                conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND],
+                        mat[jc.RHO] * mat[jc.CP], prm[P_COND_ACC])
+                prm[P_COND_ACC] = 0.0
         dtmin = 1e30
         for e in range(ne):
             if dte[e] < dtmin:

@@ -63,6 +63,10 @@ class CuttingMesh:
     y_cut: float
     element_size: float
     layer_top: float
+    #: node splitting (``split_height`` given): partner of each node on the parting line
+    #: (-1 elsewhere); the copy used by the chip elements above has ``upper`` True
+    twin: np.ndarray | None = None
+    upper: np.ndarray | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -75,19 +79,31 @@ class CuttingMesh:
 
 def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
                fine_depth_factor: float = 1.0, height_factor: float = 5.0,
-               grading: float = 1.25, layer_offset: float = 0.5) -> CuttingMesh:
+               grading: float = 1.25, layer_offset: float = 0.5,
+               split_height: float | None = None) -> CuttingMesh:
     """Graded mesh for uncut chip thickness ``h`` [m], element size ``le`` [m], cut length [m].
 
     The workpiece spans x in [0, ahead + cut_length]; the cut runs from the right end to
     x = ahead. ``layer_offset`` places the separation layer: its top is at
     y = -h + layer_offset * le (1: the layer lies just above the cut line, 0.5: centred on it).
+
+    With ``split_height`` [m] there is no separation layer: the nodes of the parting line
+    y = -h + split_height are doubled (the chip elements above use one copy, the workpiece
+    below the other; ``twin`` pairs them) so the solver can tie them and split them where
+    the tool edge reaches them.
     """
-    top_chip = -(h - layer_offset * le)
+    if split_height is not None:
+        top_chip = -(h - split_height)
+    else:
+        top_chip = -(h - layer_offset * le)
     n_chip = max(1, int(round(-top_chip / le)))
     y_rows = [0.0]
     y_rows += list(np.linspace(0.0, top_chip, n_chip + 1)[1:])
-    y_rows.append(top_chip - le)  # separation layer
-    layer_row = n_chip  # row index from the top
+    if split_height is None:
+        y_rows.append(top_chip - le)  # separation layer
+        layer_row = n_chip  # row index from the top
+    else:
+        layer_row = -10  # no layer row
     fine_depth = fine_depth_factor * h
     n_fine = max(1, int(round(fine_depth / le)))
     y0 = y_rows[-1]
@@ -130,6 +146,24 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
             layer[e] = j == layer_e_row
             chip[e] = j in chip_rows
             e += 1
+    twin = upper = None
+    if split_height is not None:
+        # double the parting-line nodes (not the fixed one at x = 0): the elements of the
+        # row above (the chip's bottom row) take the new copies
+        jrow = n_ey - n_chip  # node row of the parting line
+        row_nodes = jrow * nxn + np.arange(1, nxn)
+        n_old = nodes.shape[0]
+        new_ids = n_old + np.arange(row_nodes.size)
+        nodes = np.vstack([nodes, nodes[row_nodes]])
+        remap = np.arange(nodes.shape[0])
+        remap[row_nodes] = new_ids
+        above = np.arange(jrow * n_ex, (jrow + 1) * n_ex)  # element row jrow (above line)
+        conn[above] = remap[conn[above]]
+        twin = -np.ones(nodes.shape[0], dtype=np.int64)
+        twin[row_nodes] = new_ids
+        twin[new_ids] = row_nodes
+        upper = np.zeros(nodes.shape[0], dtype=bool)
+        upper[new_ids] = True
     fixed = (np.abs(nodes[:, 0]) < 1e-15) | (np.abs(nodes[:, 1] - yc[0]) < 1e-15)
     surface = np.abs(nodes[:, 1]) < 1e-15
     n_nodes = nodes.shape[0]
@@ -148,4 +182,4 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
     return CuttingMesh(nodes=nodes, conn=conn, layer=layer, chip=chip, fixed=fixed,
                        surface=surface, node_elems_ptr=ptr, node_elems=ne, node_corner=nc,
                        length=total, height=-yc[0], y_cut=-h, element_size=le,
-                       layer_top=top_chip)
+                       layer_top=top_chip, twin=twin, upper=upper)

@@ -58,7 +58,8 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     surface by more than h and at least 1.5 h along the rake from the edge. For each outer
     node, thickness = distance to the inner polyline, and the ratio divides it by the
     original thickness of the surviving material of that column (0 - y0 of the inner node);
-    the reported ratio is the median.
+    the reported ratio is the median. With node splitting (no material lost) the ratio is
+    the experimental one, chip thickness / uncut chip thickness h.
     """
     le = mesh.element_size
     y_inner0 = mesh.layer_top
@@ -69,6 +70,9 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     alive_n = ~st.ndead
     s_along = (x - cx) * trx + (y - cy) * try_
     passed = alive_n & (st.x0 > cx) & (st.y0 > y_inner0 - 1e-3 * le)
+    split = mesh.twin is not None
+    if split:  # node splitting: the lower copies of the parting line stay with the work
+        passed &= ~((mesh.twin >= 0) & ~mesh.upper)
     formed = passed & (y > h) & (s_along > 1.5 * h)
     outer = formed & (np.abs(st.y0) < 1e-3 * le)
     h_chip0 = -mesh.layer_top
@@ -93,7 +97,8 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     # original thickness of the surviving material near each outer node's column
     near = np.argmin(np.abs(st.x0[outer][:, None] - np.array(kept)[None, :]), axis=1)
     t0 = -ly0[near]
-    ratios = d / t0
+    # node splitting loses no material: the ratio is the measured one, chip thickness / h
+    ratios = d / h if split else d / t0
     tc = float(np.median(d))
     ratio = float(np.median(ratios))
     return ChipGeometry(tc, float(np.median(t0)), ratio, shear_angle_deg(ratio, rake),

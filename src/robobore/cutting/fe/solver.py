@@ -82,6 +82,11 @@ class FEState:
     buf: np.ndarray = field(default=None)  # type: ignore[assignment]
     x0: np.ndarray = field(default=None)  # type: ignore[assignment]
     y0: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: node splitting: partner node (-1: none) and whether the pair is still tied
+    twin: np.ndarray = field(default=None)  # type: ignore[assignment]
+    tied: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: scratch for the heat-conduction update (n_elem,)
+    tbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -91,7 +96,7 @@ class FEState:
                 self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
-                self.buf)
+                self.buf, self.twin, self.tied, self.tbuf)
 
     @property
     def n_elements(self) -> int:
@@ -121,13 +126,14 @@ def default_prm() -> np.ndarray:
     p[K.P_SAMPLE_DT] = 1e30
     p[K.P_TEND] = 1e30
     p[K.P_EROSION] = K.ERODE_NONE
+    p[K.P_GATE] = -1.0
     return p
 
 
 def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
                prm: np.ndarray | None = None, layer: np.ndarray | None = None,
-               n_samples: int = 1, tool_center: tuple[float, float] = (1e3, 1e3)
-               ) -> FEState:
+               n_samples: int = 1, tool_center: tuple[float, float] = (1e3, 1e3),
+               twin: np.ndarray | None = None) -> FEState:
     """State for a quad mesh ``nodes`` (n, 2) [m], ``conn`` (e, 4) counter-clockwise.
 
     Lumped nodal masses from the (mass-scaled) density; stresses zero; temperature at
@@ -177,7 +183,11 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
         hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
         enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64),
-        snbr=np.zeros((0, 4), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)))
+        snbr=np.zeros((0, 4), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)),
+        twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
+        tied=(np.zeros(n, np.int64) if twin is None
+              else (np.asarray(twin) >= 0).astype(np.int64)),
+        tbuf=z(ne))
     init_forces(st)
     return st
 
@@ -276,6 +286,22 @@ class CuttingSetup:
     mu: float
 
 
+def _layer_offset(cfg: FEConfig, le: float) -> float:
+    """Top of the separation layer above the cut line, in element sizes (see build_mesh)."""
+    if cfg.mesh.separation_height_um is not None:
+        return 1.0 + cfg.mesh.separation_height_um * 1e-6 / le
+    return {"above_cut_line": 1.0, "centred": 0.5, "below_cut_line": 0.0}[
+        cfg.mesh.separation_layer]
+
+
+def _split_height(cfg: FEConfig) -> float | None:
+    """Parting-line height above the cut line [m] for node splitting, else None."""
+    if cfg.mesh.separation != "node_split":
+        return None
+    sh = cfg.mesh.separation_height_um
+    return (0.0 if sh is None else sh) * 1e-6
+
+
 def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     """Build mesh, tool and state for the orthogonal-cutting model of ``cfg``."""
     mat = load_material(cfg.material.name, source=source)
@@ -289,9 +315,8 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     mesh = build_mesh(h, le, L, ahead=cfg.mesh.ahead_mm * 1e-3,
                       fine_depth_factor=cfg.mesh.fine_depth_factor,
                       height_factor=cfg.mesh.height_factor, grading=cfg.mesh.grading,
-                      layer_offset={"above_cut_line": 1.0, "centred": 0.5,
-                                    "below_cut_line": 0.0}[
-                          cfg.mesh.separation_layer])
+                      layer_offset=_layer_offset(cfg, le),
+                      split_height=_split_height(cfg))
     s = cfg.solver
     p = default_prm()
     p[K.P_CFL] = s.cfl
@@ -328,8 +353,12 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p[K.P_RZ_OMEGA] = s.rezone_relaxation
     p[K.P_RZ_MAXMOVE] = 0.2
     p[K.P_DT_ERODE] = -s.erode_time_step_fraction
+    p[K.P_COND_EVERY] = s.conduction_interval if s.heat_conduction else 0
+    p[K.P_GATE] = -1.0 if s.separation_gate_um is None else s.separation_gate_um * 1e-6
+    if cfg.mesh.separation == "node_split" and s.separation_gate_um is None:
+        p[K.P_GATE] = 0.0
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, layer=mesh.layer,
-                    n_samples=s.n_samples, tool_center=(cx0, cy0))
+                    n_samples=s.n_samples, tool_center=(cx0, cy0), twin=mesh.twin)
     if s.rezone_interval > 0:
         st.snodes, st.snbr = smoothing_stencil(mesh)
     if ts is not None:
