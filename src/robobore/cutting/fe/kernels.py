@@ -67,6 +67,8 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
                    erosion):
     """Stress update and element nodal forces at the new configuration.
 
+    Returns ``(dtmin, bad)``: the smallest element stable step [s] (1e30 when no element is
+    alive) and the largest index of an inverted element (-1: none).
     Writes ``fex``/``fey`` (n_elem, 4) internal nodal forces [N/m], ``dte`` (n_elem,) the
     element stable step [s], ``ie`` internal energy per element [J/m] (cumulative),
     ``plast`` plastic work per element [J/m], ``hge`` hourglass work [J/m]. Erodes
@@ -88,6 +90,8 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
     bv2 = prm[P_BV2]
     dlim = prm[P_DIST]
     dt_erode = prm[P_DT_ERODE]
+    dtmin = 1e30
+    bad = -1
     for e in prange(ne):
         if alive[e] != 1:
             for k in range(4):
@@ -111,6 +115,8 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
         if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
             # inverted (-2: an error unless the distortion limit caught it) or distorted (-1)
             alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
+            if alive[e] == -2:
+                bad = max(bad, e)
             for k in range(4):
                 fex[e, k] = 0.0
                 fey[e, k] = 0.0
@@ -191,6 +197,7 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
             qrate = bv1 * c + bv2 * le * (-trd)
             qbv = rho_c * le * qrate * (-trd)
         dte[e] = le / (qrate + math.sqrt(qrate * qrate + c * c))
+        dtmin = min(dtmin, dte[e])
         if dte[e] < dt_erode:
             # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
             # element whose stable step fell below the floor is deleted
@@ -245,6 +252,7 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
                         gmin = g
                 if gmin <= gate:
                     alive[e] = 0
+    return dtmin, bad
 
 
 @njit(parallel=True, cache=True)
@@ -253,7 +261,9 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
                 prm, dt, twin, tied):
     """Gather element forces, add tool contact, advance velocities and positions.
 
-    Contact uses positions at step n and velocities at n-1/2; ``cfx``/``cfy`` receive the
+    Returns ``(fx, fy, n_contact)``: the total contact force on the workpiece [N/m] and the
+    number of nodes in contact. Contact uses positions at step n and velocities at n-1/2;
+    ``cfx``/``cfy`` receive the
     contact force on each node [N/m]; ``fric`` (cumulative) the frictional dissipation,
     ``pen`` the current penalty energy, ``nwork`` (cumulative) the contact work on the node
     [J/m]. Nodes left without a live element are retired (velocity zeroed, their kinetic
@@ -270,6 +280,9 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
     nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
     mu, tau, pf = prm[P_MU], prm[P_TAU], prm[P_PEN]
     gate = prm[P_GATE]
+    fsx = 0.0
+    fsy = 0.0
+    ncont = 0
     for n in prange(nn):
         cfx[n] = 0.0
         cfy[n] = 0.0
@@ -331,6 +344,10 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
             pen[n] = share * 0.5 * fn * (-gap)
         cfx[n] = share * fcx
         cfy[n] = share * fcy
+        if fcx != 0.0 or fcy != 0.0:
+            fsx += share * fcx
+            fsy += share * fcy
+            ncont += 1
         ox = vx[n]
         oy = vy[n]
         nvx = ox + dt * (fx + fcx) / m
@@ -343,6 +360,7 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
             nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
             vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
             fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
+    return fsx, fsy, ncont
 
 
 @njit(parallel=True, cache=True)
@@ -444,8 +462,6 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     cfl = prm[P_CFL]
     rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
-    nn = x.shape[0]
-    ne = conn.shape[0]
     taken = 0
     for _s in range(n_steps):
         dt = clock[1]
@@ -454,17 +470,9 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         cy = tool[T_GY] + tool[T_UY]
         tvx = -vc + tool[T_VUX]
         tvy = tool[T_VUY]
-        node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
-                    cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy, prm, dt,
-                    twin, tied)
-        fwx = 0.0
-        fwy = 0.0
-        ncont = 0
-        for n in range(nn):
-            if cfx[n] != 0.0 or cfy[n] != 0.0:
-                fwx += cfx[n]
-                fwy += cfy[n]
-                ncont += 1
+        fwx, fwy, ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
+                                      area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
+                                      nwork, cx, cy, tvx, tvy, prm, dt, twin, tied)
         # force on the tool = - force on the workpiece [N/m]
         tool[T_FX] = -fwx
         tool[T_FY] = -fwy
@@ -487,9 +495,9 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
                    prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE])
         prm[P_TCX] = tool[T_GX] + tool[T_UX]
         prm[P_TCY] = tool[T_GY] + tool[T_UY]
-        element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
-                       temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
-                       prm, dt, erosion)
+        dtmin, bad = element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy,
+                                    pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex,
+                                    fey, dte, plast, rate, mat, prm, dt, erosion)
         cond_every = int(prm[P_COND_EVERY])
         if cond_every > 0:
             prm[P_COND_ACC] += dt
@@ -497,14 +505,9 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
                 conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND],
                         mat[jc.RHO] * mat[jc.CP], prm[P_COND_ACC])
                 prm[P_COND_ACC] = 0.0
-        dtmin = 1e30
-        for e in range(ne):
-            if dte[e] < dtmin:
-                dtmin = dte[e]
-            if alive[e] == -2:
-                ist[I_BADELEM] = e
-                ist[I_STATUS] = STATUS_INVERTED
-        if ist[I_STATUS] == STATUS_INVERTED:
+        if bad >= 0:
+            ist[I_BADELEM] = bad
+            ist[I_STATUS] = STATUS_INVERTED
             return taken + 1
         if dtmin >= 1e30:
             ist[I_STATUS] = STATUS_NO_ELEMENTS
