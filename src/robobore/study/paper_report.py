@@ -319,9 +319,11 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                       caption="Virtual orthogonal cutting tests (2D FE) and the fit")
         for w in coeffs.get("warnings", []):
             rep.add_note("Calibration warning: " + w + ".")
-        rep.add_note("The 2D FE engine under-predicts the measured TC4 forces (about -20 % "
-                     "cutting, -75 % feed force, see docs/fe.md); the FE-calibrated "
-                     "coefficients inherit that bias.")
+        rep.add_note("The 2D FE engine under-predicts the measured TC4 orthogonal forces of "
+                     "Ducobu et al. (with the example's 10 um elements and node splitting: "
+                     "-12 to -28 % cutting, -55 to -70 % feed force; the forces also depend "
+                     "on the engine's numerical erosion limits, see docs/fe.md); the "
+                     "FE-calibrated coefficients inherit that bias.")
 
     # ---------------------------------------------------------------- figures
     rep.add_section("Simulated boring: forces and vibration")
