@@ -59,6 +59,11 @@ def main() -> None:
                     help="mesh.separation (default: the engine's default)")
     ap.add_argument("--separation-height-um", type=float, default=None,
                     help="mesh.separation_height_um (default: the engine's default)")
+    ap.add_argument("--conduction", action="store_true", help="solver.heat_conduction = true")
+    ap.add_argument("--distortion-limit", type=float, default=None,
+                    help="solver.distortion_limit (default: the engine's default)")
+    ap.add_argument("--erode-dt-fraction", type=float, default=None,
+                    help="solver.erode_time_step_fraction (default: the engine's default)")
     args = ap.parse_args()
     ref = json.loads(args.data.read_text())["measured"]
     pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
@@ -67,7 +72,9 @@ def main() -> None:
     rows = []
     print(f"# FE orthogonal validation: length {args.length_mm} mm, element "
           f"{args.element_um} um, separation {args.separation or 'default'} "
-          f"(height {args.separation_height_um} um), load {os.getloadavg()[0]:.1f}")
+          f"(height {args.separation_height_um} um), conduction {args.conduction}, erosion "
+          f"limits {args.distortion_limit} / {args.erode_dt_fraction}, "
+          f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} | {'E err':>6} {'wall s':>6}")
     print(hdr)
@@ -80,8 +87,15 @@ def main() -> None:
             mesh["separation"] = args.separation
         if args.separation_height_um is not None:
             mesh["separation_height_um"] = args.separation_height_um
+        solver: dict = {}
+        if args.conduction:
+            solver["heat_conduction"] = True
+        if args.distortion_limit is not None:
+            solver["distortion_limit"] = args.distortion_limit
+        if args.erode_dt_fraction is not None:
+            solver["erode_time_step_fraction"] = args.erode_dt_fraction
         cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3),
-                                  {"mesh": mesh} if mesh else None))
+                                  {"mesh": mesh, "solver": solver}))
         res = simulate_orthogonal(cfg)
         s = res.summary
         fc_m, ff_m, r_m = ref["Fc"][hk][vk], ref["Ff"][hk][vk], ref["chip_ratio"][hk][vk]
