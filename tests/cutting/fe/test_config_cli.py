@@ -36,6 +36,17 @@ def test_contract_example_parses():
     assert cfg.solver.mass_scaling == 100.0
 
 
+@pytest.mark.parametrize("name", sorted(p.name for p in EXAMPLE.parent.glob("fe_orthogonal*.toml")))
+def test_every_orthogonal_example_parses(name):
+    cfg = load_fe_config(EXAMPLE.parent / name)
+    assert cfg.cut.length_mm > 0
+
+
+def test_separation_line_must_leave_a_chip_row():
+    with pytest.raises(ConfigError, match="separation_height_um"):
+        parse_config(_with("mesh", "separation_height_um", 55.0))
+
+
 def test_friction_table_interpolates():
     cfg = parse_config(_with("contact", "friction", "table"))
     assert cfg.friction_coefficient() == pytest.approx(0.18)
