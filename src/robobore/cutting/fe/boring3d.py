@@ -41,6 +41,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from robobore.cutting.fe import kernels3d as K3
+from robobore.cutting.fe.solver import apply_solver_settings
 from robobore.cutting.fe.solver3d import (
     FEState3,
     advance3,
@@ -314,17 +315,7 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     mesh = build_boring_mesh(ins, ap, f, le, L, cfg.mesh.depth_factor,
                              cfg.mesh.side_margin_um * 1e-6, cfg.mesh.ahead_mm * 1e-3)
     s = cfg.solver
-    p = default_prm3()
-    p[K3.P_CFL] = s.cfl
-    p[K3.P_MS] = s.mass_scaling
-    p[K3.P_HGV] = s.hourglass_viscous
-    p[K3.P_HGS] = s.hourglass_stiffness
-    p[K3.P_BV1] = s.bulk_viscosity_linear
-    p[K3.P_BV2] = s.bulk_viscosity_quadratic
-    p[K3.P_DIST] = s.distortion_limit
-    p[K3.P_DT_ERODE] = -s.erode_time_step_fraction
-    p[K3.P_EROSION] = {"none": K3.ERODE_NONE, "layer": K3.ERODE_LAYER,
-                       "everywhere": K3.ERODE_ALL}[s.erosion]
+    p = apply_solver_settings(default_prm3(), s, K3)
     p[K3.P_MU] = cfg.contact.friction
     p[K3.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K3.P_PEN] = cfg.contact.penalty_factor

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.physics import contact_force, radial_return, tool_gap, tool_support_step
@@ -291,14 +292,14 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
             continue
         tw = twin[n]
         pair = tw >= 0 and tied[n] != 0
-        # node ids as int64 (the prange index is unsigned: mixing would give floats)
-        na = ptr[0] * 0 + n
-        nb = na - na - 1
+        # node ids as int64 (the prange index is unsigned: mixing would give floats); a
+        # tied pair is gathered in a fixed order so that both copies compute the same sums
+        na = np.int64(n)
+        nb = np.int64(-1)
         share = 1.0
         if pair:
-            nself = twin[tw]
-            na = min(nself, tw)
-            nb = max(nself, tw)
+            nb = max(na, tw)
+            na = min(na, tw)
             share = 0.5
         fx = 0.0
         fy = 0.0
@@ -372,42 +373,40 @@ def conduct(conn, x, y, alive, enbr, temp, tbuf, kcond, rcp, dt_th):
     ``G = k L_edge / d_centroids * dt_th`` [J/K per m of width]. ``G`` is capped at a quarter
     of the smaller of the two heat capacities ``rho cp A`` (stability of the explicit update
     for any element shape; symmetric, so heat is conserved exactly). Eroded elements and
-    free surfaces are adiabatic (so is the tool). ``tbuf`` (n_elem,) is scratch.
+    free surfaces are adiabatic (so is the tool). ``tbuf`` (n_elem, 4) is scratch: centroid
+    x, y and area of every element, then its new temperature.
     """
     ne = conn.shape[0]
     for e in prange(ne):
-        tbuf[e] = temp[e]
-        if alive[e] != 1:
-            continue
         i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-        ax = 0.25 * (x[i1] + x[i2] + x[i3] + x[i4])
-        ay = 0.25 * (y[i1] + y[i2] + y[i3] + y[i4])
-        ae = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-        ce = rcp * ae
+        tbuf[e, 0] = 0.25 * (x[i1] + x[i2] + x[i3] + x[i4])
+        tbuf[e, 1] = 0.25 * (y[i1] + y[i2] + y[i3] + y[i4])
+        tbuf[e, 2] = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+    for e in prange(ne):
+        tbuf[e, 3] = temp[e]
+        ae = tbuf[e, 2]
+        if alive[e] != 1 or ae <= 0.0:
+            continue
         dq = 0.0
         for k in range(4):
             nb = enbr[e, k]
             if nb < 0 or alive[nb] != 1:
                 continue
-            j1, j2, j3, j4 = conn[nb, 0], conn[nb, 1], conn[nb, 2], conn[nb, 3]
-            bx = 0.25 * (x[j1] + x[j2] + x[j3] + x[j4])
-            by = 0.25 * (y[j1] + y[j2] + y[j3] + y[j4])
-            an = 0.5 * ((x[j3] - x[j1]) * (y[j4] - y[j2]) + (x[j2] - x[j4]) * (y[j3] - y[j1]))
+            an = tbuf[nb, 2]
             na = conn[e, k]
             nb2 = conn[e, (k + 1) % 4]
             ledge = math.sqrt((x[nb2] - x[na]) ** 2 + (y[nb2] - y[na]) ** 2)
-            d = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
-            if d <= 0.0 or ae <= 0.0 or an <= 0.0:
+            d = math.sqrt((tbuf[nb, 0] - tbuf[e, 0]) ** 2 + (tbuf[nb, 1] - tbuf[e, 1]) ** 2)
+            if d <= 0.0 or an <= 0.0:
                 continue
             g = kcond * ledge / d * dt_th
             gmax = 0.25 * rcp * min(ae, an)
             if g > gmax:
                 g = gmax
             dq += g * (temp[nb] - temp[e])
-        if ce > 0.0:
-            tbuf[e] = temp[e] + dq / ce
+        tbuf[e, 3] = temp[e] + dq / (rcp * ae)
     for e in prange(ne):
-        temp[e] = tbuf[e]
+        temp[e] = tbuf[e, 3]
 
 
 @njit(cache=True)

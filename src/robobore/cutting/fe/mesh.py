@@ -64,9 +64,15 @@ class CuttingMesh:
     element_size: float
     layer_top: float
     #: node splitting (``split_height`` given): partner of each node on the parting line
-    #: (-1 elsewhere); the copy used by the chip elements above has ``upper`` True
+    #: (-1 elsewhere); the copy used by the chip elements above is the one added last
     twin: np.ndarray | None = None
-    upper: np.ndarray | None = None
+
+    @property
+    def upper(self) -> np.ndarray | None:
+        """Node splitting: True for the parting-line copies the chip elements use."""
+        if self.twin is None:
+            return None
+        return (self.twin >= 0) & (self.twin < np.arange(self.twin.size))
 
     @property
     def n_nodes(self) -> int:
@@ -146,7 +152,7 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
             layer[e] = j == layer_e_row
             chip[e] = j in chip_rows
             e += 1
-    twin = upper = None
+    twin = None
     if split_height is not None:
         # double the parting-line nodes (not the fixed one at x = 0): the elements of the
         # row above (the chip's bottom row) take the new copies
@@ -162,8 +168,6 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
         twin = -np.ones(nodes.shape[0], dtype=np.int64)
         twin[row_nodes] = new_ids
         twin[new_ids] = row_nodes
-        upper = np.zeros(nodes.shape[0], dtype=bool)
-        upper[new_ids] = True
     fixed = (np.abs(nodes[:, 0]) < 1e-15) | (np.abs(nodes[:, 1] - yc[0]) < 1e-15)
     surface = np.abs(nodes[:, 1]) < 1e-15
     n_nodes = nodes.shape[0]
@@ -182,4 +186,4 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
     return CuttingMesh(nodes=nodes, conn=conn, layer=layer, chip=chip, fixed=fixed,
                        surface=surface, node_elems_ptr=ptr, node_elems=ne, node_corner=nc,
                        length=total, height=-yc[0], y_cut=-h, element_size=le,
-                       layer_top=top_chip, twin=twin, upper=upper)
+                       layer_top=top_chip, twin=twin)

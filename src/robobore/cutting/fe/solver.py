@@ -85,7 +85,7 @@ class FEState:
     #: node splitting: partner node (-1: none) and whether the pair is still tied
     twin: np.ndarray = field(default=None)  # type: ignore[assignment]
     tied: np.ndarray = field(default=None)  # type: ignore[assignment]
-    #: scratch for the heat-conduction update (n_elem,)
+    #: scratch for the heat-conduction update (n_elem, 4)
     tbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
@@ -187,7 +187,7 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),
-        tbuf=z(ne))
+        tbuf=z((ne, 4)))
     init_forces(st)
     return st
 
@@ -286,6 +286,26 @@ class CuttingSetup:
     mu: float
 
 
+def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
+    """Write the solver settings shared by the 2D and 3D configs into ``p`` (returned).
+
+    ``s`` is a ``[solver]`` section (2D or 3D), ``kernels`` the engine's kernel module (its
+    ``P_*`` indices and ``ERODE_*`` codes).
+    """
+    k = kernels
+    p[k.P_CFL] = s.cfl
+    p[k.P_MS] = s.mass_scaling
+    p[k.P_HGV] = s.hourglass_viscous
+    p[k.P_HGS] = s.hourglass_stiffness
+    p[k.P_BV1] = s.bulk_viscosity_linear
+    p[k.P_BV2] = s.bulk_viscosity_quadratic
+    p[k.P_DIST] = s.distortion_limit
+    p[k.P_DT_ERODE] = -s.erode_time_step_fraction
+    p[k.P_EROSION] = {"none": k.ERODE_NONE, "layer": k.ERODE_LAYER,
+                      "everywhere": k.ERODE_ALL}[s.erosion]
+    return p
+
+
 def _layer_offset(cfg: FEConfig, le: float) -> float:
     """Top of the separation layer above the cut line, in element sizes (see build_mesh)."""
     if cfg.mesh.separation_height_um is not None:
@@ -318,14 +338,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                       layer_offset=_layer_offset(cfg, le),
                       split_height=_split_height(cfg))
     s = cfg.solver
-    p = default_prm()
-    p[K.P_CFL] = s.cfl
-    p[K.P_MS] = s.mass_scaling
-    p[K.P_HGV] = s.hourglass_viscous
-    p[K.P_HGS] = s.hourglass_stiffness
-    p[K.P_BV1] = s.bulk_viscosity_linear
-    p[K.P_BV2] = s.bulk_viscosity_quadratic
-    p[K.P_DIST] = s.distortion_limit
+    p = apply_solver_settings(default_prm(), s, K)
     mu = cfg.friction_coefficient()
     p[K.P_MU] = mu
     p[K.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
@@ -335,8 +348,6 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p[K.P_NFX], p[K.P_NFY] = math.sin(clr), -math.cos(clr)
     p[K.P_VC] = vc
     p[K.P_WIDTH] = cfg.cut.width_mm * 1e-3
-    p[K.P_EROSION] = {"none": K.ERODE_NONE, "layer": K.ERODE_LAYER,
-                      "everywhere": K.ERODE_ALL}[s.erosion]
     gap0 = 0.5 * le
     cx0 = mesh.length + r + gap0
     cy0 = -h + r
@@ -352,11 +363,11 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p[K.P_RZ_EVERY] = s.rezone_interval
     p[K.P_RZ_OMEGA] = s.rezone_relaxation
     p[K.P_RZ_MAXMOVE] = 0.2
-    p[K.P_DT_ERODE] = -s.erode_time_step_fraction
     p[K.P_COND_EVERY] = s.conduction_interval if s.heat_conduction else 0
-    p[K.P_GATE] = -1.0 if s.separation_gate_um is None else s.separation_gate_um * 1e-6
-    if cfg.mesh.separation == "node_split" and s.separation_gate_um is None:
-        p[K.P_GATE] = 0.0
+    if s.separation_gate_um is not None:
+        p[K.P_GATE] = s.separation_gate_um * 1e-6
+    elif cfg.mesh.separation == "node_split":
+        p[K.P_GATE] = 0.0  # pairs part when they touch the tool
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, layer=mesh.layer,
                     n_samples=s.n_samples, tool_center=(cx0, cy0), twin=mesh.twin)
     if s.rezone_interval > 0:
