@@ -25,7 +25,13 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from robobore.cutting.fe.physics import contact_force, radial_return, tool_gap, tool_support_step
+from robobore.cutting.fe.physics import (
+    contact_force,
+    jc_damage_increment,
+    radial_return,
+    tool_gap,
+    tool_support_step,
+)
 from robobore.cutting.fe.rezone import rezone
 from robobore.material import johnson_cook as jc
 
@@ -62,20 +68,29 @@ H_EERO, H_NCONT = 12, 13
 N_HIST = 14
 
 
-@njit(parallel=True, cache=True)
-def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp,
-                   dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
-                   erosion):
-    """Stress update and element nodal forces at the new configuration.
+def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                    temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
+                    erosion):
+    """Stress update and nodal forces of quad ``e`` (one element, scalar code).
 
-    Returns ``(dtmin, bad)``: the smallest element stable step [s] (1e30 when no element is
-    alive) and the largest index of an inverted element (-1: none).
-    Writes ``fex``/``fey`` (n_elem, 4) internal nodal forces [N/m], ``dte`` (n_elem,) the
-    element stable step [s], ``ie`` internal energy per element [J/m] (cumulative),
-    ``plast`` plastic work per element [J/m], ``hge`` hourglass work [J/m]. Erodes
-    elements (``alive`` = 0 damage, -1 distortion).
+    The whole per-element update of :func:`element_update`: kinematics at the new
+    configuration, Jaumann rotation, elastic trial, Johnson-Cook radial return, adiabatic
+    heating, damage, bulk viscosity, stable step, internal energy, Flanagan-Belytschko
+    hourglass forces, erosion (damage, optionally gated by the tool distance; distortion;
+    time step). Reads and writes array elements only and allocates nothing, so the same
+    source is compiled for the CPU (:data:`quad_element`) and for a GPU
+    (``numba.cuda.jit(device=True)`` after :func:`robobore.material.johnson_cook.rebind`,
+    in :mod:`robobore.cutting.fe.gpu2d`).
+
+    Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
+    was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
     """
-    ne = conn.shape[0]
+    if alive[e] != 1:
+        for k in range(4):
+            fex[e, k] = 0.0
+            fey[e, k] = 0.0
+        dte[e] = 1e30
+        return 1e30, False
     E = mat[jc.E_MOD]
     nu = mat[jc.NU]
     G = E / (2.0 * (1.0 + nu))
@@ -91,184 +106,202 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
     bv2 = prm[P_BV2]
     dlim = prm[P_DIST]
     dt_erode = prm[P_DT_ERODE]
-    dtmin = 1e30
-    bad = -1
-    for e in prange(ne):
-        if alive[e] != 1:
-            for k in range(4):
-                fex[e, k] = 0.0
-                fey[e, k] = 0.0
-            dte[e] = 1e30
-            continue
-        i1 = conn[e, 0]
-        i2 = conn[e, 1]
-        i3 = conn[e, 2]
-        i4 = conn[e, 3]
-        x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
-        y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
-        A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
-        # corner Jacobians (2x twice the corner triangle area); all > 0 for a convex quad
-        c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
-        c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
-        c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
-        c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
-        cmin = min(min(c1, c2), min(c3, c4))
-        if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
-            # inverted (-2: an error unless the distortion limit caught it) or distorted (-1)
-            alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
-            if alive[e] == -2:
-                bad = max(bad, e)
-            for k in range(4):
-                fex[e, k] = 0.0
-                fey[e, k] = 0.0
-            dte[e] = 1e30
-            continue
-        inv2a = 0.5 / A
-        bx1 = (y2 - y4) * inv2a
-        bx2 = (y3 - y1) * inv2a
-        bx3 = (y4 - y2) * inv2a
-        bx4 = (y1 - y3) * inv2a
-        by1 = (x4 - x2) * inv2a
-        by2 = (x1 - x3) * inv2a
-        by3 = (x2 - x4) * inv2a
-        by4 = (x3 - x1) * inv2a
-        u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
-        w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
-        dvxdx = u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
-        dvxdy = u1 * by1 + u2 * by2 + u3 * by3 + u4 * by4
-        dvydx = w1 * bx1 + w2 * bx2 + w3 * bx3 + w4 * bx4
-        dvydy = w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4
-        dxx = dvxdx
-        dyy = dvydy
-        dxy = 0.5 * (dvxdy + dvydx)
-        spin = 0.5 * (dvxdy - dvydx)
-        trd = dxx + dyy
-        # old total stress (for the midpoint stress power)
-        p_old = pres[e]
-        oxx = sdx[e] - p_old
-        oyy = sdy[e] - p_old
-        oxy = sdxy[e]
-        # Jaumann rotation of the deviatoric stress (zz unaffected in plane strain)
-        sx = sdx[e]
-        sy = sdy[e]
-        sxy = sdxy[e]
-        rs = dt * spin
-        sx_r = sx + 2.0 * rs * sxy
-        sy_r = sy - 2.0 * rs * sxy
-        sxy_r = sxy + rs * (sy - sx)
-        # elastic trial
-        tr3 = trd * dt / 3.0
-        tx = sx_r + 2.0 * G * (dxx * dt - tr3)
-        ty = sy_r + 2.0 * G * (dyy * dt - tr3)
-        tz = sdz[e] + 2.0 * G * (-tr3)
-        txy = sxy_r + 2.0 * G * dxy * dt
-        p_new = p_old - K * trd * dt
-        nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
-                                                       G, a_, b_, n_, c_, m_, e0, tr_, tm_)
-        if dep > 0.0:
-            eps_p[e] += dep
-            rate[e] = dep / dt
-            wp = syld * dep
-            plast[e] += wp * A
-            temp[e] += beta * wp / rcp
-            q = syld
-            if q > 0.0:
-                triax = -p_new / q
-            else:
-                triax = 0.0
-            dmg[e] += jc.jc_damage_increment(dep, triax, dep / dt, temp[e], mat[jc.D1],
-                                             mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
-                                             e0, tr_, tm_)
+    i1 = conn[e, 0]
+    i2 = conn[e, 1]
+    i3 = conn[e, 2]
+    i4 = conn[e, 3]
+    x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
+    y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
+    A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
+    # corner Jacobians (2x twice the corner triangle area); all > 0 for a convex quad
+    c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
+    c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
+    c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
+    c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
+    cmin = min(min(c1, c2), min(c3, c4))
+    if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
+        # inverted (-2: an error unless the distortion limit caught it) or distorted (-1)
+        alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
+        for k in range(4):
+            fex[e, k] = 0.0
+            fey[e, k] = 0.0
+        dte[e] = 1e30
+        return 1e30, alive[e] == -2
+    inv2a = 0.5 / A
+    bx1 = (y2 - y4) * inv2a
+    bx2 = (y3 - y1) * inv2a
+    bx3 = (y4 - y2) * inv2a
+    bx4 = (y1 - y3) * inv2a
+    by1 = (x4 - x2) * inv2a
+    by2 = (x1 - x3) * inv2a
+    by3 = (x2 - x4) * inv2a
+    by4 = (x3 - x1) * inv2a
+    u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
+    w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
+    dvxdx = u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
+    dvxdy = u1 * by1 + u2 * by2 + u3 * by3 + u4 * by4
+    dvydx = w1 * bx1 + w2 * bx2 + w3 * bx3 + w4 * bx4
+    dvydy = w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4
+    dxx = dvxdx
+    dyy = dvydy
+    dxy = 0.5 * (dvxdy + dvydx)
+    spin = 0.5 * (dvxdy - dvydx)
+    trd = dxx + dyy
+    # old total stress (for the midpoint stress power)
+    p_old = pres[e]
+    oxx = sdx[e] - p_old
+    oyy = sdy[e] - p_old
+    oxy = sdxy[e]
+    # Jaumann rotation of the deviatoric stress (zz unaffected in plane strain)
+    sx = sdx[e]
+    sy = sdy[e]
+    sxy = sdxy[e]
+    rs = dt * spin
+    sx_r = sx + 2.0 * rs * sxy
+    sy_r = sy - 2.0 * rs * sxy
+    sxy_r = sxy + rs * (sy - sx)
+    # elastic trial
+    tr3 = trd * dt / 3.0
+    tx = sx_r + 2.0 * G * (dxx * dt - tr3)
+    ty = sy_r + 2.0 * G * (dyy * dt - tr3)
+    tz = sdz[e] + 2.0 * G * (-tr3)
+    txy = sxy_r + 2.0 * G * dxy * dt
+    p_new = p_old - K * trd * dt
+    nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
+                                                   G, a_, b_, n_, c_, m_, e0, tr_, tm_)
+    if dep > 0.0:
+        eps_p[e] += dep
+        rate[e] = dep / dt
+        wp = syld * dep
+        plast[e] += wp * A
+        temp[e] += beta * wp / rcp
+        q = syld
+        if q > 0.0:
+            triax = -p_new / q
         else:
-            rate[e] = 0.0
-        sdx[e] = nsx
-        sdy[e] = nsy
-        sdz[e] = nsz
-        sdxy[e] = nsxy
-        pres[e] = p_new
-        # bulk viscosity (compression only) and stable step
-        rho_c = rho_s * area0[e] / A
-        c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
-        bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
-                + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
-        le = 1.0 / math.sqrt(bsum)
-        qbv = 0.0
-        qrate = 0.0
-        if trd < 0.0:
-            qrate = bv1 * c + bv2 * le * (-trd)
-            qbv = rho_c * le * qrate * (-trd)
-        dte[e] = le / (qrate + math.sqrt(qrate * qrate + c * c))
-        dtmin = min(dtmin, dte[e])
-        if dte[e] < dt_erode:
-            # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
-            # element whose stable step fell below the floor is deleted
-            alive[e] = -1
-        fxx = nsx - p_new - qbv
-        fyy = nsy - p_new - qbv
-        # stress power (midpoint) -> internal energy
-        ie[e] += A * dt * (0.5 * (oxx + fxx) * dxx + 0.5 * (oyy + fyy) * dyy
-                           + (oxy + nsxy) * dxy)
-        # hourglass (Flanagan-Belytschko): gamma vectors for h = (1, -1, 1, -1)
-        hx = x1 - x2 + x3 - x4
-        hy = y1 - y2 + y3 - y4
-        g1 = 0.25 * (1.0 - hx * bx1 - hy * by1)
-        g2 = 0.25 * (-1.0 - hx * bx2 - hy * by2)
-        g3 = 0.25 * (1.0 - hx * bx3 - hy * by3)
-        g4 = 0.25 * (-1.0 - hx * bx4 - hy * by4)
-        qx = g1 * u1 + g2 * u2 + g3 * u3 + g4 * u4
-        qy = g1 * w1 + g2 * w2 + g3 * w3 + g4 * w4
-        # stiffness part: stored, co-rotated, rate-form
-        hsx = qhx[e]
-        hsy = qhy[e]
-        hsx, hsy = hsx + rs * hsy, hsy - rs * hsx
-        kh = hgs * G * A * bsum
-        hsx += dt * kh * qx
-        hsy += dt * kh * qy
-        qhx[e] = hsx
-        qhy[e] = hsy
-        cv = 2.0 * hgv * rho_c * c * math.sqrt(A)
-        Qx = hsx + cv * qx
-        Qy = hsy + cv * qy
-        hge[e] += dt * (Qx * qx + Qy * qy)
-        fex[e, 0] = A * (fxx * bx1 + nsxy * by1) + Qx * g1
-        fex[e, 1] = A * (fxx * bx2 + nsxy * by2) + Qx * g2
-        fex[e, 2] = A * (fxx * bx3 + nsxy * by3) + Qx * g3
-        fex[e, 3] = A * (fxx * bx4 + nsxy * by4) + Qx * g4
-        fey[e, 0] = A * (nsxy * bx1 + fyy * by1) + Qy * g1
-        fey[e, 1] = A * (nsxy * bx2 + fyy * by2) + Qy * g2
-        fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
-        fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
-        # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
-        if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
-            gate = prm[P_GATE]
-            if gate < 0.0 or not layer[e]:
+            triax = 0.0
+        dmg[e] += jc_damage_increment(dep, triax, dep / dt, temp[e], mat[jc.D1],
+                                      mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
+                                      e0, tr_, tm_)
+    else:
+        rate[e] = 0.0
+    sdx[e] = nsx
+    sdy[e] = nsy
+    sdz[e] = nsz
+    sdxy[e] = nsxy
+    pres[e] = p_new
+    # bulk viscosity (compression only) and stable step
+    rho_c = rho_s * area0[e] / A
+    c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
+    bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
+            + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
+    le = 1.0 / math.sqrt(bsum)
+    qbv = 0.0
+    qrate = 0.0
+    if trd < 0.0:
+        qrate = bv1 * c + bv2 * le * (-trd)
+        qbv = rho_c * le * qrate * (-trd)
+    dte_e = le / (qrate + math.sqrt(qrate * qrate + c * c))
+    dte[e] = dte_e
+    if dte_e < dt_erode:
+        # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
+        # element whose stable step fell below the floor is deleted
+        alive[e] = -1
+    fxx = nsx - p_new - qbv
+    fyy = nsy - p_new - qbv
+    # stress power (midpoint) -> internal energy
+    ie[e] += A * dt * (0.5 * (oxx + fxx) * dxx + 0.5 * (oyy + fyy) * dyy
+                       + (oxy + nsxy) * dxy)
+    # hourglass (Flanagan-Belytschko): gamma vectors for h = (1, -1, 1, -1)
+    hx = x1 - x2 + x3 - x4
+    hy = y1 - y2 + y3 - y4
+    g1 = 0.25 * (1.0 - hx * bx1 - hy * by1)
+    g2 = 0.25 * (-1.0 - hx * bx2 - hy * by2)
+    g3 = 0.25 * (1.0 - hx * bx3 - hy * by3)
+    g4 = 0.25 * (-1.0 - hx * bx4 - hy * by4)
+    qx = g1 * u1 + g2 * u2 + g3 * u3 + g4 * u4
+    qy = g1 * w1 + g2 * w2 + g3 * w3 + g4 * w4
+    # stiffness part: stored, co-rotated, rate-form
+    hsx = qhx[e]
+    hsy = qhy[e]
+    hsx, hsy = hsx + rs * hsy, hsy - rs * hsx
+    kh = hgs * G * A * bsum
+    hsx += dt * kh * qx
+    hsy += dt * kh * qy
+    qhx[e] = hsx
+    qhy[e] = hsy
+    cv = 2.0 * hgv * rho_c * c * math.sqrt(A)
+    Qx = hsx + cv * qx
+    Qy = hsy + cv * qy
+    hge[e] += dt * (Qx * qx + Qy * qy)
+    fex[e, 0] = A * (fxx * bx1 + nsxy * by1) + Qx * g1
+    fex[e, 1] = A * (fxx * bx2 + nsxy * by2) + Qx * g2
+    fex[e, 2] = A * (fxx * bx3 + nsxy * by3) + Qx * g3
+    fex[e, 3] = A * (fxx * bx4 + nsxy * by4) + Qx * g4
+    fey[e, 0] = A * (nsxy * bx1 + fyy * by1) + Qy * g1
+    fey[e, 1] = A * (nsxy * bx2 + fyy * by2) + Qy * g2
+    fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
+    fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
+    # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
+    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+        gate = prm[P_GATE]
+        if gate < 0.0 or not layer[e]:
+            alive[e] = 0
+        else:
+            gmin = 1e30
+            for k in range(4):
+                nk = conn[e, k]
+                g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
+                                       prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
+                if g < gmin:
+                    gmin = g
+            if gmin <= gate:
                 alive[e] = 0
-            else:
-                gmin = 1e30
-                for k in range(4):
-                    nk = conn[e, k]
-                    g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
-                                           prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
-                    if g < gmin:
-                        gmin = g
-                if gmin <= gate:
-                    alive[e] = 0
-    return dtmin, bad
+    return dte_e, False
+
+
+quad_element = njit(cache=True, inline="always")(quad_element_py)
 
 
 @njit(parallel=True, cache=True)
-def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
-                cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx, tool_vy,
-                prm, dt, twin, tied):
-    """Gather element forces, add tool contact, advance velocities and positions.
+def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp,
+                   dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
+                   erosion):
+    """Stress update and element nodal forces at the new configuration.
 
-    Returns ``(fx, fy, n_contact)``: the total contact force on the workpiece [N/m] and the
-    number of nodes in contact. Contact uses positions at step n and velocities at n-1/2;
-    ``cfx``/``cfy`` receive the
-    contact force on each node [N/m]; ``fric`` (cumulative) the frictional dissipation,
-    ``pen`` the current penalty energy, ``nwork`` (cumulative) the contact work on the node
-    [J/m]. Nodes left without a live element are retired (velocity zeroed, their kinetic
-    energy booked in ``ero_ke``).
+    Returns ``(dtmin, bad)``: the smallest element stable step [s] (1e30 when no element is
+    alive) and the largest index of an inverted element (-1: none).
+    Writes ``fex``/``fey`` (n_elem, 4) internal nodal forces [N/m], ``dte`` (n_elem,) the
+    element stable step [s], ``ie`` internal energy per element [J/m] (cumulative),
+    ``plast`` plastic work per element [J/m], ``hge`` hourglass work [J/m]. Erodes
+    elements (``alive`` = 0 damage, -1 distortion).
+    """
+    ne = conn.shape[0]
+    dtmin = 1e30
+    bad = -1
+    for e in prange(ne):
+        d, inv = quad_element(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
+                              eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
+                              rate, mat, prm, dt, erosion)
+        dtmin = min(dtmin, d)
+        if inv:
+            bad = max(bad, e)
+    return dtmin, bad
+
+
+def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
+                 cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx,
+                 tool_vy, prm, dt, twin, tied):
+    """Gather element forces on node ``n``, add tool contact, advance its velocity and position.
+
+    One node of :func:`node_update` (scalar code, allocates nothing: compiled for the CPU as
+    :data:`quad_node` and for a GPU in :mod:`robobore.cutting.fe.gpu2d`). Returns
+    ``(fx, fy, touched)``: this node's contact force on the workpiece [N/m] (``cfx[n]``,
+    ``cfy[n]``) and whether it touched the tool. Contact uses positions at step n and
+    velocities at n-1/2; ``cfx``/``cfy`` receive the contact force on the node [N/m]; ``fric``
+    (cumulative) the frictional dissipation, ``pen`` the current penalty energy, ``nwork``
+    (cumulative) the contact work on the node [J/m]. A node left without a live element is
+    retired (velocity zeroed, its kinetic energy booked in ``ero_ke``).
 
     Node splitting: a node with ``twin[n] >= 0`` and ``tied[n]`` moves with its twin as one
     node (forces and masses of both, summed in a fixed order so that both copies stay
@@ -276,92 +309,153 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
     (``tied`` = 0) when it comes within ``prm[P_GATE]`` of the tool surface: the material
     separates where it meets the cutting edge.
     """
-    nn = x.shape[0]
     r = prm[P_R]
     nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
     mu, tau, pf = prm[P_MU], prm[P_TAU], prm[P_PEN]
     gate = prm[P_GATE]
+    cfx[n] = 0.0
+    cfy[n] = 0.0
+    pen[n] = 0.0
+    if ndead[n]:
+        return 0.0, 0.0, False
+    tw = twin[n]
+    pair = tw >= 0 and tied[n] != 0
+    # node ids as int64 (the prange index is unsigned: mixing would give floats); a
+    # tied pair is gathered in a fixed order so that both copies compute the same sums
+    na = np.int64(n)
+    nb = np.int64(-1)
+    share = 1.0
+    if pair:
+        nb = max(na, tw)
+        na = min(na, tw)
+        share = 0.5
+    fx = 0.0
+    fy = 0.0
+    nlive = 0
+    asum = 0.0
+    m = 0.0
+    for j in range(2):
+        nk = na if j == 0 else nb
+        if nk < 0:
+            continue
+        m += mass[nk]
+        for k in range(ptr[nk], ptr[nk + 1]):
+            e = nel[k]
+            if alive[e] == 1:
+                c = ncorner[k]
+                fx -= fex[e, c]
+                fy -= fey[e, c]
+                nlive += 1
+                asum += area0[e]
+    if nlive == 0:
+        ndead[n] = 1
+        ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
+        vx[n] = 0.0
+        vy[n] = 0.0
+        return 0.0, 0.0, False
+    if fixed[n]:
+        vx[n] = 0.0
+        vy[n] = 0.0
+        return 0.0, 0.0, False
+    gap, gnx, gny = tool_gap(x[n], y[n], tool_cx, tool_cy, nrx, nry, nfx, nfy, r)
+    if pair and gap <= gate:
+        tied[n] = 0
+    fcx = 0.0
+    fcy = 0.0
+    ft = 0.0
+    vt0 = 0.0
+    if gap < 0.0:
+        vrx = vx[n] - tool_vx
+        vry = vy[n] - tool_vy
+        trib = math.sqrt(asum / nlive)
+        fcx, fcy, fn, ft = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf, dt)
+        vt0 = -vrx * gny + vry * gnx
+        pen[n] = share * 0.5 * fn * (-gap)
+    cfx[n] = share * fcx
+    cfy[n] = share * fcy
+    touched = fcx != 0.0 or fcy != 0.0
+    ox = vx[n]
+    oy = vy[n]
+    nvx = ox + dt * (fx + fcx) / m
+    nvy = oy + dt * (fy + fcy) / m
+    vx[n] = nvx
+    vy[n] = nvy
+    x[n] += dt * nvx
+    y[n] += dt * nvy
+    if gap < 0.0:
+        nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
+        vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
+        fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
+    return share * fcx, share * fcy, touched
+
+
+quad_node = njit(cache=True, inline="always")(quad_node_py)
+
+
+@njit(parallel=True, cache=True)
+def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
+                cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx, tool_vy,
+                prm, dt, twin, tied):
+    """:func:`quad_node_py` over all nodes (parallel).
+
+    Returns ``(fx, fy, n_contact)``: the total contact force on the workpiece [N/m] and the
+    number of nodes in contact.
+    """
     fsx = 0.0
     fsy = 0.0
     ncont = 0
-    for n in prange(nn):
-        cfx[n] = 0.0
-        cfy[n] = 0.0
-        pen[n] = 0.0
-        if ndead[n]:
-            continue
-        tw = twin[n]
-        pair = tw >= 0 and tied[n] != 0
-        # node ids as int64 (the prange index is unsigned: mixing would give floats); a
-        # tied pair is gathered in a fixed order so that both copies compute the same sums
-        na = np.int64(n)
-        nb = np.int64(-1)
-        share = 1.0
-        if pair:
-            nb = max(na, tw)
-            na = min(na, tw)
-            share = 0.5
-        fx = 0.0
-        fy = 0.0
-        nlive = 0
-        asum = 0.0
-        m = 0.0
-        for j in range(2):
-            nk = na if j == 0 else nb
-            if nk < 0:
-                continue
-            m += mass[nk]
-            for k in range(ptr[nk], ptr[nk + 1]):
-                e = nel[k]
-                if alive[e] == 1:
-                    c = ncorner[k]
-                    fx -= fex[e, c]
-                    fy -= fey[e, c]
-                    nlive += 1
-                    asum += area0[e]
-        if nlive == 0:
-            ndead[n] = 1
-            ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
-            vx[n] = 0.0
-            vy[n] = 0.0
-            continue
-        if fixed[n]:
-            vx[n] = 0.0
-            vy[n] = 0.0
-            continue
-        gap, gnx, gny = tool_gap(x[n], y[n], tool_cx, tool_cy, nrx, nry, nfx, nfy, r)
-        if pair and gap <= gate:
-            tied[n] = 0
-        fcx = 0.0
-        fcy = 0.0
-        ft = 0.0
-        vt0 = 0.0
-        if gap < 0.0:
-            vrx = vx[n] - tool_vx
-            vry = vy[n] - tool_vy
-            trib = math.sqrt(asum / nlive)
-            fcx, fcy, fn, ft = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf, dt)
-            vt0 = -vrx * gny + vry * gnx
-            pen[n] = share * 0.5 * fn * (-gap)
-        cfx[n] = share * fcx
-        cfy[n] = share * fcy
-        if fcx != 0.0 or fcy != 0.0:
-            fsx += share * fcx
-            fsy += share * fcy
+    for n in prange(x.shape[0]):
+        fcx, fcy, touched = quad_node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
+                                      area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
+                                      nwork, tool_cx, tool_cy, tool_vx, tool_vy, prm, dt, twin,
+                                      tied)
+        if touched:
+            fsx += fcx
+            fsy += fcy
             ncont += 1
-        ox = vx[n]
-        oy = vy[n]
-        nvx = ox + dt * (fx + fcx) / m
-        nvy = oy + dt * (fy + fcy) / m
-        vx[n] = nvx
-        vy[n] = nvy
-        x[n] += dt * nvx
-        y[n] += dt * nvy
-        if gap < 0.0:
-            nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
-            vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
-            fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
     return fsx, fsy, ncont
+
+
+def quad_centroid_py(e, conn, x, y, tbuf):
+    """Centroid x, y and area of quad ``e`` into ``tbuf[e, 0:3]`` (first pass of conduction)."""
+    i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
+    tbuf[e, 0] = 0.25 * (x[i1] + x[i2] + x[i3] + x[i4])
+    tbuf[e, 1] = 0.25 * (y[i1] + y[i2] + y[i3] + y[i4])
+    tbuf[e, 2] = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+
+
+def quad_conduct_py(e, conn, x, y, alive, enbr, temp, tbuf, kcond, rcp, dt_th):
+    """New temperature of quad ``e`` into ``tbuf[e, 3]`` (second pass of conduction).
+
+    Needs ``tbuf[:, 0:3]`` of every element (:func:`quad_centroid_py`); reads ``temp`` only,
+    so all elements can run at once. See :func:`conduct`.
+    """
+    tbuf[e, 3] = temp[e]
+    ae = tbuf[e, 2]
+    if alive[e] != 1 or ae <= 0.0:
+        return
+    dq = 0.0
+    for k in range(4):
+        nb = enbr[e, k]
+        if nb < 0 or alive[nb] != 1:
+            continue
+        an = tbuf[nb, 2]
+        na = conn[e, k]
+        nb2 = conn[e, (k + 1) % 4]
+        ledge = math.sqrt((x[nb2] - x[na]) ** 2 + (y[nb2] - y[na]) ** 2)
+        d = math.sqrt((tbuf[nb, 0] - tbuf[e, 0]) ** 2 + (tbuf[nb, 1] - tbuf[e, 1]) ** 2)
+        if d <= 0.0 or an <= 0.0:
+            continue
+        g = kcond * ledge / d * dt_th
+        gmax = 0.25 * rcp * min(ae, an)
+        if g > gmax:
+            g = gmax
+        dq += g * (temp[nb] - temp[e])
+    tbuf[e, 3] = temp[e] + dq / (rcp * ae)
+
+
+quad_centroid = njit(cache=True, inline="always")(quad_centroid_py)
+quad_conduct = njit(cache=True, inline="always")(quad_conduct_py)
 
 
 @njit(parallel=True, cache=True)
@@ -378,39 +472,15 @@ def conduct(conn, x, y, alive, enbr, temp, tbuf, kcond, rcp, dt_th):
     """
     ne = conn.shape[0]
     for e in prange(ne):
-        i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-        tbuf[e, 0] = 0.25 * (x[i1] + x[i2] + x[i3] + x[i4])
-        tbuf[e, 1] = 0.25 * (y[i1] + y[i2] + y[i3] + y[i4])
-        tbuf[e, 2] = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+        quad_centroid(e, conn, x, y, tbuf)
     for e in prange(ne):
-        tbuf[e, 3] = temp[e]
-        ae = tbuf[e, 2]
-        if alive[e] != 1 or ae <= 0.0:
-            continue
-        dq = 0.0
-        for k in range(4):
-            nb = enbr[e, k]
-            if nb < 0 or alive[nb] != 1:
-                continue
-            an = tbuf[nb, 2]
-            na = conn[e, k]
-            nb2 = conn[e, (k + 1) % 4]
-            ledge = math.sqrt((x[nb2] - x[na]) ** 2 + (y[nb2] - y[na]) ** 2)
-            d = math.sqrt((tbuf[nb, 0] - tbuf[e, 0]) ** 2 + (tbuf[nb, 1] - tbuf[e, 1]) ** 2)
-            if d <= 0.0 or an <= 0.0:
-                continue
-            g = kcond * ledge / d * dt_th
-            gmax = 0.25 * rcp * min(ae, an)
-            if g > gmax:
-                g = gmax
-            dq += g * (temp[nb] - temp[e])
-        tbuf[e, 3] = temp[e] + dq / (rcp * ae)
+        quad_conduct(e, conn, x, y, alive, enbr, temp, tbuf, kcond, rcp, dt_th)
     for e in prange(ne):
         temp[e] = tbuf[e, 3]
 
 
-@njit(cache=True)
-def _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
+def sum_energies_py(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
+    """Totals of the energy accumulators into ``en`` [J/m] (serial, a fixed order)."""
     ke = 0.0
     for n in range(mass.shape[0]):
         ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
@@ -443,6 +513,51 @@ def _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork,
     en[E_EROKE] = sek
 
 
+_sum_energies = njit(cache=True)(sum_energies_py)
+
+
+def tool_kinematics_py(tool, prm):
+    """Tool edge centre (cx, cy) [m] and velocity (tvx, tvy) [m/s] at the start of a step."""
+    return (tool[T_GX] + tool[T_UX], tool[T_GY] + tool[T_UY], -prm[P_VC] + tool[T_VUX],
+            tool[T_VUY])
+
+
+def tool_step_py(tool, prm, fwx, fwy, dt):
+    """Advance the tool over one step under the contact force (fwx, fwy) on the workpiece.
+
+    Stores the force on the tool, integrates the support springs (when ``prm[P_SUPPORT]``),
+    moves the guide point at -vc, records the new edge centre in ``prm[P_TCX]``/``[P_TCY]``
+    (for the erosion gate) and returns the work of the tool on the workpiece over the step
+    [J/m] (midpoint velocities).
+    """
+    vc = prm[P_VC]
+    width = prm[P_WIDTH]
+    tvx = -vc + tool[T_VUX]
+    tvy = tool[T_VUY]
+    # force on the tool = - force on the workpiece [N/m]
+    tool[T_FX] = -fwx
+    tool[T_FY] = -fwy
+    if prm[P_SUPPORT] > 0.5:
+        ux, vux = tool_support_step(tool[T_UX], tool[T_VUX], -fwx * width, prm[P_KX],
+                                    prm[P_CX], prm[P_MX], dt)
+        uy, vuy = tool_support_step(tool[T_UY], tool[T_VUY], -fwy * width, prm[P_KY],
+                                    prm[P_CY], prm[P_MY], dt)
+        tool[T_UX] = ux
+        tool[T_VUX] = vux
+        tool[T_UY] = uy
+        tool[T_VUY] = vuy
+    tool[T_GX] -= vc * dt
+    tvx_new = -vc + tool[T_VUX]
+    tvy_new = tool[T_VUY]
+    prm[P_TCX] = tool[T_GX] + tool[T_UX]
+    prm[P_TCY] = tool[T_GY] + tool[T_UY]
+    return dt * (fwx * 0.5 * (tvx + tvx_new) + fwy * 0.5 * (tvy + tvy_new))
+
+
+tool_kinematics = njit(cache=True)(tool_kinematics_py)
+tool_step = njit(cache=True)(tool_step_py)
+
+
 @njit(cache=True)
 def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
@@ -455,9 +570,6 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     STATUS_NONFINITE or STATUS_DT_COLLAPSE. Returns the number of steps taken.
     """
     erosion = int(prm[P_EROSION])
-    support = prm[P_SUPPORT] > 0.5
-    vc = prm[P_VC]
-    width = prm[P_WIDTH]
     cfl = prm[P_CFL]
     rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
@@ -465,35 +577,15 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     for _s in range(n_steps):
         dt = clock[1]
         t = clock[0]
-        cx = tool[T_GX] + tool[T_UX]
-        cy = tool[T_GY] + tool[T_UY]
-        tvx = -vc + tool[T_VUX]
-        tvy = tool[T_VUY]
+        cx, cy, tvx, tvy = tool_kinematics(tool, prm)
         fwx, fwy, ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
                                       area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
                                       nwork, cx, cy, tvx, tvy, prm, dt, twin, tied)
-        # force on the tool = - force on the workpiece [N/m]
-        tool[T_FX] = -fwx
-        tool[T_FY] = -fwy
-        if support:
-            ux, vux = tool_support_step(tool[T_UX], tool[T_VUX], -fwx * width, prm[P_KX],
-                                        prm[P_CX], prm[P_MX], dt)
-            uy, vuy = tool_support_step(tool[T_UY], tool[T_VUY], -fwy * width, prm[P_KY],
-                                        prm[P_CY], prm[P_MY], dt)
-            tool[T_UX] = ux
-            tool[T_VUX] = vux
-            tool[T_UY] = uy
-            tool[T_VUY] = vuy
-        tool[T_GX] -= vc * dt
-        tvx_new = -vc + tool[T_VUX]
-        tvy_new = tool[T_VUY]
-        en[E_EXT] += dt * (fwx * 0.5 * (tvx + tvx_new) + fwy * 0.5 * (tvy + tvy_new))
+        en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
         if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
             rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
                    sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
                    prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE])
-        prm[P_TCX] = tool[T_GX] + tool[T_UX]
-        prm[P_TCY] = tool[T_GY] + tool[T_UY]
         dtmin, bad = element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy,
                                     pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex,
                                     fey, dte, plast, rate, mat, prm, dt, erosion)
