@@ -1,5 +1,5 @@
 """CLI commands of the FE stage (registered by ``robobore.cli``): ``robobore fe orthogonal``
-and, from :mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
+(``--device cpu|gpu``) and, from :mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
 
 from __future__ import annotations
 
@@ -26,6 +26,7 @@ _KEYS = [
     ("eroded_distortion", "elements eroded (distortion/time step)"),
     ("friction_coefficient", "Coulomb friction used"),
     ("n_elements", "elements"),
+    ("device", "device"),
     ("steps", "time steps"),
     ("wall_time_s", "wall time [s]"),
     ("element_updates_per_s", "element updates per second"),
@@ -38,20 +39,22 @@ def orthogonal_cmd(
     plot: Path | None = typer.Option(None, "--plot", help="Write chip pictures (PNG) here."),
     vtk: Path | None = typer.Option(None, "--vtk", help="Write the final mesh (VTU) here."),
     out: Path | None = typer.Option(None, "--out", help="Write histories to this netCDF file."),
+    device: str = typer.Option("cpu", "--device", help="cpu (default) or gpu (numba-cuda)."),
 ) -> None:
     """Explicit plane-strain FE simulation of orthogonal cutting (Johnson-Cook material,
     rigid tool on optional springs/dampers)."""
-    run_orthogonal_cli(config, as_json, plot, vtk, out)
+    run_orthogonal_cli(config, as_json, plot, vtk, out, device)
 
 
 @handle_errors
-def run_orthogonal_cli(config, as_json, plot, vtk, out) -> None:
+def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
     from robobore.cutting.fe.config import load_fe_config
     from robobore.cutting.fe.output import plot_chip, to_dataset, write_vtk
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.solver import check_device, simulate_orthogonal
     from robobore.io.results import write_netcdf
 
     cfg = load_fe_config(config)
+    check_device(device, cfg, str(config))
     total = 1000
     with progress_bar("FE cutting", total, enabled=not as_json) as advance:
         done = [0]
@@ -62,7 +65,7 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out) -> None:
                 advance(n - done[0])
                 done[0] = n
 
-        res = simulate_orthogonal(cfg, source=str(config), progress=prog)
+        res = simulate_orthogonal(cfg, source=str(config), progress=prog, device=device)
     files = {}
     if out is not None:
         files["netcdf"] = str(write_netcdf(to_dataset(res), out, config=res.config))

@@ -377,7 +377,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         for i, (k, m) in enumerate(zip(ts.stiffness_N_per_m, ts.mass_kg, strict=True)):  # type: ignore[arg-type]
             if dt * math.sqrt(k / m) > 0.5:
                 raise ConfigError("tool support too stiff for the explicit time step",
-                                  source, field=f"tool_support.stiffness_N_per_m[{i}]",
+                                  file=source, field=f"tool_support.stiffness_N_per_m[{i}]",
                                   value=k, expected=f"k < {0.25 * m / dt**2:.3g} N/m for "
                                   f"mass {m} kg and time step {dt:.3g} s")
     return CuttingSetup(cfg=cfg, material=mat, mesh=mesh, state=st, h=h, vc=vc, rake=rake,
@@ -395,8 +395,27 @@ def energy_error(en: np.ndarray) -> float:
     return float(abs(en[K.E_EXT] - parts) / scale)
 
 
-def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None = None):
-    """Run the cutting model to the end; returns (wall time [s], steps taken)."""
+def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
+    """ConfigError unless ``device`` is "cpu" or a usable "gpu" that runs every option."""
+    if device not in ("cpu", "gpu"):
+        raise ConfigError("unknown device", field="--device", value=device,
+                          expected="cpu or gpu")
+    if device == "gpu":
+        from robobore.cutting.fe.gpu import require_gpu
+        from robobore.cutting.fe.gpu2d import check_gpu_supported
+
+        check_gpu_supported(cfg.solver.rezone_interval, source)
+        require_gpu()
+
+
+def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None = None,
+                   device: str = "cpu"):
+    """Run the cutting model to the end; returns (wall time [s], steps taken).
+
+    ``device``: "cpu" (numba, parallel; the default) or "gpu" (numba-cuda,
+    :func:`robobore.cutting.fe.gpu2d.advance_gpu`).
+    """
+    check_device(device, setup.cfg)
     st = setup.state
     limit = setup.cfg.solver.energy_error_limit
 
@@ -409,8 +428,14 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
                     f" error {err:.3g} > solver.energy_error_limit {limit}")
 
     t0 = time.perf_counter()
-    steps = advance(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
-                    progress=progress, check=check)
+    if device == "gpu":
+        from robobore.cutting.fe.gpu2d import advance_gpu
+
+        steps = advance_gpu(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
+                            progress=progress, check=check)
+    else:
+        steps = advance(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
+                        progress=progress, check=check)
     return time.perf_counter() - t0, steps
 
 
@@ -433,14 +458,20 @@ def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
 
 
 def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
-                        progress: Callable[[float], None] | None = None):
-    """Set up and run the orthogonal-cutting model; returns an :class:`FEResult`."""
+                        progress: Callable[[float], None] | None = None,
+                        device: str = "cpu"):
+    """Set up and run the orthogonal-cutting model; returns an :class:`FEResult`.
+
+    ``device``: "cpu" (default) or "gpu" (see :func:`run_orthogonal`); checked before the
+    mesh is built.
+    """
     from robobore.cutting.fe.output import FEResult, measure_chip, steady_window
 
+    check_device(device, cfg, source)
     setup = setup_orthogonal(cfg, source)
     st = setup.state
     dt0 = float(st.clock[1])
-    wall, steps = run_orthogonal(setup, progress)
+    wall, steps = run_orthogonal(setup, progress, device)
     hist = st.hist
     ok = np.isfinite(hist[:, K.H_T])
     hh = hist[ok]
@@ -472,6 +503,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "wall_time_s": wall,
         "element_updates_per_s": n_el * steps / max(wall, 1e-12),
         "steps": int(steps),
+        "device": device,
         "time_step_s": dt0,
         "n_elements": n_el,
         "n_nodes": int(st.x.shape[0]),

@@ -1,0 +1,341 @@
+"""GPU backend of the 2D explicit engine (numba-cuda), built from the SAME scalar physics.
+
+The per-element, per-node, tool and conduction updates are the plain-Python scalar functions
+of the CPU engine (:func:`kernels.quad_element_py`, :func:`kernels.quad_node_py`,
+:func:`kernels.tool_kinematics_py`, :func:`kernels.tool_step_py`,
+:func:`kernels.quad_centroid_py`, :func:`kernels.quad_conduct_py`,
+:func:`kernels.sum_energies_py`) and the shared material/contact/support functions
+(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics`), re-bound to
+device versions with :func:`robobore.material.johnson_cook.rebind` and compiled with
+``numba.cuda.jit(device=True)``; the CPU engine calls the ``njit`` versions of the same
+functions from its ``prange`` loops.
+
+One time step is four kernel launches: nodes (contact force and contact count summed with
+atomics), the tool (one thread: support springs, external work), elements (stable step by
+atomic min, inverted element by atomic max) and the step end (one thread: time, status,
+time-averaged histories and, at each sample, the energy totals summed serially in the CPU
+engine's order). With ``solver.heat_conduction`` three more launches (centroids, fluxes,
+copy) run every ``solver.conduction_interval`` steps. The loop stays on the device; the host
+copies the state back between chunks (for the progress bar and the energy check).
+
+Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``).
+Importing this module needs neither; :func:`robobore.cutting.fe.gpu.require_gpu` raises a
+clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
+the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine; GPU
+speed is unmeasured (no GPU was available).
+
+Not ported: rezoning (``solver.rezone_interval`` > 0, an experimental option that is off by
+default) is refused with a ConfigError.
+"""
+
+from __future__ import annotations
+
+import functools
+import math  # noqa: F401  (math.isfinite inside the kernels)
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.gpu import require_gpu
+from robobore.errors import ConfigError, NumericalError
+
+__all__ = ["advance_gpu", "check_gpu_supported"]
+
+_THREADS = 128
+# reduction slots on the device
+R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
+N_RED = 5
+
+#: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
+#: substitute its own inside the kernels)
+cuda = None
+
+
+def check_gpu_supported(rezone_interval: int, source: str | None = None) -> None:
+    """Raise a ConfigError for a setting the GPU engine does not run (rezoning)."""
+    if rezone_interval > 0:
+        raise ConfigError("rezoning is not available on the GPU", file=source,
+                          field="solver.rezone_interval", value=rezone_interval,
+                          expected="0 (off, the default) with --device gpu, or --device cpu")
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels():
+    """Compile (lazily, once) the device functions and kernels."""
+    global cuda
+    from numba import cuda as _cuda
+
+    cuda = _cuda
+
+    from robobore.cutting.fe.physics import contact_force_py, tool_gap_py, tool_support_step_py
+    from robobore.material import johnson_cook as jc
+
+    dev = cuda.jit(device=True)
+    th = dev(jc.homologous_temperature_py)
+    flow = dev(jc.rebind(jc.jc_flow_stress_py, homologous_temperature=th))
+    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
+    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
+    ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
+    rret = dev(jc.rebind(jc.radial_return_py, jc_return=ret))
+    tg = dev(tool_gap_py)
+    cf = dev(contact_force_py)
+    sup = dev(tool_support_step_py)
+    elem = dev(jc.rebind(K.quad_element_py, radial_return=rret, jc_damage_increment=dmg,
+                         tool_gap=tg))
+    node = dev(jc.rebind(K.quad_node_py, tool_gap=tg, contact_force=cf))
+    kin = dev(K.tool_kinematics_py)
+    tstep = dev(jc.rebind(K.tool_step_py, tool_support_step=sup))
+    cent = dev(K.quad_centroid_py)
+    cond = dev(K.quad_conduct_py)
+    sumen = dev(K.sum_energies_py)
+
+    I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K.I_STATUS, K.I_STEP, K.I_SAMPLE, K.I_BADELEM
+    ST_OK, ST_DONE, ST_INV = K.STATUS_OK, K.STATUS_DONE, K.STATUS_INVERTED
+    ST_NOEL, ST_NONF, ST_DTC = K.STATUS_NO_ELEMENTS, K.STATUS_NONFINITE, K.STATUS_DT_COLLAPSE
+    P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K.P_CFL, K.P_DTMIN, K.P_TEND, K.P_SAMPLE_DT
+    P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
+    T_FX, T_FY, T_UX, T_UY, T_GX = K.T_FX, K.T_FY, K.T_UX, K.T_UY, K.T_GX
+    E_EXT, E_KIN, E_INT, E_PLAST, E_HG, E_FRIC, E_ERODED = (K.E_EXT, K.E_KIN, K.E_INT,
+                                                            K.E_PLAST, K.E_HG, K.E_FRIC,
+                                                            K.E_ERODED)
+    H_T, H_FX, H_FY, H_UX, H_UY, H_TIP_X, H_NCONT = (K.H_T, K.H_FX, K.H_FY, K.H_UX, K.H_UY,
+                                                     K.H_TIP_X, K.H_NCONT)
+    H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO = (K.H_EKIN, K.H_EINT, K.H_EPL,
+                                                             K.H_EHG, K.H_EFRIC, K.H_EEXT,
+                                                             K.H_EERO)
+    KCOND, RHO, CP = jc.KCOND, jc.RHO, jc.CP
+
+    @cuda.jit
+    def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
+                fric, pen, ndead, ero_ke, nwork, prm, tool, clock, ist, twin, tied, red):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cx, cy, tvx, tvy = kin(tool, prm)
+        fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0,
+                                 fex, fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy,
+                                 tvx, tvy, prm, clock[1], twin, tied)
+        if touched:
+            cuda.atomic.add(red, R_FX, fcx)
+            cuda.atomic.add(red, R_FY, fcy)
+            cuda.atomic.add(red, R_NC, 1.0)
+
+    @cuda.jit
+    def k_tool(tool, prm, en, clock, ist, red):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        dt = clock[1]
+        en[E_EXT] += tstep(tool, prm, red[R_FX], red[R_FY], dt)
+        if prm[P_COND_EVERY] > 0.0:
+            prm[P_COND_ACC] += dt
+        red[R_DTMIN] = 1e30
+        red[R_BAD] = -1.0
+
+    @cuda.jit
+    def k_elems(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm,
+                qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, clock, erosion,
+                ist, red):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                      temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm,
+                      clock[1], erosion)
+        cuda.atomic.min(red, R_DTMIN, d)
+        if inv:
+            cuda.atomic.max(red, R_BAD, float(e))
+
+    @cuda.jit
+    def k_centroids(conn, x, y, tbuf, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cent(e, conn, x, y, tbuf)
+
+    @cuda.jit
+    def k_conduct(conn, x, y, alive, enbr, temp, tbuf, mat, prm, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
+             prm[P_COND_ACC])
+
+    @cuda.jit
+    def k_conduct_end(temp, tbuf, prm, ist):
+        e = cuda.grid(1)
+        if e >= temp.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        temp[e] = tbuf[e, 3]
+        if e == 0:
+            prm[P_COND_ACC] = 0.0
+
+    @cuda.jit
+    def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
+                 alive, fric, pen, ero_ke, nwork):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        dt = clock[1]
+        fwx = red[R_FX]
+        fwy = red[R_FY]
+        nc = red[R_NC]
+        red[R_FX] = 0.0
+        red[R_FY] = 0.0
+        red[R_NC] = 0.0
+        if red[R_BAD] >= 0.0:
+            ist[I_BADELEM] = int(red[R_BAD])
+            ist[I_STATUS] = ST_INV
+            return
+        dtmin = red[R_DTMIN]
+        if dtmin >= 1e30:
+            ist[I_STATUS] = ST_NOEL
+            return
+        new_dt = prm[P_CFL] * dtmin
+        t = clock[0] + dt
+        clock[0] = t
+        ist[I_STEP] += 1
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(new_dt)):
+            ist[I_STATUS] = ST_NONF
+            return
+        clock[1] = new_dt
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = ST_DTC
+            return
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_NCONT] += dt * nc
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            if not math.isfinite(en[E_KIN]):
+                ist[I_STATUS] = ST_NONF
+                return
+            hist[k, H_T] = t
+            hist[k, H_FX] = hacc[H_FX] / ta
+            hist[k, H_FY] = hacc[H_FY] / ta
+            hist[k, H_UX] = hacc[H_UX] / ta
+            hist[k, H_UY] = hacc[H_UY] / ta
+            hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
+            hist[k, H_EKIN] = en[E_KIN]
+            hist[k, H_EINT] = en[E_INT]
+            hist[k, H_EPL] = en[E_PLAST]
+            hist[k, H_EHG] = en[E_HG]
+            hist[k, H_EFRIC] = en[E_FRIC]
+            hist[k, H_EEXT] = en[E_EXT]
+            hist[k, H_EERO] = en[E_ERODED]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = ST_DONE
+            sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+
+    return k_nodes, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end, k_finish
+
+
+#: FEState arrays used by the kernels (copied to the device)
+_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
+           "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
+           "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
+           "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
+           "hacc", "hist", "enbr", "twin", "tied", "tbuf")
+#: the arrays the kernels change (copied back to the host)
+_MUTABLE = ("x", "y", "vx", "vy", "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p",
+            "temp", "dmg", "qhx", "qhy", "ie", "hge", "fex", "fey", "dte", "plast", "rate",
+            "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm", "tool", "en", "ist",
+            "clock", "hacc", "hist", "tied", "tbuf")
+
+
+def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
+                progress: Callable[[float], None] | None = None,
+                check: Callable[[Any], None] | None = None) -> int:
+    """GPU counterpart of :func:`robobore.cutting.fe.solver.advance` (same contract).
+
+    Copies the :class:`~robobore.cutting.fe.solver.FEState` to the device, runs chunks of
+    ``chunk_steps`` steps there, copies the step counter and clock back after each chunk
+    (the whole state when ``check`` is given, before calling it) and the whole state at the
+    end. Returns the number of steps taken. Raises NumericalError on instability (same
+    messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
+    rezoning.
+    """
+    from robobore.cutting.fe.solver import _STATUS_TEXT
+
+    if st.snodes is not None and st.snodes.shape[0] > 0:
+        check_gpu_supported(int(st.prm[K.P_RZ_EVERY]))
+    require_gpu()
+    (k_nodes, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
+     k_finish) = _kernels()
+    st.prm[K.P_TEND] = t_end
+    st.ist[K.I_STATUS] = K.STATUS_OK
+    g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _ARRAYS}
+    red = np.zeros(N_RED)
+    red[R_DTMIN] = 1e30
+    red[R_BAD] = -1.0
+    dred = cuda.to_device(red)
+    nn = st.x.shape[0]
+    ne = st.conn.shape[0]
+    gn = (nn + _THREADS - 1) // _THREADS
+    ge = (ne + _THREADS - 1) // _THREADS
+    erosion = int(st.prm[K.P_EROSION])
+    cond_every = int(st.prm[K.P_COND_EVERY])
+    t_start = st.time
+    step0 = int(st.ist[K.I_STEP])
+    while True:
+        # while the status is OK every launch sequence is exactly one step, so the host
+        # knows the step index (conduction runs where ist[I_STEP] % cond_every == 0, as on
+        # the CPU); once the status changes the remaining launches return at once
+        step = int(st.ist[K.I_STEP])
+        for i in range(chunk_steps):
+            k_nodes[gn, _THREADS](g["x"], g["y"], g["vx"], g["vy"], g["mass"], g["fixed"],
+                                  g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
+                                  g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
+                                  g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
+                                  g["clock"], g["ist"], g["twin"], g["tied"], dred)
+            k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+            k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
+                                  g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
+                                  g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
+                                  g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
+                                  g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
+                                  g["clock"], erosion, g["ist"], dred)
+            if cond_every > 0 and (step + i) % cond_every == 0:
+                k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
+                k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
+                                        g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
+                k_conduct_end[ge, _THREADS](g["temp"], g["tbuf"], g["prm"], g["ist"])
+            k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
+                           g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
+                           g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"],
+                           g["nwork"])
+        for name in ("ist", "clock"):
+            getattr(st, name)[...] = g[name].copy_to_host()
+        status = int(st.ist[K.I_STATUS])
+        if status in _STATUS_TEXT or status == K.STATUS_DONE or check is not None:
+            _copy_back(st, g)
+        if status in _STATUS_TEXT:
+            raise NumericalError(
+                f"simulation (GPU) unstable at step {int(st.ist[K.I_STEP])}, time "
+                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
+                + (f" (element {int(st.ist[K.I_BADELEM])})"
+                   if status == K.STATUS_INVERTED else "")
+                + "; try a smaller solver.cfl, a larger mesh.element_size_um or less mass "
+                "scaling")
+        if progress is not None:
+            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
+        if check is not None:
+            check(st)
+        if status == K.STATUS_DONE or st.time >= t_end:
+            _copy_back(st, g)
+            return int(st.ist[K.I_STEP]) - step0
+
+
+def _copy_back(st: Any, g: dict) -> None:
+    for name in _MUTABLE:
+        getattr(st, name)[...] = g[name].copy_to_host()
