@@ -92,6 +92,17 @@ def test_bad_tool_support(tmp_path):
         parse_config(d)
 
 
+def test_tool_support_too_stiff_for_the_step():
+    from robobore.cutting.fe.solver import setup_orthogonal
+
+    d = _with("tool_support", "stiffness_N_per_m", [1e13, 1e7])
+    d["tool_support"].update(damping_N_s_per_m=10.0, mass_kg=0.001)
+    d["cut"]["length_mm"] = 0.05
+    d["mesh"]["element_size_um"] = 20.0
+    with pytest.raises(ConfigError, match=r"tool_support.stiffness_N_per_m\[0\]"):
+        setup_orthogonal(parse_config(d), source="c.toml")
+
+
 def test_cli_runs_a_short_cut(tmp_path):
     """A very short, coarse cut through the CLI: JSON keys, netCDF, VTK and PNG files."""
     txt = (EXAMPLE.read_text().replace("length_mm = 1.0", "length_mm = 0.05")
@@ -107,6 +118,7 @@ def test_cli_runs_a_short_cut(tmp_path):
               "peak_temperature_K", "energy_error", "wall_time_s", "element_updates_per_s"):
         assert k in out
     assert out["cutting_force_N_per_mm"] > 0
+    assert out["device"] == "cpu"
     assert (tmp_path / "r.nc").is_file()
     assert (tmp_path / "vtk" / "fe_orthogonal_final.vtu").is_file()
     assert (tmp_path / "png" / "fe_chip_temperature_K.png").is_file()

@@ -13,6 +13,13 @@ with orthogonal hourglass control", IJNME 17, 679-706; Belytschko, Liu, Moran (2
 *Nonlinear Finite Elements for Continua and Structures*, ch. 6 (explicit, stable step,
 energy balance).
 
+The per-element, per-node, conduction and tool updates are plain-Python scalar functions
+(``quad_element_py``, ``quad_node_py``, ``quad_centroid_py``, ``quad_conduct_py``,
+``tool_kinematics_py``, ``tool_step_py``, ``sum_energies_py``) that allocate nothing; the CPU
+loops below call their ``njit`` versions (``inline="always"``: the compiled loops are those of
+inline code) and keep the reductions, and :mod:`robobore.cutting.fe.gpu2d` compiles the same
+source for an NVIDIA GPU.
+
 Layout of the small state arrays (indices are module constants):
 ``prm`` float64 parameters, ``tool`` float64 tool state, ``en`` float64 energy accumulators,
 ``ist`` int64 counters/status, ``hist`` (n_samples, N_HIST) time-averaged histories.
