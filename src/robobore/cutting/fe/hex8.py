@@ -68,7 +68,9 @@ P_THETA0, P_SAMPLE_DT, P_TEND, P_EROSION = 33, 34, 35, 36
 # 1: parallel element/node loops (prange), 0: serial (better for small meshes or a loaded
 # machine, where every parallel region's barrier waits for a descheduled thread)
 P_PARALLEL = 37
-N_PRM = 38
+# node splitting: a tied pair parts within this distance of the insert [m]
+P_GATE = 38
+N_PRM = 39
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 
 
@@ -304,9 +306,13 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     ozz = szz - p_old
     ie[e] += V * dt * (0.5 * ((oxx + fxx) * dxx + (oyy + fyy) * dyy + (ozz + fzz) * dzz)
                        + (sxy + txy) * dxy + (syz + tyz) * dyz + (szx + tzx) * dzx)
-    # hourglass control (Flanagan-Belytschko 1981): stiffness part stored and co-rotated
-    kh = 4.0 * prm[P_HGS] * G * V * bsum
-    cv = 4.0 * prm[P_HGV] * rho_c * c * V ** (2.0 / 3.0)
+    # hourglass control (Flanagan-Belytschko 1981): stiffness part stored and co-rotated.
+    # Scaled so that a hexahedron in plane strain resists an in-plane hourglass mode per unit
+    # volume exactly as the 2D engine's quad does with the same coefficients (quad: hgs G A
+    # b.b and 2 hgv rho c sqrt(A); a cube of side a: 2 hgs G a and 2 hgv rho c a^2 here),
+    # so one [solver] setting means the same in both engines (docs/fe3d.md, "Element").
+    kh = (4.0 / 3.0) * prm[P_HGS] * G * V * bsum
+    cv = 2.0 * prm[P_HGV] * rho_c * c * V ** (2.0 / 3.0)
     ehg = 0.0
     hx0 = x0 + x1 - x2 - x3 - x4 - x5 + x6 + x7
     hy0 = y0 + y1 - y2 - y3 - y4 - y5 + y6 + y7
