@@ -100,12 +100,29 @@ class CutSection(_Strict):
 
 
 class ContactSection(_Strict):
-    #: Coulomb coefficient (the paper: 0.3)
-    friction: float = Field(default=0.3, ge=0.0, le=2.0)
+    #: Coulomb coefficient (the paper: 0.3), or "table": the 2D engine's Rech et al. (2013)
+    #: mu(vc) table at the run's cutting speed, what the FE calibration of the mechanistic
+    #: coefficients uses (:data:`robobore.cutting.fe.config.FRICTION_TABLE_MU`)
+    friction: float | Literal["table"] = "table"
     #: cap on the contact shear stress [MPa]
     shear_limit_MPa: float = Field(default=576.0, gt=0.0)
     #: penalty factor: normal stiffness = factor * nodal mass / dt^2
     penalty_factor: float = Field(default=0.1, gt=0.0, le=0.5)
+
+    @field_validator("friction")
+    @classmethod
+    def _mu(cls, v: Any) -> Any:
+        if not isinstance(v, str) and not 0.0 <= v <= 2.0:
+            raise ValueError('friction must be in 0..2 or "table"')
+        return v
+
+    def coefficient(self, vc_m_per_min: float) -> float:
+        """Coulomb coefficient used at the cutting speed (the value given, or the table's)."""
+        if self.friction == "table":
+            from robobore.cutting.fe.config import FRICTION_TABLE_MU, FRICTION_TABLE_VC_M_MIN
+
+            return float(np.interp(vc_m_per_min, FRICTION_TABLE_VC_M_MIN, FRICTION_TABLE_MU))
+        return float(self.friction)
 
 
 class MeshSection(_Strict):
@@ -117,6 +134,19 @@ class MeshSection(_Strict):
     side_margin_um: float = Field(default=0.0, ge=0.0)
     #: uncut material left ahead of the insert at the end of the cut [mm]
     ahead_mm: float = Field(default=0.06, gt=0.0, le=5.0)
+    #: how the chip separates from the workpiece: "erosion_layer" (elements crossed by the
+    #: edge path erode by Johnson-Cook damage) or "node_split" (the nodes of a parting
+    #: surface are doubled and tied, and part where they reach the insert: the 2D engine's
+    #: method, used by the FE calibration of the mechanistic coefficients; with the 2-4
+    #: elements through the boring chip that 3D affords on a CPU it gave larger forces than
+    #: the layer, docs/fe3d.md)
+    separation: Literal["node_split", "erosion_layer"] = "erosion_layer"
+    #: node splitting: height of the parting surface above the edge's lowest points,
+    #: along the profile normal [um] (the 2D calibration's 5 um = 0.25 edge radii)
+    separation_height_um: float = Field(default=5.0, ge=0.0)
+    #: node splitting: element rows of the chip above the parting surface (0 = about one
+    #: per element size of the thickest chip section, at least 3)
+    chip_rows: int = Field(default=0, ge=0, le=50)
 
 
 class SolverSection(_Strict):
@@ -142,6 +172,8 @@ class SolverSection(_Strict):
     steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
     #: stop with NumericalError when the energy error exceeds this after 10 % of the cut
     energy_error_limit: float = Field(default=0.5, gt=0.0)
+    #: node splitting: a tied pair parts within this distance of the insert [um]
+    separation_gate_um: float = Field(default=0.0, ge=0.0)
 
 
 def _triple(v: Any) -> list[float]:
@@ -232,6 +264,8 @@ class BoringMesh:
     z_range: tuple[float, float]
     length: float
     y_bottom: float
+    #: node splitting: partner of each node on the parting surface (-1: none), else None
+    twin: np.ndarray | None = None
 
 
 def _lead_end(insert: BoringInsert, ap: float) -> float:
@@ -246,10 +280,50 @@ def _lead_end(insert: BoringInsert, ap: float) -> float:
     return hi
 
 
+def parting_surface(insert: BoringInsert, zs: np.ndarray, height: float,
+                    y_low: float) -> np.ndarray:
+    """Height y(z) [m] of the surface ``height`` [m] above the insert's edge profile.
+
+    The offset is along the profile normal (in each normal section of the edge, the 2D
+    engine's parting line ``height`` above the edge's lowest point): the points whose
+    :func:`kernels3d.edge_section` distance is ``re - height``. Solved by bisection in y on
+    [y_low, nose radius] at each z of ``zs``.
+    """
+    rn, re = insert.nose_radius_m, insert.edge_radius_m
+    kap = math.radians(insert.approach_angle_deg)
+    kend = math.radians(insert.end_edge_angle_deg)
+    target = re - height
+    out = np.empty(zs.size)
+    for i, z in enumerate(zs):
+        lo, hi = y_low, rn * (1.0 - 1e-9)
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if K3.edge_section(mid, float(z), rn, kap, kend, re)[0] > target:
+                lo = mid
+            else:
+                hi = mid
+        out[i] = 0.5 * (lo + hi)
+    return out
+
+
 def build_boring_mesh(insert: BoringInsert, ap: float, f: float, le: float, length: float,
                       depth_factor: float = 1.5, side_margin: float = 0.0,
-                      ahead: float = 0.06e-3) -> BoringMesh:
-    """Wall block with the previous revolution's feed marks on its top surface (SI)."""
+                      ahead: float = 0.06e-3, split_height: float | None = None,
+                      chip_rows: int = 0) -> BoringMesh:
+    """Wall block with the previous revolution's feed marks on its top surface (SI).
+
+    Without ``split_height`` every node column is divided uniformly from the bottom to the
+    top surface and the separation layer (elements crossed by the edge path y = drop(z))
+    is marked for damage erosion. With ``split_height`` [m] (node splitting) the node rows
+    follow the parting surface (:func:`parting_surface`, ``split_height`` above the edge
+    profile): ``chip_rows`` rows between it and the top surface, the rest below, and the
+    nodes of the parting surface are doubled (``twin``; the chip's rows use the copies).
+    Where the chip above the parting surface would be thinner than ``chip_rows`` x 0.25 le
+    (its thin ends, where the 2D picture has almost only ploughing) the parting surface is
+    lowered to keep that thickness, so no element is thinner than 0.25 le; there the edge
+    path crosses chip rows, and the chip elements it crosses form an erosion layer (damage
+    erosion, as without splitting).
+    """
     z_end = _lead_end(insert, ap)
     margin = side_margin if side_margin > 0 else 3 * le
     z0 = -0.5 * f - margin
@@ -258,32 +332,69 @@ def build_boring_mesh(insert: BoringInsert, ap: float, f: float, le: float, leng
     lx = length + ahead
     nx = max(2, int(math.ceil(lx / le)))
     nz = max(2, int(math.ceil((z1 - z0) / le)))
-    ny = max(3, int(math.ceil((depth + ap) / le)))
     xs = np.linspace(0.0, lx, nx + 1)
     zs = np.linspace(z0, z1, nz + 1)
     ytop = np.minimum(ap, insert.drop(zs + f))
-    eta = np.linspace(0.0, 1.0, ny + 1)
+    twin = None
+    if split_height is None:
+        ny = max(3, int(math.ceil((depth + ap) / le)))
+        eta = np.linspace(0.0, 1.0, ny + 1)
+        Y = -depth + (ytop[None, :] + depth) * eta[:, None]  # (ny + 1, nz + 1)
+        js = -1
+    else:
+        ys0 = parting_surface(insert, zs, split_height, -depth)
+        n_up = chip_rows if chip_rows > 0 else max(3, int(round(float(np.max(ytop - ys0)) / le)))
+        ys = np.minimum(ys0, ytop - n_up * 0.25 * le)
+        lowered = ys < ys0 - 1e-12 * le
+        n_dn = max(3, int(math.ceil((depth + float(np.max(ys))) / le)))
+        ny = n_dn + n_up
+        js = n_dn
+        e_dn = np.linspace(0.0, 1.0, n_dn + 1)[:, None]
+        e_up = np.linspace(0.0, 1.0, n_up + 1)[1:, None]
+        Y = np.vstack([-depth + (ys[None, :] + depth) * e_dn,
+                       ys[None, :] + (ytop - ys)[None, :] * e_up])
     X = np.broadcast_to(xs[:, None, None], (nx + 1, ny + 1, nz + 1))
-    Y = -depth + (ytop[None, None, :] + depth) * eta[None, :, None]
-    Y = np.broadcast_to(Y, (nx + 1, ny + 1, nz + 1))
+    Y = np.broadcast_to(Y[None, :, :], (nx + 1, ny + 1, nz + 1))
     Z = np.broadcast_to(zs[None, None, :], (nx + 1, ny + 1, nz + 1))
     nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1).copy()
     idx = np.arange(nodes.shape[0]).reshape(nx + 1, ny + 1, nz + 1)
-    conn = hex_conn(idx)
     # VTK order needs the (x, y, z) index grid to be right-handed: it is (x, y, z)
     fixed = np.zeros(nodes.shape[0], np.int64)
     fixed[idx[:, 0, :].ravel()] = 7
     fixed[idx[-1, :, :].ravel()] = 7
     fixed[idx[:, :, 0].ravel()] = 7
     fixed[idx[:, :, -1].ravel()] = 7
+    conn = hex_conn(idx)
+    if js > 0:
+        # double the free nodes of the parting surface; the rows above take the copies
+        line = idx[:, js, :].ravel()
+        line = line[fixed[line] == 0]
+        n_old = nodes.shape[0]
+        new_ids = n_old + np.arange(line.size)
+        nodes = np.vstack([nodes, nodes[line]])
+        fixed = np.concatenate([fixed, np.zeros(line.size, np.int64)])
+        remap = np.arange(nodes.shape[0])
+        remap[line] = new_ids
+        erow = np.broadcast_to(np.arange(ny)[None, :, None], (nx, ny, nz)).ravel()
+        above = erow >= js
+        conn[above] = remap[conn[above]]
+        twin = -np.ones(nodes.shape[0], np.int64)
+        twin[line] = new_ids
+        twin[new_ids] = line
     cen = nodes[conn].mean(axis=1)
     prof = insert.drop(cen[:, 2])
     chip = cen[:, 1] > prof
     ye = nodes[conn][:, :, 1]
     layer = (ye.min(axis=1) <= prof) & (ye.max(axis=1) >= prof)
+    if js > 0:
+        # where the parting surface had to be lowered the edge path crosses chip rows: those
+        # elements erode by damage (the erosion layer), elsewhere the chip parts at the pairs
+        kz = np.broadcast_to(np.arange(nz)[None, None, :], (nx, ny, nz)).ravel()
+        low_col = lowered[kz] | lowered[kz + 1]
+        layer &= low_col & (erow >= js)
     return BoringMesh(nodes=nodes, conn=conn, fixed=fixed, chip=chip, layer=layer,
-                      shape=(nx, ny, nz),
-                      z_range=(z0, z1), length=lx, y_bottom=-depth)
+                      shape=(nx, ny, nz), z_range=(z0, z1), length=lx, y_bottom=-depth,
+                      twin=twin)
 
 
 # ---------------------------------------------------------------------------------- setup
@@ -312,11 +423,15 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     R = 0.5 * cfg.cut.bore_diameter_mm * 1e-3
     n_rps = cfg.cut.speed_rpm / 60.0
     vc = 2 * math.pi * R * n_rps
+    split = cfg.mesh.separation == "node_split"
     mesh = build_boring_mesh(ins, ap, f, le, L, cfg.mesh.depth_factor,
-                             cfg.mesh.side_margin_um * 1e-6, cfg.mesh.ahead_mm * 1e-3)
+                             cfg.mesh.side_margin_um * 1e-6, cfg.mesh.ahead_mm * 1e-3,
+                             split_height=cfg.mesh.separation_height_um * 1e-6 if split
+                             else None, chip_rows=cfg.mesh.chip_rows)
     s = cfg.solver
     p = apply_solver_settings(default_prm3(), s, K3)
-    p[K3.P_MU] = cfg.contact.friction
+    p[K3.P_MU] = cfg.contact.coefficient(vc * 60.0)
+    p[K3.P_GATE] = cfg.solver.separation_gate_um * 1e-6 if split else -1.0
     p[K3.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K3.P_PEN] = cfg.contact.penalty_factor
     p[K3.P_TOOL] = 1.0
@@ -343,7 +458,7 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
         p[K3.P_MX], p[K3.P_MY], p[K3.P_MZ] = ts.mass_kg
         p[K3.P_THETA0] = math.radians(ts.theta0_deg)
     st = make_state3(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, n_samples=s.n_samples,
-                     tool_tip=(x0, 0.0, 0.0), layer=mesh.layer,
+                     tool_tip=(x0, 0.0, 0.0), layer=mesh.layer, twin=mesh.twin,
                      parallel=None if s.parallel == "auto" else bool(s.parallel))
     if ts is not None:
         dt = float(st.clock[1])

@@ -16,7 +16,8 @@ clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is
 the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine.
 
 Limits: per-sample energy histories are not recorded on the GPU (the final energy totals
-are computed on the host from the copied-back state); the 2D engine has no GPU port yet.
+are computed on the host from the copied-back state). The 2D engine's GPU port, built the
+same way from its scalar functions, is :mod:`robobore.cutting.fe.gpu2d`.
 """
 
 from __future__ import annotations
@@ -91,7 +92,8 @@ def _kernels():
     ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
     elem = dev(jc.rebind(hex_element_py, jc_return=ret, jc_damage_increment=dmg))
     tg = dev(tool_gap_py)
-    gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg))
+    sec = dev(K3.edge_section_py)
+    gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg, edge_section=sec))
     cf3 = dev(K3.contact_force3_py)
     node = dev(jc.rebind(K3.hex_node_py, insert_gap3=gap3, contact_force3=cf3))
     sup = dev(tool_support_step_py)
@@ -110,13 +112,13 @@ def _kernels():
 
     @cuda.jit
     def k_nodes(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-                pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red):
+                pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red, twin, tied):
         n = cuda.grid(1)
         if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
             return
         cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
         node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-             pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1])
+             pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1], twin, tied)
         if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
             cuda.atomic.add(red, R_FX, cf[n, 0])
             cuda.atomic.add(red, R_FY, cf[n, 1])
@@ -210,7 +212,7 @@ def _kernels():
 #: arrays of FEState3 that the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "z", "vx", "vy", "vz", "alive", "sd", "pres", "eps_p", "temp", "dmg",
             "qh", "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
-            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist")
+            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist", "tied")
 
 
 def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
@@ -235,7 +237,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                       "ncorner", "conn", "alive", "layer", "sd", "pres", "eps_p", "temp",
                       "dmg", "qh", "vol0", "ie", "hge", "fe", "dte", "plast", "rate", "cf",
                       "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en",
-                      "ist", "clock", "hacc", "hist")}
+                      "ist", "clock", "hacc", "hist", "twin", "tied")}
     red = np.zeros(N_RED)
     red[R_DTMIN] = 1e30
     red[R_BAD] = -1.0
@@ -254,7 +256,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                                   g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
                                   g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
                                   g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
-                                  g["ist"], dred)
+                                  g["ist"], dred, g["twin"], g["tied"])
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
                                   g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.hex8 import (
@@ -45,6 +46,7 @@ from robobore.cutting.fe.hex8 import (
     P_DT_ERODE,
     P_DTMIN,
     P_EROSION,
+    P_GATE,
     P_HGS,
     P_HGV,
     P_KAPPA,
@@ -123,22 +125,16 @@ H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO, H_NCONT = 9, 10, 11, 12, 
 N_HIST = 17
 
 
-def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
-    """Signed distance of a point to the boring insert and the insert's outward normal.
+def edge_section_py(py, pz, rn, kappa, kend, re):
+    """Position of a point relative to the insert's edge profile, in the y-z plane.
 
-    ``(px, py, pz)`` [m] is the point relative to the insert's tip reference (the lowest point
-    of the nose, on the cutting edge) in the local frame (x cutting direction, y out of the
-    workpiece, z feed). The edge profile in the y-z plane is the nose arc of radius ``rn``
-    (centre at y = rn, z = 0) spanning local approach angles -kend..kappa, continued by the
-    major edge (approach angle ``kappa`` to the feed axis) and the minor (end) edge (angle
-    ``kend``). In every normal section of the edge the insert is the 2D wedge of the 2D
-    engine (:func:`physics.tool_gap_py`: normal rake ``rake``, clearance ``clr``, edge radius
-    ``re`` [rad, m]); the wedge apex runs along the profile offset by ``re`` into the tool.
-    The inclination enters as ``x -> x - tani * s`` with ``s`` the arc length along the edge
-    from the tip (small-angle model). Exact for points in a normal section; near the surface
-    (where contact acts) the error is second order in the distance.
-
-    Returns ``(gap, nx, ny, nz)``: gap > 0 outside, < 0 penetration depth [m]; unit normal.
+    The edge profile is the nose arc of radius ``rn`` (centre at y = rn, z = 0) spanning
+    local approach angles -kend..kappa, continued by the major edge (approach angle
+    ``kappa``) and the minor edge (end-edge angle ``kend``). Returns ``(s, arc, my, mz)``:
+    ``s`` the distance of the point from the wedge apex line (the profile offset by the edge
+    radius ``re`` into the tool), positive out of the tool, so the profile itself (the
+    lowest points of the edge in its normal sections) is ``s = re``; ``arc`` the arc length
+    along the edge from the tip; ``(my, mz)`` the unit outward normal of the profile there.
     """
     ra = rn - re
     qz = pz
@@ -162,6 +158,30 @@ def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
         my = qy / d
         s = d - ra
         arc = rn * psi
+    return s, arc, my, mz
+
+
+edge_section = njit(cache=True)(edge_section_py)
+
+
+def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
+    """Signed distance of a point to the boring insert and the insert's outward normal.
+
+    ``(px, py, pz)`` [m] is the point relative to the insert's tip reference (the lowest point
+    of the nose, on the cutting edge) in the local frame (x cutting direction, y out of the
+    workpiece, z feed). The edge profile in the y-z plane is the nose arc of radius ``rn``
+    (centre at y = rn, z = 0) spanning local approach angles -kend..kappa, continued by the
+    major edge (approach angle ``kappa`` to the feed axis) and the minor (end) edge (angle
+    ``kend``). In every normal section of the edge the insert is the 2D wedge of the 2D
+    engine (:func:`physics.tool_gap_py`: normal rake ``rake``, clearance ``clr``, edge radius
+    ``re`` [rad, m]); the wedge apex runs along the profile offset by ``re`` into the tool.
+    The inclination enters as ``x -> x - tani * s`` with ``s`` the arc length along the edge
+    from the tip (small-angle model). Exact for points in a normal section; near the surface
+    (where contact acts) the error is second order in the distance.
+
+    Returns ``(gap, nx, ny, nz)``: gap > 0 outside, < 0 penetration depth [m]; unit normal.
+    """
+    s, arc, my, mz = edge_section(py, pz, rn, kappa, kend, re)
     u = px - tani * arc
     # 2D wedge of the 2D engine, mirrored (it cuts along -x): apex at the origin
     gap, n2x, n2y = tool_gap(-u, -s, 0.0, 0.0, -math.cos(rake), math.sin(rake),
@@ -209,7 +229,7 @@ contact_force3 = njit(cache=True)(contact_force3_py)
 
 
 def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
-                fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt):
+                fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, twin, tied):
     """Gather element forces on node ``n``, add insert contact, advance v and x (one node).
 
     Contact uses positions at step n and velocities at n-1/2 (as the 2D engine). ``cf[n]``
@@ -218,6 +238,13 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     left without a live element is retired (its kinetic energy booked in ``ero_ke``).
     ``fixed[n]`` bit mask (1 x, 2 y, 4 z): that velocity component is held (prescribed).
     ``(cx, cy, cz)`` tool tip reference, ``(tvx, tvy, tvz)`` tool velocity (local frame).
+
+    Node splitting (the 2D engine's rule, :func:`kernels.node_update`): a node with
+    ``twin[n] >= 0`` and ``tied[n]`` moves with its twin as one node -- forces and masses of
+    both copies summed in a fixed order (lower id first) so that both stay bitwise
+    identical, the contact force computed once with the pair's mass and booked half on each
+    copy. The pair is released (``tied[n]`` = 0 on both, which compute the same gap) when it
+    comes within ``prm[P_GATE]`` of the insert: the material parts where it meets the edge.
     """
     cf[n, 0] = 0.0
     cf[n, 1] = 0.0
@@ -225,20 +252,35 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     pen[n] = 0.0
     if ndead[n]:
         return
+    tw = twin[n]
+    pair = tw >= 0 and tied[n] != 0
+    na = n
+    nb = -1
+    share = 1.0
+    if pair:
+        na = min(n, tw)
+        nb = max(n, tw)
+        share = 0.5
     fx = 0.0
     fy = 0.0
     fz = 0.0
     nlive = 0
     vsum = 0.0
-    for k in range(ptr[n], ptr[n + 1]):
-        e = nel[k]
-        if alive[e] == 1:
-            c3 = 3 * ncorner[k]
-            fx -= fe[e, c3]
-            fy -= fe[e, c3 + 1]
-            fz -= fe[e, c3 + 2]
-            nlive += 1
-            vsum += vol0[e]
+    m = 0.0
+    for j in range(2):
+        nk = na if j == 0 else nb
+        if nk < 0:
+            continue
+        m += mass[nk]
+        for k in range(ptr[nk], ptr[nk + 1]):
+            e = nel[k]
+            if alive[e] == 1:
+                c3 = 3 * ncorner[k]
+                fx -= fe[e, c3]
+                fy -= fe[e, c3 + 1]
+                fz -= fe[e, c3 + 2]
+                nlive += 1
+                vsum += vol0[e]
     if nlive == 0:
         ndead[n] = 1
         ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n] + vz[n] * vz[n])
@@ -246,7 +288,6 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
         vy[n] = 0.0
         vz[n] = 0.0
         return
-    m = mass[n]
     fcx = 0.0
     fcy = 0.0
     fcz = 0.0
@@ -258,10 +299,14 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     gap = 1.0
     px = x[n] - cx
     # cheap bound: a node ahead of the rounded edge and of a non-negative-rake face is free
-    if prm[P_TOOL] > 0.5 and not (px > prm[P_RE] and prm[P_RAKE] >= 0.0 and prm[P_TANI] == 0.0):
+    # (and farther than the separation gate)
+    ahead = prm[P_RE] + (prm[P_GATE] if prm[P_GATE] > 0.0 else 0.0)
+    if prm[P_TOOL] > 0.5 and not (px > ahead and prm[P_RAKE] >= 0.0 and prm[P_TANI] == 0.0):
         gap, gnx, gny, gnz = insert_gap3(px, y[n] - cy, z[n] - cz, prm[P_RN],
                                          prm[P_KAPPA], prm[P_KEND], prm[P_RAKE], prm[P_CLR],
                                          prm[P_RE], prm[P_TANI])
+        if pair and gap <= prm[P_GATE]:
+            tied[n] = 0
         if gap < 0.0:
             vrx = vx[n] - tvx
             vry = vy[n] - tvy
@@ -271,10 +316,10 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
                 gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, prm[P_MU], prm[P_TAU], prm[P_PEN],
                 dt)
             vt0 = vrx * tx + vry * ty + vrz * tz
-            pen[n] = 0.5 * fn * (-gap)
-    cf[n, 0] = fcx
-    cf[n, 1] = fcy
-    cf[n, 2] = fcz
+            pen[n] = share * 0.5 * fn * (-gap)
+    cf[n, 0] = share * fcx
+    cf[n, 1] = share * fcy
+    cf[n, 2] = share * fcz
     ox = vx[n]
     oy = vy[n]
     oz = vz[n]
@@ -289,10 +334,10 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     y[n] += dt * nvy
     z[n] += dt * nvz
     if gap < 0.0:
-        nwork[n] += dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy)
-                          + fcz * 0.5 * (oz + nvz))
+        nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy)
+                                  + fcz * 0.5 * (oz + nvz))
         vt1 = (nvx - tvx) * tx + (nvy - tvy) * ty + (nvz - tvz) * tz
-        fric[n] += dt * ft * 0.5 * (vt0 + vt1)
+        fric[n] += share * dt * ft * 0.5 * (vt0 + vt1)
 
 
 hex_node = njit(cache=True)(hex_node_py)
@@ -309,11 +354,12 @@ def element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, te
 
 @njit(parallel=True, cache=True)
 def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-                 pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt):
+                 pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, twin, tied):
     """:func:`hex_node_py` over all nodes (parallel)."""
     for n in prange(x.shape[0]):
-        hex_node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
-                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+        hex_node(np.int64(n), x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
+                 fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
+                 twin, tied)
 
 
 @njit(cache=True)
@@ -327,11 +373,12 @@ def element_update3_serial(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, ep
 
 @njit(cache=True)
 def node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
-                        cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt):
+                        cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
+                        twin, tied):
     """:func:`hex_node_py` over all nodes (one thread)."""
     for n in range(x.shape[0]):
         hex_node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
-                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, twin, tied)
 
 
 @njit(cache=True)
@@ -433,7 +480,7 @@ tool_step = njit(cache=True)(tool_step_py)
 @njit(cache=True)
 def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
                sd, pres, eps_p, temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
-               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist):
+               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, twin, tied):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
@@ -450,11 +497,12 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
         cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
         if par:
             node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
-                         cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt)
+                         cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
+                         twin, tied)
         else:
             node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
                                 fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx,
-                                tvy, tvz, dt)
+                                tvy, tvz, dt, twin, tied)
         fwx = 0.0
         fwy = 0.0
         fwz = 0.0

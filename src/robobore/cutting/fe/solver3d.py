@@ -72,6 +72,9 @@ class FEState3:
     clock: np.ndarray
     hacc: np.ndarray
     hist: np.ndarray
+    #: node splitting: partner node (-1: none) and whether the pair is still tied (int64)
+    twin: np.ndarray
+    tied: np.ndarray
 
     def kernel_args(self) -> tuple:
         """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
@@ -104,6 +107,7 @@ def default_prm3() -> np.ndarray:
     p[K3.P_SAMPLE_DT] = 1e30
     p[K3.P_TEND] = 1e30
     p[K3.P_EROSION] = K3.ERODE_NONE
+    p[K3.P_GATE] = -1.0
     p[K3.P_KAPPA] = np.pi / 2
     p[K3.P_KEND] = np.radians(5.0)
     p[K3.P_RN] = 1e-3
@@ -136,7 +140,8 @@ PARALLEL_MIN_ELEMENTS = 20000
 def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
                 prm: np.ndarray | None = None, n_samples: int = 1,
                 layer: np.ndarray | None = None, parallel: bool | None = None,
-                tool_tip: tuple[float, float, float] = (1e3, 1e3, 1e3)) -> FEState3:
+                tool_tip: tuple[float, float, float] = (1e3, 1e3, 1e3),
+                twin: np.ndarray | None = None) -> FEState3:
     """State for a hexahedral mesh ``nodes`` (n, 3) [m], ``conn`` (e, 8) in VTK order.
 
     ``fixed`` (n,) bit mask (1 x, 2 y, 4 z: velocity component held at its value, i.e.
@@ -146,6 +151,8 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
     element/node loops with ``prange`` (None: when the mesh has at least
     :data:`PARALLEL_MIN_ELEMENTS` elements; on a small mesh, or a machine with more busy
     threads than cores, the per-step barriers cost more than the parallel work saves).
+    ``twin`` (n,) pairs the doubled nodes of a parting surface (node splitting, -1 = none);
+    the pairs start tied.
     """
     nodes = np.ascontiguousarray(nodes, dtype=np.float64)
     conn = np.ascontiguousarray(conn, dtype=np.int64)
@@ -185,7 +192,14 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         fric=z(n), pen=z(n), ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n),
         mat=material.to_array(), prm=prm, tool=tool, en=z(K3.N_EN),
         ist=np.zeros(K3.N_IST, np.int64), clock=z(3), hacc=z(K3.N_HIST),
-        hist=np.full((max(1, n_samples), K3.N_HIST), np.nan))
+        hist=np.full((max(1, n_samples), K3.N_HIST), np.nan),
+        twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64).copy()),
+        tied=(np.zeros(n, np.int64) if twin is None
+              else (np.asarray(twin) >= 0).astype(np.int64)))
+    if st.twin.shape != (n,) or np.any(st.twin[st.twin >= 0] >= n) or np.any(
+            st.twin[st.twin[st.twin >= 0]] != np.flatnonzero(st.twin >= 0)):
+        raise ConfigError("twin must pair nodes symmetrically", field="twin",
+                          value=str(st.twin.shape), expected=f"(n,) = ({n},), twin[twin[i]] = i")
     init_forces3(st)
     return st
 
