@@ -112,13 +112,13 @@ def _kernels():
 
     @cuda.jit
     def k_nodes(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-                pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red, twin, tied):
+                pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red, pairs):
         n = cuda.grid(1)
         if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
             return
         cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
         node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-             pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1], twin, tied)
+             pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1], pairs)
         if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
             cuda.atomic.add(red, R_FX, cf[n, 0])
             cuda.atomic.add(red, R_FY, cf[n, 1])
@@ -212,7 +212,7 @@ def _kernels():
 #: arrays of FEState3 that the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "z", "vx", "vy", "vz", "alive", "sd", "pres", "eps_p", "temp", "dmg",
             "qh", "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
-            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist", "tied")
+            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist", "pairs")
 
 
 def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
@@ -237,7 +237,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                       "ncorner", "conn", "alive", "layer", "sd", "pres", "eps_p", "temp",
                       "dmg", "qh", "vol0", "ie", "hge", "fe", "dte", "plast", "rate", "cf",
                       "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en",
-                      "ist", "clock", "hacc", "hist", "twin", "tied")}
+                      "ist", "clock", "hacc", "hist", "pairs")}
     red = np.zeros(N_RED)
     red[R_DTMIN] = 1e30
     red[R_BAD] = -1.0
@@ -256,7 +256,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                                   g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
                                   g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
                                   g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
-                                  g["ist"], dred, g["twin"], g["tied"])
+                                  g["ist"], dred, g["pairs"])
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
                                   g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],

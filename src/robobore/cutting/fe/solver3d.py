@@ -72,13 +72,23 @@ class FEState3:
     clock: np.ndarray
     hacc: np.ndarray
     hist: np.ndarray
-    #: node splitting: partner node (-1: none) and whether the pair is still tied (int64)
-    twin: np.ndarray
-    tied: np.ndarray
+    #: node splitting, (n, 2) int64: partner node (-1: none) and whether the pair is still
+    #: tied (one array: see :func:`kernels3d.hex_node_py`)
+    pairs: np.ndarray
 
     def kernel_args(self) -> tuple:
         """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
         return tuple(getattr(self, f.name) for f in fields(self))
+
+    @property
+    def twin(self) -> np.ndarray:
+        """Partner of each node on a parting surface (-1: none), a view."""
+        return self.pairs[:, 0]
+
+    @property
+    def tied(self) -> np.ndarray:
+        """1 while a node's pair is tied, a view."""
+        return self.pairs[:, 1]
 
     @property
     def n_elements(self) -> int:
@@ -177,6 +187,11 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
     ptr[1:] = np.cumsum(counts)
     order = np.argsort(conn.ravel(), kind="stable")
     z = np.zeros
+    tw = -np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)
+    if tw.shape != (n,) or np.any(tw >= n) or np.any(
+            tw[tw[tw >= 0]] != np.flatnonzero(tw >= 0)):
+        raise ConfigError("twin must pair nodes symmetrically", field="twin",
+                          value=str(tw.shape), expected=f"(n,) = ({n},), twin[twin[i]] = i")
     tool = z(K3.N_TOOL)
     tool[K3.T_GX], tool[K3.T_GY], tool[K3.T_GZ] = tool_tip
     tool[K3.T_THETA] = prm[K3.P_THETA0]
@@ -193,13 +208,7 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         mat=material.to_array(), prm=prm, tool=tool, en=z(K3.N_EN),
         ist=np.zeros(K3.N_IST, np.int64), clock=z(3), hacc=z(K3.N_HIST),
         hist=np.full((max(1, n_samples), K3.N_HIST), np.nan),
-        twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64).copy()),
-        tied=(np.zeros(n, np.int64) if twin is None
-              else (np.asarray(twin) >= 0).astype(np.int64)))
-    if st.twin.shape != (n,) or np.any(st.twin[st.twin >= 0] >= n) or np.any(
-            st.twin[st.twin[st.twin >= 0]] != np.flatnonzero(st.twin >= 0)):
-        raise ConfigError("twin must pair nodes symmetrically", field="twin",
-                          value=str(st.twin.shape), expected=f"(n,) = ({n},), twin[twin[i]] = i")
+        pairs=np.ascontiguousarray(np.stack([tw, (tw >= 0).astype(np.int64)], axis=1)))
     init_forces3(st)
     return st
 
