@@ -4,7 +4,8 @@ Usage::
 
     python benchmarks/bench_fe3d.py speed [--elements 30000] [--steps 200]
     python benchmarks/bench_fe3d.py paper [--sizes 16.7 12.5] [--cut-mm 0.15]
-        [--mass-scaling 400] [--coefficients FILE] [--out results.json]
+        [--mass-scaling 400] [--coefficients FILE] [--friction 0.3|table]
+        [--separation erosion_layer|node_split] [--out results.json]
 
 ``speed`` prints element-updates per second of the full time step (nodes, contact, elements,
 tool) on a wall block of about ``--elements`` hexahedra, serial and parallel, with the load
@@ -69,7 +70,8 @@ def speed(n_elements: int, steps: int) -> dict:
     return out
 
 
-def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None) -> dict:
+def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None,
+          friction: str | None = None, separation: str | None = None) -> dict:
     from robobore.cutting.fe.boring3d import (
         compare_with_mechanistic,
         parse_boring_config,
@@ -78,6 +80,10 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
     from robobore.io.config import load_toml
 
     base = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
+    if friction is not None:
+        base["contact"]["friction"] = friction if friction == "table" else float(friction)
+    if separation is not None:
+        base["mesh"]["separation"] = separation
     res: dict = {"runs": [], "cut_length_mm": cut_mm, "mass_scaling": ms}
     for le in sizes:
         d = json.loads(json.dumps(base))
@@ -130,12 +136,16 @@ def main() -> None:
     ap.add_argument("--cut-mm", type=float, default=0.15)
     ap.add_argument("--mass-scaling", type=float, default=400.0)
     ap.add_argument("--coefficients", default=None)
+    ap.add_argument("--friction", default=None,
+                    help='Coulomb coefficient or "table" (default: the example\'s 0.3)')
+    ap.add_argument("--separation", choices=["erosion_layer", "node_split"], default=None)
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     if a.mode == "speed":
         out = speed(a.elements, a.steps)
     else:
-        out = paper(a.sizes, a.cut_mm, a.mass_scaling, a.coefficients)
+        out = paper(a.sizes, a.cut_mm, a.mass_scaling, a.coefficients, a.friction,
+                    a.separation)
     if a.out:
         from robobore.io.results import write_json
 

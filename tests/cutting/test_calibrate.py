@@ -151,6 +151,20 @@ def test_example_config_is_valid():
     assert c.rake_deg == 7.0 and c.material == "TC4"
 
 
+def test_boring_chip_calibration_example_is_valid():
+    """examples/calibration_boring_chip.toml (thin chips of the paper's boring condition)
+    parses, and its FE points respect the engine's element size <= h / 3 check."""
+    from pathlib import Path
+
+    from robobore.cutting.fe.config import parse_config
+
+    path = Path(__file__).parents[2] / "examples" / "calibration_boring_chip.toml"
+    c = cal.load_calibration_config(path)
+    assert c.fe.separation == "node_split"
+    for h in c.uncut_chip_thickness_um:
+        parse_config(cal.fe_config_dict(c, h, c.cutting_speed_m_per_min[0]))
+
+
 def test_fit_warnings_flag_bad_fits():
     """A thrust force that is not linear in h (the FE scatter seen in the example) is
     flagged, a good fit is not."""
