@@ -112,9 +112,13 @@ def test_cli_json_contract(tiny_run):
     for key in ("force_mean_N", "force_amplitude_N"):
         assert set(out[key]) == {"x", "y", "z"}
     for key in ("feed_amplitude_um", "wall_time_s", "element_updates_per_s", "device",
-                "energy_error", "n_elements", "mechanistic_comparison"):
+                "energy_error", "n_elements", "mechanistic_comparison", "separation",
+                "friction_coefficient"):
         assert key in out
     assert out["device"] == "cpu"
+    # defaults: erosion layer, the Rech table at 300 r/min on a 40 mm bore (37.7 m/min)
+    assert out["separation"] == "erosion_layer" and out["pairs_parted"] == 0
+    assert out["friction_coefficient"] == pytest.approx(0.1723, abs=1e-3)
     assert all((d / "vtk" / f"boring_{n}.vtu").exists() for n in ("initial", "final"))
 
 
