@@ -49,6 +49,7 @@ from robobore.cutting.fe.solver3d import (
     energy_error,
     hex_conn,
     make_state3,
+    split_node_layer,
 )
 from robobore.cutting.geometry import BoringInsert, chip_area
 from robobore.errors import ConfigError, NumericalError
@@ -367,20 +368,7 @@ def build_boring_mesh(insert: BoringInsert, ap: float, f: float, le: float, leng
     conn = hex_conn(idx)
     if js > 0:
         # double the free nodes of the parting surface; the rows above take the copies
-        line = idx[:, js, :].ravel()
-        line = line[fixed[line] == 0]
-        n_old = nodes.shape[0]
-        new_ids = n_old + np.arange(line.size)
-        nodes = np.vstack([nodes, nodes[line]])
-        fixed = np.concatenate([fixed, np.zeros(line.size, np.int64)])
-        remap = np.arange(nodes.shape[0])
-        remap[line] = new_ids
-        erow = np.broadcast_to(np.arange(ny)[None, :, None], (nx, ny, nz)).ravel()
-        above = erow >= js
-        conn[above] = remap[conn[above]]
-        twin = -np.ones(nodes.shape[0], np.int64)
-        twin[line] = new_ids
-        twin[new_ids] = line
+        nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, js)
     cen = nodes[conn].mean(axis=1)
     prof = insert.drop(cen[:, 2])
     chip = cen[:, 1] > prof
@@ -389,9 +377,8 @@ def build_boring_mesh(insert: BoringInsert, ap: float, f: float, le: float, leng
     if js > 0:
         # where the parting surface had to be lowered the edge path crosses chip rows: those
         # elements erode by damage (the erosion layer), elsewhere the chip parts at the pairs
-        kz = np.broadcast_to(np.arange(nz)[None, None, :], (nx, ny, nz)).ravel()
-        low_col = lowered[kz] | lowered[kz + 1]
-        layer &= low_col & (erow >= js)
+        _, erow, kz = np.unravel_index(np.arange(conn.shape[0]), (nx, ny, nz))
+        layer &= (lowered[kz] | lowered[kz + 1]) & (erow >= js)
     return BoringMesh(nodes=nodes, conn=conn, fixed=fixed, chip=chip, layer=layer,
                       shape=(nx, ny, nz), z_range=(z0, z1), length=lx, y_bottom=-depth,
                       twin=twin)

@@ -29,7 +29,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from robobore.errors import ConfigError, NumericalError
+from robobore.errors import ConfigError
 
 __all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled"]
 
@@ -71,6 +71,19 @@ def require_gpu() -> None:
 cuda = None
 
 
+def jc_device_functions(dev):
+    """Device versions ``(damage increment, return mapping)`` of the Johnson-Cook functions
+    (shared by the 2D and 3D GPU engines); ``dev`` = ``numba.cuda.jit(device=True)``."""
+    from robobore.material import johnson_cook as jc
+
+    th = dev(jc.homologous_temperature_py)
+    flow = dev(jc.rebind(jc.jc_flow_stress_py, homologous_temperature=th))
+    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
+    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
+    ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
+    return dmg, ret
+
+
 @functools.lru_cache(maxsize=1)
 def _kernels():
     """Compile (lazily, once) the device functions and kernels."""
@@ -85,11 +98,7 @@ def _kernels():
     from robobore.material import johnson_cook as jc
 
     dev = cuda.jit(device=True)
-    th = dev(jc.homologous_temperature_py)
-    flow = dev(jc.rebind(jc.jc_flow_stress_py, homologous_temperature=th))
-    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
-    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
-    ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
+    dmg, ret = jc_device_functions(dev)
     elem = dev(jc.rebind(hex_element_py, jc_return=ret, jc_damage_increment=dmg))
     tg = dev(tool_gap_py)
     sec = dev(K3.edge_section_py)
@@ -226,7 +235,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     GPU is usable.
     """
     from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.solver import _STATUS_TEXT
+    from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     require_gpu()
     k_nodes, k_tool, k_elems, k_finish = _kernels()
@@ -271,10 +280,8 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
         if status in _STATUS_TEXT or status == K3.STATUS_DONE or check is not None:
             _copy_back(st, g)
         if status in _STATUS_TEXT:
-            raise NumericalError(
-                f"3D simulation (GPU) unstable at step {int(st.ist[K3.I_STEP])}, time "
-                f"{st.time:.6g} s: {_STATUS_TEXT[status]}; try a smaller solver.cfl, a "
-                "larger mesh.element_size_um or less mass scaling")
+            raise instability_error(st, "3D simulation (GPU)", "a smaller solver.cfl, a larger "
+                                    "mesh.element_size_um or less mass scaling")
         if progress is not None:
             progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
         if check is not None:

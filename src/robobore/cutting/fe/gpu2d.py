@@ -38,8 +38,8 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.gpu import require_gpu
-from robobore.errors import ConfigError, NumericalError
+from robobore.cutting.fe.gpu import jc_device_functions, require_gpu
+from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported"]
 
@@ -73,11 +73,7 @@ def _kernels():
     from robobore.material import johnson_cook as jc
 
     dev = cuda.jit(device=True)
-    th = dev(jc.homologous_temperature_py)
-    flow = dev(jc.rebind(jc.jc_flow_stress_py, homologous_temperature=th))
-    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
-    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
-    ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
+    dmg, ret = jc_device_functions(dev)
     rret = dev(jc.rebind(jc.radial_return_py, jc_return=ret))
     tg = dev(tool_gap_py)
     cf = dev(contact_force_py)
@@ -265,7 +261,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
     rezoning.
     """
-    from robobore.cutting.fe.solver import _STATUS_TEXT
+    from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     if st.snodes is not None and st.snodes.shape[0] > 0:
         check_gpu_supported(int(st.prm[K.P_RZ_EVERY]))
@@ -320,13 +316,8 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         if status in _STATUS_TEXT or status == K.STATUS_DONE or check is not None:
             _copy_back(st, g)
         if status in _STATUS_TEXT:
-            raise NumericalError(
-                f"simulation (GPU) unstable at step {int(st.ist[K.I_STEP])}, time "
-                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
-                + (f" (element {int(st.ist[K.I_BADELEM])})"
-                   if status == K.STATUS_INVERTED else "")
-                + "; try a smaller solver.cfl, a larger mesh.element_size_um or less mass "
-                "scaling")
+            raise instability_error(st, "simulation (GPU)", "a smaller solver.cfl, a larger "
+                                    "mesh.element_size_um or less mass scaling")
         if progress is not None:
             progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
         if check is not None:

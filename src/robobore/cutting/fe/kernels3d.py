@@ -257,39 +257,22 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
         return
     tw = pairs[n, 0]
     pair = tw >= 0 and pairs[n, 1] != 0
-    share = 1.0
+    # a tied pair: both copies gather in the same order (lower id first), bitwise equal sums
+    na = min(n, tw) if pair else n
+    nb = max(n, tw) if pair else -1
+    share = 0.5 if pair else 1.0
     fx = 0.0
     fy = 0.0
     fz = 0.0
     nlive = 0
     vsum = 0.0
-    if pair:
-        # both copies gather in the same order (lower id first): bitwise equal sums
-        share = 0.5
-        na = min(n, tw)
-        nb = max(n, tw)
-        m = mass[na] + mass[nb]
-        for k in range(ptr[na], ptr[na + 1]):
-            e = nel[k]
-            if alive[e] == 1:
-                c3 = 3 * ncorner[k]
-                fx -= fe[e, c3]
-                fy -= fe[e, c3 + 1]
-                fz -= fe[e, c3 + 2]
-                nlive += 1
-                vsum += vol0[e]
-        for k in range(ptr[nb], ptr[nb + 1]):
-            e = nel[k]
-            if alive[e] == 1:
-                c3 = 3 * ncorner[k]
-                fx -= fe[e, c3]
-                fy -= fe[e, c3 + 1]
-                fz -= fe[e, c3 + 2]
-                nlive += 1
-                vsum += vol0[e]
-    else:
-        m = mass[n]
-        for k in range(ptr[n], ptr[n + 1]):
+    m = 0.0
+    for j in range(2):
+        nk = na if j == 0 else nb
+        if nk < 0:
+            continue
+        m += mass[nk]
+        for k in range(ptr[nk], ptr[nk + 1]):
             e = nel[k]
             if alive[e] == 1:
                 c3 = 3 * ncorner[k]

@@ -23,7 +23,14 @@ import numpy as np
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.config import FEConfig
 from robobore.cutting.fe.solver import apply_solver_settings, energy_error
-from robobore.cutting.fe.solver3d import FEState3, advance3, default_prm3, hex_conn, make_state3
+from robobore.cutting.fe.solver3d import (
+    FEState3,
+    advance3,
+    default_prm3,
+    hex_conn,
+    make_state3,
+    split_node_layer,
+)
 from robobore.errors import ConfigError
 from robobore.material import load_material
 
@@ -72,18 +79,7 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     fixed[idx[:, 0, :].ravel()] = 7
     fixed[idx[-1, :, :].ravel()] = 7
     # parting line: double its nodes (not the fully fixed ones); the chip rows take the copies
-    line = idx[:, n_dn, :].ravel()
-    line = line[fixed[line] != 7]
-    new = nodes.shape[0] + np.arange(line.size)
-    nodes = np.vstack([nodes, nodes[line]])
-    fixed = np.concatenate([fixed, fixed[line]])
-    remap = np.arange(nodes.shape[0])
-    remap[line] = new
-    erow = np.broadcast_to(np.arange(ny)[None, :, None], (nx, ny, n_z)).ravel()
-    conn[erow >= n_dn] = remap[conn[erow >= n_dn]]
-    twin = -np.ones(nodes.shape[0], np.int64)
-    twin[line] = new
-    twin[new] = line
+    nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, n_dn)
     p = apply_solver_settings(default_prm3(), cfg.solver, K3)
     p[K3.P_MU] = cfg.friction_coefficient()
     p[K3.P_TAU] = cfg.contact.shear_limit_MPa * 1e6

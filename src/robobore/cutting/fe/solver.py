@@ -218,6 +218,17 @@ _STATUS_TEXT = {
 }
 
 
+def instability_error(st: Any, label: str, hint: str) -> NumericalError:
+    """The error for a run stopped by an instability status (2D or 3D, CPU or GPU): step,
+    time, cause (and the inverted element), what to change."""
+    status = int(st.ist[K.I_STATUS])
+    return NumericalError(
+        f"{label} unstable at step {int(st.ist[K.I_STEP])}, time {st.time:.6g} s: "
+        f"{_STATUS_TEXT[status]}"
+        + (f" (element {int(st.ist[K.I_BADELEM])})" if status == K.STATUS_INVERTED else "")
+        + f"; try {hint}")
+
+
 def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: int, *,
                  chunk_steps: int, label: str, hint: str,
                  progress: Callable[[float], None] | None = None,
@@ -239,12 +250,7 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
         total += int(taken)
         status = int(st.ist[K.I_STATUS])
         if status in _STATUS_TEXT:
-            raise NumericalError(
-                f"{label} unstable at step {int(st.ist[K.I_STEP])}, time "
-                f"{st.time:.6g} s: {_STATUS_TEXT[status]}"
-                + (f" (element {int(st.ist[K.I_BADELEM])})"
-                   if status == K.STATUS_INVERTED else "")
-                + f"; try {hint}")
+            raise instability_error(st, label, hint)
         if progress is not None:
             progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
         if check is not None:

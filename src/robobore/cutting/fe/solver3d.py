@@ -20,7 +20,7 @@ from robobore.errors import ConfigError
 from robobore.material import Material
 
 __all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "advance3", "energy_error",
-           "hex_volumes"]
+           "hex_volumes", "split_node_layer"]
 
 #: node sign pattern of the reference hexahedron (VTK order), shape (8, 3)
 HEX_SIGNS = np.array([(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),
@@ -271,3 +271,27 @@ def hex_conn(idx: np.ndarray) -> np.ndarray:
     g = idx[1:, 1:, 1:]
     h = idx[:-1, 1:, 1:]
     return np.stack([a, b, c, d, e, f, g, h], axis=-1).reshape(-1, 8).astype(np.int64)
+
+
+def split_node_layer(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, idx: np.ndarray,
+                     j: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Node splitting on node layer ``j`` of a structured mesh (``idx`` from :func:`box_mesh`
+    or the like, elements in :func:`hex_conn` order): its nodes that are not fully fixed are
+    doubled, the elements of rows ``>= j`` take the copies (which inherit the fixed bits).
+    Returns ``(nodes, conn, fixed, twin)`` with ``twin`` pairing each copy with its original.
+    """
+    nx, ny, nz = (k - 1 for k in idx.shape)
+    line = idx[:, j, :].ravel()
+    line = line[fixed[line] != 7]
+    new = nodes.shape[0] + np.arange(line.size)
+    nodes = np.vstack([nodes, nodes[line]])
+    fixed = np.concatenate([fixed, fixed[line]])
+    remap = np.arange(nodes.shape[0])
+    remap[line] = new
+    above = np.broadcast_to(np.arange(ny)[None, :, None], (nx, ny, nz)).ravel() >= j
+    conn = conn.copy()
+    conn[above] = remap[conn[above]]
+    twin = -np.ones(nodes.shape[0], np.int64)
+    twin[line] = new
+    twin[new] = line
+    return nodes, conn, fixed, twin
