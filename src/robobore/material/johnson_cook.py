@@ -106,25 +106,26 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
     sy0 = jc_flow_stress(eps_p, 0.0, T, a, b, n, c, m, eps0, Troom, Tmelt)
     if q <= sy0:
         return 0.0, sy0
+    # T is held over the increment: the thermal factor is evaluated once; each iteration
+    # then costs one power and one logarithm (flow stress and its derivative share them)
+    therm = 1.0 - homologous_temperature(T, Troom, Tmelt) ** m
     lo = 0.0
     hi = q / (3.0 * G)
     d = (q - sy0) / (3.0 * G)
-    sy = sy0
     for _ in range(60):
-        sy = jc_flow_stress(eps_p + d, d / dt, T, a, b, n, c, m, eps0, Troom, Tmelt)
+        ep = eps_p + d
+        epn = ep**n
+        hard = a + b * epn
+        r = d / (dt * eps0)
+        rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
+        sy = hard * rate * therm
         f = q - 3.0 * G * d - sy
         if f > 0.0:
             lo = d
         else:
             hi = d
         # derivative of sigma_y wrt d (hardening + rate), analytic
-        ep = eps_p + d
-        hard = a + b * ep**n
-        r = d / (dt * eps0)
-        rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
-        ts = homologous_temperature(T, Troom, Tmelt)
-        therm = 1.0 - ts**m
-        dhard = n * b * ep ** (n - 1.0) if ep > 1e-12 else 1e12 * b
+        dhard = n * b * epn / ep if ep > 1e-12 else 1e12 * b
         drate = c / d if r > 1.0 else 0.0
         dsy = (dhard * rate + hard * drate) * therm
         fp = -3.0 * G - dsy
