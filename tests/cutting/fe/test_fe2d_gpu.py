@@ -139,9 +139,10 @@ def _simulator_usable() -> bool:
 def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path):
     """40 steps of a node-split cut in progress (tool on springs, contact, plastic chip,
     released and tied pairs, conduction every 4 steps, histories every 5 steps): the CUDA
-    kernels run in numba's simulator agree with the CPU engine (one thread) to 1e-9
-    relative. Not bit-identical: the contact force and contact count are summed with
-    atomics in thread order on the device."""
+    kernels run in numba's simulator give the same bits as the CPU engine: both devices
+    run the same scalar functions, sum the contact force in the same fixed order
+    (``kernels.contact_total``), and use atomics only for exact operations (a count, a min,
+    a max)."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", NUMBA_NUM_THREADS="1")
     p = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True,
                        text=True, timeout=600, cwd=tmp_path)
@@ -161,4 +162,4 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path):
     for k in ("x", "y", "vx", "vy", "sdx", "sdy", "sdxy", "pres", "eps_p", "temp", "dmg",
               "qhx", "ie", "hge", "fex", "cfx", "cfy", "fric", "nwork", "tool", "hist", "en",
               "clock"):
-        assert r[k] < 1e-9, (k, r)
+        assert r[k] == 0.0, (k, r)

@@ -96,6 +96,10 @@ class SolverSection(_Strict):
     mass_scaling: float = Field(default=1.0, ge=1.0, le=1e6)
     #: fraction of the stable time step (element length / dilatational wave speed)
     cfl: float = Field(default=0.8, gt=0.0, le=1.0)
+    #: element formulation: "q4r" (one-point quad with Flanagan-Belytschko hourglass
+    #: control) or "q4_bbar" (2x2 Gauss points with mean-dilatation B-bar: no hourglass
+    #: modes, about 2x the element cost; the hourglass coefficients are not used)
+    element: Literal["q4r", "q4_bbar"] = "q4r"
     #: Flanagan-Belytschko hourglass control coefficients (viscous, stiffness)
     hourglass_viscous: float = Field(default=0.05, ge=0.0, le=0.5)
     hourglass_stiffness: float = Field(default=0.05, ge=0.0, le=0.5)
@@ -191,6 +195,11 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           field="mesh.separation_height_um", value=sh,
                           expected=f"a height in um at most uncut_chip_thickness_um - "
                           f"element_size_um = {h - le:.4g} um (one element row of chip)")
+    if cfg.solver.element == "q4_bbar" and cfg.solver.rezone_interval > 0:
+        raise ConfigError("rezoning does not remap the Gauss-point state of the B-bar "
+                          "element", file=source, field="solver.rezone_interval",
+                          value=cfg.solver.rezone_interval,
+                          expected='0 with solver.element = "q4_bbar", or element "q4r"')
     return cfg
 
 

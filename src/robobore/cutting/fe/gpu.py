@@ -5,10 +5,11 @@ The per-element and per-node updates are the plain-Python scalar functions of th
 and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
 :mod:`robobore.cutting.fe.physics`), re-bound to device versions with
 :func:`robobore.material.johnson_cook.rebind` and compiled with
-``numba.cuda.jit(device=True)``. One time step is four kernel launches: nodes (contact
-forces summed with atomics), the tool (one thread), elements (stable step by atomic min),
-and the step end (one thread: time, status, time-averaged histories). The loop stays on the
-device; the host only checks the status between chunks.
+``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
+force total (one block, in the CPU's fixed lane order, so a run is reproducible bit for
+bit), the tool (one thread), elements (stable step by atomic min), and the step end (one
+thread: time, status, time-averaged histories). The loop stays on the device; the host only
+checks the status between chunks.
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``, i.e.
 ``numba-cuda``). Importing this module never needs either; :func:`require_gpu` raises a
@@ -91,6 +92,7 @@ def _kernels():
     from numba import cuda as _cuda
 
     cuda = _cuda
+    from numba import float64 as _float64
 
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.hex8 import hex_element_py
@@ -108,6 +110,9 @@ def _kernels():
     sup = dev(tool_support_step_py)
     kin = dev(K3.tool_kinematics_py)
     tstep = dev(jc.rebind(K3.tool_step_py, tool_kinematics=kin, tool_support_step=sup))
+    lsum3 = dev(K3.lane_sum3_py)
+    LANES = K3.N_SUM_LANES
+    float64 = _float64
 
     I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K3.I_STATUS, K3.I_STEP, K3.I_SAMPLE, K3.I_BADELEM
     ST_OK, ST_DONE, ST_INV = K3.STATUS_OK, K3.STATUS_DONE, K3.STATUS_INVERTED
@@ -128,11 +133,36 @@ def _kernels():
         cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
         node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
              pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1], pairs)
-        if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
-            cuda.atomic.add(red, R_FX, cf[n, 0])
-            cuda.atomic.add(red, R_FY, cf[n, 1])
-            cuda.atomic.add(red, R_FZ, cf[n, 2])
-            cuda.atomic.add(red, R_NC, 1.0)
+
+    @cuda.jit
+    def k_contact_sum(cf, red):
+        # the CPU's fixed-order total (kernels3d.contact_total3): one thread per lane, then
+        # the lanes in order by thread 0 -- reproducible bit for bit
+        t = cuda.threadIdx.x
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        pz = cuda.shared.array(LANES, float64)
+        pn = cuda.shared.array(LANES, float64)
+        a, b, c, k = lsum3(cf, t, LANES)
+        px[t] = a
+        py[t] = b
+        pz[t] = c
+        pn[t] = k
+        cuda.syncthreads()
+        if t == 0:
+            sx = 0.0
+            sy = 0.0
+            sz = 0.0
+            sn = 0.0
+            for j in range(LANES):
+                sx += px[j]
+                sy += py[j]
+                sz += pz[j]
+                sn += pn[j]
+            red[R_FX] = sx
+            red[R_FY] = sy
+            red[R_FZ] = sz
+            red[R_NC] = sn
 
     @cuda.jit
     def k_tool(tool, prm, en, clock, ist, red):
@@ -215,7 +245,7 @@ def _kernels():
         if t >= prm[P_TEND]:
             ist[I_STATUS] = ST_DONE
 
-    return k_nodes, k_tool, k_elems, k_finish
+    return k_nodes, k_contact_sum, k_tool, k_elems, k_finish
 
 
 #: arrays of FEState3 that the kernels change (copied back to the host)
@@ -238,7 +268,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     require_gpu()
-    k_nodes, k_tool, k_elems, k_finish = _kernels()
+    k_nodes, k_contact_sum, k_tool, k_elems, k_finish = _kernels()
     st.prm[K3.P_TEND] = t_end
     st.ist[K3.I_STATUS] = K3.STATUS_OK
     d = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name)))
@@ -266,6 +296,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                                   g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
                                   g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
                                   g["ist"], dred, g["pairs"])
+            k_contact_sum[1, K3.N_SUM_LANES](g["cf"], dred)
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
                                   g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],

@@ -10,13 +10,16 @@ device versions with :func:`robobore.material.johnson_cook.rebind` and compiled 
 ``numba.cuda.jit(device=True)``; the CPU engine calls the ``njit`` versions of the same
 functions from its ``prange`` loops.
 
-One time step is four kernel launches: nodes (contact force and contact count summed with
-atomics), the tool (one thread: support springs, external work), elements (stable step by
-atomic min, inverted element by atomic max) and the step end (one thread: time, status,
-time-averaged histories and, at each sample, the energy totals summed serially in the CPU
-engine's order). With ``solver.heat_conduction`` three more launches (centroids, fluxes,
-copy) run every ``solver.conduction_interval`` steps. The loop stays on the device; the host
-copies the state back between chunks (for the progress bar and the energy check).
+One time step is five kernel launches: nodes (contact count by atomic add), the contact-
+force total (one block, summed in the CPU engine's fixed lane order,
+``kernels.contact_total``: the same bits on both devices), the tool (one thread: support
+springs, external work), elements (stable step by atomic min, inverted element by atomic
+max) and the step end (one thread: time, status, time-averaged histories and, at each
+sample, the energy totals summed serially in the CPU engine's order). With
+``solver.heat_conduction`` three more launches (centroids, fluxes, copy) run every
+``solver.conduction_interval`` steps. The loop stays on the device; the host copies the
+state back between chunks (for the progress bar and the energy check).
+
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``).
 Importing this module needs neither; :func:`robobore.cutting.fe.gpu.require_gpu` raises a
@@ -53,8 +56,13 @@ N_RED = 5
 cuda = None
 
 
-def check_gpu_supported(rezone_interval: int, source: str | None = None) -> None:
-    """Raise a ConfigError for a setting the GPU engine does not run (rezoning)."""
+def check_gpu_supported(rezone_interval: int, source: str | None = None,
+                        element: str = "q4r") -> None:
+    """Raise a ConfigError for a setting the GPU engine does not run (rezoning, B-bar)."""
+    if element != "q4r":
+        raise ConfigError("the B-bar element is not ported to the GPU", file=source,
+                          field="solver.element", value=element,
+                          expected='"q4r" with --device gpu, or --device cpu')
     if rezone_interval > 0:
         raise ConfigError("rezoning is not available on the GPU", file=source,
                           field="solver.rezone_interval", value=rezone_interval,
@@ -68,6 +76,7 @@ def _kernels():
     from numba import cuda as _cuda
 
     cuda = _cuda
+    from numba import float64 as _float64
 
     from robobore.cutting.fe.physics import contact_force_py, tool_gap_py, tool_support_step_py
     from robobore.material import johnson_cook as jc
@@ -86,6 +95,9 @@ def _kernels():
     cent = dev(K.quad_centroid_py)
     cond = dev(K.quad_conduct_py)
     sumen = dev(K.sum_energies_py)
+    lsum = dev(K.lane_sum_py)
+    LANES = K.N_SUM_LANES
+    float64 = _float64
 
     I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K.I_STATUS, K.I_STEP, K.I_SAMPLE, K.I_BADELEM
     ST_OK, ST_DONE, ST_INV = K.STATUS_OK, K.STATUS_DONE, K.STATUS_INVERTED
@@ -114,9 +126,26 @@ def _kernels():
                                  fex, fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy,
                                  tvx, tvy, prm, clock[1], twin, tied)
         if touched:
-            cuda.atomic.add(red, R_FX, fcx)
-            cuda.atomic.add(red, R_FY, fcy)
-            cuda.atomic.add(red, R_NC, 1.0)
+            cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
+
+    @cuda.jit
+    def k_contact_sum(cfx, cfy, red):
+        # the CPU's fixed-order total (kernels.contact_total): one thread per lane, then
+        # the lanes in order by thread 0 -- the same bits on both devices
+        t = cuda.threadIdx.x
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        px[t] = lsum(cfx, t, LANES)
+        py[t] = lsum(cfy, t, LANES)
+        cuda.syncthreads()
+        if t == 0:
+            sx = 0.0
+            sy = 0.0
+            for j in range(LANES):
+                sx += px[j]
+                sy += py[j]
+            red[R_FX] = sx
+            red[R_FY] = sy
 
     @cuda.jit
     def k_tool(tool, prm, en, clock, ist, red):
@@ -233,7 +262,8 @@ def _kernels():
             ist[I_STATUS] = ST_DONE
             sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
 
-    return k_nodes, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end, k_finish
+    return (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
+            k_finish)
 
 
 #: FEState arrays used by the kernels (copied to the device)
@@ -259,14 +289,16 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     (the whole state when ``check`` is given, before calling it) and the whole state at the
     end. Returns the number of steps taken. Raises NumericalError on instability (same
     messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
-    rezoning.
+    rezoning or the B-bar element.
     """
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     if st.snodes is not None and st.snodes.shape[0] > 0:
         check_gpu_supported(int(st.prm[K.P_RZ_EVERY]))
+    if int(st.prm[K.P_ELEM]) != K.ELEM_Q4R:
+        check_gpu_supported(0, element="q4_bbar")
     require_gpu()
-    (k_nodes, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
+    (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_finish) = _kernels()
     st.prm[K.P_TEND] = t_end
     st.ist[K.I_STATUS] = K.STATUS_OK
@@ -294,6 +326,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                                   g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
                                   g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
                                   g["clock"], g["ist"], g["twin"], g["tied"], dred)
+            k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], dred)
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
                                   g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],

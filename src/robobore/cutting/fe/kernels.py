@@ -55,7 +55,14 @@ P_GATE, P_TCX, P_TCY = 32, 33, 34
 #: heat conduction: steps between conduction updates (0: adiabatic), time accumulated since
 #: the last one [s]
 P_COND_EVERY, P_COND_ACC = 35, 36
-N_PRM = 37
+#: element formulation: ELEM_Q4R (one-point quad + hourglass control) or ELEM_Q4BBAR (2x2
+#: Gauss points with mean-dilatation B-bar, no hourglass modes)
+P_ELEM = 37
+N_PRM = 38
+ELEM_Q4R, ELEM_Q4BBAR = 0, 1
+#: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
+G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
+N_GPS = 5
 # erosion modes
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 # --- tool state: guide x, y; displacement u, v; velocity of displacement; force
@@ -296,6 +303,268 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
     return dtmin, bad
 
 
+def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                 temp, dmg, gps, area0, ie, fex, fey, dte, plast, rate, mat, prm, dt, erosion):
+    """Fully integrated quad ``e`` with mean-dilatation B-bar (scalar code, allocates nothing).
+
+    Four Gauss points (2x2) each carry their own deviatoric stress and plastic strain
+    (``gps[e, k, G_*]``); the pressure is one per element, from the element's mean
+    dilatation rate (the centroid b-vectors of the one-point element are exactly the
+    area-averaged shape-function gradients of the bilinear quad), so there is no volumetric
+    locking in isochoric plastic flow (Nagtegaal, Parks & Rice 1974; Hughes 1980 "B-bar") and
+    no hourglass mode at all: hourglass-shaped deformation strains the Gauss points, which
+    resist it with the material's own (elastic or plastic) response. The temperature and the
+    damage stay one per element (Gauss-point plastic work and damage increments are
+    area-weighted); ``sdx``, ``sdy``, ``sdz``, ``sdxy``, ``eps_p`` and ``rate`` receive the
+    area-weighted Gauss-point means (for the outputs, conduction and erosion).
+
+    Internal force ``f_I = sum_k detJ_k B_k^T sigma_k`` with ``sigma_k = s_k - p``: for a
+    deviatoric ``s_k`` and an element-constant ``p`` this equals the B-bar force
+    ``sum_k detJ_k Bbar_k^T sigma_k`` (Belytschko, Liu, Moran 2000, sec. 8.5). Stable step,
+    bulk viscosity and erosion as :func:`quad_element_py`; returns ``(dte, inverted)``.
+    """
+    if alive[e] != 1:
+        for k in range(4):
+            fex[e, k] = 0.0
+            fey[e, k] = 0.0
+        dte[e] = 1e30
+        return 1e30, False
+    E = mat[jc.E_MOD]
+    nu = mat[jc.NU]
+    G = E / (2.0 * (1.0 + nu))
+    K = E / (3.0 * (1.0 - 2.0 * nu))
+    rho_s = mat[jc.RHO] * prm[P_MS]
+    rcp = mat[jc.RHO] * mat[jc.CP]
+    beta = mat[jc.BETA_TQ]
+    a_, b_, n_, c_, m_ = mat[jc.A], mat[jc.B], mat[jc.N], mat[jc.C], mat[jc.M]
+    e0, tr_, tm_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT]
+    bv1 = prm[P_BV1]
+    bv2 = prm[P_BV2]
+    dlim = prm[P_DIST]
+    dt_erode = prm[P_DT_ERODE]
+    i1 = conn[e, 0]
+    i2 = conn[e, 1]
+    i3 = conn[e, 2]
+    i4 = conn[e, 3]
+    x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
+    y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
+    A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
+    c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
+    c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
+    c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
+    c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
+    cmin = min(min(c1, c2), min(c3, c4))
+    if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
+        alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
+        for k in range(4):
+            fex[e, k] = 0.0
+            fey[e, k] = 0.0
+        dte[e] = 1e30
+        return 1e30, alive[e] == -2
+    u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
+    w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
+    # mean dilatation rate from the centroid (area-averaged) gradients
+    inv2a = 0.5 / A
+    bx1 = (y2 - y4) * inv2a
+    bx2 = (y3 - y1) * inv2a
+    bx3 = (y4 - y2) * inv2a
+    bx4 = (y1 - y3) * inv2a
+    by1 = (x4 - x2) * inv2a
+    by2 = (x1 - x3) * inv2a
+    by3 = (x2 - x4) * inv2a
+    by4 = (x3 - x1) * inv2a
+    trd = (u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
+           + w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4)
+    p_old = pres[e]
+    p_new = p_old - K * trd * dt
+    rho_c = rho_s * area0[e] / A
+    c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
+    bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
+            + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
+    le = 1.0 / math.sqrt(bsum)
+    qbv = 0.0
+    qrate = 0.0
+    if trd < 0.0:
+        qrate = bv1 * c + bv2 * le * (-trd)
+        qbv = rho_c * le * qrate * (-trd)
+    dte_e = le / (qrate + math.sqrt(qrate * qrate + c * c))
+    dte[e] = dte_e
+    # bilinear map x = a0 + a1 xi + a2 eta + a3 xi eta (same for y)
+    ax1 = 0.25 * (-x1 + x2 + x3 - x4)
+    ax2 = 0.25 * (-x1 - x2 + x3 + x4)
+    ax3 = 0.25 * (x1 - x2 + x3 - x4)
+    ay1 = 0.25 * (-y1 + y2 + y3 - y4)
+    ay2 = 0.25 * (-y1 - y2 + y3 + y4)
+    ay3 = 0.25 * (y1 - y2 + y3 - y4)
+    gq = 0.5773502691896258  # 1 / sqrt(3)
+    f1x = f2x = f3x = f4x = f1y = f2y = f3y = f4y = 0.0
+    wsum = 0.0
+    ssx = 0.0
+    ssy = 0.0
+    ssz = 0.0
+    ssxy = 0.0
+    seps = 0.0
+    srate = 0.0
+    wp_tot = 0.0
+    dd = 0.0
+    pw = 0.0
+    t_e = temp[e]
+    therm = 1.0 - jc.homologous_temperature(t_e, tr_, tm_) ** m_
+    for k in range(4):
+        xi = -gq if (k == 0 or k == 3) else gq
+        eta = -gq if k < 2 else gq
+        xx = ax1 + ax3 * eta  # dx/dxi
+        xe = ax2 + ax3 * xi   # dx/deta
+        yx = ay1 + ay3 * eta
+        ye = ay2 + ay3 * xi
+        dj = xx * ye - yx * xe
+        idj = 1.0 / dj
+        # dN/dxi and dN/deta of nodes 1..4 at (xi, eta): nodes at (-1,-1),(1,-1),(1,1),(-1,1)
+        nx1 = -0.25 * (1.0 - eta)
+        nx2 = 0.25 * (1.0 - eta)
+        nx3 = 0.25 * (1.0 + eta)
+        nx4 = -0.25 * (1.0 + eta)
+        ne1 = -0.25 * (1.0 - xi)
+        ne2 = -0.25 * (1.0 + xi)
+        ne3 = 0.25 * (1.0 + xi)
+        ne4 = 0.25 * (1.0 - xi)
+        gx1 = (ye * nx1 - yx * ne1) * idj
+        gx2 = (ye * nx2 - yx * ne2) * idj
+        gx3 = (ye * nx3 - yx * ne3) * idj
+        gx4 = (ye * nx4 - yx * ne4) * idj
+        gy1 = (-xe * nx1 + xx * ne1) * idj
+        gy2 = (-xe * nx2 + xx * ne2) * idj
+        gy3 = (-xe * nx3 + xx * ne3) * idj
+        gy4 = (-xe * nx4 + xx * ne4) * idj
+        dvxdx = u1 * gx1 + u2 * gx2 + u3 * gx3 + u4 * gx4
+        dvxdy = u1 * gy1 + u2 * gy2 + u3 * gy3 + u4 * gy4
+        dvydx = w1 * gx1 + w2 * gx2 + w3 * gx3 + w4 * gx4
+        dvydy = w1 * gy1 + w2 * gy2 + w3 * gy3 + w4 * gy4
+        dxx = dvxdx
+        dyy = dvydy
+        dxy = 0.5 * (dvxdy + dvydx)
+        rs = dt * 0.5 * (dvxdy - dvydx)
+        sx = gps[e, k, G_SX]
+        sy = gps[e, k, G_SY]
+        sz = gps[e, k, G_SZ]
+        sxy = gps[e, k, G_SXY]
+        ep = gps[e, k, G_EPS]
+        oxx = sx - p_old
+        oyy = sy - p_old
+        oxy = sxy
+        sx_r = sx + 2.0 * rs * sxy
+        sy_r = sy - 2.0 * rs * sxy
+        sxy_r = sxy + rs * (sy - sx)
+        # deviatoric trial from the Gauss point's own strain rate
+        tr3 = (dxx + dyy) * dt / 3.0
+        tx = sx_r + 2.0 * G * (dxx * dt - tr3)
+        ty = sy_r + 2.0 * G * (dyy * dt - tr3)
+        tz = sz + 2.0 * G * (-tr3)
+        txy = sxy_r + 2.0 * G * dxy * dt
+        # elastic check first (the same yield test as radial_return, with the element's
+        # thermal factor computed once): most Gauss points of the mesh stay elastic
+        qt = math.sqrt(1.5 * (tx * tx + ty * ty + tz * tz + 2.0 * txy * txy))
+        sy0 = (a_ + b_ * ep**n_) * therm
+        if qt <= sy0:
+            nsx, nsy, nsz, nsxy, dep, syld = tx, ty, tz, txy, 0.0, sy0
+        else:
+            nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, ep, t_e, dt, G,
+                                                           a_, b_, n_, c_, m_, e0, tr_, tm_)
+        if dep > 0.0:
+            ep += dep
+            wp_tot += syld * dep * dj
+            if syld > 0.0:
+                triax = -p_new / syld
+            else:
+                triax = 0.0
+            dd += dj * jc_damage_increment(dep, triax, dep / dt, t_e, mat[jc.D1],
+                                           mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
+                                           e0, tr_, tm_)
+            srate += dj * dep / dt
+        gps[e, k, G_SX] = nsx
+        gps[e, k, G_SY] = nsy
+        gps[e, k, G_SZ] = nsz
+        gps[e, k, G_SXY] = nsxy
+        gps[e, k, G_EPS] = ep
+        fxx = nsx - p_new - qbv
+        fyy = nsy - p_new - qbv
+        pw += dj * (0.5 * (oxx + fxx) * dxx + 0.5 * (oyy + fyy) * dyy + (oxy + nsxy) * dxy)
+        f1x += dj * (fxx * gx1 + nsxy * gy1)
+        f2x += dj * (fxx * gx2 + nsxy * gy2)
+        f3x += dj * (fxx * gx3 + nsxy * gy3)
+        f4x += dj * (fxx * gx4 + nsxy * gy4)
+        f1y += dj * (nsxy * gx1 + fyy * gy1)
+        f2y += dj * (nsxy * gx2 + fyy * gy2)
+        f3y += dj * (nsxy * gx3 + fyy * gy3)
+        f4y += dj * (nsxy * gx4 + fyy * gy4)
+        wsum += dj
+        ssx += dj * nsx
+        ssy += dj * nsy
+        ssz += dj * nsz
+        ssxy += dj * nsxy
+        seps += dj * ep
+    fex[e, 0] = f1x
+    fex[e, 1] = f2x
+    fex[e, 2] = f3x
+    fex[e, 3] = f4x
+    fey[e, 0] = f1y
+    fey[e, 1] = f2y
+    fey[e, 2] = f3y
+    fey[e, 3] = f4y
+    iw = 1.0 / wsum
+    sdx[e] = ssx * iw
+    sdy[e] = ssy * iw
+    sdz[e] = ssz * iw
+    sdxy[e] = ssxy * iw
+    eps_p[e] = seps * iw
+    rate[e] = srate * iw
+    pres[e] = p_new
+    if wp_tot > 0.0:
+        plast[e] += wp_tot
+        temp[e] += beta * wp_tot / (rcp * A)
+        dmg[e] += dd * iw
+    ie[e] += dt * pw
+    if dte_e < dt_erode:
+        alive[e] = -1
+    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+        gate = prm[P_GATE]
+        if gate < 0.0 or not layer[e]:
+            alive[e] = 0
+        else:
+            gmin = 1e30
+            for k in range(4):
+                nk = conn[e, k]
+                g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
+                                       prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
+                if g < gmin:
+                    gmin = g
+            if gmin <= gate:
+                alive[e] = 0
+    return dte_e, False
+
+
+quad_bbar = njit(cache=True, inline="always")(quad_bbar_py)
+
+
+@njit(parallel=True, cache=True)
+def element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                        temp, dmg, gps, area0, ie, fex, fey, dte, plast, rate, mat, prm, dt,
+                        erosion):
+    """:func:`quad_bbar_py` over all elements (parallel); returns ``(dtmin, bad)`` as
+    :func:`element_update`."""
+    ne = conn.shape[0]
+    dtmin = 1e30
+    bad = -1
+    for e in prange(ne):
+        d, inv = quad_bbar(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
+                           eps_p, temp, dmg, gps, area0, ie, fex, fey, dte, plast, rate, mat,
+                           prm, dt, erosion)
+        dtmin = min(dtmin, d)
+        if inv:
+            bad = max(bad, e)
+    return dtmin, bad
+
+
 def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
                  cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx,
                  tool_vy, prm, dt, twin, tied):
@@ -421,6 +690,36 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
             fsy += fcy
             ncont += 1
     return fsx, fsy, ncont
+
+
+#: lanes of the fixed-order contact-force total (one GPU block of this many threads)
+N_SUM_LANES = 256
+
+
+def lane_sum_py(a, lane, lanes):
+    """Sum of ``a[lane], a[lane + lanes], ...`` in index order (one lane of
+    :func:`contact_total_py`)."""
+    s = 0.0
+    for n in range(lane, a.shape[0], lanes):
+        s += a[n]
+    return s
+
+
+lane_sum = njit(cache=True, inline="always")(lane_sum_py)
+
+
+@njit(cache=True)
+def contact_total(cfx, cfy):
+    """Total contact force on the workpiece [N/m] from the per-node forces, summed in a fixed
+    order: ``N_SUM_LANES`` strided lane sums, then the lanes in order. The GPU engine sums
+    the same way (one thread per lane), so both devices get the same bits whatever the
+    thread count."""
+    fx = 0.0
+    fy = 0.0
+    for lane in range(N_SUM_LANES):
+        fx += lane_sum(cfx, lane, N_SUM_LANES)
+        fy += lane_sum(cfy, lane, N_SUM_LANES)
+    return fx, fy
 
 
 def quad_centroid_py(e, conn, x, y, tbuf):
@@ -569,7 +868,8 @@ tool_step = njit(cache=True)(tool_step_py)
 def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
-              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf):
+              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
+              gps):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -577,6 +877,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     STATUS_NONFINITE or STATUS_DT_COLLAPSE. Returns the number of steps taken.
     """
     erosion = int(prm[P_EROSION])
+    bbar = int(prm[P_ELEM]) == ELEM_Q4BBAR
     cfl = prm[P_CFL]
     rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
@@ -585,17 +886,23 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         dt = clock[1]
         t = clock[0]
         cx, cy, tvx, tvy = tool_kinematics(tool, prm)
-        fwx, fwy, ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
+        _fx, _fy, ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
                                       area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
                                       nwork, cx, cy, tvx, tvy, prm, dt, twin, tied)
+        fwx, fwy = contact_total(cfx, cfy)
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
         if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
             rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
                    sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
                    prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE])
-        dtmin, bad = element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy,
-                                    pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex,
-                                    fey, dte, plast, rate, mat, prm, dt, erosion)
+        if bbar:
+            dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
+                                             sdxy, pres, eps_p, temp, dmg, gps, area0, ie, fex,
+                                             fey, dte, plast, rate, mat, prm, dt, erosion)
+        else:
+            dtmin, bad = element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy,
+                                        pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex,
+                                        fey, dte, plast, rate, mat, prm, dt, erosion)
         cond_every = int(prm[P_COND_EVERY])
         if cond_every > 0:
             prm[P_COND_ACC] += dt

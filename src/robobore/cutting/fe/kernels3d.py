@@ -92,6 +92,7 @@ from robobore.cutting.fe.kernels import (
     I_STEP,
     N_EN,
     N_IST,
+    N_SUM_LANES,
     STATUS_DONE,
     STATUS_DT_COLLAPSE,
     STATUS_INVERTED,
@@ -477,6 +478,43 @@ def tool_step_py(tool, prm, fwx, fwy, fwz, dt):
 tool_step = njit(cache=True)(tool_step_py)
 
 
+def lane_sum3_py(cf, lane, lanes):
+    """Lane ``lane`` of :func:`contact_total3`: the sums of ``cf[n, 0:3]`` over ``n = lane,
+    lane + lanes, ...`` in index order and the number of those nodes in contact."""
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    nc = 0
+    for n in range(lane, cf.shape[0], lanes):
+        if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
+            sx += cf[n, 0]
+            sy += cf[n, 1]
+            sz += cf[n, 2]
+            nc += 1
+    return sx, sy, sz, nc
+
+
+lane_sum3 = njit(cache=True, inline="always")(lane_sum3_py)
+
+
+@njit(cache=True)
+def contact_total3(cf):
+    """Total contact force on the workpiece [N] and number of contact nodes, summed in the
+    fixed lane order of :func:`robobore.cutting.fe.kernels.contact_total` (the GPU engine
+    sums the same way, so a GPU run is reproducible bit for bit)."""
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    nc = 0
+    for lane in range(N_SUM_LANES):
+        a, b, c, k = lane_sum3(cf, lane, N_SUM_LANES)
+        fx += a
+        fy += b
+        fz += c
+        nc += k
+    return fx, fy, fz, nc
+
+
 @njit(cache=True)
 def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
                sd, pres, eps_p, temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
@@ -488,7 +526,6 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
     """
     erosion = int(prm[P_EROSION])
     par = prm[P_PARALLEL] > 0.5
-    nn = x.shape[0]
     ne = conn.shape[0]
     taken = 0
     for _s in range(n_steps):
@@ -503,16 +540,7 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
             node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
                                 fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx,
                                 tvy, tvz, dt, pairs)
-        fwx = 0.0
-        fwy = 0.0
-        fwz = 0.0
-        ncont = 0
-        for n in range(nn):
-            if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
-                fwx += cf[n, 0]
-                fwy += cf[n, 1]
-                fwz += cf[n, 2]
-                ncont += 1
+        fwx, fwy, fwz, ncont = contact_total3(cf)
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, fwz, dt)
         if par:
             element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg,

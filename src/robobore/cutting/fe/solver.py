@@ -87,6 +87,8 @@ class FEState:
     tied: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: scratch for the heat-conduction update (n_elem, 4)
     tbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: Gauss-point state of the B-bar element (n_elem, 4, N_GPS); (0, 4, N_GPS) for Q4R
+    gps: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -96,7 +98,7 @@ class FEState:
                 self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
-                self.buf, self.twin, self.tied, self.tbuf)
+                self.buf, self.twin, self.tied, self.tbuf, self.gps)
 
     @property
     def n_elements(self) -> int:
@@ -187,7 +189,8 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),
-        tbuf=z((ne, 4)))
+        tbuf=z((ne, 4)),
+        gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)))
     init_forces(st)
     return st
 
@@ -309,6 +312,8 @@ def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
     p[k.P_DT_ERODE] = -s.erode_time_step_fraction
     p[k.P_EROSION] = {"none": k.ERODE_NONE, "layer": k.ERODE_LAYER,
                       "everywhere": k.ERODE_ALL}[s.erosion]
+    if hasattr(k, "P_ELEM"):
+        p[k.P_ELEM] = {"q4r": k.ELEM_Q4R, "q4_bbar": k.ELEM_Q4BBAR}[s.element]
     return p
 
 
@@ -410,7 +415,7 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
         from robobore.cutting.fe.gpu import require_gpu
         from robobore.cutting.fe.gpu2d import check_gpu_supported
 
-        check_gpu_supported(cfg.solver.rezone_interval, source)
+        check_gpu_supported(cfg.solver.rezone_interval, source, cfg.solver.element)
         require_gpu()
 
 
