@@ -87,8 +87,13 @@ def _kernels():
     tg = dev(tool_gap_py)
     cf = dev(contact_force_py)
     sup = dev(tool_support_step_py)
-    elem = dev(jc.rebind(K.quad_element_py, radial_return=rret, jc_damage_increment=dmg,
-                         tool_gap=tg))
+    retire = dev(K.quad_retire_py)
+    elem = dev(jc.rebind(
+        K.quad_element_py, radial_return=rret, jc_damage_increment=dmg,
+        quad_area_corners=dev(K.quad_area_corners_py),
+        quad_distorted=dev(jc.rebind(K.quad_distorted_py, quad_retire=retire)),
+        quad_bvectors=dev(K.quad_bvectors_py), quad_step=dev(K.quad_step_py),
+        damage_erosion=dev(jc.rebind(K.damage_erosion_py, tool_gap=tg))))
     node = dev(jc.rebind(K.quad_node_py, tool_gap=tg, contact_force=cf))
     kin = dev(K.tool_kinematics_py)
     tstep = dev(jc.rebind(K.tool_step_py, tool_support_step=sup))

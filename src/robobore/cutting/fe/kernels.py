@@ -82,6 +82,88 @@ H_EERO, H_NCONT = 12, 13
 N_HIST = 14
 
 
+def quad_area_corners_py(x1, x2, x3, x4, y1, y2, y3, y4):
+    """Area of a quad and its smallest corner Jacobian (twice the corner triangle area; all
+    > 0 for a convex, counter-clockwise quad)."""
+    A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
+    c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
+    c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
+    c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
+    c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
+    return A, min(min(c1, c2), min(c3, c4))
+
+
+def quad_retire_py(e, fex, fey, dte):
+    """Zero the nodal forces of element ``e`` and give it an infinite stable step."""
+    for k in range(4):
+        fex[e, k] = 0.0
+        fey[e, k] = 0.0
+    dte[e] = 1e30
+
+
+def quad_distorted_py(e, alive, fex, fey, dte, area0, A, cmin, dlim):
+    """True (and the element retired) when quad ``e`` is inverted (``alive`` = -2: an error
+    unless the distortion limit caught it) or below the distortion limit (-1)."""
+    if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
+        alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
+        quad_retire(e, fex, fey, dte)
+        return True
+    return False
+
+
+def quad_bvectors_py(x1, x2, x3, x4, y1, y2, y3, y4, A):
+    """Centroid gradients b_I = dN_I/dx, dN_I/dy of the bilinear quad (= their area means;
+    Flanagan & Belytschko 1981)."""
+    inv2a = 0.5 / A
+    return ((y2 - y4) * inv2a, (y3 - y1) * inv2a, (y4 - y2) * inv2a, (y1 - y3) * inv2a,
+            (x4 - x2) * inv2a, (x1 - x3) * inv2a, (x2 - x4) * inv2a, (x3 - x1) * inv2a)
+
+
+def quad_step_py(rho_s, a0, A, K, G, bsum, trd, bv1, bv2):
+    """Current density, wave speed, bulk-viscosity pressure and stable step of a quad.
+
+    ``rho_s`` scaled density, ``a0``/``A`` initial/current area, ``bsum`` = sum b_I . b_I
+    (element length 1/sqrt(bsum)), ``trd`` the dilatation rate; the bulk viscosity (linear
+    ``bv1``, quadratic ``bv2``) acts in compression only. Returns ``(rho_c, c, qbv, dte)``.
+    """
+    rho_c = rho_s * a0 / A
+    c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
+    le = 1.0 / math.sqrt(bsum)
+    qbv = 0.0
+    qrate = 0.0
+    if trd < 0.0:
+        qrate = bv1 * c + bv2 * le * (-trd)
+        qbv = rho_c * le * qrate * (-trd)
+    return rho_c, c, qbv, le / (qrate + math.sqrt(qrate * qrate + c * c))
+
+
+def damage_erosion_py(e, conn, x, y, alive, layer, dmg, prm, erosion):
+    """Erode quad ``e`` once its Johnson-Cook damage reached 1 (everywhere, or in the
+    separation layer; there optionally only with a node within ``prm[P_GATE]`` of the tool)."""
+    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+        gate = prm[P_GATE]
+        if gate < 0.0 or not layer[e]:
+            alive[e] = 0
+        else:
+            gmin = 1e30
+            for k in range(4):
+                nk = conn[e, k]
+                g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
+                                       prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
+                if g < gmin:
+                    gmin = g
+            if gmin <= gate:
+                alive[e] = 0
+
+
+quad_area_corners = njit(cache=True, inline="always")(quad_area_corners_py)
+quad_retire = njit(cache=True, inline="always")(quad_retire_py)
+quad_distorted = njit(cache=True, inline="always")(quad_distorted_py)
+quad_bvectors = njit(cache=True, inline="always")(quad_bvectors_py)
+quad_step = njit(cache=True, inline="always")(quad_step_py)
+damage_erosion = njit(cache=True, inline="always")(damage_erosion_py)
+
+
 def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
                     temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
                     erosion):
@@ -100,10 +182,7 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
     """
     if alive[e] != 1:
-        for k in range(4):
-            fex[e, k] = 0.0
-            fey[e, k] = 0.0
-        dte[e] = 1e30
+        quad_retire(e, fex, fey, dte)
         return 1e30, False
     E = mat[jc.E_MOD]
     nu = mat[jc.NU]
@@ -126,30 +205,10 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     i4 = conn[e, 3]
     x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
     y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
-    A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
-    # corner Jacobians (2x twice the corner triangle area); all > 0 for a convex quad
-    c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
-    c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
-    c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
-    c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
-    cmin = min(min(c1, c2), min(c3, c4))
-    if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
-        # inverted (-2: an error unless the distortion limit caught it) or distorted (-1)
-        alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
-        for k in range(4):
-            fex[e, k] = 0.0
-            fey[e, k] = 0.0
-        dte[e] = 1e30
+    A, cmin = quad_area_corners(x1, x2, x3, x4, y1, y2, y3, y4)
+    if quad_distorted(e, alive, fex, fey, dte, area0, A, cmin, dlim):
         return 1e30, alive[e] == -2
-    inv2a = 0.5 / A
-    bx1 = (y2 - y4) * inv2a
-    bx2 = (y3 - y1) * inv2a
-    bx3 = (y4 - y2) * inv2a
-    bx4 = (y1 - y3) * inv2a
-    by1 = (x4 - x2) * inv2a
-    by2 = (x1 - x3) * inv2a
-    by3 = (x2 - x4) * inv2a
-    by4 = (x3 - x1) * inv2a
+    bx1, bx2, bx3, bx4, by1, by2, by3, by4 = quad_bvectors(x1, x2, x3, x4, y1, y2, y3, y4, A)
     u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
     w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
     dvxdx = u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
@@ -205,17 +264,9 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     sdxy[e] = nsxy
     pres[e] = p_new
     # bulk viscosity (compression only) and stable step
-    rho_c = rho_s * area0[e] / A
-    c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
     bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
             + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
-    le = 1.0 / math.sqrt(bsum)
-    qbv = 0.0
-    qrate = 0.0
-    if trd < 0.0:
-        qrate = bv1 * c + bv2 * le * (-trd)
-        qbv = rho_c * le * qrate * (-trd)
-    dte_e = le / (qrate + math.sqrt(qrate * qrate + c * c))
+    rho_c, c, qbv, dte_e = quad_step(rho_s, area0[e], A, K, G, bsum, trd, bv1, bv2)
     dte[e] = dte_e
     if dte_e < dt_erode:
         # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
@@ -257,20 +308,7 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
     fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
     # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
-    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
-        gate = prm[P_GATE]
-        if gate < 0.0 or not layer[e]:
-            alive[e] = 0
-        else:
-            gmin = 1e30
-            for k in range(4):
-                nk = conn[e, k]
-                g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
-                                       prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
-                if g < gmin:
-                    gmin = g
-            if gmin <= gate:
-                alive[e] = 0
+    damage_erosion(e, conn, x, y, alive, layer, dmg, prm, erosion)
     return dte_e, False
 
 
@@ -324,10 +362,7 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     bulk viscosity and erosion as :func:`quad_element_py`; returns ``(dte, inverted)``.
     """
     if alive[e] != 1:
-        for k in range(4):
-            fex[e, k] = 0.0
-            fey[e, k] = 0.0
-        dte[e] = 1e30
+        quad_retire(e, fex, fey, dte)
         return 1e30, False
     E = mat[jc.E_MOD]
     nu = mat[jc.NU]
@@ -348,46 +383,20 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     i4 = conn[e, 3]
     x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
     y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
-    A = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1))
-    c1 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1)
-    c2 = (x3 - x2) * (y1 - y2) - (y3 - y2) * (x1 - x2)
-    c3 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3)
-    c4 = (x1 - x4) * (y3 - y4) - (y1 - y4) * (x3 - x4)
-    cmin = min(min(c1, c2), min(c3, c4))
-    if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
-        alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
-        for k in range(4):
-            fex[e, k] = 0.0
-            fey[e, k] = 0.0
-        dte[e] = 1e30
+    A, cmin = quad_area_corners(x1, x2, x3, x4, y1, y2, y3, y4)
+    if quad_distorted(e, alive, fex, fey, dte, area0, A, cmin, dlim):
         return 1e30, alive[e] == -2
     u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
     w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
     # mean dilatation rate from the centroid (area-averaged) gradients
-    inv2a = 0.5 / A
-    bx1 = (y2 - y4) * inv2a
-    bx2 = (y3 - y1) * inv2a
-    bx3 = (y4 - y2) * inv2a
-    bx4 = (y1 - y3) * inv2a
-    by1 = (x4 - x2) * inv2a
-    by2 = (x1 - x3) * inv2a
-    by3 = (x2 - x4) * inv2a
-    by4 = (x3 - x1) * inv2a
+    bx1, bx2, bx3, bx4, by1, by2, by3, by4 = quad_bvectors(x1, x2, x3, x4, y1, y2, y3, y4, A)
     trd = (u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
            + w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4)
     p_old = pres[e]
     p_new = p_old - K * trd * dt
-    rho_c = rho_s * area0[e] / A
-    c = math.sqrt((K + 4.0 * G / 3.0) / rho_c)
     bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
             + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
-    le = 1.0 / math.sqrt(bsum)
-    qbv = 0.0
-    qrate = 0.0
-    if trd < 0.0:
-        qrate = bv1 * c + bv2 * le * (-trd)
-        qbv = rho_c * le * qrate * (-trd)
-    dte_e = le / (qrate + math.sqrt(qrate * qrate + c * c))
+    _rho_c, _c, qbv, dte_e = quad_step(rho_s, area0[e], A, K, G, bsum, trd, bv1, bv2)
     dte[e] = dte_e
     # bilinear map x = a0 + a1 xi + a2 eta + a3 xi eta (same for y)
     ax1 = 0.25 * (-x1 + x2 + x3 - x4)
@@ -526,20 +535,7 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     ie[e] += dt * pw
     if dte_e < dt_erode:
         alive[e] = -1
-    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
-        gate = prm[P_GATE]
-        if gate < 0.0 or not layer[e]:
-            alive[e] = 0
-        else:
-            gmin = 1e30
-            for k in range(4):
-                nk = conn[e, k]
-                g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
-                                       prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
-                if g < gmin:
-                    gmin = g
-            if gmin <= gate:
-                alive[e] = 0
+    damage_erosion(e, conn, x, y, alive, layer, dmg, prm, erosion)
     return dte_e, False
 
 
