@@ -196,10 +196,6 @@ def _kernels():
         fwy = red[R_FY]
         fwz = red[R_FZ]
         nc = red[R_NC]
-        red[R_FX] = 0.0
-        red[R_FY] = 0.0
-        red[R_FZ] = 0.0
-        red[R_NC] = 0.0
         if red[R_BAD] >= 0.0:
             ist[I_BADELEM] = int(red[R_BAD])
             ist[I_STATUS] = ST_INV

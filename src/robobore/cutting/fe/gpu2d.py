@@ -210,9 +210,7 @@ def _kernels():
         fwx = red[R_FX]
         fwy = red[R_FY]
         nc = red[R_NC]
-        red[R_FX] = 0.0
-        red[R_FY] = 0.0
-        red[R_NC] = 0.0
+        red[R_NC] = 0.0  # the force total is rewritten by k_contact_sum every step
         if red[R_BAD] >= 0.0:
             ist[I_BADELEM] = int(red[R_BAD])
             ist[I_STATUS] = ST_INV

@@ -670,22 +670,18 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
                 prm, dt, twin, tied):
     """:func:`quad_node_py` over all nodes (parallel).
 
-    Returns ``(fx, fy, n_contact)``: the total contact force on the workpiece [N/m] and the
-    number of nodes in contact.
+    Returns the number of nodes in contact; their contact forces are in ``cfx``/``cfy``
+    (summed in a fixed order by :func:`contact_total`).
     """
-    fsx = 0.0
-    fsy = 0.0
     ncont = 0
     for n in prange(x.shape[0]):
-        fcx, fcy, touched = quad_node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
-                                      area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
-                                      nwork, tool_cx, tool_cy, tool_vx, tool_vy, prm, dt, twin,
-                                      tied)
+        _fcx, _fcy, touched = quad_node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
+                                        area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
+                                        nwork, tool_cx, tool_cy, tool_vx, tool_vy, prm, dt,
+                                        twin, tied)
         if touched:
-            fsx += fcx
-            fsy += fcy
             ncont += 1
-    return fsx, fsy, ncont
+    return ncont
 
 
 #: lanes of the fixed-order contact-force total (one GPU block of this many threads)
@@ -882,9 +878,9 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         dt = clock[1]
         t = clock[0]
         cx, cy, tvx, tvy = tool_kinematics(tool, prm)
-        _fx, _fy, ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
-                                      area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
-                                      nwork, cx, cy, tvx, tvy, prm, dt, twin, tied)
+        ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
+                            fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy,
+                            prm, dt, twin, tied)
         fwx, fwy = contact_total(cfx, cfy)
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
         if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
