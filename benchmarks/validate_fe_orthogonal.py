@@ -10,7 +10,8 @@ through ``contact.friction = "table"``; nothing is fitted to these points.
 Usage::
 
     python benchmarks/validate_fe_orthogonal.py [--length-mm 1.0] [--element-um 10]
-        [--data PATH] [--json OUT.json] [--points 60:30,40:5]
+        [--data PATH] [--json OUT.json] [--points 60:30,40:5] [--separation node_split]
+        [--separation-height-um 5] [--edge-um 2.5] [--band-um 10,10] [--conduction]
 
 Prints a table (measured, simulated, error, pass) and the run times.
 """
@@ -64,6 +65,11 @@ def main() -> None:
                     help="solver.distortion_limit (default: the engine's default)")
     ap.add_argument("--erode-dt-fraction", type=float, default=None,
                     help="solver.erode_time_step_fraction (default: the engine's default)")
+    ap.add_argument("--edge-um", type=float, default=None,
+                    help="mesh.edge_element_um: refined band round the parting line "
+                    "(node splitting)")
+    ap.add_argument("--band-um", type=str, default=None,
+                    help="mesh.edge_band_um as ABOVE,BELOW (default: the engine's default)")
     args = ap.parse_args()
     ref = json.loads(args.data.read_text())["measured"]
     pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
@@ -72,7 +78,8 @@ def main() -> None:
     rows = []
     print(f"# FE orthogonal validation: length {args.length_mm} mm, element "
           f"{args.element_um} um, separation {args.separation or 'default'} "
-          f"(height {args.separation_height_um} um), conduction {args.conduction}, erosion "
+          f"(height {args.separation_height_um} um), edge band {args.edge_um} um "
+          f"({args.band_um or 'default'}), conduction {args.conduction}, erosion "
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
@@ -87,6 +94,10 @@ def main() -> None:
             mesh["separation"] = args.separation
         if args.separation_height_um is not None:
             mesh["separation_height_um"] = args.separation_height_um
+        if args.edge_um is not None:
+            mesh["edge_element_um"] = args.edge_um
+        if args.band_um is not None:
+            mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
         solver: dict = {}
         if args.conduction:
             solver["heat_conduction"] = True

@@ -88,6 +88,19 @@ class MeshSection(_Strict):
     separation_height_um: float | None = Field(default=None, ge=0.0)
     #: uncut material left ahead of the tool at the end of the cut [mm]
     ahead_mm: float = Field(default=0.3, gt=0.0, le=20.0)
+    #: element size [um] in a band round the parting line, where the material passes the
+    #: cutting edge (node splitting only); element_size_um / edge_element_um must be 2, 4
+    #: or 8 (conforming 2:1 transition rows). None: uniform element_size_um
+    edge_element_um: float | None = Field(default=None, gt=0.0)
+    #: extent of the refined band above and below the parting line [um]
+    edge_band_um: tuple[float, float] = (10.0, 10.0)
+
+    @field_validator("edge_band_um")
+    @classmethod
+    def _band(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if any(not (x > 0.0) for x in v):
+            raise ValueError("both extents (above, below) must be > 0 um")
+        return v
 
 
 class SolverSection(_Strict):
@@ -195,6 +208,23 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           field="mesh.separation_height_um", value=sh,
                           expected=f"a height in um at most uncut_chip_thickness_um - "
                           f"element_size_um = {h - le:.4g} um (one element row of chip)")
+    ee = cfg.mesh.edge_element_um
+    if ee is not None:
+        if cfg.mesh.separation != "node_split":
+            raise ConfigError("edge refinement needs node splitting", file=source,
+                              field="mesh.edge_element_um", value=ee,
+                              expected='no value, or mesh.separation = "node_split"')
+        ratio = le / ee
+        if min(abs(ratio - r) for r in (2, 4, 8)) > 1e-6 * ratio:
+            raise ConfigError("edge element size must divide the element size by 2, 4 or 8",
+                              file=source, field="mesh.edge_element_um", value=ee,
+                              expected=f"one of {le / 2:.4g}, {le / 4:.4g}, {le / 8:.4g} um "
+                              f"(element_size_um / 2, 4, 8)")
+        if cfg.solver.rezone_interval > 0:
+            raise ConfigError("rezoning needs the uniform structured mesh", file=source,
+                              field="solver.rezone_interval",
+                              value=cfg.solver.rezone_interval,
+                              expected="0 with mesh.edge_element_um")
     if cfg.solver.element == "q4_bbar" and cfg.solver.rezone_interval > 0:
         raise ConfigError("rezoning does not remap the Gauss-point state of the B-bar "
                           "element", file=source, field="solver.rezone_interval",

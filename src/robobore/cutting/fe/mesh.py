@@ -16,6 +16,7 @@ Elements are numbered row by row, nodes counter-clockwise (n1..n4).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -125,17 +126,7 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
     chip_rows = set(range(n_ey - n_chip, n_ey))
 
     total = ahead + cut_length
-    fine_start = max(0.0, ahead - 3.0 * h)
-    n_fx = max(1, int(round((total - fine_start) / le)))
-    x_fine = np.linspace(fine_start, total, n_fx + 1)
-    if fine_start > 0.25 * le:
-        xs = np.cumsum(_graded(fine_start, le * grading, grading))
-        x_left = fine_start - xs
-        x_left[-1] = 0.0
-        xc = np.concatenate([x_left[::-1], x_fine])
-    else:
-        x_fine[0] = 0.0
-        xc = x_fine
+    xc = _columns(h, le, total, ahead, grading)
     n_ex = len(xc) - 1
 
     X, Y = np.meshgrid(xc, yc)  # (ny, nx)
@@ -168,7 +159,177 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
         twin = -np.ones(nodes.shape[0], dtype=np.int64)
         twin[row_nodes] = new_ids
         twin[new_ids] = row_nodes
-    fixed = (np.abs(nodes[:, 0]) < 1e-15) | (np.abs(nodes[:, 1] - yc[0]) < 1e-15)
+    return _finish(nodes, conn, layer, chip, yc[0], total, h, le, top_chip, twin)
+
+
+def _columns(h: float, le: float, total: float, ahead: float, grading: float) -> np.ndarray:
+    """Column lines of the coarse grid: uniform ``le`` over the cut and 3 h beyond, graded
+    towards x = 0 (as :func:`build_mesh`)."""
+    fine_start = max(0.0, ahead - 3.0 * h)
+    n_fx = max(1, int(round((total - fine_start) / le)))
+    x_fine = np.linspace(fine_start, total, n_fx + 1)
+    if fine_start > 0.25 * le:
+        xs = np.cumsum(_graded(fine_start, le * grading, grading))
+        x_left = fine_start - xs
+        x_left[-1] = 0.0
+        return np.concatenate([x_left[::-1], x_fine])
+    x_fine[0] = 0.0
+    return x_fine
+
+
+def _subdivide(xc: np.ndarray, k: int) -> np.ndarray:
+    """Each interval of ``xc`` cut into 2**k equal parts."""
+    n = 2 ** k
+    t = np.arange(n) / n
+    inner = (xc[:-1, None] + t[None, :] * np.diff(xc)[:, None]).ravel()
+    return np.append(inner, xc[-1])
+
+
+def build_edge_refined_mesh(h: float, le: float, cut_length: float, *, split_height: float,
+                            levels: int, band_above: float, band_below: float,
+                            ahead: float = 0.3e-3, fine_depth_factor: float = 1.0,
+                            height_factor: float = 5.0, grading: float = 1.25) -> CuttingMesh:
+    """Node-splitting mesh refined ``levels`` times (element size ``le / 2**levels``) in a
+    band round the parting line, where the material passes the cutting edge.
+
+    Frame and boundaries as :func:`build_mesh`. The parting line y_p = -h + split_height
+    carries the finest nodes (doubled, ``twin``). The band has ``band_above`` [m] of fine
+    rows above y_p (the stagnation zone and the chip underside that wraps round the edge)
+    and ``band_below`` [m] below it (the material ploughed under the edge radius). Each
+    size change is a conforming 2:1 transition row: over every pair of coarse columns
+    six quads join the four fine columns below (or above) to the two coarse ones, with
+    three mid-height nodes, the row as tall as the coarse element (no hanging nodes, so
+    the solver needs nothing special). Above the band the chip keeps rows of about ``le``;
+    below it a zone of ``le`` rows reaches ``fine_depth_factor * h`` under the cut line,
+    then rows grow by ``grading`` down to ``height_factor * h``.
+    """
+    if levels < 1:
+        raise ValueError("levels must be >= 1 (use build_mesh for a uniform mesh)")
+    a = [le / 2 ** k for k in range(levels + 1)]  # element size of each level
+    af = a[levels]
+    y_p = -h + split_height
+    trans_h = sum(a[:levels])  # transition rows, coarse-level height each
+    chip_above = -y_p
+    n_up = max(1, int(math.ceil(band_above / af - 1e-9)))
+    while n_up > 1 and chip_above - n_up * af - trans_h < -1e-9 * le:
+        n_up -= 1
+    coarse_top = chip_above - n_up * af - trans_h
+    if coarse_top < -1e-9 * le:
+        raise ValueError(
+            f"the chip above the parting line ({chip_above * 1e6:.4g} um) is too thin for "
+            f"{levels} refinement levels of {le * 1e6:.4g} um elements (needs "
+            f"{(af + trans_h) * 1e6:.4g} um)")
+    n_ctop = int(round(coarse_top / le))
+    # rows from the top down: (y_top, y_bottom, level_top, level_bottom)
+    rows: list[tuple[float, float, int, int]] = []
+    y = 0.0
+    if n_ctop >= 1:
+        hc = coarse_top / n_ctop
+        for _ in range(n_ctop):
+            rows.append((y, y - hc, 0, 0))
+            y -= hc
+        hf = af
+    else:
+        hf = (n_up * af + max(coarse_top, 0.0)) / n_up  # spread the rest over the fine rows
+    for k in range(levels):  # transitions above the band: coarse on top
+        rows.append((y, y - a[k], k, k + 1))
+        y -= a[k]
+    for _ in range(n_up):
+        rows.append((y, y - hf, levels, levels))
+        y -= hf
+    y = y_p  # exact parting line
+    rows[-1] = (rows[-1][0], y_p, levels, levels)
+    n_dn = max(1, int(math.ceil(band_below / af - 1e-9)))
+    for _ in range(n_dn):
+        rows.append((y, y - af, levels, levels))
+        y -= af
+    for k in range(levels - 1, -1, -1):  # transitions below: fine on top
+        rows.append((y, y - a[k], k + 1, k))
+        y -= a[k]
+    y_fine_end = -h - fine_depth_factor * h
+    n_fz = max(1, int(round((y - y_fine_end) / le))) if y - y_fine_end > 0.25 * le else 0
+    if n_fz:
+        hz = (y - y_fine_end) / n_fz
+        for _ in range(n_fz):
+            rows.append((y, y - hz, 0, 0))
+            y -= hz
+    depth_rest = height_factor * h + y
+    if depth_rest > 0.25 * le:
+        for s in _graded(depth_rest, le * grading, grading):
+            rows.append((y, y - s, 0, 0))
+            y -= s
+    y_bottom = y
+
+    total = ahead + cut_length
+    xc = _columns(h, le, total, ahead, grading)
+    if (len(xc) - 1) % 2:  # transition templates need pairs of coarse columns
+        xc = np.insert(xc, 1, 0.5 * (xc[0] + xc[1]))
+    xl = [_subdivide(xc, k) for k in range(levels + 1)]
+
+    nodes: list[tuple[float, float]] = []
+
+    def line(yv: float, lev: int) -> np.ndarray:
+        ids = np.arange(len(nodes), len(nodes) + xl[lev].size)
+        nodes.extend((float(xv), yv) for xv in xl[lev])
+        return ids
+
+    conn: list[tuple[int, int, int, int]] = []
+
+    def quad(q: tuple[int, int, int, int]) -> None:
+        p = np.array([nodes[i] for i in q])
+        area2 = np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+        conn.append(q if area2 > 0 else (q[0], q[3], q[2], q[1]))
+
+    # build bottom -> top so elements and nodes run row by row upwards
+    rows_up = rows[::-1]
+    lower = line(rows_up[0][1], rows_up[0][3])
+    for (yt, yb, lt, lb) in rows_up:
+        upper = line(yt, lt)
+        if lt == lb:
+            for i in range(lower.size - 1):
+                quad((lower[i], lower[i + 1], upper[i + 1], upper[i]))
+        else:
+            fine, coarse = (lower, upper) if lb > lt else (upper, lower)
+            ym = 0.5 * (yt + yb)
+            xf = xl[max(lt, lb)]
+            mid = -np.ones(xf.size, dtype=np.int64)
+            for i in range(xf.size):
+                if i % 4:
+                    mid[i] = len(nodes)
+                    nodes.append((float(xf[i]), ym))
+            for p in range(coarse.size // 2):
+                b = fine[4 * p:4 * p + 5]
+                t = coarse[2 * p:2 * p + 3]
+                m = mid[4 * p:4 * p + 5]
+                for q in ((b[0], b[1], m[1], t[0]), (b[1], b[2], m[2], m[1]),
+                          (b[2], b[3], m[3], m[2]), (b[3], b[4], t[2], m[3]),
+                          (m[1], m[2], t[1], t[0]), (m[2], m[3], t[2], t[1])):
+                    quad(q)
+        lower = upper
+    xy = np.array(nodes)
+    conn_a = np.array(conn, dtype=np.int64)
+    cy = xy[conn_a, 1].mean(axis=1)
+    chip = cy > y_p
+    # node splitting: double the parting-line nodes (not the fixed one at x = 0); the chip
+    # elements above take the new copies
+    tol = 1e-6 * af
+    on_line = np.where((np.abs(xy[:, 1] - y_p) < tol) & (xy[:, 0] > tol))[0]
+    n_old = xy.shape[0]
+    new_ids = n_old + np.arange(on_line.size)
+    xy = np.vstack([xy, xy[on_line]])
+    remap = np.arange(xy.shape[0])
+    remap[on_line] = new_ids
+    conn_a[chip] = remap[conn_a[chip]]
+    twin = -np.ones(xy.shape[0], dtype=np.int64)
+    twin[on_line] = new_ids
+    twin[new_ids] = on_line
+    return _finish(xy, conn_a, np.zeros(conn_a.shape[0], dtype=bool), chip, y_bottom,
+                   total, h, le, y_p, twin)
+
+
+def _finish(nodes, conn, layer, chip, y_bottom, total, h, le, layer_top, twin) -> CuttingMesh:
+    """Boundary flags and the node -> element CSR of a cutting mesh."""
+    fixed = (np.abs(nodes[:, 0]) < 1e-15) | (np.abs(nodes[:, 1] - y_bottom) < 1e-15)
     surface = np.abs(nodes[:, 1]) < 1e-15
     n_nodes = nodes.shape[0]
     counts = np.bincount(conn.ravel(), minlength=n_nodes)
@@ -185,5 +346,5 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
             fill[n] += 1
     return CuttingMesh(nodes=nodes, conn=conn, layer=layer, chip=chip, fixed=fixed,
                        surface=surface, node_elems_ptr=ptr, node_elems=ne, node_corner=nc,
-                       length=total, height=-yc[0], y_cut=-h, element_size=le,
-                       layer_top=top_chip, twin=twin)
+                       length=total, height=-y_bottom, y_cut=-h, element_size=le,
+                       layer_top=layer_top, twin=twin)

@@ -19,7 +19,7 @@ import numpy as np
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config import FEConfig
-from robobore.cutting.fe.mesh import CuttingMesh, build_mesh
+from robobore.cutting.fe.mesh import CuttingMesh, build_edge_refined_mesh, build_mesh
 from robobore.cutting.fe.rezone import N_RZ_FIELDS, edge_neighbours, smoothing_stencil
 from robobore.errors import ConfigError, NumericalError
 from robobore.material import Material, load_material
@@ -343,11 +343,26 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     r = cfg.tool.edge_radius_um * 1e-6
     rake = math.radians(cfg.tool.rake_deg)
     clr = math.radians(cfg.tool.clearance_deg)
-    mesh = build_mesh(h, le, L, ahead=cfg.mesh.ahead_mm * 1e-3,
-                      fine_depth_factor=cfg.mesh.fine_depth_factor,
-                      height_factor=cfg.mesh.height_factor, grading=cfg.mesh.grading,
-                      layer_offset=_layer_offset(cfg, le),
-                      split_height=_split_height(cfg))
+    cm = cfg.mesh
+    if cm.edge_element_um is not None:
+        try:
+            mesh = build_edge_refined_mesh(
+                h, le, L, split_height=_split_height(cfg) or 0.0,
+                levels=int(round(math.log2(cm.element_size_um / cm.edge_element_um))),
+                band_above=cm.edge_band_um[0] * 1e-6, band_below=cm.edge_band_um[1] * 1e-6,
+                ahead=cm.ahead_mm * 1e-3, fine_depth_factor=cm.fine_depth_factor,
+                height_factor=cm.height_factor, grading=cm.grading)
+        except ValueError as exc:
+            raise ConfigError(str(exc), file=source, field="mesh.edge_element_um",
+                              value=cm.edge_element_um,
+                              expected="fewer refinement levels, smaller elements or a "
+                              "lower mesh.separation_height_um") from exc
+    else:
+        mesh = build_mesh(h, le, L, ahead=cm.ahead_mm * 1e-3,
+                          fine_depth_factor=cm.fine_depth_factor,
+                          height_factor=cm.height_factor, grading=cm.grading,
+                          layer_offset=_layer_offset(cfg, le),
+                          split_height=_split_height(cfg))
     s = cfg.solver
     p = apply_solver_settings(default_prm(), s, K)
     mu = cfg.friction_coefficient()
