@@ -83,7 +83,8 @@ def main() -> None:
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
-           f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} | {'E err':>6} {'wall s':>6}")
+           f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} | {'E err':>6} {'ero%':>5} "
+           f"{'wall s':>6}")
     print(hdr)
     for h, vc in pts:
         hk = f"{h:g}"
@@ -120,11 +121,15 @@ def main() -> None:
                    Ff_err_pct=eff, chip_ratio_meas=r_m, chip_ratio_sim=s["chip_ratio"],
                    energy_error=s["energy_error"], wall_s=time.perf_counter() - t0,
                    pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
-                   friction=s["friction_coefficient"])
+                   friction=s["friction_coefficient"],
+                   eroded_distortion=s.get("eroded_distortion"),
+                   eroded_chip_mass_fraction=s.get("eroded_chip_mass_fraction"),
+                   peak_temperature_K=s.get("peak_temperature_K"))
         rows.append(row)
         print(f"{h:5.0f} {vc:4.0f} | {fc_m:7.1f} {row['Fc_sim']:7.1f} {efc:6.1f} | {ff_m:7.1f} "
               f"{row['Ff_sim']:7.1f} {eff:6.1f} | {r_m:6.2f} {row['chip_ratio_sim']:6.2f} | "
-              f"{row['energy_error']:6.3f} {row['wall_s']:6.0f}  "
+              f"{row['energy_error']:6.3f} "
+              f"{100 * (row['eroded_chip_mass_fraction'] or 0.0):5.1f} {row['wall_s']:6.0f}  "
               f"{'Fc ok' if ok[0] else 'Fc FAIL'} {'Ff ok' if ok[1] else 'Ff FAIL'} "
               f"{'r ok' if ok[2] else 'r FAIL'}", flush=True)
     n = len(rows)
