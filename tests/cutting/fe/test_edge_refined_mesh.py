@@ -139,3 +139,13 @@ def test_short_cut_on_refined_mesh():
     pairs = np.where(twin >= 0)[0]
     gap = np.hypot(f["x"][pairs] - f["x"][twin[pairs]], f["y"][pairs] - f["y"][twin[pairs]])
     assert np.count_nonzero(gap > 0.1 * 5e-6) >= 4
+
+
+def test_chip_too_thin_is_a_config_error():
+    d = {k: dict(v) for k, v in BASE.items()}
+    d["cut"]["uncut_chip_thickness_um"] = 15.0
+    d["mesh"].update(element_size_um=5.0, edge_element_um=2.5, separation_height_um=9.0)
+    with pytest.raises(ConfigError) as ei:
+        setup_orthogonal(parse_config(d, "t.toml"), "t.toml")
+    assert ei.value.field == "mesh.edge_element_um"
+    assert "too thin" in str(ei.value)
