@@ -145,20 +145,11 @@ def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,
             e += 1
     twin = None
     if split_height is not None:
-        # double the parting-line nodes (not the fixed one at x = 0): the elements of the
-        # row above (the chip's bottom row) take the new copies
+        # the parting line's nodes (not the fixed one at x = 0); the elements of the row
+        # above it (the chip's bottom row) take the new copies
         jrow = n_ey - n_chip  # node row of the parting line
-        row_nodes = jrow * nxn + np.arange(1, nxn)
-        n_old = nodes.shape[0]
-        new_ids = n_old + np.arange(row_nodes.size)
-        nodes = np.vstack([nodes, nodes[row_nodes]])
-        remap = np.arange(nodes.shape[0])
-        remap[row_nodes] = new_ids
         above = np.arange(jrow * n_ex, (jrow + 1) * n_ex)  # element row jrow (above line)
-        conn[above] = remap[conn[above]]
-        twin = -np.ones(nodes.shape[0], dtype=np.int64)
-        twin[row_nodes] = new_ids
-        twin[new_ids] = row_nodes
+        nodes, twin = _split_nodes(nodes, conn, jrow * nxn + np.arange(1, nxn), above)
     return _finish(nodes, conn, layer, chip, yc[0], total, h, le, top_chip, twin)
 
 
@@ -275,11 +266,6 @@ def build_edge_refined_mesh(h: float, le: float, cut_length: float, *, split_hei
 
     conn: list[tuple[int, int, int, int]] = []
 
-    def quad(q: tuple[int, int, int, int]) -> None:
-        p = np.array([nodes[i] for i in q])
-        area2 = np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
-        conn.append(q if area2 > 0 else (q[0], q[3], q[2], q[1]))
-
     # build bottom -> top so elements and nodes run row by row upwards
     rows_up = rows[::-1]
     lower = line(rows_up[0][1], rows_up[0][3])
@@ -287,9 +273,12 @@ def build_edge_refined_mesh(h: float, le: float, cut_length: float, *, split_hei
         upper = line(yt, lt)
         if lt == lb:
             for i in range(lower.size - 1):
-                quad((lower[i], lower[i + 1], upper[i + 1], upper[i]))
+                conn.append((lower[i], lower[i + 1], upper[i + 1], upper[i]))
         else:
-            fine, coarse = (lower, upper) if lb > lt else (upper, lower)
+            # the template is counter-clockwise with the fine line below; mirrored (fine
+            # line above) its quads run clockwise and are reversed
+            fine_below = lb > lt
+            fine, coarse = (lower, upper) if fine_below else (upper, lower)
             ym = 0.5 * (yt + yb)
             xf = xl[max(lt, lb)]
             mid = -np.ones(xf.size, dtype=np.int64)
@@ -304,27 +293,35 @@ def build_edge_refined_mesh(h: float, le: float, cut_length: float, *, split_hei
                 for q in ((b[0], b[1], m[1], t[0]), (b[1], b[2], m[2], m[1]),
                           (b[2], b[3], m[3], m[2]), (b[3], b[4], t[2], m[3]),
                           (m[1], m[2], t[1], t[0]), (m[2], m[3], t[2], t[1])):
-                    quad(q)
+                    conn.append(q if fine_below else (q[0], q[3], q[2], q[1]))
         lower = upper
     xy = np.array(nodes)
     conn_a = np.array(conn, dtype=np.int64)
     cy = xy[conn_a, 1].mean(axis=1)
     chip = cy > y_p
-    # node splitting: double the parting-line nodes (not the fixed one at x = 0); the chip
+    # node splitting: the parting line's nodes (not the fixed one at x = 0); the chip
     # elements above take the new copies
     tol = 1e-6 * af
     on_line = np.where((np.abs(xy[:, 1] - y_p) < tol) & (xy[:, 0] > tol))[0]
-    n_old = xy.shape[0]
-    new_ids = n_old + np.arange(on_line.size)
-    xy = np.vstack([xy, xy[on_line]])
-    remap = np.arange(xy.shape[0])
-    remap[on_line] = new_ids
-    conn_a[chip] = remap[conn_a[chip]]
-    twin = -np.ones(xy.shape[0], dtype=np.int64)
-    twin[on_line] = new_ids
-    twin[new_ids] = on_line
+    xy, twin = _split_nodes(xy, conn_a, on_line, np.where(chip)[0])
     return _finish(xy, conn_a, np.zeros(conn_a.shape[0], dtype=bool), chip, y_bottom,
                    total, h, le, y_p, twin)
+
+
+def _split_nodes(nodes: np.ndarray, conn: np.ndarray, line: np.ndarray,
+                 above: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Double the nodes ``line`` (copies appended in that order); the elements ``above``
+    take the copies (``conn`` is changed in place). Returns the new node array and ``twin``
+    (partner of each doubled node, -1 elsewhere)."""
+    new_ids = nodes.shape[0] + np.arange(line.size)
+    nodes = np.vstack([nodes, nodes[line]])
+    remap = np.arange(nodes.shape[0])
+    remap[line] = new_ids
+    conn[above] = remap[conn[above]]
+    twin = -np.ones(nodes.shape[0], dtype=np.int64)
+    twin[line] = new_ids
+    twin[new_ids] = line
+    return nodes, twin
 
 
 def _finish(nodes, conn, layer, chip, y_bottom, total, h, le, layer_top, twin) -> CuttingMesh:
