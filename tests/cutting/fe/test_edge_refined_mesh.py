@@ -149,3 +149,94 @@ def test_chip_too_thin_is_a_config_error():
         setup_orthogonal(parse_config(d, "t.toml"), "t.toml")
     assert ei.value.field == "mesh.edge_element_um"
     assert "too thin" in str(ei.value)
+
+
+def test_chip_ratio_uses_the_parting_line_as_the_underside():
+    """Chip thickness from a known deformed shape: the chip material that has passed a tool
+    at x = cx is stretched by s = 2.5 normal to the parting line (y_p), so the chip is
+    (0 - y_p) s thick and the ratio is that over h (exact up to round-off; tolerance
+    1e-9). The same with runs of underside band elements eroded (their parting-line nodes
+    dead): the parting line is a material line, so the thickness is still measured from
+    it, not from the lowest surviving node of each column (which lies inside the chip)."""
+    from types import SimpleNamespace
+
+    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.output import measure_chip
+
+    h, sep, s = 60e-6, 5e-6, 2.5
+    m = build_edge_refined_mesh(h, LE, 0.3e-3, split_height=sep, levels=2,
+                                band_above=10e-6, band_below=10e-6, ahead=0.1e-3)
+    y_p = m.layer_top
+    x0, y0 = m.nodes[:, 0].copy(), m.nodes[:, 1].copy()
+    cx, rake = 0.25e-3, np.radians(15.0)
+    chip_nodes = (x0 > cx) & (y0 > y_p - 1e-12)
+    chip_nodes &= ~((m.twin >= 0) & ~m.upper)  # the work's copies stay put
+    y = y0.copy()
+    y[chip_nodes] = y_p + (y0[chip_nodes] - y_p) * s
+    tool = np.zeros(K.N_TOOL)
+    tool[K.T_GX], tool[K.T_GY] = cx, -h + 20e-6
+    st = SimpleNamespace(x=x0.copy(), y=y, x0=x0, y0=y0, tool=tool,
+                         ndead=np.zeros(x0.size, bool))
+    want = (0.0 - y_p) * s / h
+    assert measure_chip(st, m, h, rake, 0.5).ratio == pytest.approx(want, rel=1e-9)
+    # erode the chip elements on the parting line in pairs of neighbouring elements: the
+    # parting-line node between each pair loses all its elements
+    cen = m.nodes[m.conn].mean(axis=1)
+    on_line = np.isclose(y0[m.conn].min(axis=1), y_p) & m.chip & (cen[:, 0] > cx)
+    idx = np.where(on_line)[0]
+    idx = idx[np.argsort(cen[idx, 0])]
+    gone = idx[(np.arange(idx.size) // 2) % 3 == 0]
+    alive = np.ones(m.conn.shape[0], bool)
+    alive[gone] = False
+    live_nodes = np.zeros(x0.size, bool)
+    live_nodes[m.conn[alive].ravel()] = True
+    st.ndead = ~live_nodes
+    assert st.ndead[(m.twin >= 0) & m.upper].sum() > 5
+    assert measure_chip(st, m, h, rake, 0.5).ratio == pytest.approx(want, rel=1e-9)
+
+
+def test_chip_ratio_from_the_chip_speed():
+    """Continuity h vc = t_c v_chip (Merchant 1945): chip nodes sliding along the rake face
+    at v_chip relative to the tool give r = vc / v_chip (exact, 1e-12); chip nodes outside
+    the sampling window, nodes of the workpiece and dead nodes do not count."""
+    from types import SimpleNamespace
+
+    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.output import chip_ratio_from_velocity
+
+    h, vc, r_true = 60e-6, 0.5, 1.37
+    m = build_edge_refined_mesh(h, LE, 0.3e-3, split_height=SH, levels=2,
+                                band_above=10e-6, band_below=10e-6, ahead=0.1e-3)
+    rake = np.radians(15.0)
+    cx, cy = 0.25e-3, -h + 20e-6
+    tr = np.array([np.sin(rake), np.cos(rake)])
+    nr = np.array([-np.cos(rake), np.sin(rake)])
+    x0, y0 = m.nodes[:, 0].copy(), m.nodes[:, 1].copy()
+    x, y = x0.copy(), y0.copy()
+    vx = np.full(x0.size, 7.0)  # anything outside the window: must not count
+    vy = np.full(x0.size, -3.0)
+    chip = (x0 > cx) & (y0 > m.layer_top - 1e-12) & ~((m.twin >= 0) & ~m.upper)
+    idx = np.where(chip)[0]
+    rng = np.random.default_rng(3)
+    inside = idx[: idx.size // 2]
+    s_al = rng.uniform(1.05 * h, 2.95 * h, inside.size)
+    q = rng.uniform(0.0, 2.0 * h, inside.size)
+    x[inside] = cx + s_al * tr[0] + q * nr[0]
+    y[inside] = cy + s_al * tr[1] + q * nr[1]
+    tool = np.zeros(K.N_TOOL)
+    tool[K.T_GX], tool[K.T_GY] = cx, cy
+    vchip = vc / r_true
+    vx[inside] = -vc + vchip * tr[0]
+    vy[inside] = vchip * tr[1]
+    ndead = np.zeros(x0.size, bool)
+    ndead[inside[:5]] = True
+    vx[inside[:5]] = 100.0
+    st = SimpleNamespace(x=x, y=y, x0=x0, y0=y0, vx=vx, vy=vy, tool=tool, ndead=ndead)
+    r, n = chip_ratio_from_velocity(st, m, h, rake, vc)
+    assert n == inside.size - 5
+    assert r == pytest.approx(r_true, rel=1e-12)
+    # a workpiece node moved into the window is not chip material
+    work = np.where(~chip & (x0 > cx))[0][:40]
+    x[work] = cx + 2 * h * tr[0]
+    y[work] = cy + 2 * h * tr[1]
+    assert chip_ratio_from_velocity(st, m, h, rake, vc) == (r, n)

@@ -54,6 +54,15 @@ class ContactSection(_Strict):
     shear_limit_MPa: float = Field(default=576.0, gt=0.0)
     #: penalty factor: normal stiffness = factor * nodal mass / dt^2 (0 < factor <= 0.5)
     penalty_factor: float = Field(default=0.1, gt=0.0, le=0.5)
+    #: thermal contact with the tool, used with ``solver.heat_conduction`` (adiabatic runs
+    #: exchange no heat): interface conductance [W/(m^2 K)] between the workpiece surface
+    #: in contact and the tool, a heat sink at ``tool_temperature_K`` (0: adiabatic tool)
+    thermal_conductance_W_per_m2K: float = Field(default=1.0e5, ge=0.0, le=1.0e9)
+    #: fraction of the frictional dissipation that heats the workpiece (chip underside and
+    #: machined surface); the rest goes into the tool
+    friction_heat_fraction: float = Field(default=0.5, ge=0.0, le=1.0)
+    #: temperature of the tool [K]; None: the material's room temperature
+    tool_temperature_K: float | None = Field(default=None, gt=0.0, le=3000.0)
 
     @field_validator("friction")
     @classmethod

@@ -16,9 +16,11 @@ force total (one block, summed in the CPU engine's fixed lane order,
 springs, external work), elements (stable step by atomic min, inverted element by atomic
 max) and the step end (one thread: time, status, time-averaged histories and, at each
 sample, the energy totals summed serially in the CPU engine's order). With
-``solver.heat_conduction`` three more launches (centroids, fluxes, copy) run every
-``solver.conduction_interval`` steps. The loop stays on the device; the host copies the
-state back between chunks (for the progress bar and the energy check).
+``solver.heat_conduction`` more launches run every ``solver.conduction_interval`` steps:
+centroids, fluxes, copy, the tied parting-line edges (node splitting), the thermal
+contact with the tool (nodes, then elements) and the reset of the accumulated time. The
+loop stays on the device; the host copies the state back between chunks (for the progress
+bar and the energy check).
 
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``).
@@ -99,6 +101,9 @@ def _kernels():
     tstep = dev(jc.rebind(K.tool_step_py, tool_support_step=sup))
     cent = dev(K.quad_centroid_py)
     cond = dev(K.quad_conduct_py)
+    pedge = dev(K.parting_edge_py)
+    thnode = dev(K.tool_heat_node_py)
+    thelem = dev(K.tool_heat_elem_py)
     sumen = dev(K.sum_energies_py)
     lsum = dev(K.lane_sum_py)
     LANES = K.N_SUM_LANES
@@ -109,6 +114,7 @@ def _kernels():
     ST_NOEL, ST_NONF, ST_DTC = K.STATUS_NO_ELEMENTS, K.STATUS_NONFINITE, K.STATUS_DT_COLLAPSE
     P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K.P_CFL, K.P_DTMIN, K.P_TEND, K.P_SAMPLE_DT
     P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
+    P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
     T_FX, T_FY, T_UX, T_UY, T_GX = K.T_FX, K.T_FY, K.T_UX, K.T_UY, K.T_GX
     E_EXT, E_KIN, E_INT, E_PLAST, E_HG, E_FRIC, E_ERODED = (K.E_EXT, K.E_KIN, K.E_INT,
                                                             K.E_PLAST, K.E_HG, K.E_FRIC,
@@ -198,8 +204,37 @@ def _kernels():
         if e >= temp.shape[0] or ist[I_STATUS] != ST_OK:
             return
         temp[e] = tbuf[e, 3]
-        if e == 0:
-            prm[P_COND_ACC] = 0.0
+
+    @cuda.jit
+    def k_parting(ppair, x, y, alive, tied, temp, tbuf, mat, prm, ist):
+        i = cuda.grid(1)
+        if i >= ppair.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        pedge(i, ppair, x, y, alive, tied, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
+              prm[P_COND_ACC])
+
+    @cuda.jit
+    def k_theat_nodes(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp,
+                      tbuf, tcq, mat, prm, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        thnode(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp,
+               tbuf, tcq, mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
+               prm[P_COND_ACC])
+
+    @cuda.jit
+    def k_theat_elems(conn, alive, temp, tcq, mat, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
+
+    @cuda.jit
+    def k_conduct_reset(prm, ist):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        prm[P_COND_ACC] = 0.0
 
     @cuda.jit
     def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
@@ -266,7 +301,7 @@ def _kernels():
             sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
 
     return (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
-            k_finish)
+            k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish)
 
 
 #: FEState arrays used by the kernels (copied to the device)
@@ -274,12 +309,12 @@ _ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn
            "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
            "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
            "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
-           "hacc", "hist", "enbr", "twin", "tied", "tbuf")
+           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair")
 #: the arrays the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "vx", "vy", "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p",
             "temp", "dmg", "qhx", "qhy", "ie", "hge", "fex", "fey", "dte", "plast", "rate",
             "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm", "tool", "en", "ist",
-            "clock", "hacc", "hist", "tied", "tbuf")
+            "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq")
 
 
 def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
@@ -302,7 +337,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         check_gpu_supported(0, element="q4_bbar")
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
-     k_finish) = _kernels()
+     k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish) = _kernels()
     st.prm[K.P_TEND] = t_end
     st.ist[K.I_STATUS] = K.STATUS_OK
     g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _ARRAYS}
@@ -316,6 +351,9 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     ge = (ne + _THREADS - 1) // _THREADS
     erosion = int(st.prm[K.P_EROSION])
     cond_every = int(st.prm[K.P_COND_EVERY])
+    npair = int(st.ppair.shape[0])
+    gp = max(1, (npair + _THREADS - 1) // _THREADS)
+    theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
     t_start = st.time
     step0 = int(st.ist[K.I_STEP])
     while True:
@@ -342,6 +380,19 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                 k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
                                         g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
                 k_conduct_end[ge, _THREADS](g["temp"], g["tbuf"], g["prm"], g["ist"])
+                if npair > 0:
+                    k_parting[gp, _THREADS](g["ppair"], g["x"], g["y"], g["alive"], g["tied"],
+                                            g["temp"], g["tbuf"], g["mat"], g["prm"],
+                                            g["ist"])
+                if theat:
+                    k_theat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["ptr"],
+                                                g["nel"], g["ncorner"], g["alive"], g["enbr"],
+                                                g["cfx"], g["cfy"], g["fric"], g["fheat"],
+                                                g["temp"], g["tbuf"], g["tcq"], g["mat"],
+                                                g["prm"], g["ist"])
+                    k_theat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["tcq"],
+                                                g["mat"], g["ist"])
+                k_conduct_reset[1, 1](g["prm"], g["ist"])
             k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
                            g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
                            g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"],

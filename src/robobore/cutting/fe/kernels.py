@@ -58,7 +58,11 @@ P_COND_EVERY, P_COND_ACC = 35, 36
 #: element formulation: ELEM_Q4R (one-point quad + hourglass control) or ELEM_Q4BBAR (2x2
 #: Gauss points with mean-dilatation B-bar, no hourglass modes)
 P_ELEM = 37
-N_PRM = 38
+#: thermal contact with the tool (heat conduction runs only): interface conductance
+#: [W/(m^2 K)] to a tool held at ``P_TTOOL`` [K], and the fraction of the frictional
+#: dissipation that heats the workpiece (the rest goes into the tool)
+P_HC, P_FHEAT, P_TTOOL = 38, 39, 40
+N_PRM = 41
 ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
@@ -777,6 +781,126 @@ def conduct(conn, x, y, alive, enbr, temp, tbuf, kcond, rcp, dt_th):
         temp[e] = tbuf[e, 3]
 
 
+def parting_edge_py(i, ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
+    """Conduction across parting-line edge ``i`` while both its node pairs are still tied.
+
+    ``ppair`` (m, 4): an element, the element across the parting line, and the first one's
+    two nodes on the edge (:func:`robobore.cutting.fe.solver.parting_edges`). The two
+    elements share no nodes (the line's nodes are doubled), so :func:`conduct` sees the
+    line as a free surface; while the pairs are tied the material is continuous there and
+    heat flows across with the two-point conductance (and cap) of :func:`quad_conduct_py`.
+    Needs the centroids and areas in ``tbuf[:, 0:3]``. An element lies on at most one edge
+    of ``ppair``, so all edges can run at once; heat is conserved exactly.
+    """
+    ea, eb, na, nb = ppair[i, 0], ppair[i, 1], ppair[i, 2], ppair[i, 3]
+    if alive[ea] != 1 or alive[eb] != 1 or tied[na] == 0 or tied[nb] == 0:
+        return
+    aa = tbuf[ea, 2]
+    ab = tbuf[eb, 2]
+    d = math.sqrt((tbuf[eb, 0] - tbuf[ea, 0]) ** 2 + (tbuf[eb, 1] - tbuf[ea, 1]) ** 2)
+    if d <= 0.0 or aa <= 0.0 or ab <= 0.0:
+        return
+    ledge = math.sqrt((x[nb] - x[na]) ** 2 + (y[nb] - y[na]) ** 2)
+    g = kcond * ledge / d * dt_th
+    gmax = 0.25 * rcp * min(aa, ab)
+    if g > gmax:
+        g = gmax
+    q = g * (temp[eb] - temp[ea])
+    temp[ea] += q / (rcp * aa)
+    temp[eb] -= q / (rcp * ab)
+
+
+def tool_heat_node_py(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
+                      temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th):
+    """Heat [J/m] node ``n`` exchanges with the tool since the last call, into ``tcq[n]``.
+
+    The node takes ``eta`` of the frictional dissipation booked on it since the last call
+    (``fric - fheat``; the rest heats the tool). A node in contact (non-zero contact force)
+    exchanges ``hc L_n (t_tool - T_n) dt_th`` with the tool, a heat sink at ``t_tool``:
+    ``T_n`` is the area-weighted mean temperature of the node's live elements, ``L_n`` half
+    the length of each free-surface edge joining it to another node in contact. The
+    conductance is capped at a quarter of the heat capacity of the node's elements
+    (stability, as in :func:`quad_conduct_py`). ``tcq[n]`` = (heat, area of the node's live
+    elements). Needs the areas in ``tbuf[:, 2]``.
+    """
+    q = eta * (fric[n] - fheat[n])
+    fheat[n] = fric[n]
+    asum = 0.0
+    tsum = 0.0
+    for k in range(ptr[n], ptr[n + 1]):
+        e = nel[k]
+        if alive[e] == 1:
+            a = tbuf[e, 2]
+            asum += a
+            tsum += a * temp[e]
+    tcq[n, 1] = asum
+    if asum <= 0.0:
+        tcq[n, 0] = 0.0
+        return
+    if hc > 0.0 and (cfx[n] != 0.0 or cfy[n] != 0.0):
+        ln = 0.0
+        for k in range(ptr[n], ptr[n + 1]):
+            e = nel[k]
+            if alive[e] != 1:
+                continue
+            c = ncorner[k]
+            for j in range(2):
+                # edge c (n -> next corner), then edge c - 1 (previous corner -> n)
+                kk = c if j == 0 else (c + 3) % 4
+                o = conn[e, (c + 1) % 4] if j == 0 else conn[e, (c + 3) % 4]
+                nb = enbr[e, kk]
+                if nb >= 0 and alive[nb] == 1:
+                    continue
+                if cfx[o] == 0.0 and cfy[o] == 0.0:
+                    continue
+                ln += 0.5 * math.sqrt((x[o] - x[n]) ** 2 + (y[o] - y[n]) ** 2)
+        g = hc * ln * dt_th
+        gmax = 0.25 * rcp * asum
+        if g > gmax:
+            g = gmax
+        q += g * (t_tool - tsum / asum)
+    tcq[n, 0] = q
+
+
+def tool_heat_elem_py(e, conn, alive, temp, tcq, rcp):
+    """Element ``e`` takes, from each corner node, heat / (rho cp area of that node's live
+    elements): a node's heat goes to its elements in proportion to their areas."""
+    if alive[e] != 1:
+        return
+    dT = 0.0
+    for c in range(4):
+        n = conn[e, c]
+        if tcq[n, 0] != 0.0 and tcq[n, 1] > 0.0:
+            dT += tcq[n, 0] / (rcp * tcq[n, 1])
+    temp[e] += dT
+
+
+parting_edge = njit(cache=True, inline="always")(parting_edge_py)
+tool_heat_node = njit(cache=True, inline="always")(tool_heat_node_py)
+tool_heat_elem = njit(cache=True, inline="always")(tool_heat_elem_py)
+
+
+@njit(parallel=True, cache=True)
+def parting_conduct(ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
+    """:func:`parting_edge_py` over all parting-line edges (after :func:`conduct`)."""
+    for i in prange(ppair.shape[0]):
+        parting_edge(i, ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th)
+
+
+@njit(parallel=True, cache=True)
+def tool_heat(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp, tbuf,
+              tcq, rcp, hc, eta, t_tool, dt_th):
+    """Thermal contact with the tool over ``dt_th`` [s] (after :func:`conduct`): frictional
+    heat and the interface conductance, node by node (:func:`tool_heat_node_py`), then into
+    the elements (:func:`tool_heat_elem_py`). Heat is conserved between nodes and
+    elements."""
+    for n in prange(x.shape[0]):
+        tool_heat_node(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
+                       temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th)
+    for e in prange(conn.shape[0]):
+        tool_heat_elem(e, conn, alive, temp, tcq, rcp)
+
+
 def sum_energies_py(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
     """Totals of the energy accumulators into ``en`` [J/m] (serial, a fixed order)."""
     ke = 0.0
@@ -861,7 +985,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
               en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
-              gps):
+              gps, fheat, tcq, ppair):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -899,8 +1023,16 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         if cond_every > 0:
             prm[P_COND_ACC] += dt
             if ist[I_STEP] % cond_every == 0:
-                conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND],
-                        mat[jc.RHO] * mat[jc.CP], prm[P_COND_ACC])
+                rcp = mat[jc.RHO] * mat[jc.CP]
+                conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp,
+                        prm[P_COND_ACC])
+                if ppair.shape[0] > 0:
+                    parting_conduct(ppair, x, y, alive, tied, temp, tbuf, mat[jc.KCOND], rcp,
+                                    prm[P_COND_ACC])
+                if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+                    tool_heat(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric,
+                              fheat, temp, tbuf, tcq, rcp, prm[P_HC], prm[P_FHEAT],
+                              prm[P_TTOOL], prm[P_COND_ACC])
                 prm[P_COND_ACC] = 0.0
         if bad >= 0:
             ist[I_BADELEM] = bad

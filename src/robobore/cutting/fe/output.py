@@ -52,7 +52,9 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
 
     The chip is the material of the chip layer (rows above the separation layer) that has
     passed the tool. Outer surface: nodes that started on the free surface (y0 = 0). Inner
-    surface: in every original node column, the lowest node still attached to a live
+    surface: with node splitting, the chip's copies of the parting-line nodes (a material
+    line: it stays the underside where fine elements next to it were eroded); with the
+    erosion layer, in every original node column the lowest node still attached to a live
     element (the chip underside after the separation layer -- and any chip element
     deleted by time-step erosion -- is gone). Only formed chip is used: above the free
     surface by more than h and at least 1.5 h along the rake from the edge. For each outer
@@ -79,17 +81,23 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     nan = ChipGeometry(math.nan, h_chip0, math.nan, math.nan, int(outer.sum()))
     if outer.sum() < 2:
         return nan
-    # inner surface: lowest live node of each passed column
-    cols = np.unique(st.x0[passed])
     ix, iy, iy0, kept = [], [], [], []
-    for c in cols:
-        sel = np.where(passed & (np.abs(st.x0 - c) < 1e-3 * le))[0]
-        j = sel[np.argmin(st.y0[sel])]
-        if st.y0[j] < -0.5 * le:
-            ix.append(x[j])
-            iy.append(y[j])
-            iy0.append(st.y0[j])
-            kept.append(c)
+    if split:
+        # inner surface: the chip's copies of the parting-line nodes (a material line, so
+        # the underside even where fine elements next to it were eroded), in material order
+        line = np.where(passed & (mesh.twin >= 0) & mesh.upper)[0]
+        line = line[np.argsort(st.x0[line], kind="stable")]
+        ix, iy, iy0, kept = list(x[line]), list(y[line]), list(st.y0[line]), list(st.x0[line])
+    else:
+        # inner surface: lowest live node of each passed column
+        for c in np.unique(st.x0[passed]):
+            sel = np.where(passed & (np.abs(st.x0 - c) < 1e-3 * le))[0]
+            j = sel[np.argmin(st.y0[sel])]
+            if st.y0[j] < -0.5 * le:
+                ix.append(x[j])
+                iy.append(y[j])
+                iy0.append(st.y0[j])
+                kept.append(c)
     if len(ix) < 2:
         return nan
     lx, ly, ly0 = np.array(ix), np.array(iy), np.array(iy0)
@@ -103,6 +111,42 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     ratio = float(np.median(ratios))
     return ChipGeometry(tc, float(np.median(t0)), ratio, shear_angle_deg(ratio, rake),
                         int(outer.sum()))
+
+
+def chip_ratio_from_velocity(st, mesh, h: float, rake: float, vc: float) -> tuple[float, int]:
+    """Chip ratio from the chip's speed along the rake face: r = vc / v_chip.
+
+    Plane-strain continuity in the tool's frame (h vc = t_c v_chip; Merchant 1945) gives the
+    chip thickness ratio from the speed of the chip relative to the tool. The sample: live
+    chip nodes (material of the chip layer that has passed the tool) between h and 3 h along
+    the rake face from the edge centre and within 4 h of the rake line, where the chip has
+    formed and still slides on or leaves the rake; their speeds relative to the tool,
+    median. Needs the node velocities (``st.vx``, ``st.vy``, at step n - 1/2) and the tool
+    velocity (guide speed -vc plus the support's ``T_VUX``, ``T_VUY``). Unlike the
+    thickness measured on the deformed chip it does not need the chip's underside, which the
+    distortion erosion at the edge takes away. Returns (ratio, number of nodes); NaN when
+    fewer than 3 nodes qualify.
+    """
+    le = mesh.element_size
+    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
+    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    tvx = -vc + st.tool[K.T_VUX]
+    tvy = st.tool[K.T_VUY]
+    trx, try_ = math.sin(rake), math.cos(rake)  # along the rake face, away from the edge
+    nrx, nry = -math.cos(rake), math.sin(rake)  # rake normal, into the chip
+    s_along = (st.x - cx) * trx + (st.y - cy) * try_
+    s_norm = (st.x - cx) * nrx + (st.y - cy) * nry
+    chip = ~st.ndead & (st.x0 > cx) & (st.y0 > mesh.layer_top - 1e-3 * le)
+    if mesh.twin is not None:  # the work's copies of the parting line stay behind
+        chip &= ~((mesh.twin >= 0) & ~mesh.upper)
+    sel = chip & (s_along >= h) & (s_along <= 3.0 * h) & (s_norm >= -0.5 * le) \
+        & (s_norm <= 4.0 * h)
+    n = int(sel.sum())
+    if n < 3:
+        return math.nan, n
+    v = np.hypot(st.vx[sel] - tvx, st.vy[sel] - tvy)
+    vm = float(np.median(v))
+    return (vc / vm if vm > 0.0 else math.nan), n
 
 
 @dataclass

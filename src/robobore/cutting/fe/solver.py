@@ -89,6 +89,12 @@ class FEState:
     tbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: Gauss-point state of the B-bar element (n_elem, 4, N_GPS); (0, 4, N_GPS) for Q4R
     gps: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: thermal contact: frictional dissipation already turned into heat (n_nodes,), scratch
+    #: (n_nodes, 2), and the parting-line edges (m, 4) = element above, element below, and
+    #: the two nodes of the element above (conduction across the still-tied pairs)
+    fheat: np.ndarray = field(default=None)  # type: ignore[assignment]
+    tcq: np.ndarray = field(default=None)  # type: ignore[assignment]
+    ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -98,7 +104,8 @@ class FEState:
                 self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
-                self.buf, self.twin, self.tied, self.tbuf, self.gps)
+                self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
+                self.ppair)
 
     @property
     def n_elements(self) -> int:
@@ -190,9 +197,36 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),
         tbuf=z((ne, 4)),
-        gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)))
+        gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)),
+        fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin))
     init_forces(st)
     return st
+
+
+def parting_edges(conn: np.ndarray, twin: np.ndarray | None) -> np.ndarray:
+    """(m, 4) int64: the edges of a node-splitting parting line, as element, element across,
+    and the element's two nodes on the edge (the twins of the element across's nodes)."""
+    if twin is None:
+        return np.zeros((0, 4), np.int64)
+    tw = np.asarray(twin, np.int64)
+    owner: dict[tuple[int, int], tuple[int, int, int]] = {}
+    rows: list[tuple[int, int, int, int]] = []
+    for e in range(conn.shape[0]):
+        for k in range(4):
+            a, b = int(conn[e, k]), int(conn[e, (k + 1) % 4])
+            if tw[a] < 0 or tw[b] < 0:
+                continue
+            other = (min(int(tw[a]), int(tw[b])), max(int(tw[a]), int(tw[b])))
+            if other in owner:
+                e2, _, _ = owner.pop(other)
+                rows.append((e2, e, int(tw[a]), int(tw[b])))
+            else:
+                owner[(min(a, b), max(a, b))] = (e, a, b)
+    out = np.array(rows, dtype=np.int64).reshape(-1, 4)
+    # each element on one edge at most: the edges can then be updated in parallel
+    if np.unique(out[:, :2]).size != 2 * out.shape[0]:
+        raise ValueError("an element has two edges on the parting line")
+    return out
 
 
 def init_forces(st: FEState) -> float:
@@ -390,6 +424,10 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p[K.P_RZ_OMEGA] = s.rezone_relaxation
     p[K.P_RZ_MAXMOVE] = 0.2
     p[K.P_COND_EVERY] = s.conduction_interval if s.heat_conduction else 0
+    cc = cfg.contact
+    p[K.P_HC] = cc.thermal_conductance_W_per_m2K
+    p[K.P_FHEAT] = cc.friction_heat_fraction
+    p[K.P_TTOOL] = mat.T_room if cc.tool_temperature_K is None else cc.tool_temperature_K
     if s.separation_gate_um is not None:
         p[K.P_GATE] = s.separation_gate_um * 1e-6
     elif cfg.mesh.separation == "node_split":
@@ -480,7 +518,8 @@ def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
             "conn": st.conn.copy(), "alive": st.alive.copy(), "eps_p": st.eps_p.copy(),
             "temperature_K": st.temp.copy(), "damage": st.dmg.copy(), "von_mises_Pa": vm,
             "pressure_Pa": st.pres.copy(), "tool_outline": np.array([ox, oy]),
-            "tool_center": np.array([cx, cy])}
+            "tool_center": np.array([cx, cy]), "vx": st.vx.copy(), "vy": st.vy.copy(),
+            "tool_velocity": np.array([-setup.vc + st.tool[K.T_VUX], st.tool[K.T_VUY]])}
 
 
 def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
@@ -491,7 +530,12 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     ``device``: "cpu" (default) or "gpu" (see :func:`run_orthogonal`); checked before the
     mesh is built.
     """
-    from robobore.cutting.fe.output import FEResult, measure_chip, steady_window
+    from robobore.cutting.fe.output import (
+        FEResult,
+        chip_ratio_from_velocity,
+        measure_chip,
+        steady_window,
+    )
 
     check_device(device, cfg, source)
     setup = setup_orthogonal(cfg, source)
@@ -511,6 +555,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     x_tip_start = setup.mesh.length
     cut_pos_mm = (x_tip_start - hh[:, K.H_TIP_X] + cfg.tool.edge_radius_um * 1e-6) * 1e3
     chip = measure_chip(st, setup.mesh, setup.h, setup.rake, setup.vc)
+    r_vel, n_vel = chip_ratio_from_velocity(st, setup.mesh, setup.h, setup.rake, setup.vc)
     en = st.en
     n_el = st.n_elements
     summary: dict[str, Any] = {
@@ -522,6 +567,8 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
                                 float(cut_pos_mm[win][-1]) if win.any() else math.nan],
         "chip_ratio": chip.ratio,
         "chip_ratio_points": chip.n_points,
+        "chip_ratio_velocity": r_vel,
+        "chip_ratio_velocity_points": n_vel,
         "chip_thickness_um": chip.thickness * 1e6,
         "shear_angle_deg": chip.shear_angle_deg,
         "peak_temperature_K": float(np.max(st.temp[st.alive == 1])),
