@@ -74,6 +74,9 @@ def main() -> None:
                     help="contact.thermal_conductance_W_per_m2K (with --conduction)")
     ap.add_argument("--friction-heat-fraction", type=float, default=None,
                     help="contact.friction_heat_fraction (with --conduction)")
+    ap.add_argument("--save-dir", type=Path, default=None,
+                    help="write each point's final state (deformed mesh, fields, node "
+                    "velocities) to DIR/h<h>_vc<vc>.npz")
     args = ap.parse_args()
     ref = json.loads(args.data.read_text())["measured"]
     pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
@@ -121,6 +124,11 @@ def main() -> None:
                                   {"mesh": mesh, "solver": solver, "contact": contact}))
         res = simulate_orthogonal(cfg)
         s = res.summary
+        if args.save_dir is not None:
+            import numpy as np
+
+            args.save_dir.mkdir(parents=True, exist_ok=True)
+            np.savez_compressed(args.save_dir / f"h{hk}_vc{vk}.npz", **res.final)
         fc_m, ff_m, r_m = ref["Fc"][hk][vk], ref["Ff"][hk][vk], ref["chip_ratio"][hk][vk]
         efc = 100 * (s["cutting_force_N_per_mm"] - fc_m) / fc_m
         eff = 100 * (s["feed_force_N_per_mm"] - ff_m) / ff_m

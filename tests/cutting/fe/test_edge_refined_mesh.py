@@ -198,7 +198,8 @@ def test_chip_ratio_uses_the_parting_line_as_the_underside():
 def test_chip_ratio_from_the_chip_speed():
     """Continuity h vc = t_c v_chip (Merchant 1945): chip nodes sliding along the rake face
     at v_chip relative to the tool give r = vc / v_chip (exact, 1e-12); chip nodes outside
-    the sampling window, nodes of the workpiece and dead nodes do not count."""
+    the sampling window, nodes of the workpiece and dead nodes do not count; a speed that
+    varies across the chip is averaged with the nodal masses."""
     from types import SimpleNamespace
 
     from robobore.cutting.fe import kernels as K
@@ -231,7 +232,9 @@ def test_chip_ratio_from_the_chip_speed():
     ndead = np.zeros(x0.size, bool)
     ndead[inside[:5]] = True
     vx[inside[:5]] = 100.0
-    st = SimpleNamespace(x=x, y=y, x0=x0, y0=y0, vx=vx, vy=vy, tool=tool, ndead=ndead)
+    mass = rng.uniform(0.5, 2.0, x0.size)
+    st = SimpleNamespace(x=x, y=y, x0=x0, y0=y0, vx=vx, vy=vy, tool=tool, ndead=ndead,
+                         mass=mass)
     r, n = chip_ratio_from_velocity(st, m, h, rake, vc)
     assert n == inside.size - 5
     assert r == pytest.approx(r_true, rel=1e-12)
@@ -240,3 +243,10 @@ def test_chip_ratio_from_the_chip_speed():
     x[work] = cx + 2 * h * tr[0]
     y[work] = cy + 2 * h * tr[1]
     assert chip_ratio_from_velocity(st, m, h, rake, vc) == (r, n)
+    # a sheared chip (speed rising across the thickness) gives the mass-weighted mean speed
+    win = inside[5:]
+    w = rng.uniform(0.6, 1.4, win.size)
+    vx[win] = -vc + vchip * w * tr[0]
+    vy[win] = vchip * w * tr[1]
+    want = vc / (vchip * np.average(w, weights=mass[win]))
+    assert chip_ratio_from_velocity(st, m, h, rake, vc)[0] == pytest.approx(want, rel=1e-12)

@@ -81,9 +81,12 @@ SCRIPT = textwrap.dedent("""
                                 and np.array_equal(b.y[tied], b.y[b.twin[tied]])),
            "same_tied": bool(np.array_equal(a.tied, b.tied)),
            "same_alive": bool(np.array_equal(a.alive, b.alive)),
-           "samples": int(a.ist[K.I_SAMPLE] - k0)}
+           "samples": int(a.ist[K.I_SAMPLE] - k0),
+           "friction_heat_J_per_m": float(np.sum(a.fheat - st.fheat)),
+           "parting_edges": int(st.ppair.shape[0])}
     for k in ("x", "y", "vx", "vy", "sdx", "sdy", "sdxy", "pres", "eps_p", "temp", "dmg",
-              "qhx", "ie", "hge", "fex", "cfx", "cfy", "fric", "nwork", "tool", "hist"):
+              "qhx", "ie", "hge", "fex", "cfx", "cfy", "fric", "nwork", "tool", "hist",
+              "fheat"):
         out[k] = rel(getattr(a, k), getattr(b, k))
     out["en"] = rel(a.en, b.en)
     out["clock"] = rel(a.clock, b.clock)
@@ -138,7 +141,8 @@ def _simulator_usable() -> bool:
 @pytest.mark.skipif(not _simulator_usable(), reason="numba has no CUDA target/simulator")
 def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path):
     """40 steps of a node-split cut in progress (tool on springs, contact, plastic chip,
-    released and tied pairs, conduction every 4 steps, histories every 5 steps): the CUDA
+    released and tied pairs, conduction every 4 steps with the thermal contact and the tied
+    parting-line edges, histories every 5 steps): the CUDA
     kernels run in numba's simulator give the same bits as the CPU engine: both devices
     run the same scalar functions, sum the contact force in the same fixed order
     (``kernels.contact_total``), and use atomics only for exact operations (a count, a min,
@@ -158,8 +162,11 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path):
     assert r["support_um"] > 0, r
     assert r["temp_cond"] > 0, r
     assert r["samples"] >= 7, r
+    # the thermal contact (frictional heat, tool conductance) and the tied parting-line
+    # conduction run in the compared steps
+    assert r["friction_heat_J_per_m"] > 0 and r["parting_edges"] > 0, r
     assert r["tied_bitwise"] and r["same_tied"] and r["same_alive"], r
     for k in ("x", "y", "vx", "vy", "sdx", "sdy", "sdxy", "pres", "eps_p", "temp", "dmg",
               "qhx", "ie", "hge", "fex", "cfx", "cfy", "fric", "nwork", "tool", "hist", "en",
-              "clock"):
+              "clock", "fheat"):
         assert r[k] == 0.0, (k, r)

@@ -121,8 +121,11 @@ def chip_ratio_from_velocity(st, mesh, h: float, rake: float, vc: float) -> tupl
     chip nodes (material of the chip layer that has passed the tool) between h and 3 h along
     the rake face from the edge centre and within 4 h of the rake line, where the chip has
     formed and still slides on or leaves the rake; their speeds relative to the tool,
-    median. Needs the node velocities (``st.vx``, ``st.vy``, at step n - 1/2) and the tool
-    velocity (guide speed -vc plus the support's ``T_VUX``, ``T_VUY``). Unlike the
+    averaged with the nodal masses (so over the chip's cross-section, as continuity
+    needs). Valid for a chip in steady flow only: a chip still thickening (upsetting)
+    moves slower than continuity says. Needs the node velocities (``st.vx``, ``st.vy``, at
+    step n - 1/2), masses and the tool velocity (guide speed -vc plus the support's
+    ``T_VUX``, ``T_VUY``). Unlike the
     thickness measured on the deformed chip it does not need the chip's underside, which the
     distortion erosion at the edge takes away. Returns (ratio, number of nodes); NaN when
     fewer than 3 nodes qualify.
@@ -145,7 +148,9 @@ def chip_ratio_from_velocity(st, mesh, h: float, rake: float, vc: float) -> tupl
     if n < 3:
         return math.nan, n
     v = np.hypot(st.vx[sel] - tvx, st.vy[sel] - tvy)
-    vm = float(np.median(v))
+    # mass-weighted: the edge band's nodes are 16x denser than the chip's and sit in the
+    # slow secondary shear zone; a plain median of node speeds would follow them
+    vm = float(np.average(v, weights=st.mass[sel]))
     return (vc / vm if vm > 0.0 else math.nan), n
 
 
