@@ -90,8 +90,8 @@ class FEState:
     #: Gauss-point state of the B-bar element (n_elem, 4, N_GPS); (0, 4, N_GPS) for Q4R
     gps: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: thermal contact: frictional dissipation already turned into heat (n_nodes,), scratch
-    #: (n_nodes, 2), and the parting-line edges (m, 4) = element above, element below, and
-    #: the two nodes of the element above (conduction across the still-tied pairs)
+    #: (n_nodes, 2), and the parting-line edges (m, 4) = an element, the element across the
+    #: line, and the first one's two nodes on the edge (conduction across tied pairs)
     fheat: np.ndarray = field(default=None)  # type: ignore[assignment]
     tcq: np.ndarray = field(default=None)  # type: ignore[assignment]
     ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
