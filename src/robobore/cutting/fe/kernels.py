@@ -825,6 +825,10 @@ def tool_heat_node_py(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, f
     """
     q = eta * (fric[n] - fheat[n])
     fheat[n] = fric[n]
+    touching = hc > 0.0 and (cfx[n] != 0.0 or cfy[n] != 0.0)
+    if q == 0.0 and not touching:
+        tcq[n, 0] = 0.0  # nothing to hand on: the element pass skips this node
+        return
     asum = 0.0
     tsum = 0.0
     for k in range(ptr[n], ptr[n + 1]):
@@ -837,7 +841,7 @@ def tool_heat_node_py(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, f
     if asum <= 0.0:
         tcq[n, 0] = 0.0
         return
-    if hc > 0.0 and (cfx[n] != 0.0 or cfy[n] != 0.0):
+    if touching:
         ln = 0.0
         for k in range(ptr[n], ptr[n + 1]):
             e = nel[k]

@@ -47,6 +47,18 @@ def _point_polyline_distance(px: np.ndarray, py: np.ndarray, lx: np.ndarray,
     return d.min(axis=1)
 
 
+def _passed_chip(st, mesh) -> tuple[float, float, np.ndarray]:
+    """Tool edge centre (x, y) and the live nodes of chip-layer material the tool has passed
+    (with node splitting without the work's copies of the parting line)."""
+    le = mesh.element_size
+    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
+    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    passed = ~st.ndead & (st.x0 > cx) & (st.y0 > mesh.layer_top - 1e-3 * le)
+    if mesh.twin is not None:  # node splitting: the lower copies stay with the work
+        passed &= ~((mesh.twin >= 0) & ~mesh.upper)
+    return cx, cy, passed
+
+
 def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     """Chip thickness from the deformed mesh.
 
@@ -64,17 +76,11 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     the experimental one, chip thickness / uncut chip thickness h.
     """
     le = mesh.element_size
-    y_inner0 = mesh.layer_top
     x, y = st.x, st.y
-    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
-    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    cx, cy, passed = _passed_chip(st, mesh)
     trx, try_ = math.sin(rake), math.cos(rake)
-    alive_n = ~st.ndead
     s_along = (x - cx) * trx + (y - cy) * try_
-    passed = alive_n & (st.x0 > cx) & (st.y0 > y_inner0 - 1e-3 * le)
     split = mesh.twin is not None
-    if split:  # node splitting: the lower copies of the parting line stay with the work
-        passed &= ~((mesh.twin >= 0) & ~mesh.upper)
     formed = passed & (y > h) & (s_along > 1.5 * h)
     outer = formed & (np.abs(st.y0) < 1e-3 * le)
     h_chip0 = -mesh.layer_top
@@ -131,17 +137,13 @@ def chip_ratio_from_velocity(st, mesh, h: float, rake: float, vc: float) -> tupl
     fewer than 3 nodes qualify.
     """
     le = mesh.element_size
-    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
-    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    cx, cy, chip = _passed_chip(st, mesh)
     tvx = -vc + st.tool[K.T_VUX]
     tvy = st.tool[K.T_VUY]
     trx, try_ = math.sin(rake), math.cos(rake)  # along the rake face, away from the edge
     nrx, nry = -math.cos(rake), math.sin(rake)  # rake normal, into the chip
     s_along = (st.x - cx) * trx + (st.y - cy) * try_
     s_norm = (st.x - cx) * nrx + (st.y - cy) * nry
-    chip = ~st.ndead & (st.x0 > cx) & (st.y0 > mesh.layer_top - 1e-3 * le)
-    if mesh.twin is not None:  # the work's copies of the parting line stay behind
-        chip &= ~((mesh.twin >= 0) & ~mesh.upper)
     sel = chip & (s_along >= h) & (s_along <= 3.0 * h) & (s_norm >= -0.5 * le) \
         & (s_norm <= 4.0 * h)
     n = int(sel.sum())
