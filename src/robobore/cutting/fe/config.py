@@ -143,6 +143,15 @@ class SolverSection(_Strict):
     rezone_interval: int = Field(default=0, ge=0, le=10**6)
     #: relaxation of each smoothing pass (fraction of the move towards the neighbour mean)
     rezone_relaxation: float = Field(default=0.3, gt=0.0, le=1.0)
+    #: steps between ALE passes of the ploughed layer (node splitting only): the node rows
+    #: within ``edge_ale_depth_um`` under the parting line, once their column's pair has
+    #: been released at the edge, slide along their rows back towards their initial x
+    #: (Eulerian in the cutting direction, Lagrangian in depth) and the element state is
+    #: remapped (donor cell, see robobore.cutting.fe.rezone); 0 = off (pure Lagrangian)
+    edge_ale_interval: int = Field(default=0, ge=0, le=10**6)
+    #: depth [um] of the ploughed layer under the parting line that edge_ale_interval
+    #: treats (rows strictly above this depth move; default: the edge band's lower part)
+    edge_ale_depth_um: float = Field(default=10.0, gt=0.0)
     #: erode an element whose stable time step falls below this fraction of the initial
     #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
     erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
@@ -234,6 +243,21 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                               field="solver.rezone_interval",
                               value=cfg.solver.rezone_interval,
                               expected="0 with mesh.edge_element_um")
+    ale = cfg.solver.edge_ale_interval
+    if ale > 0:
+        if cfg.mesh.separation != "node_split":
+            raise ConfigError("the ploughed-layer ALE needs node splitting", file=source,
+                              field="solver.edge_ale_interval", value=ale,
+                              expected='0, or mesh.separation = "node_split"')
+        if cfg.solver.rezone_interval > 0:
+            raise ConfigError("chip rezoning and the ploughed-layer ALE exclude each other",
+                              file=source, field="solver.edge_ale_interval", value=ale,
+                              expected="0 when solver.rezone_interval > 0")
+        if cfg.solver.element == "q4_bbar":
+            raise ConfigError("the ploughed-layer ALE does not remap the Gauss-point state "
+                              "of the B-bar element", file=source,
+                              field="solver.edge_ale_interval", value=ale,
+                              expected='0 with solver.element = "q4_bbar", or element "q4r"')
     if cfg.solver.element == "q4_bbar" and cfg.solver.rezone_interval > 0:
         raise ConfigError("rezoning does not remap the Gauss-point state of the B-bar "
                           "element", file=source, field="solver.rezone_interval",

@@ -44,6 +44,7 @@ import numpy as np
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.gpu import jc_device_functions, require_gpu
+from robobore.cutting.fe.rezone import MODE_ROWS
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported"]
@@ -59,8 +60,9 @@ cuda = None
 
 
 def check_gpu_supported(rezone_interval: int, source: str | None = None,
-                        element: str = "q4r") -> None:
-    """Raise a ConfigError for a setting the GPU engine does not run (rezoning, B-bar)."""
+                        element: str = "q4r", edge_ale_interval: int = 0) -> None:
+    """Raise a ConfigError for a setting the GPU engine does not run (rezoning, the
+    ploughed-layer ALE, B-bar)."""
     if element != "q4r":
         raise ConfigError("the B-bar element is not ported to the GPU", file=source,
                           field="solver.element", value=element,
@@ -68,6 +70,10 @@ def check_gpu_supported(rezone_interval: int, source: str | None = None,
     if rezone_interval > 0:
         raise ConfigError("rezoning is not available on the GPU", file=source,
                           field="solver.rezone_interval", value=rezone_interval,
+                          expected="0 (off, the default) with --device gpu, or --device cpu")
+    if edge_ale_interval > 0:
+        raise ConfigError("the ploughed-layer ALE is not available on the GPU", file=source,
+                          field="solver.edge_ale_interval", value=edge_ale_interval,
                           expected="0 (off, the default) with --device gpu, or --device cpu")
 
 
@@ -327,11 +333,13 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     (the whole state when ``check`` is given, before calling it) and the whole state at the
     end. Returns the number of steps taken. Raises NumericalError on instability (same
     messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
-    rezoning or the B-bar element.
+    rezoning, the ploughed-layer ALE or the B-bar element.
     """
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     if st.snodes is not None and st.snodes.shape[0] > 0:
+        if int(st.prm[K.P_RZ_MODE]) == MODE_ROWS:
+            check_gpu_supported(0, edge_ale_interval=int(st.prm[K.P_RZ_EVERY]))
         check_gpu_supported(int(st.prm[K.P_RZ_EVERY]))
     if int(st.prm[K.P_ELEM]) != K.ELEM_Q4R:
         check_gpu_supported(0, element="q4_bbar")

@@ -62,7 +62,9 @@ P_ELEM = 37
 #: [W/(m^2 K)] to a tool held at ``P_TTOOL`` [K], and the fraction of the frictional
 #: dissipation that heats the workpiece (the rest goes into the tool)
 P_HC, P_FHEAT, P_TTOOL = 38, 39, 40
-N_PRM = 41
+#: node relocation of the rezoning passes (rezone.MODE_LAPLACE or rezone.MODE_ROWS)
+P_RZ_MODE = 41
+N_PRM = 42
 ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
@@ -989,7 +991,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
               en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
-              gps, fheat, tcq, ppair):
+              gps, fheat, tcq, ppair, x0, y0, vbuf):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -1014,7 +1016,9 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
             rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
                    sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
-                   prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE])
+                   prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE], int(prm[P_RZ_MODE]), tied, x0, y0,
+                   vbuf, (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX],
+                          prm[P_NFY], prm[P_R]))
         if bbar:
             dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
                                              sdxy, pres, eps_p, temp, dmg, gps, area0, ie, fex,

@@ -15,7 +15,26 @@ Courant number stays below 1.
 
 Remapped element fields: deviatoric stress, pressure, plastic strain, temperature, damage,
 stored hourglass force; element mass (held as the reference area ``area0`` = mass /
-scaled density) is remapped conservatively and the lumped nodal masses recomputed.
+scaled density) is remapped conservatively and the lumped nodal masses recomputed. Only
+edges shared by two live elements carry a flux: what an edge on the outline (or next to an
+eroded element) sweeps as its nodes slide along a curved surface is not mass that enters
+or leaves the model, so mass is conserved exactly and the intensive fields are divided by
+the area their fluxes account for (a uniform field stays uniform).
+
+Two ways of choosing the new node positions share the remap:
+
+* ``MODE_LAPLACE`` (``solver.rezone_interval``, structured uniform mesh): the chip interior
+  is smoothed as above (:func:`smoothing_stencil`).
+* ``MODE_ROWS`` (``solver.edge_ale_interval``, node splitting): the **ploughed layer** --
+  the node rows within ``depth`` under the parting line, which pass under the cutting edge
+  and which a Lagrangian mesh shears until the distortion erosion deletes them -- is made
+  Eulerian in the cutting direction and Lagrangian in depth. Once a column's parting-line
+  pair has been released (the material there has met the edge), its surface node slides
+  along the surface (the polyline through it and its row neighbours) back towards its
+  initial x, by at most ``max_move`` of the shorter row segment
+  per pass; the machined surface (the top row) keeps its shape, the rows under it are
+  spread evenly in depth between it and the layer's bottom row (which stays Lagrangian),
+  and the material flows through the elements (:func:`row_stencil`, :func:`_row_move`).
 """
 
 from __future__ import annotations
@@ -23,13 +42,18 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe.physics import tool_gap
+
 N_RZ_FIELDS = 11
+#: node relocation of a rezoning pass: Laplacian smoothing, or sliding along node rows
+MODE_LAPLACE, MODE_ROWS = 0, 1
 
 
 def smoothing_stencil(mesh) -> tuple[np.ndarray, np.ndarray]:
     """Interior chip-layer nodes of a structured cutting mesh and their 4 neighbours.
 
-    Returns ``nodes`` (k,) and ``nbr`` (k, 4) node indices.
+    Returns ``nodes`` (k,) and ``nbr`` (k, 6) node indices (the 4 neighbours, then -1, -1:
+    the layout of :func:`row_stencil`).
     """
     conn = mesh.conn
     # structured grid sizes from the node coordinates of row 0
@@ -49,8 +73,71 @@ def smoothing_stencil(mesh) -> tuple[np.ndarray, np.ndarray]:
         for i in range(1, nx_nodes - 1):
             n = j * nx_nodes + i
             nodes.append(n)
-            nbr.append((n - 1, n + 1, n - nx_nodes, n + nx_nodes))
-    return np.array(nodes, dtype=np.int64), np.array(nbr, dtype=np.int64).reshape(-1, 4)
+            nbr.append((n - 1, n + 1, n - nx_nodes, n + nx_nodes, -1, -1))
+    return np.array(nodes, dtype=np.int64), np.array(nbr, dtype=np.int64).reshape(-1, 6)
+
+
+def row_stencil(mesh, depth: float) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes of the ploughed layer of a node-splitting mesh for ``MODE_ROWS``.
+
+    The node rows (equal initial y) from the parting line (its workpiece-side copies) down
+    to, but not including, ``depth`` [m] below it; in each row, the nodes whose left and
+    right neighbours (by initial x) are joined to them by element edges. Fixed nodes are
+    left out. Returns ``nodes`` (k,) and ``nbr`` (k, 6) = (left, right, parting-line node
+    of the same column, node of the same column at ``depth`` (-1: none, or the node is on
+    the parting line), node above, node below in the column (-1: none)); a node moves only
+    once its parting-line node is released.
+    """
+    if mesh.twin is None:
+        raise ValueError("row_stencil needs a node-splitting mesh (twin)")
+    xy = mesh.nodes
+    y_p = mesh.layer_top
+    tol = 1e-6 * mesh.element_size
+    idx = np.arange(mesh.n_nodes)
+    upper = (mesh.twin >= 0) & (mesh.twin < idx)
+    below = (xy[:, 1] <= y_p + tol) & (xy[:, 1] > y_p - depth - tol)
+    cand = np.where(~upper & below)[0]
+    edges: set[tuple[int, int]] = set()
+    for el in mesh.conn:
+        for k in range(4):
+            a, b = int(el[k]), int(el[(k + 1) % 4])
+            edges.add((a, b) if a < b else (b, a))
+
+    def joined(a: int, b: int) -> bool:
+        return (min(a, b), max(a, b)) in edges
+
+    rkey = np.round((y_p - xy[cand, 1]) / tol).astype(np.int64)
+    xkey = np.round(xy[cand, 0] / tol).astype(np.int64)
+    at = {(int(r), int(c)): int(n) for r, c, n in zip(rkey, xkey, cand, strict=True)}
+    rows = np.unique(rkey)
+    bottom_key = int(np.round(depth / tol))
+    nodes: list[int] = []
+    nbr: list[tuple[int, int, int, int, int, int]] = []
+    for j, key in enumerate(rows):
+        if key >= bottom_key:
+            break
+        row = cand[rkey == key]
+        row = row[np.argsort(xy[row, 0])]
+        for i in range(1, row.size - 1):
+            n, lft, rgt = int(row[i]), int(row[i - 1]), int(row[i + 1])
+            if mesh.fixed[n] or not (joined(lft, n) and joined(n, rgt)):
+                continue
+            c = int(np.round(xy[n, 0] / tol))
+            pc = at.get((int(rows[0]), c), -1)
+            if pc < 0:
+                continue
+            up = at.get((int(rows[j - 1]), c), -1) if j > 0 else -1
+            dn = at.get((int(rows[j + 1]), c), -1) if j + 1 < rows.size else -1
+            bt = at.get((bottom_key, c), -1) if j > 0 else -1
+            if up >= 0 and not joined(up, n):
+                up = -1
+            if dn >= 0 and not joined(n, dn):
+                dn = -1
+            if bt >= 0 and (up < 0 or dn < 0):
+                bt = -1
+            nodes.append(n)
+            nbr.append((lft, rgt, pc, bt, up, dn))
+    return np.array(nodes, dtype=np.int64), np.array(nbr, dtype=np.int64).reshape(-1, 6)
 
 
 def edge_neighbours(conn: np.ndarray) -> np.ndarray:
@@ -79,12 +166,85 @@ def _swept(ax0, ay0, bx0, by0, ax1, ay1, bx1, by1):
     return -0.5 * s
 
 
+@njit(cache=True, inline="always")
+def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
+    """MODE_ROWS: move node ``n`` of the ploughed layer back towards its column.
+
+    A node of the machined surface (the parting-line row) slides along the surface (its row
+    line) towards its initial x. A node under it that has a column node at the layer's
+    depth moves towards its initial x and towards its initial share of the column between
+    the surface node and that bottom node (the layer's compression under the edge is spread
+    over all its rows instead of crushing the top one); without one it slides along its
+    row. Each move is at most ``max_move`` of the shortest distance to the node's row and
+    column neighbours.
+
+    A surface node that the slide would put into the tool, or deeper into it than it was --
+    the chord between two surface nodes wrapped round the edge lies inside the tool -- is
+    put back along the tool normal to the tool surface (or to its old penetration), so the
+    pass adds no penalty energy. ``tg`` = tool edge centre x, y, rake and flank normals,
+    edge radius.
+    """
+    lft, rgt, pc, bt = snbr[k, 0], snbr[k, 1], snbr[k, 2], snbr[k, 3]
+    if tied[pc] != 0:
+        return
+    hl = np.sqrt((x[lft] - x[n]) ** 2 + (y[lft] - y[n]) ** 2)
+    hr = np.sqrt((x[rgt] - x[n]) ** 2 + (y[rgt] - y[n]) ** 2)
+    if bt >= 0:
+        up, dn = snbr[k, 4], snbr[k, 5]
+        hv = min(abs(y[up] - y[n]), abs(y[dn] - y[n]))
+        lim = max_move * min(min(hl, hr), hv)
+        f = (y0[pc] - y0[n]) / (y0[pc] - y0[bt])
+        dx = x0[n] - x[n]
+        dy = y[pc] + f * (y[bt] - y[pc]) - y[n]
+        d = np.sqrt(dx * dx + dy * dy)
+        if d > lim:
+            dx *= lim / d
+            dy *= lim / d
+        xn[n] = x[n] + dx
+        yn[n] = y[n] + dy
+        return
+    lim = max_move * min(hl, hr)
+    dx = x0[n] - x[n]
+    if dx > lim:
+        dx = lim
+    elif dx < -lim:
+        dx = -lim
+    if dx > 0.0:
+        run = x[rgt] - x[n]
+        if run <= 0.1 * hr:  # row folded back or too steep: leave the node
+            return
+        dy = dx * (y[rgt] - y[n]) / run
+    elif dx < 0.0:
+        run = x[lft] - x[n]
+        if run >= -0.1 * hl:
+            return
+        dy = dx * (y[lft] - y[n]) / run
+    else:
+        return
+    px = x[n] + dx
+    py = y[n] + dy
+    if pc == n:
+        g0, _n0x, _n0y = tool_gap(x[n], y[n], tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+        g1, n1x, n1y = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+        gt = min(g0, 0.0)
+        if g1 < gt:
+            px += (gt - g1) * n1x
+            py += (gt - g1) * n1y
+    xn[n] = px
+    yn[n] = py
+
+
 @njit(parallel=True, cache=True)
 def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
            sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s, omega,
-           max_move):
-    """One smoothing + remap pass (see module docstring). ``xn``, ``yn`` (n_nodes,) and
-    ``buf`` (n_elem, N_RZ_FIELDS) are work arrays. Returns the number of nodes moved."""
+           max_move, mode, tied, x0, y0, vbuf, tg):
+    """One relocation + remap pass (see module docstring). ``mode``: MODE_LAPLACE (``omega``
+    the relaxation) or MODE_ROWS (``tied``, ``x0``, ``y0``: pair state and initial
+    positions of the nodes).
+    ``xn``, ``yn`` (n_nodes,) and ``buf`` (n_elem, N_RZ_FIELDS) are work arrays. Returns
+    the number of nodes moved. ``vbuf`` (n_nodes, 2) is scratch for the velocity
+    increments (all computed from the old velocities before any is applied); ``tg`` the
+    tool geometry for MODE_ROWS (see :func:`_row_move`)."""
     nn = x.shape[0]
     ne = conn.shape[0]
     for n in prange(nn):
@@ -98,6 +258,9 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
             if alive[nel[q]] != 1:
                 ok = False
         if not ok:
+            continue
+        if mode == MODE_ROWS:
+            _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg)
             continue
         ax = 0.25 * (x[snbr[k, 0]] + x[snbr[k, 1]] + x[snbr[k, 2]] + x[snbr[k, 3]])
         ay = 0.25 * (y[snbr[k, 0]] + y[snbr[k, 1]] + y[snbr[k, 2]] + y[snbr[k, 3]])
@@ -122,8 +285,11 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
             continue
         i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
         a_old = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-        a_new = 0.5 * ((xn[i3] - xn[i1]) * (yn[i4] - yn[i2])
-                       + (xn[i2] - xn[i4]) * (yn[i3] - yn[i1]))
+        # the area after the pass that the fluxes account for: the old area plus the areas
+        # swept by the edges shared with live elements (an edge on the outline or next to
+        # an eroded element carries no flux, so a boundary node that slides along a
+        # curved surface neither creates nor destroys mass)
+        a_new = a_old
         c0 = sdx[e] * a_old
         c1 = sdy[e] * a_old
         c2 = sdz[e] * a_old
@@ -141,11 +307,13 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
             sw = _swept(x[a], y[a], x[b], y[b], xn[a], yn[a], xn[b], yn[b])
             if sw == 0.0:
                 continue
+            nb = np.int64(enbr[e, kk])
+            if nb < 0 or alive[nb] != 1:
+                continue
+            a_new += sw
             u = np.int64(e)
             if sw > 0.0:
-                nb = np.int64(enbr[e, kk])
-                if nb >= 0 and alive[nb] == 1:
-                    u = nb
+                u = nb
             iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
             au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
                         + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
@@ -176,6 +344,8 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
     moved = 0
     for k in range(snodes.shape[0]):
         n = snodes[k]
+        vbuf[n, 0] = 0.0
+        vbuf[n, 1] = 0.0
         dx = xn[n] - x[n]
         dy = yn[n] - y[n]
         if dx == 0.0 and dy == 0.0:
@@ -205,8 +375,12 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
             gyy += vy[i1] * by1 + vy[i2] * by2 + vy[i3] * by3 + vy[i4] * by4
             cnt += 1
         if cnt > 0:
-            vx[n] += (gxx * dx + gxy * dy) / cnt
-            vy[n] += (gyx * dx + gyy * dy) / cnt
+            vbuf[n, 0] = (gxx * dx + gxy * dy) / cnt
+            vbuf[n, 1] = (gyx * dx + gyy * dy) / cnt
+    for k in range(snodes.shape[0]):
+        n = snodes[k]
+        vx[n] += vbuf[n, 0]
+        vy[n] += vbuf[n, 1]
     # 4. write back element fields and positions, recompute nodal masses
     for e in prange(ne):
         if alive[e] != 1:

@@ -20,7 +20,13 @@ import numpy as np
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config import FEConfig
 from robobore.cutting.fe.mesh import CuttingMesh, build_edge_refined_mesh, build_mesh
-from robobore.cutting.fe.rezone import N_RZ_FIELDS, edge_neighbours, smoothing_stencil
+from robobore.cutting.fe.rezone import (
+    MODE_ROWS,
+    N_RZ_FIELDS,
+    edge_neighbours,
+    row_stencil,
+    smoothing_stencil,
+)
 from robobore.errors import ConfigError, NumericalError
 from robobore.material import Material, load_material
 
@@ -95,6 +101,8 @@ class FEState:
     fheat: np.ndarray = field(default=None)  # type: ignore[assignment]
     tcq: np.ndarray = field(default=None)  # type: ignore[assignment]
     ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: rezoning: velocity increments of the moved nodes (n_nodes, 2), scratch
+    vbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -105,7 +113,7 @@ class FEState:
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
                 self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
-                self.ppair)
+                self.ppair, self.x0, self.y0, self.vbuf)
 
     @property
     def n_elements(self) -> int:
@@ -192,13 +200,13 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
         hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
         enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64),
-        snbr=np.zeros((0, 4), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)),
+        snbr=np.zeros((0, 6), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)),
         twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),
         tbuf=z((ne, 4)),
         gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)),
-        fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin))
+        fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)))
     init_forces(st)
     return st
 
@@ -423,6 +431,9 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p[K.P_RZ_EVERY] = s.rezone_interval
     p[K.P_RZ_OMEGA] = s.rezone_relaxation
     p[K.P_RZ_MAXMOVE] = 0.2
+    if s.edge_ale_interval > 0:
+        p[K.P_RZ_EVERY] = s.edge_ale_interval
+        p[K.P_RZ_MODE] = MODE_ROWS
     p[K.P_COND_EVERY] = s.conduction_interval if s.heat_conduction else 0
     cc = cfg.contact
     p[K.P_HC] = cc.thermal_conductance_W_per_m2K
@@ -436,6 +447,8 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                     n_samples=s.n_samples, tool_center=(cx0, cy0), twin=mesh.twin)
     if s.rezone_interval > 0:
         st.snodes, st.snbr = smoothing_stencil(mesh)
+    if s.edge_ale_interval > 0:
+        st.snodes, st.snbr = row_stencil(mesh, s.edge_ale_depth_um * 1e-6)
     if ts is not None:
         dt = st.clock[1]
         for i, (k, m) in enumerate(zip(ts.stiffness_N_per_m, ts.mass_kg, strict=True)):  # type: ignore[arg-type]
@@ -468,7 +481,8 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
         from robobore.cutting.fe.gpu import require_gpu
         from robobore.cutting.fe.gpu2d import check_gpu_supported
 
-        check_gpu_supported(cfg.solver.rezone_interval, source, cfg.solver.element)
+        check_gpu_supported(cfg.solver.rezone_interval, source, cfg.solver.element,
+                            cfg.solver.edge_ale_interval)
         require_gpu()
 
 
