@@ -337,12 +337,11 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     """
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
-    if st.snodes is not None and st.snodes.shape[0] > 0:
-        if int(st.prm[K.P_RZ_MODE]) == MODE_ROWS:
-            check_gpu_supported(0, edge_ale_interval=int(st.prm[K.P_RZ_EVERY]))
-        check_gpu_supported(int(st.prm[K.P_RZ_EVERY]))
-    if int(st.prm[K.P_ELEM]) != K.ELEM_Q4R:
-        check_gpu_supported(0, element="q4_bbar")
+    every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
+    rows = int(st.prm[K.P_RZ_MODE]) == MODE_ROWS
+    check_gpu_supported(0 if rows else every, None,
+                        "q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar",
+                        every if rows else 0)
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish) = _kernels()
