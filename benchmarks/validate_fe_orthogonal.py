@@ -74,6 +74,9 @@ def main() -> None:
                     help="contact.thermal_conductance_W_per_m2K (with --conduction)")
     ap.add_argument("--friction-heat-fraction", type=float, default=None,
                     help="contact.friction_heat_fraction (with --conduction)")
+    ap.add_argument("--friction", type=str, default=None,
+                    help='contact.friction: a number (e.g. 0.3, the paper\'s modified Coulomb '
+                         'value) or "table" (Rech et al. 2013, the default of config())')
     ap.add_argument("--save-dir", type=Path, default=None,
                     help="write each point's final state (deformed mesh, fields, node "
                     "velocities) to DIR/h<h>_vc<vc>.npz")
@@ -88,7 +91,8 @@ def main() -> None:
           f"(height {args.separation_height_um} um), edge band {args.edge_um} um "
           f"({args.band_um or 'default'}), conduction {args.conduction}, erosion "
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, tool conductance "
-          f"{args.tool_conductance}, friction heat {args.friction_heat_fraction}, "
+          f"{args.tool_conductance}, friction {args.friction or 'table'}, friction heat "
+          f"{args.friction_heat_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
@@ -116,6 +120,9 @@ def main() -> None:
         if args.erode_dt_fraction is not None:
             solver["erode_time_step_fraction"] = args.erode_dt_fraction
         contact: dict = {}
+        if args.friction is not None:
+            contact["friction"] = (args.friction if args.friction == "table"
+                                   else float(args.friction))
         if args.tool_conductance is not None:
             contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
         if args.friction_heat_fraction is not None:

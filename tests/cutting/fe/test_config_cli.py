@@ -127,3 +127,9 @@ def test_cli_runs_a_short_cut(tmp_path):
     ds = xr.open_dataset(tmp_path / "r.nc")
     assert ds["cutting_force_N_per_mm"].attrs["units"] == "N/mm"
     assert "robobore_config" in ds.attrs
+    # the force split by tool face: JSON, netCDF histories and attributes, force plot
+    assert set(out["force_by_face_N_per_mm"]) == {"rake", "edge", "flank"}
+    assert ds["edge_feed_force_N_per_mm"].attrs["units"] == "N/mm"
+    assert ds.attrs["edge_cutting_force_N_per_mm"] == pytest.approx(
+        out["force_by_face_N_per_mm"]["edge"]["cutting"])
+    assert (tmp_path / "png" / "fe_forces.png").is_file()

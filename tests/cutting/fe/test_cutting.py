@@ -100,3 +100,53 @@ def test_tool_vibration_changes_forces(rigid, supported):
     n = min(len(hr["time_s"]), len(hs["time_s"]))
     diff = np.abs(hs["cutting_force_N_per_mm"][:n] - hr["cutting_force_N_per_mm"][:n])
     assert np.max(diff) > 0.1 * rigid.summary["cutting_force_N_per_mm"]
+
+
+def test_force_by_face_sums_to_the_total(rigid):
+    """The rake / edge / flank split (kernels.contact_split) adds up to the tool force in
+    every sample (same per-node forces, summed in another order: 1e-9 relative)."""
+    h = rigid.history
+    for comp in ("cutting", "feed"):
+        parts = sum(h[f"{face}_{comp}_force_N_per_mm"] for face in ("rake", "edge", "flank"))
+        tot = h[f"{comp}_force_N_per_mm"]
+        assert np.allclose(parts, tot, rtol=1e-9, atol=1e-9 * np.max(np.abs(tot)))
+    f = rigid.summary["force_by_face_N_per_mm"]
+    # with rake 15 deg and mu 0.18 the rake face pulls the tool into the work (feed < 0,
+    # N (mu cos a - sin a) < 0); the edge arc pushes it out (feed > 0); both resist the cut
+    assert f["rake"]["feed"] < 0.0
+    assert f["edge"]["feed"] > 0.0
+    assert f["rake"]["cutting"] > 0.0 and f["edge"]["cutting"] > 0.0
+
+
+def test_contact_split_classifies_by_face():
+    """Nodes placed on the rake face, the edge arc and the flank of a tool with rake 15 deg,
+    clearance 2 deg, r = 20 um at the origin: each force lands in its face's slot."""
+    from robobore.cutting.fe.kernels import contact_split
+
+    r = 20e-6
+    rake, clr = math.radians(15.0), math.radians(2.0)
+    nrx, nry = -math.cos(rake), math.sin(rake)
+    nfx, nfy = math.sin(clr), -math.cos(clr)
+    trx, try_ = nry, -nrx  # up the rake face
+    tfx, tfy = -nfy, nfx  # back along the flank
+    pts = [  # (x, y, face index)
+        (r * nrx + 30e-6 * trx, r * nry + 30e-6 * try_, 0),  # on the rake face
+        (0.0, -r, 1),  # lowest point of the arc
+        (-r * math.sqrt(0.5), -r * math.sqrt(0.5), 1),  # front of the arc
+        (r * nfx + 25e-6 * tfx, r * nfy + 25e-6 * tfy, 2),  # on the flank
+    ]
+    n = len(pts) + 1  # one node without contact
+    x = np.zeros(n)
+    y = np.full(n, -1.0)
+    cfx = np.zeros(n)
+    cfy = np.zeros(n)
+    for i, (px, py, _) in enumerate(pts):
+        x[i], y[i] = px, py
+        cfx[i], cfy[i] = 1.0 + i, 10.0 * (1.0 + i)
+    out = np.zeros(6)
+    contact_split(cfx, cfy, x, y, 0.0, 0.0, nrx, nry, nfx, nfy, out)
+    want = np.zeros(6)
+    for i, (_, _, k) in enumerate(pts):
+        want[2 * k] -= cfx[i]
+        want[2 * k + 1] -= cfy[i]
+    assert np.array_equal(out, want)

@@ -80,8 +80,10 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
         result["files"] = files
 
     def render(r: dict) -> None:
-        stdout.print(kv_table("FE orthogonal cutting",
-                              [(label, r.get(k)) for k, label in _KEYS if k in r]))
+        rows = [(label, r.get(k)) for k, label in _KEYS if k in r]
+        for face, f in r.get("force_by_face_N_per_mm", {}).items():
+            rows.append((f"{face} Fc / Ff [N/mm]", f"{f['cutting']:.2f} / {f['feed']:.2f}"))
+        stdout.print(kv_table("FE orthogonal cutting", rows))
         for k, v in r.get("files", {}).items():
             stdout.print(f"{k}: {v}")
 
@@ -98,11 +100,17 @@ def _plot_forces(res, path: Path) -> Path:
     fig, ax = plt.subplots(figsize=(7, 4), dpi=120)
     ax.plot(h["cut_length_mm"], h["cutting_force_N_per_mm"], label="Fc")
     ax.plot(h["cut_length_mm"], h["feed_force_N_per_mm"], label="Ff")
+    for face, style in (("rake", ":"), ("edge", "--"), ("flank", "-.")):
+        if f"{face}_cutting_force_N_per_mm" in h:  # CPU runs: the split by tool face
+            ax.plot(h["cut_length_mm"], h[f"{face}_cutting_force_N_per_mm"], style,
+                    color="C0", lw=0.8, label=f"Fc {face}")
+            ax.plot(h["cut_length_mm"], h[f"{face}_feed_force_N_per_mm"], style,
+                    color="C1", lw=0.8, label=f"Ff {face}")
     a, b = res.summary["averaging_window_mm"]
     ax.axvspan(a, b, color="0.9", label="averaging window")
     ax.set_xlabel("length of cut [mm]")
     ax.set_ylabel("force on the tool [N/mm]")
-    ax.legend()
+    ax.legend(fontsize=7, ncol=2)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.stem + ".tmp.png")
     fig.savefig(tmp)

@@ -85,7 +85,10 @@ STATUS_NO_ELEMENTS = 5
 # --- history columns (time averages over each sample interval)
 H_T, H_FX, H_FY, H_UX, H_UY, H_TIP_X, H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT = range(12)
 H_EERO, H_NCONT = 12, 13
-N_HIST = 14
+# force on the tool by face (rake, edge arc, flank), x and y [N/m]; CPU engine only (the GPU
+# engine leaves these columns NaN)
+H_FX_RAKE, H_FY_RAKE, H_FX_EDGE, H_FY_EDGE, H_FX_FLANK, H_FY_FLANK = range(14, 20)
+N_HIST = 20
 
 
 def quad_area_corners_py(x1, x2, x3, x4, y1, y2, y3, y4):
@@ -720,6 +723,38 @@ def contact_total(cfx, cfy):
     return fx, fy
 
 
+@njit(cache=True)
+def contact_split(cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out):
+    """Contact force on the tool by face into ``out`` = [Fx, Fy] of the rake face, the edge
+    arc and the flank [N/m] (serial, fixed order).
+
+    A node belongs to the face whose branch of :func:`robobore.cutting.fe.physics.tool_gap_py`
+    gives its gap: rake or flank where its projection falls on that face, the edge arc
+    otherwise (a node deep inside the wedge goes to the nearer face, as there).
+    """
+    for j in range(6):
+        out[j] = 0.0
+    for i in range(cfx.shape[0]):
+        fx = cfx[i]
+        fy = cfy[i]
+        if fx == 0.0 and fy == 0.0:
+            continue
+        dx = x[i] - cx
+        dy = y[i] - cy
+        sr = dx * nrx + dy * nry
+        sf = dx * nfx + dy * nfy
+        if sr <= 0.0 and sf <= 0.0:
+            k = 0 if sr >= sf else 2
+        elif sr > 0.0 and (dx * nry - dy * nrx) >= 0.0:
+            k = 0
+        elif sf > 0.0 and (-dx * nfy + dy * nfx) >= 0.0:
+            k = 2
+        else:
+            k = 1
+        out[2 * k] -= fx
+        out[2 * k + 1] -= fy
+
+
 def quad_centroid_py(e, conn, x, y, tbuf):
     """Centroid x, y and area of quad ``e`` into ``tbuf[e, 0:3]`` (first pass of conduction)."""
     i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
@@ -1003,6 +1038,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     cfl = prm[P_CFL]
     rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
+    fsplit = np.zeros(6)
     taken = 0
     for _s in range(n_steps):
         dt = clock[1]
@@ -1012,6 +1048,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
                             fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy,
                             prm, dt, twin, tied)
         fwx, fwy = contact_total(cfx, cfy)
+        contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+                      fsplit)
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
         if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
             rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
@@ -1068,6 +1106,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         hacc[H_UX] += dt * tool[T_UX]
         hacc[H_UY] += dt * tool[T_UY]
         hacc[H_NCONT] += dt * ncont
+        for j in range(6):
+            hacc[H_FX_RAKE + j] += dt * fsplit[j]
         clock[2] += dt
         k = ist[I_SAMPLE]
         if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
@@ -1082,6 +1122,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
             hist[k, H_UX] = hacc[H_UX] / ta
             hist[k, H_UY] = hacc[H_UY] / ta
             hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            for j in range(6):
+                hist[k, H_FX_RAKE + j] = hacc[H_FX_RAKE + j] / ta
             hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
             hist[k, H_EKIN] = en[E_KIN]
             hist[k, H_EINT] = en[E_INT]

@@ -188,6 +188,8 @@ def to_dataset(res: FEResult):
         "energy_hourglass_J_per_m": "J/m", "energy_contact_J_per_m": "J/m",
         "energy_eroded_J_per_m": "J/m", "contact_nodes": "1",
     }
+    for face in ("rake", "edge", "flank"):
+        units[f"{face}_cutting_force_N_per_mm"] = units[f"{face}_feed_force_N_per_mm"] = "N/mm"
     data = {k: ("time", np.asarray(v), {"units": units.get(k, "")})
             for k, v in hist.items() if k != "time_s"}
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"})})
@@ -196,6 +198,9 @@ def to_dataset(res: FEResult):
             ds.attrs[k] = int(v)
         elif isinstance(v, int | float | str):
             ds.attrs[k] = v
+    for face, f in res.summary.get("force_by_face_N_per_mm", {}).items():
+        for comp, val in f.items():
+            ds.attrs[f"{face}_{comp}_force_N_per_mm"] = val
     return ds
 
 

@@ -517,6 +517,10 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
     return time.perf_counter() - t0, steps
 
 
+#: tool faces of the force split (``force_by_face_N_per_mm``; kernels.contact_split)
+FACES = ("rake", "edge", "flank")
+
+
 def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
     from robobore.cutting.fe.output import tool_outline
 
@@ -610,6 +614,13 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "energy_internal_J_per_m": float(en[K.E_INT]),
         "hourglass_fraction": float(en[K.E_HG] / max(en[K.E_INT], 1e-300)),
     }
+    faces = hh[:, K.H_FX_RAKE:K.H_FX_RAKE + 6] * 1e-3
+    has_faces = bool(win.any() and np.all(np.isfinite(faces[win])))
+    if has_faces:  # CPU engine only
+        fm = faces[win].mean(axis=0)
+        summary["force_by_face_N_per_mm"] = {
+            face: {"cutting": float(fm[2 * j]), "feed": float(fm[2 * j + 1])}
+            for j, face in enumerate(FACES)}
     if cfg.tool_support is not None:
         kx, ky = cfg.tool_support.stiffness_N_per_m  # type: ignore[misc]
         w = cfg.cut.width_mm
@@ -640,5 +651,9 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "energy_contact_J_per_m": hh[:, K.H_EFRIC],
         "energy_eroded_J_per_m": hh[:, K.H_EERO],
     }
+    if has_faces:
+        for j, face in enumerate(FACES):
+            history[f"{face}_cutting_force_N_per_mm"] = faces[:, 2 * j]
+            history[f"{face}_feed_force_N_per_mm"] = faces[:, 2 * j + 1]
     return FEResult(summary=summary, history=history, config=cfg.model_dump(),
                     final=_final_fields(setup))
