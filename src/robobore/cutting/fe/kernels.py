@@ -89,6 +89,8 @@ H_EERO, H_NCONT = 12, 13
 # engine leaves these columns NaN)
 H_FX_RAKE, H_FY_RAKE, H_FX_EDGE, H_FY_EDGE, H_FX_FLANK, H_FY_FLANK = range(14, 20)
 N_HIST = 20
+#: names of the tool faces of that split, in column order (summary ``force_by_face_N_per_mm``)
+FACES = ("rake", "edge", "flank")
 
 
 def quad_area_corners_py(x1, x2, x3, x4, y1, y2, y3, y4):

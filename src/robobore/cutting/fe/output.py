@@ -188,7 +188,7 @@ def to_dataset(res: FEResult):
         "energy_hourglass_J_per_m": "J/m", "energy_contact_J_per_m": "J/m",
         "energy_eroded_J_per_m": "J/m", "contact_nodes": "1",
     }
-    for face in ("rake", "edge", "flank"):
+    for face in K.FACES:
         units[f"{face}_cutting_force_N_per_mm"] = units[f"{face}_feed_force_N_per_mm"] = "N/mm"
     data = {k: ("time", np.asarray(v), {"units": units.get(k, "")})
             for k, v in hist.items() if k != "time_s"}

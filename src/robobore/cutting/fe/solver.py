@@ -517,10 +517,6 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
     return time.perf_counter() - t0, steps
 
 
-#: tool faces of the force split (``force_by_face_N_per_mm``; kernels.contact_split)
-FACES = ("rake", "edge", "flank")
-
-
 def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
     from robobore.cutting.fe.output import tool_outline
 
@@ -620,7 +616,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         fm = faces[win].mean(axis=0)
         summary["force_by_face_N_per_mm"] = {
             face: {"cutting": float(fm[2 * j]), "feed": float(fm[2 * j + 1])}
-            for j, face in enumerate(FACES)}
+            for j, face in enumerate(K.FACES)}
     if cfg.tool_support is not None:
         kx, ky = cfg.tool_support.stiffness_N_per_m  # type: ignore[misc]
         w = cfg.cut.width_mm
@@ -652,7 +648,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "energy_eroded_J_per_m": hh[:, K.H_EERO],
     }
     if has_faces:
-        for j, face in enumerate(FACES):
+        for j, face in enumerate(K.FACES):
             history[f"{face}_cutting_force_N_per_mm"] = faces[:, 2 * j]
             history[f"{face}_feed_force_N_per_mm"] = faces[:, 2 * j + 1]
     return FEResult(summary=summary, history=history, config=cfg.model_dump(),
