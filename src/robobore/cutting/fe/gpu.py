@@ -96,13 +96,13 @@ def _kernels():
 
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.hex8 import hex_element_py
-    from robobore.cutting.fe.physics import tool_gap_py, tool_support_step_py
+    from robobore.cutting.fe.physics import tool_face_py, tool_gap_py, tool_support_step_py
     from robobore.material import johnson_cook as jc
 
     dev = cuda.jit(device=True)
     dmg, ret = jc_device_functions(dev)
     elem = dev(jc.rebind(hex_element_py, jc_return=ret, jc_damage_increment=dmg))
-    tg = dev(tool_gap_py)
+    tg = dev(jc.rebind(tool_gap_py, tool_face=dev(tool_face_py)))
     sec = dev(K3.edge_section_py)
     gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg, edge_section=sec))
     cf3 = dev(K3.contact_force3_py)

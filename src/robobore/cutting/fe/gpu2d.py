@@ -86,13 +86,18 @@ def _kernels():
     cuda = _cuda
     from numba import float64 as _float64
 
-    from robobore.cutting.fe.physics import contact_force_py, tool_gap_py, tool_support_step_py
+    from robobore.cutting.fe.physics import (
+        contact_force_py,
+        tool_face_py,
+        tool_gap_py,
+        tool_support_step_py,
+    )
     from robobore.material import johnson_cook as jc
 
     dev = cuda.jit(device=True)
     dmg, ret = jc_device_functions(dev)
     rret = dev(jc.rebind(jc.radial_return_py, jc_return=ret))
-    tg = dev(tool_gap_py)
+    tg = dev(jc.rebind(tool_gap_py, tool_face=dev(tool_face_py)))
     cf = dev(contact_force_py)
     sup = dev(tool_support_step_py)
     retire = dev(K.quad_retire_py)

@@ -36,6 +36,7 @@ from robobore.cutting.fe.physics import (
     contact_force,
     jc_damage_increment,
     radial_return,
+    tool_face,
     tool_gap,
     tool_support_step,
 )
@@ -728,12 +729,8 @@ def contact_total(cfx, cfy):
 @njit(cache=True)
 def contact_split(cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out):
     """Contact force on the tool by face into ``out`` = [Fx, Fy] of the rake face, the edge
-    arc and the flank [N/m] (serial, fixed order).
-
-    A node belongs to the face whose branch of :func:`robobore.cutting.fe.physics.tool_gap_py`
-    gives its gap: rake or flank where its projection falls on that face, the edge arc
-    otherwise (a node deep inside the wedge goes to the nearer face, as there).
-    """
+    arc and the flank [N/m] (serial, fixed order). A node belongs to the face that gives
+    its gap (:func:`robobore.cutting.fe.physics.tool_face_py`)."""
     for j in range(6):
         out[j] = 0.0
     for i in range(cfx.shape[0]):
@@ -741,18 +738,7 @@ def contact_split(cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out):
         fy = cfy[i]
         if fx == 0.0 and fy == 0.0:
             continue
-        dx = x[i] - cx
-        dy = y[i] - cy
-        sr = dx * nrx + dy * nry
-        sf = dx * nfx + dy * nfy
-        if sr <= 0.0 and sf <= 0.0:
-            k = 0 if sr >= sf else 2
-        elif sr > 0.0 and (dx * nry - dy * nrx) >= 0.0:
-            k = 0
-        elif sf > 0.0 and (-dx * nfy + dy * nfx) >= 0.0:
-            k = 2
-        else:
-            k = 1
+        k = tool_face(x[i] - cx, y[i] - cy, nrx, nry, nfx, nfy)
         out[2 * k] -= fx
         out[2 * k + 1] -= fy
 

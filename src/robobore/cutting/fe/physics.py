@@ -4,6 +4,7 @@ Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` ver
 
 * Johnson-Cook flow stress, failure strain, damage increment and radial return -- re-exported
   from :mod:`robobore.material.johnson_cook`;
+* :func:`tool_face_py` -- the face of the tool (rake, edge arc, flank) closest to a point;
 * :func:`tool_gap_py` -- signed distance of a point to the analytic rigid tool (rake face,
   edge-radius arc, flank with clearance) and the outward normal;
 * :func:`contact_force_py` -- penalty normal force, Coulomb friction with a shear-stress cap;
@@ -31,6 +32,25 @@ from robobore.material.johnson_cook import (  # noqa: F401  (re-exports)
     rebind,
 )
 
+#: faces of the analytic tool (:func:`tool_face_py`)
+FACE_RAKE, FACE_EDGE, FACE_FLANK = 0, 1, 2
+
+
+def tool_face_py(dx, dy, nrx, nry, nfx, nfy):
+    """Which face of the tool is closest to the point at (dx, dy) from the edge centre:
+    FACE_RAKE or FACE_FLANK where the point's projection falls on that face (a point inside
+    the wedge goes to the nearer face), FACE_EDGE (the edge-radius arc) otherwise. Normals
+    as in :func:`tool_gap_py`."""
+    sr = dx * nrx + dy * nry
+    sf = dx * nfx + dy * nfy
+    if sr <= 0.0 and sf <= 0.0:
+        return FACE_RAKE if sr >= sf else FACE_FLANK
+    if sr > 0.0 and (dx * nry - dy * nrx) >= 0.0:
+        return FACE_RAKE
+    if sf > 0.0 and (-dx * nfy + dy * nfx) >= 0.0:
+        return FACE_FLANK
+    return FACE_EDGE
+
 
 def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
     """Signed gap of point (px, py) to the rigid tool and the tool's outward normal.
@@ -38,23 +58,19 @@ def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
     The tool is the set of points within ``r`` (edge radius) of the wedge with apex at the
     edge centre (cx, cy) bounded by the rake face (outward unit normal (nrx, nry)) and the
     flank face (outward unit normal (nfx, nfy)). The rake face runs from the edge up along
-    t_r = (nry, -nrx); the flank runs from the edge back along t_f = (-nfy, nfx).
+    t_r = (nry, -nrx); the flank runs from the edge back along t_f = (-nfy, nfx). The closest
+    face is :func:`tool_face_py`'s.
 
     Returns ``(gap, nx, ny)``: gap > 0 outside (distance to the surface), gap < 0 inside
     (penetration depth); (nx, ny) the outward normal of the closest surface point [m].
     """
     dx = px - cx
     dy = py - cy
-    sr = dx * nrx + dy * nry
-    sf = dx * nfx + dy * nfy
-    if sr <= 0.0 and sf <= 0.0:
-        if sr >= sf:
-            return sr - r, nrx, nry
-        return sf - r, nfx, nfy
-    if sr > 0.0 and (dx * nry - dy * nrx) >= 0.0:
-        return sr - r, nrx, nry
-    if sf > 0.0 and (-dx * nfy + dy * nfx) >= 0.0:
-        return sf - r, nfx, nfy
+    face = tool_face(dx, dy, nrx, nry, nfx, nfy)
+    if face == FACE_RAKE:
+        return dx * nrx + dy * nry - r, nrx, nry
+    if face == FACE_FLANK:
+        return dx * nfx + dy * nfy - r, nfx, nfy
     d = math.sqrt(dx * dx + dy * dy)
     return d - r, dx / d, dy / d
 
@@ -99,6 +115,7 @@ def tool_support_step_py(u, v, force, k, c, m, dt):
     return u + dt * vn, vn
 
 
+tool_face = njit(cache=True, inline="always")(tool_face_py)
 tool_gap = njit(cache=True)(tool_gap_py)
 contact_force = njit(cache=True)(contact_force_py)
 tool_support_step = njit(cache=True)(tool_support_step_py)
