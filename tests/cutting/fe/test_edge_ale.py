@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import edge_band_dict
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config import parse_config
@@ -22,23 +23,12 @@ from robobore.cutting.fe.rezone import MODE_ROWS, rezone, row_stencil
 from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 
-BASE = {
-    "material": {"name": "TC4"},
-    "tool": {"rake_deg": 7.0, "clearance_deg": 7.0, "edge_radius_um": 20.0},
-    "cut": {"uncut_chip_thickness_um": 30.0, "cutting_speed_m_per_min": 37.7,
-            "length_mm": 0.04, "width_mm": 1.0},
-    "contact": {"friction": 0.2},
-    "mesh": {"element_size_um": 10.0, "separation": "node_split",
-             "separation_height_um": 5.0, "edge_element_um": 5.0},
-    "solver": {"mass_scaling": 100.0, "edge_ale_interval": 10, "edge_ale_depth_um": 10.0},
-}
+ALE = {"edge_ale_interval": 10, "edge_ale_depth_um": 10.0}
 
 
 def _cfg(**sections):
-    d = {k: dict(v) for k, v in BASE.items()}
-    for sec, kv in sections.items():
-        d[sec].update(kv)
-    return parse_config(d, "t.toml")
+    solver = {**ALE, **sections.pop("solver", {})}
+    return parse_config(edge_band_dict(solver=solver, **sections), "t.toml")
 
 
 def _edges(conn):

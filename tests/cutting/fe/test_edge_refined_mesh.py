@@ -16,6 +16,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
+from conftest import edge_band_dict
 
 from robobore.cutting.fe.config import parse_config
 from robobore.cutting.fe.mesh import build_edge_refined_mesh
@@ -95,22 +96,8 @@ def test_chip_too_thin_for_the_refinement():
                                 band_above=5e-6, band_below=5e-6)
 
 
-BASE = {
-    "material": {"name": "TC4"},
-    "tool": {"rake_deg": 7.0, "clearance_deg": 7.0, "edge_radius_um": 20.0},
-    "cut": {"uncut_chip_thickness_um": 30.0, "cutting_speed_m_per_min": 37.7,
-            "length_mm": 0.04, "width_mm": 1.0},
-    "contact": {"friction": 0.2},
-    "mesh": {"element_size_um": 10.0, "separation": "node_split",
-             "separation_height_um": 5.0, "edge_element_um": 5.0},
-    "solver": {"mass_scaling": 100.0},
-}
-
-
 def _cfg(**mesh):
-    d = {k: dict(v) for k, v in BASE.items()}
-    d["mesh"].update(mesh)
-    return parse_config(d, "t.toml")
+    return parse_config(edge_band_dict(mesh=mesh), "t.toml")
 
 
 @pytest.mark.parametrize("mesh, field", [
@@ -142,9 +129,9 @@ def test_short_cut_on_refined_mesh():
 
 
 def test_chip_too_thin_is_a_config_error():
-    d = {k: dict(v) for k, v in BASE.items()}
-    d["cut"]["uncut_chip_thickness_um"] = 15.0
-    d["mesh"].update(element_size_um=5.0, edge_element_um=2.5, separation_height_um=9.0)
+    d = edge_band_dict(cut={"uncut_chip_thickness_um": 15.0},
+                       mesh={"element_size_um": 5.0, "edge_element_um": 2.5,
+                             "separation_height_um": 9.0})
     with pytest.raises(ConfigError) as ei:
         setup_orthogonal(parse_config(d, "t.toml"), "t.toml")
     assert ei.value.field == "mesh.edge_element_um"
