@@ -74,7 +74,17 @@ def main() -> None:
                     help="contact.thermal_conductance_W_per_m2K (with --conduction)")
     ap.add_argument("--friction-heat-fraction", type=float, default=None,
                     help="contact.friction_heat_fraction (with --conduction)")
-    ap.add_argument("--friction", type=str, default=None,
+    def friction(v: str) -> float | str:
+        if v == "table":
+            return v
+        try:
+            return float(v)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"--friction {v!r}: expected a Coulomb coefficient (e.g. 0.3) or 'table'"
+            ) from None
+
+    ap.add_argument("--friction", type=friction, default=None,
                     help='contact.friction: a number (e.g. 0.3, the paper\'s modified Coulomb '
                          'value) or "table" (Rech et al. 2013, the default of config())')
     ap.add_argument("--save-dir", type=Path, default=None,
@@ -121,8 +131,7 @@ def main() -> None:
             solver["erode_time_step_fraction"] = args.erode_dt_fraction
         contact: dict = {}
         if args.friction is not None:
-            contact["friction"] = (args.friction if args.friction == "table"
-                                   else float(args.friction))
+            contact["friction"] = args.friction
         if args.tool_conductance is not None:
             contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
         if args.friction_heat_fraction is not None:
