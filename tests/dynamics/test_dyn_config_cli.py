@@ -177,3 +177,19 @@ def test_model_equivalent_from_json_files(tmp_path):
     r = runner.invoke(app, ["model", "equivalent", "--stiffness-file", str(s), "--modes-file",
                             str(m), "--assign", "0,2,9"])
     assert r.exit_code == 2 and "assignment.z" in r.output
+
+
+def test_cutting_trailing_edge_switch(tmp_path):
+    """``[cutting] trailing_edge`` (default true) reaches the process: the trailing side of the
+    nose adds depth-independent edge lengths, false leaves none; a non-boolean names the key."""
+    from robobore.dynamics.config import build_process, load_dynamics_config
+
+    text = (EX / "boring_paper.toml").read_text()
+    on = build_process(load_dynamics_config(EX / "boring_paper.toml")[0])
+    assert on.edge_fixed_m.sum() == pytest.approx(82.907e-6, rel=1e-4)  # r 0.4, 5 deg, f 0.15
+    p = _write(tmp_path, text.replace("depth_mm = 0.05", "depth_mm = 0.05\ntrailing_edge = false"))
+    off = build_process(load_dynamics_config(p)[0])
+    assert not off.edge_fixed_m.any() and off.n_elements < on.n_elements
+    p = _write(tmp_path, text.replace("depth_mm = 0.05", "depth_mm = 0.05\ntrailing_edge = 3"))
+    r = runner.invoke(app, ["lobes", str(p), "--json"])
+    assert r.exit_code == 2 and "cutting.trailing_edge" in r.output

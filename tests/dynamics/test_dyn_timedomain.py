@@ -126,6 +126,45 @@ def test_rigid_boring_reproduces_static_forces():
     assert ds["force"].attrs["units"] == "N" and ds["displacement"].attrs["units"] == "m"
 
 
+def test_trailing_edge_rubs_with_a_feed_set_length():
+    """The trailing side of the nose (rubbing elements, h0 = 0) keeps its length when the
+    simulated depth differs from the process's reference depth, while the leading edge
+    stretches with it: rigid tool, edge coefficients only (Ktc negligible), reference depth
+    0.3 mm simulated at 0.15 mm. Tangential amplitude Kte (L_lead a / a_ref + L_trail) and
+    feed mean from the element orientations, both from edge_elements directly (1 %; stretching
+    the trailing side too would put the X/Y amplitude 14 % off). The trailing elements carry
+    no chip width and leave the regenerative directional matrix and the depth-modulation
+    stiffness unchanged (1e-12)."""
+    from robobore.cutting.geometry import edge_elements
+
+    ins = BoringInsert(nose_radius_m=0.4e-3)
+    c = CuttingCoefficients(Ktc=1.0, Krc=0.0, Kfc=0.0, Kte=2e4, Kfe=4e4)
+    ref, a, f = 0.3e-3, 0.15e-3, 0.15e-3
+    pr = boring_process(ins, c, ref, f, n_elements=30)
+    off = boring_process(ins, c, ref, f, n_elements=30, trailing_edge=False)
+    el = edge_elements(ins, ref, f, 30)
+    tr = el.trailing
+    assert np.all(pr.h0[tr] == 0) and np.all(pr.width_per_depth[tr] == 0)
+    assert np.all(pr.edge_per_depth[tr] == 0) and np.allclose(pr.edge_fixed_m[tr], el.dS[tr])
+    assert np.all(pr.edge_fixed_m[~tr] == 0)
+    th = np.linspace(0.0, 2 * np.pi, 7)
+    assert np.allclose(pr.directional_matrix(th), off.directional_matrix(th), rtol=1e-12,
+                       atol=0)
+    assert np.allclose(pr.process_stiffness(th), off.process_stiffness(th), rtol=1e-12,
+                       atol=0)
+    s = summarize(simulate(_rigid(), pr, SimulationSettings(300.0, a, 6, samples_per_rev=720),
+                           ins))
+    ft = 2e4 * (el.leading_length * a / ref + el.trailing_length)
+    ff = -4e4 * (np.sum(np.sin(el.kappa[~tr]) * el.dS[~tr]) * a / ref
+                 + np.sum(np.sin(el.kappa[tr]) * el.dS[tr]))
+    fr = -4e4 * (np.sum(np.cos(el.kappa[~tr]) * el.dS[~tr]) * a / ref
+                 + np.sum(np.cos(el.kappa[tr]) * el.dS[tr]))
+    assert s["force_amplitude_N"]["x"] == pytest.approx(math.hypot(ft, fr), rel=0.01)
+    assert s["force_mean_N"]["z"] == pytest.approx(ff, rel=0.01)
+    stretched = 2e4 * el.engaged_length * a / ref
+    assert abs(stretched / ft - 1) > 0.1
+
+
 def test_surface_roughness_of_round_nose():
     """Rigid tool, feed inside the nose arc: Ra = f^2 / (18 sqrt(3) r) = 0.0321 f^2 / r and
     Rz = f^2 / (8 r) (circular-arc feed marks, e.g. Shaw, Metal Cutting Principles). 3 %."""

@@ -13,9 +13,15 @@ thickness ``h``, chip width ``db`` and edge length ``dS``::
 The thrust acts along the local chip-thickness direction ``(-sin k, -cos k)`` in (feed, radial)
 coordinates, i.e. it is resolved by the local approach angle ``k`` into
 ``feed = -dFf sin k + dFl cos k`` and ``radial = -dFf cos k - dFl sin k`` (forces ON THE TOOL,
-radial positive outwards). The rotating-frame totals ``(F_tangential, F_radial, F_feed)`` go to
-the boring frame (X horizontal, Y vertical, Z feed) with the bar's rotation angle ``theta``
-(from X towards Y; the insert moves along ``e_t = (-sin theta, cos theta, 0)``)::
+radial positive outwards). Every element is engaged edge and carries its edge forces
+(``K*e dS``), including the rubbing-only elements on the trailing side of the nose
+(``h = 0``, ``k < 0``; see :func:`robobore.cutting.geometry.edge_elements`): there the edge
+normal leans the other way along the feed, so their thrust has a feed component of the
+opposite sign (``-Kfe dS sin k > 0``) that partly cancels the leading side's.
+
+The rotating-frame totals ``(F_tangential, F_radial, F_feed)`` go to the boring frame
+(X horizontal, Y vertical, Z feed) with the bar's rotation angle ``theta`` (from X towards Y;
+the insert moves along ``e_t = (-sin theta, cos theta, 0)``)::
 
     F = -Ft e_t(theta) + Fr e_r(theta) + Fz e_z
 
@@ -269,10 +275,13 @@ class ElementForces:
 
 
 def element_forces(el: EdgeElements, c: CuttingCoefficients) -> ElementForces:
-    """Edge-element forces and their rotating-frame sums (see module docstring)."""
+    """Edge-element forces and their rotating-frame sums (see module docstring).
+
+    Shearing terms on the chip ``h db`` of each element, edge terms on its length ``dS``:
+    every element of ``el`` is engaged edge, those with ``h = 0`` (trailing side of the nose)
+    carry the edge forces only."""
     dA = el.h * el.db
-    cut = el.h > 0
-    dS = np.where(cut, el.dS, 0.0)
+    dS = el.dS
     dFt = c.Ktc * dA + c.Kte * dS
     dFf = c.Kfc * dA + c.Kfe * dS
     dFl = c.Krc * dA + c.Kre * dS
@@ -294,15 +303,18 @@ def rotating_to_boring(tangential: float, radial: float, feed: float,
 
 def boring_forces(insert: BoringInsert, depth_m: float, feed_per_rev_m: float,
                   coefficients: CuttingCoefficients, n_theta: int = 360,
-                  n_elements: int = 40) -> dict[str, Any]:
+                  n_elements: int = 40, trailing_edge: bool = True) -> dict[str, Any]:
     """Static (rigid-tool) boring forces over one revolution.
 
     Returns a dict with ``theta_rad`` (n,), ``force_N`` (3, n) in the boring frame (sum over
     the inserts, equally spaced), rotating-frame totals per insert, chip area, and per-axis
-    mean and amplitude (half peak-to-peak).
+    mean and amplitude (half peak-to-peak). ``trailing_edge`` (default True): edge forces
+    also on the engaged trailing side of the nose
+    (:func:`robobore.cutting.geometry.edge_elements`); False gives the earlier
+    leading-edge-only model.
     """
     fz = feed_per_rev_m / insert.n_inserts
-    el = edge_elements(insert, depth_m, fz, n_elements)
+    el = edge_elements(insert, depth_m, fz, n_elements, trailing_edge=trailing_edge)
     ef = element_forces(el, coefficients)
     th = np.linspace(0.0, 2 * np.pi, n_theta, endpoint=False)
     F = np.zeros((3, n_theta))

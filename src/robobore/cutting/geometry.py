@@ -22,10 +22,17 @@ previous pass (shifted by ``-f``) and the pre-bore surface. Its exact area is
 on the bore (``~ f^3 / (12 r)`` when the feed is inside the nose). ``A = ap f`` is the
 textbook value when the scallop is negligible.
 
-Edge elements: the engaged (leading) edge from the tip to the pre-bore surface is cut into
-``n`` elements of equal arc length ``dS = db``; each element takes the chip slices at the radial
+Edge elements: the leading edge from the tip to the pre-bore surface is cut into ``n``
+elements of equal arc length ``dS = db``; each element takes the chip slices at the radial
 levels it spans (see :func:`edge_elements`), so ``h = f sin(kappa_local)`` where the chip is
-fully covered and ``sum(h db)`` is the exact chip area.
+fully covered and ``sum(h db)`` is the exact chip area. The engaged edge also runs back over
+the trailing side of the nose, from the tip to the point ``zeta_i < 0`` where the current
+profile meets the previous pass's (``drop(zeta_i) = min(ap, drop(zeta_i + f))``; ``-f/2`` on a
+pure arc). The chip there is a thin sliver that the radial-level attribution gives to the
+leading side, so those *trailing* elements carry no chip (``h = db = 0``) but their edge length
+``dS`` and local orientation ``kappa < 0``: the edge (ploughing/rubbing) force acts over the
+whole engaged edge (Kaymakci et al. 2012: edge forces integrated from the intersection with the
+previous pass to the depth-of-cut end).
 """
 
 from __future__ import annotations
@@ -148,10 +155,13 @@ class BoringInsert:
 class EdgeElements:
     """Engaged edge discretised into elements (structure of arrays, all shape ``(n,)``).
 
-    ``s`` arc-length position of the element centre [m]; ``zeta``, ``drop`` its profile
-    position [m]; ``kappa`` local approach angle [rad]; ``h`` local uncut chip thickness [m];
-    ``db`` chip width [m]; ``dS`` edge length [m]. ``area`` is the exact chip area [m^2]
-    (1-D integral), ``area_elements`` = ``sum(h db)``.
+    ``s`` arc-length position of the element centre [m] (negative on the trailing side);
+    ``zeta``, ``drop`` its profile position [m]; ``kappa`` local approach angle [rad] (negative
+    on the trailing side); ``h`` local uncut chip thickness [m]; ``db`` chip width [m]; ``dS``
+    edge length [m]. ``area`` is the exact chip area [m^2] (1-D integral), ``area_elements`` =
+    ``sum(h db)``. Every element is engaged edge: the first ``n_trailing`` elements (ordered by
+    ``s``, from the intersection with the previous pass at ``trailing_end_zeta_m`` to the tip)
+    only rub (``h = db = 0``, edge forces only); the others cut the chip.
     """
 
     s: np.ndarray
@@ -165,14 +175,32 @@ class EdgeElements:
     area_elements: float
     depth_m: float
     feed_m: float
+    n_trailing: int = 0
+    trailing_end_zeta_m: float = 0.0
 
     @property
     def n(self) -> int:
         return int(self.s.size)
 
     @property
+    def trailing(self) -> np.ndarray:
+        """Mask of the trailing (rubbing-only) elements, shape ``(n,)``."""
+        return np.arange(self.n) < self.n_trailing
+
+    @property
     def engaged_length(self) -> float:
+        """Total engaged edge length [m] (leading + trailing side)."""
         return float(self.dS.sum())
+
+    @property
+    def trailing_length(self) -> float:
+        """Engaged edge length on the trailing side of the nose [m]."""
+        return float(self.dS[: self.n_trailing].sum())
+
+    @property
+    def leading_length(self) -> float:
+        """Engaged edge length on the leading (chip-cutting) side [m]."""
+        return float(self.dS[self.n_trailing:].sum())
 
     @property
     def equivalent_approach_angle(self) -> float:
@@ -268,8 +296,50 @@ def _width_at_drop(insert: BoringInsert, d: np.ndarray) -> np.ndarray:
     return b - a
 
 
+def trailing_intersection(insert: BoringInsert, depth_m: float, feed_m: float) -> float:
+    """zeta [m] (< 0) where the engaged edge ends on the trailing side of the nose.
+
+    The root of ``g(zeta) = min(ap, drop(zeta + f)) - drop(zeta)`` on ``(-f, 0)``: from the tip
+    back to it the current profile lies below the surface left by the previous pass (or the
+    pre-bore surface), so the edge is in contact. ``g`` falls strictly from ``g(0) > 0`` to
+    ``g(-f) < 0`` (``drop`` grows away from the tip on both sides), so the root is unique;
+    bisection to ``f 2^-80``. Works on the nose arc (``-f/2`` for a pure arc) and on the
+    straight minor edge beyond it (large feed or small end-edge angle).
+    """
+    _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
+    _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
+
+    def g(z: np.ndarray) -> np.ndarray:
+        return _prev_surface_drop(insert, z, feed_m, depth_m) - insert.drop(z)
+
+    return float(_bisect(g, np.zeros(1), np.full(1, -feed_m), iters=80)[0])
+
+
+def _s_of_zeta_trail(insert: BoringInsert, zeta: float) -> float:
+    """Arc length s [m] (<= 0) of the trailing-side profile point at axial offset ``zeta <= 0``."""
+    r, ke = insert.nose_radius_m, insert.kappa_end
+    z = -zeta
+    if z <= r * math.sin(ke):
+        return -r * math.asin(min(z / r, 1.0))
+    return -(r * ke + (z - r * math.sin(ke)) / math.cos(ke))
+
+
+def _trailing_nodes(insert: BoringInsert, s_i: float, n: int) -> np.ndarray:
+    """Element boundaries from ``s_i < 0`` to the tip; the arc / minor-edge corner is a node
+    (so every element has one orientation law), each piece gets elements by its length."""
+    s_corner = -insert.nose_radius_m * insert.kappa_end
+    if s_i < s_corner:
+        L_str, L_arc = s_corner - s_i, -s_corner
+        n_str = max(1, round(n * L_str / (L_str + L_arc)))
+        n_arc = max(1, n - n_str)
+        return np.concatenate([np.linspace(s_i, s_corner, n_str + 1),
+                               np.linspace(s_corner, 0.0, n_arc + 1)[1:]])
+    return np.linspace(s_i, 0.0, n + 1)
+
+
 def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
-                  n_elements: int = 40, n_quad: int = 16) -> EdgeElements:
+                  n_elements: int = 40, n_quad: int = 16, trailing_edge: bool = True,
+                  n_trailing: int | None = None) -> EdgeElements:
     """Discretise the engaged edge for depth ``depth_m`` [m] and feed per insert ``feed_m`` [m].
 
     The chip is attributed to the edge by radial levels ``d`` (slices at constant radius): the
@@ -278,14 +348,26 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
     levels ``d1 < d2`` of the leading edge (from the tip to the pre-bore surface) has area
     ``integral min(f, w(d)) dd`` (``n_quad``-point Gauss-Legendre) and local thickness
     ``h = area / dS``; on a fully covered straight edge this is ``h = f sin(kappa)``
-    (Kaymakci et al. 2012) and ``sum(h db)`` equals the exact chip area. The trailing (minor)
-    side only generates the surface. Works for depths inside the nose radius (only the arc
-    cuts) and beyond it (the major edge cuts too).
+    (Kaymakci et al. 2012) and ``sum(h db)`` equals the exact chip area. Works for depths
+    inside the nose radius (only the arc cuts) and beyond it (the major edge cuts too).
+    ``n_elements`` is the number of these leading (chip-cutting) elements.
+
+    ``trailing_edge`` (default True): also the trailing side of the nose from the tip back to
+    :func:`trailing_intersection` (where the current profile meets the previous pass's), which
+    is in contact with the work and carries edge (ploughing) forces but, by the radial-level
+    attribution, no chip: ``n_trailing`` elements (default: in proportion to its length
+    relative to the leading edge, at least 1; the arc / minor-edge corner is an element
+    boundary) with ``h = db = 0``, their length ``dS`` and local approach angle ``kappa < 0``.
+    They come first (ordered by ``s``); the chip-area identity is unchanged.
     """
     _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
     _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
-    if n_elements < 1:
-        raise ConfigError("need at least one element", field="n_elements", value=n_elements)
+    if int(n_elements) != n_elements or n_elements < 1:
+        raise ConfigError("need at least one element", field="n_elements", value=n_elements,
+                          expected="an integer >= 1")
+    if n_trailing is not None and (int(n_trailing) != n_trailing or n_trailing < 1):
+        raise ConfigError("need at least one trailing element", field="n_trailing",
+                          value=n_trailing, expected="an integer >= 1 (or None: automatic)")
     s_end = _s_of_drop_lead(insert, depth_m)
     edges = np.linspace(0.0, s_end, n_elements + 1)
     _, d_edges, _, _ = insert.point(edges)
@@ -300,10 +382,28 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
     integrand = np.minimum(feed_m, _width_at_drop(insert, dd))
     area_e = (0.5 * (d2 - d1)[:, 0]) * (integrand * wg[None, :]).sum(axis=1)
     h = area_e / dS
+    db = dS.copy()
     area = chip_area(insert, depth_m, feed_m)
-    return EdgeElements(s=s, zeta=zeta, drop=drop, kappa=kl, h=h, db=dS.copy(), dS=dS,
-                        area=area, area_elements=float((h * dS).sum()), depth_m=float(depth_m),
-                        feed_m=float(feed_m))
+    area_elements = float((h * db).sum())
+    n_tr = 0
+    z_i = 0.0
+    if trailing_edge:
+        z_i = trailing_intersection(insert, depth_m, feed_m)
+        s_i = _s_of_zeta_trail(insert, z_i)
+        n_auto = max(1, round(n_elements * (-s_i) / s_end))
+        t_edges = _trailing_nodes(insert, s_i, int(n_trailing or n_auto))
+        n_tr = t_edges.size - 1
+        s_t = 0.5 * (t_edges[1:] + t_edges[:-1])
+        z_t, d_t, k_t, _ = insert.point(s_t)
+        s, zeta, drop, kl = (np.concatenate([a, b]) for a, b in
+                             ((s_t, s), (z_t, zeta), (d_t, drop), (k_t, kl)))
+        dS = np.concatenate([np.diff(t_edges), dS])
+        h = np.concatenate([np.zeros(n_tr), h])
+        db = np.concatenate([np.zeros(n_tr), db])
+    return EdgeElements(s=s, zeta=zeta, drop=drop, kappa=kl, h=h, db=db, dS=dS,
+                        area=area, area_elements=area_elements, depth_m=float(depth_m),
+                        feed_m=float(feed_m), n_trailing=int(n_tr), trailing_end_zeta_m=z_i)
 
 
-__all__ = ["BoringInsert", "EdgeElements", "chip_area", "scallop_area", "edge_elements"]
+__all__ = ["BoringInsert", "EdgeElements", "chip_area", "scallop_area", "edge_elements",
+           "trailing_intersection"]

@@ -78,7 +78,8 @@ def lobes_cmd(
     out["process"] = pr.label
     if pr.reference_depth_m is not None:
         notes.append(f"boring process linearised at depth {pr.reference_depth_m * 1e3:g} mm "
-                     "(engaged edge stretched with depth)")
+                     "(leading edge stretched with depth; the trailing side of the nose "
+                     "keeps its feed-set length)")
     out["notes"] = notes
     if plot is not None:
         curves = stability.lobe_curves(st, pr, 12) if method == "frequency" else None

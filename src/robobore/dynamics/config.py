@@ -191,6 +191,9 @@ class CuttingCfg(_Strict):
     depth_mm: float = Field(gt=0, le=50)
     overlap_factor: float = Field(1.0, ge=0, le=1)
     depth_modulation: bool = True
+    # edge (ploughing) force also on the engaged trailing side of the nose (from the tip to
+    # where it meets the previous pass); false: the earlier leading-edge-only model
+    trailing_edge: bool = True
 
 
 class CoefficientsCfg(_Strict):
@@ -308,7 +311,8 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
     return boring_process(ins, build_coefficients(cfg, source),
                           cut.depth_mm * 1e-3 if depth_m is None else depth_m,
                           cut.feed_mm_per_rev * 1e-3, overlap=cut.overlap_factor,
-                          depth_modulation=cut.depth_modulation)
+                          depth_modulation=cut.depth_modulation,
+                          trailing_edge=cut.trailing_edge)
 
 
 __all__ = ["DynamicsConfig", "load_dynamics_config", "build_structure", "build_process",

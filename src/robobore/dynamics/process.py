@@ -9,13 +9,20 @@ are three unit vectors of the boring frame:
   feed (bore axis); ``theta`` is the bar angle from X towards Y;
 * single-point cutting with fixed directions (``rotating=False``): ``B = I`` (X, Y, Z).
 
-For element ``e`` at depth of cut ``a`` (per unit depth widths ``w_e``, edge lengths ``s_e``)::
+For element ``e`` at depth of cut ``a`` (per unit depth widths ``w_e``, edge lengths ``s_e``,
+depth-independent edge lengths ``l_e``)::
 
     h_e  = p h0_e - n_e . B (r(t) - mu r_s)        (p: passes since the surface at this angle
                                                     was cut; r_s: tool displacement then)
-    F    = B^T sum_e [ shear_e h_e w_e a g + edge_e s_e a g ]     if h_e > 0, else 0
+    F    = B^T sum_e [ shear_e h_e w_e a g  (if h_e > 0)
+                       + edge_e (s_e a g + l_e)  (while the insert cuts at all) ]
     g    = max(0, 1 + dd . B r / a)                 (depth modulation against the pre-bore
                                                     surface; dd = 0 for the general case)
+
+``l_e`` (``edge_fixed_m``) is the engaged edge on the trailing side of the nose: its length is
+set by the feed (where the nose meets the previous pass), not by the depth, so it neither
+stretches with the simulated depth nor enters the depth-modulation stiffness. Those elements
+have ``h0 = w = 0``: they rub (edge force) but carry no chip and no regeneration.
 
 ``n_e`` (chip normal: a tool displacement along it REDUCES the chip), ``shear_e`` [N/m^2] and
 ``edge_e`` [N/m] are basis coordinates; forces are ON THE TOOL; ``mu`` is the overlap factor
@@ -32,6 +39,7 @@ import numpy as np
 
 from robobore.cutting.forces import CuttingCoefficients
 from robobore.cutting.geometry import BoringInsert, edge_elements
+from robobore.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -51,6 +59,20 @@ class CuttingProcess:
     feed_per_rev_m: float = 0.0
     reference_depth_m: float | None = None
     label: str = ""
+    edge_fixed_m: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        E = int(np.asarray(self.h0).size)
+        if self.edge_fixed_m is None:
+            object.__setattr__(self, "edge_fixed_m", np.zeros(E))
+        else:
+            lf = np.asarray(self.edge_fixed_m, float)
+            if lf.shape != (E,) or not np.all(np.isfinite(lf)) or np.any(lf < 0):
+                raise ConfigError("depth-independent edge lengths must be one finite length "
+                                  ">= 0 per element", field="edge_fixed_m",
+                                  value=lf.tolist() if lf.size < 10 else f"shape {lf.shape}",
+                                  expected=f"{E} lengths >= 0 in m")
+            object.__setattr__(self, "edge_fixed_m", lf)
 
     @property
     def n_elements(self) -> int:
@@ -102,7 +124,8 @@ class CuttingProcess:
         ``dF = P(theta) r`` with
         ``P = sum_p B_p^T [sum_e (w_e h0_e shear_e + s_e edge_e)] dd^T B_p`` (per unit depth
         widths ``w_e`` and edge lengths ``s_e``; it does not scale with depth: the width
-        change is the displacement itself)."""
+        change is the displacement itself). The depth-independent (trailing-side) edge
+        lengths ``edge_fixed_m`` do not change with the depth and are not in ``P``."""
         th = np.atleast_1d(np.asarray(theta, float))
         vec = (np.einsum("e,e,ei->i", self.width_per_depth, self.h0, self.shear)
                + np.einsum("e,ei->i", self.edge_per_depth, self.edge))
@@ -137,7 +160,8 @@ def single_point_process(cutting_coefficient_N_per_m2: float, force_direction: n
 def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, depth_m: float,
                    feed_per_rev_m: float, n_elements: int = 24, overlap: float = 1.0,
                    depth_modulation: bool = True,
-                   min_chip_thickness_m: float | None = None) -> CuttingProcess:
+                   min_chip_thickness_m: float | None = None,
+                   trailing_edge: bool = True) -> CuttingProcess:
     """Rotating boring bar: edge elements of ``insert`` at depth ``depth_m`` (see
     :mod:`robobore.cutting.geometry`) with the mechanistic force model
     (:mod:`robobore.cutting.forces`). Element widths scale linearly with the simulated depth
@@ -150,9 +174,20 @@ def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dept
     edge (ploughing) force but carry no shearing force and no regeneration. Near the nose tip
     the nominal thickness tends to zero, and a linear model that kept those elements fully
     engaged would overstate the regenerative gain (the time domain drops them as soon as the
-    tool vibrates)."""
+    tool vibrates).
+
+    ``trailing_edge`` (default True): the engaged trailing side of the nose (from the tip to
+    where the nose meets the previous pass, :func:`robobore.cutting.geometry.edge_elements`)
+    adds rubbing elements: ``h0 = 0``, no chip width, their edge force (``Kte``, ``Kfe`` times
+    the length, thrust normal to the local edge) on a length that does not scale with the
+    depth (``edge_fixed_m``: set by the feed at the nominal cut; the vibration does not move
+    the intersection point in this model). In the time domain they are switched with the
+    insert like the other edge forces (on while any element cuts), never on their own
+    ``h``; they add to the nominal force and the steady deflection, not to the regenerative
+    directional matrix nor to the depth-modulation stiffness."""
     fz = feed_per_rev_m / insert.n_inserts
-    el = edge_elements(insert, depth_m, fz, n_elements)
+    el = edge_elements(insert, depth_m, fz, n_elements, trailing_edge=trailing_edge)
+    trail = el.trailing
     hmin = 0.25 * insert.edge_radius_m if min_chip_thickness_m is None else min_chip_thickness_m
     shearing = el.h >= hmin
     sk, ck = np.sin(el.kappa), np.cos(el.kappa)
@@ -166,13 +201,15 @@ def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dept
     # h0: the element's nominal thickness; per unit depth widths
     return CuttingProcess(
         rotating=True, n_inserts=insert.n_inserts, h0=el.h.copy(),
-        width_per_depth=el.db / depth_m * shearing, edge_per_depth=el.dS / depth_m,
+        width_per_depth=el.db / depth_m * shearing,
+        edge_per_depth=np.where(trail, 0.0, el.dS / depth_m),
         normal=normal,
         shear=shear, edge=edge,
         depth_direction=np.array([0.0, 1.0, 0.0]) if depth_modulation else np.zeros(3),
         overlap=float(overlap), feed_per_rev_m=feed_per_rev_m, reference_depth_m=depth_m,
         label=f"boring bar, {insert.n_inserts} insert(s), nose {insert.nose_radius_m * 1e3:g} mm, "
-              f"kappa_r {insert.approach_angle_deg:g} deg")
+              f"kappa_r {insert.approach_angle_deg:g} deg",
+        edge_fixed_m=np.where(trail, el.dS, 0.0))
 
 
 def tooth_period(speed_rpm: float, n_inserts: int) -> float:

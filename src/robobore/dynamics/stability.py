@@ -280,18 +280,27 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
 
 
 def deflected_depth_weights(structure: ToolPointStructure, process: CuttingProcess,
-                            speed_rpm: float, theta: np.ndarray) -> np.ndarray | None:
+                            speed_rpm: float, theta: np.ndarray,
+                            depth_m: float | None = None) -> np.ndarray | None:
     """Actual/nominal depth of each insert along the steady deflected path, shape (n, N).
 
-    The radial deflection under the nominal force scales with the depth, so the ratio
-    ``1 + e_r . r_p / a`` does not depend on it. ``None`` for fixed-direction processes or
-    without depth modulation (no such effect)."""
+    The steady deflection is ``r(a) = a r_1 + r_0``: ``r_1`` from the force that scales with
+    the depth, ``r_0`` from the depth-independent edge force on the trailing side of the nose
+    (``process.edge_fixed_m``). The ratio ``1 + e_r . r(a) / a`` is evaluated at ``depth_m``;
+    without it (or without such edge lengths) only ``r_1`` counts, which does not depend on
+    the depth. ``None`` for fixed-direction processes or without depth modulation (no such
+    effect)."""
     if not process.rotating or not np.any(process.depth_direction):
         return None
     from robobore.dynamics.timedomain import forced_response
 
     Ns = 720
-    rp = forced_response(structure, process, speed_rpm, 1.0, Ns)  # per unit depth, (Ns,3)
+    rp = forced_response(structure, process, speed_rpm, 1.0, Ns)  # (Ns,3), a = 1 m
+    if np.any(process.edge_fixed_m):
+        r0 = forced_response(structure, process, speed_rpm, 0.0, Ns)  # fixed edge force only
+        rp = rp - r0  # per unit depth
+        if depth_m is not None and depth_m > 0.0:
+            rp = rp + r0 / depth_m
     ang = 2 * np.pi * np.arange(rp.shape[0]) / rp.shape[0]
     th = np.mod(np.atleast_1d(theta), 2 * np.pi)
     r = np.column_stack([np.interp(th, ang, rp[:, k], period=2 * np.pi) for k in range(3)])
@@ -347,7 +356,7 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
     n_th = 1 if constant else steps
     # coefficient angle at the middle of each step (delay = one insert pitch)
     theta = (np.arange(n_th) + 0.5) * dt * 2 * np.pi * speed_rpm / 60.0
-    wts = (deflected_depth_weights(structure, process, speed_rpm, theta)
+    wts = (deflected_depth_weights(structure, process, speed_rpm, theta, depth_m)
            if about_deflected else None)
     W, Pm = _modal_mats(structure, process, theta, include_process_stiffness, wts)
     mu = process.overlap

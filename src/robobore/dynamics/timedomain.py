@@ -11,9 +11,10 @@ from the surface left by the previous passes:
   (several when the tool had left the cut), so multiple inserts give the delay 1/(N n);
 * the tool leaves the cut where ``h_e <= 0``: no shearing force there, and the surface is not
   updated at an angle where no element cut (it keeps the older surface); the edge (ploughing)
-  forces act on the nominally engaged edge while the insert cuts at all and vanish when it
-  has left the cut (switching them element by element at ``h = 0`` would act as a relay and
-  sustain an artificial micro-vibration);
+  forces act on the nominally engaged edge -- including the rubbing-only elements on the
+  trailing side of the nose (``h0 = 0``, depth-independent length ``edge_fixed_m``) -- while
+  the insert cuts at all and vanish when it has left the cut (switching them element by
+  element at ``h = 0`` would act as a relay and sustain an artificial micro-vibration);
 * the modal equations are integrated by exact discretisation with the force held over the step
   (zero-order hold; unconditionally stable, exact for the free response), the force being
   evaluated with the displacement extrapolated to the step midpoint (second order in the
@@ -69,7 +70,7 @@ def modal_zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.
 
 
 @nb.njit(cache=True)
-def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, nrm, shr, edg, dd,
+def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, shr, edg, dd,
                      inv_depth, mu, om, zeta, minv, half_dt, q, qd, sr, tlast, F_out, X_out,
                      A_out, area_out, limit):  # pragma: no cover - compiled
     """Integrate ``n_steps``; returns the number of steps done (fewer when the tool-point
@@ -129,11 +130,12 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, nrm, shr, ed
                     f0 += shr[e, 0] * a
                     f1 += shr[e, 1] * a
                     f2 += shr[e, 2] * a
-                if h0[e] > 0.0:
-                    s = ds[e] * g
-                    e0 += edg[e, 0] * s
-                    e1 += edg[e, 1] * s
-                    e2 += edg[e, 2] * s
+                # engaged edge length: the leading part stretches with the actual depth,
+                # the trailing side of the nose (dsf, set by the feed) does not
+                s = ds[e] * g + dsf[e]
+                e0 += edg[e, 0] * s
+                e1 += edg[e, 1] * s
+                e2 += edg[e, 2] * s
             if area > 0.0:
                 # edge (ploughing) forces act on the nominally engaged edge while the insert
                 # is in the cut; switching them per element at h = 0 would make a relay
@@ -248,7 +250,8 @@ def periodic_start(structure: ToolPointStructure, process: CuttingProcess, Ns: i
     theta = 2 * np.pi * np.arange(Ns) / Ns
     B = process.basis(theta)  # (Ns,3,3)
     f0 = (np.einsum("e,e,ei->i", process.width_per_depth * depth_m, process.h0, process.shear)
-          + np.einsum("e,ei->i", process.edge_per_depth * depth_m, process.edge))
+          + np.einsum("e,ei->i", process.edge_per_depth * depth_m + process.edge_fixed_m,
+                      process.edge))
     F = np.zeros((Ns, 3))
     for p in range(N):
         idx = (np.arange(Ns) + p * spp) % Ns
@@ -324,7 +327,8 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     area = np.empty((n_steps, N))
     n_done = _simulate_kernel(n_steps, Ns, N, Phi, Gam,
                               np.ascontiguousarray(structure.directions), basis, process.h0, w,
-                              ds, process.normal, process.shear, process.edge,
+                              ds, np.ascontiguousarray(process.edge_fixed_m, dtype=np.float64),
+                              process.normal, process.shear, process.edge,
                               process.depth_direction, inv_depth, process.overlap,
                               structure.omega, structure.damping_ratio,
                               1.0 / structure.modal_mass, 0.5 * dt, q, qd, sr, tlast, F, X, acc,
