@@ -87,6 +87,9 @@ def main() -> None:
     ap.add_argument("--friction", type=friction, default=None,
                     help='contact.friction: a number (e.g. 0.3, the paper\'s modified Coulomb '
                          'value) or "table" (Rech et al. 2013, the default of config())')
+    ap.add_argument("--frame", choices=["workpiece", "tool"], default=None,
+                    help='mesh.frame: "tool" runs the tool-frame ALE model (--edge-um is then '
+                    'the element round the edge; the separation options are not used)')
     ap.add_argument("--save-dir", type=Path, default=None,
                     help="write each point's final state (deformed mesh, fields, node "
                     "velocities) to DIR/h<h>_vc<vc>.npz")
@@ -96,7 +99,8 @@ def main() -> None:
     if args.points:
         pts = [tuple(float(x) for x in p.split(":")) for p in args.points.split(",")]
     rows = []
-    print(f"# FE orthogonal validation: length {args.length_mm} mm, element "
+    print(f"# FE orthogonal validation: frame {args.frame or 'workpiece'}, length "
+          f"{args.length_mm} mm, element "
           f"{args.element_um} um, separation {args.separation or 'default'} "
           f"(height {args.separation_height_um} um), edge band {args.edge_um} um "
           f"({args.band_um or 'default'}), conduction {args.conduction}, erosion "
@@ -114,6 +118,8 @@ def main() -> None:
         vk = f"{vc:g}"
         t0 = time.perf_counter()
         mesh = {}
+        if args.frame is not None:
+            mesh["frame"] = args.frame
         if args.separation is not None:
             mesh["separation"] = args.separation
         if args.separation_height_um is not None:

@@ -59,21 +59,42 @@ def test_tool_gap_is_a_distance(px, py, r):
 def test_contact_law_coulomb_and_cap():
     m, dt = 1e-6, 1e-8
     # sliding fast: friction = mu * Fn, opposite to the sliding velocity
-    fx, fy, fn, ft = P.contact_force(-1e-8, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt)
+    fx, fy, fn, ft, fd = P.contact_force(-1e-8, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt,
+                                         0.0)
+    assert fd == 0.0
     assert fn == pytest.approx(0.1 * m / dt**2 * 1e-8)
     assert ft == pytest.approx(0.2 * fn) and fy == pytest.approx(fn)
     # tangent t = (-ny, nx) = (-1, 0); vt = -1 (sliding along +x) -> friction along t positive
     assert fx == pytest.approx(-0.2 * fn)
     # shear cap: tau * length below mu * Fn
-    _, _, fn2, ft2 = P.contact_force(-1e-8, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e5, 0.1, dt)
+    _, _, fn2, ft2, _ = P.contact_force(-1e-8, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e5, 0.1, dt,
+                                        0.0)
     assert 1e5 * 1e-5 < 0.2 * fn2
     assert abs(ft2) == pytest.approx(1e5 * 1e-5)
     # sticking: small slip velocity -> force stopping it in one step
-    _, _, _, ft3 = P.contact_force(-1e-8, 0.0, 1.0, 1e-9, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt)
+    _, _, _, ft3, _ = P.contact_force(-1e-8, 0.0, 1.0, 1e-9, 0.0, m, 1e-5, 0.2, 1e30, 0.1,
+                                      dt, 0.0)
     assert abs(ft3) == pytest.approx(m * 1e-9 / dt)
     # no contact
-    assert P.contact_force(1e-9, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt) == (
-        0.0, 0.0, 0.0, 0.0)
+    assert P.contact_force(1e-9, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt, 0.3) == (
+        0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_contact_damping():
+    """Viscous normal damping c = 2 zeta sqrt(k m) on the relative normal velocity (exact),
+    never adhesive: a node leaving the tool fast gets no pull (fn >= 0)."""
+    m, dt, pf, z = 1e-6, 1e-8, 0.1, 0.2
+    k = pf * m / dt**2
+    c = 2 * z * (k * m) ** 0.5
+    # approaching along -n at 0.01 m/s: the damping adds c * 0.01 to the penalty force
+    _, fy, fn, _, fd = P.contact_force(-1e-8, 0.0, 1.0, 0.0, -0.01, m, 1e-5, 0.0, 1e30, pf, dt,
+                                       z)
+    assert fd == pytest.approx(c * 0.01, rel=1e-12)
+    assert fn == pytest.approx(k * 1e-8 + c * 0.01, rel=1e-12) and fy == pytest.approx(fn)
+    # leaving at 10 m/s: the damping would pull harder than the spring pushes -> fn = 0
+    _, _, fn2, _, fd2 = P.contact_force(-1e-8, 0.0, 1.0, 0.0, 10.0, m, 1e-5, 0.0, 1e30, pf, dt,
+                                        z)
+    assert fn2 == 0.0 and fd2 == pytest.approx(-k * 1e-8)
 
 
 def test_rake_face_contact_patch():

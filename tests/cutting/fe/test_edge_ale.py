@@ -74,7 +74,9 @@ def _pass(st, max_move=0.2):
            st.snodes, st.snbr, st.xn, st.yn, st.buf, st.sdx, st.sdy, st.sdz, st.sdxy,
            st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy, st.area0, rho_s, 0.0,
            max_move, MODE_ROWS, st.tied, st.x0, st.y0, st.vbuf,
-           (1.0, 1.0, -1.0, 0.0, 0.0, -1.0, 1e-5))  # tool far away
+           (1.0, 1.0, -1.0, 0.0, 0.0, -1.0, 1e-5),  # tool far away
+           np.zeros((0, 7), np.int64), np.zeros((0, 6)), np.zeros((0, 4), np.int64), 293.0,
+           0.0)
 
 
 def _areas(st):

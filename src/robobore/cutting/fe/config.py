@@ -61,6 +61,12 @@ class ContactSection(_Strict):
     #: fraction of the frictional dissipation that heats the workpiece (chip underside and
     #: machined surface); the rest goes into the tool
     friction_heat_fraction: float = Field(default=0.5, ge=0.0, le=1.0)
+    #: viscous damping of the contact's normal penalty spring, as a fraction of its critical
+    #: damping (LS-DYNA's VDC); it damps the contact chatter, through which an explicit
+    #: penalty contact otherwise creates energy (k dg^2 / 2 a step), and its dissipation is
+    #: booked with the friction's. None: 0 for mesh.frame = "workpiece", 1 (critical) for "tool"
+    #: (whose edge-arc nodes are in contact for the whole run)
+    normal_damping: float | None = Field(default=None, ge=0.0, le=1.0)
     #: temperature of the tool [K]; None: the material's room temperature
     tool_temperature_K: float | None = Field(default=None, gt=0.0, le=3000.0)
 
@@ -103,6 +109,20 @@ class MeshSection(_Strict):
     edge_element_um: float | None = Field(default=None, gt=0.0)
     #: extent of the refined band above and below the parting line [um]
     edge_band_um: tuple[float, float] = (10.0, 10.0)
+    #: the mesh's frame: "workpiece" (Lagrangian: the mesh moves with the material, chip and
+    #: workpiece part by ``separation``) or "tool" (ALE: the mesh travels with the tool,
+    #: material flows in ahead of it and out behind the flank and through the chip's top,
+    #: no separation criterion and no erosion; see robobore.cutting.fe.toolframe). With
+    #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
+    #: round the edge (default element_size_um / 4), and the separation keys are not used
+    frame: Literal["workpiece", "tool"] = "workpiece"
+    #: tool frame: chip thickness / h of the pre-shaped chip the run starts from (the
+    #: chip's shape then follows from the flow)
+    initial_chip_ratio: float = Field(default=1.6, ge=1.0, le=5.0)
+    #: tool frame: height [um] above the tool's lowest point where the mesh's chip and
+    #: workpiece blocks meet on the edge arc (a mesh choice, not where the material divides);
+    #: None: min(edge radius, h) / 2
+    join_height_um: float | None = Field(default=None, gt=0.0)
 
     @field_validator("edge_band_um")
     @classmethod
@@ -152,6 +172,9 @@ class SolverSection(_Strict):
     #: depth [um] of the ploughed layer under the parting line that edge_ale_interval
     #: treats (rows strictly above this depth move; default: the edge band's lower part)
     edge_ale_depth_um: float = Field(default=10.0, gt=0.0)
+    #: tool frame (mesh.frame = "tool"): steps between the passes that move the mesh back
+    #: to its place in the tool's frame and remap the element state and node velocities
+    ale_interval: int = Field(default=10, ge=1, le=10**4)
     #: erode an element whose stable time step falls below this fraction of the initial
     #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
     erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
@@ -227,6 +250,8 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           expected=f"a height in um at most uncut_chip_thickness_um - "
                           f"element_size_um = {h - le:.4g} um (one element row of chip)")
     ee = cfg.mesh.edge_element_um
+    if cfg.mesh.frame == "tool":
+        return _check_tool_frame(cfg, source)
     if ee is not None:
         if cfg.mesh.separation != "node_split":
             raise ConfigError("edge refinement needs node splitting", file=source,
@@ -263,6 +288,39 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           "element", file=source, field="solver.rezone_interval",
                           value=cfg.solver.rezone_interval,
                           expected='0 with solver.element = "q4_bbar", or element "q4r"')
+    return cfg
+
+
+def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
+    """Cross-field checks of the tool-frame ALE model (mesh.frame = "tool")."""
+    le = cfg.mesh.element_size_um
+    ee = cfg.mesh.edge_element_um
+    if ee is not None and ee > le:
+        raise ConfigError("edge element larger than the element size", file=source,
+                          field="mesh.edge_element_um", value=ee,
+                          expected=f"at most mesh.element_size_um = {le:.4g} um")
+    if cfg.tool.edge_radius_um <= 0.0:
+        raise ConfigError("the tool-frame mesh wraps the cutting edge: it needs an edge "
+                          "radius", file=source, field="tool.edge_radius_um",
+                          value=cfg.tool.edge_radius_um, expected='> 0 um with mesh.frame '
+                          '= "tool"')
+    jh = cfg.mesh.join_height_um
+    r = cfg.tool.edge_radius_um
+    h = cfg.cut.uncut_chip_thickness_um
+    if jh is not None and (jh > r or jh > 0.75 * h):
+        raise ConfigError("join height off the lower front of the edge arc", file=source,
+                          field="mesh.join_height_um", value=jh,
+                          expected=f"at most the edge radius ({r:.4g} um) and 3/4 of the "
+                          f"uncut chip thickness ({0.75 * h:.4g} um)")
+    s = cfg.solver
+    for name, bad, want in (("rezone_interval", s.rezone_interval > 0, "0"),
+                            ("edge_ale_interval", s.edge_ale_interval > 0, "0"),
+                            ("element", s.element != "q4r", '"q4r"'),
+                            ("erosion", s.erosion == "everywhere", '"layer" or "none"')):
+        if bad:
+            raise ConfigError("not available with the tool-frame mesh", file=source,
+                              field=f"solver.{name}", value=getattr(s, name),
+                              expected=f'{want} with mesh.frame = "tool"')
     return cfg
 
 

@@ -65,7 +65,11 @@ P_ELEM = 37
 P_HC, P_FHEAT, P_TTOOL = 38, 39, 40
 #: node relocation of the rezoning passes (rezone.MODE_LAPLACE or rezone.MODE_ROWS)
 P_RZ_MODE = 41
-N_PRM = 42
+#: tool-frame ALE: the tool edge centre's x at the start [m] (the mesh travels with the tool)
+P_ALE_X0 = 42
+#: viscous contact damping, fraction of the contact spring's critical damping
+P_CDAMP = 43
+N_PRM = 44
 ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
@@ -583,7 +587,8 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
     ``(fx, fy, touched)``: this node's contact force on the workpiece [N/m] (``cfx[n]``,
     ``cfy[n]``) and whether it touched the tool. Contact uses positions at step n and
     velocities at n-1/2; ``cfx``/``cfy`` receive the contact force on the node [N/m]; ``fric``
-    (cumulative) the frictional dissipation, ``pen`` the current penalty energy, ``nwork``
+    (cumulative) the frictional dissipation and the contact damping's, ``pen`` the current
+    penalty energy, ``nwork``
     (cumulative) the contact work on the node [J/m]. A node left without a live element is
     retired (velocity zeroed, its kinetic energy booked in ``ero_ke``).
 
@@ -647,14 +652,18 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
     fcx = 0.0
     fcy = 0.0
     ft = 0.0
+    fd = 0.0
     vt0 = 0.0
+    vn0 = 0.0
     if gap < 0.0:
         vrx = vx[n] - tool_vx
         vry = vy[n] - tool_vy
         trib = math.sqrt(asum / nlive)
-        fcx, fcy, fn, ft = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf, dt)
+        fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
+                                             dt, prm[P_CDAMP])
         vt0 = -vrx * gny + vry * gnx
-        pen[n] = share * 0.5 * fn * (-gap)
+        vn0 = vrx * gnx + vry * gny
+        pen[n] = share * 0.5 * (fn - fd) * (-gap)
     cfx[n] = share * fcx
     cfy[n] = share * fcy
     touched = fcx != 0.0 or fcy != 0.0
@@ -670,6 +679,9 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
         nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
         vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
         fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
+        if fd != 0.0:  # contact damping: booked with the frictional dissipation
+            vn1 = (nvx - tool_vx) * gnx + (nvy - tool_vy) * gny
+            fric[n] -= share * dt * fd * 0.5 * (vn0 + vn1)
     return share * fcx, share * fcy, touched
 
 
@@ -1014,7 +1026,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
               en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
-              gps, fheat, tcq, ppair, x0, y0, vbuf):
+              gps, fheat, tcq, ppair, x0, y0, vbuf, acls, aflt, bflag):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -1044,7 +1056,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
                    sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
                    prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE], int(prm[P_RZ_MODE]), tied, x0, y0,
                    vbuf, (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX],
-                          prm[P_NFY], prm[P_R]))
+                          prm[P_NFY], prm[P_R]), acls, aflt, bflag, mat[jc.TROOM],
+                   prm[P_TCX] - prm[P_ALE_X0])
         if bbar:
             dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
                                              sdxy, pres, eps_p, temp, dmg, gps, area0, ie, fex,

@@ -7,7 +7,8 @@ Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` ver
 * :func:`tool_face_py` -- the face of the tool (rake, edge arc, flank) closest to a point;
 * :func:`tool_gap_py` -- signed distance of a point to the analytic rigid tool (rake face,
   edge-radius arc, flank with clearance) and the outward normal;
-* :func:`contact_force_py` -- penalty normal force, Coulomb friction with a shear-stress cap;
+* :func:`contact_force_py` -- penalty normal force (optionally damped), Coulomb friction with
+  a shear-stress cap;
 * :func:`tool_support_step_py` -- one central-difference step of a mass on a spring/damper.
 
 All take and return floats and allocate nothing (device-function ready; see
@@ -75,22 +76,30 @@ def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
     return d - r, dx / d, dy / d
 
 
-def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt):
+def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
+                     damping):
     """Contact force on a node touching the rigid tool [N per m of width].
 
     Normal: penalty ``Fn = pen_factor * mass / dt**2 * (-gap)`` (mass-proportional penalty,
     stable for ``pen_factor`` << 1 and independent of mass scaling: penetration under a force
-    F is F dt^2 / (pen_factor m)). Tangential: the force that would stop the relative
-    sliding velocity in one step, limited by Coulomb ``mu * Fn`` and by the shear-stress cap
-    ``tau_max * trib_len`` (the node's tributary contact length). (vrx, vry) is the node's
-    velocity relative to the tool [m/s]; mass the node's (scaled) mass [kg/m].
+    F is F dt^2 / (pen_factor m)), plus a viscous contact damping ``-c v_n`` on the relative
+    normal velocity with ``c = 2 damping sqrt(k m)`` (``damping``: fraction of the contact
+    spring's critical damping, as LS-DYNA's VDC; 0: none), the total kept >= 0 (no
+    adhesion). Tangential: the force that would stop the relative sliding velocity in one
+    step, limited by Coulomb ``mu * Fn`` and by the shear-stress cap ``tau_max * trib_len``
+    (the node's tributary contact length). (vrx, vry) is the node's velocity relative to the
+    tool [m/s]; mass the node's (scaled) mass [kg/m].
 
-    Returns ``(fx, fy, fn, ft)`` with fn >= 0 and ft the signed tangential component along
-    t = (-ny, nx). Zero for gap >= 0.
+    Returns ``(fx, fy, fn, ft, fd)`` with fn >= 0 the normal force, ft the signed tangential
+    component along t = (-ny, nx) and fd the damping part of fn. Zero for gap >= 0.
     """
     if gap >= 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    fn = pen_factor * mass / (dt * dt) * (-gap)
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    fp = pen_factor * mass / (dt * dt) * (-gap)
+    fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * (vrx * nx + vry * ny)
+    if fp + fd < 0.0:
+        fd = -fp
+    fn = fp + fd
     tx = -ny
     ty = nx
     vt = vrx * tx + vry * ty
@@ -100,7 +109,7 @@ def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_fac
         fcap = tau_max * trib_len
     fmag = fstick if fstick < fcap else fcap
     ft = -fmag if vt > 0.0 else fmag
-    return fn * nx + ft * tx, fn * ny + ft * ty, fn, ft
+    return fn * nx + ft * tx, fn * ny + ft * ty, fn, ft, fd
 
 
 def tool_support_step_py(u, v, force, k, c, m, dt):

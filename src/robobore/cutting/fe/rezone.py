@@ -45,8 +45,18 @@ from numba import njit, prange
 from robobore.cutting.fe.physics import tool_gap
 
 N_RZ_FIELDS = 11
-#: node relocation of a rezoning pass: Laplacian smoothing, or sliding along node rows
-MODE_LAPLACE, MODE_ROWS = 0, 1
+#: node relocation of a rezoning pass: Laplacian smoothing, sliding along node rows, or the
+#: tool-frame ALE (every node back to its place in the tool's frame, see
+#: :mod:`robobore.cutting.fe.toolframe`)
+MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME = 0, 1, 2
+#: tool-frame node classes (``acls[:, 0]``): interior, rigid (inflow face, bottom), on a
+#: surface chain (free or against the tool), chain end on an outflow line, on an outflow face
+TF_INTERIOR, TF_RIGID, TF_CHAIN, TF_LINE, TF_FACE = 0, 1, 2, 3, 4
+#: flux through an element edge on the outline (``bflag``): none, virgin material flowing
+#: in (inflow face), open (outflow; a backflow brings the element's own state)
+BF_CLOSED, BF_VIRGIN, BF_OPEN = 0, 1, 2
+#: Jacobi sweeps of the mesh-displacement interpolation per tool-frame pass
+TF_SWEEPS = 4
 
 
 def smoothing_stencil(mesh) -> tuple[np.ndarray, np.ndarray]:
@@ -234,24 +244,170 @@ def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
     yn[n] = py
 
 
+
+@njit(cache=True, inline="always")
+def _limit(px, py, tx, ty, lim):
+    """``(tx, ty)`` moved back towards ``(px, py)`` so that the move is at most ``lim``."""
+    dx = tx - px
+    dy = ty - py
+    d = np.sqrt(dx * dx + dy * dy)
+    if d > lim > 0.0:
+        return px + dx * lim / d, py + dy * lim / d
+    return tx, ty
+
+
+@njit(cache=True, inline="always")
+def _off_tool(px, py, qx, qy, tg):
+    """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
+    ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
+    slides along a chord wrapped round the edge adds no penalty energy."""
+    g0, _a, _b = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+    g1, n1x, n1y = tool_gap(qx, qy, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+    gt = min(g0, 0.0)
+    if g1 < gt:
+        return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
+    return qx, qy
+
+
+@njit(parallel=True, cache=True)
+def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scratch):
+    """MODE_TOOLFRAME: new node positions ``xn``, ``yn`` (see
+    :mod:`robobore.cutting.fe.toolframe`). ``x0``, ``y0`` are the nodes' places in the tool
+    frame at the start (the tool's edge centre then at x = its current x - ``off``);
+    ``acls``/``aflt`` the classes, neighbours, face fractions, line directions, local sizes
+    and the mesh displacement carried from pass to pass (``aflt[:, 4:6]``, updated);
+    ``scratch`` (n, 2) work array.
+    """
+    nn = x.shape[0]
+    # 1. rigid nodes, surface chains and the chain ends on the outflow lines
+    for n in prange(nn):
+        c = acls[n, 0]
+        px = x[n]
+        py = y[n]
+        qx = x0[n] + off
+        qy = y0[n]
+        if c == TF_RIGID:
+            xn[n] = qx
+            yn[n] = qy
+        elif c == TF_CHAIN:
+            a = acls[n, 1]
+            b = acls[n, 2]
+            tx = px
+            ty = py
+            best = (qx - px) ** 2 + (qy - py) ** 2
+            la = np.sqrt((x[a] - px) ** 2 + (y[a] - py) ** 2)
+            lb = np.sqrt((x[b] - px) ** 2 + (y[b] - py) ** 2)
+            for k in range(2):
+                m = a if k == 0 else b
+                ex = x[m] - px
+                ey = y[m] - py
+                l2 = ex * ex + ey * ey
+                if l2 <= 0.0:
+                    continue
+                t = ((qx - px) * ex + (qy - py) * ey) / l2
+                if t <= 0.0:
+                    continue
+                t = min(t, 1.0)
+                sx = px + t * ex
+                sy = py + t * ey
+                d = (qx - sx) ** 2 + (qy - sy) ** 2
+                if d < best:
+                    best = d
+                    tx = sx
+                    ty = sy
+            tx, ty = _limit(px, py, tx, ty, max_move * min(la, lb))
+            tx, ty = _off_tool(px, py, tx, ty, tg)
+            xn[n] = tx
+            yn[n] = ty
+        elif c == TF_LINE:
+            # where the surface (its last segment, extended) crosses the line through the
+            # node's tool-frame place along aflt[n, 1:3], at most aflt[n, 0] from that place
+            a = acls[n, 1]
+            ex = px - x[a]
+            ey = py - y[a]
+            dx = aflt[n, 1]
+            dy = aflt[n, 2]
+            cr = ex * dy - ey * dx
+            le = np.sqrt(ex * ex + ey * ey)
+            if abs(cr) > 0.05 * le:
+                t = ((qx - x[a]) * dy - (qy - y[a]) * dx) / cr
+                tx = x[a] + t * ex
+                ty = y[a] + t * ey
+                s = (tx - qx) * dx + (ty - qy) * dy
+            else:  # surface nearly along the line: project onto it
+                s = (px - qx) * dx + (py - qy) * dy
+            # at most aflt[n, 0] along the line from the node's place
+            s = max(-aflt[n, 0], min(aflt[n, 0], s))
+            tx = qx + s * dx
+            ty = qy + s * dy
+            tx, ty = _limit(px, py, tx, ty, max_move * le)
+            tx, ty = _off_tool(px, py, tx, ty, tg)
+            xn[n] = tx
+            yn[n] = ty
+    # 2. outflow faces between their (now placed) ends
+    for n in prange(nn):
+        if acls[n, 0] == TF_FACE:
+            a = acls[n, 1]
+            b = acls[n, 2]
+            f = aflt[n, 0]
+            xn[n] = xn[a] + f * (xn[b] - xn[a])
+            yn[n] = yn[a] + f * (yn[b] - yn[a])
+    # 3. mesh displacement: boundary values, then Jacobi sweeps of the interior
+    for n in prange(nn):
+        if acls[n, 0] != TF_INTERIOR:
+            aflt[n, 4] = xn[n] - x0[n] - off
+            aflt[n, 5] = yn[n] - y0[n]
+    for _sweep in range(TF_SWEEPS):
+        for n in prange(nn):
+            if acls[n, 0] != TF_INTERIOR:
+                continue
+            sx = 0.0
+            sy = 0.0
+            for k in range(4):
+                m = acls[n, 3 + k]
+                sx += aflt[m, 4]
+                sy += aflt[m, 5]
+            scratch[n, 0] = 0.25 * sx
+            scratch[n, 1] = 0.25 * sy
+        for n in prange(nn):
+            if acls[n, 0] == TF_INTERIOR:
+                aflt[n, 4] = scratch[n, 0]
+                aflt[n, 5] = scratch[n, 1]
+    for n in prange(nn):
+        if acls[n, 0] == TF_INTERIOR:
+            tx, ty = _limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
+                            max_move * aflt[n, 3])
+            xn[n] = tx
+            yn[n] = ty
+
+
 @njit(parallel=True, cache=True)
 def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
            sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s, omega,
-           max_move, mode, tied, x0, y0, vbuf, tg):
+           max_move, mode, tied, x0, y0, vbuf, tg, acls, aflt, bflag, t_room, off):
     """One relocation + remap pass (see module docstring). ``mode``: MODE_LAPLACE (``omega``
     the relaxation) or MODE_ROWS (``tied``, ``x0``, ``y0``: pair state and initial
     positions of the nodes).
     ``xn``, ``yn`` (n_nodes,) and ``buf`` (n_elem, N_RZ_FIELDS) are work arrays. Returns
     the number of nodes moved. ``vbuf`` (n_nodes, 2) is scratch for the velocity
     increments (all computed from the old velocities before any is applied); ``tg`` the
-    tool geometry for MODE_ROWS (see :func:`_row_move`)."""
+    tool geometry for MODE_ROWS and MODE_TOOLFRAME (see :func:`_row_move`).
+
+    MODE_TOOLFRAME (:func:`toolframe_targets`): ``acls``, ``aflt`` the node classes and data,
+    ``off`` the tool's x travel since the start [m]; ``snodes`` are the nodes whose velocity
+    is remapped (all but the rigid ones). ``bflag`` (n_elem, 4), any mode with
+    ``bflag.shape[0] > 0``: flux type of each outline edge (BF_*): virgin material at
+    ``t_room`` [K] flows in through BF_VIRGIN edges, material leaves through BF_VIRGIN and
+    BF_OPEN edges (and comes back through BF_OPEN ones with the element's own state)."""
     nn = x.shape[0]
     ne = conn.shape[0]
     for n in prange(nn):
         xn[n] = x[n]
         yn[n] = y[n]
     # 1. new positions of movable nodes
-    for k in prange(snodes.shape[0]):
+    if mode == MODE_TOOLFRAME:
+        toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, vbuf)
+    for k in prange(snodes.shape[0] if mode != MODE_TOOLFRAME else 0):
         n = snodes[k]
         ok = True
         for q in range(ptr[n], ptr[n + 1]):
@@ -308,12 +464,23 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
             if sw == 0.0:
                 continue
             nb = np.int64(enbr[e, kk])
-            if nb < 0 or alive[nb] != 1:
+            if nb < 0:
+                # an outline edge carries a flux only where bflag opens it
+                if bflag.shape[0] == 0 or bflag[e, kk] == BF_CLOSED:
+                    continue
+                a_new += sw
+                if sw > 0.0 and bflag[e, kk] == BF_VIRGIN:
+                    c6 += sw * t_room  # virgin: no stress, strain, damage; A0 = A
+                    c10 += sw
+                    continue
+                u = np.int64(e)  # outflow (or backflow through an open face): own state
+            elif alive[nb] != 1:
                 continue
-            a_new += sw
-            u = np.int64(e)
-            if sw > 0.0:
-                u = nb
+            else:
+                a_new += sw
+                u = np.int64(e)
+                if sw > 0.0:
+                    u = nb
             iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
             au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
                         + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))

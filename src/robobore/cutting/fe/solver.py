@@ -22,7 +22,9 @@ from robobore.cutting.fe.config import FEConfig
 from robobore.cutting.fe.mesh import CuttingMesh, build_edge_refined_mesh, build_mesh
 from robobore.cutting.fe.rezone import (
     MODE_ROWS,
+    MODE_TOOLFRAME,
     N_RZ_FIELDS,
+    TF_RIGID,
     edge_neighbours,
     row_stencil,
     smoothing_stencil,
@@ -103,6 +105,12 @@ class FEState:
     ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: rezoning: velocity increments of the moved nodes (n_nodes, 2), scratch
     vbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: tool-frame ALE (``mesh.frame = "tool"``, robobore.cutting.fe.toolframe): node classes
+    #: and neighbours (n, 7), node data (n, 6), flux type of each element edge (e, 4); empty
+    #: for the Lagrangian models
+    acls: np.ndarray = field(default=None)  # type: ignore[assignment]
+    aflt: np.ndarray = field(default=None)  # type: ignore[assignment]
+    bflag: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -113,7 +121,7 @@ class FEState:
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
                 self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
-                self.ppair, self.x0, self.y0, self.vbuf)
+                self.ppair, self.x0, self.y0, self.vbuf, self.acls, self.aflt, self.bflag)
 
     @property
     def n_elements(self) -> int:
@@ -206,7 +214,8 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
               else (np.asarray(twin) >= 0).astype(np.int64)),
         tbuf=z((ne, 4)),
         gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)),
-        fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)))
+        fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)),
+        acls=np.zeros((0, 7), np.int64), aflt=z((0, 6)), bflag=np.zeros((0, 4), np.int64))
     init_forces(st)
     return st
 
@@ -335,6 +344,9 @@ class CuttingSetup:
     t_end: float
     t_contact: float
     mu: float
+    #: tool edge centre x [m] at which the cut length is 0 (the cut position of a sample is
+    #: this minus the edge centre's x)
+    x_cut_start: float = math.nan
 
 
 def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
@@ -386,7 +398,22 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     rake = math.radians(cfg.tool.rake_deg)
     clr = math.radians(cfg.tool.clearance_deg)
     cm = cfg.mesh
-    if cm.edge_element_um is not None:
+    tool_frame = cm.frame == "tool"
+    if tool_frame:
+        from robobore.cutting.fe.toolframe import build_toolframe_mesh
+
+        ee = (cm.element_size_um / 4.0 if cm.edge_element_um is None else cm.edge_element_um)
+        try:
+            mesh = build_toolframe_mesh(
+                h, r, rake, clr, element_size=le, edge_size=ee * 1e-6,
+                chip_ratio=cm.initial_chip_ratio,
+                join_height=None if cm.join_height_um is None else cm.join_height_um * 1e-6)
+        except ValueError as exc:
+            raise ConfigError(str(exc), file=source, field="mesh.initial_chip_ratio",
+                              value=cm.initial_chip_ratio,
+                              expected="a larger initial chip ratio (the chip's root must "
+                              "lie ahead of the edge)") from exc
+    elif cm.edge_element_um is not None:
         try:
             mesh = build_edge_refined_mesh(
                 h, le, L, split_height=_split_height(cfg) or 0.0,
@@ -411,16 +438,25 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p[K.P_MU] = mu
     p[K.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K.P_PEN] = cfg.contact.penalty_factor
+    nd = cfg.contact.normal_damping
+    p[K.P_CDAMP] = (1.0 if cm.frame == "tool" else 0.0) if nd is None else nd
     p[K.P_R] = r
     p[K.P_NRX], p[K.P_NRY] = -math.cos(rake), math.sin(rake)
     p[K.P_NFX], p[K.P_NFY] = math.sin(clr), -math.cos(clr)
     p[K.P_VC] = vc
     p[K.P_WIDTH] = cfg.cut.width_mm * 1e-3
-    gap0 = 0.5 * le
-    cx0 = mesh.length + r + gap0
-    cy0 = -h + r
-    t_contact = gap0 / vc
-    t_end = (L + r + gap0) / vc
+    if tool_frame:
+        cx0, cy0 = mesh.tool_center  # the mesh starts round the tool
+        t_contact = 0.0
+        t_end = L / vc
+        x_cut_start = cx0
+    else:
+        gap0 = 0.5 * le
+        cx0 = mesh.length + r + gap0
+        cy0 = -h + r
+        t_contact = gap0 / vc
+        t_end = (L + r + gap0) / vc
+        x_cut_start = mesh.length + r
     p[K.P_SAMPLE_DT] = t_end / s.n_samples
     ts = cfg.tool_support
     if ts is not None:
@@ -443,8 +479,22 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_GATE] = s.separation_gate_um * 1e-6
     elif cfg.mesh.separation == "node_split":
         p[K.P_GATE] = 0.0  # pairs part when they touch the tool
-    st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, layer=mesh.layer,
-                    n_samples=s.n_samples, tool_center=(cx0, cy0), twin=mesh.twin)
+    if tool_frame:
+        # no separation, no erosion (the mesh does not move with the material, and a hole
+        # would have no flux rule); the ALE pass every solver.ale_interval steps
+        p[K.P_EROSION] = K.ERODE_NONE
+        p[K.P_DT_ERODE] = 0.0
+        p[K.P_GATE] = -1.0
+        p[K.P_RZ_EVERY] = s.ale_interval
+        p[K.P_RZ_MODE] = MODE_TOOLFRAME
+        p[K.P_ALE_X0], p[K.P_TCX], p[K.P_TCY] = cx0, cx0, cy0
+    st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p,
+                    layer=getattr(mesh, "layer", None), n_samples=s.n_samples,
+                    tool_center=(cx0, cy0), twin=getattr(mesh, "twin", None))
+    if tool_frame:
+        st.acls, st.aflt, st.bflag = mesh.acls.copy(), mesh.aflt.copy(), mesh.bflag.copy()
+        st.snodes = np.where(mesh.acls[:, 0] != TF_RIGID)[0].astype(np.int64)
+        st.snbr = np.zeros((st.snodes.size, 6), np.int64)
     if s.rezone_interval > 0:
         st.snodes, st.snbr = smoothing_stencil(mesh)
     if s.edge_ale_interval > 0:
@@ -458,7 +508,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                                   value=k, expected=f"k < {0.25 * m / dt**2:.3g} N/m for "
                                   f"mass {m} kg and time step {dt:.3g} s")
     return CuttingSetup(cfg=cfg, material=mat, mesh=mesh, state=st, h=h, vc=vc, rake=rake,
-                        t_end=t_end, t_contact=t_contact, mu=mu)
+                        t_end=t_end, t_contact=t_contact, mu=mu, x_cut_start=x_cut_start)
 
 
 def energy_error(en: np.ndarray) -> float:
@@ -477,6 +527,10 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
     if device not in ("cpu", "gpu"):
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
+    if device == "gpu" and cfg.mesh.frame == "tool":
+        raise ConfigError("the tool-frame ALE model runs on the CPU only", file=source,
+                          field="--device", value=device,
+                          expected='cpu with mesh.frame = "tool"')
     if device == "gpu":
         from robobore.cutting.fe.gpu import require_gpu
         from robobore.cutting.fe.gpu2d import check_gpu_supported
@@ -566,10 +620,16 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     win = steady_window(t, t0w, setup.t_end + 1e-12)
     fc = hh[:, K.H_FX] * 1e-3
     ff = hh[:, K.H_FY] * 1e-3
-    x_tip_start = setup.mesh.length
-    cut_pos_mm = (x_tip_start - hh[:, K.H_TIP_X] + cfg.tool.edge_radius_um * 1e-6) * 1e3
-    chip = measure_chip(st, setup.mesh, setup.h, setup.rake, setup.vc)
-    r_vel, n_vel = chip_ratio_from_velocity(st, setup.mesh, setup.h, setup.rake, setup.vc)
+    cut_pos_mm = (setup.x_cut_start - hh[:, K.H_TIP_X]) * 1e3
+    if cfg.mesh.frame == "tool":
+        from robobore.cutting.fe.toolframe import measure_chip_toolframe
+
+        chip, r_vel, n_vel = measure_chip_toolframe(st, setup.mesh, setup.h, setup.rake,
+                                                    setup.vc)
+    else:
+        chip = measure_chip(st, setup.mesh, setup.h, setup.rake, setup.vc)
+        r_vel, n_vel = chip_ratio_from_velocity(st, setup.mesh, setup.h, setup.rake,
+                                                setup.vc)
     en = st.en
     n_el = st.n_elements
     summary: dict[str, Any] = {
