@@ -167,7 +167,8 @@ def main() -> None:
                    friction=s["friction_coefficient"],
                    eroded_distortion=s.get("eroded_distortion"),
                    eroded_chip_mass_fraction=s.get("eroded_chip_mass_fraction"),
-                   peak_temperature_K=s.get("peak_temperature_K"))
+                   peak_temperature_K=s.get("peak_temperature_K"),
+                   force_by_face_N_per_mm=s.get("force_by_face_N_per_mm"))
         rows.append(row)
         print(f"{h:5.0f} {vc:4.0f} | {fc_m:7.1f} {row['Fc_sim']:7.1f} {efc:6.1f} | {ff_m:7.1f} "
               f"{row['Ff_sim']:7.1f} {eff:6.1f} | {r_m:6.2f} {row['chip_ratio_sim']:6.2f} "
