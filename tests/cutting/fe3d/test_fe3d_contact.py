@@ -47,7 +47,7 @@ def test_contact_force3_hand_calculation():
                                             1e9, pf, dt)
     assert ft3 == pytest.approx(1e9 * 1e-12)
     # 2D equivalence in the x-y plane
-    f2 = contact_force_py(-1e-7, 0.6, 0.8, 0.3, -0.2, m, 1.0, mu, 1e30, pf, dt)
+    f2 = contact_force_py(-1e-7, 0.6, 0.8, 0.3, -0.2, m, 1.0, mu, 1e30, pf, dt, 0.0)
     f3 = K3.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt)
     assert f3[0] == pytest.approx(f2[0]) and f3[1] == pytest.approx(f2[1]) and f3[2] == 0.0
 

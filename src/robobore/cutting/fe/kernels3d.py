@@ -9,7 +9,8 @@ New scalar functions, written in the same device-ready style (``_py`` original +
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
 * :func:`contact_force3_py` -- the 2D contact law (:func:`physics.contact_force_py`: mass-
-  proportional penalty, Coulomb friction, shear-stress cap) with a tangential *vector*;
+  proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
+  tangential *vector*;
 * :func:`hex_node_py` -- gather, contact and central-difference update of one node.
 
 Energy indices, status codes and the energy-balance definition are the 2D engine's

@@ -39,8 +39,23 @@ def _graded(length: float, h0: float, ratio: float) -> np.ndarray:
     return np.array(sizes)
 
 
+class QuadMeshSizes:
+    """``n_nodes`` and ``n_elements`` of a mesh with ``nodes`` (n, 2) and ``conn`` (e, 4)."""
+
+    nodes: np.ndarray
+    conn: np.ndarray
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.conn.shape[0])
+
+
 @dataclass(frozen=True)
-class CuttingMesh:
+class CuttingMesh(QuadMeshSizes):
     """Quad mesh: ``nodes`` (n_nodes, 2) [m], ``conn`` (n_elem, 4) counter-clockwise.
 
     ``layer`` (n_elem,) bool: separation-layer elements; ``chip`` (n_elem,) bool: elements
@@ -74,14 +89,6 @@ class CuttingMesh:
         if self.twin is None:
             return None
         return (self.twin >= 0) & (self.twin < np.arange(self.twin.size))
-
-    @property
-    def n_nodes(self) -> int:
-        return int(self.nodes.shape[0])
-
-    @property
-    def n_elements(self) -> int:
-        return int(self.conn.shape[0])
 
 
 def build_mesh(h: float, le: float, cut_length: float, *, ahead: float = 0.3e-3,

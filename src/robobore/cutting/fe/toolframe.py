@@ -55,6 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.mesh import QuadMeshSizes
 from robobore.cutting.fe.output import ChipGeometry, _point_polyline_distance, shear_angle_deg
 from robobore.cutting.fe.rezone import (
     BF_OPEN,
@@ -68,7 +69,7 @@ from robobore.cutting.fe.rezone import (
 
 
 @dataclass
-class ToolFrameMesh:
+class ToolFrameMesh(QuadMeshSizes):
     """Quad mesh (``nodes`` (n, 2) [m], ``conn`` (e, 4) counter-clockwise) of the tool-frame
     model with its ALE data: ``acls`` (n, 7) int = class, two surface/face neighbours, four
     edge neighbours (-1 pad); ``aflt`` (n, 6) = face fraction (outflow-face nodes) or the
@@ -95,14 +96,6 @@ class ToolFrameMesh:
     h: float
     edge_size: float
     element_size: float
-
-    @property
-    def n_nodes(self) -> int:
-        return int(self.nodes.shape[0])
-
-    @property
-    def n_elements(self) -> int:
-        return int(self.conn.shape[0])
 
 
 def _graded_steps(length: float, first: float, largest: float, ratio: float) -> np.ndarray:
