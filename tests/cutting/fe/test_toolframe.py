@@ -110,8 +110,7 @@ def test_remap_open_boundaries_balance_mass():
     assert np.allclose(st.x[rigid] - x_old[rigid], off, atol=1e-15)
     # nodes on the horizontal surfaces (free surface ahead, machined surface behind) slide
     # along them by the tool's travel (a surface node moves only along its surface)
-    flat = np.concatenate([st_nodes for st_nodes in (su.mesh.machined_nodes[-5:-1],
-                                                     su.mesh.chip_top_nodes[1:4])])
+    flat = np.concatenate((su.mesh.machined_nodes[-5:-1], su.mesh.chip_top_nodes[1:4]))
     assert np.allclose(st.x[flat] - x_old[flat], off, atol=1e-15)
     swept_in = swept_out = 0.0
     for e in range(st.conn.shape[0]):

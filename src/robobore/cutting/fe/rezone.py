@@ -177,6 +177,30 @@ def _swept(ax0, ay0, bx0, by0, ax1, ay1, bx1, by1):
 
 
 @njit(cache=True, inline="always")
+def _limit(px, py, tx, ty, lim):
+    """``(tx, ty)`` moved back towards ``(px, py)`` so that the move is at most ``lim``."""
+    dx = tx - px
+    dy = ty - py
+    d = np.sqrt(dx * dx + dy * dy)
+    if d > lim:
+        return px + dx * lim / d, py + dy * lim / d
+    return tx, ty
+
+
+@njit(cache=True, inline="always")
+def _off_tool(px, py, qx, qy, tg):
+    """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
+    ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
+    slides along a chord wrapped round the edge adds no penalty energy."""
+    g0, _a, _b = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+    g1, n1x, n1y = tool_gap(qx, qy, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+    gt = min(g0, 0.0)
+    if g1 < gt:
+        return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
+    return qx, qy
+
+
+@njit(cache=True, inline="always")
 def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
     """MODE_ROWS: move node ``n`` of the ploughed layer back towards its column.
 
@@ -202,16 +226,9 @@ def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
     if bt >= 0:
         up, dn = snbr[k, 4], snbr[k, 5]
         hv = min(abs(y[up] - y[n]), abs(y[dn] - y[n]))
-        lim = max_move * min(min(hl, hr), hv)
         f = (y0[pc] - y0[n]) / (y0[pc] - y0[bt])
-        dx = x0[n] - x[n]
-        dy = y[pc] + f * (y[bt] - y[pc]) - y[n]
-        d = np.sqrt(dx * dx + dy * dy)
-        if d > lim:
-            dx *= lim / d
-            dy *= lim / d
-        xn[n] = x[n] + dx
-        yn[n] = y[n] + dy
+        xn[n], yn[n] = _limit(x[n], y[n], x0[n], y[pc] + f * (y[bt] - y[pc]),
+                              max_move * min(min(hl, hr), hv))
         return
     lim = max_move * min(hl, hr)
     dx = x0[n] - x[n]
@@ -234,39 +251,35 @@ def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
     px = x[n] + dx
     py = y[n] + dy
     if pc == n:
-        g0, _n0x, _n0y = tool_gap(x[n], y[n], tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
-        g1, n1x, n1y = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
-        gt = min(g0, 0.0)
-        if g1 < gt:
-            px += (gt - g1) * n1x
-            py += (gt - g1) * n1y
+        px, py = _off_tool(x[n], y[n], px, py, tg)
     xn[n] = px
     yn[n] = py
 
 
-
-@njit(cache=True, inline="always")
-def _limit(px, py, tx, ty, lim):
-    """``(tx, ty)`` moved back towards ``(px, py)`` so that the move is at most ``lim``."""
-    dx = tx - px
-    dy = ty - py
-    d = np.sqrt(dx * dx + dy * dy)
-    if d > lim > 0.0:
-        return px + dx * lim / d, py + dy * lim / d
-    return tx, ty
-
-
-@njit(cache=True, inline="always")
-def _off_tool(px, py, qx, qy, tg):
-    """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
-    ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
-    slides along a chord wrapped round the edge adds no penalty energy."""
-    g0, _a, _b = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
-    g1, n1x, n1y = tool_gap(qx, qy, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
-    gt = min(g0, 0.0)
-    if g1 < gt:
-        return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
-    return qx, qy
+@njit(parallel=True, cache=True)
+def _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode, tied, x0,
+              y0, tg):
+    """MODE_LAPLACE / MODE_ROWS: new positions of the nodes ``snodes`` whose elements are all
+    alive (Laplacian smoothing with relaxation ``omega``, or :func:`_row_move`)."""
+    for k in prange(snodes.shape[0]):
+        n = snodes[k]
+        ok = True
+        for q in range(ptr[n], ptr[n + 1]):
+            if alive[nel[q]] != 1:
+                ok = False
+        if not ok:
+            continue
+        if mode == MODE_ROWS:
+            _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg)
+            continue
+        ax = 0.25 * (x[snbr[k, 0]] + x[snbr[k, 1]] + x[snbr[k, 2]] + x[snbr[k, 3]])
+        ay = 0.25 * (y[snbr[k, 0]] + y[snbr[k, 1]] + y[snbr[k, 2]] + y[snbr[k, 3]])
+        # limit by the local size (mean distance to the neighbours)
+        h = 0.0
+        for j in range(4):
+            h += np.sqrt((x[snbr[k, j]] - x[n]) ** 2 + (y[snbr[k, j]] - y[n]) ** 2)
+        xn[n], yn[n] = _limit(x[n], y[n], x[n] + omega * (ax - x[n]),
+                              y[n] + omega * (ay - y[n]), max_move * 0.25 * h)
 
 
 @njit(parallel=True, cache=True)
@@ -407,32 +420,9 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
     # 1. new positions of movable nodes
     if mode == MODE_TOOLFRAME:
         toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, vbuf)
-    for k in prange(snodes.shape[0] if mode != MODE_TOOLFRAME else 0):
-        n = snodes[k]
-        ok = True
-        for q in range(ptr[n], ptr[n + 1]):
-            if alive[nel[q]] != 1:
-                ok = False
-        if not ok:
-            continue
-        if mode == MODE_ROWS:
-            _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg)
-            continue
-        ax = 0.25 * (x[snbr[k, 0]] + x[snbr[k, 1]] + x[snbr[k, 2]] + x[snbr[k, 3]])
-        ay = 0.25 * (y[snbr[k, 0]] + y[snbr[k, 1]] + y[snbr[k, 2]] + y[snbr[k, 3]])
-        dx = omega * (ax - x[n])
-        dy = omega * (ay - y[n])
-        # limit by the local size (mean distance to the neighbours)
-        h = 0.0
-        for j in range(4):
-            h += np.sqrt((x[snbr[k, j]] - x[n]) ** 2 + (y[snbr[k, j]] - y[n]) ** 2)
-        h *= 0.25
-        d = np.sqrt(dx * dx + dy * dy)
-        if d > max_move * h:
-            dx *= max_move * h / d
-            dy *= max_move * h / d
-        xn[n] = x[n] + dx
-        yn[n] = y[n] + dy
+    else:
+        _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode, tied,
+                  x0, y0, tg)
     # 2. element fluxes into buf (old geometry x, y -> new geometry xn, yn)
     for e in prange(ne):
         for f in range(N_RZ_FIELDS):

@@ -76,7 +76,10 @@ class ToolFrameMesh(QuadMeshSizes):
     longest slide along the line (chain ends), line direction (2), reference local size,
     mesh displacement (2); ``bflag`` (e, 4) flux type of each element edge;
     ``fixed`` (n,) nodes held in x and y (inflow face, bottom); ``chip`` (e,) block B.
-    ``tool_center`` (cx, cy) [m] and the chip's outflow face (two points) for the outputs.
+    ``tool_center`` (cx, cy) [m] at the start; for the outputs the node lists of the chip's
+    free surface (``chip_top_nodes``, inflow -> chip top), its underside along the tool
+    (``chip_under_nodes``, join point -> chip top), the chip's top face (``outflow_nodes``,
+    rake side first) and the machined surface (``machined_nodes``, join point -> back face).
     """
 
     nodes: np.ndarray
@@ -87,8 +90,6 @@ class ToolFrameMesh(QuadMeshSizes):
     aflt: np.ndarray
     bflag: np.ndarray
     tool_center: tuple[float, float]
-    outflow_rake: np.ndarray
-    outflow_free: np.ndarray
     chip_top_nodes: np.ndarray
     chip_under_nodes: np.ndarray
     outflow_nodes: np.ndarray
@@ -227,8 +228,7 @@ def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
     nb = bot_b.shape[0] - 1
     # rows of block B: uniform-ish, first row at ~edge size on the tool side
     n_jb = max(6, int(math.ceil(tc / (0.5 * (fine + coarse)))) + 2)
-    w = _graded_steps(1.0, fine / tc, 1.0 / (n_jb - 3), ratio)
-    eta_b = w
+    eta_b = _graded_steps(1.0, fine / tc, 1.0 / (n_jb - 3), ratio)
     jb = eta_b.size - 1
     # ---- assemble nodes: block A (i = 0..na, j = 0..ja), then block B rows j >= 1
     nodes = []
@@ -256,7 +256,6 @@ def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
             idx_b[i, j] = len(nodes)
             nodes.append((p[0], p[1]))
     nodes = np.array(nodes, np.float64)
-    # shared node S and the bottom of block B at the rake side lie on the tool: exact
     n_nodes = nodes.shape[0]
     conn = []
     chip = []
@@ -331,10 +330,9 @@ def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
         for k, m in enumerate(lst[:4]):
             acls[n, 3 + k] = m
         aflt[n, 3] = min(float(np.hypot(*(nodes[m] - nodes[n]))) for m in lst)
-    # outputs: the chip's top-face ends, the free chip surface and the machined surface
     return ToolFrameMesh(
         nodes=nodes, conn=conn, fixed=fixed, chip=chip, acls=acls, aflt=aflt, bflag=bflag,
-        tool_center=(cx, cy), outflow_rake=Ob, outflow_free=Ot,
+        tool_center=(cx, cy),
         chip_top_nodes=idx_b[:, jb].copy(), chip_under_nodes=idx_b[n1:, 0].copy(),
         outflow_nodes=idx_b[nb, :].copy(), machined_nodes=idx_a[i_s:, ja].copy(), h=h,
         edge_size=edge_size, element_size=element_size)
