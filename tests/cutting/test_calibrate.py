@@ -134,6 +134,10 @@ def test_grid_is_cached(tmp_path, monkeypatch):
     assert r2["coefficients"] == r1["coefficients"]
     cal.calibrate_forces(_cfg(fe={"length_mm": 0.5}), cache=cache)
     assert len(calls) == 8
+    # a new engine revision (physics changed) does not reuse the old engine's forces
+    monkeypatch.setattr(cal, "FE_ENGINE_REVISION", cal.FE_ENGINE_REVISION + 1)
+    r3 = cal.calibrate_forces(cfg, cache=cache)
+    assert len(calls) == 12 and r3["fe_cached_points"] == 0
 
 
 def test_bad_config_names_field():

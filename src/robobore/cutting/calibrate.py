@@ -176,12 +176,19 @@ def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+#: revision of the FE engine's physics in the cache key: bump it whenever a change of the
+#: engine changes its results for the same config, so that cached FE forces of the old engine
+#: are not reused. 2: the contact's stick/slip return mapping on the trial velocity (2026-11-22)
+FE_ENGINE_REVISION = 2
+
+
 def fe_cache_inputs(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     """Cache key inputs: the full FE config after defaults (a changed default changes the
-    key)."""
+    key) and :data:`FE_ENGINE_REVISION`."""
     from robobore.cutting.fe.config import parse_config
 
-    return {"fe_config": parse_config(fe_cfg).model_dump(mode="json")}
+    return {"fe_config": parse_config(fe_cfg).model_dump(mode="json"),
+            "engine_revision": FE_ENGINE_REVISION}
 
 
 def _limit_numba_threads(n: int) -> None:
@@ -378,6 +385,7 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
         "grid": {"uncut_chip_thickness_um": cfg.uncut_chip_thickness_um,
                  "cutting_speed_m_per_min": cfg.cutting_speed_m_per_min},
         "robobore_version": __version__,
+        "fe_engine_revision": FE_ENGINE_REVISION,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
 

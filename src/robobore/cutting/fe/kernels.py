@@ -660,7 +660,7 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
         vry = vy[n] - tool_vy
         trib = math.sqrt(asum / nlive)
         fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
-                                             dt, prm[P_CDAMP])
+                                             dt, prm[P_CDAMP], fx, fy)
         vt0 = -vrx * gny + vry * gnx
         vn0 = vrx * gnx + vry * gny
         pen[n] = share * 0.5 * (fn - fd) * (-gap)

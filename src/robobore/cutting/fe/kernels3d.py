@@ -193,14 +193,16 @@ def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
 
 
 def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_max, pen_factor,
-                      dt):
+                      dt, fox, foy, foz):
     """Contact force on a node touching the rigid insert [N] (3D form of the 2D law).
 
     Normal: penalty ``Fn = pen_factor * mass / dt^2 * (-gap)`` (as
-    :func:`physics.contact_force_py`). Tangential: the force that stops the relative sliding
-    velocity (vector ``v_r - (v_r.n) n``) in one step, limited by Coulomb ``mu Fn`` and by the
-    shear cap ``tau_max * trib_area`` (the node's tributary contact area [m^2]), opposite
-    to the sliding direction. ``(vrx, vry, vrz)`` node velocity relative to the tool [m/s].
+    :func:`physics.contact_force_py`). Tangential: the same return mapping on the trial
+    sliding velocity (the tangential part of ``v_r + dt fo / mass``, ``fo`` = ``(fox, foy,
+    foz)`` the node's element forces this step [N]): the force that stops it in one step,
+    limited by Coulomb ``mu Fn`` and by the shear cap ``tau_max * trib_area`` (the node's
+    tributary contact area [m^2]), opposite to the trial sliding direction. ``(vrx, vry,
+    vrz)`` node velocity relative to the tool [m/s].
 
     Returns ``(fx, fy, fz, fn, ft, tx, ty, tz)``: force, normal magnitude, tangential
     magnitude and the unit sliding direction (zero vector when not sliding).
@@ -208,10 +210,13 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
     if gap >= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     fn = pen_factor * mass / (dt * dt) * (-gap)
-    vn = vrx * nx + vry * ny + vrz * nz
-    vtx = vrx - vn * nx
-    vty = vry - vn * ny
-    vtz = vrz - vn * nz
+    wx = vrx + dt * fox / mass
+    wy = vry + dt * foy / mass
+    wz = vrz + dt * foz / mass
+    vn = wx * nx + wy * ny + wz * nz
+    vtx = wx - vn * nx
+    vty = wy - vn * ny
+    vtz = wz - vn * nz
     vt = math.sqrt(vtx * vtx + vty * vty + vtz * vtz)
     if vt <= 0.0:
         return fn * nx, fn * ny, fn * nz, fn, 0.0, 0.0, 0.0, 0.0
@@ -316,7 +321,8 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
             trib = (vsum / nlive) ** (2.0 / 3.0)
             fcx, fcy, fcz, fn, ft, tx, ty, tz = contact_force3(
                 gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, prm[P_MU], prm[P_TAU], prm[P_PEN],
-                dt)
+                dt, 0.0 if (fixed[n] & 1) else fx, 0.0 if (fixed[n] & 2) else fy,
+                0.0 if (fixed[n] & 4) else fz)
             vt0 = vrx * tx + vry * ty + vrz * tz
             pen[n] = share * 0.5 * fn * (-gap)
     cf[n, 0] = share * fcx

@@ -77,7 +77,7 @@ def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
 
 
 def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
-                     damping):
+                     damping, fox, foy):
     """Contact force on a node touching the rigid tool [N per m of width].
 
     Normal: penalty ``Fn = pen_factor * mass / dt**2 * (-gap)`` (mass-proportional penalty,
@@ -85,10 +85,15 @@ def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_fac
     F is F dt^2 / (pen_factor m)), plus a viscous contact damping ``-c v_n`` on the relative
     normal velocity with ``c = 2 damping sqrt(k m)`` (``damping``: fraction of the contact
     spring's critical damping, as LS-DYNA's VDC; 0: none), the total kept >= 0 (no
-    adhesion). Tangential: the force that would stop the relative sliding velocity in one
-    step, limited by Coulomb ``mu * Fn`` and by the shear-stress cap ``tau_max * trib_len``
-    (the node's tributary contact length). (vrx, vry) is the node's velocity relative to the
-    tool [m/s]; mass the node's (scaled) mass [kg/m].
+    adhesion). Tangential: a return mapping on the trial sliding velocity ``vt* = vt + dt
+    (fo . t) / mass`` -- the velocity the node would slide with after this step's other
+    forces ``(fox, foy)`` [N/m] (its element forces) -- the stick force that stops it,
+    ``mass |vt*| / dt``, limited by Coulomb ``mu * Fn`` and by the shear-stress cap
+    ``tau_max * trib_len`` (the node's tributary contact length), opposite to ``vt*``.
+    (Stopping only the start-of-step velocity instead would let the element forces
+    re-accelerate the node every step: a viscous interface ``mass v / dt ~ rho c v`` that
+    undercuts Coulomb wherever the contact pressure is high.) (vrx, vry) is the node's
+    velocity relative to the tool [m/s]; mass the node's (scaled) mass [kg/m].
 
     Returns ``(fx, fy, fn, ft, fd)`` with fn >= 0 the normal force, ft the signed tangential
     component along t = (-ny, nx) and fd the damping part of fn. Zero for gap >= 0.
@@ -102,7 +107,7 @@ def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_fac
     fn = fp + fd
     tx = -ny
     ty = nx
-    vt = vrx * tx + vry * ty
+    vt = vrx * tx + vry * ty + dt * (fox * tx + foy * ty) / mass
     fstick = mass * abs(vt) / dt
     fcap = mu * fn
     if tau_max * trib_len < fcap:

@@ -587,7 +587,9 @@ def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
             "temperature_K": st.temp.copy(), "damage": st.dmg.copy(), "von_mises_Pa": vm,
             "pressure_Pa": st.pres.copy(), "tool_outline": np.array([ox, oy]),
             "tool_center": np.array([cx, cy]), "vx": st.vx.copy(), "vy": st.vy.copy(),
-            "tool_velocity": np.array([-setup.vc + st.tool[K.T_VUX], st.tool[K.T_VUY]])}
+            "tool_velocity": np.array([-setup.vc + st.tool[K.T_VUX], st.tool[K.T_VUY]]),
+            "deviatoric_stress_Pa": np.array([sxx, syy, szz, sxy]),
+            "contact_force_N_per_m": np.array([st.cfx, st.cfy])}
 
 
 def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
