@@ -45,7 +45,10 @@ def handle_errors(func: F) -> F:
         try:
             return func(*args, **kwargs)
         except RoboboreError as exc:
-            stderr.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, markup=True)
+            # soft_wrap: one line whatever the terminal width (paths stay copyable, and the
+            # message does not break where a long temporary path happens to end)
+            stderr.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, markup=True,
+                         soft_wrap=True)
             raise typer.Exit(code=2) from None
 
     return wrapper  # type: ignore[return-value]
