@@ -304,6 +304,7 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     ty = 0.0
     tz = 0.0
     gap = 1.0
+    fb = fixed[n]  # held velocity components: no element force in the trial slip, no update
     px = x[n] - cx
     # cheap bound: a node ahead of the rounded edge and of a non-negative-rake face is free
     # (and farther than the separation gate)
@@ -321,8 +322,7 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
             trib = (vsum / nlive) ** (2.0 / 3.0)
             fcx, fcy, fcz, fn, ft, tx, ty, tz = contact_force3(
                 gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, prm[P_MU], prm[P_TAU], prm[P_PEN],
-                dt, 0.0 if (fixed[n] & 1) else fx, 0.0 if (fixed[n] & 2) else fy,
-                0.0 if (fixed[n] & 4) else fz)
+                dt, 0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy, 0.0 if (fb & 4) else fz)
             vt0 = vrx * tx + vry * ty + vrz * tz
             pen[n] = share * 0.5 * fn * (-gap)
     cf[n, 0] = share * fcx
@@ -331,7 +331,6 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     ox = vx[n]
     oy = vy[n]
     oz = vz[n]
-    fb = fixed[n]
     nvx = ox if (fb & 1) else ox + dt * (fx + fcx) / m
     nvy = oy if (fb & 2) else oy + dt * (fy + fcy) / m
     nvz = oz if (fb & 4) else oz + dt * (fz + fcz) / m
