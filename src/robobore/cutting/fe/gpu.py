@@ -35,6 +35,8 @@ from robobore.errors import ConfigError
 __all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled"]
 
 _THREADS = 128
+#: largest block size of the persistent kernel (its shared compaction counters)
+_MAX_BLOCK = 1024
 # reduction slots on the device
 R_DTMIN, R_BAD, R_FX, R_FY, R_FZ, R_NC = 0, 1, 2, 3, 4, 5
 N_RED = 6
@@ -93,6 +95,7 @@ def _kernels():
 
     cuda = _cuda
     from numba import float64 as _float64
+    from numba import int64 as _int64
 
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.hex8 import hex_element_py
@@ -113,6 +116,8 @@ def _kernels():
     lsum3 = dev(K3.lane_sum3_py)
     LANES = K3.N_SUM_LANES
     float64 = _float64
+    int64 = _int64
+    NCNT = _MAX_BLOCK + 1
 
     I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K3.I_STATUS, K3.I_STEP, K3.I_SAMPLE, K3.I_BADELEM
     ST_OK, ST_DONE, ST_INV = K3.STATUS_OK, K3.STATUS_DONE, K3.STATUS_INVERTED
@@ -184,10 +189,9 @@ def _kernels():
         if alive[e] == -2:
             red[R_BAD] = e
 
-    @cuda.jit
-    def k_finish(tool, prm, clock, ist, hacc, hist, en, red):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
+    @cuda.jit(device=True)
+    def finish(tool, prm, clock, ist, hacc, hist, en, red):
+        # the step end (one thread): time, stable step, status, time-averaged histories
         dt = clock[1]
         t = clock[0] + dt
         clock[0] = t
@@ -241,7 +245,122 @@ def _kernels():
         if t >= prm[P_TEND]:
             ist[I_STATUS] = ST_DONE
 
-    return k_nodes, k_contact_sum, k_tool, k_elems, k_finish
+    @cuda.jit
+    def k_finish(tool, prm, clock, ist, hacc, hist, en, red):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        finish(tool, prm, clock, ist, hacc, hist, en, red)
+
+    @cuda.jit
+    def k_run(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
+              sd, pres, eps_p, temp, dm, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
+              ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, erosion,
+              red, cflag, clist):
+        # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
+        # of the five kernels above separated by grid-wide barriers, so the host launches
+        # once per chunk instead of five times per step. Same functions, same order, same
+        # bits as the five launches.
+        grid = cuda.cg.this_grid()
+        tid = cuda.grid(1)
+        nthr = cuda.gridsize(1)
+        t = cuda.threadIdx.x
+        nb = cuda.blockDim.x
+        nn = x.shape[0]
+        ne = conn.shape[0]
+        nchunk = cflag.shape[0]
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        pz = cuda.shared.array(LANES, float64)
+        pn = cuda.shared.array(LANES, float64)
+        cnt = cuda.shared.array(NCNT, int64)
+        for _ in range(n_steps):
+            if ist[I_STATUS] != ST_OK:
+                return
+            dt = clock[1]
+            cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
+            for n in range(tid, nn, nthr):
+                node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
+                     cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
+                     pairs)
+                if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
+                    cflag[n // LANES] = 1  # the chunk of LANES nodes holding n has contact
+            grid.sync()
+            if cuda.blockIdx.x == 0:
+                # block 0: the contact-force total in the CPU's lane order, visiting only
+                # the chunks that hold a contact node (the others add nothing), then the tool
+                q = (nchunk + nb - 1) // nb
+                c0 = min(t * q, nchunk)
+                c1 = min(c0 + q, nchunk)
+                k = 0
+                for c in range(c0, c1):
+                    if cflag[c] != 0:
+                        k += 1
+                cnt[t] = k
+                cuda.syncthreads()
+                if t == 0:
+                    acc = 0
+                    for j in range(nb):
+                        v = cnt[j]
+                        cnt[j] = acc
+                        acc += v
+                    cnt[nb] = acc
+                cuda.syncthreads()
+                k = cnt[t]
+                for c in range(c0, c1):
+                    if cflag[c] != 0:
+                        clist[k] = c
+                        k += 1
+                        cflag[c] = 0
+                cuda.syncthreads()
+                m = cnt[nb]
+                for lane in range(t, LANES, nb):
+                    sx = 0.0
+                    sy = 0.0
+                    sz = 0.0
+                    sc = 0
+                    for i in range(m):
+                        n = clist[i] * LANES + lane
+                        if n < nn and (cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0):
+                            sx += cf[n, 0]
+                            sy += cf[n, 1]
+                            sz += cf[n, 2]
+                            sc += 1
+                    px[lane] = sx
+                    py[lane] = sy
+                    pz[lane] = sz
+                    pn[lane] = sc
+                cuda.syncthreads()
+                if t == 0:
+                    sx = 0.0
+                    sy = 0.0
+                    sz = 0.0
+                    sn = 0.0
+                    for j in range(LANES):
+                        sx += px[j]
+                        sy += py[j]
+                        sz += pz[j]
+                        sn += pn[j]
+                    red[R_FX] = sx
+                    red[R_FY] = sy
+                    red[R_FZ] = sz
+                    red[R_NC] = sn
+                    en[E_EXT] += tstep(tool, prm, sx, sy, sz, dt)
+            # elements (they do not read the tool or the contact forces: no barrier needed
+            # after block 0's work above)
+            for e in range(tid, ne, nthr):
+                elem(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dm, qh,
+                     vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+                cuda.atomic.min(red, R_DTMIN, dte[e])
+                if alive[e] == -2:
+                    red[R_BAD] = e
+            grid.sync()
+            if tid == 0:
+                finish(tool, prm, clock, ist, hacc, hist, en, red)
+                red[R_DTMIN] = 1e30
+                red[R_BAD] = -1.0
+            grid.sync()
+
+    return k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run
 
 
 #: arrays of FEState3 that the kernels change (copied back to the host)
@@ -252,19 +371,26 @@ _MUTABLE = ("x", "y", "z", "vx", "vy", "vz", "alive", "sd", "pres", "eps_p", "te
 
 def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                  progress: Callable[[float], None] | None = None,
-                 check: Callable[[object], None] | None = None) -> int:
+                 check: Callable[[object], None] | None = None,
+                 profile: dict[str, float] | None = None,
+                 persistent: bool | None = None) -> int:
     """GPU counterpart of :func:`robobore.cutting.fe.solver3d.advance3` (same contract).
 
     Copies the state to the device, runs chunks of ``chunk_steps`` steps, copies the state
     back after each chunk (for ``check``/``progress``) and at the end, and computes the
     energy totals on the host. Raises NumericalError on instability, ConfigError when no
-    GPU is usable.
+    GPU is usable. ``profile`` (a dict, for benchmarks): synchronize after every launch and
+    add each kernel's wall time [s] under its name (slows the run down; five launches a
+    step). ``persistent``: run each chunk as one cooperative launch of the persistent
+    kernel (``None``, the default: when the device supports cooperative launches and no
+    ``profile`` is asked for; the same bits as the five launches a step, without their
+    host-side launch cost).
     """
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     require_gpu()
-    k_nodes, k_contact_sum, k_tool, k_elems, k_finish = _kernels()
+    k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run = _kernels()
     st.prm[K3.P_TEND] = t_end
     st.ist[K3.I_STATUS] = K3.STATUS_OK
     d = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name)))
@@ -285,22 +411,42 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     t_start = st.time
     step0 = int(st.ist[K3.I_STEP])
     g = d
+    tick = _ticker(profile)
+    run = None
+    auto = persistent is None
+    if auto:
+        persistent = profile is None
+    if persistent:
+        nchunk = (nn + K3.N_SUM_LANES - 1) // K3.N_SUM_LANES
+        cflag = cuda.to_device(np.zeros(nchunk, np.int32))
+        clist = cuda.to_device(np.zeros(nchunk, np.int64))
+        args = [g[name] for name in _RUN_ARGS]
+        args += [erosion, dred, cflag, clist]
+        run = _cooperative(k_run, [1] + args, _THREADS, fallback=auto)
     while True:
-        for _ in range(chunk_steps):
+        if run is not None:
+            run(chunk_steps, *args)
+        for _ in range(0 if run is not None else chunk_steps):
+            tick(None)
             k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
                                   g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
                                   g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
                                   g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
                                   g["ist"], dred, g["pairs"])
+            tick("nodes")
             k_contact_sum[1, K3.N_SUM_LANES](g["cf"], dred)
+            tick("contact_sum")
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+            tick("tool")
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
                                   g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],
                                   g["temp"], g["dmg"], g["qh"], g["vol0"], g["ie"], g["hge"],
                                   g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                                   g["clock"], erosion, g["ist"], dred)
+            tick("elements")
             k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
                            g["en"], dred)
+            tick("finish")
         for name in ("ist", "clock"):
             getattr(st, name)[...] = g[name].copy_to_host()
         status = int(st.ist[K3.I_STATUS])
@@ -316,6 +462,69 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
         if status == K3.STATUS_DONE or st.time >= t_end:
             _copy_back(st, g)
             return int(st.ist[K3.I_STEP]) - step0
+
+
+#: the state arrays of the persistent kernel, in its argument order (then erosion, red,
+#: the chunk flags and the chunk list)
+_RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
+             "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
+             "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
+             "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs")
+
+
+def _cooperative(kernel, args: list, threads: int, fallback: bool = False):
+    """``launch(*args)`` of a grid-synchronising kernel with as many blocks of ``threads``
+    as the device keeps resident at once (a cooperative launch needs them all resident);
+    one block in numba's simulator (the only cooperative grid it runs).
+
+    When the kernel cannot be compiled or made resident: ``None`` with ``fallback`` (the
+    caller then launches one kernel per phase, with a warning), else a ConfigError."""
+    if simulator_enabled():
+        return lambda *a: kernel[1, threads](*a)
+    try:
+        spec = kernel.specialize(*args)
+        ov = next(iter(spec.overloads.values()))
+        blocks = int(ov.max_cooperative_grid_blocks(threads))
+        if blocks < 1:
+            raise RuntimeError("not one block of the persistent kernel fits on a "
+                               "multiprocessor")
+    except Exception as e:
+        if not fallback:
+            raise ConfigError(f"the persistent GPU kernel is not usable here: {e}",
+                              field="--device", value="gpu",
+                              expected="a GPU and numba-cuda that run cooperative launches "
+                                       "(persistent=False launches one kernel per phase)"
+                              ) from e
+        import warnings
+
+        warnings.warn(f"persistent GPU kernel not usable ({type(e).__name__}: {e}); "
+                      "launching one kernel per phase and step (slower on small meshes)",
+                      RuntimeWarning, stacklevel=3)
+        return None
+    launcher = spec[blocks, threads]
+    return lambda *a: launcher(*a)
+
+
+def _ticker(profile: dict[str, float] | None) -> Callable[[str | None], None]:
+    """``tick(name)``: with a ``profile`` dict, wait for the device and add the wall time
+    since the previous tick under ``name`` (``None`` only restarts the clock); without one,
+    a no-op (the launches stay asynchronous)."""
+    if profile is None:
+        return lambda name: None
+    import time
+
+    from numba import cuda as _cuda
+
+    last = [time.perf_counter()]
+
+    def tick(name: str | None) -> None:
+        _cuda.synchronize()
+        now = time.perf_counter()
+        if name is not None:
+            profile[name] = profile.get(name, 0.0) + now - last[0]
+        last[0] = now
+
+    return tick
 
 
 def _copy_back(st, g) -> None:

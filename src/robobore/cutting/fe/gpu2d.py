@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.gpu import jc_device_functions, require_gpu
+from robobore.cutting.fe.gpu import _MAX_BLOCK, jc_device_functions, require_gpu
 from robobore.cutting.fe.rezone import MODE_ROWS
 from robobore.errors import ConfigError
 
@@ -85,6 +85,7 @@ def _kernels():
 
     cuda = _cuda
     from numba import float64 as _float64
+    from numba import int64 as _int64
 
     from robobore.cutting.fe.physics import (
         contact_force_py,
@@ -119,6 +120,8 @@ def _kernels():
     lsum = dev(K.lane_sum_py)
     LANES = K.N_SUM_LANES
     float64 = _float64
+    int64 = _int64
+    NCNT = _MAX_BLOCK + 1
 
     I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K.I_STATUS, K.I_STEP, K.I_SAMPLE, K.I_BADELEM
     ST_OK, ST_DONE, ST_INV = K.STATUS_OK, K.STATUS_DONE, K.STATUS_INVERTED
@@ -247,11 +250,10 @@ def _kernels():
             return
         prm[P_COND_ACC] = 0.0
 
-    @cuda.jit
-    def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
-                 alive, fric, pen, ero_ke, nwork):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
+    @cuda.jit(device=True)
+    def finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge, alive,
+               fric, pen, ero_ke, nwork):
+        # the step end (one thread): time, stable step, status, histories
         dt = clock[1]
         fwx = red[R_FX]
         fwy = red[R_FY]
@@ -311,8 +313,145 @@ def _kernels():
             ist[I_STATUS] = ST_DONE
             sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
 
+    @cuda.jit
+    def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
+                 alive, fric, pen, ero_ke, nwork):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge, alive,
+               fric, pen, ero_ke, nwork)
+
+    @cuda.jit
+    def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
+              sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte,
+              plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool, en, ist,
+              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, erosion, cond_every,
+              theat, red, cflag, clist):
+        # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
+        # of the kernels above separated by grid-wide barriers (one launch per chunk instead
+        # of five to twelve per step); same functions, same order, same bits
+        grid = cuda.cg.this_grid()
+        tid = cuda.grid(1)
+        nthr = cuda.gridsize(1)
+        t = cuda.threadIdx.x
+        nb = cuda.blockDim.x
+        nn = x.shape[0]
+        ne = conn.shape[0]
+        npair = ppair.shape[0]
+        nchunk = cflag.shape[0]
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        cnt = cuda.shared.array(NCNT, int64)
+        for _ in range(n_steps):
+            if ist[I_STATUS] != ST_OK:
+                return
+            step = ist[I_STEP]
+            dt = clock[1]
+            cx, cy, tvx, tvy = kin(tool, prm)
+            for n in range(tid, nn, nthr):
+                fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
+                                         area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
+                                         nwork, cx, cy, tvx, tvy, prm, dt, twin, tied)
+                if touched:
+                    cuda.atomic.add(red, R_NC, 1.0)
+                if cfx[n] != 0.0 or cfy[n] != 0.0:
+                    cflag[n // LANES] = 1  # the chunk of LANES nodes holding n has contact
+            grid.sync()
+            if cuda.blockIdx.x == 0:
+                # block 0: the contact-force total in the CPU's lane order over the chunks
+                # holding a contact node (the others hold zeros), then the tool
+                q = (nchunk + nb - 1) // nb
+                c0 = min(t * q, nchunk)
+                c1 = min(c0 + q, nchunk)
+                k = 0
+                for c in range(c0, c1):
+                    if cflag[c] != 0:
+                        k += 1
+                cnt[t] = k
+                cuda.syncthreads()
+                if t == 0:
+                    acc = 0
+                    for j in range(nb):
+                        v = cnt[j]
+                        cnt[j] = acc
+                        acc += v
+                    cnt[nb] = acc
+                cuda.syncthreads()
+                k = cnt[t]
+                for c in range(c0, c1):
+                    if cflag[c] != 0:
+                        clist[k] = c
+                        k += 1
+                        cflag[c] = 0
+                cuda.syncthreads()
+                m = cnt[nb]
+                for lane in range(t, LANES, nb):
+                    sx = 0.0
+                    sy = 0.0
+                    for i in range(m):
+                        n = clist[i] * LANES + lane
+                        if n < nn:
+                            sx += cfx[n]
+                            sy += cfy[n]
+                    px[lane] = sx
+                    py[lane] = sy
+                cuda.syncthreads()
+                if t == 0:
+                    sx = 0.0
+                    sy = 0.0
+                    for j in range(LANES):
+                        sx += px[j]
+                        sy += py[j]
+                    red[R_FX] = sx
+                    red[R_FY] = sy
+                    en[E_EXT] += tstep(tool, prm, sx, sy, dt)
+                    if prm[P_COND_EVERY] > 0.0:
+                        prm[P_COND_ACC] += dt
+            # elements (they read neither the tool nor the contact forces)
+            for e in range(tid, ne, nthr):
+                d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
+                              eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
+                              rate, mat, prm, dt, erosion)
+                cuda.atomic.min(red, R_DTMIN, d)
+                if inv:
+                    cuda.atomic.max(red, R_BAD, float(e))
+            grid.sync()
+            if cond_every > 0 and step % cond_every == 0:
+                for e in range(tid, ne, nthr):
+                    cent(e, conn, x, y, tbuf)
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND],
+                         mat[RHO] * mat[CP], prm[P_COND_ACC])
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    temp[e] = tbuf[e, 3]
+                grid.sync()
+                if npair > 0:
+                    for i in range(tid, npair, nthr):
+                        pedge(i, ppair, x, y, alive, tied, temp, tbuf, mat[KCOND],
+                              mat[RHO] * mat[CP], prm[P_COND_ACC])
+                    grid.sync()
+                if theat != 0:
+                    for n in range(tid, nn, nthr):
+                        thnode(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric,
+                               fheat, temp, tbuf, tcq, mat[RHO] * mat[CP], prm[P_HC],
+                               prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
+                    grid.sync()
+                    for e in range(tid, ne, nthr):
+                        thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
+                    grid.sync()
+                if tid == 0:
+                    prm[P_COND_ACC] = 0.0
+            if tid == 0:
+                finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
+                       alive, fric, pen, ero_ke, nwork)
+                red[R_DTMIN] = 1e30
+                red[R_BAD] = -1.0
+            grid.sync()
+
     return (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
-            k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish)
+            k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run)
 
 
 #: FEState arrays used by the kernels (copied to the device)
@@ -330,7 +469,9 @@ _MUTABLE = ("x", "y", "vx", "vy", "alive", "sdx", "sdy", "sdz", "sdxy", "pres", 
 
 def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                 progress: Callable[[float], None] | None = None,
-                check: Callable[[Any], None] | None = None) -> int:
+                check: Callable[[Any], None] | None = None,
+                profile: dict[str, float] | None = None,
+                persistent: bool | None = None) -> int:
     """GPU counterpart of :func:`robobore.cutting.fe.solver.advance` (same contract).
 
     Copies the :class:`~robobore.cutting.fe.solver.FEState` to the device, runs chunks of
@@ -338,8 +479,11 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     (the whole state when ``check`` is given, before calling it) and the whole state at the
     end. Returns the number of steps taken. Raises NumericalError on instability (same
     messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
-    rezoning, the ploughed-layer ALE or the B-bar element.
+    rezoning, the ploughed-layer ALE or the B-bar element. ``profile`` and ``persistent``:
+    as in :func:`robobore.cutting.fe.gpu.advance3_gpu` (per-kernel wall times for
+    benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
+    from robobore.cutting.fe.gpu import _cooperative, _ticker
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
@@ -349,7 +493,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                         every if rows else 0)
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
-     k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish) = _kernels()
+     k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run) = _kernels()
     st.prm[K.P_TEND] = t_end
     st.ist[K.I_STATUS] = K.STATUS_OK
     g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _ARRAYS}
@@ -368,25 +512,44 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
     t_start = st.time
     step0 = int(st.ist[K.I_STEP])
+    tick = _ticker(profile)
+    run = None
+    auto = persistent is None
+    if auto:
+        persistent = profile is None
+    if persistent:
+        nchunk = (nn + K.N_SUM_LANES - 1) // K.N_SUM_LANES
+        cflag = cuda.to_device(np.zeros(nchunk, np.int32))
+        clist = cuda.to_device(np.zeros(nchunk, np.int64))
+        args = [g[name] for name in _ARRAYS]
+        args += [erosion, cond_every, int(theat), dred, cflag, clist]
+        run = _cooperative(k_run, [1] + args, _THREADS, fallback=auto)
     while True:
+        if run is not None:
+            run(chunk_steps, *args)
         # while the status is OK every launch sequence is exactly one step, so the host
         # knows the step index (conduction runs where ist[I_STEP] % cond_every == 0, as on
         # the CPU); once the status changes the remaining launches return at once
         step = int(st.ist[K.I_STEP])
-        for i in range(chunk_steps):
+        for i in range(0 if run is not None else chunk_steps):
+            tick(None)
             k_nodes[gn, _THREADS](g["x"], g["y"], g["vx"], g["vy"], g["mass"], g["fixed"],
                                   g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
                                   g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
                                   g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
                                   g["clock"], g["ist"], g["twin"], g["tied"], dred)
+            tick("nodes")
             k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], dred)
+            tick("contact_sum")
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+            tick("tool")
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
                                   g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
                                   g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
                                   g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
                                   g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                                   g["clock"], erosion, g["ist"], dred)
+            tick("elements")
             if cond_every > 0 and (step + i) % cond_every == 0:
                 k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
                 k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
@@ -405,10 +568,12 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                     k_theat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["tcq"],
                                                 g["mat"], g["ist"])
                 k_conduct_reset[1, 1](g["prm"], g["ist"])
+                tick("conduction")
             k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
                            g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
                            g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"],
                            g["nwork"])
+            tick("finish")
         for name in ("ist", "clock"):
             getattr(st, name)[...] = g[name].copy_to_host()
         status = int(st.ist[K.I_STATUS])

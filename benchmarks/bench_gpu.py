@@ -1,0 +1,389 @@
+"""GPU vs CPU for the explicit FE engines: agreement and throughput (needs an NVIDIA GPU
+and numba-cuda for the GPU parts; the CPU parts run anywhere).
+
+Usage::
+
+    python benchmarks/bench_gpu.py env
+    python benchmarks/bench_gpu.py check3d [--steps 60 2000]
+    python benchmarks/bench_gpu.py speed3d [--sizes 10 5 3.3] [--gpu-steps 2000]
+        [--cpu-steps 40] [--cpu-threads 2] [--no-gpu] [--profile]
+    python benchmarks/bench_gpu.py paper3d [--sizes 10] [--devices cpu gpu] [--cut-mm 0.15]
+        [--mass-scaling 400] [--coefficients FILE]
+    python benchmarks/bench_gpu.py speed2d [--sizes 10 2.5] [--gpu-steps 4000] [--cpu-steps 200]
+    python benchmarks/bench_gpu.py ortho2d [--devices cpu gpu] [--length-mm 1.0]
+
+Every mode prints its figures and, with ``--out FILE``, writes them as JSON (atomic).
+
+``check3d``: the small cut of ``tests/cutting/fe3d/test_fe3d_gpu.py`` (insert on springs,
+contact, plasticity, erosion) on the real GPU against the CPU engine: relative state
+differences after each step count (the simulator test gets 1e-9; on hardware the GPU's own
+math library and fused multiply-adds differ in the last bits, and an explicit cut amplifies
+them over many steps).
+
+``speed3d`` / ``speed2d``: the boring example (3D) / the contract config (2D) meshed at each
+element size; the same initial state is advanced ``--gpu-steps`` on the GPU and
+``--cpu-steps`` on the CPU with ``--cpu-threads`` numba threads (the loops forced parallel):
+element-updates per second of each, their ratio, and the state difference after the CPU's
+steps (the GPU runs the same steps first). ``--profile`` adds a per-kernel breakdown (a
+synchronised rerun).
+
+The GPU runs use the persistent kernel (one cooperative launch per chunk of steps, the
+default); ``gpu_launch_per_kernel`` is the same state advanced with one launch per kernel and
+step (the fallback path), whose host-side launch cost dominates small meshes.
+
+``paper3d`` / ``ortho2d``: whole runs (the 3D paper condition of ``bench_fe3d.py paper``,
+the 2D contract config) on each device: forces, energy error, wall time and the relative
+force differences between the devices.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _rel(u, v) -> float:
+    u = np.nan_to_num(np.asarray(u, float))
+    v = np.nan_to_num(np.asarray(v, float))
+    return float(np.max(np.abs(u - v)) / max(float(np.max(np.abs(u))), 1e-300))
+
+
+def env() -> dict:
+    out = {"python": platform.python_version(), "numba": numba.__version__,
+           "numpy": np.__version__, "cpus": os.cpu_count(),
+           "numba_threads": numba.get_num_threads()}
+    try:
+        import numba_cuda  # noqa: F401
+
+        out["numba_cuda"] = getattr(numba_cuda, "__version__", "?")
+    except Exception as e:  # pragma: no cover - depends on the machine
+        out["numba_cuda"] = f"not importable: {e}"
+    from robobore.cutting.fe.gpu import cuda_available
+
+    out["cuda_available"] = cuda_available()
+    if out["cuda_available"]:
+        from numba import cuda
+
+        try:
+            dev = cuda.get_current_device()
+            out["gpu"] = dev.name.decode() if isinstance(dev.name, bytes) else str(dev.name)
+            out["compute_capability"] = list(dev.compute_capability)
+            out["multiprocessors"] = int(dev.MULTIPROCESSOR_COUNT)
+        except AttributeError:  # numba's CUDA simulator
+            out["gpu"] = "numba CUDA simulator"
+    print(json.dumps(out, indent=1), flush=True)
+    return out
+
+
+# ----------------------------------------------------------------------------------- 3D
+def _small3d():
+    import math
+
+    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.solver3d import box_mesh, default_prm3, make_state3
+    from robobore.material import load_material
+
+    le = 20e-6
+    nodes, conn, idx = box_mesh(4, 2, 3, 4 * le, 2 * le, 3 * le, origin=(0.0, -2 * le, -1.5 * le))
+    fixed = np.zeros(len(nodes), np.int64)
+    fixed[idx[:, 0, :].ravel()] = 7
+    fixed[idx[-1, :, :].ravel()] = 7
+    p = default_prm3()
+    p[K3.P_TOOL] = 1.0
+    p[K3.P_RN], p[K3.P_KAPPA], p[K3.P_KEND] = 0.4e-3, math.pi / 2, math.radians(5)
+    p[K3.P_RAKE], p[K3.P_CLR], p[K3.P_RE] = math.radians(7), math.radians(7), 10e-6
+    p[K3.P_MU], p[K3.P_TAU] = 0.3, 576e6
+    p[K3.P_MS] = 100.0
+    p[K3.P_VC], p[K3.P_VF], p[K3.P_RADIUS] = 5.0, 1e-3, 0.02
+    p[K3.P_SUPPORT] = 1.0
+    p[K3.P_KX] = p[K3.P_KY] = p[K3.P_KZ] = 1e7
+    p[K3.P_CX] = p[K3.P_CY] = p[K3.P_CZ] = 50.0
+    p[K3.P_MX] = p[K3.P_MY] = p[K3.P_MZ] = 1e-3
+    p[K3.P_EROSION] = K3.ERODE_ALL
+    p[K3.P_SAMPLE_DT] = 2e-9
+    return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=4000,
+                       tool_tip=(-12e-6, -1.2 * le, 0.0), parallel=False)
+
+
+def _diff3(a, b) -> dict:
+    from robobore.cutting.fe import kernels3d as K3
+
+    out = {k: _rel(getattr(a, k), getattr(b, k))
+           for k in ("x", "vx", "vy", "vz", "sd", "pres", "eps_p", "temp", "tool")}
+    out["forces"] = _rel(a.tool[K3.T_FX:K3.T_FZ + 1], b.tool[K3.T_FX:K3.T_FZ + 1])
+    out["same_alive"] = bool(np.array_equal(a.alive, b.alive))
+    return out
+
+
+def check3d(steps: list[int]) -> dict:
+    from robobore.cutting.fe.gpu import advance3_gpu
+    from robobore.cutting.fe.solver3d import advance3
+
+    res = {}
+    for n in steps:
+        a = _small3d()
+        t_end = n * a.clock[1]
+        na = advance3(a, t_end, chunk_steps=max(n, 10))
+        for persistent in (True, False):
+            b = _small3d()
+            nb = advance3_gpu(b, t_end, chunk_steps=max(n, 10), persistent=persistent)
+            d = _diff3(a, b)
+            d["steps"] = [na, nb]
+            d["contact_force_N"] = float(np.abs(a.cf).sum())
+            key = f"{n} steps, {'persistent' if persistent else 'launch per kernel'}"
+            res[key] = d
+            print(f"check3d {key}: " + json.dumps(d), flush=True)
+    return res
+
+
+def _boring_dict(le: float, ms: float, cut_mm: float, parallel):
+    from robobore.io.config import load_toml
+
+    d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
+    d["mesh"]["element_size_um"] = le
+    d["cut"]["cut_length_mm"] = cut_mm
+    d["solver"]["mass_scaling"] = ms
+    d["contact"]["friction"] = "table"
+    if parallel is not None:
+        d["solver"]["parallel"] = parallel
+    return d
+
+
+def _timed(fn, *args, **kwargs) -> tuple[float, int]:
+    """(wall time [s], return value) of ``fn(*args, **kwargs)``."""
+    t0 = time.perf_counter()
+    n = fn(*args, **kwargs)
+    return time.perf_counter() - t0, n
+
+
+def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
+            use_gpu: bool, profile: bool) -> dict:
+    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.solver3d import advance3
+
+    numba.set_num_threads(cpu_threads)
+    res = {"cpu_threads": cpu_threads, "runs": []}
+    for le in sizes:
+        s = setup_boring(parse_boring_config(_boring_dict(le, 400.0, 0.15, True)))
+        st0 = s.state
+        dt = float(st0.clock[1])
+        ne = st0.n_elements
+        row = {"element_size_um": le, "elements": ne, "nodes": int(st0.x.shape[0]),
+               "time_step_s": dt}
+        # CPU: warm up (compile / cache) on a copy, then the timed steps
+        w = copy.deepcopy(st0)
+        advance3(w, st0.time + 2.5 * dt, chunk_steps=10)
+        c = copy.deepcopy(st0)
+        t_c = st0.time + (cpu_steps - 0.5) * dt
+        wall, n = _timed(advance3, c, t_c, chunk_steps=cpu_steps)
+        row["cpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall}
+        if use_gpu:
+            from robobore.cutting.fe.gpu import advance3_gpu
+
+            w = copy.deepcopy(st0)
+            advance3_gpu(w, st0.time + 2.5 * dt, chunk_steps=10)  # compile, first launches
+            g = copy.deepcopy(st0)
+            wall, n = _timed(advance3_gpu, g, t_c, chunk_steps=cpu_steps)
+            row["same_steps_difference"] = _diff3(c, g)
+            g = copy.deepcopy(st0)
+            t_g = st0.time + (gpu_steps - 0.5) * dt
+            wall, n = _timed(advance3_gpu, g, t_g, chunk_steps=gpu_steps)
+            row["gpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall,
+                          "includes": "host-device copies of the whole state, in and out"}
+            row["speedup"] = row["gpu"]["element_updates_per_s"] / \
+                row["cpu"]["element_updates_per_s"]
+            g = copy.deepcopy(st0)
+            m = min(gpu_steps, 1000)
+            wall, n = _timed(advance3_gpu, g, st0.time + (m - 0.5) * dt, chunk_steps=m,
+                             persistent=False)
+            row["gpu_launch_per_kernel"] = {"steps": n, "wall_s": wall,
+                                            "element_updates_per_s": ne * n / wall}
+            if profile:
+                prof: dict[str, float] = {}
+                g = copy.deepcopy(st0)
+                m = min(gpu_steps, 500)
+                advance3_gpu(g, st0.time + (m - 0.5) * dt, chunk_steps=m, profile=prof)
+                row["gpu_profile_us_per_step"] = {k: 1e6 * v / m for k, v in prof.items()}
+        res["runs"].append(row)
+        print(json.dumps(row), flush=True)
+    return res
+
+
+def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
+            coefficients: str | None) -> dict:
+    from robobore.cutting.fe.boring3d import (
+        compare_with_mechanistic,
+        parse_boring_config,
+        simulate_boring,
+    )
+
+    res = {"runs": []}
+    for le in sizes:
+        by = {}
+        for dev in devices:
+            cfg = parse_boring_config(_boring_dict(le, ms, cut_mm, True if dev == "cpu"
+                                                   else None))
+            r = simulate_boring(cfg, device=dev)
+            s = r.summary
+            by[dev] = {k: s[k] for k in ("force_rotating_N", "force_mean_N",
+                                         "force_amplitude_N", "energy_error",
+                                         "hourglass_fraction", "n_elements", "steps",
+                                         "wall_time_s", "element_updates_per_s",
+                                         "eroded_damage", "eroded_distortion")}
+            by[dev]["comparison"] = compare_with_mechanistic(r, coefficients)
+            print(f"paper3d {le} um {dev}: " + json.dumps(by[dev]), flush=True)
+        row = {"element_size_um": le, "by_device": by}
+        if "cpu" in by and "gpu" in by:
+            a, b = by["cpu"]["force_rotating_N"], by["gpu"]["force_rotating_N"]
+            row["gpu_vs_cpu"] = {k: (b[k] - a[k]) / abs(a[k]) for k in a}
+            print(f"paper3d {le} um gpu vs cpu: " + json.dumps(row["gpu_vs_cpu"]), flush=True)
+        res["runs"].append(row)
+    return res
+
+
+# ----------------------------------------------------------------------------------- 2D
+def _ortho_cfg(le: float, length_mm: float, parallel: bool | None):
+    from robobore.cutting.fe.config import load_fe_config
+
+    cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
+    cfg.mesh.element_size_um = le
+    cfg.cut.length_mm = length_mm
+    if parallel is not None and hasattr(cfg.solver, "parallel"):
+        cfg.solver.parallel = parallel
+    return cfg
+
+
+def _diff2(a, b) -> dict:
+    from robobore.cutting.fe import kernels as K
+
+    out = {k: _rel(getattr(a, k), getattr(b, k))
+           for k in ("x", "y", "vx", "vy", "sdx", "pres", "eps_p", "temp", "tool")}
+    out["forces"] = _rel(a.tool[K.T_FX:K.T_FY + 1], b.tool[K.T_FX:K.T_FY + 1])
+    out["same_alive"] = bool(np.array_equal(a.alive, b.alive))
+    return out
+
+
+def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
+            use_gpu: bool, profile: bool) -> dict:
+    from robobore.cutting.fe.solver import advance, setup_orthogonal
+
+    numba.set_num_threads(cpu_threads)
+    res = {"cpu_threads": cpu_threads, "runs": []}
+    for le in sizes:
+        s = setup_orthogonal(_ortho_cfg(le, 1.0, True))
+        st0 = s.state
+        dt = float(st0.clock[1])
+        ne = int(st0.conn.shape[0])
+        row = {"element_size_um": le, "elements": ne, "nodes": int(st0.x.shape[0]),
+               "time_step_s": dt}
+        w = copy.deepcopy(st0)
+        advance(w, st0.time + 2.5 * dt, chunk_steps=10)
+        c = copy.deepcopy(st0)
+        t_c = st0.time + (cpu_steps - 0.5) * dt
+        wall, n = _timed(advance, c, t_c, chunk_steps=cpu_steps)
+        row["cpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall}
+        if use_gpu:
+            from robobore.cutting.fe.gpu2d import advance_gpu
+
+            w = copy.deepcopy(st0)
+            advance_gpu(w, st0.time + 2.5 * dt, chunk_steps=10)
+            g = copy.deepcopy(st0)
+            wall, n = _timed(advance_gpu, g, t_c, chunk_steps=cpu_steps)
+            row["same_steps_difference"] = _diff2(c, g)
+            g = copy.deepcopy(st0)
+            t_g = st0.time + (gpu_steps - 0.5) * dt
+            wall, n = _timed(advance_gpu, g, t_g, chunk_steps=gpu_steps)
+            row["gpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall,
+                          "includes": "host-device copies of the whole state, in and out"}
+            row["speedup"] = row["gpu"]["element_updates_per_s"] / \
+                row["cpu"]["element_updates_per_s"]
+            g = copy.deepcopy(st0)
+            m = min(gpu_steps, 1000)
+            t_m = st0.time + (m - 0.5) * dt
+            wall, n = _timed(advance_gpu, g, t_m, chunk_steps=m, persistent=False)
+            row["gpu_launch_per_kernel"] = {"steps": n, "wall_s": wall,
+                                            "element_updates_per_s": ne * n / wall}
+            if profile:
+                prof: dict[str, float] = {}
+                g = copy.deepcopy(st0)
+                m = min(gpu_steps, 500)
+                advance_gpu(g, st0.time + (m - 0.5) * dt, chunk_steps=m, profile=prof)
+                row["gpu_profile_us_per_step"] = {k: 1e6 * v / m for k, v in prof.items()}
+        res["runs"].append(row)
+        print(json.dumps(row), flush=True)
+    return res
+
+
+def ortho2d(devices: list[str], length_mm: float, le: float) -> dict:
+    from robobore.cutting.fe.solver import simulate_orthogonal
+
+    by = {}
+    for dev in devices:
+        r = simulate_orthogonal(_ortho_cfg(le, length_mm, None), device=dev)
+        s = r.summary
+        by[dev] = {k: s.get(k) for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
+                                         "chip_ratio", "peak_temperature_K", "energy_error",
+                                         "n_elements", "steps", "wall_time_s",
+                                         "element_updates_per_s")}
+        print(f"ortho2d {dev}: " + json.dumps(by[dev]), flush=True)
+    res = {"element_size_um": le, "length_mm": length_mm, "by_device": by}
+    if "cpu" in by and "gpu" in by:
+        res["gpu_vs_cpu"] = {k: (by["gpu"][k] - by["cpu"][k]) / abs(by["cpu"][k])
+                             for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
+                                       "chip_ratio")}
+        print("ortho2d gpu vs cpu: " + json.dumps(res["gpu_vs_cpu"]), flush=True)
+    return res
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("mode", choices=["env", "check3d", "speed3d", "paper3d", "speed2d",
+                                     "ortho2d"])
+    ap.add_argument("--steps", type=int, nargs="+", default=[60, 2000])
+    ap.add_argument("--sizes", type=float, nargs="+", default=None)
+    ap.add_argument("--gpu-steps", type=int, default=2000)
+    ap.add_argument("--cpu-steps", type=int, default=40)
+    ap.add_argument("--cpu-threads", type=int, default=2)
+    ap.add_argument("--no-gpu", action="store_true")
+    ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--devices", nargs="+", default=["cpu", "gpu"])
+    ap.add_argument("--cut-mm", type=float, default=0.15)
+    ap.add_argument("--mass-scaling", type=float, default=400.0)
+    ap.add_argument("--coefficients", default=None)
+    ap.add_argument("--length-mm", type=float, default=1.0)
+    ap.add_argument("--element-um", type=float, default=10.0)
+    ap.add_argument("--out", default=None)
+    a = ap.parse_args()
+    if a.mode == "env":
+        out = env()
+    elif a.mode == "check3d":
+        out = check3d(a.steps)
+    elif a.mode == "speed3d":
+        out = speed3d(a.sizes or [10.0, 5.0, 3.3], a.gpu_steps, a.cpu_steps, a.cpu_threads,
+                      not a.no_gpu, a.profile)
+    elif a.mode == "paper3d":
+        out = paper3d(a.sizes or [10.0], a.devices, a.cut_mm, a.mass_scaling, a.coefficients)
+    elif a.mode == "speed2d":
+        out = speed2d(a.sizes or [10.0, 2.5], a.gpu_steps, a.cpu_steps, a.cpu_threads,
+                      not a.no_gpu, a.profile)
+    else:
+        out = ortho2d(a.devices, a.length_mm, a.element_um)
+    out["load_average"] = os.getloadavg()[0]
+    if a.out:
+        from robobore.io.results import write_json
+
+        write_json(a.out, out)
+
+
+if __name__ == "__main__":
+    main()
