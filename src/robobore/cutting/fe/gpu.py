@@ -87,13 +87,53 @@ def jc_device_functions(dev):
     return dmg, ret
 
 
-@functools.lru_cache(maxsize=1)
-def _kernels():
-    """Compile (lazily, once) the device functions and kernels."""
+def bind_cuda():
+    """Bind (once) and return the ``numba.cuda`` module as this module's global ``cuda``,
+    which the kernels and :func:`chunk_list_py` name."""
     global cuda
     from numba import cuda as _cuda
 
     cuda = _cuda
+    return _cuda
+
+
+def chunk_list_py(cflag, clist, cnt, t, nb):
+    """Block-level step of the persistent kernels (every thread ``t`` of a block of ``nb``
+    calls it): list the chunks whose flag is set in ``cflag`` into ``clist`` in increasing
+    index order, clear those flags, and return how many there are. ``cnt`` is a shared int
+    array of ``nb + 1`` (a prefix sum of the per-thread counts over contiguous ranges)."""
+    nchunk = cflag.shape[0]
+    q = (nchunk + nb - 1) // nb
+    c0 = min(t * q, nchunk)
+    c1 = min(c0 + q, nchunk)
+    k = 0
+    for c in range(c0, c1):
+        if cflag[c] != 0:
+            k += 1
+    cnt[t] = k
+    cuda.syncthreads()
+    if t == 0:
+        acc = 0
+        for j in range(nb):
+            v = cnt[j]
+            cnt[j] = acc
+            acc += v
+        cnt[nb] = acc
+    cuda.syncthreads()
+    k = cnt[t]
+    for c in range(c0, c1):
+        if cflag[c] != 0:
+            clist[k] = c
+            k += 1
+            cflag[c] = 0
+    cuda.syncthreads()
+    return cnt[nb]
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels():
+    """Compile (lazily, once) the device functions and kernels."""
+    bind_cuda()
     from numba import float64 as _float64
     from numba import int64 as _int64
 
@@ -114,6 +154,7 @@ def _kernels():
     kin = dev(K3.tool_kinematics_py)
     tstep = dev(jc.rebind(K3.tool_step_py, tool_kinematics=kin, tool_support_step=sup))
     lsum3 = dev(K3.lane_sum3_py)
+    chunks = dev(chunk_list_py)
     LANES = K3.N_SUM_LANES
     float64 = _float64
     int64 = _int64
@@ -267,7 +308,6 @@ def _kernels():
         nb = cuda.blockDim.x
         nn = x.shape[0]
         ne = conn.shape[0]
-        nchunk = cflag.shape[0]
         px = cuda.shared.array(LANES, float64)
         py = cuda.shared.array(LANES, float64)
         pz = cuda.shared.array(LANES, float64)
@@ -288,31 +328,7 @@ def _kernels():
             if cuda.blockIdx.x == 0:
                 # block 0: the contact-force total in the CPU's lane order, visiting only
                 # the chunks that hold a contact node (the others add nothing), then the tool
-                q = (nchunk + nb - 1) // nb
-                c0 = min(t * q, nchunk)
-                c1 = min(c0 + q, nchunk)
-                k = 0
-                for c in range(c0, c1):
-                    if cflag[c] != 0:
-                        k += 1
-                cnt[t] = k
-                cuda.syncthreads()
-                if t == 0:
-                    acc = 0
-                    for j in range(nb):
-                        v = cnt[j]
-                        cnt[j] = acc
-                        acc += v
-                    cnt[nb] = acc
-                cuda.syncthreads()
-                k = cnt[t]
-                for c in range(c0, c1):
-                    if cflag[c] != 0:
-                        clist[k] = c
-                        k += 1
-                        cflag[c] = 0
-                cuda.syncthreads()
-                m = cnt[nb]
+                m = chunks(cflag, clist, cnt, t, nb)
                 for lane in range(t, LANES, nb):
                     sx = 0.0
                     sy = 0.0

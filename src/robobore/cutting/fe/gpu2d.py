@@ -43,7 +43,13 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.gpu import _MAX_BLOCK, jc_device_functions, require_gpu
+from robobore.cutting.fe.gpu import (
+    _MAX_BLOCK,
+    bind_cuda,
+    chunk_list_py,
+    jc_device_functions,
+    require_gpu,
+)
 from robobore.cutting.fe.rezone import MODE_ROWS
 from robobore.errors import ConfigError
 
@@ -81,9 +87,7 @@ def check_gpu_supported(rezone_interval: int, source: str | None = None,
 def _kernels():
     """Compile (lazily, once) the device functions and kernels."""
     global cuda
-    from numba import cuda as _cuda
-
-    cuda = _cuda
+    cuda = bind_cuda()  # also the gpu module's, for chunk_list_py
     from numba import float64 as _float64
     from numba import int64 as _int64
 
@@ -118,6 +122,7 @@ def _kernels():
     thelem = dev(K.tool_heat_elem_py)
     sumen = dev(K.sum_energies_py)
     lsum = dev(K.lane_sum_py)
+    chunks = dev(chunk_list_py)
     LANES = K.N_SUM_LANES
     float64 = _float64
     int64 = _int64
@@ -338,7 +343,6 @@ def _kernels():
         nn = x.shape[0]
         ne = conn.shape[0]
         npair = ppair.shape[0]
-        nchunk = cflag.shape[0]
         px = cuda.shared.array(LANES, float64)
         py = cuda.shared.array(LANES, float64)
         cnt = cuda.shared.array(NCNT, int64)
@@ -360,31 +364,7 @@ def _kernels():
             if cuda.blockIdx.x == 0:
                 # block 0: the contact-force total in the CPU's lane order over the chunks
                 # holding a contact node (the others hold zeros), then the tool
-                q = (nchunk + nb - 1) // nb
-                c0 = min(t * q, nchunk)
-                c1 = min(c0 + q, nchunk)
-                k = 0
-                for c in range(c0, c1):
-                    if cflag[c] != 0:
-                        k += 1
-                cnt[t] = k
-                cuda.syncthreads()
-                if t == 0:
-                    acc = 0
-                    for j in range(nb):
-                        v = cnt[j]
-                        cnt[j] = acc
-                        acc += v
-                    cnt[nb] = acc
-                cuda.syncthreads()
-                k = cnt[t]
-                for c in range(c0, c1):
-                    if cflag[c] != 0:
-                        clist[k] = c
-                        k += 1
-                        cflag[c] = 0
-                cuda.syncthreads()
-                m = cnt[nb]
+                m = chunks(cflag, clist, cnt, t, nb)
                 for lane in range(t, LANES, nb):
                     sx = 0.0
                     sy = 0.0
