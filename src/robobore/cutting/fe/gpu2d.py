@@ -387,7 +387,9 @@ def _kernels():
                     en[E_EXT] += tstep(tool, prm, sx, sy, dt)
                     if prm[P_COND_EVERY] > 0.0:
                         prm[P_COND_ACC] += dt
-            # elements (they read neither the tool nor the contact forces)
+            # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
+            # elements' gated erosion reads (as after k_tool): a barrier before the elements
+            grid.sync()
             for e in range(tid, ne, nthr):
                 d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
                               eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
