@@ -1,0 +1,125 @@
+"""Compile the GPU engines' persistent kernels for a GPU architecture WITHOUT a GPU, and print
+their resource use (registers, spills) from ``ptxas``.
+
+A device call costs minutes; this catches compile errors (a non-constant shared-array shape,
+an untyped closure) and register growth on any machine. Needs, in the environment that runs
+it (a side virtual environment is fine)::
+
+    pip install -e . "numba-cuda" nvidia-cuda-nvcc-cu12 nvidia-cuda-nvrtc-cu12
+
+Usage::
+
+    python benchmarks/gpu_compile_check.py [--cc 9.0]
+
+numba-cuda asks the current device for its compute capability when it compiles device
+functions; with no device there, this script answers with ``--cc`` (a development aid, not
+something the engines do).
+"""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+import types
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _ptxas() -> str | None:
+    """The ``ptxas`` of the nvidia-cuda-nvcc wheel, or None."""
+    try:
+        import nvidia
+    except ImportError:
+        return None
+    for base in nvidia.__path__:
+        hits = glob.glob(os.path.join(base, "cuda_nvcc", "bin", "ptxas"))
+        if hits:
+            return hits[0]
+    return None
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cc", default="9.0", help="compute capability, e.g. 9.0 (H100)")
+    a = ap.parse_args()
+    cc = tuple(int(v) for v in a.cc.split("."))
+    try:
+        import numba.cuda.dispatcher as disp
+        import numba_cuda  # noqa: F401  (numba's built-in CUDA target cannot do this)
+        from numba import cuda, typeof
+    except Exception as e:  # pragma: no cover - depends on the environment
+        print(f"needs numba-cuda ({type(e).__name__}: {e}): pip install numba-cuda "
+              "nvidia-cuda-nvcc-cu12 nvidia-cuda-nvrtc-cu12 (see the module docstring)")
+        return 2
+    disp.get_current_device = lambda: types.SimpleNamespace(compute_capability=cc)
+
+    from robobore.cutting.fe import gpu, gpu2d
+    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.solver import setup_orthogonal
+    from robobore.io.config import load_toml
+
+    d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
+    d["mesh"]["element_size_um"] = 16.6
+    st3 = setup_boring(parse_boring_config(d)).state
+    cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
+    cfg.cut.length_mm = 0.05
+    st2 = setup_orthogonal(cfg).state
+
+    def chunk_arrays(nn: int) -> list:
+        n = (nn + K.N_SUM_LANES - 1) // K.N_SUM_LANES
+        return [np.zeros(n, np.int32), np.zeros(n, np.int64)]
+
+    cases = {
+        "3D k_run": (gpu._kernels()[-1],
+                     [1] + [np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS]
+                     + [int(st3.prm[K3.P_EROSION]), np.zeros(gpu.N_RED)]
+                     + chunk_arrays(st3.x.shape[0])),
+        "2D k_run": (gpu2d._kernels()[-1],
+                     [1] + [np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS]
+                     + [int(st2.prm[K.P_EROSION]), 1, 1, np.zeros(gpu2d.N_RED)]
+                     + chunk_arrays(st2.x.shape[0])),
+    }
+    ptxas = _ptxas()
+    rc = 0
+    for name, (kernel, args) in cases.items():
+        t0 = time.perf_counter()
+        try:
+            ptx, _ = cuda.compile_ptx(kernel.py_func, tuple(typeof(v) for v in args), cc=cc)
+        except Exception as e:
+            print(f"{name}: DOES NOT COMPILE: {type(e).__name__}: {str(e)[:2000]}")
+            rc = 1
+            continue
+        line = f"{name}: PTX {len(ptx)} characters in {time.perf_counter() - t0:.1f} s"
+        if ptxas is not None:
+            with tempfile.TemporaryDirectory() as tmp:
+                f = Path(tmp) / "k.ptx"
+                f.write_text(ptx)
+                p = subprocess.run([ptxas, f"-arch=sm_{cc[0]}{cc[1]}", "-c", "-v", str(f),
+                                    "-o", str(Path(tmp) / "k.o")],
+                                   capture_output=True, text=True)
+            regs = re.findall(r"Used (\d+) registers", p.stderr)
+            spill = re.findall(r"(\d+) bytes spill stores, (\d+) bytes spill loads", p.stderr)
+            if p.returncode != 0:
+                line += f"; ptxas failed: {p.stderr[-500:]}"
+                rc = 1
+            else:
+                line += (f"; {regs[-1] if regs else '?'} registers a thread, spills "
+                         f"(stores/loads bytes) {spill[-1] if spill else '?'}")
+        print(line, flush=True)
+    return rc
+
+
+if __name__ == "__main__":
+    sys.exit(main())
