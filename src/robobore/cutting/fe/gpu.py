@@ -428,20 +428,11 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     step0 = int(st.ist[K3.I_STEP])
     g = d
     tick = _ticker(profile)
-    run = None
-    auto = persistent is None
-    if auto:
-        persistent = profile is None
-    if persistent:
-        nchunk = (nn + K3.N_SUM_LANES - 1) // K3.N_SUM_LANES
-        cflag = cuda.to_device(np.zeros(nchunk, np.int32))
-        clist = cuda.to_device(np.zeros(nchunk, np.int64))
-        args = [g[name] for name in _RUN_ARGS]
-        args += [erosion, dred, cflag, clist]
-        run = _cooperative(k_run, [1] + args, _THREADS, fallback=auto)
+    run = _persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
+                          profile, persistent)
     while True:
         if run is not None:
-            run(chunk_steps, *args)
+            run(chunk_steps)
         for _ in range(0 if run is not None else chunk_steps):
             tick(None)
             k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
@@ -486,6 +477,25 @@ _RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "nc
              "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
              "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
              "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs")
+
+
+def _persistent_run(kernel, args: list, n_nodes: int, profile, persistent: bool | None):
+    """``run(n_steps)`` of a persistent kernel whose arguments are ``n_steps``, ``args``, the
+    chunk flags and the chunk list (allocated here for ``n_nodes`` nodes); ``None`` where the
+    caller launches one kernel per phase (``persistent`` False, or None with a ``profile``,
+    or a cooperative launch that cannot be set up -- then with a warning)."""
+    from robobore.cutting.fe.kernels import N_SUM_LANES
+
+    auto = persistent is None
+    if not (profile is None if auto else persistent):
+        return None
+    nchunk = (n_nodes + N_SUM_LANES - 1) // N_SUM_LANES
+    args = list(args) + [cuda.to_device(np.zeros(nchunk, np.int32)),
+                         cuda.to_device(np.zeros(nchunk, np.int64))]
+    launch = _cooperative(kernel, [1] + args, _THREADS, fallback=auto)
+    if launch is None:
+        return None
+    return lambda n_steps: launch(n_steps, *args)
 
 
 def _cooperative(kernel, args: list, threads: int, fallback: bool = False):

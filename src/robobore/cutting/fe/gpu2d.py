@@ -465,7 +465,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     as in :func:`robobore.cutting.fe.gpu.advance3_gpu` (per-kernel wall times for
     benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
-    from robobore.cutting.fe.gpu import _cooperative, _ticker
+    from robobore.cutting.fe.gpu import _persistent_run, _ticker
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
@@ -495,20 +495,11 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     t_start = st.time
     step0 = int(st.ist[K.I_STEP])
     tick = _ticker(profile)
-    run = None
-    auto = persistent is None
-    if auto:
-        persistent = profile is None
-    if persistent:
-        nchunk = (nn + K.N_SUM_LANES - 1) // K.N_SUM_LANES
-        cflag = cuda.to_device(np.zeros(nchunk, np.int32))
-        clist = cuda.to_device(np.zeros(nchunk, np.int64))
-        args = [g[name] for name in _ARRAYS]
-        args += [erosion, cond_every, int(theat), dred, cflag, clist]
-        run = _cooperative(k_run, [1] + args, _THREADS, fallback=auto)
+    run = _persistent_run(k_run, [g[name] for name in _ARRAYS]
+                          + [erosion, cond_every, int(theat), dred], nn, profile, persistent)
     while True:
         if run is not None:
-            run(chunk_steps, *args)
+            run(chunk_steps)
         # while the status is OK every launch sequence is exactly one step, so the host
         # knows the step index (conduction runs where ist[I_STEP] % cond_every == 0, as on
         # the CPU); once the status changes the remaining launches return at once
