@@ -166,54 +166,59 @@ def _timed(fn, *args, **kwargs) -> tuple[float, int]:
     return time.perf_counter() - t0, n
 
 
+def _speed_row(st0, n_elements: int, advance, advance_gpu, diff, gpu_steps: int,
+               cpu_steps: int, use_gpu: bool, profile: bool) -> dict:
+    """Throughput of one engine from the initial state ``st0`` on the CPU (``advance``) and
+    on the GPU (``advance_gpu``: persistent kernel, then one launch per kernel), and the
+    state difference ``diff(cpu, gpu)`` after the same steps."""
+    dt = float(st0.clock[1])
+
+    def t_after(steps: int) -> float:
+        return st0.time + (steps - 0.5) * dt
+
+    def rate(wall: float, n: int) -> dict:
+        return {"steps": n, "wall_s": wall, "element_updates_per_s": n_elements * n / wall}
+
+    row = {"elements": n_elements, "nodes": int(st0.x.shape[0]), "time_step_s": dt}
+    advance(copy.deepcopy(st0), t_after(3), chunk_steps=10)  # compile / load the cache
+    c = copy.deepcopy(st0)
+    row["cpu"] = rate(*_timed(advance, c, t_after(cpu_steps), chunk_steps=cpu_steps))
+    if not use_gpu:
+        return row
+    advance_gpu(copy.deepcopy(st0), t_after(3), chunk_steps=10)  # compile, first launches
+    g = copy.deepcopy(st0)
+    advance_gpu(g, t_after(cpu_steps), chunk_steps=cpu_steps)
+    row["same_steps_difference"] = diff(c, g)
+    row["gpu"] = rate(*_timed(advance_gpu, copy.deepcopy(st0), t_after(gpu_steps),
+                              chunk_steps=gpu_steps))
+    row["gpu"]["includes"] = "host-device copies of the whole state, in and out"
+    row["speedup"] = row["gpu"]["element_updates_per_s"] / row["cpu"]["element_updates_per_s"]
+    m = min(gpu_steps, 1000)
+    row["gpu_launch_per_kernel"] = rate(*_timed(advance_gpu, copy.deepcopy(st0), t_after(m),
+                                                chunk_steps=m, persistent=False))
+    if profile:
+        prof: dict[str, float] = {}
+        m = min(gpu_steps, 500)
+        advance_gpu(copy.deepcopy(st0), t_after(m), chunk_steps=m, profile=prof)
+        row["gpu_profile_us_per_step"] = {k: 1e6 * v / m for k, v in prof.items()}
+    return row
+
+
 def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
     from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.fe.solver3d import advance3
 
+    advance3_gpu = None
+    if use_gpu:
+        from robobore.cutting.fe.gpu import advance3_gpu
     numba.set_num_threads(cpu_threads)
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
-        s = setup_boring(parse_boring_config(_boring_dict(le, 400.0, 0.15, True)))
-        st0 = s.state
-        dt = float(st0.clock[1])
-        ne = st0.n_elements
-        row = {"element_size_um": le, "elements": ne, "nodes": int(st0.x.shape[0]),
-               "time_step_s": dt}
-        # CPU: warm up (compile / cache) on a copy, then the timed steps
-        w = copy.deepcopy(st0)
-        advance3(w, st0.time + 2.5 * dt, chunk_steps=10)
-        c = copy.deepcopy(st0)
-        t_c = st0.time + (cpu_steps - 0.5) * dt
-        wall, n = _timed(advance3, c, t_c, chunk_steps=cpu_steps)
-        row["cpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall}
-        if use_gpu:
-            from robobore.cutting.fe.gpu import advance3_gpu
-
-            w = copy.deepcopy(st0)
-            advance3_gpu(w, st0.time + 2.5 * dt, chunk_steps=10)  # compile, first launches
-            g = copy.deepcopy(st0)
-            wall, n = _timed(advance3_gpu, g, t_c, chunk_steps=cpu_steps)
-            row["same_steps_difference"] = _diff3(c, g)
-            g = copy.deepcopy(st0)
-            t_g = st0.time + (gpu_steps - 0.5) * dt
-            wall, n = _timed(advance3_gpu, g, t_g, chunk_steps=gpu_steps)
-            row["gpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall,
-                          "includes": "host-device copies of the whole state, in and out"}
-            row["speedup"] = row["gpu"]["element_updates_per_s"] / \
-                row["cpu"]["element_updates_per_s"]
-            g = copy.deepcopy(st0)
-            m = min(gpu_steps, 1000)
-            wall, n = _timed(advance3_gpu, g, st0.time + (m - 0.5) * dt, chunk_steps=m,
-                             persistent=False)
-            row["gpu_launch_per_kernel"] = {"steps": n, "wall_s": wall,
-                                            "element_updates_per_s": ne * n / wall}
-            if profile:
-                prof: dict[str, float] = {}
-                g = copy.deepcopy(st0)
-                m = min(gpu_steps, 500)
-                advance3_gpu(g, st0.time + (m - 0.5) * dt, chunk_steps=m, profile=prof)
-                row["gpu_profile_us_per_step"] = {k: 1e6 * v / m for k, v in prof.items()}
+        st0 = setup_boring(parse_boring_config(_boring_dict(le, 400.0, 0.15, True))).state
+        row = {"element_size_um": le, **_speed_row(st0, st0.n_elements, advance3,
+                                                    advance3_gpu, _diff3, gpu_steps,
+                                                    cpu_steps, use_gpu, profile)}
         res["runs"].append(row)
         print(json.dumps(row), flush=True)
     return res
@@ -252,14 +257,12 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
 
 
 # ----------------------------------------------------------------------------------- 2D
-def _ortho_cfg(le: float, length_mm: float, parallel: bool | None):
+def _ortho_cfg(le: float, length_mm: float):
     from robobore.cutting.fe.config import load_fe_config
 
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
     cfg.mesh.element_size_um = le
     cfg.cut.length_mm = length_mm
-    if parallel is not None and hasattr(cfg.solver, "parallel"):
-        cfg.solver.parallel = parallel
     return cfg
 
 
@@ -277,48 +280,16 @@ def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
             use_gpu: bool, profile: bool) -> dict:
     from robobore.cutting.fe.solver import advance, setup_orthogonal
 
+    advance_gpu = None
+    if use_gpu:
+        from robobore.cutting.fe.gpu2d import advance_gpu
     numba.set_num_threads(cpu_threads)
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
-        s = setup_orthogonal(_ortho_cfg(le, 1.0, True))
-        st0 = s.state
-        dt = float(st0.clock[1])
-        ne = int(st0.conn.shape[0])
-        row = {"element_size_um": le, "elements": ne, "nodes": int(st0.x.shape[0]),
-               "time_step_s": dt}
-        w = copy.deepcopy(st0)
-        advance(w, st0.time + 2.5 * dt, chunk_steps=10)
-        c = copy.deepcopy(st0)
-        t_c = st0.time + (cpu_steps - 0.5) * dt
-        wall, n = _timed(advance, c, t_c, chunk_steps=cpu_steps)
-        row["cpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall}
-        if use_gpu:
-            from robobore.cutting.fe.gpu2d import advance_gpu
-
-            w = copy.deepcopy(st0)
-            advance_gpu(w, st0.time + 2.5 * dt, chunk_steps=10)
-            g = copy.deepcopy(st0)
-            wall, n = _timed(advance_gpu, g, t_c, chunk_steps=cpu_steps)
-            row["same_steps_difference"] = _diff2(c, g)
-            g = copy.deepcopy(st0)
-            t_g = st0.time + (gpu_steps - 0.5) * dt
-            wall, n = _timed(advance_gpu, g, t_g, chunk_steps=gpu_steps)
-            row["gpu"] = {"steps": n, "wall_s": wall, "element_updates_per_s": ne * n / wall,
-                          "includes": "host-device copies of the whole state, in and out"}
-            row["speedup"] = row["gpu"]["element_updates_per_s"] / \
-                row["cpu"]["element_updates_per_s"]
-            g = copy.deepcopy(st0)
-            m = min(gpu_steps, 1000)
-            t_m = st0.time + (m - 0.5) * dt
-            wall, n = _timed(advance_gpu, g, t_m, chunk_steps=m, persistent=False)
-            row["gpu_launch_per_kernel"] = {"steps": n, "wall_s": wall,
-                                            "element_updates_per_s": ne * n / wall}
-            if profile:
-                prof: dict[str, float] = {}
-                g = copy.deepcopy(st0)
-                m = min(gpu_steps, 500)
-                advance_gpu(g, st0.time + (m - 0.5) * dt, chunk_steps=m, profile=prof)
-                row["gpu_profile_us_per_step"] = {k: 1e6 * v / m for k, v in prof.items()}
+        st0 = setup_orthogonal(_ortho_cfg(le, 1.0)).state
+        row = {"element_size_um": le, **_speed_row(st0, int(st0.conn.shape[0]), advance,
+                                                    advance_gpu, _diff2, gpu_steps,
+                                                    cpu_steps, use_gpu, profile)}
         res["runs"].append(row)
         print(json.dumps(row), flush=True)
     return res
@@ -329,7 +300,7 @@ def ortho2d(devices: list[str], length_mm: float, le: float) -> dict:
 
     by = {}
     for dev in devices:
-        r = simulate_orthogonal(_ortho_cfg(le, length_mm, None), device=dev)
+        r = simulate_orthogonal(_ortho_cfg(le, length_mm), device=dev)
         s = r.summary
         by[dev] = {k: s.get(k) for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
                                          "chip_ratio", "peak_temperature_K", "energy_error",

@@ -170,6 +170,25 @@ def _kernels():
                                                K3.H_UY, K3.H_UZ)
     H_NCONT, H_TIPX, H_THETA, H_EEXT = K3.H_NCONT, K3.H_TIPX, K3.H_THETA, K3.H_EEXT
 
+    @cuda.jit(device=True)
+    def lanes_total(px, py, pz, pn, red):
+        # the lanes' partial sums added in lane order by one thread: the order of the CPU's
+        # kernels3d.contact_total3, so the total has the same bits on both devices
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
+        sn = 0.0
+        for j in range(LANES):
+            sx += px[j]
+            sy += py[j]
+            sz += pz[j]
+            sn += pn[j]
+        red[R_FX] = sx
+        red[R_FY] = sy
+        red[R_FZ] = sz
+        red[R_NC] = sn
+        return sx, sy, sz
+
     @cuda.jit
     def k_nodes(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
                 pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red, pairs):
@@ -196,19 +215,7 @@ def _kernels():
         pn[t] = k
         cuda.syncthreads()
         if t == 0:
-            sx = 0.0
-            sy = 0.0
-            sz = 0.0
-            sn = 0.0
-            for j in range(LANES):
-                sx += px[j]
-                sy += py[j]
-                sz += pz[j]
-                sn += pn[j]
-            red[R_FX] = sx
-            red[R_FY] = sy
-            red[R_FZ] = sz
-            red[R_NC] = sn
+            lanes_total(px, py, pz, pn, red)
 
     @cuda.jit
     def k_tool(tool, prm, en, clock, ist, red):
@@ -347,19 +354,7 @@ def _kernels():
                     pn[lane] = sc
                 cuda.syncthreads()
                 if t == 0:
-                    sx = 0.0
-                    sy = 0.0
-                    sz = 0.0
-                    sn = 0.0
-                    for j in range(LANES):
-                        sx += px[j]
-                        sy += py[j]
-                        sz += pz[j]
-                        sn += pn[j]
-                    red[R_FX] = sx
-                    red[R_FY] = sy
-                    red[R_FZ] = sz
-                    red[R_NC] = sn
+                    sx, sy, sz = lanes_total(px, py, pz, pn, red)
                     en[E_EXT] += tstep(tool, prm, sx, sy, sz, dt)
             # elements (they do not read the tool or the contact forces: no barrier needed
             # after block 0's work above)
@@ -409,12 +404,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run = _kernels()
     st.prm[K3.P_TEND] = t_end
     st.ist[K3.I_STATUS] = K3.STATUS_OK
-    d = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name)))
-         for name in ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel",
-                      "ncorner", "conn", "alive", "layer", "sd", "pres", "eps_p", "temp",
-                      "dmg", "qh", "vol0", "ie", "hge", "fe", "dte", "plast", "rate", "cf",
-                      "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en",
-                      "ist", "clock", "hacc", "hist", "pairs")}
+    g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _RUN_ARGS}
     red = np.zeros(N_RED)
     red[R_DTMIN] = 1e30
     red[R_BAD] = -1.0
@@ -426,7 +416,6 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     erosion = int(st.prm[K3.P_EROSION])
     t_start = st.time
     step0 = int(st.ist[K3.I_STEP])
-    g = d
     tick = _ticker(profile)
     run = _persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
                           profile, persistent)
@@ -471,8 +460,8 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
             return int(st.ist[K3.I_STEP]) - step0
 
 
-#: the state arrays of the persistent kernel, in its argument order (then erosion, red,
-#: the chunk flags and the chunk list)
+#: the state arrays on the device, in the persistent kernel's argument order (then erosion,
+#: red, the chunk flags and the chunk list)
 _RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
              "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
              "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",

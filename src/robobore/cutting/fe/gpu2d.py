@@ -145,6 +145,19 @@ def _kernels():
                                                              K.H_EERO)
     KCOND, RHO, CP = jc.KCOND, jc.RHO, jc.CP
 
+    @cuda.jit(device=True)
+    def lanes_total(px, py, red):
+        # the lanes' partial sums added in lane order by one thread: the order of the CPU's
+        # kernels.contact_total, so the total has the same bits on both devices
+        sx = 0.0
+        sy = 0.0
+        for j in range(LANES):
+            sx += px[j]
+            sy += py[j]
+        red[R_FX] = sx
+        red[R_FY] = sy
+        return sx, sy
+
     @cuda.jit
     def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
                 fric, pen, ndead, ero_ke, nwork, prm, tool, clock, ist, twin, tied, red):
@@ -169,13 +182,7 @@ def _kernels():
         py[t] = lsum(cfy, t, LANES)
         cuda.syncthreads()
         if t == 0:
-            sx = 0.0
-            sy = 0.0
-            for j in range(LANES):
-                sx += px[j]
-                sy += py[j]
-            red[R_FX] = sx
-            red[R_FY] = sy
+            lanes_total(px, py, red)
 
     @cuda.jit
     def k_tool(tool, prm, en, clock, ist, red):
@@ -377,13 +384,7 @@ def _kernels():
                     py[lane] = sy
                 cuda.syncthreads()
                 if t == 0:
-                    sx = 0.0
-                    sy = 0.0
-                    for j in range(LANES):
-                        sx += px[j]
-                        sy += py[j]
-                    red[R_FX] = sx
-                    red[R_FY] = sy
+                    sx, sy = lanes_total(px, py, red)
                     en[E_EXT] += tstep(tool, prm, sx, sy, dt)
                     if prm[P_COND_EVERY] > 0.0:
                         prm[P_COND_ACC] += dt
