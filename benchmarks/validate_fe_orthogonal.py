@@ -12,6 +12,7 @@ Usage::
     python benchmarks/validate_fe_orthogonal.py [--length-mm 1.0] [--element-um 10]
         [--data PATH] [--json OUT.json] [--points 60:30,40:5] [--separation node_split]
         [--separation-height-um 5] [--edge-um 2.5] [--band-um 10,10] [--conduction]
+        [--frame tool] [--friction 0.3|table] [--friction-velocity sliding] [--save-dir DIR]
 
 Prints a table (measured, simulated, error, pass) and the run times.
 """
@@ -87,6 +88,9 @@ def main() -> None:
     ap.add_argument("--friction", type=friction, default=None,
                     help='contact.friction: a number (e.g. 0.3, the paper\'s modified Coulomb '
                          'value) or "table" (Rech et al. 2013, the default of config())')
+    ap.add_argument("--friction-velocity", choices=["cutting_speed", "sliding"], default=None,
+                    help='contact.friction_velocity: read the friction table at the cutting '
+                    'speed (default) or at each contact node\'s sliding speed')
     ap.add_argument("--frame", choices=["workpiece", "tool"], default=None,
                     help='mesh.frame: "tool" runs the tool-frame ALE model (--edge-um is then '
                     'the element round the edge; the separation options are not used)')
@@ -105,7 +109,8 @@ def main() -> None:
           f"(height {args.separation_height_um} um), edge band {args.edge_um} um "
           f"({args.band_um or 'default'}), conduction {args.conduction}, erosion "
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, tool conductance "
-          f"{args.tool_conductance}, friction {args.friction or 'table'}, friction heat "
+          f"{args.tool_conductance}, friction {args.friction or 'table'} at "
+          f"{args.friction_velocity or 'cutting_speed'}, friction heat "
           f"{args.friction_heat_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
@@ -138,6 +143,8 @@ def main() -> None:
         contact: dict = {}
         if args.friction is not None:
             contact["friction"] = args.friction
+        if args.friction_velocity is not None:
+            contact["friction_velocity"] = args.friction_velocity
         if args.tool_conductance is not None:
             contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
         if args.friction_heat_fraction is not None:
@@ -164,7 +171,7 @@ def main() -> None:
                    pass_chip_velocity=bool(abs(s["chip_ratio_velocity"] - r_m) <= 0.3 * r_m),
                    energy_error=s["energy_error"], wall_s=time.perf_counter() - t0,
                    pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
-                   friction=s["friction_coefficient"],
+                   friction=s["friction_coefficient"], friction_law=s.get("friction_law"),
                    eroded_distortion=s.get("eroded_distortion"),
                    eroded_chip_mass_fraction=s.get("eroded_chip_mass_fraction"),
                    peak_temperature_K=s.get("peak_temperature_K"),

@@ -38,7 +38,7 @@ SCRIPT = textwrap.dedent("""
         "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
         "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
                 "length_mm": 0.06, "width_mm": 1.0},
-        "contact": {"friction": 0.18},
+        "contact": {"friction": "table", "friction_velocity": "sliding"},
         "mesh": {"element_size_um": 15.0, "separation": "node_split",
                  "separation_height_um": 5.0},
         "solver": {"mass_scaling": 100.0, "heat_conduction": True,
@@ -146,7 +146,8 @@ def _simulator_usable() -> bool:
 def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
     """40 steps of a node-split cut in progress (tool on springs, contact, plastic chip,
     released and tied pairs, conduction every 4 steps with the thermal contact and the tied
-    parting-line edges, histories every 5 steps): the CUDA
+    parting-line edges, histories every 5 steps, friction from the Rech table at each
+    contact node's sliding speed): the CUDA
     kernels run in numba's simulator give the same bits as the CPU engine: both devices
     run the same scalar functions, sum the contact force in the same fixed order
     (``kernels.contact_total``), and use atomics only for exact operations (a count, a min,

@@ -25,6 +25,7 @@ _KEYS = [
     ("eroded_damage", "elements eroded (damage)"),
     ("eroded_distortion", "elements eroded (distortion/time step)"),
     ("friction_coefficient", "Coulomb friction used"),
+    ("friction_law", "friction law"),
     ("n_elements", "elements"),
     ("device", "device"),
     ("steps", "time steps"),

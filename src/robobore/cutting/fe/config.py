@@ -22,6 +22,8 @@ from robobore.io.config import load_toml, validate_model
 #: "table": linear interpolation, constant beyond the ends.
 FRICTION_TABLE_VC_M_MIN = np.array([5.0, 7.5, 10.0, 20.0, 30.0, 40.0])
 FRICTION_TABLE_MU = np.array([0.24, 0.22, 0.21, 0.19, 0.18, 0.17])
+#: most points of a friction table (the engine's parameter slots: kernels.MU_TABLE_MAX)
+MU_TABLE_MAX = 8
 
 
 class _Strict(BaseModel):
@@ -70,12 +72,54 @@ class ContactSection(_Strict):
     #: temperature of the tool [K]; None: the material's room temperature
     tool_temperature_K: float | None = Field(default=None, gt=0.0, le=3000.0)
 
+    #: what the friction table's velocity is (friction = "table"): "cutting_speed" -- one
+    #: coefficient for the whole run, the table at cut.cutting_speed_m_per_min -- or
+    #: "sliding" -- every node in contact, every step, uses the table at its own sliding
+    #: speed relative to the tool (the chip's speed ~vc / r up the rake, ~0 in the stagnation
+    #: zone at the edge): how a tribometer's mu(sliding velocity) is read, as Abaqus'
+    #: slip-rate-dependent friction; constant beyond the table's ends. 2D engine only
+    friction_velocity: Literal["cutting_speed", "sliding"] = "cutting_speed"
+    #: the friction table's velocities [m/min], increasing, 2..8 points; None: the Rech et
+    #: al. 2013 table (FRICTION_TABLE_VC_M_MIN). Give friction_table_mu with it
+    friction_table_velocity_m_per_min: list[float] | None = None
+    #: the friction table's Coulomb coefficients (0..2), one per velocity
+    friction_table_mu: list[float] | None = None
+
     @field_validator("friction")
     @classmethod
     def _mu(cls, v: Any) -> Any:
         if isinstance(v, float) and not (0.0 <= v <= 2.0):
             raise ValueError("friction coefficient must be within 0..2")
         return v
+
+    @model_validator(mode="after")
+    def _table(self) -> ContactSection:
+        v, mu = self.friction_table_velocity_m_per_min, self.friction_table_mu
+        if (v is None) != (mu is None):
+            raise ValueError("friction_table_velocity_m_per_min and friction_table_mu go "
+                             "together: give both or neither")
+        table_keys = v is not None or self.friction_velocity != "cutting_speed"
+        if self.friction != "table" and table_keys:
+            raise ValueError(f"friction = {self.friction!r} is a constant coefficient: the "
+                             "friction table keys (friction_table_*, friction_velocity) need "
+                             'friction = "table"')
+        if v is not None and mu is not None:
+            if not 2 <= len(v) <= MU_TABLE_MAX or len(mu) != len(v):
+                raise ValueError(f"friction table: {len(v)} velocities and {len(mu)} "
+                                 f"coefficients; expected the same number, 2..{MU_TABLE_MAX}")
+            if v[0] < 0.0 or any(b <= a for a, b in zip(v, v[1:], strict=False)):
+                raise ValueError(f"friction_table_velocity_m_per_min = {v}: expected "
+                                 "increasing velocities >= 0 m/min")
+            if any(not 0.0 <= m <= 2.0 for m in mu):
+                raise ValueError(f"friction_table_mu = {mu}: expected coefficients in 0..2")
+        return self
+
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """The friction table: velocities [m/min] and Coulomb coefficients."""
+        if self.friction_table_velocity_m_per_min is None:
+            return FRICTION_TABLE_VC_M_MIN, FRICTION_TABLE_MU
+        return (np.asarray(self.friction_table_velocity_m_per_min, float),
+                np.asarray(self.friction_table_mu, float))
 
 
 class MeshSection(_Strict):
@@ -227,11 +271,25 @@ class FEConfig(_Strict):
     tool_support: ToolSupport | None = None
 
     def friction_coefficient(self) -> float:
-        """Coulomb coefficient used (the value given, or the table at the cutting speed)."""
+        """Coulomb coefficient used (the value given, or the table at the cutting speed).
+
+        With ``contact.friction_velocity = "sliding"`` this is the table at the cutting speed
+        (nominal); each contact node then uses the table at its own sliding speed.
+        """
         if self.contact.friction == "table":
-            return float(np.interp(self.cut.cutting_speed_m_per_min,
-                                   FRICTION_TABLE_VC_M_MIN, FRICTION_TABLE_MU))
+            v, mu = self.contact.table()
+            return float(np.interp(self.cut.cutting_speed_m_per_min, v, mu))
         return float(self.contact.friction)
+
+    def friction_law(self) -> str:
+        """The friction law in words (for summaries)."""
+        c = self.contact
+        if c.friction != "table":
+            return f"Coulomb {float(c.friction):g}"
+        src = "Rech et al. 2013" if c.friction_table_velocity_m_per_min is None else "user"
+        arg = "each node's sliding speed" if c.friction_velocity == "sliding" else \
+            "the cutting speed"
+        return f"Coulomb, {src} table at {arg}"
 
 
 def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:

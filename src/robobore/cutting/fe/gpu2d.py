@@ -107,12 +107,13 @@ def _kernels():
     sup = dev(tool_support_step_py)
     retire = dev(K.quad_retire_py)
     elem = dev(jc.rebind(
-        K.quad_element_py, radial_return=rret, jc_damage_increment=dmg,
+        K.quad_element_py, radial_return=rret, jc_damage_increment=dmg, quad_retire=retire,
         quad_area_corners=dev(K.quad_area_corners_py),
         quad_distorted=dev(jc.rebind(K.quad_distorted_py, quad_retire=retire)),
         quad_bvectors=dev(K.quad_bvectors_py), quad_step=dev(K.quad_step_py),
         damage_erosion=dev(jc.rebind(K.damage_erosion_py, tool_gap=tg))))
-    node = dev(jc.rebind(K.quad_node_py, tool_gap=tg, contact_force=cf))
+    node = dev(jc.rebind(K.quad_node_py, tool_gap=tg, contact_force=cf,
+                         friction_at=dev(K.friction_at_py)))
     kin = dev(K.tool_kinematics_py)
     tstep = dev(jc.rebind(K.tool_step_py, tool_support_step=sup))
     cent = dev(K.quad_centroid_py)

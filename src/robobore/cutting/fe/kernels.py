@@ -69,7 +69,14 @@ P_RZ_MODE = 41
 P_ALE_X0 = 42
 #: viscous contact damping, fraction of the contact spring's critical damping
 P_CDAMP = 43
-N_PRM = 44
+#: friction vs sliding velocity (``contact.friction_velocity = "sliding"``): number of table
+#: points (0: the constant ``P_MU``), then MU_TABLE_MAX velocities [m/s] (increasing) and
+#: MU_TABLE_MAX coefficients; each contact node uses the table at its own sliding speed
+P_MUTAB_N = 44
+MU_TABLE_MAX = 8
+P_MUTAB_V = 45
+P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
+N_PRM = P_MUTAB_MU + MU_TABLE_MAX
 ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
@@ -577,6 +584,30 @@ def element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, p
     return dtmin, bad
 
 
+def friction_at_py(prm, speed):
+    """Coulomb coefficient at the sliding speed ``speed`` [m/s] (>= 0).
+
+    ``prm[P_MUTAB_N]`` = 0: the constant ``prm[P_MU]``; otherwise the table in
+    ``prm[P_MUTAB_V:]`` / ``prm[P_MUTAB_MU:]``, linear between its points and constant beyond
+    its ends (as Abaqus' slip-rate-dependent friction tables).
+    """
+    n = int(prm[P_MUTAB_N])
+    if n == 0:
+        return prm[P_MU]
+    if speed <= prm[P_MUTAB_V]:
+        return prm[P_MUTAB_MU]
+    for i in range(1, n):
+        v1 = prm[P_MUTAB_V + i]
+        if speed <= v1:
+            v0 = prm[P_MUTAB_V + i - 1]
+            m0 = prm[P_MUTAB_MU + i - 1]
+            return m0 + (prm[P_MUTAB_MU + i] - m0) * (speed - v0) / (v1 - v0)
+    return prm[P_MUTAB_MU + n - 1]
+
+
+friction_at = njit(cache=True, inline="always")(friction_at_py)
+
+
 def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
                  cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx,
                  tool_vy, prm, dt, twin, tied):
@@ -600,7 +631,7 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
     """
     r = prm[P_R]
     nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
-    mu, tau, pf = prm[P_MU], prm[P_TAU], prm[P_PEN]
+    tau, pf = prm[P_TAU], prm[P_PEN]
     gate = prm[P_GATE]
     cfx[n] = 0.0
     cfy[n] = 0.0
@@ -659,9 +690,10 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
         vrx = vx[n] - tool_vx
         vry = vy[n] - tool_vy
         trib = math.sqrt(asum / nlive)
+        vt0 = -vrx * gny + vry * gnx
+        mu = friction_at(prm, abs(vt0))
         fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
                                              dt, prm[P_CDAMP], fx, fy)
-        vt0 = -vrx * gny + vry * gnx
         vn0 = vrx * gnx + vry * gny
         pen[n] = share * 0.5 * (fn - fd) * (-gap)
     cfx[n] = share * fcx

@@ -81,6 +81,11 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     # parting line: double its nodes (not the fully fixed ones); the chip rows take the copies
     nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, n_dn)
     p = apply_solver_settings(default_prm3(), cfg.solver, K3)
+    if cfg.contact.friction_velocity != "cutting_speed":
+        raise ConfigError("friction by sliding speed is implemented in the 2D engine only",
+                          field="contact.friction_velocity",
+                          value=cfg.contact.friction_velocity,
+                          expected='"cutting_speed" for the 3D slab')
     p[K3.P_MU] = cfg.friction_coefficient()
     p[K3.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K3.P_PEN] = cfg.contact.penalty_factor

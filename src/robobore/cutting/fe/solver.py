@@ -436,6 +436,11 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p = apply_solver_settings(default_prm(), s, K)
     mu = cfg.friction_coefficient()
     p[K.P_MU] = mu
+    if cfg.contact.friction == "table" and cfg.contact.friction_velocity == "sliding":
+        tv, tmu = cfg.contact.table()
+        p[K.P_MUTAB_N] = tv.size
+        p[K.P_MUTAB_V:K.P_MUTAB_V + tv.size] = tv / 60.0
+        p[K.P_MUTAB_MU:K.P_MUTAB_MU + tv.size] = tmu
     p[K.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K.P_PEN] = cfg.contact.penalty_factor
     nd = cfg.contact.normal_damping
@@ -657,6 +662,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "n_elements": n_el,
         "n_nodes": int(st.x.shape[0]),
         "friction_coefficient": setup.mu,
+        "friction_law": cfg.friction_law(),
         "uncut_chip_thickness_um": cfg.cut.uncut_chip_thickness_um,
         "cutting_speed_m_per_min": cfg.cut.cutting_speed_m_per_min,
         "eroded_damage": int(np.sum(st.alive == 0)),

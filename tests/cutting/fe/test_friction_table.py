@@ -1,0 +1,123 @@
+"""Friction as a function of the sliding velocity (``contact.friction_velocity = "sliding"``).
+
+Reference: a tribometer gives the Coulomb coefficient against the *sliding* velocity (Rech et
+al. 2013, CIRP Annals 62, 79-82, the source of the Ti6Al4V table bundled in
+robobore.cutting.fe.config); a slip-rate-dependent table is read piecewise linearly and is
+constant beyond its ends (as Abaqus' friction tables). The engine looks the coefficient up
+per contact node and step at the node's sliding speed relative to the tool.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import elastic_tc4, strip_mesh
+
+from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe import physics as P
+from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.errors import ConfigError
+
+
+def _prm(v_m_s, mu):
+    p = default_prm()
+    p[K.P_MU] = 0.123
+    p[K.P_MUTAB_N] = len(v_m_s)
+    p[K.P_MUTAB_V:K.P_MUTAB_V + len(v_m_s)] = v_m_s
+    p[K.P_MUTAB_MU:K.P_MUTAB_MU + len(mu)] = mu
+    return p
+
+
+def test_friction_at_is_the_piecewise_linear_table():
+    p = _prm([0.1, 0.5, 1.0], [0.4, 0.2, 0.25])
+    for speed, want in [(0.0, 0.4), (0.1, 0.4), (0.3, 0.3), (0.5, 0.2), (0.75, 0.225),
+                        (1.0, 0.25), (7.0, 0.25)]:
+        assert K.friction_at(p, speed) == pytest.approx(want, rel=1e-14)
+        assert K.friction_at_py(p, speed) == pytest.approx(want, rel=1e-14)
+        assert K.friction_at(p, speed) == pytest.approx(
+            float(np.interp(speed, [0.1, 0.5, 1.0], [0.4, 0.2, 0.25])), rel=1e-14)
+    p[K.P_MUTAB_N] = 0  # no table: the constant coefficient
+    assert K.friction_at(p, 0.3) == 0.123
+
+
+def _cfg(**contact):
+    return {"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
+            "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
+                    "length_mm": 0.01},
+            "contact": {"friction": "table", **contact},
+            "mesh": {"element_size_um": 20, "frame": "tool", "edge_element_um": 5},
+            "solver": {"mass_scaling": 100, "n_samples": 20}}
+
+
+@pytest.mark.parametrize("contact, words", [
+    ({"friction": 0.2, "friction_velocity": "sliding"}, "need friction"),
+    ({"friction": 0.2, "friction_table_velocity_m_per_min": [0, 10],
+      "friction_table_mu": [0.3, 0.2]}, "need friction"),
+    ({"friction_table_velocity_m_per_min": [0, 10]}, "give both"),
+    ({"friction_table_velocity_m_per_min": [0, 10], "friction_table_mu": [0.3]}, "same number"),
+    ({"friction_table_velocity_m_per_min": list(range(9)), "friction_table_mu": [0.2] * 9},
+     "2..8"),
+    ({"friction_table_velocity_m_per_min": [10, 5], "friction_table_mu": [0.3, 0.2]},
+     "increasing"),
+    ({"friction_table_velocity_m_per_min": [-1, 5], "friction_table_mu": [0.3, 0.2]},
+     "increasing"),
+    ({"friction_table_velocity_m_per_min": [0, 5], "friction_table_mu": [0.3, 2.5]}, "0..2"),
+])
+def test_friction_table_config_errors(contact, words):
+    with pytest.raises(ConfigError, match=words) as e:
+        parse_config(_cfg(**contact))
+    assert "contact" in str(e.value)
+
+
+def test_friction_table_at_the_cutting_speed():
+    c = parse_config(_cfg(friction_table_velocity_m_per_min=[0, 60],
+                          friction_table_mu=[0.5, 0.1]))
+    assert c.friction_coefficient() == pytest.approx(0.3)
+    assert c.friction_law() == "Coulomb, user table at the cutting speed"
+    c = parse_config(_cfg())  # the bundled Rech et al. table: 0.18 at 30 m/min
+    assert c.friction_coefficient() == pytest.approx(0.18)
+    assert "Rech" in c.friction_law()
+
+
+def _sliding_block(vc, table_v_m_s, table_mu):
+    """A 200 x 40 um elastic TC4 block, fixed at its bottom, its top 1 nm inside a flat
+    tool face (clearance 0, flank normal (0, -1)) that slides over it in -x at ``vc``."""
+    L, H = 200e-6, 40e-6
+    nodes, conn = strip_mesh(20, 4, L, H)
+    prm = _prm(table_v_m_s, table_mu)
+    prm[K.P_MS] = 100.0  # quasi-static: the friction's shear wave moves the nodes little
+    prm[K.P_R] = 2e-6
+    prm[K.P_NRX], prm[K.P_NRY] = -1.0, 0.0
+    prm[K.P_NFX], prm[K.P_NFY] = 0.0, -1.0
+    prm[K.P_VC] = vc
+    prm[K.P_CDAMP] = 1.0  # critically damped contact: the 1 nm overlap settles, no chatter
+    st = make_state(nodes, conn, nodes[:, 1] < 1e-15, elastic_tc4(), prm=prm,
+                    tool_center=(-10e-6, H + 2e-6 - 1e-9))
+    advance(st, 5e-6 / vc)  # 5 um of sliding
+    cx, cy = st.tool[K.T_GX], st.tool[K.T_GY]
+    out = []
+    for n in np.flatnonzero(np.hypot(st.cfx, st.cfy) > 0):
+        _, gnx, gny = P.tool_gap(st.x[n], st.y[n], cx, cy, -1.0, 0.0, 0.0, -1.0, 2e-6)
+        fn = st.cfx[n] * gnx + st.cfy[n] * gny
+        ft = -st.cfx[n] * gny + st.cfy[n] * gnx
+        vt = -(st.vx[n] + vc) * gny + st.vy[n] * gnx
+        out.append((abs(vt), abs(ft) / fn))
+    return np.array(out)
+
+
+def test_the_engine_slides_against_the_table_at_the_sliding_speed():
+    """A tool face sliding over a block at 0.5 and at 0.25 m/s with mu falling linearly
+    from 0.5 at rest to 0.1 at 1 m/s (and the constant coefficient P_MU = 0.123 unused):
+    every node of the top face is in contact, slides at about the tool's speed (within
+    10 %: the elastic block shears a little) and carries the table's coefficient at its
+    sliding speed within 0.002 (the engine reads the table at the start-of-step speed, the
+    state holds the end-of-step one, ~0.003 m/s apart here) -- 0.3 and 0.4 at the tool's
+    speed (within 0.02)."""
+    v_tab, mu_tab = [0.0, 1.0], [0.5, 0.1]
+    for vc, mu_vc in ((0.5, 0.3), (0.25, 0.4)):
+        r = _sliding_block(vc, v_tab, mu_tab)
+        assert len(r) == 21
+        assert np.allclose(r[:, 0], vc, rtol=0.1)
+        assert np.allclose(r[:, 1], np.interp(r[:, 0], v_tab, mu_tab), rtol=0, atol=2e-3)
+        assert np.allclose(r[:, 1], mu_vc, atol=0.02)
