@@ -121,3 +121,15 @@ def test_the_engine_slides_against_the_table_at_the_sliding_speed():
         assert np.allclose(r[:, 0], vc, rtol=0.1)
         assert np.allclose(r[:, 1], np.interp(r[:, 0], v_tab, mu_tab), rtol=0, atol=2e-3)
         assert np.allclose(r[:, 1], mu_vc, atol=0.02)
+
+
+def test_sliding_friction_is_refused_by_the_3d_slab():
+    from robobore.cutting.fe.slab3d import setup_slab3
+
+    cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
+                        "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
+                                "length_mm": 0.05},
+                        "contact": {"friction": "table", "friction_velocity": "sliding"},
+                        "mesh": {"element_size_um": 20, "separation": "node_split"}})
+    with pytest.raises(ConfigError, match="friction_velocity"):
+        setup_slab3(cfg)
