@@ -84,6 +84,10 @@ class ContactSection(_Strict):
     friction_table_velocity_m_per_min: list[float] | None = None
     #: the friction table's Coulomb coefficients (0..2), one per velocity
     friction_table_mu: list[float] | None = None
+    #: friction_velocity = "sliding": time constant of the low-pass filter on each node's
+    #: sliding speed, as the tool's travel in it [um] (a contact node's velocity chatters
+    #: from step to step; the filtered speed is the material's mean sliding speed there)
+    sliding_filter_um: float = Field(default=1.0, gt=0.0, le=1000.0)
 
     @field_validator("friction")
     @classmethod
@@ -103,6 +107,9 @@ class ContactSection(_Strict):
             raise ValueError(f"friction = {self.friction!r} is a constant coefficient: the "
                              "friction table keys (friction_table_*, friction_velocity) need "
                              'friction = "table"')
+        if "sliding_filter_um" in self.model_fields_set and self.friction_velocity != "sliding":
+            raise ValueError("sliding_filter_um filters the sliding speed of "
+                             'friction_velocity = "sliding"; it is not used otherwise')
         if v is not None and mu is not None:
             if not 2 <= len(v) <= MU_TABLE_MAX or len(mu) != len(v):
                 raise ValueError(f"friction table: {len(v)} velocities and {len(mu)} "

@@ -161,14 +161,14 @@ def _kernels():
 
     @cuda.jit
     def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
-                fric, pen, ndead, ero_ke, nwork, prm, tool, clock, ist, twin, tied, red):
+                fric, pen, ndead, ero_ke, nwork, prm, tool, clock, ist, twin, tied, vslip, red):
         n = cuda.grid(1)
         if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
             return
         cx, cy, tvx, tvy = kin(tool, prm)
         fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0,
                                  fex, fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy,
-                                 tvx, tvy, prm, clock[1], twin, tied)
+                                 tvx, tvy, prm, clock[1], twin, tied, vslip)
         if touched:
             cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
 
@@ -338,7 +338,8 @@ def _kernels():
     def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
               sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte,
               plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool, en, ist,
-              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, erosion, cond_every,
+              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, vslip, erosion,
+              cond_every,
               theat, red, cflag, clist):
         # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
         # of the kernels above separated by grid-wide barriers (one launch per chunk instead
@@ -363,7 +364,8 @@ def _kernels():
             for n in range(tid, nn, nthr):
                 fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
                                          area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
-                                         nwork, cx, cy, tvx, tvy, prm, dt, twin, tied)
+                                         nwork, cx, cy, tvx, tvy, prm, dt, twin, tied,
+                                         vslip)
                 if touched:
                     cuda.atomic.add(red, R_NC, 1.0)
                 if cfx[n] != 0.0 or cfy[n] != 0.0:
@@ -443,12 +445,12 @@ _ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn
            "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
            "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
            "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
-           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair")
+           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair", "vslip")
 #: the arrays the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "vx", "vy", "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p",
             "temp", "dmg", "qhx", "qhy", "ie", "hge", "fex", "fey", "dte", "plast", "rate",
             "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm", "tool", "en", "ist",
-            "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq")
+            "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq", "vslip")
 
 
 def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
@@ -512,7 +514,8 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                                   g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
                                   g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
                                   g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
-                                  g["clock"], g["ist"], g["twin"], g["tied"], dred)
+                                  g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"],
+                                  dred)
             tick("nodes")
             k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], dred)
             tick("contact_sum")

@@ -76,7 +76,9 @@ P_MUTAB_N = 44
 MU_TABLE_MAX = 8
 P_MUTAB_V = 45
 P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
-N_PRM = P_MUTAB_MU + MU_TABLE_MAX
+#: time constant [s] of the filter on the sliding speed the friction table is read at
+P_SLIP_TAU = P_MUTAB_MU + MU_TABLE_MAX
+N_PRM = P_SLIP_TAU + 1
 ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
@@ -610,7 +612,7 @@ friction_at = njit(cache=True, inline="always")(friction_at_py)
 
 def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
                  cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx,
-                 tool_vy, prm, dt, twin, tied):
+                 tool_vy, prm, dt, twin, tied, vslip):
     """Gather element forces on node ``n``, add tool contact, advance its velocity and position.
 
     One node of :func:`node_update` (scalar code, allocates nothing: compiled for the CPU as
@@ -691,7 +693,13 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
         vry = vy[n] - tool_vy
         trib = math.sqrt(asum / nlive)
         vt0 = -vrx * gny + vry * gnx
-        mu = friction_at(prm, abs(vt0))
+        mu = prm[P_MU]
+        if prm[P_MUTAB_N] > 0.0:
+            # the sliding speed, filtered over the time constant prm[P_SLIP_TAU]: a contact
+            # node's velocity chatters from step to step, its mean is the material's sliding
+            vs = vslip[n] + min(1.0, dt / prm[P_SLIP_TAU]) * (abs(vt0) - vslip[n])
+            vslip[n] = vs
+            mu = friction_at(prm, vs)
         fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
                                              dt, prm[P_CDAMP], fx, fy)
         vn0 = vrx * gnx + vry * gny
@@ -723,7 +731,7 @@ quad_node = njit(cache=True, inline="always")(quad_node_py)
 @njit(parallel=True, cache=True)
 def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
                 cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx, tool_vy,
-                prm, dt, twin, tied):
+                prm, dt, twin, tied, vslip):
     """:func:`quad_node_py` over all nodes (parallel).
 
     Returns the number of nodes in contact; their contact forces are in ``cfx``/``cfy``
@@ -734,7 +742,7 @@ def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
         _fcx, _fcy, touched = quad_node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
                                         area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
                                         nwork, tool_cx, tool_cy, tool_vx, tool_vy, prm, dt,
-                                        twin, tied)
+                                        twin, tied, vslip)
         if touched:
             ncont += 1
     return ncont
@@ -1058,7 +1066,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
               en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
-              gps, fheat, tcq, ppair, x0, y0, vbuf, acls, aflt, bflag):
+              gps, fheat, tcq, ppair, x0, y0, vbuf, acls, aflt, bflag, vslip):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
@@ -1078,7 +1086,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
         cx, cy, tvx, tvy = tool_kinematics(tool, prm)
         ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
                             fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy,
-                            prm, dt, twin, tied)
+                            prm, dt, twin, tied, vslip)
         fwx, fwy = contact_total(cfx, cfy)
         contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
                       fsplit)

@@ -111,6 +111,8 @@ class FEState:
     acls: np.ndarray = field(default=None)  # type: ignore[assignment]
     aflt: np.ndarray = field(default=None)  # type: ignore[assignment]
     bflag: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: friction by sliding speed: each node's filtered sliding speed [m/s] (n_nodes,)
+    vslip: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -121,7 +123,8 @@ class FEState:
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
                 self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
-                self.ppair, self.x0, self.y0, self.vbuf, self.acls, self.aflt, self.bflag)
+                self.ppair, self.x0, self.y0, self.vbuf, self.acls, self.aflt, self.bflag,
+                self.vslip)
 
     @property
     def n_elements(self) -> int:
@@ -215,7 +218,8 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         tbuf=z((ne, 4)),
         gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)),
         fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)),
-        acls=np.zeros((0, 7), np.int64), aflt=z((0, 6)), bflag=np.zeros((0, 4), np.int64))
+        acls=np.zeros((0, 7), np.int64), aflt=z((0, 6)), bflag=np.zeros((0, 4), np.int64),
+        vslip=z(n))
     init_forces(st)
     return st
 
@@ -441,6 +445,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_MUTAB_N] = tv.size
         p[K.P_MUTAB_V:K.P_MUTAB_V + tv.size] = tv / 60.0
         p[K.P_MUTAB_MU:K.P_MUTAB_MU + tv.size] = tmu
+        p[K.P_SLIP_TAU] = cfg.contact.sliding_filter_um * 1e-6 / vc
     p[K.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K.P_PEN] = cfg.contact.penalty_factor
     nd = cfg.contact.normal_damping
@@ -594,7 +599,8 @@ def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
             "tool_center": np.array([cx, cy]), "vx": st.vx.copy(), "vy": st.vy.copy(),
             "tool_velocity": np.array([-setup.vc + st.tool[K.T_VUX], st.tool[K.T_VUY]]),
             "deviatoric_stress_Pa": np.array([sxx, syy, szz, sxy]),
-            "contact_force_N_per_m": np.array([st.cfx, st.cfy])}
+            "contact_force_N_per_m": np.array([st.cfx, st.cfy]),
+            "sliding_speed_m_per_s": st.vslip.copy()}
 
 
 def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
