@@ -82,7 +82,7 @@ def test_friction_table_at_the_cutting_speed():
     assert "Rech" in c.friction_law()
 
 
-def _sliding_block(vc, table_v_m_s, table_mu):
+def _sliding_block(vc, table_v_m_s, table_mu, tau=None):
     """A 200 x 40 um elastic TC4 block, fixed at its bottom, its top 1 nm inside a flat
     tool face (clearance 0, flank normal (0, -1)) that slides over it in -x at ``vc``."""
     L, H = 200e-6, 40e-6
@@ -94,7 +94,8 @@ def _sliding_block(vc, table_v_m_s, table_mu):
     prm[K.P_NFX], prm[K.P_NFY] = 0.0, -1.0
     prm[K.P_VC] = vc
     prm[K.P_CDAMP] = 1.0  # critically damped contact: the 1 nm overlap settles, no chatter
-    prm[K.P_SLIP_TAU] = 0.2e-6 / vc  # sliding-speed filter: 0.2 um of the 5 um travel
+    # sliding-speed filter: 0.2 um of the 5 um travel
+    prm[K.P_SLIP_TAU] = 0.2e-6 / vc if tau is None else tau
     st = make_state(nodes, conn, nodes[:, 1] < 1e-15, elastic_tc4(), prm=prm,
                     tool_center=(-10e-6, H + 2e-6 - 1e-9))
     advance(st, 5e-6 / vc)  # 5 um of sliding
@@ -136,3 +137,11 @@ def test_sliding_friction_is_refused_by_the_3d_slab():
                         "mesh": {"element_size_um": 20, "separation": "node_split"}})
     with pytest.raises(ConfigError, match="friction_velocity"):
         setup_slab3(cfg)
+
+
+def test_no_filter_time_constant_reads_the_raw_speed():
+    """prm[P_SLIP_TAU] = 0 (the block test's state built by hand without it): the table is
+    read at the node's unfiltered speed, no division by zero."""
+    r = _sliding_block(0.5, [0.0, 1.0], [0.5, 0.1], tau=0.0)
+    assert len(r) == 21 and np.all(np.isfinite(r))
+    assert np.allclose(r[:, 1], np.interp(r[:, 2], [0.0, 1.0], [0.5, 0.1]), rtol=1e-9)

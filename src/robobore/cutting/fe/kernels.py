@@ -630,6 +630,10 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
     bitwise identical; the contact force is shared half and half). The pair is released
     (``tied`` = 0) when it comes within ``prm[P_GATE]`` of the tool surface: the material
     separates where it meets the cutting edge.
+
+    Friction: the constant ``prm[P_MU]``, or with a table (``prm[P_MUTAB_N]`` > 0) the
+    table at the node's sliding speed relative to the tool, low-pass filtered with the time
+    constant ``prm[P_SLIP_TAU]`` and kept in ``vslip[n]`` [m/s] (:func:`friction_at_py`).
     """
     r = prm[P_R]
     nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
@@ -697,7 +701,9 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
         if prm[P_MUTAB_N] > 0.0:
             # the sliding speed, filtered over the time constant prm[P_SLIP_TAU]: a contact
             # node's velocity chatters from step to step, its mean is the material's sliding
-            vs = vslip[n] + min(1.0, dt / prm[P_SLIP_TAU]) * (abs(vt0) - vslip[n])
+            tau_s = prm[P_SLIP_TAU]
+            a = dt / tau_s if tau_s > dt else 1.0  # tau_s <= dt: no filter
+            vs = vslip[n] + a * (abs(vt0) - vslip[n])
             vslip[n] = vs
             mu = friction_at(prm, vs)
         fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
