@@ -14,11 +14,11 @@ Usage::
 
 Every mode prints its figures and, with ``--out FILE``, writes them as JSON (atomic).
 
-``check3d``: the small cut of ``tests/cutting/fe3d/test_fe3d_gpu.py`` (insert on springs,
-contact, plasticity, erosion) on the real GPU against the CPU engine: relative state
-differences after each step count (the simulator test gets 1e-9; on hardware the GPU's own
-math library and fused multiply-adds differ in the last bits, and an explicit cut amplifies
-them over many steps).
+``check3d``: the small cut of :func:`small3d` (insert on springs, contact, plasticity,
+erosion; also the state of ``tests/cutting/fe3d/test_fe3d_gpu.py``) on the real GPU against
+the CPU engine: relative state differences after each step count (the simulator test gets
+1e-9; on hardware the GPU's own math library and fused multiply-adds differ in the last
+bits, and an explicit cut amplifies them over many steps).
 
 ``speed3d`` / ``speed2d``: the boring example (3D) / the contract config (2D) meshed at each
 element size; the same initial state is advanced ``--gpu-steps`` on the GPU and
@@ -86,7 +86,10 @@ def env() -> dict:
 
 
 # ----------------------------------------------------------------------------------- 3D
-def _small3d():
+def small3d(n_samples: int = 4000):
+    """The small 3D cut of ``check3d`` and of tests/cutting/fe3d/test_fe3d_gpu.py (which loads
+    it from this file): a 24-element TC4 block, the insert on springs entering it, erosion,
+    histories every 2 ns."""
     import math
 
     from robobore.cutting.fe import kernels3d as K3
@@ -111,7 +114,7 @@ def _small3d():
     p[K3.P_MX] = p[K3.P_MY] = p[K3.P_MZ] = 1e-3
     p[K3.P_EROSION] = K3.ERODE_ALL
     p[K3.P_SAMPLE_DT] = 2e-9
-    return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=4000,
+    return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=n_samples,
                        tool_tip=(-12e-6, -1.2 * le, 0.0), parallel=False)
 
 
@@ -131,11 +134,11 @@ def check3d(steps: list[int]) -> dict:
 
     res = {}
     for n in steps:
-        a = _small3d()
+        a = small3d()
         t_end = n * a.clock[1]
         na = advance3(a, t_end, chunk_steps=max(n, 10))
         for persistent in (True, False):
-            b = _small3d()
+            b = small3d()
             nb = advance3_gpu(b, t_end, chunk_steps=max(n, 10), persistent=persistent)
             d = _diff3(a, b)
             d["steps"] = [na, nb]

@@ -12,44 +12,32 @@ import os
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 
 from robobore.cutting.fe import gpu
 from robobore.errors import ConfigError
 
+#: the GPU benchmark script; its ``small3d`` builds the simulator test's state
+BENCH = Path(__file__).parents[3] / "benchmarks" / "bench_gpu.py"
+
 SCRIPT = textwrap.dedent("""
-    import json, math, sys
+    import importlib.util, json, sys
     import numpy as np
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.gpu import advance3_gpu
-    from robobore.cutting.fe.solver3d import advance3, box_mesh, default_prm3, make_state3
-    from robobore.material import load_material
+    from robobore.cutting.fe.solver3d import advance3
+
+    # the state builder of benchmarks/bench_gpu.py (its check3d runs the same cut on a GPU)
+    spec = importlib.util.spec_from_file_location("bench_gpu", sys.argv[2])
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
 
     def build():
-        le = 20e-6
-        nodes, conn, idx = box_mesh(4, 2, 3, 4 * le, 2 * le, 3 * le,
-                                    origin=(0.0, -2 * le, -1.5 * le))
-        fixed = np.zeros(len(nodes), np.int64)
-        fixed[idx[:, 0, :].ravel()] = 7
-        fixed[idx[-1, :, :].ravel()] = 7
-        p = default_prm3()
-        p[K3.P_TOOL] = 1.0
-        p[K3.P_RN], p[K3.P_KAPPA], p[K3.P_KEND] = 0.4e-3, math.pi / 2, math.radians(5)
-        p[K3.P_RAKE], p[K3.P_CLR], p[K3.P_RE] = math.radians(7), math.radians(7), 10e-6
-        p[K3.P_MU], p[K3.P_TAU] = 0.3, 576e6
-        p[K3.P_MS] = 100.0
-        p[K3.P_VC], p[K3.P_VF], p[K3.P_RADIUS] = 5.0, 1e-3, 0.02
-        p[K3.P_SUPPORT] = 1.0
-        p[K3.P_KX] = p[K3.P_KY] = p[K3.P_KZ] = 1e7
-        p[K3.P_CX] = p[K3.P_CY] = p[K3.P_CZ] = 50.0
-        p[K3.P_MX] = p[K3.P_MY] = p[K3.P_MZ] = 1e-3
-        p[K3.P_EROSION] = K3.ERODE_ALL
-        p[K3.P_SAMPLE_DT] = 2e-9
-        return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=40,
-                           tool_tip=(-12e-6, -1.2 * le, 0.0), parallel=False)
+        return bench.small3d(n_samples=40)
 
     a = build()
     b = build()
@@ -96,7 +84,8 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
     bit-identical), both the persistent kernel (one cooperative launch per chunk, the
     default) and the fallback of one launch per kernel and step."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    p = subprocess.run([sys.executable, "-c", SCRIPT, path], env=env, capture_output=True,
+    p = subprocess.run([sys.executable, "-c", SCRIPT, path, str(BENCH)], env=env,
+                       capture_output=True,
                        text=True, timeout=600, cwd=tmp_path)
     assert p.returncode == 0, p.stderr[-3000:]
     line = [s for s in p.stdout.splitlines() if s.startswith("RESULT")][-1]
@@ -128,9 +117,7 @@ def test_gpu_benchmark_script_runs_its_cpu_part(tmp_path):
     """benchmarks/bench_gpu.py (the script that measured the H100 figures of docs/fe3d.md)
     keeps running where there is no GPU: its environment report and the CPU half of the 3D
     throughput comparison, with the JSON it writes."""
-    from pathlib import Path
-
-    script = Path(__file__).parents[3] / "benchmarks" / "bench_gpu.py"
+    script = BENCH
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_ENABLE_CUDASIM"}
     out = tmp_path / "speed.json"
     p = subprocess.run([sys.executable, "-W", "ignore", str(script), "speed3d", "--no-gpu",
