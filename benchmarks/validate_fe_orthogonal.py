@@ -12,7 +12,8 @@ Usage::
     python benchmarks/validate_fe_orthogonal.py [--length-mm 1.0] [--element-um 10]
         [--data PATH] [--json OUT.json] [--points 60:30,40:5] [--separation node_split]
         [--separation-height-um 5] [--edge-um 2.5] [--band-um 10,10] [--conduction]
-        [--frame tool] [--friction 0.3|table] [--friction-velocity sliding] [--save-dir DIR]
+        [--frame tool] [--friction 0.3|table] [--friction-velocity sliding]
+        [--shear-limit-mpa 576] [--save-dir DIR]
 
 Prints a table (measured, simulated, error, pass) and the run times.
 """
@@ -88,6 +89,9 @@ def main() -> None:
     ap.add_argument("--friction", type=friction, default=None,
                     help='contact.friction: a number (e.g. 0.3, the paper\'s modified Coulomb '
                          'value) or "table" (Rech et al. 2013, the default of config())')
+    ap.add_argument("--shear-limit-mpa", type=float, default=None,
+                    help="contact.shear_limit_MPa: the cap on the contact shear stress (default "
+                    "576, the source's value; a large value lifts the cap)")
     ap.add_argument("--friction-velocity", choices=["cutting_speed", "sliding"], default=None,
                     help='contact.friction_velocity: read the friction table at the cutting '
                     'speed (default) or at each contact node\'s sliding speed')
@@ -110,7 +114,8 @@ def main() -> None:
           f"({args.band_um or 'default'}), conduction {args.conduction}, erosion "
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, tool conductance "
           f"{args.tool_conductance}, friction {args.friction or 'table'} at "
-          f"{args.friction_velocity or 'cutting_speed'}, friction heat "
+          f"{args.friction_velocity or 'cutting_speed'}, shear limit "
+          f"{args.shear_limit_mpa or 576.0} MPa, friction heat "
           f"{args.friction_heat_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
@@ -143,6 +148,8 @@ def main() -> None:
         contact: dict = {}
         if args.friction is not None:
             contact["friction"] = args.friction
+        if args.shear_limit_mpa is not None:
+            contact["shear_limit_MPa"] = args.shear_limit_mpa
         if args.friction_velocity is not None:
             contact["friction_velocity"] = args.friction_velocity
         if args.tool_conductance is not None:
