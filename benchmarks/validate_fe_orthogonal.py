@@ -31,6 +31,8 @@ from robobore.cutting.fe.solver import simulate_orthogonal
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / \
     "ti64_orthogonal_cutting_forces.json"
+#: the source's cap on the contact shear stress (its model_inputs_used_by_source)
+SHEAR_LIMIT_MPA = 576.0
 
 
 def config(h_um: float, vc: float, length_mm: float, le_um: float, extra=None) -> dict:
@@ -39,7 +41,7 @@ def config(h_um: float, vc: float, length_mm: float, le_um: float, extra=None) -
         "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
         "cut": {"uncut_chip_thickness_um": h_um, "cutting_speed_m_per_min": vc,
                 "length_mm": length_mm, "width_mm": 1.0},
-        "contact": {"friction": "table", "shear_limit_MPa": 576.0},
+        "contact": {"friction": "table", "shear_limit_MPa": SHEAR_LIMIT_MPA},
         "mesh": {"element_size_um": le_um},
         # same inertia ratio as the contract (100 at 30 m/min): factor 100 (30/vc)^2 keeps
         # vc / (scaled wave speed) and hence the step count per mm of cut constant;
@@ -91,7 +93,7 @@ def main() -> None:
                          'value) or "table" (Rech et al. 2013, the default of config())')
     ap.add_argument("--shear-limit-mpa", type=float, default=None,
                     help="contact.shear_limit_MPa: the cap on the contact shear stress (default "
-                    "576, the source's value; a large value lifts the cap)")
+                    f"{SHEAR_LIMIT_MPA:g}, the source's value; a large value lifts the cap)")
     ap.add_argument("--friction-velocity", choices=["cutting_speed", "sliding"], default=None,
                     help='contact.friction_velocity: read the friction table at the cutting '
                     'speed (default) or at each contact node\'s sliding speed')
@@ -115,7 +117,7 @@ def main() -> None:
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, tool conductance "
           f"{args.tool_conductance}, friction {args.friction or 'table'} at "
           f"{args.friction_velocity or 'cutting_speed'}, shear limit "
-          f"{args.shear_limit_mpa or 576.0} MPa, friction heat "
+          f"{args.shear_limit_mpa or SHEAR_LIMIT_MPA} MPa, friction heat "
           f"{args.friction_heat_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
