@@ -11,6 +11,7 @@ Usage::
         [--mass-scaling 400] [--coefficients FILE]
     python benchmarks/bench_gpu.py speed2d [--sizes 10 2.5] [--gpu-steps 4000] [--cpu-steps 200]
     python benchmarks/bench_gpu.py ortho2d [--devices cpu gpu] [--length-mm 1.0]
+        [--element-um 10] [--config FILE]
 
 Every mode prints its figures and, with ``--out FILE``, writes them as JSON (atomic).
 
@@ -32,8 +33,9 @@ default); ``gpu_launch_per_kernel`` is the same state advanced with one launch p
 step (the fallback path), whose host-side launch cost dominates small meshes.
 
 ``paper3d`` / ``ortho2d``: whole runs (the 3D paper condition of ``bench_fe3d.py paper``,
-the 2D contract config) on each device: forces, energy error, wall time and the relative
-force differences between the devices.
+the 2D contract config or, with ``--config``, any workpiece-frame 2D config; ``--length-mm`` /
+``--element-um`` override the config's when given) on each device: forces, energy error,
+wall time and the relative force differences between the devices.
 """
 
 from __future__ import annotations
@@ -260,12 +262,14 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
 
 
 # ----------------------------------------------------------------------------------- 2D
-def _ortho_cfg(le: float, length_mm: float):
+def _ortho_cfg(le: float | None, length_mm: float | None, config: str | None = None):
     from robobore.cutting.fe.config import load_fe_config
 
-    cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
-    cfg.mesh.element_size_um = le
-    cfg.cut.length_mm = length_mm
+    cfg = load_fe_config(config or ROOT / "examples" / "fe_orthogonal.toml")
+    if le is not None:
+        cfg.mesh.element_size_um = le
+    if length_mm is not None:
+        cfg.cut.length_mm = length_mm
     return cfg
 
 
@@ -298,19 +302,23 @@ def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
     return res
 
 
-def ortho2d(devices: list[str], length_mm: float, le: float) -> dict:
+def ortho2d(devices: list[str], length_mm: float | None, le: float | None,
+            config: str | None = None) -> dict:
     from robobore.cutting.fe.solver import simulate_orthogonal
 
     by = {}
     for dev in devices:
-        r = simulate_orthogonal(_ortho_cfg(le, length_mm), device=dev)
+        cfg = _ortho_cfg(le, length_mm, config)
+        le, length_mm = cfg.mesh.element_size_um, cfg.cut.length_mm
+        r = simulate_orthogonal(cfg, device=dev)
         s = r.summary
         by[dev] = {k: s.get(k) for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
                                          "chip_ratio", "peak_temperature_K", "energy_error",
                                          "n_elements", "steps", "wall_time_s",
                                          "element_updates_per_s")}
         print(f"ortho2d {dev}: " + json.dumps(by[dev]), flush=True)
-    res = {"element_size_um": le, "length_mm": length_mm, "by_device": by}
+    res = {"config": str(config or "examples/fe_orthogonal.toml"), "element_size_um": le,
+           "length_mm": length_mm, "by_device": by}
     if "cpu" in by and "gpu" in by:
         res["gpu_vs_cpu"] = {k: (by["gpu"][k] - by["cpu"][k]) / abs(by["cpu"][k])
                              for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
@@ -334,8 +342,9 @@ def main() -> None:
     ap.add_argument("--cut-mm", type=float, default=0.15)
     ap.add_argument("--mass-scaling", type=float, default=400.0)
     ap.add_argument("--coefficients", default=None)
-    ap.add_argument("--length-mm", type=float, default=1.0)
-    ap.add_argument("--element-um", type=float, default=10.0)
+    ap.add_argument("--length-mm", type=float, default=None)
+    ap.add_argument("--element-um", type=float, default=None)
+    ap.add_argument("--config", default=None)
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     if a.mode == "env":
@@ -351,7 +360,7 @@ def main() -> None:
         out = speed2d(a.sizes or [10.0, 2.5], a.gpu_steps, a.cpu_steps, a.cpu_threads,
                       not a.no_gpu, a.profile)
     else:
-        out = ortho2d(a.devices, a.length_mm, a.element_um)
+        out = ortho2d(a.devices, a.length_mm, a.element_um, a.config)
     out["load_average"] = os.getloadavg()[0]
     if a.out:
         from robobore.io.results import write_json
