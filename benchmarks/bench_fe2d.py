@@ -5,6 +5,11 @@ cut) or a shorter cut, after a warm-up that compiles/loads the numba cache, and 
 wall time, steps, element updates per second, threads and the machine load.
 
     python benchmarks/bench_fe2d.py [--length-mm 1.0] [--element-um 10] [--threads N]
+        [--config FILE] [--conduction]
+
+``--config`` measures another config (e.g. examples/fe_orthogonal_toolframe.toml, the
+tool-frame ALE model of the validation); ``--length-mm`` / ``--element-um`` then override
+its values only when given. ``--conduction`` sets solver.heat_conduction.
 """
 
 from __future__ import annotations
@@ -24,20 +29,30 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "fe_orthogonal.toml
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--length-mm", type=float, default=1.0)
-    ap.add_argument("--element-um", type=float, default=10.0)
+    ap.add_argument("--length-mm", type=float, default=None, help="default: the config's "
+                    "(1.0 for the contract)")
+    ap.add_argument("--element-um", type=float, default=None, help="default: the config's "
+                    "(10 for the contract)")
     ap.add_argument("--threads", type=int, default=None)
+    ap.add_argument("--config", type=Path, default=EXAMPLE)
+    ap.add_argument("--conduction", action="store_true")
     args = ap.parse_args()
     if args.threads:
         numba.set_num_threads(args.threads)
-    cfg = load_fe_config(EXAMPLE)
+    cfg = load_fe_config(args.config)
+    if args.conduction:
+        cfg.solver.heat_conduction = True
     warm = cfg.model_copy(deep=True)
     warm.cut.length_mm = 0.02
     t0 = time.perf_counter()
     simulate_orthogonal(warm)
     print(f"warm-up (compile or load cache): {time.perf_counter() - t0:.1f} s")
-    cfg.cut.length_mm = args.length_mm
-    cfg.mesh.element_size_um = args.element_um
+    if args.length_mm is not None:
+        cfg.cut.length_mm = args.length_mm
+    if args.element_um is not None:
+        cfg.mesh.element_size_um = args.element_um
+    print(f"config {args.config}, {cfg.cut.length_mm} mm, {cfg.mesh.element_size_um} um, "
+          f"frame {cfg.mesh.frame}, conduction {cfg.solver.heat_conduction}")
     load0 = os.getloadavg()
     res = simulate_orthogonal(cfg)
     s = res.summary

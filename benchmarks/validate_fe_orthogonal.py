@@ -179,6 +179,8 @@ def main() -> None:
                    chip_ratio_velocity=s["chip_ratio_velocity"],
                    pass_chip_velocity=bool(abs(s["chip_ratio_velocity"] - r_m) <= 0.3 * r_m),
                    energy_error=s["energy_error"], wall_s=time.perf_counter() - t0,
+                   steps=s.get("steps"), n_elements=s.get("n_elements"),
+                   element_updates_per_s=s.get("element_updates_per_s"),
                    pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
                    friction=s["friction_coefficient"], friction_law=s.get("friction_law"),
                    eroded_distortion=s.get("eroded_distortion"),

@@ -128,3 +128,19 @@ def test_bad_material_file(tmp_path):
     f.write_text(src.replace("E_GPa = 113.8", "E_GPa = -1.0"))
     with pytest.raises(ConfigError, match="elastic.E_GPa"):
         load_material(str(f))
+
+
+@settings(max_examples=80, deadline=None)
+@given(ep=st.floats(0.0, 3.0), T=st.floats(293.0, 1500.0), log_rate=st.floats(0.0, 6.5),
+       dt=st.floats(1e-10, 1e-7))
+def test_radial_return_recovers_a_constructed_root(ep, T, log_rate, dt):
+    """A trial stress built from a known increment d (q = 3 G d + sigma_y(ep + d, d / dt, T),
+    plastic strain rates 1 to 3e6 1/s, the range of a cut) returns that d: the start of the
+    Newton solve (the smaller of two upper bounds of the root) must not change the root.
+    Tolerance 1e-9 relative (the solve stops at 1e-12 relative in d)."""
+    m = TC4
+    d_true = 10.0 ** log_rate * dt
+    q = 3 * m.G * d_true + _jc_hand(ep + d_true, d_true / dt, T)
+    out = jc.radial_return(*_trial(q), ep, T, dt, m.G, m.A, m.B, m.n, m.C, m.m, 1.0, 293.0,
+                           1873.0)
+    assert out[4] == pytest.approx(d_true, rel=1e-9)
