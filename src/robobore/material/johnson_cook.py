@@ -108,7 +108,7 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
     flow stress to q, dt eps0 exp((q / sigma_y0 - 1) / C) (sigma_y0: the flow stress at
     eps_p and the reference rate). The first alone overestimates the root by orders of
     magnitude at cutting rates (it ignores the 20-30 % the rate term adds), which cost
-    ~12 safeguarded iterations a return; from the smaller bound Newton takes ~4 (session 14,
+    ~10 safeguarded iterations a return; from the smaller bound Newton takes ~4 (session 14,
     docs/fe.md).
     """
     # T is held over the increment: the thermal factor is evaluated once; each iteration
@@ -116,7 +116,7 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
     # Every flow stress below is jc_flow_stress's product, (A + B ep^n) * rate * therm.
     therm = 1.0 - homologous_temperature(T, Troom, Tmelt) ** m
     ep0 = eps_p if eps_p > 0.0 else 0.0
-    sy0 = (a + b * ep0**n) * 1.0 * therm
+    sy0 = (a + b * ep0**n) * therm
     if q <= sy0:
         return 0.0, sy0
     lo = 0.0
