@@ -306,19 +306,19 @@ def ortho2d(devices: list[str], length_mm: float | None, le: float | None,
             config: str | None = None) -> dict:
     from robobore.cutting.fe.solver import simulate_orthogonal
 
+    cfg = _ortho_cfg(le, length_mm, config)
     by = {}
     for dev in devices:
-        cfg = _ortho_cfg(le, length_mm, config)
-        le, length_mm = cfg.mesh.element_size_um, cfg.cut.length_mm
-        r = simulate_orthogonal(cfg, device=dev)
+        r = simulate_orthogonal(cfg.model_copy(deep=True), device=dev)
         s = r.summary
         by[dev] = {k: s.get(k) for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
                                          "chip_ratio", "peak_temperature_K", "energy_error",
                                          "n_elements", "steps", "wall_time_s",
                                          "element_updates_per_s")}
         print(f"ortho2d {dev}: " + json.dumps(by[dev]), flush=True)
-    res = {"config": str(config or "examples/fe_orthogonal.toml"), "element_size_um": le,
-           "length_mm": length_mm, "by_device": by}
+    res = {"config": str(config or "examples/fe_orthogonal.toml"),
+           "element_size_um": cfg.mesh.element_size_um, "length_mm": cfg.cut.length_mm,
+           "by_device": by}
     if "cpu" in by and "gpu" in by:
         res["gpu_vs_cpu"] = {k: (by["gpu"][k] - by["cpu"][k]) / abs(by["cpu"][k])
                              for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",

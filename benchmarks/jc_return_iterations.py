@@ -50,7 +50,8 @@ def _solve(q, ep0, T, dt, G, k, start):
     (``jc.rebind``): ``abs`` counts the iterations, and for ``start = "perfectly_plastic"``
     ``math.exp`` answers infinity. Returns (d, iterations)."""
     count = _Counter()
-    names = {"abs": count, "homologous_temperature": jc.homologous_temperature_py}
+    names = {"abs": count, "homologous_temperature": jc.homologous_temperature_py,
+             "jc_athermal": jc.jc_athermal_py}
     if start == "perfectly_plastic":
         names["math"] = _NO_RATE_BOUND
     d, _ = jc.rebind(jc.jc_return_py, **names)(q, ep0, T, dt, G, *k)

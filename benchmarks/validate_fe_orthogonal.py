@@ -117,7 +117,8 @@ def main() -> None:
           f"limits {args.distortion_limit} / {args.erode_dt_fraction}, tool conductance "
           f"{args.tool_conductance}, friction {args.friction or 'table'} at "
           f"{args.friction_velocity or 'cutting_speed'}, shear limit "
-          f"{args.shear_limit_mpa or SHEAR_LIMIT_MPA} MPa, friction heat "
+          f"{SHEAR_LIMIT_MPA if args.shear_limit_mpa is None else args.shear_limit_mpa} MPa, "
+          f"friction heat "
           f"{args.friction_heat_fraction}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "

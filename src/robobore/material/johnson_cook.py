@@ -42,6 +42,18 @@ def homologous_temperature_py(T, Troom, Tmelt):
     return ts
 
 
+def jc_athermal_py(eps_p, eps_rate, a, b, n, c, eps0):
+    """The strain and rate factors of the Johnson-Cook flow stress [Pa],
+    (A + B eps_p^n) (1 + C ln(max(eps_rate/eps0, 1))), eps_p clipped at 0: the flow stress
+    is this times the thermal factor 1 - T*^m (:func:`jc_return_py` computes that factor once
+    per increment)."""
+    ep = eps_p if eps_p > 0.0 else 0.0
+    hard = a + b * ep**n
+    r = eps_rate / eps0
+    rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
+    return hard * rate
+
+
 def jc_flow_stress_py(eps_p, eps_rate, T, a, b, n, c, m, eps0, Troom, Tmelt):
     """Johnson-Cook flow stress [Pa].
 
@@ -49,13 +61,8 @@ def jc_flow_stress_py(eps_p, eps_rate, T, a, b, n, c, m, eps0, Troom, Tmelt):
     The rate term is clipped at eps_rate = eps0 (no strengthening below the reference rate,
     and no logarithm of zero); T* is clipped to [0, 1].
     """
-    ep = eps_p if eps_p > 0.0 else 0.0
-    hard = a + b * ep**n
-    r = eps_rate / eps0
-    rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
     ts = homologous_temperature(T, Troom, Tmelt)
-    therm = 1.0 - ts**m
-    return hard * rate * therm
+    return jc_athermal(eps_p, eps_rate, a, b, n, c, eps0) * (1.0 - ts**m)
 
 
 def jc_failure_strain_py(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt):
@@ -112,11 +119,9 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
     docs/fe.md).
     """
     # T is held over the increment: the thermal factor is evaluated once; each iteration
-    # then costs one power and one logarithm (flow stress and its derivative share them).
-    # Every flow stress below is jc_flow_stress's product, (A + B ep^n) * rate * therm.
+    # then costs one power and one logarithm (flow stress and its derivative share them)
     therm = 1.0 - homologous_temperature(T, Troom, Tmelt) ** m
-    ep0 = eps_p if eps_p > 0.0 else 0.0
-    sy0 = (a + b * ep0**n) * therm
+    sy0 = jc_athermal(eps_p, 0.0, a, b, n, c, eps0) * therm
     if q <= sy0:
         return 0.0, sy0
     lo = 0.0
@@ -154,12 +159,7 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
             d = dn
             break
         d = dn
-    ep = eps_p + d
-    if ep < 0.0:
-        ep = 0.0
-    r = (d / dt) / eps0
-    rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
-    return d, (a + b * ep**n) * rate * therm
+    return d, jc_athermal(eps_p + d, d / dt, a, b, n, c, eps0) * therm
 
 
 def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
@@ -194,6 +194,7 @@ def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, T
 
 
 homologous_temperature = njit(cache=True)(homologous_temperature_py)
+jc_athermal = njit(cache=True)(jc_athermal_py)
 jc_flow_stress = njit(cache=True)(jc_flow_stress_py)
 jc_failure_strain = njit(cache=True)(jc_failure_strain_py)
 jc_damage_increment = njit(cache=True)(jc_damage_increment_py)
@@ -204,9 +205,10 @@ radial_return = njit(cache=True)(radial_return_py)
 def rebind(func, **names):
     """Copy of a ``_py`` function whose global names are replaced (for device ports).
 
-    Example: ``rebind(jc_return_py, jc_flow_stress=flow_dev, homologous_temperature=th_dev)``
+    Example: ``rebind(jc_return_py, jc_athermal=athermal_dev, homologous_temperature=th_dev)``
     then ``rebind(radial_return_py, jc_return=return_dev)``; likewise
-    ``rebind(jc_flow_stress_py, homologous_temperature=th_dev)``, each wrapped with
+    ``rebind(jc_flow_stress_py, jc_athermal=athermal_dev, homologous_temperature=th_dev)``,
+    each wrapped with
     ``numba.cuda.jit(device=True)``.
     """
     g = dict(func.__globals__)
@@ -216,6 +218,7 @@ def rebind(func, **names):
 
 __all__ = [
     "homologous_temperature_py",
+    "jc_athermal_py",
     "jc_flow_stress_py",
     "jc_failure_strain_py",
     "jc_damage_increment_py",
@@ -223,6 +226,7 @@ __all__ = [
     "jc_return_py",
     "jc_return",
     "homologous_temperature",
+    "jc_athermal",
     "jc_flow_stress",
     "jc_failure_strain",
     "jc_damage_increment",

@@ -80,10 +80,10 @@ def jc_device_functions(dev):
     from robobore.material import johnson_cook as jc
 
     th = dev(jc.homologous_temperature_py)
-    flow = dev(jc.rebind(jc.jc_flow_stress_py, homologous_temperature=th))
+    athermal = dev(jc.jc_athermal_py)
     fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
     dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
-    ret = dev(jc.rebind(jc.jc_return_py, jc_flow_stress=flow, homologous_temperature=th))
+    ret = dev(jc.rebind(jc.jc_return_py, jc_athermal=athermal, homologous_temperature=th))
     return dmg, ret
 
 
