@@ -103,6 +103,8 @@ def main() -> None:
     ap.add_argument("--save-dir", type=Path, default=None,
                     help="write each point's final state (deformed mesh, fields, node "
                     "velocities) to DIR/h<h>_vc<vc>.npz")
+    ap.add_argument("--device", choices=["cpu", "gpu"], default="cpu",
+                    help="run each point on the CPU (numba) or the GPU (numba-cuda)")
     args = ap.parse_args()
     ref = json.loads(args.data.read_text())["measured"]
     pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
@@ -119,7 +121,7 @@ def main() -> None:
           f"{args.friction_velocity or 'cutting_speed'}, shear limit "
           f"{SHEAR_LIMIT_MPA if args.shear_limit_mpa is None else args.shear_limit_mpa} MPa, "
           f"friction heat "
-          f"{args.friction_heat_fraction}, "
+          f"{args.friction_heat_fraction}, device {args.device}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
@@ -161,7 +163,7 @@ def main() -> None:
             contact["friction_heat_fraction"] = args.friction_heat_fraction
         cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3),
                                   {"mesh": mesh, "solver": solver, "contact": contact}))
-        res = simulate_orthogonal(cfg)
+        res = simulate_orthogonal(cfg, device=args.device)
         s = res.summary
         if args.save_dir is not None:
             import numpy as np
@@ -182,7 +184,7 @@ def main() -> None:
                    energy_error=s["energy_error"], wall_s=time.perf_counter() - t0,
                    steps=s.get("steps"), n_elements=s.get("n_elements"),
                    element_updates_per_s=s.get("element_updates_per_s"),
-                   pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
+                   device=args.device, pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
                    friction=s["friction_coefficient"], friction_law=s.get("friction_law"),
                    eroded_distortion=s.get("eroded_distortion"),
                    eroded_chip_mass_fraction=s.get("eroded_chip_mass_fraction"),

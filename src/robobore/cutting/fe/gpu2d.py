@@ -29,8 +29,21 @@ clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is
 the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine; GPU
 speed is unmeasured (no GPU was available).
 
-Not ported: rezoning (``solver.rezone_interval`` > 0, an experimental option that is off by
-default) is refused with a ConfigError.
+The tool-frame ALE model (``mesh.frame = "tool"``) runs here too (session 15): every
+``solver.ale_interval`` steps, after the tool step, the persistent kernel runs the ALE pass of
+:func:`robobore.cutting.fe.rezone.rezone` (``MODE_TOOLFRAME``) from the same scalar functions
+(``tf_place_py``, ``tf_face_py``, the Jacobi sweeps ``tf_sweep_py`` / ``tf_sweep_copy_py``,
+``tf_interior_py``, the donor-cell remap ``rz_flux_py``, ``rz_velocity_py``, ``rz_write_py``,
+``rz_node_mass_py``), a grid barrier wherever one pass reads what another wrote (14 per
+pass); the launch-per-kernel path launches one kernel per pass. The contact force by tool
+face (``kernels.contact_split``) is added by one thread in increasing node order over the
+chunks holding a contact node: the CPU's serial order, the same bits.
+
+Kernel parameters: the persistent kernel takes the whole state, 3944 bytes of CUDA's classic
+4096-byte limit (checked by a test with numba's data model).
+
+Not ported: Laplacian rezoning (``solver.rezone_interval`` > 0), the ploughed-layer ALE and
+the B-bar element are refused with a ConfigError.
 """
 
 from __future__ import annotations
@@ -43,6 +56,7 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe import rezone as RZ
 from robobore.cutting.fe.gpu import (
     _MAX_BLOCK,
     bind_cuda,
@@ -50,7 +64,7 @@ from robobore.cutting.fe.gpu import (
     jc_device_functions,
     require_gpu,
 )
-from robobore.cutting.fe.rezone import MODE_ROWS
+from robobore.cutting.fe.rezone import MODE_ROWS, MODE_TOOLFRAME
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported"]
@@ -58,7 +72,9 @@ __all__ = ["advance_gpu", "check_gpu_supported"]
 _THREADS = 128
 # reduction slots on the device
 R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
-N_RED = 5
+#: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
+R_SPLIT = 5
+N_RED = 11
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)
@@ -102,7 +118,21 @@ def _kernels():
     dev = cuda.jit(device=True)
     dmg, ret = jc_device_functions(dev)
     rret = dev(jc.rebind(jc.radial_return_py, jc_return=ret))
-    tg = dev(jc.rebind(tool_gap_py, tool_face=dev(tool_face_py)))
+    tface = dev(tool_face_py)
+    tg = dev(jc.rebind(tool_gap_py, tool_face=tface))
+    # the tool-frame ALE pass (rezone.py's scalar functions)
+    lim = dev(RZ.limit_py)
+    tplace = dev(jc.rebind(RZ.tf_place_py, _limit=lim,
+                           _off_tool=dev(jc.rebind(RZ.off_tool_py, tool_gap=tg))))
+    tfacep = dev(RZ.tf_face_py)
+    tsweep = dev(RZ.tf_sweep_py)
+    tscopy = dev(RZ.tf_sweep_copy_py)
+    tinter = dev(jc.rebind(RZ.tf_interior_py, _limit=lim))
+    rflux = dev(jc.rebind(RZ.rz_flux_py, _swept=dev(RZ.swept_py)))
+    rvel = dev(RZ.rz_velocity_py)
+    rwrite = dev(RZ.rz_write_py)
+    rmass = dev(RZ.rz_node_mass_py)
+    SWEEPS = RZ.TF_SWEEPS
     cf = dev(contact_force_py)
     sup = dev(tool_support_step_py)
     retire = dev(K.quad_retire_py)
@@ -135,6 +165,10 @@ def _kernels():
     P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K.P_CFL, K.P_DTMIN, K.P_TEND, K.P_SAMPLE_DT
     P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
     P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
+    P_TCX, P_TCY, P_NRX, P_NRY, P_NFX, P_NFY, P_R = (K.P_TCX, K.P_TCY, K.P_NRX, K.P_NRY,
+                                                     K.P_NFX, K.P_NFY, K.P_R)
+    P_ALE_X0, P_RZ_MAXMOVE, P_MS = K.P_ALE_X0, K.P_RZ_MAXMOVE, K.P_MS
+    H_FX_RAKE = K.H_FX_RAKE
     T_FX, T_FY, T_UX, T_UY, T_GX = K.T_FX, K.T_FY, K.T_UX, K.T_UY, K.T_GX
     E_EXT, E_KIN, E_INT, E_PLAST, E_HG, E_FRIC, E_ERODED = (K.E_EXT, K.E_KIN, K.E_INT,
                                                             K.E_PLAST, K.E_HG, K.E_FRIC,
@@ -144,7 +178,7 @@ def _kernels():
     H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO = (K.H_EKIN, K.H_EINT, K.H_EPL,
                                                              K.H_EHG, K.H_EFRIC, K.H_EEXT,
                                                              K.H_EERO)
-    KCOND, RHO, CP = jc.KCOND, jc.RHO, jc.CP
+    KCOND, RHO, CP, TROOM = jc.KCOND, jc.RHO, jc.CP, jc.TROOM
 
     @cuda.jit(device=True)
     def lanes_total(px, py, red):
@@ -158,6 +192,28 @@ def _kernels():
         red[R_FX] = sx
         red[R_FY] = sy
         return sx, sy
+
+    @cuda.jit(device=True)
+    def split_add(n, x, y, cfx, cfy, cx, cy, prm, red):
+        # node n's share of the contact force by tool face (kernels.contact_split's body;
+        # called in increasing node order by one thread: the CPU's serial order)
+        fx = cfx[n]
+        fy = cfy[n]
+        if fx == 0.0 and fy == 0.0:
+            return
+        k = tface(x[n] - cx, y[n] - cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY])
+        red[R_SPLIT + 2 * k] -= fx
+        red[R_SPLIT + 2 * k + 1] -= fy
+
+    @cuda.jit(device=True)
+    def split_reset(red):
+        for j in range(6):
+            red[R_SPLIT + j] = 0.0
+
+    @cuda.jit(device=True)
+    def tool_geometry(prm):
+        return (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+                prm[P_R])
 
     @cuda.jit
     def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
@@ -173,9 +229,11 @@ def _kernels():
             cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
 
     @cuda.jit
-    def k_contact_sum(cfx, cfy, red):
+    def k_contact_sum(cfx, cfy, x, y, tool, prm, red):
         # the CPU's fixed-order total (kernels.contact_total): one thread per lane, then
-        # the lanes in order by thread 0 -- the same bits on both devices
+        # the lanes in order by thread 0 -- the same bits on both devices; then the split by
+        # tool face over every node in order (the persistent kernel visits only the chunks
+        # holding a contact node)
         t = cuda.threadIdx.x
         px = cuda.shared.array(LANES, float64)
         py = cuda.shared.array(LANES, float64)
@@ -184,6 +242,97 @@ def _kernels():
         cuda.syncthreads()
         if t == 0:
             lanes_total(px, py, red)
+            cx, cy, tvx, tvy = kin(tool, prm)
+            split_reset(red)
+            for n in range(x.shape[0]):
+                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
+
+    @cuda.jit
+    def k_ale_place(x, y, xn, yn, x0, y0, acls, aflt, prm, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        xn[n] = x[n]
+        yn[n] = y[n]
+        tplace(n, x, y, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0],
+               prm[P_RZ_MAXMOVE], tool_geometry(prm))
+
+    @cuda.jit
+    def k_ale_face(xn, yn, x0, y0, acls, aflt, prm, ist):
+        n = cuda.grid(1)
+        if n >= xn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tfacep(n, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0])
+
+    @cuda.jit
+    def k_ale_sweep(acls, aflt, vbuf, ist):
+        n = cuda.grid(1)
+        if n >= acls.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tsweep(n, acls, aflt, vbuf)
+
+    @cuda.jit
+    def k_ale_sweep_copy(acls, aflt, vbuf, ist):
+        n = cuda.grid(1)
+        if n >= acls.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tscopy(n, acls, aflt, vbuf)
+
+    @cuda.jit
+    def k_ale_interior(x, y, xn, yn, x0, y0, acls, aflt, prm, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tinter(n, x, y, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0],
+               prm[P_RZ_MAXMOVE])
+
+    @cuda.jit
+    def k_ale_flux(conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+                   eps_p, temp, dm, qhx, qhy, area0, mat, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+              eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
+
+    @cuda.jit
+    def k_ale_velocity(snodes, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf, ist):
+        k = cuda.grid(1)
+        if k >= snodes.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+
+    @cuda.jit
+    def k_ale_apply(snodes, vx, vy, vbuf, ist):
+        k = cuda.grid(1)
+        if k >= snodes.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        n = snodes[k]
+        vx[n] += vbuf[n, 0]
+        vy[n] += vbuf[n, 1]
+
+    @cuda.jit
+    def k_ale_write(alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0,
+                    ist):
+        e = cuda.grid(1)
+        if e >= alive.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rwrite(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0)
+
+    @cuda.jit
+    def k_ale_nodes(x, y, xn, yn, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        x[n] = xn[n]
+        y[n] = yn[n]
+
+    @cuda.jit
+    def k_ale_mass(ptr, nel, area0, mass, mat, prm, ist):
+        n = cuda.grid(1)
+        if n >= mass.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rmass(n, ptr, nel, area0, mat[RHO] * prm[P_MS], mass)
 
     @cuda.jit
     def k_tool(tool, prm, en, clock, ist, red):
@@ -296,6 +445,8 @@ def _kernels():
         hacc[H_UX] += dt * tool[T_UX]
         hacc[H_UY] += dt * tool[T_UY]
         hacc[H_NCONT] += dt * nc
+        for j in range(6):
+            hacc[H_FX_RAKE + j] += dt * red[R_SPLIT + j]
         clock[2] += dt
         k = ist[I_SAMPLE]
         if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
@@ -310,6 +461,8 @@ def _kernels():
             hist[k, H_UX] = hacc[H_UX] / ta
             hist[k, H_UY] = hacc[H_UY] / ta
             hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            for j in range(6):
+                hist[k, H_FX_RAKE + j] = hacc[H_FX_RAKE + j] / ta
             hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
             hist[k, H_EKIN] = en[E_KIN]
             hist[k, H_EINT] = en[E_INT]
@@ -338,9 +491,9 @@ def _kernels():
     def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
               sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte,
               plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool, en, ist,
-              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, vslip, erosion,
-              cond_every,
-              theat, red, cflag, clist):
+              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, vslip, snodes, x0,
+              y0, xn, yn, buf, vbuf, acls, aflt, bflag, erosion, cond_every, theat, rz_every,
+              red, cflag, clist):
         # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
         # of the kernels above separated by grid-wide barriers (one launch per chunk instead
         # of five to twelve per step); same functions, same order, same bits
@@ -352,6 +505,8 @@ def _kernels():
         nn = x.shape[0]
         ne = conn.shape[0]
         npair = ppair.shape[0]
+        nsn = snodes.shape[0]
+        rho_s = mat[RHO] * prm[P_MS]
         px = cuda.shared.array(LANES, float64)
         py = cuda.shared.array(LANES, float64)
         cnt = cuda.shared.array(NCNT, int64)
@@ -388,12 +543,64 @@ def _kernels():
                 cuda.syncthreads()
                 if t == 0:
                     sx, sy = lanes_total(px, py, red)
+                    # the split by tool face, in increasing node order over the listed
+                    # chunks (the CPU's serial order; the other nodes carry no force)
+                    split_reset(red)
+                    for i in range(m):
+                        for lane in range(LANES):
+                            n = clist[i] * LANES + lane
+                            if n < nn:
+                                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
                     en[E_EXT] += tstep(tool, prm, sx, sy, dt)
                     if prm[P_COND_EVERY] > 0.0:
                         prm[P_COND_ACC] += dt
             # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
-            # elements' gated erosion reads (as after k_tool): a barrier before the elements
+            # elements' gated erosion and the ALE pass read (as after k_tool): a barrier
             grid.sync()
+            if rz_every > 0 and step % rz_every == 0:
+                # the tool-frame ALE pass (rezone.rezone, MODE_TOOLFRAME): the same passes in
+                # the same order, a barrier wherever one reads what another wrote
+                off = prm[P_TCX] - prm[P_ALE_X0]
+                mm = prm[P_RZ_MAXMOVE]
+                tgeo = tool_geometry(prm)
+                for n in range(tid, nn, nthr):
+                    xn[n] = x[n]
+                    yn[n] = y[n]
+                    tplace(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm, tgeo)
+                grid.sync()
+                for n in range(tid, nn, nthr):
+                    tfacep(n, xn, yn, x0, y0, acls, aflt, off)
+                grid.sync()
+                for _sw in range(SWEEPS):
+                    for n in range(tid, nn, nthr):
+                        tsweep(n, acls, aflt, vbuf)
+                    grid.sync()
+                    for n in range(tid, nn, nthr):
+                        tscopy(n, acls, aflt, vbuf)
+                    grid.sync()
+                for n in range(tid, nn, nthr):
+                    tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz,
+                          sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
+                for k in range(tid, nsn, nthr):
+                    rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+                grid.sync()
+                for k in range(tid, nsn, nthr):
+                    n = snodes[k]
+                    vx[n] += vbuf[n, 0]
+                    vy[n] += vbuf[n, 1]
+                for e in range(tid, ne, nthr):
+                    rwrite(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx,
+                           qhy, area0)
+                for n in range(tid, nn, nthr):
+                    x[n] = xn[n]
+                    y[n] = yn[n]
+                grid.sync()
+                for n in range(tid, nn, nthr):
+                    rmass(n, ptr, nel, area0, rho_s, mass)
+                grid.sync()
             for e in range(tid, ne, nthr):
                 d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
                               eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
@@ -436,8 +643,10 @@ def _kernels():
                 red[R_BAD] = -1.0
             grid.sync()
 
+    ale = (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
+           k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass)
     return (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
-            k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run)
+            k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run, ale)
 
 
 #: FEState arrays used by the kernels (copied to the device)
@@ -445,12 +654,14 @@ _ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn
            "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
            "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
            "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
-           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair", "vslip")
+           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair", "vslip",
+           "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
 #: the arrays the kernels change (copied back to the host)
-_MUTABLE = ("x", "y", "vx", "vy", "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p",
-            "temp", "dmg", "qhx", "qhy", "ie", "hge", "fex", "fey", "dte", "plast", "rate",
-            "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm", "tool", "en", "ist",
-            "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq", "vslip")
+_MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "sdx", "sdy", "sdz", "sdxy", "pres",
+            "eps_p", "temp", "dmg", "qhx", "qhy", "area0", "ie", "hge", "fex", "fey", "dte",
+            "plast", "rate", "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm",
+            "tool", "en", "ist", "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq",
+            "vslip", "xn", "yn", "buf", "vbuf", "aflt")
 
 
 def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
@@ -473,13 +684,19 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
-    rows = int(st.prm[K.P_RZ_MODE]) == MODE_ROWS
-    check_gpu_supported(0 if rows else every, None,
+    mode = int(st.prm[K.P_RZ_MODE])
+    rows = mode == MODE_ROWS
+    toolframe = mode == MODE_TOOLFRAME and every > 0
+    check_gpu_supported(0 if rows or toolframe else every, None,
                         "q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar",
                         every if rows else 0)
+    rz_every = every if toolframe else 0
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
-     k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run) = _kernels()
+     k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,
+     ale) = _kernels()
+    (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
+     k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass) = ale
     st.prm[K.P_TEND] = t_end
     st.ist[K.I_STATUS] = K.STATUS_OK
     g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _ARRAYS}
@@ -495,12 +712,15 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     cond_every = int(st.prm[K.P_COND_EVERY])
     npair = int(st.ppair.shape[0])
     gp = max(1, (npair + _THREADS - 1) // _THREADS)
+    nsn = int(st.snodes.shape[0])
+    gs = max(1, (nsn + _THREADS - 1) // _THREADS)
     theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
     t_start = st.time
     step0 = int(st.ist[K.I_STEP])
     tick = _ticker(profile)
     run = _persistent_run(k_run, [g[name] for name in _ARRAYS]
-                          + [erosion, cond_every, int(theat), dred], nn, profile, persistent)
+                          + [erosion, cond_every, int(theat), rz_every, dred], nn, profile,
+                          persistent)
     while True:
         if run is not None:
             run(chunk_steps)
@@ -517,10 +737,14 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                                   g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"],
                                   dred)
             tick("nodes")
-            k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], dred)
+            k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
+                                            g["prm"], dred)
             tick("contact_sum")
             k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
             tick("tool")
+            if rz_every > 0 and (step + i) % rz_every == 0:
+                _ale_launches(g, ale, gn, ge, gs)
+                tick("ale")
             k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
                                   g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
                                   g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
@@ -567,6 +791,35 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         if status == K.STATUS_DONE or st.time >= t_end:
             _copy_back(st, g)
             return int(st.ist[K.I_STEP]) - step0
+
+
+def _ale_launches(g: dict, ale: tuple, gn: int, ge: int, gs: int) -> None:
+    """One tool-frame ALE pass as one launch per phase (the persistent kernel's phases)."""
+    (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
+     k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass) = ale
+    T = _THREADS
+    k_ale_place[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["x0"], g["y0"], g["acls"],
+                       g["aflt"], g["prm"], g["ist"])
+    k_ale_face[gn, T](g["xn"], g["yn"], g["x0"], g["y0"], g["acls"], g["aflt"], g["prm"],
+                      g["ist"])
+    for _ in range(RZ.TF_SWEEPS):
+        k_ale_sweep[gn, T](g["acls"], g["aflt"], g["vbuf"], g["ist"])
+        k_ale_sweep_copy[gn, T](g["acls"], g["aflt"], g["vbuf"], g["ist"])
+    k_ale_interior[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["x0"], g["y0"], g["acls"],
+                          g["aflt"], g["prm"], g["ist"])
+    k_ale_flux[ge, T](g["conn"], g["x"], g["y"], g["xn"], g["yn"], g["alive"], g["enbr"],
+                      g["bflag"], g["buf"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"], g["pres"],
+                      g["eps_p"], g["temp"], g["dmg"], g["qhx"], g["qhy"], g["area0"],
+                      g["mat"], g["ist"])
+    k_ale_velocity[gs, T](g["snodes"], g["x"], g["y"], g["xn"], g["yn"], g["vx"], g["vy"],
+                          g["ptr"], g["nel"], g["conn"], g["vbuf"], g["ist"])
+    k_ale_apply[gs, T](g["snodes"], g["vx"], g["vy"], g["vbuf"], g["ist"])
+    k_ale_write[ge, T](g["alive"], g["buf"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
+                       g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"], g["qhy"],
+                       g["area0"], g["ist"])
+    k_ale_nodes[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["ist"])
+    k_ale_mass[gn, T](g["ptr"], g["nel"], g["area0"], g["mass"], g["mat"], g["prm"],
+                      g["ist"])
 
 
 def _copy_back(st: Any, g: dict) -> None:

@@ -39,6 +39,8 @@ Two ways of choosing the new node positions share the remap:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, prange
 
@@ -168,27 +170,24 @@ def edge_neighbours(conn: np.ndarray) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
-def _swept(ax0, ay0, bx0, by0, ax1, ay1, bx1, by1):
+def swept_py(ax0, ay0, bx0, by0, ax1, ay1, bx1, by1):
     """Area swept outward by edge a->b of a counter-clockwise element moving 0 -> 1."""
     s = (ax0 * by0 - bx0 * ay0) + (bx0 * by1 - bx1 * by0) + (bx1 * ay1 - ax1 * by1) \
         + (ax1 * ay0 - ax0 * ay1)
     return -0.5 * s
 
 
-@njit(cache=True, inline="always")
-def _limit(px, py, tx, ty, lim):
+def limit_py(px, py, tx, ty, lim):
     """``(tx, ty)`` moved back towards ``(px, py)`` so that the move is at most ``lim``."""
     dx = tx - px
     dy = ty - py
-    d = np.sqrt(dx * dx + dy * dy)
+    d = math.sqrt(dx * dx + dy * dy)
     if d > lim:
         return px + dx * lim / d, py + dy * lim / d
     return tx, ty
 
 
-@njit(cache=True, inline="always")
-def _off_tool(px, py, qx, qy, tg):
+def off_tool_py(px, py, qx, qy, tg):
     """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
     ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
     slides along a chord wrapped round the edge adds no penalty energy."""
@@ -198,6 +197,11 @@ def _off_tool(px, py, qx, qy, tg):
     if g1 < gt:
         return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
     return qx, qy
+
+
+_swept = njit(cache=True)(swept_py)
+_limit = njit(cache=True, inline="always")(limit_py)
+_off_tool = njit(cache=True, inline="always")(off_tool_py)
 
 
 @njit(cache=True, inline="always")
@@ -282,6 +286,280 @@ def _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode
                               y[n] + omega * (ay - y[n]), max_move * 0.25 * h)
 
 
+# -- the tool-frame and remap passes as scalar functions (one node or element each), called
+# -- by the CPU's prange loops below and by the GPU kernels (robobore.cutting.fe.gpu2d)
+
+def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
+    """MODE_TOOLFRAME, first pass, node ``n``: the new place of a rigid node, a surface-chain
+    node or a chain end on an outflow line into ``xn[n]``, ``yn[n]`` (other classes: left
+    as they are). Reads the old positions only."""
+    c = acls[n, 0]
+    px = x[n]
+    py = y[n]
+    qx = x0[n] + off
+    qy = y0[n]
+    if c == TF_RIGID:
+        xn[n] = qx
+        yn[n] = qy
+    elif c == TF_CHAIN:
+        a = acls[n, 1]
+        b = acls[n, 2]
+        tx = px
+        ty = py
+        best = (qx - px) ** 2 + (qy - py) ** 2
+        la = math.sqrt((x[a] - px) ** 2 + (y[a] - py) ** 2)
+        lb = math.sqrt((x[b] - px) ** 2 + (y[b] - py) ** 2)
+        for k in range(2):
+            m = a if k == 0 else b
+            ex = x[m] - px
+            ey = y[m] - py
+            l2 = ex * ex + ey * ey
+            if l2 <= 0.0:
+                continue
+            t = ((qx - px) * ex + (qy - py) * ey) / l2
+            if t <= 0.0:
+                continue
+            t = min(t, 1.0)
+            sx = px + t * ex
+            sy = py + t * ey
+            d = (qx - sx) ** 2 + (qy - sy) ** 2
+            if d < best:
+                best = d
+                tx = sx
+                ty = sy
+        tx, ty = _limit(px, py, tx, ty, max_move * min(la, lb))
+        tx, ty = _off_tool(px, py, tx, ty, tg)
+        xn[n] = tx
+        yn[n] = ty
+    elif c == TF_LINE:
+        # where the surface (its last segment, extended) crosses the line through the
+        # node's tool-frame place along aflt[n, 1:3], at most aflt[n, 0] from that place
+        a = acls[n, 1]
+        ex = px - x[a]
+        ey = py - y[a]
+        dx = aflt[n, 1]
+        dy = aflt[n, 2]
+        cr = ex * dy - ey * dx
+        le = math.sqrt(ex * ex + ey * ey)
+        if abs(cr) > 0.05 * le:
+            t = ((qx - x[a]) * dy - (qy - y[a]) * dx) / cr
+            tx = x[a] + t * ex
+            ty = y[a] + t * ey
+            s = (tx - qx) * dx + (ty - qy) * dy
+        else:  # surface nearly along the line: project onto it
+            s = (px - qx) * dx + (py - qy) * dy
+        # at most aflt[n, 0] along the line from the node's place
+        s = max(-aflt[n, 0], min(aflt[n, 0], s))
+        tx = qx + s * dx
+        ty = qy + s * dy
+        tx, ty = _limit(px, py, tx, ty, max_move * le)
+        tx, ty = _off_tool(px, py, tx, ty, tg)
+        xn[n] = tx
+        yn[n] = ty
+
+
+def tf_face_py(n, xn, yn, x0, y0, acls, aflt, off):
+    """MODE_TOOLFRAME, second pass, node ``n`` (after :func:`tf_place_py` of every node):
+    an outflow-face node spread between its two (placed) ends; then, for every node but an
+    interior one, its mesh displacement (the boundary values of the interpolation)."""
+    c = acls[n, 0]
+    if c == TF_FACE:
+        a = acls[n, 1]
+        b = acls[n, 2]
+        f = aflt[n, 0]
+        xn[n] = xn[a] + f * (xn[b] - xn[a])
+        yn[n] = yn[a] + f * (yn[b] - yn[a])
+    if c != TF_INTERIOR:
+        aflt[n, 4] = xn[n] - x0[n] - off
+        aflt[n, 5] = yn[n] - y0[n]
+
+
+def tf_sweep_py(n, acls, aflt, scratch):
+    """One Jacobi sweep of the mesh-displacement interpolation, interior node ``n``: the mean
+    of its four edge neighbours into ``scratch[n]`` (all nodes, then :func:`tf_sweep_copy_py`)."""
+    if acls[n, 0] != TF_INTERIOR:
+        return
+    sx = 0.0
+    sy = 0.0
+    for k in range(4):
+        m = acls[n, 3 + k]
+        sx += aflt[m, 4]
+        sy += aflt[m, 5]
+    scratch[n, 0] = 0.25 * sx
+    scratch[n, 1] = 0.25 * sy
+
+
+def tf_sweep_copy_py(n, acls, aflt, scratch):
+    """Second half of a Jacobi sweep: interior node ``n`` takes its new displacement."""
+    if acls[n, 0] == TF_INTERIOR:
+        aflt[n, 4] = scratch[n, 0]
+        aflt[n, 5] = scratch[n, 1]
+
+
+def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
+    """MODE_TOOLFRAME, last pass, interior node ``n``: its place in the tool frame plus the
+    interpolated mesh displacement, the move limited to ``max_move`` of its local size."""
+    if acls[n, 0] == TF_INTERIOR:
+        tx, ty = _limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
+                        max_move * aflt[n, 3])
+        xn[n] = tx
+        yn[n] = ty
+
+
+def rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+               eps_p, temp, dmg, qhx, qhy, area0, t_room):
+    """Donor-cell remap of element ``e`` (old geometry ``x``, ``y`` -> new ``xn``, ``yn``):
+    its new intensive fields and reference area into ``buf[e]`` (see :func:`rezone`).
+    Reads the old state only, so all elements can run at once."""
+    for f in range(N_RZ_FIELDS):
+        buf[e, f] = 0.0
+    if alive[e] != 1:
+        return
+    i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
+    a_old = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+    # the area after the pass that the fluxes account for: the old area plus the areas
+    # swept by the edges shared with live elements (an edge on the outline or next to
+    # an eroded element carries no flux, so a boundary node that slides along a
+    # curved surface neither creates nor destroys mass)
+    a_new = a_old
+    c0 = sdx[e] * a_old
+    c1 = sdy[e] * a_old
+    c2 = sdz[e] * a_old
+    c3 = sdxy[e] * a_old
+    c4 = pres[e] * a_old
+    c5 = eps_p[e] * a_old
+    c6 = temp[e] * a_old
+    c7 = dmg[e] * a_old
+    c8 = qhx[e] * a_old
+    c9 = qhy[e] * a_old
+    c10 = area0[e]
+    for kk in range(4):
+        a = conn[e, kk]
+        b = conn[e, (kk + 1) % 4]
+        sw = _swept(x[a], y[a], x[b], y[b], xn[a], yn[a], xn[b], yn[b])
+        if sw == 0.0:
+            continue
+        nb = np.int64(enbr[e, kk])
+        u = nb
+        if nb < 0:
+            # an outline edge carries a flux only where bflag opens it
+            if bflag.shape[0] == 0 or bflag[e, kk] == BF_CLOSED:
+                continue
+            a_new += sw
+            if sw > 0.0 and bflag[e, kk] == BF_VIRGIN:
+                c6 += sw * t_room  # virgin: no stress, strain, damage; A0 = A
+                c10 += sw
+                continue
+            u = np.int64(e)  # outflow (or backflow through an open face): own state
+        elif alive[nb] != 1:
+            continue
+        else:
+            a_new += sw
+            if sw <= 0.0:
+                u = np.int64(e)
+        iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
+        au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
+                    + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
+        c0 += sw * sdx[u]
+        c1 += sw * sdy[u]
+        c2 += sw * sdz[u]
+        c3 += sw * sdxy[u]
+        c4 += sw * pres[u]
+        c5 += sw * eps_p[u]
+        c6 += sw * temp[u]
+        c7 += sw * dmg[u]
+        c8 += sw * qhx[u]
+        c9 += sw * qhy[u]
+        c10 += sw * area0[u] / au
+    inv = 1.0 / a_new
+    buf[e, 0] = c0 * inv
+    buf[e, 1] = c1 * inv
+    buf[e, 2] = c2 * inv
+    buf[e, 3] = c3 * inv
+    buf[e, 4] = c4 * inv
+    buf[e, 5] = c5 * inv
+    buf[e, 6] = c6 * inv
+    buf[e, 7] = c7 * inv
+    buf[e, 8] = c8 * inv
+    buf[e, 9] = c9 * inv
+    buf[e, 10] = c10
+
+
+def rz_velocity_py(n, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf):
+    """Velocity increment of moved node ``n`` into ``vbuf[n]``: first-order Taylor with the
+    mean old velocity gradient of its elements (read from the old state only). Returns 1
+    when the node moves, else 0."""
+    vbuf[n, 0] = 0.0
+    vbuf[n, 1] = 0.0
+    dx = xn[n] - x[n]
+    dy = yn[n] - y[n]
+    if dx == 0.0 and dy == 0.0:
+        return 0
+    gxx = 0.0
+    gxy = 0.0
+    gyx = 0.0
+    gyy = 0.0
+    cnt = 0
+    for q in range(ptr[n], ptr[n + 1]):
+        e = nel[q]
+        i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
+        A = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+        inv2a = 0.5 / A
+        bx1 = (y[i2] - y[i4]) * inv2a
+        bx2 = (y[i3] - y[i1]) * inv2a
+        bx3 = (y[i4] - y[i2]) * inv2a
+        bx4 = (y[i1] - y[i3]) * inv2a
+        by1 = (x[i4] - x[i2]) * inv2a
+        by2 = (x[i1] - x[i3]) * inv2a
+        by3 = (x[i2] - x[i4]) * inv2a
+        by4 = (x[i3] - x[i1]) * inv2a
+        gxx += vx[i1] * bx1 + vx[i2] * bx2 + vx[i3] * bx3 + vx[i4] * bx4
+        gxy += vx[i1] * by1 + vx[i2] * by2 + vx[i3] * by3 + vx[i4] * by4
+        gyx += vy[i1] * bx1 + vy[i2] * bx2 + vy[i3] * bx3 + vy[i4] * bx4
+        gyy += vy[i1] * by1 + vy[i2] * by2 + vy[i3] * by3 + vy[i4] * by4
+        cnt += 1
+    if cnt > 0:
+        vbuf[n, 0] = (gxx * dx + gxy * dy) / cnt
+        vbuf[n, 1] = (gyx * dx + gyy * dy) / cnt
+    return 1
+
+
+def rz_write_py(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0):
+    """Live element ``e`` takes its remapped fields from ``buf[e]``."""
+    if alive[e] != 1:
+        return
+    sdx[e] = buf[e, 0]
+    sdy[e] = buf[e, 1]
+    sdz[e] = buf[e, 2]
+    sdxy[e] = buf[e, 3]
+    pres[e] = buf[e, 4]
+    eps_p[e] = buf[e, 5]
+    temp[e] = buf[e, 6]
+    dmg[e] = buf[e, 7]
+    qhx[e] = buf[e, 8]
+    qhy[e] = buf[e, 9]
+    area0[e] = buf[e, 10]
+
+
+def rz_node_mass_py(n, ptr, nel, area0, rho_s, mass):
+    """Lumped mass of node ``n`` from its elements' (remapped) reference areas."""
+    m = 0.0
+    for q in range(ptr[n], ptr[n + 1]):
+        m += 0.25 * rho_s * area0[nel[q]]
+    mass[n] = m
+
+
+tf_place = njit(cache=True, inline="always")(tf_place_py)
+tf_face = njit(cache=True, inline="always")(tf_face_py)
+tf_sweep = njit(cache=True, inline="always")(tf_sweep_py)
+tf_sweep_copy = njit(cache=True, inline="always")(tf_sweep_copy_py)
+tf_interior = njit(cache=True, inline="always")(tf_interior_py)
+rz_flux = njit(cache=True, inline="always")(rz_flux_py)
+rz_velocity = njit(cache=True, inline="always")(rz_velocity_py)
+rz_write = njit(cache=True, inline="always")(rz_write_py)
+rz_node_mass = njit(cache=True, inline="always")(rz_node_mass_py)
+
+
 @njit(parallel=True, cache=True)
 def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scratch):
     """MODE_TOOLFRAME: new node positions ``xn``, ``yn`` (see
@@ -289,109 +567,26 @@ def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scrat
     frame at the start (the tool's edge centre then at x = its current x - ``off``);
     ``acls``/``aflt`` the classes, neighbours, face fractions, line directions, local sizes
     and the mesh displacement carried from pass to pass (``aflt[:, 4:6]``, updated);
-    ``scratch`` (n, 2) work array.
+    ``scratch`` (n, 2) work array. The passes (:func:`tf_place_py`, :func:`tf_face_py`,
+    ``TF_SWEEPS`` x :func:`tf_sweep_py` + :func:`tf_sweep_copy_py`,
+    :func:`tf_interior_py`) each read only what the previous ones wrote.
     """
     nn = x.shape[0]
     # 1. rigid nodes, surface chains and the chain ends on the outflow lines
     for n in prange(nn):
-        c = acls[n, 0]
-        px = x[n]
-        py = y[n]
-        qx = x0[n] + off
-        qy = y0[n]
-        if c == TF_RIGID:
-            xn[n] = qx
-            yn[n] = qy
-        elif c == TF_CHAIN:
-            a = acls[n, 1]
-            b = acls[n, 2]
-            tx = px
-            ty = py
-            best = (qx - px) ** 2 + (qy - py) ** 2
-            la = np.sqrt((x[a] - px) ** 2 + (y[a] - py) ** 2)
-            lb = np.sqrt((x[b] - px) ** 2 + (y[b] - py) ** 2)
-            for k in range(2):
-                m = a if k == 0 else b
-                ex = x[m] - px
-                ey = y[m] - py
-                l2 = ex * ex + ey * ey
-                if l2 <= 0.0:
-                    continue
-                t = ((qx - px) * ex + (qy - py) * ey) / l2
-                if t <= 0.0:
-                    continue
-                t = min(t, 1.0)
-                sx = px + t * ex
-                sy = py + t * ey
-                d = (qx - sx) ** 2 + (qy - sy) ** 2
-                if d < best:
-                    best = d
-                    tx = sx
-                    ty = sy
-            tx, ty = _limit(px, py, tx, ty, max_move * min(la, lb))
-            tx, ty = _off_tool(px, py, tx, ty, tg)
-            xn[n] = tx
-            yn[n] = ty
-        elif c == TF_LINE:
-            # where the surface (its last segment, extended) crosses the line through the
-            # node's tool-frame place along aflt[n, 1:3], at most aflt[n, 0] from that place
-            a = acls[n, 1]
-            ex = px - x[a]
-            ey = py - y[a]
-            dx = aflt[n, 1]
-            dy = aflt[n, 2]
-            cr = ex * dy - ey * dx
-            le = np.sqrt(ex * ex + ey * ey)
-            if abs(cr) > 0.05 * le:
-                t = ((qx - x[a]) * dy - (qy - y[a]) * dx) / cr
-                tx = x[a] + t * ex
-                ty = y[a] + t * ey
-                s = (tx - qx) * dx + (ty - qy) * dy
-            else:  # surface nearly along the line: project onto it
-                s = (px - qx) * dx + (py - qy) * dy
-            # at most aflt[n, 0] along the line from the node's place
-            s = max(-aflt[n, 0], min(aflt[n, 0], s))
-            tx = qx + s * dx
-            ty = qy + s * dy
-            tx, ty = _limit(px, py, tx, ty, max_move * le)
-            tx, ty = _off_tool(px, py, tx, ty, tg)
-            xn[n] = tx
-            yn[n] = ty
-    # 2. outflow faces between their (now placed) ends
+        tf_place(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg)
+    # 2. outflow faces between their (now placed) ends; the boundary values of the mesh
+    # displacement
     for n in prange(nn):
-        if acls[n, 0] == TF_FACE:
-            a = acls[n, 1]
-            b = acls[n, 2]
-            f = aflt[n, 0]
-            xn[n] = xn[a] + f * (xn[b] - xn[a])
-            yn[n] = yn[a] + f * (yn[b] - yn[a])
-    # 3. mesh displacement: boundary values, then Jacobi sweeps of the interior
-    for n in prange(nn):
-        if acls[n, 0] != TF_INTERIOR:
-            aflt[n, 4] = xn[n] - x0[n] - off
-            aflt[n, 5] = yn[n] - y0[n]
+        tf_face(n, xn, yn, x0, y0, acls, aflt, off)
+    # 3. Jacobi sweeps of the interior
     for _sweep in range(TF_SWEEPS):
         for n in prange(nn):
-            if acls[n, 0] != TF_INTERIOR:
-                continue
-            sx = 0.0
-            sy = 0.0
-            for k in range(4):
-                m = acls[n, 3 + k]
-                sx += aflt[m, 4]
-                sy += aflt[m, 5]
-            scratch[n, 0] = 0.25 * sx
-            scratch[n, 1] = 0.25 * sy
+            tf_sweep(n, acls, aflt, scratch)
         for n in prange(nn):
-            if acls[n, 0] == TF_INTERIOR:
-                aflt[n, 4] = scratch[n, 0]
-                aflt[n, 5] = scratch[n, 1]
+            tf_sweep_copy(n, acls, aflt, scratch)
     for n in prange(nn):
-        if acls[n, 0] == TF_INTERIOR:
-            tx, ty = _limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
-                            max_move * aflt[n, 3])
-            xn[n] = tx
-            yn[n] = ty
+        tf_interior(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move)
 
 
 @njit(parallel=True, cache=True)
@@ -411,7 +606,11 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
     is remapped (all but the rigid ones). ``bflag`` (n_elem, 4), any mode with
     ``bflag.shape[0] > 0``: flux type of each outline edge (BF_*): virgin material at
     ``t_room`` [K] flows in through BF_VIRGIN edges, material leaves through BF_VIRGIN and
-    BF_OPEN edges (and comes back through BF_OPEN ones with the element's own state)."""
+    BF_OPEN edges (and comes back through BF_OPEN ones with the element's own state).
+
+    The passes are the scalar functions :func:`rz_flux_py`, :func:`rz_velocity_py`,
+    :func:`rz_write_py` and :func:`rz_node_mass_py` (and the tool-frame ones), which the
+    GPU engine runs in the same order (:mod:`robobore.cutting.fe.gpu2d`)."""
     nn = x.shape[0]
     ne = conn.shape[0]
     for n in prange(nn):
@@ -425,140 +624,22 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
                   x0, y0, tg)
     # 2. element fluxes into buf (old geometry x, y -> new geometry xn, yn)
     for e in prange(ne):
-        for f in range(N_RZ_FIELDS):
-            buf[e, f] = 0.0
-        if alive[e] != 1:
-            continue
-        i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-        a_old = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-        # the area after the pass that the fluxes account for: the old area plus the areas
-        # swept by the edges shared with live elements (an edge on the outline or next to
-        # an eroded element carries no flux, so a boundary node that slides along a
-        # curved surface neither creates nor destroys mass)
-        a_new = a_old
-        c0 = sdx[e] * a_old
-        c1 = sdy[e] * a_old
-        c2 = sdz[e] * a_old
-        c3 = sdxy[e] * a_old
-        c4 = pres[e] * a_old
-        c5 = eps_p[e] * a_old
-        c6 = temp[e] * a_old
-        c7 = dmg[e] * a_old
-        c8 = qhx[e] * a_old
-        c9 = qhy[e] * a_old
-        c10 = area0[e]
-        for kk in range(4):
-            a = conn[e, kk]
-            b = conn[e, (kk + 1) % 4]
-            sw = _swept(x[a], y[a], x[b], y[b], xn[a], yn[a], xn[b], yn[b])
-            if sw == 0.0:
-                continue
-            nb = np.int64(enbr[e, kk])
-            if nb < 0:
-                # an outline edge carries a flux only where bflag opens it
-                if bflag.shape[0] == 0 or bflag[e, kk] == BF_CLOSED:
-                    continue
-                a_new += sw
-                if sw > 0.0 and bflag[e, kk] == BF_VIRGIN:
-                    c6 += sw * t_room  # virgin: no stress, strain, damage; A0 = A
-                    c10 += sw
-                    continue
-                u = np.int64(e)  # outflow (or backflow through an open face): own state
-            elif alive[nb] != 1:
-                continue
-            else:
-                a_new += sw
-                u = np.int64(e)
-                if sw > 0.0:
-                    u = nb
-            iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
-            au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
-                        + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
-            c0 += sw * sdx[u]
-            c1 += sw * sdy[u]
-            c2 += sw * sdz[u]
-            c3 += sw * sdxy[u]
-            c4 += sw * pres[u]
-            c5 += sw * eps_p[u]
-            c6 += sw * temp[u]
-            c7 += sw * dmg[u]
-            c8 += sw * qhx[u]
-            c9 += sw * qhy[u]
-            c10 += sw * area0[u] / au
-        inv = 1.0 / a_new
-        buf[e, 0] = c0 * inv
-        buf[e, 1] = c1 * inv
-        buf[e, 2] = c2 * inv
-        buf[e, 3] = c3 * inv
-        buf[e, 4] = c4 * inv
-        buf[e, 5] = c5 * inv
-        buf[e, 6] = c6 * inv
-        buf[e, 7] = c7 * inv
-        buf[e, 8] = c8 * inv
-        buf[e, 9] = c9 * inv
-        buf[e, 10] = c10
+        rz_flux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+                eps_p, temp, dmg, qhx, qhy, area0, t_room)
     # 3. nodal velocity: first-order Taylor with the mean old gradient of adjacent elements
     moved = 0
-    for k in range(snodes.shape[0]):
-        n = snodes[k]
-        vbuf[n, 0] = 0.0
-        vbuf[n, 1] = 0.0
-        dx = xn[n] - x[n]
-        dy = yn[n] - y[n]
-        if dx == 0.0 and dy == 0.0:
-            continue
-        moved += 1
-        gxx = 0.0
-        gxy = 0.0
-        gyx = 0.0
-        gyy = 0.0
-        cnt = 0
-        for q in range(ptr[n], ptr[n + 1]):
-            e = nel[q]
-            i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-            A = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-            inv2a = 0.5 / A
-            bx1 = (y[i2] - y[i4]) * inv2a
-            bx2 = (y[i3] - y[i1]) * inv2a
-            bx3 = (y[i4] - y[i2]) * inv2a
-            bx4 = (y[i1] - y[i3]) * inv2a
-            by1 = (x[i4] - x[i2]) * inv2a
-            by2 = (x[i1] - x[i3]) * inv2a
-            by3 = (x[i2] - x[i4]) * inv2a
-            by4 = (x[i3] - x[i1]) * inv2a
-            gxx += vx[i1] * bx1 + vx[i2] * bx2 + vx[i3] * bx3 + vx[i4] * bx4
-            gxy += vx[i1] * by1 + vx[i2] * by2 + vx[i3] * by3 + vx[i4] * by4
-            gyx += vy[i1] * bx1 + vy[i2] * bx2 + vy[i3] * bx3 + vy[i4] * bx4
-            gyy += vy[i1] * by1 + vy[i2] * by2 + vy[i3] * by3 + vy[i4] * by4
-            cnt += 1
-        if cnt > 0:
-            vbuf[n, 0] = (gxx * dx + gxy * dy) / cnt
-            vbuf[n, 1] = (gyx * dx + gyy * dy) / cnt
-    for k in range(snodes.shape[0]):
+    for k in prange(snodes.shape[0]):
+        moved += rz_velocity(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+    for k in prange(snodes.shape[0]):
         n = snodes[k]
         vx[n] += vbuf[n, 0]
         vy[n] += vbuf[n, 1]
     # 4. write back element fields and positions, recompute nodal masses
     for e in prange(ne):
-        if alive[e] != 1:
-            continue
-        sdx[e] = buf[e, 0]
-        sdy[e] = buf[e, 1]
-        sdz[e] = buf[e, 2]
-        sdxy[e] = buf[e, 3]
-        pres[e] = buf[e, 4]
-        eps_p[e] = buf[e, 5]
-        temp[e] = buf[e, 6]
-        dmg[e] = buf[e, 7]
-        qhx[e] = buf[e, 8]
-        qhy[e] = buf[e, 9]
-        area0[e] = buf[e, 10]
+        rz_write(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0)
     for n in prange(nn):
         x[n] = xn[n]
         y[n] = yn[n]
     for n in prange(nn):
-        m = 0.0
-        for q in range(ptr[n], ptr[n + 1]):
-            m += 0.25 * rho_s * area0[nel[q]]
-        mass[n] = m
+        rz_node_mass(n, ptr, nel, area0, rho_s, mass)
     return moved

@@ -537,10 +537,6 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
     if device not in ("cpu", "gpu"):
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
-    if device == "gpu" and cfg.mesh.frame == "tool":
-        raise ConfigError("the tool-frame ALE model runs on the CPU only", file=source,
-                          field="--device", value=device,
-                          expected='cpu with mesh.frame = "tool"')
     if device == "gpu":
         from robobore.cutting.fe.gpu import require_gpu
         from robobore.cutting.fe.gpu2d import check_gpu_supported
