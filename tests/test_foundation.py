@@ -37,6 +37,9 @@ def test_validate_model_names_key_and_file():
         validate_model(_Cfg, {"inner": {"stiffness_N_per_m": -1.0}}, source="x.toml")
     assert ei.value.field == "inner.stiffness_N_per_m"
     assert "x.toml" in str(ei.value) and "-1.0" in str(ei.value)
+    # the value is shown once (it was doubled: "(got -1.0) (got -1.0)") and kept as data
+    assert str(ei.value).count("(got -1.0)") == 1, str(ei.value)
+    assert ei.value.value == -1.0
 
 
 def test_load_toml_errors(tmp_path):

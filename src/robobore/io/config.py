@@ -53,12 +53,11 @@ def validate_model(model: type[M], data: dict[str, Any], source: str | Path = "<
             lines.append(f"[{_loc(e)}] {msg}{shown}")
         first = errs[0] if errs else {}
         first_in = first.get("input")
-        raise ConfigError(
-            "; ".join(lines),
-            file=str(source),
-            field=_loc(first) or None,
-            value=None if isinstance(first_in, dict) else first_in,
-        ) from None
+        # every line already shows its value: the structured ``value`` is set afterwards so
+        # that the message does not repeat the first one
+        err = ConfigError("; ".join(lines), file=str(source), field=_loc(first) or None)
+        err.value = None if isinstance(first_in, dict) else first_in
+        raise err from None
 
 
 def load_config(model: type[M], path: str | Path) -> M:
