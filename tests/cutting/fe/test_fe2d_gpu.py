@@ -24,7 +24,23 @@ from robobore.errors import ConfigError
 
 EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
 
-SCRIPT = textwrap.dedent("""
+#: shared by the simulator scripts: histories every 5 steps over the compared steps
+PRELUDE = textwrap.dedent("""
+    import numpy as np
+    from robobore.cutting.fe import kernels as K
+
+    def sample_every_5_steps(st, rows):
+        dt = float(st.clock[1])
+        st.prm[K.P_SAMPLE_DT] = 5 * dt
+        k0 = int(st.clock[0] / st.prm[K.P_SAMPLE_DT])
+        st.ist[K.I_SAMPLE] = k0
+        st.hist = np.full((k0 + rows, K.N_HIST), np.nan)
+        st.hacc[:] = 0.0
+        st.clock[2] = 0.0
+        return dt, k0
+""")
+
+SCRIPT = PRELUDE + textwrap.dedent("""
     import copy, json, sys
     import numpy as np
     from numba import cuda
@@ -51,14 +67,7 @@ SCRIPT = textwrap.dedent("""
     # into the cut on the CPU: contact, plastic chip, released and still tied pairs
     t_mid = s.t_contact + 0.5 * (s.t_end - s.t_contact)
     advance(st, t_mid)
-    dt = float(st.clock[1])
-    # histories every 5 steps over the compared steps
-    st.prm[K.P_SAMPLE_DT] = 5 * dt
-    k0 = int(st.clock[0] / st.prm[K.P_SAMPLE_DT])
-    st.ist[K.I_SAMPLE] = k0
-    st.hist = np.full((k0 + 20, K.N_HIST), np.nan)
-    st.hacc[:] = 0.0
-    st.clock[2] = 0.0
+    dt, k0 = sample_every_5_steps(st, 20)
     a = copy.deepcopy(st)
     b = copy.deepcopy(st)
     t_end = float(st.clock[0]) + 40.5 * dt
@@ -99,7 +108,7 @@ SCRIPT = textwrap.dedent("""
 
 #: the tool-frame ALE model (examples/fe_orthogonal_toolframe.toml, coarsened), 23 steps from
 #: the middle of a cut: the CPU engine, then the persistent kernel and one launch per kernel
-SCRIPT_TF = textwrap.dedent("""
+SCRIPT_TF = PRELUDE + textwrap.dedent("""
     import copy, json, sys, tomllib
     import numpy as np
     from robobore.cutting.fe import kernels as K
@@ -118,13 +127,7 @@ SCRIPT_TF = textwrap.dedent("""
     s = setup_orthogonal(parse_config(d))
     st = s.state
     advance(st, 0.5 * s.t_end)
-    dt = float(st.clock[1])
-    st.prm[K.P_SAMPLE_DT] = 5 * dt
-    k0 = int(st.clock[0] / st.prm[K.P_SAMPLE_DT])
-    st.ist[K.I_SAMPLE] = k0
-    st.hist = np.full((k0 + 10, K.N_HIST), np.nan)
-    st.hacc[:] = 0.0
-    st.clock[2] = 0.0
+    dt, k0 = sample_every_5_steps(st, 10)
     t_end = float(st.clock[0]) + 23.5 * dt
     a = copy.deepcopy(st)
     na = advance(a, t_end, chunk_steps=15)
