@@ -103,6 +103,9 @@ def main() -> None:
     ap.add_argument("--save-dir", type=Path, default=None,
                     help="write each point's final state (deformed mesh, fields, node "
                     "velocities) to DIR/h<h>_vc<vc>.npz")
+    ap.add_argument("--chip-length-um", type=float, default=None,
+                    help="mesh.chip_length_um of the tool-frame model (default: max(1.5 "
+                    "chip thicknesses, 80 um))")
     ap.add_argument("--device", choices=["cpu", "gpu"], default="cpu",
                     help="run each point on the CPU (numba) or the GPU (numba-cuda)")
     args = ap.parse_args()
@@ -121,7 +124,8 @@ def main() -> None:
           f"{args.friction_velocity or 'cutting_speed'}, shear limit "
           f"{SHEAR_LIMIT_MPA if args.shear_limit_mpa is None else args.shear_limit_mpa} MPa, "
           f"friction heat "
-          f"{args.friction_heat_fraction}, device {args.device}, "
+          f"{args.friction_heat_fraction}, chip length {args.chip_length_um or 'default'} "
+          f"um, device {args.device}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
@@ -141,6 +145,8 @@ def main() -> None:
             mesh["separation_height_um"] = args.separation_height_um
         if args.edge_um is not None:
             mesh["edge_element_um"] = args.edge_um
+        if args.chip_length_um is not None:
+            mesh["chip_length_um"] = args.chip_length_um
         if args.band_um is not None:
             mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
         solver: dict = {}

@@ -161,6 +161,7 @@ def test_short_tool_frame_cut():
     ({"tool": {"edge_radius_um": 0.0}}, "tool.edge_radius_um"),
     ({"mesh": {"edge_element_um": 20.0}}, "mesh.edge_element_um"),
     ({"mesh": {"join_height_um": 30.0}}, "mesh.join_height_um"),
+    ({"mesh": {"chip_length_um": 100.0}}, "mesh.chip_length_um"),
     ({"solver": {"element": "q4_bbar"}}, "solver.element"),
     ({"solver": {"rezone_interval": 10}}, "solver.rezone_interval"),
     ({"solver": {"erosion": "everywhere"}}, "solver.erosion"),
@@ -177,14 +178,20 @@ def test_tool_frame_config_errors(patch, field):
     assert field in str(ei.value) and "cfg.toml" in str(ei.value)
 
 
-def test_tool_frame_gpu_refused():
+def test_tool_frame_on_gpu_needs_a_gpu():
+    """The tool-frame model runs on the GPU since session 15 (the simulator test in
+    test_fe2d_gpu.py); without a usable GPU --device gpu stops with the clear error."""
+    from robobore.cutting.fe.gpu import cuda_available
     from robobore.cutting.fe.solver import check_device
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
                                 "length_mm": 0.01},
                         "mesh": {"element_size_um": 10, "frame": "tool"}})
-    with pytest.raises(ConfigError, match="--device"):
+    if cuda_available():
+        check_device("gpu", cfg)  # accepted
+        return
+    with pytest.raises(ConfigError, match="no usable NVIDIA GPU"):
         check_device("gpu", cfg)
 
 
@@ -201,3 +208,8 @@ def test_example_config_builds():
     assert p[K.P_CDAMP] == 1.0 and int(p[K.P_EROSION]) == K.ERODE_NONE
     assert su.t_contact == 0.0 and su.t_end == pytest.approx(0.3e-3 / 0.5)
     assert su.state.snodes.size == int((su.mesh.acls[:, 0] != TF_RIGID).sum())
+    # a longer chip (mesh.chip_length_um) adds elements up the rake
+    cfg2 = load_fe_config(Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml")
+    cfg2.mesh.chip_length_um = 288.0
+    n2 = setup_orthogonal(cfg2).state.conn.shape[0]
+    assert n2 > su.state.conn.shape[0]

@@ -174,6 +174,11 @@ class MeshSection(_Strict):
     #: workpiece blocks meet on the edge arc (a mesh choice, not where the material divides);
     #: None: min(edge radius, h) / 2
     join_height_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: length [um] of the pre-shaped chip up the rake face, from where the rake
+    #: face starts to the chip's top face (an outflow boundary); None: max(1.5 chip
+    #: thicknesses, 80 um). It must exceed the tool-chip contact length: a chip that still
+    #: touches the rake at its top face is held there by the boundary (docs/fe.md, session 15)
+    chip_length_um: float | None = Field(default=None, gt=0.0)
 
     @field_validator("edge_band_um")
     @classmethod
@@ -377,6 +382,11 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
                           field="mesh.join_height_um", value=jh,
                           expected=f"at most the edge radius ({r:.4g} um) and 3/4 of the "
                           f"uncut chip thickness ({0.75 * h:.4g} um)")
+    cl = cfg.mesh.chip_length_um
+    if cl is not None and cl < 2.0 * h:
+        raise ConfigError("chip too short for the tool-frame mesh", file=source,
+                          field="mesh.chip_length_um", value=cl,
+                          expected=f"at least 2 uncut chip thicknesses ({2 * h:.4g} um)")
     s = cfg.solver
     for name, bad, want in (("rezone_interval", s.rezone_interval > 0, "0"),
                             ("edge_ale_interval", s.edge_ale_interval > 0, "0"),
