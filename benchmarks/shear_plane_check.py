@@ -35,6 +35,13 @@ area-weighted strain, temperature and shear flow stress (von Mises / sqrt 3) -- 
 Merchant shear stress of the FE's own rake-face forces and chip ratio (from the JSON row next
 to the state, when given as ``FILE.npz:H_UM:VC:ROW.json``).
 
+The tool-chip contact length is estimated after Oxley as well (his eq. for h in ch. 5):
+l_c = h sin(theta) / (cos(lambda) sin(phi)) (1 + C0 n_eq / (3 tan theta)), with the friction
+angle lambda from the measured force less its edge part, theta = phi + lambda - alpha and
+the equivalent strain-hardening index of the JC law at AB, n_eq = n B eps^n / (A + B eps^n);
+C0 = 6. For a saved FE state the script reports the FE's own contact length: the farthest
+node in contact up the rake, measured from where the rake face starts.
+
 The ratio k_JC / tau says how much harder (> 1) the constants make the material than the
 measured forces and chip imply. It is an estimate: Oxley's AB state, C0 and Boothroyd's beta
 are approximations, and the measured chip of the 30 m/min points is segmented (the
@@ -59,6 +66,7 @@ from robobore.material.library import load_material
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data" / "ti64_orthogonal_cutting_forces.json"
 RAKE_DEG = 15.0
+EDGE_RADIUS = 20e-6  # the measured tools' edge radius [m] (the data file's description)
 C0_VALUES = (3.0, 6.0, 10.0)
 ETA = 0.9
 
@@ -103,6 +111,31 @@ def jc_shear_flow_stress(mat, h: float, vc: float, st: dict, c0: float) -> tuple
             break
         k = 0.5 * (k + k_new)  # damped: the softening makes the plain iteration oscillate
     return k, temp
+
+
+def oxley_contact_length(mat, h: float, st: dict, alpha: float, fc: float, ff: float,
+                         c0: float) -> float:
+    """Oxley's tool-chip contact length [m] from the measured shear angle and the friction
+    angle of the forces ``fc``, ``ff`` [N/m] on the rake."""
+    lam = alpha + math.atan2(ff, fc)
+    theta = st["phi"] + lam - alpha
+    eps = st["gamma"] / (2.0 * math.sqrt(3.0))
+    bn = mat.B * eps ** mat.n
+    n_eq = mat.n * bn / (mat.A + bn)
+    return (h * math.sin(theta) / (math.cos(lam) * math.sin(st["phi"]))
+            * (1.0 + c0 * n_eq / (3.0 * math.tan(theta))))
+
+
+def fe_contact_length(path: Path, rake: float, r: float) -> float:
+    """Farthest contact node up the rake of a saved FE state, from the rake's start [m]."""
+    d = np.load(path)
+    cx, cy = d["tool_center"]
+    tx, ty = math.sin(rake), math.cos(rake)
+    sx, sy = cx - r * math.cos(rake), cy + r * math.sin(rake)  # where the rake face starts
+    cf = d["contact_force_N_per_m"]
+    on = (cf[0] != 0.0) | (cf[1] != 0.0)
+    s = (d["x"] - sx) * tx + (d["y"] - sy) * ty
+    return float(s[on].max()) if on.any() else float("nan")
 
 
 def fe_shear_zone(mat, path: Path, h: float) -> dict:
@@ -154,7 +187,7 @@ def main() -> None:
           f"state, C0 = {', '.join(f'{c:g}' for c in C0_VALUES)}, eta {ETA}")
     print(f"{'h um':>5} {'vc':>4} | {'phi':>5} {'gamma':>5} | {'tau all':>7} {'tau-edge':>8} | "
           + " ".join(f"{'kJC C0=' + format(c, 'g'):>10} {'T K':>5}" for c in C0_VALUES)
-          + f" | {'ratio (C0 6) all / -edge':>25}")
+          + f" | {'ratio (C0 6) all / -edge':>25} | {'l_c um':>6}")
     for h in hs:
         for v in vcs:
             hm = float(h) * 1e-6
@@ -166,6 +199,8 @@ def main() -> None:
             tau_cut = measured_shear_stress(fc - edge[v][0] * 1e3, ff - edge[v][1] * 1e3, hm,
                                             st["phi"])
             jc = {c: jc_shear_flow_stress(mat, hm, vc, st, c) for c in C0_VALUES}
+            lc = oxley_contact_length(mat, hm, st, alpha, fc - edge[v][0] * 1e3,
+                                      ff - edge[v][1] * 1e3, 6.0)
             row = {"h_um": float(h), "vc_m_per_min": float(v),
                    "shear_angle_deg": math.degrees(st["phi"]), "shear_strain": st["gamma"],
                    "tau_measured_MPa": tau_all / 1e6,
@@ -174,20 +209,23 @@ def main() -> None:
                    "k_jc_MPa": {f"{c:g}": jc[c][0] / 1e6 for c in C0_VALUES},
                    "T_AB_K": {f"{c:g}": jc[c][1] for c in C0_VALUES},
                    "ratio_C0_6_all": jc[6.0][0] / tau_all,
-                   "ratio_C0_6_less_edge": jc[6.0][0] / tau_cut}
+                   "ratio_C0_6_less_edge": jc[6.0][0] / tau_cut,
+                   "oxley_contact_length_um": lc * 1e6}
             rows.append(row)
             print(f"{float(h):5.0f} {float(v):4.0f} | {row['shear_angle_deg']:5.1f} "
                   f"{st['gamma']:5.2f} | {tau_all / 1e6:7.0f} {tau_cut / 1e6:8.0f} | "
                   + " ".join(f"{jc[c][0] / 1e6:10.0f} {jc[c][1]:5.0f}" for c in C0_VALUES)
-                  + f" | {row['ratio_C0_6_all']:11.2f} / {row['ratio_C0_6_less_edge']:.2f}",
-                  flush=True)
+                  + f" | {row['ratio_C0_6_all']:11.2f} / {row['ratio_C0_6_less_edge']:.2f}"
+                  + f"{'':>9} | {lc * 1e6:6.0f}", flush=True)
     print("# edge intercepts (Fc, Ff) N/mm: "
           + ", ".join(f"{v} m/min {edge[v][0]:.1f} / {edge[v][1]:.1f}" for v in vcs))
     fe_rows = []
     for spec in args.fe_state:
         parts = spec.split(":")
         fe = fe_shear_zone(mat, Path(parts[0]), float(parts[1]) * 1e-6)
-        fe.update(state=parts[0], h_um=float(parts[1]), vc_m_per_min=float(parts[2]))
+        fe.update(state=parts[0], h_um=float(parts[1]), vc_m_per_min=float(parts[2]),
+                  contact_length_um=fe_contact_length(Path(parts[0]), alpha, EDGE_RADIUS)
+                  * 1e6)
         if len(parts) > 3:
             run = json.loads(Path(parts[3]).read_text())
             run = run["rows"] if isinstance(run, dict) else run
