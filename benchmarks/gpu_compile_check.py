@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import glob
+import inspect
 import os
 import re
 import subprocess
@@ -73,8 +74,11 @@ def main() -> int:
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
     d["mesh"]["element_size_um"] = 16.6
     st3 = setup_boring(parse_boring_config(d)).state
-    cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
-    cfg.cut.length_mm = 0.05
+    k2 = gpu2d._kernels()
+    # the tool-frame model's state: the same argument types as the workpiece frame's, with
+    # the ALE arrays filled
+    cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal_toolframe.toml")
+    cfg.cut.length_mm = 0.01
     st2 = setup_orthogonal(cfg).state
 
     def chunk_arrays(nn: int) -> list:
@@ -86,11 +90,20 @@ def main() -> int:
                      [1] + [np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS]
                      + [int(st3.prm[K3.P_EROSION]), np.zeros(gpu.N_RED)]
                      + chunk_arrays(st3.x.shape[0])),
-        "2D k_run": (gpu2d._kernels()[-1],
+        "2D k_run": (k2[-2],
                      [1] + [np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS]
-                     + [int(st2.prm[K.P_EROSION]), 1, 1, np.zeros(gpu2d.N_RED)]
+                     + [int(st2.prm[K.P_EROSION]), 1, 1, int(st2.prm[K.P_RZ_EVERY]),
+                        np.zeros(gpu2d.N_RED)]
                      + chunk_arrays(st2.x.shape[0])),
     }
+    # the launch-per-kernel path's contact total (with the split by face) and ALE kernels,
+    # their arguments by name from the tool-frame state
+    alias = {"dm": "dmg"}
+    for kern in (k2[1],) + tuple(k2[-1]):
+        names = inspect.signature(kern.py_func).parameters
+        args = [np.zeros(gpu2d.N_RED) if n == "red"
+                else np.ascontiguousarray(getattr(st2, alias.get(n, n))) for n in names]
+        cases[f"2D {kern.py_func.__name__}"] = (kern, args)
     ptxas = _ptxas()
     rc = 0
     for name, (kernel, args) in cases.items():
