@@ -61,6 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
+from robobore.cutting.fe.output import shear_angle_deg
 from robobore.material.library import load_material
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,7 +83,7 @@ def boothroyd_beta(rt_tan_phi: float) -> float:
 def shear_state(h: float, vc: float, r: float, alpha: float) -> dict:
     """Merchant geometry from the chip ratio: shear angle [rad], total shear strain, shear
     velocity [m/s], shear-plane length [m]."""
-    phi = math.atan(math.cos(alpha) / (r - math.sin(alpha)))
+    phi = math.radians(shear_angle_deg(r, alpha))
     gamma = math.cos(alpha) / (math.sin(phi) * math.cos(phi - alpha))
     vs = vc * math.cos(alpha) / math.cos(phi - alpha)
     return {"phi": phi, "gamma": gamma, "vs": vs, "l": h / math.sin(phi)}

@@ -64,7 +64,7 @@ from robobore.cutting.fe.gpu import (
     jc_device_functions,
     require_gpu,
 )
-from robobore.cutting.fe.rezone import MODE_ROWS, MODE_TOOLFRAME
+from robobore.cutting.fe.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported"]
@@ -120,6 +120,8 @@ def _kernels():
     rret = dev(jc.rebind(jc.radial_return_py, jc_return=ret))
     tface = dev(tool_face_py)
     tg = dev(jc.rebind(tool_gap_py, tool_face=tface))
+    csplit = dev(jc.rebind(K.contact_split_node_py, tool_face=tface))
+    tool_geometry = dev(K.tool_geometry_py)
     # the tool-frame ALE pass (rezone.py's scalar functions)
     lim = dev(RZ.limit_py)
     tplace = dev(jc.rebind(RZ.tf_place_py, _limit=lim,
@@ -165,8 +167,7 @@ def _kernels():
     P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K.P_CFL, K.P_DTMIN, K.P_TEND, K.P_SAMPLE_DT
     P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
     P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
-    P_TCX, P_TCY, P_NRX, P_NRY, P_NFX, P_NFY, P_R = (K.P_TCX, K.P_TCY, K.P_NRX, K.P_NRY,
-                                                     K.P_NFX, K.P_NFY, K.P_R)
+    P_TCX, P_NRX, P_NRY, P_NFX, P_NFY = K.P_TCX, K.P_NRX, K.P_NRY, K.P_NFX, K.P_NFY
     P_ALE_X0, P_RZ_MAXMOVE, P_MS = K.P_ALE_X0, K.P_RZ_MAXMOVE, K.P_MS
     H_FX_RAKE = K.H_FX_RAKE
     T_FX, T_FY, T_UX, T_UY, T_GX = K.T_FX, K.T_FY, K.T_UX, K.T_UY, K.T_GX
@@ -195,25 +196,15 @@ def _kernels():
 
     @cuda.jit(device=True)
     def split_add(n, x, y, cfx, cfy, cx, cy, prm, red):
-        # node n's share of the contact force by tool face (kernels.contact_split's body;
-        # called in increasing node order by one thread: the CPU's serial order)
-        fx = cfx[n]
-        fy = cfy[n]
-        if fx == 0.0 and fy == 0.0:
-            return
-        k = tface(x[n] - cx, y[n] - cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY])
-        red[R_SPLIT + 2 * k] -= fx
-        red[R_SPLIT + 2 * k + 1] -= fy
+        # node n's share of the contact force by tool face into red[R_SPLIT:], called in
+        # increasing node order by one thread: the CPU's serial order (kernels.contact_split)
+        csplit(n, cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+               red, R_SPLIT)
 
     @cuda.jit(device=True)
     def split_reset(red):
         for j in range(6):
             red[R_SPLIT + j] = 0.0
-
-    @cuda.jit(device=True)
-    def tool_geometry(prm):
-        return (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
-                prm[P_R])
 
     @cuda.jit
     def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
@@ -685,12 +676,11 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
 
     every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
     mode = int(st.prm[K.P_RZ_MODE])
-    rows = mode == MODE_ROWS
-    toolframe = mode == MODE_TOOLFRAME and every > 0
-    check_gpu_supported(0 if rows or toolframe else every, None,
+    # the tool-frame ALE runs here; Laplacian rezoning and the ploughed-layer ALE do not
+    check_gpu_supported(every if mode == MODE_LAPLACE else 0, None,
                         "q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar",
-                        every if rows else 0)
-    rz_every = every if toolframe else 0
+                        every if mode == MODE_ROWS else 0)
+    rz_every = every if mode == MODE_TOOLFRAME else 0
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,

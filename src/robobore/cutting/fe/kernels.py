@@ -784,21 +784,40 @@ def contact_total(cfx, cfy):
     return fx, fy
 
 
+def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o):
+    """Node ``i``'s contact force on the tool added to its face's pair in ``out[o:o + 6]``
+    = [Fx, Fy] of the rake face, the edge arc and the flank [N/m]. A node belongs to the
+    face that gives its gap (:func:`robobore.cutting.fe.physics.tool_face_py`). Called in
+    increasing node order by one thread on both devices (:func:`contact_split`, the GPU's
+    block 0), so the sums have the same bits."""
+    fx = cfx[i]
+    fy = cfy[i]
+    if fx == 0.0 and fy == 0.0:
+        return
+    k = tool_face(x[i] - cx, y[i] - cy, nrx, nry, nfx, nfy)
+    out[o + 2 * k] -= fx
+    out[o + 2 * k + 1] -= fy
+
+
+def tool_geometry_py(prm):
+    """The tool's edge centre x, y, rake and flank normals and edge radius from ``prm``: the
+    tool geometry tuple of the ALE passes (:mod:`robobore.cutting.fe.rezone`)."""
+    return (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+            prm[P_R])
+
+
+contact_split_node = njit(cache=True, inline="always")(contact_split_node_py)
+tool_geometry = njit(cache=True, inline="always")(tool_geometry_py)
+
+
 @njit(cache=True)
 def contact_split(cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out):
     """Contact force on the tool by face into ``out`` = [Fx, Fy] of the rake face, the edge
-    arc and the flank [N/m] (serial, fixed order). A node belongs to the face that gives
-    its gap (:func:`robobore.cutting.fe.physics.tool_face_py`)."""
+    arc and the flank [N/m] (serial, fixed order: :func:`contact_split_node_py`)."""
     for j in range(6):
         out[j] = 0.0
     for i in range(cfx.shape[0]):
-        fx = cfx[i]
-        fy = cfy[i]
-        if fx == 0.0 and fy == 0.0:
-            continue
-        k = tool_face(x[i] - cx, y[i] - cy, nrx, nry, nfx, nfy)
-        out[2 * k] -= fx
-        out[2 * k + 1] -= fy
+        contact_split_node(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, 0)
 
 
 def quad_centroid_py(e, conn, x, y, tbuf):
@@ -1101,8 +1120,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
             rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
                    sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
                    prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE], int(prm[P_RZ_MODE]), tied, x0, y0,
-                   vbuf, (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX],
-                          prm[P_NFY], prm[P_R]), acls, aflt, bflag, mat[jc.TROOM],
+                   vbuf, tool_geometry(prm), acls, aflt, bflag, mat[jc.TROOM],
                    prm[P_TCX] - prm[P_ALE_X0])
         if bbar:
             dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
