@@ -34,6 +34,9 @@ strain is 0.4-0.6 of the chip's median (Oxley's AB line, half the chip's strain)
 area-weighted strain, temperature and shear flow stress (von Mises / sqrt 3) -- and the
 Merchant shear stress of the FE's own rake-face forces and chip ratio (from the JSON row next
 to the state, when given as ``FILE.npz:H_UM:VC:ROW.json``).
+It also reads the chip's layer against the rake face (the secondary shear zone: elements
+within 5 um of the rake line, up to the farthest contact node): its strain, temperature and
+shear flow stress, to compare with the AB line's.
 
 The tool-chip contact length is estimated after Oxley as well (his eq. for h in ch. 5):
 l_c = h sin(theta) / (cos(lambda) sin(phi)) (1 + C0 n_eq / (3 tan theta)), with the friction
@@ -68,6 +71,8 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data" / "ti64_orthogonal_cutting_forces.json"
 RAKE_DEG = 15.0
 EDGE_RADIUS = 20e-6  # the measured tools' edge radius [m] (the data file's description)
+RAKE_LAYER = 5e-6  # depth of the chip layer against the rake read from an FE state [m]: two
+# 2.5 um edge elements of the tool-frame mesh
 C0_VALUES = (3.0, 6.0, 10.0)
 ETA = 0.9
 
@@ -137,6 +142,33 @@ def fe_contact_length(path: Path, rake: float, r: float) -> float:
     on = (cf[0] != 0.0) | (cf[1] != 0.0)
     s = (d["x"] - sx) * tx + (d["y"] - sy) * ty
     return float(s[on].max()) if on.any() else float("nan")
+
+
+def fe_rake_layer(path: Path, rake: float, r: float, depth: float = RAKE_LAYER) -> dict:
+    """The chip's layer against the rake face in a saved FE state (the secondary shear
+    zone): area-weighted plastic strain, temperature [K] and shear flow stress [MPa]
+    (von Mises / sqrt 3) of the elements whose centroid lies within ``depth`` of the rake
+    line, between where the rake face starts and the farthest contact node."""
+    d = np.load(path)
+    x, y, conn = d["x"], d["y"], d["conn"]
+    xc = x[conn].mean(1)
+    yc = y[conn].mean(1)
+    cx, cy = d["tool_center"]
+    tx, ty = math.sin(rake), math.cos(rake)
+    nx, ny = -math.cos(rake), math.sin(rake)  # rake normal, towards the chip
+    sx, sy = cx - r * math.cos(rake), cy + r * math.sin(rake)  # where the rake face starts
+    s = (xc - sx) * tx + (yc - sy) * ty
+    nrm = (xc - sx) * nx + (yc - sy) * ny
+    lc = fe_contact_length(path, rake, r)
+    sel = (nrm > 0.0) & (nrm < depth) & (s > 0.0) & (s < lc) & (d["alive"] > 0)
+    area = np.abs(0.5 * ((x[conn[:, 2]] - x[conn[:, 0]]) * (y[conn[:, 3]] - y[conn[:, 1]])
+                         - (x[conn[:, 3]] - x[conn[:, 1]]) * (y[conn[:, 2]] - y[conn[:, 0]])))
+    w = area[sel]
+    return {"rake_layer_elements": int(sel.sum()),
+            "rake_layer_strain": float(np.average(d["eps_p"][sel], weights=w)),
+            "rake_layer_T_K": float(np.average(d["temperature_K"][sel], weights=w)),
+            "rake_layer_k_MPa": float(np.average(d["von_mises_Pa"][sel], weights=w)
+                                      / math.sqrt(3.0) / 1e6)}
 
 
 def fe_shear_zone(mat, path: Path, h: float) -> dict:
@@ -227,6 +259,7 @@ def main() -> None:
         fe.update(state=parts[0], h_um=float(parts[1]), vc_m_per_min=float(parts[2]),
                   contact_length_um=fe_contact_length(Path(parts[0]), alpha, EDGE_RADIUS)
                   * 1e6)
+        fe.update(fe_rake_layer(Path(parts[0]), alpha, EDGE_RADIUS))
         if len(parts) > 3:
             run = json.loads(Path(parts[3]).read_text())
             run = run["rows"] if isinstance(run, dict) else run

@@ -106,6 +106,15 @@ def main() -> None:
     ap.add_argument("--chip-length-um", type=float, default=None,
                     help="mesh.chip_length_um of the tool-frame model (default: max(1.5 "
                     "chip thicknesses, 80 um))")
+    ap.add_argument("--depth-um", type=float, default=None,
+                    help="mesh.depth_um of the tool-frame model: the fixed bottom's depth "
+                    "below the cut line (default: max(2.5 h, 120 um))")
+    ap.add_argument("--inflow-um", type=float, default=None,
+                    help="mesh.inflow_length_um of the tool-frame model (default: max(1.5 h, "
+                    "60 um))")
+    ap.add_argument("--back-um", type=float, default=None,
+                    help="mesh.back_length_um of the tool-frame model (default: max(2 h, "
+                    "120 um))")
     ap.add_argument("--device", choices=["cpu", "gpu"], default="cpu",
                     help="run each point on the CPU (numba) or the GPU (numba-cuda)")
     args = ap.parse_args()
@@ -125,7 +134,8 @@ def main() -> None:
           f"{SHEAR_LIMIT_MPA if args.shear_limit_mpa is None else args.shear_limit_mpa} MPa, "
           f"friction heat "
           f"{args.friction_heat_fraction}, chip length {args.chip_length_um or 'default'} "
-          f"um, device {args.device}, "
+          f"um, domain depth / inflow / back {args.depth_um or 'default'} / "
+          f"{args.inflow_um or 'default'} / {args.back_um or 'default'} um, device {args.device}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
@@ -147,6 +157,10 @@ def main() -> None:
             mesh["edge_element_um"] = args.edge_um
         if args.chip_length_um is not None:
             mesh["chip_length_um"] = args.chip_length_um
+        for key, val in (("depth_um", args.depth_um), ("inflow_length_um", args.inflow_um),
+                         ("back_length_um", args.back_um)):
+            if val is not None:
+                mesh[key] = val
         if args.band_um is not None:
             mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
         solver: dict = {}

@@ -64,3 +64,44 @@ def test_boothroyd_beta_is_continuous_and_the_jc_fixed_point_holds():
     eps = st["gamma"] / (2 * math.sqrt(3))
     rate = c0 * st["vs"] / (math.sqrt(3) * st["l"])
     assert k == pytest.approx(mat.flow_stress(eps, rate, temp) / math.sqrt(3), rel=1e-5)
+
+
+def test_rake_layer_reads_only_the_chip_layer_against_the_contact(tmp_path):
+    """A constructed state: unit squares of 2 um laid along the rake line at 1 um from it
+    (inside the 5 um layer) and at 8 um (outside), some beyond the contact's end. Only the
+    first row within the contact is averaged, with the von Mises stress / sqrt 3."""
+    import numpy as np
+
+    rake, r = math.radians(15.0), 20e-6
+    cx, cy = 0.0, -40e-6
+    tx, ty = math.sin(rake), math.cos(rake)
+    nx, ny = -math.cos(rake), math.sin(rake)
+    sx, sy = cx - r * math.cos(rake), cy + r * math.sin(rake)
+    xs, ys, conn, eps, temp, vm = [], [], [], [], [], []
+    a = 1e-6  # half side
+    for k, (s, n) in enumerate([(10e-6, 2e-6), (20e-6, 2e-6), (30e-6, 2e-6),  # in the layer
+                                (20e-6, 9e-6),  # too far from the rake
+                                (70e-6, 2e-6)]):  # beyond the contact's end
+        c = (sx + s * tx + n * nx, sy + s * ty + n * ny)
+        for dx, dy in ((-a, -a), (a, -a), (a, a), (-a, a)):
+            xs.append(c[0] + dx)
+            ys.append(c[1] + dy)
+        conn.append([4 * k, 4 * k + 1, 4 * k + 2, 4 * k + 3])
+        eps.append([2.0, 3.0, 4.0, 9.0, 9.0][k])
+        temp.append([500.0, 600.0, 700.0, 1.0, 1.0][k])
+        vm.append(math.sqrt(3.0) * 1e6 * np.array([900.0, 800.0, 700.0, 1.0, 1.0])[k])
+    # contact nodes: one on the rake at s = 50 um sets the contact length
+    xs.append(sx + 50e-6 * tx)
+    ys.append(sy + 50e-6 * ty)
+    cf = np.zeros((2, len(xs)))
+    cf[0, -1] = -1.0
+    f = tmp_path / "state.npz"
+    np.savez(f, x=np.array(xs), y=np.array(ys), conn=np.array(conn), alive=np.ones(5, int),
+             eps_p=np.array(eps), temperature_K=np.array(temp), von_mises_Pa=np.array(vm),
+             tool_center=np.array([cx, cy]), contact_force_N_per_m=cf)
+    assert spc.fe_contact_length(f, rake, r) == pytest.approx(50e-6, rel=1e-9)
+    out = spc.fe_rake_layer(f, rake, r)
+    assert out["rake_layer_elements"] == 3
+    assert out["rake_layer_strain"] == pytest.approx(3.0, rel=1e-9)
+    assert out["rake_layer_T_K"] == pytest.approx(600.0, rel=1e-9)
+    assert out["rake_layer_k_MPa"] == pytest.approx(800.0, rel=1e-9)

@@ -162,6 +162,9 @@ def test_short_tool_frame_cut():
     ({"mesh": {"edge_element_um": 20.0}}, "mesh.edge_element_um"),
     ({"mesh": {"join_height_um": 30.0}}, "mesh.join_height_um"),
     ({"mesh": {"chip_length_um": 100.0}}, "mesh.chip_length_um"),
+    ({"mesh": {"depth_um": 50.0}}, "mesh.depth_um"),
+    ({"mesh": {"inflow_length_um": 50.0}}, "mesh.inflow_length_um"),
+    ({"mesh": {"back_length_um": 30.0}}, "mesh.back_length_um"),
     ({"solver": {"element": "q4_bbar"}}, "solver.element"),
     ({"solver": {"rezone_interval": 10}}, "solver.rezone_interval"),
     ({"solver": {"erosion": "everywhere"}}, "solver.erosion"),
@@ -213,3 +216,32 @@ def test_example_config_builds():
     cfg2.mesh.chip_length_um = 288.0
     n2 = setup_orthogonal(cfg2).state.conn.shape[0]
     assert n2 > su.state.conn.shape[0]
+
+
+def test_domain_keys_move_the_tool_frame_boundaries():
+    """mesh.depth_um / inflow_length_um / back_length_um place the fixed bottom, the inflow face
+    and the back face where they say (coordinates of the workpiece frame: cut line y = -h,
+    edge centre at x = 0 before the tool moves)."""
+    from pathlib import Path
+
+    from robobore.cutting.fe.config import load_fe_config
+
+    path = Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml"
+    base = setup_orthogonal(load_fe_config(path))
+    h = load_fe_config(path).cut.uncut_chip_thickness_um * 1e-6
+    cfg = load_fe_config(path)
+    cfg.mesh.depth_um = 400.0
+    cfg.mesh.back_length_um = 250.0
+    cfg.mesh.inflow_length_um = 200.0
+    su = setup_orthogonal(cfg)
+    x, y = su.mesh.nodes[:, 0], su.mesh.nodes[:, 1]
+    x0 = base.mesh.nodes[:, 0]
+    assert y.min() == pytest.approx(-h - 400e-6, rel=1e-12)
+    assert x.max() == pytest.approx(250e-6, rel=1e-12)
+    # the inflow face moves out by the difference of the two lengths (default max(1.5 h, 60))
+    assert x0.min() - x.min() == pytest.approx(200e-6 - max(1.5 * h, 60e-6), rel=1e-9)
+    # the fixed nodes are the bottom and the inflow face, wherever they are
+    fixed = su.mesh.fixed
+    assert np.all(fixed[np.isclose(y, y.min(), rtol=0, atol=1e-12)])
+    assert np.all(fixed[np.isclose(x, x.min(), rtol=0, atol=1e-12)])
+    assert su.state.conn.shape[0] > base.state.conn.shape[0]

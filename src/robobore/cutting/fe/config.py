@@ -179,6 +179,15 @@ class MeshSection(_Strict):
     #: thicknesses, 80 um). It must exceed the tool-chip contact length: a chip that still
     #: touches the rake at its top face is held there by the boundary (docs/fe.md, session 15)
     chip_length_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: depth [um] of the mesh's bottom below the cut line; the bottom is held
+    #: fixed in the workpiece (a rigid base). None: max(2.5 h, 120 um)
+    depth_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: distance [um] of the inflow face ahead of the chip's root. None:
+    #: max(1.5 h, 60 um)
+    inflow_length_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: distance [um] of the back face (the outflow of the machined surface)
+    #: behind the edge centre. None: max(2 h, 120 um)
+    back_length_um: float | None = Field(default=None, gt=0.0)
 
     @field_validator("edge_band_um")
     @classmethod
@@ -387,6 +396,15 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
         raise ConfigError("chip too short for the tool-frame mesh", file=source,
                           field="mesh.chip_length_um", value=cl,
                           expected=f"at least 2 uncut chip thicknesses ({2 * h:.4g} um)")
+    for name, val, low, what in (
+            ("depth_um", cfg.mesh.depth_um, h, "the uncut chip thickness"),
+            ("inflow_length_um", cfg.mesh.inflow_length_um, h, "the uncut chip thickness"),
+            ("back_length_um", cfg.mesh.back_length_um, max(2.0 * r, h),
+             "the larger of 2 edge radii and the uncut chip thickness")):
+        if val is not None and val < low:
+            raise ConfigError("tool-frame domain too small", file=source,
+                              field=f"mesh.{name}", value=val,
+                              expected=f"at least {what} ({low:.4g} um)")
     s = cfg.solver
     for name, bad, want in (("rezone_interval", s.rezone_interval > 0, "0"),
                             ("edge_ale_interval", s.edge_ale_interval > 0, "0"),

@@ -412,7 +412,10 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                 h, r, rake, clr, element_size=le, edge_size=ee * 1e-6,
                 chip_ratio=cm.initial_chip_ratio,
                 join_height=None if cm.join_height_um is None else cm.join_height_um * 1e-6,
-                chip_length=None if cm.chip_length_um is None else cm.chip_length_um * 1e-6)
+                chip_length=None if cm.chip_length_um is None else cm.chip_length_um * 1e-6,
+                depth=None if cm.depth_um is None else cm.depth_um * 1e-6,
+                ahead=None if cm.inflow_length_um is None else cm.inflow_length_um * 1e-6,
+                behind=None if cm.back_length_um is None else cm.back_length_um * 1e-6)
         except ValueError as exc:
             raise ConfigError(str(exc), file=source, field="mesh.initial_chip_ratio",
                               value=cm.initial_chip_ratio,
