@@ -36,7 +36,7 @@ Merchant shear stress of the FE's own rake-face forces and chip ratio (from the 
 to the state, when given as ``FILE.npz:H_UM:VC:ROW.json``).
 It also reads the chip's layer against the rake face (the secondary shear zone: elements
 within 5 um of the rake line, up to the farthest contact node): its strain, temperature and
-shear flow stress, to compare with the AB line's.
+equivalent shear stress, to compare with the AB line's.
 
 The tool-chip contact length is estimated after Oxley as well (his eq. for h in ch. 5):
 l_c = h sin(theta) / (cos(lambda) sin(phi)) (1 + C0 n_eq / (3 tan theta)), with the friction
@@ -146,9 +146,10 @@ def fe_contact_length(path: Path, rake: float, r: float) -> float:
 
 def fe_rake_layer(path: Path, rake: float, r: float, depth: float = RAKE_LAYER) -> dict:
     """The chip's layer against the rake face in a saved FE state (the secondary shear
-    zone): area-weighted plastic strain, temperature [K] and shear flow stress [MPa]
-    (von Mises / sqrt 3) of the elements whose centroid lies within ``depth`` of the rake
-    line, between where the rake face starts and the farthest contact node."""
+    zone): area-weighted plastic strain, temperature [K] and equivalent shear stress [MPa]
+    (von Mises / sqrt 3: the shear flow stress where the layer yields, less where it is
+    elastic) of the elements whose centroid lies within ``depth`` of the rake line, between
+    where the rake face starts and the farthest contact node."""
     d = np.load(path)
     x, y, conn = d["x"], d["y"], d["conn"]
     xc = x[conn].mean(1)
@@ -167,7 +168,7 @@ def fe_rake_layer(path: Path, rake: float, r: float, depth: float = RAKE_LAYER) 
     return {"rake_layer_elements": int(sel.sum()),
             "rake_layer_strain": float(np.average(d["eps_p"][sel], weights=w)),
             "rake_layer_T_K": float(np.average(d["temperature_K"][sel], weights=w)),
-            "rake_layer_k_MPa": float(np.average(d["von_mises_Pa"][sel], weights=w)
+            "rake_layer_tau_eq_MPa": float(np.average(d["von_mises_Pa"][sel], weights=w)
                                       / math.sqrt(3.0) / 1e6)}
 
 

@@ -104,4 +104,4 @@ def test_rake_layer_reads_only_the_chip_layer_against_the_contact(tmp_path):
     assert out["rake_layer_elements"] == 3
     assert out["rake_layer_strain"] == pytest.approx(3.0, rel=1e-9)
     assert out["rake_layer_T_K"] == pytest.approx(600.0, rel=1e-9)
-    assert out["rake_layer_k_MPa"] == pytest.approx(800.0, rel=1e-9)
+    assert out["rake_layer_tau_eq_MPa"] == pytest.approx(800.0, rel=1e-9)
