@@ -59,9 +59,9 @@ def _solve(q, ep0, T, dt, G, k, start):
 
 
 @njit(cache=True)
-def _returns(q, ep, T, dt, G, a, b, n, c, m, e0, tr, tm, out):
+def _returns(q, ep, T, dt, G, a, b, n, c, m, e0, tr, tm, eh, out):
     for i in range(q.shape[0]):
-        out[i] = jc.jc_return(q[i], ep[i], T[i], dt[i], G, a, b, n, c, m, e0, tr, tm)[0]
+        out[i] = jc.jc_return(q[i], ep[i], T[i], dt[i], G, a, b, n, c, m, e0, tr, tm, eh)[0]
 
 
 def main() -> None:
@@ -71,7 +71,8 @@ def main() -> None:
     a_ = ap.parse_args()
     mt = load_material("TC4")
     G = mt.G
-    k = (mt.A, mt.B, mt.n, mt.C, mt.m, mt.eps_dot0, mt.T_room, mt.T_melt)
+    k = (mt.A, mt.B, mt.n, mt.C, mt.m, mt.eps_dot0, mt.T_room, mt.T_melt,
+         mt.hardening_strain_limit)
     rng = np.random.default_rng(a_.seed)
     N = a_.samples
     ep = rng.uniform(0.0, 3.0, N)

@@ -115,6 +115,9 @@ def main() -> None:
     ap.add_argument("--back-um", type=float, default=None,
                     help="mesh.back_length_um of the tool-frame model (default: max(2 h, "
                     "120 um))")
+    ap.add_argument("--hardening-strain-limit", type=float, default=None,
+                    help="material.hardening_strain_limit: hold the Johnson-Cook hardening "
+                    "term beyond this plastic strain (default: none, the plain law)")
     ap.add_argument("--device", choices=["cpu", "gpu"], default="cpu",
                     help="run each point on the CPU (numba) or the GPU (numba-cuda)")
     args = ap.parse_args()
@@ -135,7 +138,8 @@ def main() -> None:
           f"friction heat "
           f"{args.friction_heat_fraction}, chip length {args.chip_length_um or 'default'} "
           f"um, domain depth / inflow / back {args.depth_um or 'default'} / "
-          f"{args.inflow_um or 'default'} / {args.back_um or 'default'} um, device {args.device}, "
+          f"{args.inflow_um or 'default'} / {args.back_um or 'default'} um, hardening strain "
+          f"limit {args.hardening_strain_limit or 'none'}, device {args.device}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
@@ -181,8 +185,11 @@ def main() -> None:
             contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
         if args.friction_heat_fraction is not None:
             contact["friction_heat_fraction"] = args.friction_heat_fraction
+        material = ({} if args.hardening_strain_limit is None
+                    else {"hardening_strain_limit": args.hardening_strain_limit})
         cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3),
-                                  {"mesh": mesh, "solver": solver, "contact": contact}))
+                                  {"mesh": mesh, "solver": solver, "contact": contact,
+                                   "material": material}))
         res = simulate_orthogonal(cfg, device=args.device)
         s = res.summary
         if args.save_dir is not None:

@@ -8,6 +8,7 @@ d(eps_p) = (q_trial - sigma_y0) / (3 G + H)   (their eq. 3.3.11 in von Mises for
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -44,7 +45,7 @@ def test_tc4_library_values():
 def test_flow_stress_closed_form(ep, rate, T):
     assert TC4.flow_stress(ep, rate, T) == pytest.approx(_jc_hand(ep, rate, T), rel=1e-12)
     assert jc.jc_flow_stress_py(ep, rate, T, TC4.A, TC4.B, TC4.n, TC4.C, TC4.m, 1.0, 293.0,
-                                1873.0) == pytest.approx(_jc_hand(ep, rate, T), rel=1e-12)
+                                1873.0, math.inf) == pytest.approx(_jc_hand(ep, rate, T), rel=1e-12)
 
 
 def test_failure_strain_closed_form():
@@ -71,7 +72,7 @@ def test_radial_return_linear_hardening_closed_form():
     q = 3.0e9
     s = _trial(q)
     out = jc.radial_return(*s, 0.0, 293.0, 1e-8, G, 1e9, 5e9, 1.0, 0.0, 0.7, 1.0, 293.0,
-                           1873.0)
+                           1873.0, math.inf)
     d_exact = (q - 1e9) / (3 * G + 5e9)
     assert out[4] == pytest.approx(d_exact, rel=1e-10)
     assert out[5] == pytest.approx(1e9 + 5e9 * d_exact, rel=1e-10)
@@ -86,7 +87,7 @@ def test_radial_return_consistency(q, ep, T, dt):
     s = _trial(q)
     sy0 = m.flow_stress(ep, 0.0, T)
     sx, sy, sz, sxy, d, syld = jc.radial_return(*s, ep, T, dt, m.G, m.A, m.B, m.n, m.C, m.m,
-                                                1.0, 293.0, 1873.0)
+                                                1.0, 293.0, 1873.0, math.inf)
     qn = math.sqrt(1.5 * (sx * sx + sy * sy + sz * sz + 2 * sxy * sxy))
     if q <= sy0:
         assert d == 0.0
@@ -101,7 +102,7 @@ def test_radial_return_consistency(q, ep, T, dt):
 def test_elastic_state_unchanged():
     s = _trial(0.5e9)
     out = jc.radial_return(*s, 0.0, 293.0, 1e-8, TC4.G, TC4.A, TC4.B, TC4.n, TC4.C, TC4.m, 1.0,
-                           293.0, 1873.0)
+                           293.0, 1873.0, math.inf)
     np.testing.assert_allclose(out[:4], s)
     assert out[4] == 0.0
 
@@ -142,5 +143,62 @@ def test_radial_return_recovers_a_constructed_root(ep, T, log_rate, dt):
     d_true = 10.0 ** log_rate * dt
     q = 3 * m.G * d_true + _jc_hand(ep + d_true, d_true / dt, T)
     out = jc.radial_return(*_trial(q), ep, T, dt, m.G, m.A, m.B, m.n, m.C, m.m, 1.0, 293.0,
-                           1873.0)
+                           1873.0, math.inf)
     assert out[4] == pytest.approx(d_true, rel=1e-9)
+
+
+def test_hardening_strain_limit_holds_the_hardening_term():
+    """With a hardening strain limit the flow stress is the plain law up to the limit and
+    the law at the limit beyond it (closed form); inf gives the plain law bit for bit."""
+    lim = 0.8
+    for ep in (0.0, 0.3, 0.8, 1.5, 3.0):
+        for rate, T in ((1.0, 293.0), (1e5, 600.0)):
+            got = jc.jc_flow_stress_py(ep, rate, T, TC4.A, TC4.B, TC4.n, TC4.C, TC4.m, 1.0,
+                                       293.0, 1873.0, lim)
+            assert got == pytest.approx(_jc_hand(min(ep, lim), rate, T), rel=1e-12)
+            plain = jc.jc_flow_stress_py(ep, rate, T, TC4.A, TC4.B, TC4.n, TC4.C, TC4.m, 1.0,
+                                         293.0, 1873.0, math.inf)
+            assert plain == pytest.approx(_jc_hand(ep, rate, T), rel=1e-12)
+
+
+@pytest.mark.parametrize("ep,T,log_rate,dt", [(0.5, 400.0, 4.0, 1e-9), (2.0, 700.0, 5.0, 5e-9),
+                                              (0.79, 300.0, 3.0, 1e-8)])
+def test_radial_return_with_a_hardening_strain_limit_recovers_a_constructed_root(
+        ep, T, log_rate, dt):
+    """A trial stress built from a known increment d on the held curve,
+    q = 3 G d + sigma_JC(min(ep + d, limit), d / dt, T), is returned to that d
+    (the start below, across and beyond the limit 0.8). Tolerance 1e-9 relative."""
+    m = TC4
+    lim = 0.8
+    d_true = 10.0 ** log_rate * dt
+    q = 3 * m.G * d_true + _jc_hand(min(ep + d_true, lim), d_true / dt, T)
+    out = jc.radial_return(*_trial(q), ep, T, dt, m.G, m.A, m.B, m.n, m.C, m.m, 1.0, 293.0,
+                           1873.0, lim)
+    assert out[4] == pytest.approx(d_true, rel=1e-9)
+    assert out[5] == pytest.approx(_jc_hand(min(ep + d_true, lim), d_true / dt, T), rel=1e-9)
+
+
+def test_hardening_strain_limit_from_files_and_configs(tmp_path):
+    """The key in a material file, its override in an FE config, and a bad value."""
+    from robobore.cutting.fe.config import parse_config
+    from robobore.errors import ConfigError
+    from robobore.material import load_material
+
+    assert load_material("TC4").hardening_strain_limit == math.inf
+    src = (Path(jc.__file__).parent / "library" / "tc4.toml").read_text()
+    f = tmp_path / "tc4_held.toml"
+    key = "T_melt_K = 1873.0"
+    f.write_text(src.replace(key, key + "\nhardening_strain_limit = 1.5"))
+    assert load_material(str(f)).hardening_strain_limit == 1.5
+    assert load_material(str(f), hardening_strain_limit=0.7).hardening_strain_limit == 0.7
+    assert load_material(str(f)).to_array()[jc.EPS_HMAX] == 1.5
+    f.write_text(src.replace(key, key + "\nhardening_strain_limit = -1"))
+    with pytest.raises(ConfigError, match="hardening_strain_limit"):
+        load_material(str(f))
+    base = {"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
+            "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
+                    "length_mm": 0.01}, "mesh": {"element_size_um": 10}, "solver": {}}
+    cfg = parse_config({**base, "material": {"name": "TC4", "hardening_strain_limit": 1.0}})
+    assert cfg.material.hardening_strain_limit == 1.0
+    with pytest.raises(ConfigError, match="material.hardening_strain_limit"):
+        parse_config({**base, "material": {"name": "TC4", "hardening_strain_limit": 0.0}})

@@ -29,7 +29,9 @@ from numba import njit
 A, B, N, C, M, EPS0, TROOM, TMELT = 0, 1, 2, 3, 4, 5, 6, 7
 D1, D2, D3, D4, D5 = 8, 9, 10, 11, 12
 E_MOD, NU, RHO, CP, KCOND, BETA_TQ = 13, 14, 15, 16, 17, 18
-N_MAT = 19
+#: plastic strain beyond which the hardening term stays at its value (inf: none)
+EPS_HMAX = 19
+N_MAT = 20
 
 
 def homologous_temperature_py(T, Troom, Tmelt):
@@ -42,27 +44,30 @@ def homologous_temperature_py(T, Troom, Tmelt):
     return ts
 
 
-def jc_athermal_py(eps_p, eps_rate, a, b, n, c, eps0):
+def jc_athermal_py(eps_p, eps_rate, a, b, n, c, eps0, ehmax):
     """The strain and rate factors of the Johnson-Cook flow stress [Pa],
-    (A + B eps_p^n) (1 + C ln(max(eps_rate/eps0, 1))), eps_p clipped at 0: the flow stress
-    is this times the thermal factor 1 - T*^m (:func:`jc_return_py` computes that factor once
-    per increment)."""
+    (A + B eps_p^n) (1 + C ln(max(eps_rate/eps0, 1))), eps_p clipped to [0, ehmax]: the flow
+    stress is this times the thermal factor 1 - T*^m (:func:`jc_return_py` computes that
+    factor once per increment). ``ehmax`` (the material's hardening strain limit, inf for
+    none) holds the hardening term at its value beyond that strain."""
     ep = eps_p if eps_p > 0.0 else 0.0
+    ep = ep if ep < ehmax else ehmax
     hard = a + b * ep**n
     r = eps_rate / eps0
     rate = 1.0 + c * math.log(r) if r > 1.0 else 1.0
     return hard * rate
 
 
-def jc_flow_stress_py(eps_p, eps_rate, T, a, b, n, c, m, eps0, Troom, Tmelt):
+def jc_flow_stress_py(eps_p, eps_rate, T, a, b, n, c, m, eps0, Troom, Tmelt, ehmax):
     """Johnson-Cook flow stress [Pa].
 
     sigma_y = (A + B eps_p^n) (1 + C ln(max(eps_rate/eps0, 1))) (1 - T*^m).
     The rate term is clipped at eps_rate = eps0 (no strengthening below the reference rate,
-    and no logarithm of zero); T* is clipped to [0, 1].
+    and no logarithm of zero); T* is clipped to [0, 1]; eps_p in the hardening term is
+    clipped at ``ehmax`` (inf: the plain law).
     """
     ts = homologous_temperature(T, Troom, Tmelt)
-    return jc_athermal(eps_p, eps_rate, a, b, n, c, eps0) * (1.0 - ts**m)
+    return jc_athermal(eps_p, eps_rate, a, b, n, c, eps0, ehmax) * (1.0 - ts**m)
 
 
 def jc_failure_strain_py(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt):
@@ -88,7 +93,7 @@ def jc_damage_increment_py(deps_p, triax, eps_rate, T, d1, d2, d3, d4, d5, eps0,
     return deps_p / jc_failure_strain(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt)
 
 
-def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
+def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt, ehmax):
     """Scalar Johnson-Cook return mapping: plastic strain increment and flow stress.
 
     Parameters
@@ -121,7 +126,7 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
     # T is held over the increment: the thermal factor is evaluated once; each iteration
     # then costs one power and one logarithm (flow stress and its derivative share them)
     therm = 1.0 - homologous_temperature(T, Troom, Tmelt) ** m
-    sy0 = jc_athermal(eps_p, 0.0, a, b, n, c, eps0) * therm
+    sy0 = jc_athermal(eps_p, 0.0, a, b, n, c, eps0, ehmax) * therm
     if q <= sy0:
         return 0.0, sy0
     lo = 0.0
@@ -135,6 +140,8 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
                 d = d_rate
     for _ in range(60):
         ep = eps_p + d
+        held = ep >= ehmax  # beyond the hardening strain limit: no hardening
+        ep = ehmax if held else ep
         epn = ep**n
         hard = a + b * epn
         r = d / (dt * eps0)
@@ -148,7 +155,10 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
         else:
             hi = d
         # derivative of sigma_y wrt d (hardening + rate), analytic
-        dhard = n * b * epn / ep if ep > 1e-12 else 1e12 * b
+        if held:
+            dhard = 0.0
+        else:
+            dhard = n * b * epn / ep if ep > 1e-12 else 1e12 * b
         drate = c / d if r > 1.0 else 0.0
         dsy = (dhard * rate + hard * drate) * therm
         fp = -3.0 * G - dsy
@@ -159,10 +169,11 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
             d = dn
             break
         d = dn
-    return d, jc_athermal(eps_p + d, d / dt, a, b, n, c, eps0) * therm
+    return d, jc_athermal(eps_p + d, d / dt, a, b, n, c, eps0, ehmax) * therm
 
 
-def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt):
+def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt,
+                     ehmax):
     """Radial return of a trial deviatoric stress onto the Johnson-Cook yield surface.
 
     Parameters
@@ -186,7 +197,7 @@ def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, T
     The scalar solve is :func:`jc_return_py` (shared with the 3D engine).
     """
     q = math.sqrt(1.5 * (sxx * sxx + syy * syy + szz * szz + 2.0 * sxy * sxy))
-    d, sy = jc_return(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt)
+    d, sy = jc_return(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt, ehmax)
     if d <= 0.0:
         return sxx, syy, szz, sxy, 0.0, sy
     scale = sy / q

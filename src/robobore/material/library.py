@@ -1,15 +1,16 @@
 """Material library: Johnson-Cook materials from TOML files (bundled or the user's own).
 
 A material file has the tables ``[johnson_cook]`` (A_MPa, B_MPa, n, C, m, eps_dot0_per_s,
-T_room_K, T_melt_K), ``[damage]`` (D1..D5), ``[elastic]`` (E_GPa, nu) and ``[thermal]``
-(rho_kg_m3, cp_J_kgK, k_W_mK, taylor_quinney). Bundled files live in
+T_room_K, T_melt_K; optional hardening_strain_limit), ``[damage]`` (D1..D5), ``[elastic]``
+(E_GPa, nu) and ``[thermal]`` (rho_kg_m3, cp_J_kgK, k_W_mK, taylor_quinney). Bundled files live in
 ``robobore/material/library/``; :func:`load_material` takes a bundled name (``"TC4"``) or a
 path to a TOML file.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+import math
+from dataclasses import asdict, dataclass, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,9 @@ class _JC(BaseModel):
     eps_dot0_per_s: float = Field(gt=0)
     T_room_K: float = Field(gt=0)
     T_melt_K: float = Field(gt=0)
+    #: optional: the plastic strain beyond which the hardening term B eps^n stays at its
+    #: value (the constants' fit rarely reaches the strains of a secondary shear zone)
+    hardening_strain_limit: float | None = Field(default=None, gt=0)
 
 
 class _Damage(BaseModel):
@@ -91,6 +95,8 @@ class Material:
     cp: float
     k: float
     taylor_quinney: float
+    #: plastic strain beyond which the hardening term is held (inf: the plain Johnson-Cook law)
+    hardening_strain_limit: float = math.inf
 
     @property
     def G(self) -> float:
@@ -105,7 +111,8 @@ class Material:
     def flow_stress(self, eps_p: float, eps_rate: float, T: float) -> float:
         """Johnson-Cook flow stress [Pa] at plastic strain, rate [1/s] and temperature [K]."""
         return float(jc.jc_flow_stress(eps_p, eps_rate, T, self.A, self.B, self.n, self.C,
-                                       self.m, self.eps_dot0, self.T_room, self.T_melt))
+                                       self.m, self.eps_dot0, self.T_room, self.T_melt,
+                                       self.hardening_strain_limit))
 
     def failure_strain(self, triaxiality: float, eps_rate: float, T: float) -> float:
         """Johnson-Cook failure strain at a stress triaxiality, rate [1/s], temperature [K]."""
@@ -122,6 +129,7 @@ class Material:
                                                             self.D4, self.D5)
         a[jc.E_MOD], a[jc.NU], a[jc.RHO], a[jc.CP] = self.E, self.nu, self.rho, self.cp
         a[jc.KCOND], a[jc.BETA_TQ] = self.k, self.taylor_quinney
+        a[jc.EPS_HMAX] = self.hardening_strain_limit
         return a
 
     def to_dict(self) -> dict[str, Any]:
@@ -149,12 +157,23 @@ def _from_file_data(data: dict[str, Any], source: str) -> Material:
                     eps_dot0=j.eps_dot0_per_s, T_room=j.T_room_K, T_melt=j.T_melt_K,
                     D1=d.D1, D2=d.D2, D3=d.D3, D4=d.D4, D5=d.D5, E=e.E_GPa * 1e9, nu=e.nu,
                     rho=t.rho_kg_m3, cp=t.cp_J_kgK, k=t.k_W_mK,
-                    taylor_quinney=t.taylor_quinney)
+                    taylor_quinney=t.taylor_quinney,
+                    hardening_strain_limit=(math.inf if j.hardening_strain_limit is None
+                                            else j.hardening_strain_limit))
 
 
 def load_material(name_or_path: str | Path, *, source: str | None = None,
-                  field: str = "material.name") -> Material:
-    """A bundled material by name (case-insensitive, e.g. ``"TC4"``) or a user TOML file."""
+                  field: str = "material.name",
+                  hardening_strain_limit: float | None = None) -> Material:
+    """A bundled material by name (case-insensitive, e.g. ``"TC4"``) or a user TOML file;
+    ``hardening_strain_limit``, when given, replaces the file's."""
+    mat = _load_material(name_or_path, source=source, field=field)
+    if hardening_strain_limit is not None:
+        mat = replace(mat, hardening_strain_limit=float(hardening_strain_limit))
+    return mat
+
+
+def _load_material(name_or_path: str | Path, *, source: str | None, field: str) -> Material:
     s = str(name_or_path)
     p = Path(s)
     if s.lower().endswith(".toml") or p.is_file():

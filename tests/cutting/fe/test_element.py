@@ -23,7 +23,8 @@ from robobore.material import load_material
 TC4 = load_material("TC4")
 
 
-def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, size=10e-6):
+def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, size=10e-6,
+                       mat=TC4):
     """Prescribe a homogeneous velocity field v(x) on one square element; returns history."""
     nodes = np.array([[0, 0], [size, 0], [size, size], [0, size]], float)
     conn = np.array([[0, 1, 2, 3]])
@@ -32,7 +33,7 @@ def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, si
     prm[K.P_HGV] = 0.0
     prm[K.P_BV1] = 0.0
     prm[K.P_BV2] = 0.0
-    st = make_state(nodes, conn, np.zeros(4, bool), TC4, prm=prm)
+    st = make_state(nodes, conn, np.zeros(4, bool), mat, prm=prm)
     out = []
     for _ in range(n_steps):
         vx, vy = velocity(st.x, st.y)
@@ -73,6 +74,31 @@ def test_simple_shear_follows_flow_curve():
     # Taylor-Quinney heating: dT = 0.9 * plastic work / (rho cp)
     wp = st.plast[0] / st.area0[0]
     assert T[-1] - 293.0 == pytest.approx(0.9 * wp / (TC4.rho * TC4.cp), rel=0.02)
+
+
+def test_simple_shear_with_a_hardening_strain_limit_follows_the_held_flow_curve():
+    """material.hardening_strain_limit = 0.05: the element follows the flow curve whose
+    hardening term stops at eps_p = 0.05 (closed form: sigma_JC(min(eps_p, 0.05), rate, T)),
+    and beyond it the stress no longer grows with strain, only falls with the temperature."""
+    lim = load_material("TC4", hardening_strain_limit=0.05)
+    g = 2.0e4  # 1/s
+    h, _ = _drive_one_element(lambda x, y: (g * y, 0.0 * y), lambda s: 0.0, n_steps=5000,
+                              mat=lim)
+    q, ep, rate, T = h[:, 1], h[:, 2], h[:, 3], h[:, 4]
+    t_start = np.r_[293.0, T[:-1]]
+    plastic = ep > 0.01
+    beyond = ep > 0.06
+    assert beyond.sum() > 1000
+    held = np.array([TC4.flow_stress(min(e, 0.05), r, t)
+                     for e, r, t in zip(ep, rate, t_start, strict=True)])
+    np.testing.assert_allclose(q[plastic], held[plastic], rtol=1e-6)
+    # the plain law would be harder there by B (eps^n - 0.05^n) times the other factors
+    plain = np.array([TC4.flow_stress(e, r, t) for e, r, t in zip(ep, rate, t_start,
+                                                                    strict=True)])
+    assert np.all(plain[beyond] > q[beyond])
+    assert plain[-1] > 1.04 * q[-1]  # at eps_p ~0.115: 653 MPa (0.115^0.45 - 0.05^0.45) ~ 6 %
+    # beyond the limit the stress decreases as the element heats (no hardening left)
+    assert np.all(np.diff(q[beyond]) <= 1e-6 * q[beyond][1:])
 
 
 def test_plane_strain_extension_follows_flow_curve():

@@ -126,7 +126,8 @@ def test_uniaxial_tension_follows_johnson_cook():
         eps_closed = math.log(lx / L) - sxx / mat.E
         assert st.eps_p[0] == pytest.approx(eps_closed, rel=0.01)
         sy = jc.jc_flow_stress(eps_closed, st.rate[0], st.temp[0], a[jc.A], a[jc.B], a[jc.N],
-                               a[jc.C], a[jc.M], a[jc.EPS0], a[jc.TROOM], a[jc.TMELT])
+                               a[jc.C], a[jc.M], a[jc.EPS0], a[jc.TROOM], a[jc.TMELT],
+                               a[jc.EPS_HMAX])
         assert sxx == pytest.approx(sy, rel=0.01)
         assert abs(syy) < 0.01 * sxx
     # adiabatic heating: dT = beta * W_p / (rho cp)
@@ -154,7 +155,8 @@ def test_simple_shear_follows_johnson_cook():
     assert st.eps_p[0] == pytest.approx(eps_closed, rel=0.02)
     a = st.mat
     sy = jc.jc_flow_stress(eps_closed, st.rate[0], st.temp[0], a[jc.A], a[jc.B], a[jc.N],
-                           a[jc.C], a[jc.M], a[jc.EPS0], a[jc.TROOM], a[jc.TMELT])
+                           a[jc.C], a[jc.M], a[jc.EPS0], a[jc.TROOM], a[jc.TMELT],
+                           a[jc.EPS_HMAX])
     assert math.sqrt(3.0) * tau == pytest.approx(sy, rel=0.02)
 
 

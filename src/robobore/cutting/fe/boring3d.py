@@ -41,6 +41,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from robobore.cutting.fe import kernels3d as K3
+from robobore.cutting.fe.config import MaterialSection
 from robobore.cutting.fe.solver import apply_solver_settings
 from robobore.cutting.fe.solver3d import (
     FEState3,
@@ -63,11 +64,6 @@ __all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "Borin
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid")
-
-
-class MaterialSection(_Strict):
-    #: bundled material name (e.g. "TC4") or a path to a material TOML file
-    name: str = "TC4"
 
 
 class InsertSection(_Strict):
@@ -401,7 +397,8 @@ class BoringSetup:
 
 def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     """Mesh, insert, support and state for ``cfg``."""
-    mat = load_material(cfg.material.name, source=source)
+    mat = load_material(cfg.material.name, source=source,
+                        hardening_strain_limit=cfg.material.hardening_strain_limit)
     ins = cfg.insert.to_insert()
     ap = cfg.cut.depth_of_cut_mm * 1e-3
     f = cfg.cut.feed_mm_per_rev * 1e-3

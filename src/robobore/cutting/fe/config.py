@@ -33,6 +33,10 @@ class _Strict(BaseModel):
 class MaterialSection(_Strict):
     #: bundled material name (e.g. "TC4") or a path to a material TOML file
     name: str = "TC4"
+    #: plastic strain beyond which the Johnson-Cook hardening term B eps^n is held at its
+    #: value (replaces the material file's ``hardening_strain_limit``). None: the file's
+    #: (the bundled TC4: none, the plain law)
+    hardening_strain_limit: float | None = Field(default=None, gt=0.0)
 
 
 class ToolSection(_Strict):

@@ -42,6 +42,7 @@ from robobore.material.johnson_cook import (
     D5,
     E_MOD,
     EPS0,
+    EPS_HMAX,
     NU,
     RHO,
     TMELT,
@@ -259,7 +260,7 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     q = math.sqrt(1.5 * (txx * txx + tyy * tyy + tzz * tzz
                          + 2.0 * (txy * txy + tyz * tyz + tzx * tzx)))
     dep, syld = jc_return(q, eps_p[e], temp[e], dt, G, mat[JA], mat[JB], mat[JN], mat[JC],
-                          mat[JM], mat[EPS0], mat[TROOM], mat[TMELT])
+                          mat[JM], mat[EPS0], mat[TROOM], mat[TMELT], mat[EPS_HMAX])
     if dep > 0.0:
         sc = syld / q
         txx *= sc

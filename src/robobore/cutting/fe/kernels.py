@@ -217,7 +217,7 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     rcp = mat[jc.RHO] * mat[jc.CP]
     beta = mat[jc.BETA_TQ]
     a_, b_, n_, c_, m_ = mat[jc.A], mat[jc.B], mat[jc.N], mat[jc.C], mat[jc.M]
-    e0, tr_, tm_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT]
+    e0, tr_, tm_, eh_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT], mat[jc.EPS_HMAX]
     hgv = prm[P_HGV]
     hgs = prm[P_HGS]
     bv1 = prm[P_BV1]
@@ -266,7 +266,7 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     txy = sxy_r + 2.0 * G * dxy * dt
     p_new = p_old - K * trd * dt
     nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
-                                                   G, a_, b_, n_, c_, m_, e0, tr_, tm_)
+                                                   G, a_, b_, n_, c_, m_, e0, tr_, tm_, eh_)
     if dep > 0.0:
         eps_p[e] += dep
         rate[e] = dep / dt
@@ -397,7 +397,7 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     rcp = mat[jc.RHO] * mat[jc.CP]
     beta = mat[jc.BETA_TQ]
     a_, b_, n_, c_, m_ = mat[jc.A], mat[jc.B], mat[jc.N], mat[jc.C], mat[jc.M]
-    e0, tr_, tm_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT]
+    e0, tr_, tm_, eh_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT], mat[jc.EPS_HMAX]
     bv1 = prm[P_BV1]
     bv2 = prm[P_BV2]
     dlim = prm[P_DIST]
@@ -498,12 +498,13 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
         # elastic check first (the same yield test as radial_return, with the element's
         # thermal factor computed once): most Gauss points of the mesh stay elastic
         qt = math.sqrt(1.5 * (tx * tx + ty * ty + tz * tz + 2.0 * txy * txy))
-        sy0 = (a_ + b_ * ep**n_) * therm
+        sy0 = (a_ + b_ * (ep if ep < eh_ else eh_)**n_) * therm
         if qt <= sy0:
             nsx, nsy, nsz, nsxy, dep, syld = tx, ty, tz, txy, 0.0, sy0
         else:
             nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, ep, t_e, dt, G,
-                                                           a_, b_, n_, c_, m_, e0, tr_, tm_)
+                                                           a_, b_, n_, c_, m_, e0, tr_, tm_,
+                                                           eh_)
         if dep > 0.0:
             ep += dep
             wp_tot += syld * dep * dj

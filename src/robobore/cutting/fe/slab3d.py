@@ -53,7 +53,8 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
         raise ConfigError("the 3D slab cross-check needs node splitting",
                           field="mesh.separation", value=cfg.mesh.separation,
                           expected="node_split")
-    mat = load_material(cfg.material.name)
+    mat = load_material(cfg.material.name,
+                        hardening_strain_limit=cfg.material.hardening_strain_limit)
     h = cfg.cut.uncut_chip_thickness_um * 1e-6
     le = cfg.mesh.element_size_um * 1e-6
     L = cfg.cut.length_mm * 1e-3

@@ -393,7 +393,8 @@ def _split_height(cfg: FEConfig) -> float | None:
 
 def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     """Build mesh, tool and state for the orthogonal-cutting model of ``cfg``."""
-    mat = load_material(cfg.material.name, source=source)
+    mat = load_material(cfg.material.name, source=source,
+                        hardening_strain_limit=cfg.material.hardening_strain_limit)
     h = cfg.cut.uncut_chip_thickness_um * 1e-6
     le = cfg.mesh.element_size_um * 1e-6
     L = cfg.cut.length_mm * 1e-3
