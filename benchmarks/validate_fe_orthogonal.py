@@ -26,7 +26,7 @@ import os
 import time
 from pathlib import Path
 
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config import FRICTION_TABLE_MU, FRICTION_TABLE_VC_M_MIN, parse_config
 from robobore.cutting.fe.solver import simulate_orthogonal
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / \
@@ -115,6 +115,10 @@ def main() -> None:
     ap.add_argument("--back-um", type=float, default=None,
                     help="mesh.back_length_um of the tool-frame model (default: max(2 h, "
                     "120 um))")
+    ap.add_argument("--friction-table-scale", type=float, default=None,
+                    help="contact.friction = \"table\" with the Rech et al. 2013 table's "
+                    "coefficients multiplied by this factor (a user table: "
+                    "friction_table_velocity_m_per_min / friction_table_mu)")
     ap.add_argument("--hardening-strain-limit", type=float, default=None,
                     help="material.hardening_strain_limit: hold the Johnson-Cook hardening "
                     "term beyond this plastic strain (default: none, the plain law)")
@@ -139,7 +143,8 @@ def main() -> None:
           f"{args.friction_heat_fraction}, chip length {args.chip_length_um or 'default'} "
           f"um, domain depth / inflow / back {args.depth_um or 'default'} / "
           f"{args.inflow_um or 'default'} / {args.back_um or 'default'} um, hardening strain "
-          f"limit {args.hardening_strain_limit or 'none'}, device {args.device}, "
+          f"limit {args.hardening_strain_limit or 'none'}, friction table scale "
+          f"{args.friction_table_scale or 'none'}, device {args.device}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
@@ -177,6 +182,12 @@ def main() -> None:
         contact: dict = {}
         if args.friction is not None:
             contact["friction"] = args.friction
+        if args.friction_table_scale is not None:
+            contact["friction"] = "table"
+            contact["friction_table_velocity_m_per_min"] = [float(v) for v in
+                                                            FRICTION_TABLE_VC_M_MIN]
+            contact["friction_table_mu"] = [float(args.friction_table_scale * m)
+                                            for m in FRICTION_TABLE_MU]
         if args.shear_limit_mpa is not None:
             contact["shear_limit_MPa"] = args.shear_limit_mpa
         if args.friction_velocity is not None:
