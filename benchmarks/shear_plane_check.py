@@ -132,16 +132,32 @@ def oxley_contact_length(mat, h: float, st: dict, alpha: float, fc: float, ff: f
             * (1.0 + c0 * n_eq / (3.0 * math.tan(theta))))
 
 
-def fe_contact_length(path: Path, rake: float, r: float) -> float:
-    """Farthest contact node up the rake of a saved FE state, from the rake's start [m]."""
-    d = np.load(path)
+def _quad_areas(x: np.ndarray, y: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Areas of the quads ``conn`` (half the cross product of their diagonals)."""
+    return np.abs(0.5 * ((x[conn[:, 2]] - x[conn[:, 0]]) * (y[conn[:, 3]] - y[conn[:, 1]])
+                         - (x[conn[:, 3]] - x[conn[:, 1]]) * (y[conn[:, 2]] - y[conn[:, 0]])))
+
+
+def _rake_coordinates(d, px, py, rake: float, r: float):
+    """Points' distance up the rake face from where it starts and their distance from the
+    rake line towards the chip [m], for the tool of a saved FE state ``d``."""
     cx, cy = d["tool_center"]
-    tx, ty = math.sin(rake), math.cos(rake)
     sx, sy = cx - r * math.cos(rake), cy + r * math.sin(rake)  # where the rake face starts
+    along = (px - sx) * math.sin(rake) + (py - sy) * math.cos(rake)
+    normal = -(px - sx) * math.cos(rake) + (py - sy) * math.sin(rake)
+    return along, normal
+
+
+def _contact_length(d, rake: float, r: float) -> float:
     cf = d["contact_force_N_per_m"]
     on = (cf[0] != 0.0) | (cf[1] != 0.0)
-    s = (d["x"] - sx) * tx + (d["y"] - sy) * ty
+    s, _ = _rake_coordinates(d, d["x"], d["y"], rake, r)
     return float(s[on].max()) if on.any() else float("nan")
+
+
+def fe_contact_length(path: Path, rake: float, r: float) -> float:
+    """Farthest contact node up the rake of a saved FE state, from the rake's start [m]."""
+    return _contact_length(np.load(path), rake, r)
 
 
 def fe_rake_layer(path: Path, rake: float, r: float, depth: float = RAKE_LAYER) -> dict:
@@ -152,19 +168,10 @@ def fe_rake_layer(path: Path, rake: float, r: float, depth: float = RAKE_LAYER) 
     where the rake face starts and the farthest contact node."""
     d = np.load(path)
     x, y, conn = d["x"], d["y"], d["conn"]
-    xc = x[conn].mean(1)
-    yc = y[conn].mean(1)
-    cx, cy = d["tool_center"]
-    tx, ty = math.sin(rake), math.cos(rake)
-    nx, ny = -math.cos(rake), math.sin(rake)  # rake normal, towards the chip
-    sx, sy = cx - r * math.cos(rake), cy + r * math.sin(rake)  # where the rake face starts
-    s = (xc - sx) * tx + (yc - sy) * ty
-    nrm = (xc - sx) * nx + (yc - sy) * ny
-    lc = fe_contact_length(path, rake, r)
-    sel = (nrm > 0.0) & (nrm < depth) & (s > 0.0) & (s < lc) & (d["alive"] > 0)
-    area = np.abs(0.5 * ((x[conn[:, 2]] - x[conn[:, 0]]) * (y[conn[:, 3]] - y[conn[:, 1]])
-                         - (x[conn[:, 3]] - x[conn[:, 1]]) * (y[conn[:, 2]] - y[conn[:, 0]])))
-    w = area[sel]
+    s, nrm = _rake_coordinates(d, x[conn].mean(1), y[conn].mean(1), rake, r)
+    sel = ((nrm > 0.0) & (nrm < depth) & (s > 0.0) & (s < _contact_length(d, rake, r))
+           & (d["alive"] > 0))
+    w = _quad_areas(x, y, conn)[sel]
     return {"rake_layer_elements": int(sel.sum()),
             "rake_layer_strain": float(np.average(d["eps_p"][sel], weights=w)),
             "rake_layer_T_K": float(np.average(d["temperature_K"][sel], weights=w)),
@@ -187,9 +194,7 @@ def fe_shear_zone(mat, path: Path, h: float) -> dict:
     eps_chip = float(np.median(eps[chip]))
     sel = ((yc > -0.8 * h) & (yc < -0.2 * h) & (xc < cx)
            & (eps > 0.4 * eps_chip) & (eps < 0.6 * eps_chip))
-    area = np.abs(0.5 * ((x[conn[:, 2]] - x[conn[:, 0]]) * (y[conn[:, 3]] - y[conn[:, 1]])
-                         - (x[conn[:, 3]] - x[conn[:, 1]]) * (y[conn[:, 2]] - y[conn[:, 0]])))
-    w = area[sel]
+    w = _quad_areas(x, y, conn)[sel]
     return {"chip_strain": eps_chip, "ab_elements": int(sel.sum()),
             "ab_strain": float(np.average(eps[sel], weights=w)),
             "ab_T_K": float(np.average(d["temperature_K"][sel], weights=w)),

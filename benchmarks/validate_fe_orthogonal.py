@@ -33,6 +33,14 @@ DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / \
     "ti64_orthogonal_cutting_forces.json"
 #: the source's cap on the contact shear stress (its model_inputs_used_by_source)
 SHEAR_LIMIT_MPA = 576.0
+#: the tool-frame model's mesh keys this script sets: (option, mesh key, what the key is)
+TOOLFRAME_MESH_OPTIONS = (
+    ("--chip-length-um", "chip_length_um", "(default: max(1.5 chip thicknesses, 80 um))"),
+    ("--depth-um", "depth_um", "(the fixed bottom's depth below the cut line; default: "
+     "max(2.5 h, 120 um))"),
+    ("--inflow-um", "inflow_length_um", "(default: max(1.5 h, 60 um))"),
+    ("--back-um", "back_length_um", "(default: max(2 h, 120 um))"),
+)
 
 
 def config(h_um: float, vc: float, length_mm: float, le_um: float, extra=None) -> dict:
@@ -103,18 +111,9 @@ def main() -> None:
     ap.add_argument("--save-dir", type=Path, default=None,
                     help="write each point's final state (deformed mesh, fields, node "
                     "velocities) to DIR/h<h>_vc<vc>.npz")
-    ap.add_argument("--chip-length-um", type=float, default=None,
-                    help="mesh.chip_length_um of the tool-frame model (default: max(1.5 "
-                    "chip thicknesses, 80 um))")
-    ap.add_argument("--depth-um", type=float, default=None,
-                    help="mesh.depth_um of the tool-frame model: the fixed bottom's depth "
-                    "below the cut line (default: max(2.5 h, 120 um))")
-    ap.add_argument("--inflow-um", type=float, default=None,
-                    help="mesh.inflow_length_um of the tool-frame model (default: max(1.5 h, "
-                    "60 um))")
-    ap.add_argument("--back-um", type=float, default=None,
-                    help="mesh.back_length_um of the tool-frame model (default: max(2 h, "
-                    "120 um))")
+    for flag, key, what in TOOLFRAME_MESH_OPTIONS:
+        ap.add_argument(flag, dest=key, type=float, default=None,
+                        help=f"mesh.{key} of the tool-frame model {what}")
     ap.add_argument("--friction-table-scale", type=float, default=None,
                     help="contact.friction = \"table\" with the Rech et al. 2013 table's "
                     "coefficients multiplied by this factor (a user table: "
@@ -140,10 +139,10 @@ def main() -> None:
           f"{args.friction_velocity or 'cutting_speed'}, shear limit "
           f"{SHEAR_LIMIT_MPA if args.shear_limit_mpa is None else args.shear_limit_mpa} MPa, "
           f"friction heat "
-          f"{args.friction_heat_fraction}, chip length {args.chip_length_um or 'default'} "
-          f"um, domain depth / inflow / back {args.depth_um or 'default'} / "
-          f"{args.inflow_um or 'default'} / {args.back_um or 'default'} um, hardening strain "
-          f"limit {args.hardening_strain_limit or 'none'}, friction table scale "
+          f"{args.friction_heat_fraction}, "
+          + "".join(f"{key} {getattr(args, key) or 'default'}, "
+                    for _, key, _ in TOOLFRAME_MESH_OPTIONS)
+          + f"hardening strain limit {args.hardening_strain_limit or 'none'}, friction table scale "
           f"{args.friction_table_scale or 'none'}, device {args.device}, "
           f"load {os.getloadavg()[0]:.1f}")
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
@@ -164,12 +163,9 @@ def main() -> None:
             mesh["separation_height_um"] = args.separation_height_um
         if args.edge_um is not None:
             mesh["edge_element_um"] = args.edge_um
-        if args.chip_length_um is not None:
-            mesh["chip_length_um"] = args.chip_length_um
-        for key, val in (("depth_um", args.depth_um), ("inflow_length_um", args.inflow_um),
-                         ("back_length_um", args.back_um)):
-            if val is not None:
-                mesh[key] = val
+        for _, key, _ in TOOLFRAME_MESH_OPTIONS:
+            if getattr(args, key) is not None:
+                mesh[key] = getattr(args, key)
         if args.band_um is not None:
             mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
         solver: dict = {}
@@ -184,10 +180,9 @@ def main() -> None:
             contact["friction"] = args.friction
         if args.friction_table_scale is not None:
             contact["friction"] = "table"
-            contact["friction_table_velocity_m_per_min"] = [float(v) for v in
-                                                            FRICTION_TABLE_VC_M_MIN]
-            contact["friction_table_mu"] = [float(args.friction_table_scale * m)
-                                            for m in FRICTION_TABLE_MU]
+            contact["friction_table_velocity_m_per_min"] = FRICTION_TABLE_VC_M_MIN.tolist()
+            contact["friction_table_mu"] = (args.friction_table_scale
+                                            * FRICTION_TABLE_MU).tolist()
         if args.shear_limit_mpa is not None:
             contact["shear_limit_MPa"] = args.shear_limit_mpa
         if args.friction_velocity is not None:

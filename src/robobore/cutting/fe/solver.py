@@ -391,6 +391,11 @@ def _split_height(cfg: FEConfig) -> float | None:
     return (0.0 if sh is None else sh) * 1e-6
 
 
+def _m_or_none(um: float | None) -> float | None:
+    """An optional length in um as metres (None stays None: the mesh builder's default)."""
+    return None if um is None else um * 1e-6
+
+
 def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     """Build mesh, tool and state for the orthogonal-cutting model of ``cfg``."""
     mat = load_material(cfg.material.name, source=source,
@@ -412,11 +417,9 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
             mesh = build_toolframe_mesh(
                 h, r, rake, clr, element_size=le, edge_size=ee * 1e-6,
                 chip_ratio=cm.initial_chip_ratio,
-                join_height=None if cm.join_height_um is None else cm.join_height_um * 1e-6,
-                chip_length=None if cm.chip_length_um is None else cm.chip_length_um * 1e-6,
-                depth=None if cm.depth_um is None else cm.depth_um * 1e-6,
-                ahead=None if cm.inflow_length_um is None else cm.inflow_length_um * 1e-6,
-                behind=None if cm.back_length_um is None else cm.back_length_um * 1e-6)
+                join_height=_m_or_none(cm.join_height_um),
+                chip_length=_m_or_none(cm.chip_length_um), depth=_m_or_none(cm.depth_um),
+                ahead=_m_or_none(cm.inflow_length_um), behind=_m_or_none(cm.back_length_um))
         except ValueError as exc:
             raise ConfigError(str(exc), file=source, field="mesh.initial_chip_ratio",
                               value=cm.initial_chip_ratio,
