@@ -25,7 +25,7 @@ def rows_at(folder: Path, h_um: float, vc: float) -> list[tuple[str, float, floa
         data = json.loads(f.read_text())
         rows = data if isinstance(data, list) else data.get("rows", [])
         for r in rows:
-            if (isinstance(r, dict) and "Fc_err_pct" in r and r.get("h_um") == h_um
+            if (isinstance(r, dict) and r.get("Fc_err_pct") is not None and r.get("h_um") == h_um
                     and r.get("vc_m_per_min") == vc):
                 out.append((f.stem, float(r["Fc_err_pct"]), float(r["Ff_err_pct"])))
     return out
