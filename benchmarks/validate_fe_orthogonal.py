@@ -64,6 +64,11 @@ def config(h_um: float, vc: float, length_mm: float, le_um: float, extra=None,
     return d
 
 
+def _fmt(x, fmt: str) -> str:
+    """``x`` formatted, or a right-aligned "-" of the same width where it is None."""
+    return format(x, fmt) if x is not None else format("-", ">" + fmt.split(".")[0])
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--length-mm", type=float, default=1.0)
@@ -237,8 +242,8 @@ def main() -> None:
                    energy_error=s["energy_error"], wall_s=time.perf_counter() - t0,
                    steps=s.get("steps"), n_elements=s.get("n_elements"),
                    element_updates_per_s=s.get("element_updates_per_s"),
-                   device=args.device, mass_scaling=args.mass_scaling_at_30
-                   * (30.0 / vc) ** 2, pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
+                   device=args.device, mass_scaling=cfg.solver.mass_scaling,
+                   pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
                    friction=s["friction_coefficient"], friction_law=s.get("friction_law"),
                    eroded_distortion=s.get("eroded_distortion"),
                    eroded_chip_mass_fraction=s.get("eroded_chip_mass_fraction"),
@@ -246,14 +251,11 @@ def main() -> None:
                    force_by_face_N_per_mm=s.get("force_by_face_N_per_mm"))
         rows.append(row)
 
-        def f(x, fmt):
-            return format(x, fmt) if x is not None else format("-", ">" + fmt.split(".")[0])
-
         verdict = ("(not in the measured file)" if not measured else
                    f"{'Fc ok' if ok[0] else 'Fc FAIL'} {'Ff ok' if ok[1] else 'Ff FAIL'} "
                    f"{'r ok' if ok[2] else 'r FAIL'}")
-        print(f"{h:5.0f} {vc:4.0f} | {f(fc_m, '7.1f')} {fc_s:7.1f} {f(efc, '6.1f')} | "
-              f"{f(ff_m, '7.1f')} {ff_s:7.1f} {f(eff, '6.1f')} | {f(r_m, '6.2f')} "
+        print(f"{h:5.0f} {vc:4.0f} | {_fmt(fc_m, '7.1f')} {fc_s:7.1f} {_fmt(efc, '6.1f')} | "
+              f"{_fmt(ff_m, '7.1f')} {ff_s:7.1f} {_fmt(eff, '6.1f')} | {_fmt(r_m, '6.2f')} "
               f"{r_s:6.2f} {row['chip_ratio_velocity']:6.2f} | "
               f"{row['energy_error']:6.3f} "
               f"{100 * (row['eroded_chip_mass_fraction'] or 0.0):5.1f} {row['wall_s']:6.0f}  "
