@@ -4,12 +4,15 @@ Reference: ../shared/data/ti64_orthogonal_cutting_forces.json (Ducobu, Pantale e
 2022; forces per mm of width, chip ratio). Acceptance of issue 5: |Fc error| <= 10 %,
 |Ff error| <= 35 %, chip ratio within the measured value +-30 %.
 
-The friction coefficient comes from the source's Coulomb-vs-speed table (Rech et al. 2013)
-through ``contact.friction = "table"``; nothing is fitted to these points.
+By default the friction coefficient comes from the source's Coulomb-vs-speed table (Rech et
+al. 2013) through ``contact.friction = "table"``: the a-priori engine, nothing fitted to these
+points. ``--base examples/fe_orthogonal_toolframe_calibrated.toml`` runs the CALIBRATED set
+(friction and hardening choices found by probing against these nine points, docs/fe.md).
 
 Usage::
 
-    python benchmarks/validate_fe_orthogonal.py [--length-mm 1.0] [--element-um 10]
+    python benchmarks/validate_fe_orthogonal.py [--base CONFIG.toml] [--length-mm 1.0]
+        [--element-um 10]
         [--data PATH] [--json OUT.json] [--points 60:30,40:5] [--separation node_split]
         [--separation-height-um 5] [--edge-um 2.5] [--band-um 10,10] [--conduction]
         [--frame tool] [--friction 0.3|table] [--friction-velocity sliding]
@@ -69,10 +72,91 @@ def _fmt(x, fmt: str) -> str:
     return format(x, fmt) if x is not None else format("-", ">" + fmt.split(".")[0])
 
 
-def main() -> None:
+def point_config(h: float, vc: float, args: argparse.Namespace, base: dict | None = None) -> dict:
+    """The config dict of one point: config()'s protocol, then the base file's keys (``--base``:
+    every section but the cut conditions; its cut length, element size and mass scaling where
+    the matching option is not given), then the options given on the command line."""
+    length_mm = args.length_mm
+    le_um = args.element_um
+    ms30 = args.mass_scaling_at_30
+    if base is not None:
+        bcut = base.get("cut", {})
+        if length_mm is None:
+            length_mm = bcut.get("length_mm")
+        if le_um is None:
+            le_um = base.get("mesh", {}).get("element_size_um")
+        bms = base.get("solver", {}).get("mass_scaling")
+        if ms30 is None and bms is not None:
+            # the base's factor at its own speed, carried to 30 m/min with the (30/vc)^2 rule
+            ms30 = bms * (bcut.get("cutting_speed_m_per_min", 30.0) / 30.0) ** 2
+    length_mm = 1.0 if length_mm is None else length_mm
+    le_um = 10.0 if le_um is None else le_um
+    ms30 = 100.0 if ms30 is None else ms30
+    d = config(h, vc, length_mm, min(le_um, h / 3), mass_scaling_at_30=ms30)
+    if base is not None:
+        for sec, keys in base.items():
+            if sec == "cut" or not isinstance(keys, dict):
+                continue
+            keys = {k: v for k, v in keys.items()
+                    if (sec, k) not in (("mesh", "element_size_um"), ("solver", "mass_scaling"))}
+            d.setdefault(sec, {}).update(keys)
+    mesh = {}
+    if args.frame is not None:
+        mesh["frame"] = args.frame
+    if args.separation is not None:
+        mesh["separation"] = args.separation
+    if args.separation_height_um is not None:
+        mesh["separation_height_um"] = args.separation_height_um
+    if args.edge_um is not None:
+        mesh["edge_element_um"] = args.edge_um
+    for _, key, _ in TOOLFRAME_MESH_OPTIONS:
+        if getattr(args, key) is not None:
+            mesh[key] = getattr(args, key)
+    if args.band_um is not None:
+        mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
+    solver: dict = {}
+    if args.conduction:
+        solver["heat_conduction"] = True
+    if args.distortion_limit is not None:
+        solver["distortion_limit"] = args.distortion_limit
+    if args.erode_dt_fraction is not None:
+        solver["erode_time_step_fraction"] = args.erode_dt_fraction
+    contact: dict = {}
+    if args.friction is not None:
+        contact["friction"] = args.friction
+    if args.friction_table_scale is not None:
+        contact["friction"] = "table"
+        contact["friction_table_velocity_m_per_min"] = FRICTION_TABLE_VC_M_MIN.tolist()
+        contact["friction_table_mu"] = (args.friction_table_scale
+                                        * FRICTION_TABLE_MU).tolist()
+    if args.shear_limit_mpa is not None:
+        contact["shear_limit_MPa"] = args.shear_limit_mpa
+    if args.friction_velocity is not None:
+        contact["friction_velocity"] = args.friction_velocity
+    if args.tool_conductance is not None:
+        contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
+    if args.friction_heat_fraction is not None:
+        contact["friction_heat_fraction"] = args.friction_heat_fraction
+    material = ({} if args.hardening_strain_limit is None
+                else {"hardening_strain_limit": args.hardening_strain_limit})
+    for k, v in {"mesh": mesh, "solver": solver, "contact": contact,
+                 "material": material}.items():
+        d.setdefault(k, {}).update(v)
+    return d
+
+
+def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--length-mm", type=float, default=1.0)
-    ap.add_argument("--element-um", type=float, default=10.0)
+    ap.add_argument("--base", type=Path, default=None,
+                    help="a FE config TOML whose material, tool, contact, mesh and solver keys "
+                    "every point starts from (its cut length, element size and mass scaling "
+                    "unless the options below give them; its cut conditions are replaced by "
+                    "each point's), e.g. examples/fe_orthogonal_toolframe_calibrated.toml")
+    ap.add_argument("--length-mm", type=float, default=None,
+                    help="cut.length_mm (default: the base file's, else 1.0)")
+    ap.add_argument("--element-um", type=float, default=None,
+                    help="mesh.element_size_um, at most h / 3 (default: the base file's, "
+                    "else 10)")
     ap.add_argument("--data", type=Path, default=Path(os.environ.get("ROBOBORE_TI64_DATA", DATA)))
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--points", type=str, default="", help="h_um:vc list, e.g. 60:30,40:5")
@@ -129,36 +213,40 @@ def main() -> None:
     ap.add_argument("--hardening-strain-limit", type=float, default=None,
                     help="material.hardening_strain_limit: hold the Johnson-Cook hardening "
                     "term beyond this plastic strain (default: none, the plain law)")
-    ap.add_argument("--mass-scaling-at-30", type=float, default=100.0,
+    ap.add_argument("--mass-scaling-at-30", type=float, default=None,
                     help="solver.mass_scaling at 30 m/min; a point at vc gets this times "
                     "(30 / vc)^2, which keeps the step count per mm of cut the same "
-                    "(default 100, the contract's factor)")
+                    "(default: the base file's factor carried to 30 m/min, else 100, the "
+                    "contract's factor)")
     ap.add_argument("--device", choices=["cpu", "gpu"], default="cpu",
                     help="run each point on the CPU (numba) or the GPU (numba-cuda)")
-    args = ap.parse_args()
+    return ap
+
+
+def main() -> None:
+    args = parser().parse_args()
     ref = json.loads(args.data.read_text())["measured"]
     pts = [(float(h), float(v)) for h in ref["Fc"] for v in ref["Fc"][h]]
     if args.points:
         pts = [tuple(float(x) for x in p.split(":")) for p in args.points.split(",")]
+    base = None
+    if args.base is not None:
+        import tomllib
+
+        try:
+            base = tomllib.loads(args.base.read_text())
+        except (OSError, tomllib.TOMLDecodeError) as e:
+            raise SystemExit(f"--base {args.base}: cannot read the FE config: {e}") from None
     rows = []
-    print(f"# FE orthogonal validation: frame {args.frame or 'workpiece'}, length "
-          f"{args.length_mm} mm, element "
-          f"{args.element_um} um, separation {args.separation or 'default'} "
-          f"(height {args.separation_height_um} um), edge band {args.edge_um} um "
-          f"({args.band_um or 'default'}), conduction {args.conduction}, erosion "
-          f"limits {args.distortion_limit} / {args.erode_dt_fraction}, tool conductance "
-          f"{args.tool_conductance}, friction {args.friction or 'table'} at "
-          f"{args.friction_velocity or 'cutting_speed'}, shear limit "
-          f"{SHEAR_LIMIT_MPA if args.shear_limit_mpa is None else args.shear_limit_mpa} MPa, "
-          f"friction heat "
-          f"{args.friction_heat_fraction}, "
-          + "".join(f"{key} {getattr(args, key) or 'default'}, "
-                    for _, key, _ in TOOLFRAME_MESH_OPTIONS)
-          + f"hardening strain limit {args.hardening_strain_limit or 'none'}, friction table scale "
-          f"{args.friction_table_scale or 'none'}, mass scaling "
-          f"{args.mass_scaling_at_30:g} (30/vc)^2, "
-          f"device {args.device}, "
-          f"load {os.getloadavg()[0]:.1f}")
+    d0 = point_config(*pts[0], args, base)
+    ms30 = d0["solver"]["mass_scaling"] / (30.0 / pts[0][1]) ** 2
+    # what every point runs with: the first point's keys (the cut conditions, the element's
+    # h / 3 bound and the mass scaling's (30 / vc)^2 change from point to point); keys not
+    # shown take the engine's defaults (docs/fe.md, "Config keys and defaults")
+    print(f"# FE orthogonal validation: base {args.base or 'none'}, cut length "
+          f"{d0['cut']['length_mm']} mm, mass scaling {ms30:g} (30/vc)^2, device "
+          f"{args.device}, load {os.getloadavg()[0]:.1f}; the first point's config (the cut "
+          "aside): " + json.dumps({k: v for k, v in d0.items() if k != "cut"}))
     hdr = (f"{'h um':>5} {'vc':>4} | {'Fc meas':>7} {'Fc sim':>7} {'err%':>6} | {'Ff meas':>7} "
            f"{'Ff sim':>7} {'err%':>6} | {'r meas':>6} {'r sim':>6} {'r vel':>6} | {'E err':>6} "
            f"{'ero%':>5} "
@@ -168,49 +256,8 @@ def main() -> None:
         hk = f"{h:g}"
         vk = f"{vc:g}"
         t0 = time.perf_counter()
-        mesh = {}
-        if args.frame is not None:
-            mesh["frame"] = args.frame
-        if args.separation is not None:
-            mesh["separation"] = args.separation
-        if args.separation_height_um is not None:
-            mesh["separation_height_um"] = args.separation_height_um
-        if args.edge_um is not None:
-            mesh["edge_element_um"] = args.edge_um
-        for _, key, _ in TOOLFRAME_MESH_OPTIONS:
-            if getattr(args, key) is not None:
-                mesh[key] = getattr(args, key)
-        if args.band_um is not None:
-            mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
-        solver: dict = {}
-        if args.conduction:
-            solver["heat_conduction"] = True
-        if args.distortion_limit is not None:
-            solver["distortion_limit"] = args.distortion_limit
-        if args.erode_dt_fraction is not None:
-            solver["erode_time_step_fraction"] = args.erode_dt_fraction
-        contact: dict = {}
-        if args.friction is not None:
-            contact["friction"] = args.friction
-        if args.friction_table_scale is not None:
-            contact["friction"] = "table"
-            contact["friction_table_velocity_m_per_min"] = FRICTION_TABLE_VC_M_MIN.tolist()
-            contact["friction_table_mu"] = (args.friction_table_scale
-                                            * FRICTION_TABLE_MU).tolist()
-        if args.shear_limit_mpa is not None:
-            contact["shear_limit_MPa"] = args.shear_limit_mpa
-        if args.friction_velocity is not None:
-            contact["friction_velocity"] = args.friction_velocity
-        if args.tool_conductance is not None:
-            contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
-        if args.friction_heat_fraction is not None:
-            contact["friction_heat_fraction"] = args.friction_heat_fraction
-        material = ({} if args.hardening_strain_limit is None
-                    else {"hardening_strain_limit": args.hardening_strain_limit})
-        cfg = parse_config(config(h, vc, args.length_mm, min(args.element_um, h / 3),
-                                  {"mesh": mesh, "solver": solver, "contact": contact,
-                                   "material": material},
-                                  mass_scaling_at_30=args.mass_scaling_at_30))
+        d = point_config(h, vc, args, base)
+        cfg = parse_config(d)
         res = simulate_orthogonal(cfg, device=args.device)
         s = res.summary
         if args.save_dir is not None:
@@ -243,6 +290,8 @@ def main() -> None:
                    steps=s.get("steps"), n_elements=s.get("n_elements"),
                    element_updates_per_s=s.get("element_updates_per_s"),
                    device=args.device, mass_scaling=cfg.solver.mass_scaling,
+                   base=None if args.base is None else str(args.base),
+                   hardening_strain_limit=cfg.material.hardening_strain_limit,
                    pass_Fc=ok[0], pass_Ff=ok[1], pass_chip=ok[2],
                    friction=s["friction_coefficient"], friction_law=s.get("friction_law"),
                    eroded_distortion=s.get("eroded_distortion"),
