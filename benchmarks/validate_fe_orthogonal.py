@@ -48,6 +48,23 @@ TOOLFRAME_MESH_OPTIONS = (
 )
 
 
+#: options copied as they are into a config key: (argparse dest, section, key)
+_PLAIN_OPTIONS = (
+    ("frame", "mesh", "frame"),
+    ("separation", "mesh", "separation"),
+    ("separation_height_um", "mesh", "separation_height_um"),
+    ("edge_um", "mesh", "edge_element_um"),
+    *((key, "mesh", key) for _, key, _ in TOOLFRAME_MESH_OPTIONS),
+    ("distortion_limit", "solver", "distortion_limit"),
+    ("erode_dt_fraction", "solver", "erode_time_step_fraction"),
+    ("friction", "contact", "friction"),
+    ("shear_limit_mpa", "contact", "shear_limit_MPa"),
+    ("friction_velocity", "contact", "friction_velocity"),
+    ("tool_conductance", "contact", "thermal_conductance_W_per_m2K"),
+    ("friction_heat_fraction", "contact", "friction_heat_fraction"),
+    ("hardening_strain_limit", "material", "hardening_strain_limit"),
+)
+
 def config(h_um: float, vc: float, length_mm: float, le_um: float, extra=None,
            mass_scaling_at_30: float = 100.0) -> dict:
     d = {
@@ -100,47 +117,20 @@ def point_config(h: float, vc: float, args: argparse.Namespace, base: dict | Non
             keys = {k: v for k, v in keys.items()
                     if (sec, k) not in (("mesh", "element_size_um"), ("solver", "mass_scaling"))}
             d.setdefault(sec, {}).update(keys)
-    mesh = {}
-    if args.frame is not None:
-        mesh["frame"] = args.frame
-    if args.separation is not None:
-        mesh["separation"] = args.separation
-    if args.separation_height_um is not None:
-        mesh["separation_height_um"] = args.separation_height_um
-    if args.edge_um is not None:
-        mesh["edge_element_um"] = args.edge_um
-    for _, key, _ in TOOLFRAME_MESH_OPTIONS:
-        if getattr(args, key) is not None:
-            mesh[key] = getattr(args, key)
+    opts = {"mesh": {}, "solver": {}, "contact": {}, "material": {}}
+    for dest, sec, key in _PLAIN_OPTIONS:
+        if getattr(args, dest) is not None:
+            opts[sec][key] = getattr(args, dest)
     if args.band_um is not None:
-        mesh["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
-    solver: dict = {}
+        opts["mesh"]["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
     if args.conduction:
-        solver["heat_conduction"] = True
-    if args.distortion_limit is not None:
-        solver["distortion_limit"] = args.distortion_limit
-    if args.erode_dt_fraction is not None:
-        solver["erode_time_step_fraction"] = args.erode_dt_fraction
-    contact: dict = {}
-    if args.friction is not None:
-        contact["friction"] = args.friction
+        opts["solver"]["heat_conduction"] = True
     if args.friction_table_scale is not None:
-        contact["friction"] = "table"
-        contact["friction_table_velocity_m_per_min"] = FRICTION_TABLE_VC_M_MIN.tolist()
-        contact["friction_table_mu"] = (args.friction_table_scale
-                                        * FRICTION_TABLE_MU).tolist()
-    if args.shear_limit_mpa is not None:
-        contact["shear_limit_MPa"] = args.shear_limit_mpa
-    if args.friction_velocity is not None:
-        contact["friction_velocity"] = args.friction_velocity
-    if args.tool_conductance is not None:
-        contact["thermal_conductance_W_per_m2K"] = args.tool_conductance
-    if args.friction_heat_fraction is not None:
-        contact["friction_heat_fraction"] = args.friction_heat_fraction
-    material = ({} if args.hardening_strain_limit is None
-                else {"hardening_strain_limit": args.hardening_strain_limit})
-    for k, v in {"mesh": mesh, "solver": solver, "contact": contact,
-                 "material": material}.items():
+        opts["contact"].update(friction="table",
+                               friction_table_velocity_m_per_min=FRICTION_TABLE_VC_M_MIN.tolist(),
+                               friction_table_mu=(args.friction_table_scale
+                                                  * FRICTION_TABLE_MU).tolist())
+    for k, v in opts.items():
         d.setdefault(k, {}).update(v)
     return d
 
