@@ -33,6 +33,8 @@ from pathlib import Path
 
 from robobore.cutting.fe.config import FRICTION_TABLE_MU, FRICTION_TABLE_VC_M_MIN, parse_config
 from robobore.cutting.fe.solver import simulate_orthogonal
+from robobore.errors import ConfigError
+from robobore.io.config import load_toml
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / \
     "ti64_orthogonal_cutting_forces.json"
@@ -89,50 +91,49 @@ def _fmt(x, fmt: str) -> str:
     return format(x, fmt) if x is not None else format("-", ">" + fmt.split(".")[0])
 
 
+def protocol(args: argparse.Namespace, base: dict | None = None) -> tuple[float, float, float]:
+    """(cut length mm, element size um, mass scaling at 30 m/min) of a run: the option where
+    given, else the base file's (its mass scaling carried from its own speed to 30 m/min by the
+    (30 / vc)^2 rule), else 1.0 mm, 10 um, 100."""
+    base = base or {}
+    bcut, bms = base.get("cut", {}), base.get("solver", {}).get("mass_scaling")
+    ms_base = (None if bms is None
+               else bms * (bcut.get("cutting_speed_m_per_min", 30.0) / 30.0) ** 2)
+
+    def first(*vals, default):
+        return next((v for v in vals if v is not None), default)
+
+    return (first(args.length_mm, bcut.get("length_mm"), default=1.0),
+            first(args.element_um, base.get("mesh", {}).get("element_size_um"), default=10.0),
+            first(args.mass_scaling_at_30, ms_base, default=100.0))
+
+
 def point_config(h: float, vc: float, args: argparse.Namespace, base: dict | None = None) -> dict:
     """The config dict of one point: config()'s protocol, then the base file's keys (``--base``:
     every section but the cut conditions; its cut length, element size and mass scaling where
-    the matching option is not given), then the options given on the command line."""
-    length_mm = args.length_mm
-    le_um = args.element_um
-    ms30 = args.mass_scaling_at_30
-    if base is not None:
-        bcut = base.get("cut", {})
-        if length_mm is None:
-            length_mm = bcut.get("length_mm")
-        if le_um is None:
-            le_um = base.get("mesh", {}).get("element_size_um")
-        bms = base.get("solver", {}).get("mass_scaling")
-        if ms30 is None and bms is not None:
-            # the base's factor at its own speed, carried to 30 m/min with the (30/vc)^2 rule
-            ms30 = bms * (bcut.get("cutting_speed_m_per_min", 30.0) / 30.0) ** 2
-    length_mm = 1.0 if length_mm is None else length_mm
-    le_um = 10.0 if le_um is None else le_um
-    ms30 = 100.0 if ms30 is None else ms30
-    d = config(h, vc, length_mm, min(le_um, h / 3), mass_scaling_at_30=ms30)
-    if base is not None:
-        for sec, keys in base.items():
-            if sec == "cut" or not isinstance(keys, dict):
-                continue
-            keys = {k: v for k, v in keys.items()
-                    if (sec, k) not in (("mesh", "element_size_um"), ("solver", "mass_scaling"))}
-            d.setdefault(sec, {}).update(keys)
-    opts = {"mesh": {}, "solver": {}, "contact": {}, "material": {}}
+    the matching option is not given, see ``protocol``), then the options given on the command
+    line."""
+    length_mm, le_um, ms30 = protocol(args, base)
+    extra: dict = {}
+    for sec, keys in (base or {}).items():
+        if sec != "cut" and isinstance(keys, dict):
+            extra[sec] = {k: v for k, v in keys.items() if (sec, k) not in
+                          (("mesh", "element_size_um"), ("solver", "mass_scaling"))}
+    opts: dict = {}
     for dest, sec, key in _PLAIN_OPTIONS:
         if getattr(args, dest) is not None:
-            opts[sec][key] = getattr(args, dest)
+            opts.setdefault(sec, {})[key] = getattr(args, dest)
     if args.band_um is not None:
-        opts["mesh"]["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
+        opts.setdefault("mesh", {})["edge_band_um"] = [float(v) for v in args.band_um.split(",")]
     if args.conduction:
-        opts["solver"]["heat_conduction"] = True
+        opts.setdefault("solver", {})["heat_conduction"] = True
     if args.friction_table_scale is not None:
-        opts["contact"].update(friction="table",
-                               friction_table_velocity_m_per_min=FRICTION_TABLE_VC_M_MIN.tolist(),
-                               friction_table_mu=(args.friction_table_scale
-                                                  * FRICTION_TABLE_MU).tolist())
-    for k, v in opts.items():
-        d.setdefault(k, {}).update(v)
-    return d
+        opts.setdefault("contact", {}).update(
+            friction="table", friction_table_velocity_m_per_min=FRICTION_TABLE_VC_M_MIN.tolist(),
+            friction_table_mu=(args.friction_table_scale * FRICTION_TABLE_MU).tolist())
+    for sec, keys in opts.items():
+        extra.setdefault(sec, {}).update(keys)
+    return config(h, vc, length_mm, min(le_um, h / 3), extra, mass_scaling_at_30=ms30)
 
 
 def parser() -> argparse.ArgumentParser:
@@ -221,15 +222,15 @@ def main() -> None:
         pts = [tuple(float(x) for x in p.split(":")) for p in args.points.split(",")]
     base = None
     if args.base is not None:
-        import tomllib
-
+        # a missing, unreadable or invalid base file is a ConfigError naming the file and key
         try:
-            base = tomllib.loads(args.base.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as e:
-            raise SystemExit(f"--base {args.base}: cannot read the FE config: {e}") from None
+            base = load_toml(args.base)
+            parse_config(base, str(args.base))
+        except ConfigError as e:
+            raise SystemExit(f"--base: {e}") from None
     rows = []
     d0 = point_config(*pts[0], args, base)
-    ms30 = d0["solver"]["mass_scaling"] / (30.0 / pts[0][1]) ** 2
+    ms30 = protocol(args, base)[2]
     # what every point runs with: the first point's keys (the cut conditions, the element's
     # h / 3 bound and the mass scaling's (30 / vc)^2 change from point to point); keys not
     # shown take the engine's defaults (docs/fe.md, "Config keys and defaults")

@@ -1,7 +1,8 @@
 """The calibrated validation configuration of issue 5 (examples/fe_orthogonal_toolframe_
 calibrated.toml) and benchmarks/validate_fe_orthogonal.py's ``--base`` merge: the example lands
-in the engine as documented (docs/fe.md, "Calibrated set"), and running the script from the
-file is the same run as the session-17 command-line options that produced the measured rows
+in the engine as documented (docs/fe.md, "Validation against the measured forces"), and
+running the script from the file is the same run as the session-17 command-line options that
+produced the measured rows
 (benchmarks/measured/fe_validation_2026-11-23/calibrated_*). Tolerance: round-off (1e-12) on
 the friction table, which the file holds to three decimals and the options compute as 1.5 x
 the Rech et al. 2013 table; everything else exactly equal."""
