@@ -60,8 +60,14 @@ def _root(
     version: bool = typer.Option(
         False, "--version", callback=_version_callback, is_eager=True, help="Show the version."
     ),
+    debug: bool = typer.Option(
+        False, "--debug", help="Show the Python traceback of an error (for bug reports)."
+    ),
 ) -> None:
     """robobore command line."""
+    from robobore.clitools import DEBUG
+
+    DEBUG["on"] = debug
 
 
 def _build() -> None:
@@ -76,7 +82,20 @@ _build()
 
 
 def main() -> None:  # console-script entry point
-    app()
+    """Run the CLI; a RoboboreError or OSError that escapes a command (one not wrapped in
+    ``handle_errors``) is still one line on stderr and exit code 2, not a traceback."""
+    import sys
+
+    from robobore.clitools import DEBUG, _print_error, os_error_text
+    from robobore.errors import RoboboreError
+
+    try:
+        app()
+    except (RoboboreError, OSError) as exc:
+        if DEBUG["on"] or "--debug" in sys.argv[1:]:
+            raise
+        _print_error(os_error_text(exc) if isinstance(exc, OSError) else str(exc))
+        sys.exit(2)
 
 
 if __name__ == "__main__":  # pragma: no cover

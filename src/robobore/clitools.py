@@ -37,18 +37,49 @@ stderr = Console(stderr=True)
 JSON_OPTION = typer.Option(False, "--json", help="Print machine-readable JSON on stdout.")
 
 
+#: Set by ``robobore --debug``: errors also print their Python traceback.
+DEBUG = {"on": False}
+
+
+def _print_error(text: str) -> None:
+    # soft_wrap: one line whatever the terminal width (paths stay copyable, and the
+    # message does not break where a long temporary path happens to end)
+    stderr.print(f"[bold red]error:[/] {escape(text)}", highlight=False, markup=True,
+                 soft_wrap=True)
+
+
+def os_error_text(exc: OSError) -> str:
+    """One line for an OS error on a user path: the path, what failed and the cause."""
+    what = exc.strerror or str(exc) or type(exc).__name__
+    where = exc.filename if exc.filename is not None else None
+    if where is not None:
+        extra = f" -> {exc.filename2}" if getattr(exc, "filename2", None) else ""
+        return f"{where}{extra}: {what} ({type(exc).__name__})"
+    return f"{what} ({type(exc).__name__})"
+
+
 def handle_errors(func: F) -> F:
-    """Turn a :class:`RoboboreError` into one clear line on stderr and exit code 2."""
+    """Turn a :class:`RoboboreError` (or an ``OSError`` on a user path: permission, disk
+    full, missing file) into one clear line on stderr and exit code 2; ``robobore --debug``
+    prints the traceback as well."""
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
         except RoboboreError as exc:
-            # soft_wrap: one line whatever the terminal width (paths stay copyable, and the
-            # message does not break where a long temporary path happens to end)
-            stderr.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, markup=True,
-                         soft_wrap=True)
+            if DEBUG["on"]:
+                import traceback
+
+                traceback.print_exc()
+            _print_error(str(exc))
+            raise typer.Exit(code=2) from None
+        except OSError as exc:
+            if DEBUG["on"]:
+                import traceback
+
+                traceback.print_exc()
+            _print_error(os_error_text(exc))
             raise typer.Exit(code=2) from None
 
     return wrapper  # type: ignore[return-value]

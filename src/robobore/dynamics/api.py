@@ -24,12 +24,13 @@ from robobore.errors import ConfigError
 from robobore.io.config import validate_model
 
 
-def _config(config: str | Path | dict[str, Any] | DynamicsConfig
+def _config(config: str | Path | dict[str, Any] | DynamicsConfig, source: str | None = None
             ) -> tuple[DynamicsConfig, dict[str, Any], str | None]:
     if isinstance(config, DynamicsConfig):
-        return config.model_copy(deep=True), config.model_dump(), None
+        return config.model_copy(deep=True), config.model_dump(), source
     if isinstance(config, dict):
-        return validate_model(DynamicsConfig, config), config, None
+        return (validate_model(DynamicsConfig, config, source=source or "<config>"), config,
+                source)
     cfg, raw = load_dynamics_config(config)
     return cfg, raw, str(config)
 
@@ -38,8 +39,11 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
                speed_rpm: float | None = None, depth_mm: float | None = None,
                feed_mm_per_rev: float | None = None, pressure_MPa: float | None = None,
                revolutions: int | None = None, samples_per_rev: int | None = None,
-               return_dataset: bool = False) -> dict[str, Any]:
+               return_dataset: bool = False, source: str | None = None) -> dict[str, Any]:
     """Simulate one condition; returns the summary dict (and ``"dataset"`` if asked).
+
+    ``source`` names where a dict or model config came from (a file, a section), for error
+    messages.
 
     ``pressure_MPa`` (boring configs with an ``[equivalent]`` section) replaces the pressure
     foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
@@ -47,7 +51,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     from robobore.dynamics.chatter import classify
     from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
 
-    cfg, raw, src = _config(config)
+    cfg, raw, src = _config(config, source)
     if cfg.cutting is not None:
         upd = {}
         if speed_rpm is not None:

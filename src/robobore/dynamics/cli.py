@@ -47,7 +47,9 @@ def lobes_cmd(
 
     from robobore.dynamics import stability
     from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+    from robobore.io.outputs import check_output_dir
 
+    check_output_dir(plot, "--plot", "lobes.png")
     cfg, _ = load_dynamics_config(config)
     src = str(config)
     st = build_structure(cfg, src)
@@ -160,6 +162,10 @@ def simulate_boring_cmd(
     if out is not None and out.suffix != ".nc":
         raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
                           expected="a path ending in .nc")
+    from robobore.io.outputs import check_output_dir, check_output_file
+
+    check_output_file(out, "--out", "the netCDF Dataset")
+    check_output_dir(plot, "--plot", "the PNG plots")
     with progress_bar("simulating", None, not as_json):
         result = run_boring(cfg, speed_rpm, depth_mm, feed_mm_per_rev=feed_mm_per_rev,
                             pressure_MPa=pressure_MPa, revolutions=revolutions,

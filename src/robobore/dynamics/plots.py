@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robobore.io.results import save_figure
+
 
 def _plt():
     import matplotlib
@@ -47,7 +49,7 @@ def plot_lobes(result, out_dir: str | Path, curves=None, title: str = "") -> Pat
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     path = out / "lobes.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
@@ -73,7 +75,7 @@ def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
     fig.suptitle(f"n = {ds.attrs['speed_rpm']:.0f} r/min, a = {ds.attrs['depth_m'] * 1e3:.4g} mm")
     fig.tight_layout()
     p = out / "simulation_signals.png"
-    fig.savefig(p, dpi=110)
+    save_figure(fig, p, dpi=110)
     plt.close(fig)
     paths.append(p)
 
@@ -96,7 +98,7 @@ def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
     axs[1].set_ylabel("displacement PSD [a.u.]")
     fig.tight_layout()
     p = out / "simulation_surface_spectrum.png"
-    fig.savefig(p, dpi=110)
+    save_figure(fig, p, dpi=110)
     plt.close(fig)
     paths.append(p)
     return paths

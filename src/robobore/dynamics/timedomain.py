@@ -300,6 +300,9 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     Ns = settings.samples_per_rev or auto_samples_per_rev(structure, settings.speed_rpm, N)
     Ns = int(math.ceil(Ns / N) * N)
     n_steps = int(settings.revolutions) * Ns
+    from robobore.io.memory import check_timedomain
+
+    check_timedomain(int(settings.revolutions), Ns, N)  # before the arrays are allocated
     dt = 60.0 / (settings.speed_rpm * Ns)
     Phi, Gam = modal_zoh(structure, dt)
     theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # directions at the step midpoints

@@ -1,7 +1,11 @@
-"""Results files written atomically (temporary file in the same folder, then rename).
+"""Results files written atomically and durably.
 
-An interrupted run never leaves a half-written file: either the old file (or none) is
-there, or the complete new one.
+Every writer goes through the same steps: write a temporary file in the destination's
+folder, flush it and ``fsync`` it, ``os.replace`` it onto the destination, then ``fsync``
+the folder so that the rename itself survives a power cut. An interrupted run never leaves a
+half-written or zero-byte file: either the old file (or none) is there, or the complete new
+one. :func:`atomic_path` gives writers that need a file name (netCDF, meshio, matplotlib)
+the same guarantee; :func:`save_figure` does it for matplotlib figures.
 """
 
 from __future__ import annotations
@@ -9,6 +13,8 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +40,56 @@ def _tmp_path(dest: Path) -> Path:
     return Path(name)
 
 
+def fsync_dir(folder: str | Path) -> None:
+    """``fsync`` a folder so that a rename in it is on disk (no-op where unsupported)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:  # pragma: no cover - platforms without directory handles
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover - file systems that refuse fsync on folders
+        pass
+    finally:
+        os.close(fd)
+
+
+def fsync_file(path: str | Path) -> None:
+    """``fsync`` a closed file's contents to disk."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+@contextmanager
+def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
+    """Yield a temporary path beside ``path`` for a writer that needs a file name.
+
+    When the block ends without error the temporary file is synced, renamed onto ``path``
+    and the folder synced; on error it is removed and ``path`` is untouched. ``suffix``
+    (e.g. ``".png"``) ends the temporary name, for writers that choose the format by the
+    name's extension.
+    """
+    dest = Path(path)
+    tmp = _tmp_path(dest)
+    if suffix:
+        named = tmp.with_name(tmp.name + suffix)
+        os.replace(tmp, named)
+        tmp = named
+    try:
+        yield tmp
+        fsync_file(tmp)
+        os.replace(tmp, dest)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    fsync_dir(dest.parent)
+
+
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically; returns the path."""
+    """Write ``data`` to ``path`` atomically and durably; returns the path."""
     dest = Path(path)
     tmp = _tmp_path(dest)
     try:
@@ -47,6 +101,16 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+    fsync_dir(dest.parent)
+    return dest
+
+
+def save_figure(fig: Any, path: str | Path, **savefig_kw: Any) -> Path:
+    """``fig.savefig`` to ``path`` atomically and durably (format from the extension)."""
+    dest = Path(path)
+    fmt = savefig_kw.pop("format", None) or (dest.suffix.lstrip(".") or "png")
+    with atomic_path(dest) as tmp:
+        fig.savefig(tmp, format=fmt, **savefig_kw)
     return dest
 
 
@@ -115,11 +179,6 @@ def write_netcdf(
     if seed is not None:
         ds.attrs["robobore_seed"] = int(seed)
     dest = Path(path)
-    tmp = _tmp_path(dest)
-    try:
+    with atomic_path(dest) as tmp:
         ds.to_netcdf(tmp)
-        os.replace(tmp, dest)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
     return dest

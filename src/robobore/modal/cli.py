@@ -77,6 +77,7 @@ def modes_cmd(
 ) -> None:
     """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
     from robobore.errors import ConfigError
+    from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
     from robobore.modal.frf import DoubleHitWarning, FRFData, LeakageWarning, estimate_frf
@@ -86,6 +87,8 @@ def modes_cmd(
     if example == (input_file is not None):
         raise ConfigError("give either INPUT or --example", field="INPUT", value=input_file,
                           expected="a UFF/NPZ file path or the --example flag")
+    check_output_dir(plot, "--plot", "the PNG plots")
+    check_output_file(out, "--out", "the result JSON")
     if example:
         input_file = example_path()
         if band_hz is None:
@@ -148,6 +151,7 @@ def virtual_test_cmd(
     """Write a SYNTHETIC impact-hammer test of the robot boring truth model."""
     from robobore.clitools import kv_table, stdout
     from robobore.errors import ConfigError
+    from robobore.io.outputs import check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import (
         EXAMPLE_INPUT_DOFS,
@@ -158,6 +162,8 @@ def virtual_test_cmd(
     from robobore.modal.io import write_uff_time
     from robobore.modal.virtual import robot_boring_truth, simulate_hammer_test
 
+    check_output_file(out, "OUT", "the UFF file")
+    check_output_file(Path(str(out) + ".truth.json"), "OUT", "the ground-truth JSON")
     truth = robot_boring_truth()
     if example:
         make_example(out)
@@ -176,6 +182,7 @@ def virtual_test_cmd(
         if not 0 <= noise < 1:
             raise ConfigError("noise must be a fraction in [0, 1)", field="--noise", value=noise,
                               expected="e.g. 0.01 for 1 % of RMS")
+        _check_hammer_size(len(rows), hits, truth.phi_out.shape[0], sample_rate_hz, duration_s)
         settings = {"n_hits": hits, "sample_rate_Hz": sample_rate_hz, "duration_s": duration_s,
                     "tip": tip, "noise_force": noise, "noise_response": noise, "seed": seed,
                     "double_hits": dh}
@@ -196,6 +203,27 @@ def virtual_test_cmd(
             ("hammer inputs", ", ".join(truth.input_names)),
             ("hits per input", settings["n_hits"]), ("noise (fraction of RMS)",
                                                       settings["noise_response"])]))
+
+
+def _check_hammer_size(n_inputs: int, hits: int, n_outputs: int, sample_rate_hz: float,
+                       duration_s: float) -> None:
+    """Refuse a virtual test whose records cannot fit in memory (before simulating)."""
+    import math
+
+    from robobore.errors import ConfigError
+    from robobore.io.memory import check_memory, hammer_test_bytes
+
+    for name, v in (("--sample-rate-hz", sample_rate_hz), ("--duration-s", duration_s)):
+        if not (math.isfinite(v) and v > 0):
+            raise ConfigError("must be a positive number", field=name, value=v,
+                              expected="a finite value > 0 (Hz or s)")
+    if hits < 1:
+        raise ConfigError("at least one hit per direction", field="--hits", value=hits,
+                          expected="an integer >= 1")
+    n = sample_rate_hz * duration_s
+    check_memory(hammer_test_bytes(n_inputs, hits, n_outputs, int(min(n, 1e18))),
+                 f"the virtual hammer test ({n_inputs} x {hits} hits of {n:.3g} samples)",
+                 "--sample-rate-hz, --duration-s or --hits", value=n)
 
 
 def register(groups: dict[str, typer.Typer]) -> None:

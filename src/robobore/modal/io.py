@@ -22,7 +22,6 @@ direction; outputs and inputs with the same DOF are driving points).
 from __future__ import annotations
 
 import io as _io
-import os
 import re
 from pathlib import Path
 from typing import Any
@@ -240,19 +239,16 @@ def _units_set() -> dict[str, Any]:
 
 
 def _write_sets(path: str | Path, sets: list[dict[str, Any]]) -> Path:
-    """Write datasets through pyuff into a temporary file, then rename (atomic)."""
+    """Write datasets through pyuff into a temporary file, then rename (atomic, durable)."""
     import pyuff
 
+    from robobore.io.results import atomic_path
+
     dest = Path(path)
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    tmp = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")
-    try:
+    with atomic_path(dest) as tmp:
         tmp.unlink(missing_ok=True)
         uff = pyuff.UFF(str(tmp))
         uff.write_sets(sets, mode="overwrite", force_double=True)
-        os.replace(tmp, dest)
-    finally:
-        tmp.unlink(missing_ok=True)
     return dest
 
 
@@ -331,6 +327,18 @@ def load_npz(path: str | Path) -> FRFData:
     except Exception as exc:
         raise DataError(f"not a readable NPZ file ({exc})", file=str(p),
                         expected="numpy .npz with frequency_Hz, frf, frf_type") from None
+    try:
+        return _npz_frf(z, p)
+    except ValueError as exc:  # object (pickled) arrays, which allow_pickle=False refuses
+        if "allow_pickle" not in str(exc) and "Object arrays" not in str(exc):
+            raise
+        raise DataError("NPZ file holds pickled (object) arrays, which are not read (a "
+                        "pickle can run code)", file=str(p),
+                        expected="numeric and string arrays only (numpy.savez without "
+                        "object dtype)") from None
+
+
+def _npz_frf(z: Any, p: Path) -> FRFData:
     with z:
         for key in ("frequency_Hz", "frf", "frf_type"):
             if key not in z.files:

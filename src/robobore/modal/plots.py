@@ -24,11 +24,10 @@ def _plt():
 
 
 def _save(fig, path: Path) -> Path:
+    from robobore.io.results import save_figure
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.png")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    tmp.replace(path)
-    return path
+    return save_figure(fig, path, dpi=110, bbox_inches="tight")
 
 
 def plot_frf_fit(an: ModalAnalysis, path: str | Path, output: int = 0,

@@ -234,8 +234,10 @@ def stiffness_cmd(
     """Cartesian, directional and principal stiffness of the robot at one posture."""
     import numpy as np
 
+    from robobore.io.outputs import check_output_dir
     from robobore.robot.stiffness import stiffness_at
 
+    check_output_dir(plot, "--plot", "the PNG plots")
     rb = _robot(robot, robot_file)
     q = _q(rb, joints_deg)
     k = _joint_stiffness(joint_stiffness, joint_stiffness_file, rb.n_joints)
@@ -286,9 +288,11 @@ def _plot_stiffness(r: dict[str, Any], folder: Path) -> list[str]:
     fig.suptitle(f"directional stiffness, {r['robot']} at "
                  f"{', '.join(f'{v:g}' for v in r['joints_deg'])} deg")
     fig.tight_layout()
+    from robobore.io.results import save_figure
+
     folder.mkdir(parents=True, exist_ok=True)
     p = folder / "directional_stiffness.png"
-    fig.savefig(p, dpi=110)
+    save_figure(fig, p, dpi=110)
     plt.close(fig)
     return [str(p)]
 
@@ -331,9 +335,11 @@ def campaign_cmd(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Generate a SYNTHETIC laser-tracker stiffness campaign (virtual experiment)."""
+    from robobore.io.outputs import check_output_file
     from robobore.robot import campaign as cm
     from robobore.robot.campaign_io import write_campaign
 
+    check_output_file(out, "OUT", "the campaign CSV")
     rb = _robot(robot, robot_file)
     kw: dict[str, Any] = {"robot": str(robot_file) if robot_file else rb.name, "seed": seed}
     if joint_stiffness is not None:
@@ -412,9 +418,11 @@ def identify_stiffness_cmd(
 ) -> None:
     """Identify joint stiffnesses from a laser-tracker campaign (weighted NNLS)."""
     from robobore.errors import ConfigError
+    from robobore.io.outputs import check_output_dir
     from robobore.robot.campaign_io import read_campaign
     from robobore.robot.identify import identify_joint_stiffness
 
+    check_output_dir(plot, "--plot", "the PNG plots")
     if example:
         if campaign is not None:
             raise ConfigError("give either a campaign file or --example, not both",
@@ -514,8 +522,10 @@ def _plot_identification(r: dict[str, Any], folder: Path) -> list[str]:
     ax[1].set_ylabel("translation residual (um)")
     ax[1].set_title("per-measurement residuals")
     fig.tight_layout()
+    from robobore.io.results import save_figure
+
     p = folder / "identify_stiffness.png"
-    fig.savefig(p, dpi=110)
+    save_figure(fig, p, dpi=110)
     plt.close(fig)
     return [str(p)]
 

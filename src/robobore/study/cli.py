@@ -11,8 +11,13 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.markup import escape
 
-from robobore.clitools import JSON_OPTION, emit, fmt, handle_errors, kv_table, stdout
+from robobore.clitools import JSON_OPTION, emit, fmt, handle_errors, kv_table, stderr, stdout
+
+ALLOW_FAILURES_OPTION = typer.Option(
+    False, "--allow-failures", help="Exit 0 even when some conditions failed (they are still "
+    "listed and recorded).")
 
 
 def _render_sweep(res: dict[str, Any]) -> None:
@@ -29,6 +34,8 @@ def _render_sweep(res: dict[str, Any]) -> None:
         ("wall time, s", res["wall_time_s"]),
         ("conditions/s", res["conditions_per_s"]),
     ]))
+    for w in res.get("warnings", []):
+        stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     if res["failures"]:
         t = Table(title="failed conditions (see failed/<key>.json for tracebacks)",
                   header_style="bold red")
@@ -58,13 +65,17 @@ def sweep_cmd(
         None, "--report", help="Also write a self-contained HTML report of the sweep here."),
     status: bool = typer.Option(
         False, "--status", help="Only show what is done / failed / pending; compute nothing."),
+    allow_failures: bool = ALLOW_FAILURES_OPTION,
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Run a sweep of cutting conditions (resumable: finished conditions are skipped).
 
-    Exit code 0 when every condition is done, 1 when some failed (they are listed, and
-    recorded with their traceback in the store; run the command again to retry them).
+    Exit code 0 when every condition is done, 1 when some failed or are not done (they are
+    listed, and recorded with their traceback in the store, and the store's index and the
+    report say which and why; run the command again to retry them); --allow-failures
+    exits 0 all the same.
     """
+    from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.study.sweep import plan_from_file, run_sweep
 
     plan = plan_from_file(config)
@@ -77,6 +88,8 @@ def sweep_cmd(
     if status:
         _status(plan, store, as_json)
         return
+    check_output_dir(store, "--out", "the results store")
+    check_output_file(report, "--report", "the HTML report")
     outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
                         processes=not threads, progress=sys.stderr.isatty())
     res = {"name": plan.name, "runner": plan.runner, **outcome.to_dict()}
@@ -88,7 +101,7 @@ def sweep_cmd(
                      title=f"Sweep {plan.name}").write(report)
         res["report"] = str(report)
     emit(res, as_json, _render_sweep)
-    if outcome.pending:
+    if outcome.pending and not allow_failures:
         raise typer.Exit(code=1)
 
 
@@ -170,8 +183,10 @@ def compare_cmd(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Compare measurements with a sweep's results: relative errors, groups, agreement."""
+    from robobore.io.outputs import check_output_file
     from robobore.study.compare import compare_results
 
+    check_output_file(report, "--report", "the HTML report")
     cmp = compare_results(measured, results)
     res = cmp.to_dict()
     res["measured"] = str(measured)
@@ -209,6 +224,16 @@ def _render_paper(res: dict[str, Any]) -> None:
         ("force coefficients", res.get("coefficients_mode")),
         ("wall time, s", res["wall_time_s"]),
     ]))
+    if res["failed"]:
+        t = Table(title="failed conditions", header_style="bold red")
+        for c in ("system", "condition", "error"):
+            t.add_column(c)
+        for f in res["failed"][:30]:
+            c = f["condition"]
+            t.add_row(f["system"], f"n={fmt(c['speed_rpm'])} f={fmt(c['feed_mm_per_rev'])} "
+                      f"ap={fmt(c['depth_of_cut_mm'])} P={fmt(c['pressure_MPa'])}",
+                      escape(str(f.get("error"))[:160]))
+        stdout.print(t)
     cmp = res.get("comparison")
     if cmp:
         t = Table(title="relative error vs measured (SYNTHETIC)", header_style="bold")
@@ -235,14 +260,26 @@ def paper_cmd(
                               "coefficients instead of running the FE calibration."),
     workers: int = typer.Option(2, "--workers", min=0, help="Dask worker processes for the "
                                 "sweep and FE processes (0 = serial, no Dask)."),
+    allow_failures: bool = ALLOW_FAILURES_OPTION,
     as_json: bool = JSON_OPTION,
 ) -> None:
-    """The paper's whole study: identify, model, calibrate, sweep, compare, report."""
+    """The paper's whole study: identify, model, calibrate, sweep, compare, report.
+
+    Exit code 1 when any condition failed (the report and the results are written all the
+    same and list the failed conditions with their errors); --allow-failures exits 0.
+    """
+    from robobore.io.outputs import check_output_dir
     from robobore.study.paper import run_paper
 
+    check_output_dir(out, "--out", "the study's results")
     res = run_paper(config, out, fast=fast, workers=workers,
                     progress=sys.stderr.isatty() and not as_json)
     emit(res, as_json, _render_paper)
+    if res["failed"] and not allow_failures:
+        stderr.print(f"[bold red]error:[/] {len(res['failed'])} of {res['conditions']} "
+                     "conditions failed (listed in the report and paper_summary.json); "
+                     "--allow-failures exits 0 all the same", soft_wrap=True)
+        raise typer.Exit(code=1)
 
 
 def _render_calibration(res: dict[str, Any]) -> None:
@@ -282,8 +319,10 @@ def calibrate_forces_cmd(
     """FE-calibrated mechanistic coefficients: 2D FE over h x vc, least-squares fit."""
     from robobore.clitools import progress_bar
     from robobore.cutting.calibrate import calibrate_forces, load_calibration_config
+    from robobore.io.outputs import check_output_file
     from robobore.study.paper import example_config_path
 
+    check_output_file(out, "--out", "the coefficients JSON")
     path = config if config is not None else example_config_path()
     cfg = load_calibration_config(path)
     n = len(cfg.uncut_chip_thickness_um) * len(cfg.cutting_speed_m_per_min)

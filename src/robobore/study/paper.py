@@ -254,7 +254,17 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
             raise ConfigError("stored coefficients file not found", file=str(cfg_path),
                               field="coefficients.file", value=str(p),
                               expected="a JSON file written by 'robobore calibrate forces'")
-        data = json.loads(p.read_text())
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            raise ConfigError(f"cannot read the stored coefficients ({exc})", file=str(p),
+                              field="coefficients.file",
+                              expected="a UTF-8 JSON file written by 'robobore calibrate "
+                              f"forces' (named in {cfg_path})") from None
+        if not isinstance(data, dict) or not isinstance(data.get("coefficients"), dict):
+            raise ConfigError("not a coefficients file (no 'coefficients' table)", file=str(p),
+                              field="coefficients",
+                              expected="a JSON object written by 'robobore calibrate forces'")
         data["file"] = str(p)
         data["mode"] = "stored (--fast)"
         return data
@@ -575,6 +585,9 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     plan, meta = build_plan(cfg, robot_model, mt_model)
     t = time.perf_counter()
     store = ResultsStore(outdir / "sweep")
+    from dataclasses import replace as _replace
+
+    plan = _replace(plan, source=str(cfg_path))  # per-condition errors name the config file
     outcome = run_sweep(plan, store, workers=nw, processes=nw > 0, progress=progress)
     lap("sweep", t)
     rows = []

@@ -73,9 +73,17 @@ def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
 
     model = context.get("model", {})
     opts = context.get("runner_options", {}) or {}
-    cfg = _dynamics_config(condition, model)
+    src = context.get("config_file")
+    try:
+        cfg = _dynamics_config(condition, model)
+    except ConfigError as exc:
+        if src is not None and exc.file is None:
+            raise ConfigError(exc.message, file=src, field=exc.field, value=exc.value,
+                              expected=exc.expected) from None
+        raise
     system = model.get("system", "robot")
-    r = run_boring(cfg, speed_rpm=float(condition["speed_rpm"]),
+    r = run_boring(cfg, source=f"{src} [model.dynamics]" if src else None,
+                   speed_rpm=float(condition["speed_rpm"]),
                    depth_mm=float(condition["depth_of_cut_mm"]),
                    feed_mm_per_rev=float(condition["feed_mm_per_rev"]),
                    pressure_MPa=(float(condition.get("pressure_MPa", 0.0))

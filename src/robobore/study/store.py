@@ -8,11 +8,15 @@ Layout of a store folder::
     index.json              done / failed / pending per condition of the last sweep
     summary.csv             one row per finished condition: condition + summary quantities
 
-The files under ``results/`` are the truth: a condition is done when its netCDF file exists.
-Files are written to a temporary name and renamed (``robobore.io.results``), so a killed
-sweep leaves either the complete file or none, never a half file; stale temporary files of a
-killed run are removed by :meth:`ResultsStore.cleanup_partial` when the store is opened
-for a new run. ``index.json`` and ``summary.csv`` are derived and rewritten from the files.
+The files under ``results/`` are the truth: a condition is done when its netCDF file exists
+and is not empty. Files are written to a temporary name, synced and renamed
+(``robobore.io.results``), so a killed sweep leaves either the complete file or none, never
+a half file; stale temporary files of a killed run are removed by
+:meth:`ResultsStore.cleanup_partial` when the store is opened for a new run. A result file
+that is empty or cannot be read as netCDF (a disk that lost it, a file copied by hand) is
+set aside as ``results/<key>.nc.invalid`` by :meth:`ResultsStore.set_aside_invalid` before
+a sweep runs, with a warning, and its condition is computed again. ``index.json`` and
+``summary.csv`` are derived and rewritten from the files.
 
 The key of a condition (:func:`robobore.study.conditions.condition_key`) hashes the
 condition, the runner name and the model config, so several sweeps (even with different
@@ -144,7 +148,46 @@ class ResultsStore:
         return self.failed_dir / f"{key}.json"
 
     def is_done(self, key: str) -> bool:
-        return self.result_path(key).is_file()
+        p = self.result_path(key)
+        try:
+            return p.is_file() and p.stat().st_size > 0
+        except OSError:
+            return False
+
+    def result_problem(self, key: str) -> str | None:
+        """Why the stored result of ``key`` is not usable (empty, unreadable), or None."""
+        import netCDF4
+
+        p = self.result_path(key)
+        try:
+            if p.stat().st_size == 0:
+                return "zero-byte file"
+            with netCDF4.Dataset(p) as nc:
+                if "robobore_condition" not in nc.ncattrs():
+                    return "no robobore_condition attribute"
+        except FileNotFoundError:
+            return None
+        except OSError as exc:
+            return f"unreadable ({exc.strerror or exc})"
+        return None
+
+    def set_aside_invalid(self, keys: Iterable[str]) -> list[str]:
+        """Rename the result files of ``keys`` that are empty or unreadable to
+        ``<key>.nc.invalid`` so that their conditions count as missing; returns one warning
+        line per file set aside."""
+        out = []
+        for k in keys:
+            p = self.result_path(k)
+            if not p.exists():
+                continue
+            why = self.result_problem(k)
+            if why is None:
+                continue
+            bad = p.with_name(p.name + ".invalid")
+            os.replace(p, bad)
+            out.append(f"result {p} is not usable ({why}): set aside as {bad.name}; the "
+                       "condition is computed again")
+        return out
 
     def status(self, key: str) -> str:
         """``"done"``, ``"failed"`` or ``"pending"``."""
@@ -155,7 +198,7 @@ class ResultsStore:
         return "pending"
 
     def done_keys(self) -> set[str]:
-        return {p.stem for p in self.results_dir.glob("*.nc")}
+        return {p.stem for p in self.results_dir.glob("*.nc") if self.is_done(p.stem)}
 
     def cleanup_partial(self) -> list[Path]:
         """Remove temporary files left by a killed run (never a finished result)."""

@@ -4,8 +4,10 @@ A *runner* is a picklable, importable function ``runner(condition: dict, context
 -> xarray.Dataset`` (condition: :class:`~robobore.study.conditions.Condition` as a dict;
 context: ``model`` (the model config), ``runner_options``, ``postures``, ``posture``
 (this condition's posture table or ``{}``), ``seed`` (this condition's seed), ``key``,
-``sweep``). It is named in the sweep config: a registered name (:data:`RUNNERS`) or
-``"package.module:function"``. Runners must be importable on the Dask workers.
+``sweep``, and ``config_file`` (the sweep's config file, when the plan was read from one,
+for error messages; not part of the key)). It is named in the sweep config: a registered
+name (:data:`RUNNERS`) or ``"package.module:function"``. Runners must be importable on the
+Dask workers.
 
 Execution (:func:`run_sweep`):
 
@@ -31,7 +33,7 @@ import os
 import time
 import traceback
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -90,6 +92,8 @@ class SweepPlan:
     runner: str
     items: tuple[SweepItem, ...]
     config: dict[str, Any]
+    #: the config file the plan was read from (named in per-condition error messages)
+    source: str | None = None
 
     @classmethod
     def from_config(cls, cfg: SweepConfig, conditions: list[Condition]) -> SweepPlan:
@@ -127,6 +131,8 @@ class SweepOutcome:
     wall_time_s: float
     mode: str
     failures: tuple[dict[str, Any], ...] = field(default_factory=tuple)
+    #: store problems met and repaired (result files set aside and recomputed)
+    warnings: tuple[str, ...] = field(default_factory=tuple)
 
     @property
     def conditions_per_s(self) -> float:
@@ -139,6 +145,7 @@ class SweepOutcome:
             "computed": self.computed, "failed": self.failed, "pending": self.pending,
             "wall_time_s": self.wall_time_s, "conditions_per_s": self.conditions_per_s,
             "mode": self.mode, "failures": list(self.failures),
+            "warnings": list(self.warnings),
         }
 
 
@@ -240,10 +247,18 @@ def run_sweep(
 def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: str | None,
                 workers: int | None, processes: bool, progress: bool, index_every_s: float,
                 connect_timeout_s: float) -> SweepOutcome:
+    import warnings
+
     from robobore.clitools import progress_bar
 
     store.cleanup_partial()  # safe: the lock says no other sweep is writing here
+    bad = store.set_aside_invalid(i.key for i in plan.items)
+    for w in bad:
+        warnings.warn(w, stacklevel=2)
     todo = [i for i in plan.items if not store.is_done(i.key)]
+    if plan.source is not None:  # per-condition errors name the config file
+        todo = [SweepItem(i.key, i.condition, {**i.context, "config_file": plan.source})
+                for i in todo]
     skipped = len(plan.items) - len(todo)
     t0 = time.perf_counter()
 
@@ -272,6 +287,7 @@ def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: 
         store=store.root, total=len(plan.items), skipped=skipped, computed=rec.computed,
         failed=len(rec.failures), pending=index["counts"]["failed"] + index["counts"]["pending"],
         wall_time_s=time.perf_counter() - t0, mode=mode, failures=tuple(rec.failures),
+        warnings=tuple(bad),
     )
 
 
@@ -345,7 +361,7 @@ def plan_from_file(path: str | Path) -> SweepPlan:
     from robobore.study.conditions import load_sweep_config
 
     cfg, conds = load_sweep_config(path)
-    plan = SweepPlan.from_config(cfg, conds)
+    plan = replace(SweepPlan.from_config(cfg, conds), source=str(path))
     resolve_runner(plan.runner)
     return plan
 

@@ -239,6 +239,9 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
                           field="cut.bore_diameter_mm", value=cfg.cut.bore_diameter_mm,
                           expected=f">= 20 x cut.cut_length_mm = "
                           f"{20 * cfg.cut.cut_length_mm:g} mm")
+    from robobore.io.memory import check_fe3d
+
+    check_fe3d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg
 
 

@@ -52,8 +52,12 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
     from robobore.cutting.fe.config import load_fe_config
     from robobore.cutting.fe.output import plot_chip, to_dataset, write_vtk
     from robobore.cutting.fe.solver import check_device, simulate_orthogonal
+    from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_netcdf
 
+    check_output_file(out, "--out", "the netCDF histories")
+    check_output_dir(vtk, "--vtk", "the VTU mesh")
+    check_output_dir(plot, "--plot", "the PNG pictures")
     cfg = load_fe_config(config)
     check_device(device, cfg, str(config))
     total = 1000
@@ -114,11 +118,11 @@ def _plot_forces(res, path: Path) -> Path:
     ax.set_xlabel("length of cut [mm]")
     ax.set_ylabel("force on the tool [N/mm]")
     ax.legend(fontsize=7, ncol=2)
+    from robobore.io.results import save_figure
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + ".tmp.png")
-    fig.savefig(tmp)
+    save_figure(fig, path)
     plt.close(fig)
-    tmp.replace(path)
     return path
 
 

@@ -70,6 +70,9 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
         from robobore.cutting.fe.gpu import require_gpu
 
         require_gpu()
+    from robobore.io.outputs import check_output_dir
+
+    check_output_dir(vtk, "--vtk", "the VTU meshes")
     cfg = load_boring_config(config)
     total = 1000
     with progress_bar("FE boring (3D)", total, enabled=not as_json) as advance:

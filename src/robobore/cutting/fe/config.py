@@ -423,7 +423,11 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
 
 def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
     """Validate a config dict (as read from TOML)."""
-    return check_config(validate_model(FEConfig, data, source=source or "<config>"), source)
+    cfg = check_config(validate_model(FEConfig, data, source=source or "<config>"), source)
+    from robobore.io.memory import check_fe2d
+
+    check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
+    return cfg
 
 
 def load_fe_config(path: str | Path) -> FEConfig:
