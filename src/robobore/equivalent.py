@@ -258,11 +258,18 @@ class EquivalentModel:
             except (KeyError, TypeError):
                 raise ConfigError("missing key", field="directional_stiffness_N_per_m",
                                   expected='{"x": .., "y": .., "z": ..} in N/m') from None
+            if not isinstance(ks, dict):
+                raise ConfigError("not a table of x, y, z values",
+                                  field="directional_stiffness_N_per_m", value=ks,
+                                  expected='{"x": .., "y": .., "z": ..} in N/m')
         try:
-            ml = list(modes["modes"])
+            ml = modes["modes"]
         except (KeyError, TypeError):
             raise ConfigError("missing key", field="modes",
                               expected='a list of {"frequency_Hz", "damping_ratio"}') from None
+        if not isinstance(ml, list) or not all(isinstance(md, dict) for md in ml):
+            raise ConfigError("not a list of mode tables", field="modes", value=ml,
+                              expected='a list of {"frequency_Hz", "damping_ratio"}')
         if len(ml) < 1:
             raise ConfigError("no modes given", field="modes", expected="at least one mode")
         for i, md in enumerate(ml):

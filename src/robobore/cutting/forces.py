@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -107,14 +106,14 @@ def load_coefficients(path: str | Path) -> CuttingCoefficients:
     if not p.is_file():
         raise ConfigError("coefficient file not found", file=str(p),
                           expected="a TOML or JSON file")
-    try:
-        if p.suffix.lower() == ".json":
-            data = json.loads(p.read_text())
-        else:
-            with p.open("rb") as fh:
-                data = tomllib.load(fh)
-    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot parse: {exc}", file=str(p)) from None
+    if p.suffix.lower() == ".json":
+        from robobore.io.readers import load_json
+
+        data = load_json(p, "coefficient file", "a JSON object of cutting coefficients")
+    else:
+        from robobore.io.config import load_toml
+
+        data = load_toml(p)
     if "coefficients" in data and isinstance(data["coefficients"], dict):
         data = data["coefficients"]
     return CuttingCoefficients.from_dict(data, source=str(p))

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -24,12 +23,9 @@ from robobore.errors import ConfigError
 
 
 def _read_json(path: Path, what: str) -> dict[str, Any]:
-    if not path.is_file():
-        raise ConfigError(f"{what} file not found", file=str(path), expected="a JSON file")
-    try:
-        return json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"not valid JSON: {exc}", file=str(path)) from None
+    from robobore.io.readers import load_json
+
+    return load_json(path, f"{what} file", "a JSON object (as written by robobore --json)")
 
 
 # ----------------------------------------------------------------------------- lobes
@@ -260,9 +256,16 @@ def equivalent_cmd(
         foot = PressureFoot(pressure_Pa=foot_pressure_MPa * 1e6,
                             piston_area_m2=math.pi * (foot_piston_diameter_mm * 1e-3 / 2) ** 2,
                             normal_stiffness_N_per_m=foot_normal_stiffness_N_per_m)
-    em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
-                                                  damping_N_s_per_m=damping_N_s_per_m,
-                                                  foot=foot)
+    try:
+        em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
+                                                      damping_N_s_per_m=damping_N_s_per_m,
+                                                      foot=foot)
+    except ConfigError as exc:  # name the file the bad key came from
+        src = modes_file if (exc.field or "").startswith("modes") else stiffness_file
+        if exc.file is None and src is not None:
+            raise ConfigError(exc.message, file=str(src), field=exc.field, value=exc.value,
+                              expected=exc.expected) from None
+        raise
     result = em.to_dict()
     result["table"] = em.table()
     result["tool_point_modes"] = em.tool_point_modes()

@@ -29,6 +29,14 @@ def load_toml(path: str | Path) -> dict[str, Any]:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"not valid TOML: {exc}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        hint = (" (looks like UTF-16: save it as UTF-8)"
+                if exc.object[:2] in (b"\xff\xfe", b"\xfe\xff") else "")
+        raise ConfigError(f"not UTF-8 text at byte {exc.start}{hint}", file=str(p),
+                          expected="a UTF-8 encoded TOML file") from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read the file ({exc.strerror or exc})", file=str(p),
+                          expected="a readable TOML file") from None
 
 
 def _loc(err: dict[str, Any]) -> str:

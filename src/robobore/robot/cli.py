@@ -6,7 +6,6 @@ Heavy imports (numba kernels, scipy) happen inside the commands.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -182,14 +181,11 @@ def _joint_stiffness(text: str | None, file: Path | None, n: int):
     from robobore.robot.stiffness import JointStiffness
 
     if file is not None:
+        from robobore.io.readers import load_json
+
         p = Path(file)
-        if not p.is_file():
-            raise ConfigError("file not found", file=str(p),
-                              expected="a JSON file from `robobore identify stiffness --json`")
-        try:
-            data = json.loads(p.read_text())
-        except json.JSONDecodeError as exc:
-            raise ConfigError(f"not valid JSON: {exc}", file=str(p)) from None
+        data = load_json(p, "joint stiffness file",
+                         "a JSON object from `robobore identify stiffness --json`")
         try:
             js = JointStiffness.from_dict(data)
         except InputError as exc:

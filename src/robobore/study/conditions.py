@@ -147,6 +147,14 @@ class GridSpec(BaseModel):
     pressure_MPa: Levels = Field(default_factory=lambda: [0.0])
     posture: list[str] = Field(default_factory=lambda: [DEFAULT_POSTURE], min_length=1)
 
+    def count(self) -> int:
+        """Number of conditions of the grid, without expanding it."""
+        n = len(self.posture)
+        for name in CONDITION_FIELDS:
+            v = getattr(self, name)
+            n *= v.num if isinstance(v, RangeSpec) else len(v)
+        return n
+
     def expand(self) -> list[dict[str, Any]]:
         lv = {}
         for name in CONDITION_FIELDS:
@@ -221,11 +229,25 @@ def paper_conditions(design: Literal["ofat", "grid"] = "ofat") -> list[dict[str,
     return out
 
 
+#: The most conditions one sweep plans (each is planned, keyed and tracked in memory and in
+#: ``index.json``; at about 0.1 s per condition the largest sweep is days of computing).
+MAX_SWEEP_CONDITIONS = 100_000
+
+
 def expand_conditions(cfg: SweepConfig, source: str | Path = "<config>") -> list[Condition]:
     """All conditions of a sweep config, validated, in a stable order; duplicates are errors.
 
-    Order: built-in levels, then the grid, then the explicit list.
+    Order: built-in levels, then the grid, then the explicit list. A sweep of more than
+    :data:`MAX_SWEEP_CONDITIONS` conditions is refused before anything is expanded.
     """
+    n_grid = cfg.grid.count() if cfg.grid is not None else 0
+    if n_grid + len(cfg.conditions) > MAX_SWEEP_CONDITIONS:
+        raise ConfigError(
+            f"the sweep has {n_grid + len(cfg.conditions):.4g} conditions, more than the "
+            f"{MAX_SWEEP_CONDITIONS} one sweep plans; reduce the levels of [grid] (or split "
+            "the study into several sweeps sharing one store)", file=str(source),
+            field="grid", value=n_grid + len(cfg.conditions),
+            expected=f"at most {MAX_SWEEP_CONDITIONS} conditions")
     raw: list[tuple[str, dict[str, Any]]] = []
     if cfg.sweep.levels is not None:
         design = "ofat" if cfg.sweep.levels == "paper-ofat" else "grid"
@@ -295,6 +317,7 @@ def condition_seed(base_seed: int, key: str) -> int:
 
 __all__ = [
     "CONDITION_FIELDS",
+    "MAX_SWEEP_CONDITIONS",
     "DEFAULT_POSTURE",
     "PAPER_LEVELS",
     "PAPER_BASE",

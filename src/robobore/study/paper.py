@@ -87,7 +87,8 @@ class RobotSection(_Strict):
 
 class ModalSection(_Strict):
     file: str | None = None  # None: bundled SYNTHETIC hammer test
-    band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0])
+    band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0], min_length=2,
+                                 max_length=2)  # [low, high] in Hz
     n_modes: int = Field(5, ge=3, le=50)
     max_order: int = Field(40, ge=4, le=200)
 
@@ -254,14 +255,11 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
             raise ConfigError("stored coefficients file not found", file=str(cfg_path),
                               field="coefficients.file", value=str(p),
                               expected="a JSON file written by 'robobore calibrate forces'")
-        try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, ValueError) as exc:
-            raise ConfigError(f"cannot read the stored coefficients ({exc})", file=str(p),
-                              field="coefficients.file",
-                              expected="a UTF-8 JSON file written by 'robobore calibrate "
-                              f"forces' (named in {cfg_path})") from None
-        if not isinstance(data, dict) or not isinstance(data.get("coefficients"), dict):
+        from robobore.io.readers import load_json
+
+        data = load_json(p, "coefficients file", "a JSON object written by 'robobore "
+                         f"calibrate forces' (named by [coefficients] file in {cfg_path})")
+        if not isinstance(data.get("coefficients"), dict):
             raise ConfigError("not a coefficients file (no 'coefficients' table)", file=str(p),
                               field="coefficients",
                               expected="a JSON object written by 'robobore calibrate forces'")
