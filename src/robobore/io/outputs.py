@@ -73,8 +73,12 @@ def check_output_file(path: str | Path | None, option: str, what: str = "the out
         raise ConfigError("no file name", file=str(p), field=option,
                           expected=f"a file name for {what}")
     folder = p.parent
-    _make_dir(folder, option, what)
-    _probe(folder, option, what)
+    try:
+        _make_dir(folder, option, what)
+        _probe(folder, option, what)
+    except ConfigError as exc:  # name the file the user gave, and its folder
+        raise ConfigError(f"its folder {folder}: {exc.message}", file=str(p), field=option,
+                          expected=exc.expected) from None
     if p.exists() and not os.access(p, os.W_OK) and not os.access(folder, os.W_OK):
         raise ConfigError("the file exists and cannot be replaced", file=str(p), field=option,
                           expected=f"a writable destination for {what}")

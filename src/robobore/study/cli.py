@@ -34,8 +34,6 @@ def _render_sweep(res: dict[str, Any]) -> None:
         ("wall time, s", res["wall_time_s"]),
         ("conditions/s", res["conditions_per_s"]),
     ]))
-    for w in res.get("warnings", []):
-        stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     if res["failures"]:
         t = Table(title="failed conditions (see failed/<key>.json for tracebacks)",
                   header_style="bold red")
@@ -75,7 +73,10 @@ def sweep_cmd(
     report say which and why; run the command again to retry them); --allow-failures
     exits 0 all the same.
     """
+    import warnings
+
     from robobore.io.outputs import check_output_dir, check_output_file
+    from robobore.study.store import StoreWarning
     from robobore.study.sweep import plan_from_file, run_sweep
 
     plan = plan_from_file(config)
@@ -90,8 +91,12 @@ def sweep_cmd(
         return
     check_output_dir(store, "--out", "the results store")
     check_output_file(report, "--report", "the HTML report")
-    outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
-                        processes=not threads, progress=sys.stderr.isatty())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StoreWarning)  # printed below, one line each
+        outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
+                            processes=not threads, progress=sys.stderr.isatty())
+    for w in outcome.warnings:
+        stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     res = {"name": plan.name, "runner": plan.runner, **outcome.to_dict()}
     if report is not None:
         from robobore.study.plots import sweep_report
@@ -268,12 +273,19 @@ def paper_cmd(
     Exit code 1 when any condition failed (the report and the results are written all the
     same and list the failed conditions with their errors); --allow-failures exits 0.
     """
+    import warnings
+
     from robobore.io.outputs import check_output_dir
     from robobore.study.paper import run_paper
+    from robobore.study.store import StoreWarning
 
     check_output_dir(out, "--out", "the study's results")
-    res = run_paper(config, out, fast=fast, workers=workers,
-                    progress=sys.stderr.isatty() and not as_json)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StoreWarning)  # printed below, one line each
+        res = run_paper(config, out, fast=fast, workers=workers,
+                        progress=sys.stderr.isatty() and not as_json)
+    for w in res.get("sweep", {}).get("warnings", []):
+        stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     emit(res, as_json, _render_paper)
     if res["failed"] and not allow_failures:
         stderr.print(f"[bold red]error:[/] {len(res['failed'])} of {res['conditions']} "

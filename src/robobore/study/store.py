@@ -45,6 +45,10 @@ from robobore.study.summary import SUMMARY_QUANTITIES, summarise, summary_attrs
 STORE_FORMAT = 1
 
 
+class StoreWarning(UserWarning):
+    """A store problem that was repaired (an unusable result set aside and recomputed)."""
+
+
 def _now() -> str:
     return datetime.now(UTC).isoformat(timespec="seconds")
 
@@ -362,4 +366,4 @@ def worker_label() -> str:
     return f"{socket.gethostname()}:{os.getpid()}"
 
 
-__all__ = ["ResultsStore", "StoredResult", "STORE_FORMAT", "worker_label"]
+__all__ = ["ResultsStore", "StoredResult", "StoreWarning", "STORE_FORMAT", "worker_label"]

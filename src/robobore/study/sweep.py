@@ -44,7 +44,7 @@ from robobore.study.conditions import (
     condition_key,
     condition_seed,
 )
-from robobore.study.store import ResultsStore, worker_label
+from robobore.study.store import ResultsStore, StoreWarning, worker_label
 
 Runner = Callable[[dict[str, Any], dict[str, Any]], Any]
 
@@ -254,7 +254,7 @@ def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: 
     store.cleanup_partial()  # safe: the lock says no other sweep is writing here
     bad = store.set_aside_invalid(i.key for i in plan.items)
     for w in bad:
-        warnings.warn(w, stacklevel=2)
+        warnings.warn(w, StoreWarning, stacklevel=2)
     todo = [i for i in plan.items if not store.is_done(i.key)]
     if plan.source is not None:  # per-condition errors name the config file
         todo = [SweepItem(i.key, i.condition, {**i.context, "config_file": plan.source})
