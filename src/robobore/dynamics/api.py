@@ -89,8 +89,14 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
     st = build_structure(cfg, src)
     pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None)
-    ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
-                  cfg.insert.to_insert() if cfg.is_boring else None)
+    try:
+        ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
+                      cfg.insert.to_insert() if cfg.is_boring else None)
+    except ConfigError as exc:  # a settings error (size guard): name the config file
+        if exc.file is None and src is not None:
+            raise ConfigError(exc.message, file=src, field=exc.field, value=exc.value,
+                              expected=exc.expected) from None
+        raise
     tol = cfg.simulation.ra_tolerance_um
     v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
     s = summarize(ds)

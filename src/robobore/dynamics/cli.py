@@ -165,7 +165,8 @@ def simulate_boring_cmd(
     with progress_bar("simulating", None, not as_json):
         result = run_boring(cfg, speed_rpm, depth_mm, feed_mm_per_rev=feed_mm_per_rev,
                             pressure_MPa=pressure_MPa, revolutions=revolutions,
-                            samples_per_rev=samples_per_rev, return_dataset=True)
+                            samples_per_rev=samples_per_rev, return_dataset=True,
+                            source=str(config))
     ds = result.pop("dataset")
     result.pop("config")
     speed_rpm, depth_mm = result["speed_rpm"], result["depth_mm"]
