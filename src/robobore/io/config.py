@@ -22,6 +22,8 @@ M = TypeVar("M", bound=BaseModel)
 def load_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML file into a dict; a missing file or a syntax error is a ConfigError."""
     p = Path(path)
+    if p.is_dir():
+        raise ConfigError("is a folder, not a file", file=str(p), expected="a TOML file")
     if not p.is_file():
         raise ConfigError("config file not found", file=str(p), expected="an existing TOML file")
     try:

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from robobore.errors import InputError
+from robobore.io.results import fsync_dir
 from robobore.study.hashing import canonicalise, stable_hash
 
 
@@ -117,6 +118,7 @@ class ResultCache:
             for f in tmp.iterdir():
                 with f.open("rb") as fh:
                     os.fsync(fh.fileno())
+            fsync_dir(tmp)
             try:
                 os.rename(tmp, dest)
             except OSError:
@@ -128,6 +130,7 @@ class ResultCache:
         except BaseException:
             shutil.rmtree(tmp, ignore_errors=True)
             raise
+        fsync_dir(dest.parent)  # the rename itself on disk
         return dest
 
     def entries(self, namespace: str | None = None) -> list[Path]:
