@@ -1,7 +1,7 @@
 """Memory estimates checked before large arrays are allocated.
 
-Commands whose memory grows with their input (FE meshes 2D/3D, time-domain samples, sweep
-grids, virtual hammer tests) call :func:`check_memory` with a cheap estimate computed from
+Commands whose memory grows with their input (FE meshes 2D/3D, time-domain samples,
+virtual hammer tests) call :func:`check_memory` with a cheap estimate computed from
 the config before they allocate anything. When the estimate exceeds the memory available
 now (``MemAvailable`` of ``/proc/meminfo``; elsewhere the physical memory from
 ``os.sysconf``) the command is refused with a :class:`~robobore.errors.ConfigError` naming
@@ -10,8 +10,11 @@ machine runs out of memory.
 
 The estimates are formulas, not measurements of a run: they count the arrays the command
 holds at its peak, with a stated number of bytes per element/sample (module constants
-below), and are meant to be right within a factor of about two. They refuse requests that
-cannot fit, not runs that are merely large.
+below). The element counts are checked against the meshes the builders make for the bundled
+FE examples (2D: 0.36-1.2 times the real count, the edge-refined mesh lowest; 3D: 0.89
+times). They refuse requests that cannot fit, not runs that are merely large. Sweep grids
+have a count limit instead (:data:`robobore.study.conditions.MAX_SWEEP_CONDITIONS`); lobe
+maps are bounded by their config (at most 100 000 speeds, memory linear in the count).
 
 ``ROBOBORE_MEMORY_LIMIT_BYTES`` (environment), when set, replaces the available memory (a
 cap for shared machines and for tests).
@@ -25,22 +28,18 @@ from typing import Any
 
 from robobore.errors import ConfigError
 
-#: 2D explicit FE (robobore.cutting.fe): bytes per quadrilateral element at the peak, counting
-#: its nodes (about one node per element: coordinates, velocities, accelerations, forces,
-#: masses, temperatures), the element state (stresses, strains, plastic strain, damage,
-#: temperature, hourglass forces, Gauss-point state of the B-bar element), contact arrays
-#: and the copies taken for the output frames.
+#: 2D explicit FE (robobore.cutting.fe): bytes per quadrilateral element at the peak. The
+#: arrays of a set-up run (mesh, node and element state, contact) measure 770-1050 bytes per
+#: element on the bundled fe_orthogonal*.toml examples; the rest is the history and the
+#: copies taken for the output.
 FE2D_BYTES_PER_ELEMENT = 1500
 #: 3D explicit FE (robobore.cutting.fe.boring3d): bytes per hexahedral element at the peak
-#: (as for 2D, with 3 components, 6 stress components and 8-node connectivity).
-FE3D_BYTES_PER_ELEMENT = 3000
+#: (a set-up run of examples/fe_boring_paper.toml measures 830 bytes per element).
+FE3D_BYTES_PER_ELEMENT = 1500
 #: time-domain boring (robobore.dynamics.timedomain): float64 values held per time step:
 #: force, displacement and acceleration (3 each) and the chip area per insert, times three
 #: for the Dataset built from them and the derived series (time, angle, surface).
 TIMEDOMAIN_VALUES_PER_STEP = 9
-#: sweep plans (robobore.study.sweep): bytes per planned condition (the condition and
-#: context dicts, the key), measured order of magnitude for the bundled configs.
-SWEEP_BYTES_PER_CONDITION = 4000
 
 
 def available_memory_bytes() -> int:
