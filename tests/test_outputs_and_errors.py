@@ -194,6 +194,24 @@ def test_atomic_path_failure_leaves_the_old_file(tmp_path):
     assert sorted(q.name for q in tmp_path.iterdir()) == ["keep.txt"]
 
 
+def test_atomic_path_with_a_suffix_for_writers_that_choose_by_extension(tmp_path,
+                                                                          monkeypatch):
+    """meshio (the FE VTU output) picks the format from the name: the temporary name keeps
+    the extension, and the file is synced and renamed."""
+    import meshio
+
+    from robobore.io.results import atomic_path
+
+    kinds = _record_fsyncs(monkeypatch)
+    m = meshio.Mesh(np.zeros((4, 3)), [("quad", np.array([[0, 1, 2, 3]]))])
+    with atomic_path(tmp_path / "m.vtu", suffix=".vtu") as tmp:
+        assert tmp.name.endswith(".vtu") and tmp.parent == tmp_path
+        m.write(tmp)
+    assert meshio.read(tmp_path / "m.vtu").points.shape == (4, 3)
+    assert kinds == ["file", "dir"]
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["m.vtu"]
+
+
 def test_uff_writer_is_atomic_and_durable(tmp_path, monkeypatch):
     from robobore.modal.example import make_example
 

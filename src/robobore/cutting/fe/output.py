@@ -215,11 +215,12 @@ def write_vtk(res: FEResult, path: str | Path) -> Path:
     cd = {k: [f[k][live]] for k in ("eps_p", "temperature_K", "damage", "von_mises_Pa",
                                      "pressure_Pa")}
     mesh = meshio.Mesh(pts, cells, cell_data=cd)
+    from robobore.io.results import atomic_path
+
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    tmp = p.with_suffix(".tmp.vtu")
-    mesh.write(tmp)
-    tmp.replace(p)
+    with atomic_path(p, suffix=".vtu") as tmp:  # atomic and durable
+        mesh.write(tmp)
     return p
 
 
@@ -255,12 +256,12 @@ def plot_chip(res: FEResult, path: str | Path, field_name: str = "temperature_K"
     ax.set_title(f"Fc = {s['cutting_force_N_per_mm']:.1f} N/mm, "
                  f"Ff = {s['feed_force_N_per_mm']:.1f} N/mm, chip ratio = "
                  f"{s['chip_ratio']:.2f}")
+    from robobore.io.results import save_figure
+
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    tmp = p.with_name(p.stem + ".tmp.png")
-    fig.savefig(tmp)
+    save_figure(fig, p)  # atomic and durable
     plt.close(fig)
-    tmp.replace(p)
     return p
 
 
