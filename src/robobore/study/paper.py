@@ -263,6 +263,9 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
             raise ConfigError("not a coefficients file (no 'coefficients' table)", file=str(p),
                               field="coefficients",
                               expected="a JSON object written by 'robobore calibrate forces'")
+        from robobore.cutting.forces import CuttingCoefficients
+
+        CuttingCoefficients.from_dict(data["coefficients"], source=str(p))  # checked up front
         data["file"] = str(p)
         data["mode"] = "stored (--fast)"
         return data
@@ -551,6 +554,8 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     cfg, raw, cfg_path = load_paper_config(config)
     outdir = Path(out)
     outdir.mkdir(parents=True, exist_ok=True)
+    if cfg.measured.file is not None:  # a bad measured file stops the study before it runs
+        read_measured_csv(_resolve(cfg_path, cfg.measured.file))
     nw = workers if workers is not None else 2
     timings: dict[str, float] = {}
 
