@@ -7,10 +7,15 @@ for a chatter frequency ``w`` with an eigenvalue ``lambda`` of ``G(iw) A0`` and
 ``n_k = 60 w / (N (eps + 2 pi k))``, ``eps = pi + 2 arg(lambda) (mod 2 pi)``,
 ``k = 0, 1, ...``. The lowest point of the stability envelope over ``[n_min, n_max]`` is
 therefore the smallest ``b(w)`` over the frequencies ``w`` for which some lobe number ``k``
-puts ``n_k`` inside the range: a check per grid frequency, no speed grid and no branch
-tracking. ``G(iw) = sum_j u_j u_j^T / (w_j^2 - w^2 + 2 i zeta_j w_j w)`` is built from the
-modal vectors, ``G A0 = sum_j h_j u_j (A0^T u_j)^T``, and its three eigenvalues are the roots
-of the characteristic cubic (Cardano, polished by two Newton steps).
+puts ``n_k`` inside the range: a check per grid frequency, no speed grid. Where the
+lowest point lies at an end of the range (high speeds, few lobes), it is found as in the
+stability module's envelope: the three eigenvalue branches are followed from one grid point
+to the next (nearest-neighbour pairing) and each lobe crossing ``n_min`` or ``n_max`` between
+two points is interpolated linearly.
+
+``G(iw) = sum_j u_j u_j^T / (w_j^2 - w^2 + 2 i zeta_j w_j w)`` is built from the modal
+vectors, ``G A0 = sum_j h_j u_j (A0^T u_j)^T``, and its three eigenvalues are the roots of
+the characteristic cubic (Cardano, polished by two Newton steps).
 
 Grid per structure: ``n_global`` log-spaced points over 0.2 to 5 times the mode range and
 ``n_local`` points over ``w_j (1 +- 10 zeta_j)`` around each mode. Checked against
@@ -61,8 +66,9 @@ def _cubic_roots(a, b, c, out):  # pragma: no cover - numba
 
 @njit(cache=True, parallel=True)
 def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, out_b, out_f,
-                     out_n, roots):  # pragma: no cover - numba
-    """f_hz, zeta (n, m); u, v (n, m, 3); out_b/out_f/out_n (n,); scratch roots (n, 3)."""
+                     out_n, roots, perms):  # pragma: no cover - numba
+    """f_hz, zeta (n, m); u, v (n, m, 3); out_b/out_f/out_n (n,); scratch roots (n, 3, 3)
+    (current, previous, reordered); perms (6, 3) the permutations of 3."""
     n = f_hz.shape[0]
     m = f_hz.shape[1]
     two_pi = 2.0 * math.pi
@@ -77,6 +83,7 @@ def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, o
         best = np.inf
         bw = np.nan
         bn = np.nan
+        wprev = 0.0
         npts = n_global + m * n_local
         for i in range(npts):
             if i < n_global:
@@ -87,7 +94,7 @@ def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, o
                 x = -10.0 + 20.0 * il / (n_local - 1.0)
                 w = two_pi * f_hz[k, jm] * (1.0 + max(zeta[k, jm], 1e-4) * x)
                 if w <= 0.0:
-                    continue
+                    w = 1e-9
             # M = sum_j h_j u_j v_j^T
             M00 = 0j
             M01 = 0j
@@ -117,25 +124,70 @@ def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, o
             mi = M00 * M11 - M01 * M10 + M00 * M22 - M02 * M20 + M11 * M22 - M12 * M21
             de = (M00 * (M11 * M22 - M12 * M21) - M01 * (M10 * M22 - M12 * M20)
                   + M02 * (M10 * M21 - M11 * M20))
-            _cubic_roots(-tr, mi, -de, roots[k])
+            _cubic_roots(-tr, mi, -de, roots[k, 0])
+            # follow the three eigenvalue branches from the previous grid point of the same
+            # (sorted) block: nearest-neighbour pairing over the 6 permutations
+            first = i == 0 or (i >= n_global and (i - n_global) % n_local == 0)
+            if not first:
+                bestc = np.inf
+                bp = 0
+                for pi in range(6):
+                    c = 0.0
+                    for r in range(3):
+                        c += abs(roots[k, 0, perms[pi, r]] - roots[k, 1, r])
+                    if c < bestc:
+                        bestc = c
+                        bp = pi
+                for r in range(3):
+                    roots[k, 2, r] = roots[k, 0, perms[bp, r]]
+                for r in range(3):
+                    roots[k, 0, r] = roots[k, 2, r]
             lo = 60.0 * w / (n_ins * n_max)
             hi = 60.0 * w / (n_ins * n_min)
             for r in range(3):
-                lam = roots[k, r]
+                lam = roots[k, 0, r]
                 if not lam.real < 0.0:
                     continue
                 b = -1.0 / (2.0 * lam.real)
-                if b >= best:
-                    continue
                 eps = (math.pi + 2.0 * math.atan2(lam.imag, lam.real)) % two_pi
-                kk = math.ceil((lo - eps) / two_pi)
-                if kk < 0:
-                    kk = 0
-                ph = eps + two_pi * kk
-                if ph <= hi and ph > 0.0:
-                    best = b
-                    bw = w
-                    bn = 60.0 * w / (n_ins * ph)
+                if b < best:
+                    kk = math.ceil((lo - eps) / two_pi)
+                    if kk < 0:
+                        kk = 0
+                    ph = eps + two_pi * kk
+                    if ph <= hi and ph > 0.0:
+                        best = b
+                        bw = w
+                        bn = 60.0 * w / (n_ins * ph)
+                # range ends: a lobe crossing n_min or n_max between this and the previous
+                # point of the branch (linear interpolation, as the stability module does)
+                lp = roots[k, 1, r]
+                if first or not lp.real < 0.0:
+                    continue
+                b0 = -1.0 / (2.0 * lp.real)
+                e0 = (math.pi + 2.0 * math.atan2(lp.imag, lp.real)) % two_pi
+                if abs(eps - e0) > math.pi or min(b0, b) >= best:
+                    continue
+                for side in range(2):
+                    nb = n_min if side == 0 else n_max
+                    tau = 60.0 / (n_ins * nb)
+                    p0 = (wprev * tau - e0) / two_pi
+                    p1 = (w * tau - eps) / two_pi
+                    jlo = math.ceil(min(p0, p1))
+                    if jlo < 0:
+                        jlo = 0
+                    j = jlo
+                    while j <= max(p0, p1):
+                        t = (j - p0) / (p1 - p0) if p1 != p0 else 0.0
+                        bb = b0 + t * (b - b0)
+                        if bb < best:
+                            best = bb
+                            bw = wprev + t * (w - wprev)
+                            bn = nb
+                        j += 1
+            for r in range(3):
+                roots[k, 1, r] = roots[k, 0, r]
+            wprev = w
         out_b[k] = best
         out_f[k] = bw / two_pi
         out_n[k] = bn
@@ -162,10 +214,11 @@ def critical_depth_range(frequency_Hz: np.ndarray, damping_ratio: np.ndarray, u:
     v = np.ascontiguousarray(np.einsum("ba,nmb->nma", np.asarray(A0, float), uu))
     n = f.shape[0]
     ob, of, on = np.empty(n), np.empty(n), np.empty(n)
-    roots = np.empty((n, 3), dtype=np.complex128)
+    roots = np.zeros((n, 3, 3), dtype=np.complex128)
+    perms = np.array([[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]])
     kern = _critical_kernel if n >= 16 else _critical_kernel_serial
     kern(f, z, uu, v, float(speed_min_rpm), float(speed_max_rpm), float(n_inserts),
-         int(n_global), int(n_local), ob, of, on, roots)
+         int(n_global), int(n_local), ob, of, on, roots, perms)
     return ob, of, on
 
 

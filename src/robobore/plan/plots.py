@@ -105,7 +105,8 @@ def plot_posture_plan(result: dict[str, Any], out_dir: str | Path,
         paths.append(p)
     if workspace is not None:
         fig, ax = plt.subplots(figsize=(6, 5))
-        B = np.asarray(workspace["best_criterion"], float) * _scale(result["criterion"])
+        B = np.array([[np.nan if v is None else v for v in row]
+                      for row in workspace["best_criterion"]], float) * _scale(result["criterion"])
         dx, dy = np.asarray(workspace["dx_m"]), np.asarray(workspace["dy_m"])
         im = ax.pcolormesh(dx, dy, np.ma.masked_invalid(B), shading="nearest")
         fig.colorbar(im, ax=ax, label="best " + CRITERION_LABEL[result["criterion"]])

@@ -554,7 +554,10 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
             continue
         st = model.modes(cand.q_rad[idx]).structure(0)
         L = lobes_frequency_domain(st, process, speeds)
-        lobes[name] = {"speed_rpm": speeds, "critical_depth_mm": L.critical_depth_m * 1e3}
+        lobes[name] = {"speed_rpm": speeds.tolist(),
+                       "critical_depth_mm": (L.critical_depth_m * 1e3).tolist(),
+                       "critical_depth_at_speed_mm": float(np.interp(
+                           cfg.cutting.speed_rpm, speeds, L.critical_depth_m * 1e3))}
     wall = time.perf_counter() - t0
     result = {
         "config": f,
@@ -676,8 +679,10 @@ def workspace_map(result: dict[str, Any], progress: Any = None) -> dict[str, Any
                 best[iy, ix] = float(np.max(c))
             if progress is not None:
                 progress(1)
-    return {"dx_m": list(ws.dx_m), "dy_m": list(ws.dy_m), "best_criterion": best,
-            "rotation_step_deg": ws.rotation_step_deg}
+    return {"dx_m": list(ws.dx_m), "dy_m": list(ws.dy_m),
+            "best_criterion": [[None if not np.isfinite(v) else float(v) for v in row]
+                               for row in best],
+            "criterion": inp.cfg.plan.criterion, "rotation_step_deg": ws.rotation_step_deg}
 
 
 __all__ = ["PlanConfig", "PlanInputs", "load_plan_config", "plan_posture", "run_plan",
