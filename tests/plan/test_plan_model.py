@@ -94,7 +94,9 @@ def test_mass_matrix_symmetric_positive_and_batched(rb):
 
 def test_calibration_recovers_a_known_model(rb):
     """Modes of the model with known link scales and joint dampers: the calibration matches
-    them (residual ~0) and the damping ratios exactly."""
+    the frequencies (residual ~0) and the damping ratios (the weak pull towards common
+    stiffness-proportional damping costs < 0.5 %); joint 6, which these modes do not move at
+    this posture (tool point on its axis), keeps a damper."""
     truth = PoseModel(rb, K6, np.array([3000, 3000, 800, 150, 80, 30.0]), tool=TOOL,
                       link_scale=np.array([1.2, 0.8, 1.1, 0.9, 1.0, 1.0]))
     md = truth.modes(PAPER_Q)
@@ -103,7 +105,8 @@ def test_calibration_recovers_a_known_model(rb):
     assert np.abs(cal.frequency_error_percent).max() < 1.0
     assert np.abs(cal.frequency_error_percent).max() < np.abs(
         100 * (cal.uncalibrated_frequency_Hz / f - 1)).max()
-    assert np.allclose(cal.model_damping_ratio, z, rtol=1e-6)
+    assert np.allclose(cal.model_damping_ratio, z, rtol=5e-3)
+    assert cal.model.c_Nms_per_rad[5] > 0
 
 
 def test_equivalent_model_per_direction(rb):

@@ -30,8 +30,10 @@ mass and inertia (bounded to [0.25, 4]) fitted by least squares on the log-frequ
 identified modes (identified mode j <-> the j-th of a subset of the model's modes, order kept;
 every subset is tried and the best fit kept, since the test may miss a mode), with a weak pull
 towards 1 (weight 0.05 per factor) so that the problem stays well posed with fewer modes than
-links; then the joint dampers ``c_i >= 0`` by non-negative least squares on
-``2 zeta_j w_j = sum_i c_i phi_ij^2``. The fitted factors and the residuals are reported.
+links; then the joint dampers ``c_i >= 0`` from ``2 zeta_j w_j = sum_i c_i phi_ij^2`` by
+bounded least squares, pulled towards a common stiffness-proportional damping
+(:func:`fit_joint_damping`) so that joints the measured modes do not move stay damped.
+The fitted factors and the residuals are reported.
 """
 
 from __future__ import annotations
@@ -389,15 +391,44 @@ class Calibration:
                 self.frequency_error_percent ** 2))),
             "identified_damping_ratio": self.identified_damping_ratio.tolist(),
             "model_damping_ratio": self.model_damping_ratio.tolist(),
+            "damping_residual_percent": (100 * (self.model_damping_ratio
+                                                / self.identified_damping_ratio - 1)).tolist(),
         }
+
+
+def fit_joint_damping(phi: np.ndarray, w: np.ndarray, zeta: np.ndarray, k: np.ndarray,
+                      regularisation: float = 0.01) -> np.ndarray:
+    """Joint dampers ``c_i >= 0`` [N m s/rad] from modal damping ratios (see module docstring).
+
+    ``phi`` (nj, m) mass-normalised shapes of the matched modes, ``w`` (m,) rad/s, ``zeta``
+    (m,). Written as ``c_i = r_i beta k_i`` with ``beta`` the common stiffness-proportional
+    coefficient that fits the modes best in the least-squares sense; ``r_i >= 0`` solve the
+    relative equations ``sum_i phi_ij^2 r_i beta k_i / (2 zeta_j w_j) = 1`` with a pull
+    ``regularisation (r_i - 1) = 0``. A joint that no identified mode moves keeps the common
+    coefficient (``r_i = 1``) instead of an arbitrary value, so that modes it dominates at
+    other postures stay damped.
+    """
+    from scipy.optimize import lsq_linear
+
+    y = 2 * zeta * w
+    G = (phi ** 2).T * k[None, :]  # (m, nj): 2 zeta w = G beta_i
+    if not np.any(y > 0):
+        return np.zeros(k.size)
+    gs = G.sum(axis=1)
+    beta = float(np.sum(gs * y) / np.sum(gs * gs))
+    A = np.vstack([G * beta / y[:, None], regularisation * np.eye(k.size)])
+    b = np.concatenate([np.ones(y.size), regularisation * np.ones(k.size)])
+    r = lsq_linear(A, b, bounds=(0.0, np.inf)).x
+    return r * beta * k
 
 
 def calibrate(model: PoseModel, q_meas_rad: Any, frequency_Hz: Any, damping_ratio: Any, *,
               scale_bounds: tuple[float, float] = (0.25, 4.0),
-              regularisation: float = 0.05) -> Calibration:
+              regularisation: float = 0.05,
+              damping_regularisation: float = 0.01) -> Calibration:
     """Fit link scale factors and joint dampers so the modes at ``q_meas`` match (see module
     docstring). ``frequency_Hz``/``damping_ratio``: the identified modes (any order)."""
-    from scipy.optimize import least_squares, nnls
+    from scipy.optimize import least_squares
 
     f_id = np.asarray(frequency_Hz, float)
     z_id = np.asarray(damping_ratio, float)
@@ -433,8 +464,8 @@ def calibrate(model: PoseModel, q_meas_rad: Any, frequency_Hz: Any, damping_rati
     pm = m1.modes(q)
     sel = list(pick)
     w = 2 * np.pi * pm.frequency_Hz[0, sel]
-    G = (pm.phi[0][:, sel] ** 2).T  # (nm, nj)
-    c, _ = nnls(G, 2 * z_id * w)
+    c = fit_joint_damping(pm.phi[0][:, sel], w, z_id, model.k_Nm_per_rad,
+                          damping_regularisation)
     m2 = replace(m1, c_Nms_per_rad=c)
     pm2 = m2.modes(q)
     return Calibration(m2, nm, f_id, pm2.frequency_Hz[0, sel], z_id,
