@@ -233,3 +233,23 @@ def test_missing_identification_file(ident, tmp_path):
     (tmp_path / "id" / "modes.json").unlink()
     msg = _err(cfg)
     assert "identification.modes" in msg and "modes.json" in msg and math.isfinite(1.0)
+
+
+def test_part_frame_placement_gives_the_same_bore(ident, tmp_path, paper_result):
+    """[bore] in a part frame placed by [part] origin_m / yaw_deg: the same bore in the base
+    frame gives the same candidates."""
+    p = np.asarray(paper_result["bore"]["point_m"])
+    a = np.asarray(paper_result["bore"]["axis"])
+    yaw = math.radians(30.0)
+    Rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0],
+                   [0, 0, 1.0]])
+    origin = np.array([0.5, -0.2, 0.1])
+    cfg = write_config(tmp_path, ident, point_m=f"point_m = {(Rz.T @ (p - origin)).tolist()}",
+                       axis=f"axis = {(Rz.T @ a).tolist()}",
+                       rotation_step_deg="rotation_step_deg = 10.0")
+    cfg.write_text(cfg.read_text() + f"\n[part]\norigin_m = {origin.tolist()}\nyaw_deg = 30.0\n")
+    r = plan_posture(cfg)
+    assert np.allclose(r["bore"]["point_m"], p, atol=1e-12)
+    assert r["measured"] is not None
+    assert r["recommended"]["critical_depth_mm"] == pytest.approx(
+        paper_result["recommended"]["critical_depth_mm"], rel=1e-9)

@@ -91,7 +91,10 @@ def posture_cmd(
             crit = np.array([min(c["directional_stiffness_N_per_m"].values()) if key is None
                              else c["directional_stiffness_N_per_m"][key]
                              for c in r["candidates"]])
-        for i in np.argsort(-crit, kind="stable")[:top]:
+        rec_key = (rec["tool_axis_rotation_deg"], rec["branch"])
+        first = np.array([(c["tool_axis_rotation_deg"], c["branch"]) == rec_key
+                          for c in r["candidates"]])
+        for i in np.lexsort((~first, -crit))[:top]:
             c = r["candidates"][int(i)]
             k = c["directional_stiffness_N_per_m"]
             t.add_row(f"{c['tool_axis_rotation_deg']:.1f}", str(c["branch"]),
