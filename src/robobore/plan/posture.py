@@ -558,6 +558,10 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
                        "critical_depth_mm": (L.critical_depth_m * 1e3).tolist(),
                        "critical_depth_at_speed_mm": float(np.interp(
                            cfg.cutting.speed_rpm, speeds, L.critical_depth_m * 1e3))}
+    equivalent = {}
+    for name, idx in (("recommended", best), ("measured", meas_idx)):
+        if idx is not None:
+            equivalent[name] = model.equivalent(cand.q_rad[idx]).table()
     wall = time.perf_counter() - t0
     result = {
         "config": f,
@@ -584,6 +588,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "cutting": cfg.cutting.model_dump(),
         "candidates": entries,
         "lobes": lobes,
+        "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
         "wall_time_s": wall,
     }
