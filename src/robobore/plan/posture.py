@@ -286,14 +286,13 @@ def load_plan_config(path: str | Path) -> PlanInputs:
 
 # ----------------------------------------------------------------------------- candidates
 def boring_frame(axis: np.ndarray) -> np.ndarray:
-    """Columns X (horizontal, vertical x Z), Y = Z x X, Z = the bore axis."""
+    """Columns X (horizontal, vertical x Z), Y = Z x X, Z = the bore axis (a non-vertical unit
+    vector); the robot stage's ``"boring"`` frame of a tool whose z axis is the bore axis."""
     from robobore.robot.stiffness import process_frame
 
-    R = np.eye(3)
     z = np.asarray(axis, float) / np.linalg.norm(axis)
-    x0 = np.cross([0.0, 0.0, 1.0], z)
-    x0 /= np.linalg.norm(x0)
-    R = np.column_stack([x0, np.cross(z, x0), z])
+    R = np.zeros((3, 3))
+    R[:, 2] = z
     return process_frame(R, "boring")
 
 
