@@ -37,6 +37,7 @@ groups: dict[str, typer.Typer] = {
     "simulate": _group("Time-domain process simulation."),
     "fe": _group("Explicit finite-element cutting simulation."),
     "calibrate": _group("Calibrate models from simulations."),
+    "plan": _group("Plan the robot's posture for a bore (stiffness, modes, chatter)."),
 }
 
 #: Modules that contribute commands; each has ``register(groups)``.
@@ -46,6 +47,7 @@ STAGE_CLIS = [
     "robobore.dynamics.cli",
     "robobore.cutting.fe.cli",
     "robobore.study.cli",
+    "robobore.plan.cli",
 ]
 
 

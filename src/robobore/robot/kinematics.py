@@ -38,6 +38,25 @@ LIBRARY_ENV = "ROBOBORE_ROBOT_PATH"
 
 
 @dataclass(frozen=True)
+class LinkInertia:
+    """Rigid-body data of one link, in its D-H frame i (the frame that moves with joint i).
+
+    ``mass_kg``; ``com_m`` (3,) centre of mass in frame i, m; ``inertia_kg_m2`` (6,) the
+    inertia tensor about the centre of mass in frame i as (Ixx, Iyy, Izz, Ixy, Ixz, Iyz),
+    kg m^2. Used by the pose-dependent dynamic model (:mod:`robobore.plan.model`).
+    """
+
+    mass_kg: float
+    com_m: tuple[float, float, float]
+    inertia_kg_m2: tuple[float, float, float, float, float, float]
+
+    def tensor(self) -> np.ndarray:
+        """The 3x3 inertia tensor about the centre of mass (frame i), kg m^2."""
+        xx, yy, zz, xy, xz, yz = self.inertia_kg_m2
+        return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float)
+
+
+@dataclass(frozen=True)
 class Robot:
     """A serial robot with revolute joints, as standard D-H data.
 
@@ -62,6 +81,11 @@ class Robot:
     base_transform: tuple[float, ...] = field(
         default=(1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0)
     )
+    #: inertial data per link (empty: the robot file has none); see :class:`LinkInertia`
+    links: tuple[LinkInertia, ...] = ()
+    inertia_source: str = ""
+    #: the file the robot was read from ("" when built in code)
+    file: str = ""
 
     def __post_init__(self) -> None:
         n = len(self.d_m)
@@ -86,6 +110,10 @@ class Robot:
         if len(self.base_transform) != 16:
             raise ConfigError("base_transform must have 16 values (4x4 row-major)",
                               field="base_transform")
+        if self.links and len(self.links) != n:
+            raise ConfigError(f"robot '{self.name}' has {len(self.links)} [[links]] entries",
+                              field="links", value=len(self.links),
+                              expected=f"{n} entries (one per joint) or none")
 
     @property
     def n_joints(self) -> int:
@@ -145,10 +173,37 @@ class Robot:
             description=m.description,
             source=m.source,
             base_transform=tuple(m.base_transform),
+            links=tuple(LinkInertia(li.mass_kg, tuple(li.com_m), tuple(li.inertia_kg_m2))
+                        for li in m.links),
+            inertia_source=m.inertia_source,
         )
 
 
 # --- robot files ----------------------------------------------------------------------------
+
+class _LinkFile(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    mass_kg: float = Field(gt=0, le=1e5)
+    com_m: list[float] = Field(min_length=3, max_length=3)
+    inertia_kg_m2: list[float] = Field(min_length=6, max_length=6)
+
+    @field_validator("com_m", "inertia_kg_m2")
+    @classmethod
+    def _finite(cls, v: list[float]) -> list[float]:
+        if not all(math.isfinite(x) for x in v):
+            raise ValueError("all values must be finite numbers")
+        return v
+
+    @field_validator("inertia_kg_m2")
+    @classmethod
+    def _psd(cls, v: list[float]) -> list[float]:
+        xx, yy, zz, xy, xz, yz = v
+        ev = np.linalg.eigvalsh(np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+        if ev.min() < -1e-9 * max(ev.max(), 1e-30):
+            raise ValueError("inertia tensor (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) in kg m^2 must be "
+                             "positive semi-definite")
+        return v
+
 
 class _RobotFile(BaseModel):
     model_config = ConfigDict(extra="forbid")
@@ -166,6 +221,8 @@ class _RobotFile(BaseModel):
         min_length=16,
         max_length=16,
     )
+    inertia_source: str = ""
+    links: list[_LinkFile] = Field(default_factory=list)
 
     @field_validator("d_m", "a_m", "alpha_deg", "theta_offset_deg", "lower_limit_deg",
                      "upper_limit_deg", "base_transform")
@@ -194,9 +251,12 @@ def available_robots() -> dict[str, Path]:
 
 def load_robot_file(path: str | Path) -> Robot:
     """Read a robot TOML file (see ``library/irb6600-175-2.55.toml`` for the layout)."""
+    import dataclasses
+
     from robobore.io.config import load_toml
 
-    return Robot.from_dict(load_toml(path), source=str(path))
+    r = Robot.from_dict(load_toml(path), source=str(path))
+    return dataclasses.replace(r, file=str(path))
 
 
 def get_robot(name: str | Path | Robot) -> Robot:
@@ -496,6 +556,7 @@ def rotation_vector(R: np.ndarray) -> np.ndarray:
 
 __all__ = [
     "Robot",
+    "LinkInertia",
     "available_robots",
     "get_robot",
     "load_robot_file",

@@ -623,6 +623,9 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         write_netcdf(ds, outdir / "results.nc", config=raw)
         eq_json = {k: (v.to_dict() if hasattr(v, "to_dict") else v) for k, v in eq.items()}
         write_json(outdir / "equivalent_model.json", eq_json)
+        from robobore.plan.paper import paper_posture_plan
+
+        summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs)
         done = [r for r in rows if r["summary"]]
         n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
         n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
@@ -647,6 +650,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
                                                     "agreement": cmp.agreement},
             "qualitative_checks": checks,
             "robobore_version": __version__,
+            "posture_plan": summary_posture,
         }
         rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
                            rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,

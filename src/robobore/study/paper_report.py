@@ -428,6 +428,11 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
         plt.close(fig)
         rep.add_table(cmp.table_rows(), caption="Per condition and quantity", max_rows=400)
 
+    if summary.get("posture_plan") is not None:  # robobore plan: the paper's bore
+        from robobore.plan.paper import add_posture_section
+
+        add_posture_section(rep, summary["posture_plan"])
+
     # ---------------------------------------------------------------- checks
     rep.add_section("Paper's findings")
     rep.add_text("Each qualitative finding of the paper is checked on our results (computed "

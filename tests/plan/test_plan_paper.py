@@ -1,0 +1,54 @@
+"""The posture-map section of the paper report (robobore.plan.paper), built from the paper
+study's own identification at test time."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from robobore.plan.paper import add_posture_section, paper_posture_plan
+from robobore.study.paper import identify_modes, identify_stiffness, load_paper_config
+from robobore.study.report import Report
+
+
+@pytest.fixture(scope="module")
+def plan():
+    cfg, raw, path = load_paper_config(None)
+    stiff = identify_stiffness(cfg, path)
+    modes = identify_modes(cfg, path)
+    coeffs = json.loads((path.parent / cfg.coefficients.file).read_text())
+    return paper_posture_plan(cfg, path, stiff, modes, coeffs)
+
+
+def test_paper_posture_plan(plan):
+    assert "error" not in plan, plan.get("error")
+    json.dumps(plan)  # goes into paper_summary.json
+    assert plan["measured"] is not None  # the paper's posture is a candidate
+    assert np.allclose(plan["measured"]["joints_deg"],
+                       [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95], atol=1e-6)
+    crit = np.asarray(plan["map"]["criterion"])
+    assert plan["recommended"]["criterion_value"] >= crit.max() * (1 - 1e-6)
+    assert plan["synthetic_inputs"] is True
+    ws = np.array([[np.nan if v is None else v for v in row]
+                   for row in plan["workspace"]["best_criterion"]], float)
+    assert ws.shape == (5, 5) and np.isfinite(ws[2, 2])
+    # the map's best at the paper's placement is the recommended value (10 deg grid: <=)
+    assert ws[2, 2] <= plan["recommended"]["criterion_value"] * (1 + 1e-6)
+
+
+def test_posture_section_renders(plan, tmp_path):
+    rep = Report("t")
+    add_posture_section(rep, plan)
+    p = tmp_path / "r.html"
+    rep.write(p)
+    html = p.read_text()
+    assert "Posture map for the paper" in html and "paper&#x27;s posture" in html.replace(
+        "&#39;", "&#x27;") and "<img" in html
+
+
+def test_posture_section_reports_an_error():
+    rep = Report("t")
+    add_posture_section(rep, {"error": "robot 'x' has no inertial data"})
+    assert any("no inertial data" in part for part in rep._parts)

@@ -1,0 +1,255 @@
+"""robobore plan posture: the paper's bore (acceptance), the JSON contract, outputs, and the
+errors for bad input. Identification inputs are computed from the bundled (SYNTHETIC) data at
+test time, so the tests do not depend on their exact numbers."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from robobore.cli import app
+from robobore.errors import ConfigError, DataError, InputError
+from robobore.plan.posture import plan_posture, public
+from robobore.robot.kinematics import fk, get_robot
+
+runner = CliRunner()
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "plan_paper_bore.toml"
+COEFFS = Path(__file__).resolve().parents[2] / "src" / "robobore" / "data" / "paper_example" / \
+    "tc4_fe_coefficients.json"
+PAPER_Q_DEG = [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95]
+
+
+@pytest.fixture(scope="module")
+def ident(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ident")
+    for what, name in (("stiffness", "joint_stiffness.json"), ("modes", "modes.json")):
+        r = runner.invoke(app, ["identify", what, "--example", "--json"])
+        assert r.exit_code == 0, r.output
+        (d / name).write_text(r.stdout)
+    return d
+
+
+def write_config(folder: Path, ident: Path, **edits: str) -> Path:
+    """The example config with the identification files of ``ident`` copied next to it and
+    ``edits`` (key line prefix -> replacement line) applied."""
+    folder.mkdir(parents=True, exist_ok=True)
+    sub = folder / "id"
+    sub.mkdir(exist_ok=True)
+    for f in ident.iterdir():
+        shutil.copy(f, sub / f.name)
+    text = EXAMPLE.read_text()
+    text = text.replace("plan_paper_bore/joint_stiffness.json", "id/joint_stiffness.json")
+    text = text.replace("plan_paper_bore/modes.json", "id/modes.json")
+    text = text.replace('"../src/robobore/data/paper_example/tc4_fe_coefficients.json"',
+                        json.dumps(str(COEFFS)))
+    text = re.sub(r"\[workspace\].*", "", text, flags=re.S)
+    for key, line in edits.items():
+        text, n = re.subn(rf"(?m)^{re.escape(key)} =.*$", line, text)
+        assert n == 1, key
+    p = folder / "plan.toml"
+    p.write_text(text)
+    return p
+
+
+@pytest.fixture(scope="module")
+def paper_result(ident, tmp_path_factory):
+    cfg = write_config(tmp_path_factory.mktemp("paper"), ident)
+    return plan_posture(cfg)
+
+
+def test_paper_bore_every_candidate_reaches_within_limits(paper_result):
+    r = paper_result
+    rb = get_robot("irb6600-175-2.55")
+    point, axis = np.asarray(r["bore"]["point_m"]), np.asarray(r["bore"]["axis"])
+    Q = np.radians([c["joints_deg"] for c in r["candidates"]])
+    assert Q.shape[0] == r["counts"]["candidates"] > 0
+    T = fk(rb, Q, r["tcp_m"])
+    assert np.linalg.norm(T[:, :3, 3] - point, axis=1).max() <= 1e-4
+    ang = np.degrees(np.arccos(np.clip(T[:, :3, 2] @ axis, -1, 1)))
+    assert ang.max() <= 0.05
+    lo, hi = np.array(rb.lower_limit_rad), np.array(rb.upper_limit_rad)
+    assert np.all((Q >= lo - 1e-9) & (Q <= hi + 1e-9))
+    assert all(c["singularity_measure"] >= 0.02 for c in r["candidates"])
+    # 360 rotations x 8 branches tried
+    assert r["counts"]["rotations"] == 360 and r["counts"]["ik_solutions_tried"] == 2880
+
+
+def test_paper_bore_recommended_is_best_and_paper_posture_is_a_candidate(paper_result):
+    r = paper_result
+    crit = np.array([c["critical_depth_mm"] for c in r["candidates"]], float)
+    assert r["criterion"] == "critical_depth"
+    assert r["recommended"]["critical_depth_mm"] >= crit.max() * (1 - 1e-6)
+    assert r["measured"] is not None
+    assert np.allclose(r["measured"]["joints_deg"], PAPER_Q_DEG, atol=1e-6)
+    assert r["measured_posture_reaches_bore"]
+
+
+def test_json_contract(paper_result):
+    r = public(paper_result)
+    json.dumps(r)  # serialisable as is
+    assert {"recommended", "candidates", "criterion", "wall_time_s"} <= set(r)
+    for c in [r["recommended"], *r["candidates"][:5]]:
+        assert len(c["joints_deg"]) == 6
+        assert isinstance(c["tool_axis_rotation_deg"], float)
+        assert isinstance(c["branch"], int)
+        assert set(c["directional_stiffness_N_per_m"]) == {"x", "y", "z"}
+        assert all({"frequency_Hz", "damping_ratio"} <= set(m) for m in c["modes"])
+        assert c["critical_depth_mm"] > 0
+    cal = r["calibration"]
+    assert len(cal["frequency_residual_percent"]) == cal["matched_modes"]
+
+
+def test_stiffness_criterion_recommends_the_stiffest(ident, tmp_path):
+    cfg = write_config(tmp_path, ident, criterion='criterion = "stiffness_min"',
+                       rotation_step_deg="rotation_step_deg = 10.0")
+    r = plan_posture(cfg)
+    kmin = np.array([min(c["directional_stiffness_N_per_m"].values()) for c in r["candidates"]])
+    rec = r["recommended"]
+    assert min(rec["directional_stiffness_N_per_m"].values()) >= kmin.max() * (1 - 1e-6)
+    assert r["counts"]["rotations"] == 36
+
+
+def test_offset_spindle_changes_the_map(ident, tmp_path):
+    """A tool point off the flange axis: the rotation moves the wrist centre, so stiffness
+    varies with the rotation (on the axis only joint 6 turns and the map is flat)."""
+    rb = get_robot("irb6600-175-2.55")
+    tcp = [0.2, 0.0, 0.3]
+    T = fk(rb, np.radians(PAPER_Q_DEG), tcp)
+    cfg = write_config(tmp_path, ident, tcp_m=f"tcp_m = {tcp}",
+                       point_m=f"point_m = {T[:3, 3].tolist()}",
+                       axis=f"axis = {T[:3, 2].tolist()}",
+                       rotation_step_deg="rotation_step_deg = 5.0")
+    r = plan_posture(cfg)
+    k = np.array([c["directional_stiffness_N_per_m"]["x"] for c in r["candidates"]])
+    assert k.max() / k.min() > 1.05
+    assert r["measured"] is not None
+
+
+def test_cli_writes_netcdf_json_and_plots(ident, tmp_path):
+    import xarray as xr
+
+    cfg = write_config(tmp_path / "c", ident, rotation_step_deg="rotation_step_deg = 10.0")
+    out, plots = tmp_path / "out", tmp_path / "plots"
+    r = runner.invoke(app, ["plan", "posture", str(cfg), "--json", "--out", str(out),
+                            "--plot", str(plots)])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["criterion"] == "critical_depth" and d["wall_time_s"] > 0
+    ds = xr.open_dataset(out / "posture_plan.nc")
+    assert ds.sizes["candidate"] == len(d["candidates"])
+    assert int(ds.attrs["recommended_candidate"]) >= 0
+    ds.close()
+    assert json.loads((out / "posture_plan.json").read_text())["criterion"] == "critical_depth"
+    assert (plots / "posture_map.png").stat().st_size > 0
+    # readable table by default
+    r2 = runner.invoke(app, ["plan", "posture", str(cfg)])
+    assert r2.exit_code == 0 and "posture plan" in r2.output
+
+
+# ----------------------------------------------------------------------------- bad input
+def _err(cfg: Path, exc=(ConfigError, InputError, DataError)):
+    with pytest.raises(exc) as ei:
+        plan_posture(cfg)
+    return str(ei.value)
+
+
+def test_bore_out_of_reach(ident, tmp_path):
+    cfg = write_config(tmp_path, ident, point_m="point_m = [6.0, 0.0, 0.5]")
+    msg = _err(cfg)
+    assert str(cfg) in msg and "bore.point_m" in msg and "6.0" in msg and "reach" in msg
+
+
+def test_zero_length_axis(ident, tmp_path):
+    cfg = write_config(tmp_path, ident, axis="axis = [0.0, 0.0, 0.0]")
+    msg = _err(cfg)
+    assert str(cfg) in msg and "bore.axis" in msg and "zero-length" in msg and "unit" in msg
+
+
+def test_non_unit_axis(ident, tmp_path):
+    cfg = write_config(tmp_path, ident, axis="axis = [-2.0, 0.0, 0.0]")
+    msg = _err(cfg)
+    assert str(cfg) in msg and "bore.axis" in msg and "-2.0" in msg and "unit" in msg
+
+
+def test_tcp_in_millimetres(ident, tmp_path):
+    cfg = write_config(tmp_path, ident, tcp_m="tcp_m = [0.0, 0.0, 350.0]")
+    msg = _err(cfg)
+    assert str(cfg) in msg and "tool.tcp_m" in msg and "350" in msg and "millimetres" in msg
+    assert "in m" in msg
+
+
+def test_robot_without_inertial_data(ident, tmp_path):
+    rb = get_robot("irb6600-175-2.55")
+    d = rb.to_dict()
+    d["name"] = "no-inertia"
+    lines = [f"{k} = {json.dumps(v)}" for k, v in d.items()]
+    rfile = tmp_path / "no-inertia.toml"
+    rfile.write_text("\n".join(lines) + "\n")
+    cfg = write_config(tmp_path, ident, name='name = "no-inertia.toml"')
+    msg = _err(cfg)
+    assert "no-inertia.toml" in msg and "inertial data" in msg and "mass_kg" in msg
+
+
+def test_modes_without_posture(ident, tmp_path):
+    cfg = write_config(tmp_path, ident)
+    text = re.sub(r"(?m)^posture_deg =.*$", "", cfg.read_text())
+    cfg.write_text(text)
+    msg = _err(cfg)
+    assert str(cfg) in msg and "identification.posture_deg" in msg and "modes.json" in msg
+
+
+def test_modes_file_from_another_posture(ident, tmp_path):
+    cfg = write_config(tmp_path, ident)
+    mfile = tmp_path / "id" / "modes.json"
+    d = json.loads(mfile.read_text())
+    d["posture_deg"] = [-30.0, 40.0, 10.0, -50.0, 100.0, 0.0]
+    mfile.write_text(json.dumps(d))
+    msg = _err(cfg)
+    assert str(cfg) in msg and "identification.posture_deg" in msg and "-30.0" in msg
+    # the posture recorded in the file alone is accepted (no posture in the config)
+    cfg.write_text(re.sub(r"(?m)^posture_deg =.*$", "", cfg.read_text()))
+    d["posture_deg"] = PAPER_Q_DEG
+    mfile.write_text(json.dumps(d))
+    r = runner.invoke(app, ["plan", "posture", str(cfg), "--json"])
+    assert r.exit_code == 0, r.output
+
+
+def test_cli_error_is_one_line_exit_2(ident, tmp_path):
+    cfg = write_config(tmp_path, ident, axis="axis = [0.0, 0.0, 0.0]")
+    r = runner.invoke(app, ["plan", "posture", str(cfg)])
+    assert r.exit_code == 2
+    assert "bore.axis" in r.output and "Traceback" not in r.output
+
+
+def test_missing_identification_file(ident, tmp_path):
+    cfg = write_config(tmp_path, ident)
+    (tmp_path / "id" / "modes.json").unlink()
+    msg = _err(cfg)
+    assert "identification.modes" in msg and "modes.json" in msg and math.isfinite(1.0)
+
+
+def test_part_frame_placement_gives_the_same_bore(ident, tmp_path, paper_result):
+    """[bore] in a part frame placed by [part] origin_m / yaw_deg: the same bore in the base
+    frame gives the same candidates."""
+    p = np.asarray(paper_result["bore"]["point_m"])
+    a = np.asarray(paper_result["bore"]["axis"])
+    yaw = math.radians(30.0)
+    Rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0],
+                   [0, 0, 1.0]])
+    origin = np.array([0.5, -0.2, 0.1])
+    cfg = write_config(tmp_path, ident, point_m=f"point_m = {(Rz.T @ (p - origin)).tolist()}",
+                       axis=f"axis = {(Rz.T @ a).tolist()}",
+                       rotation_step_deg="rotation_step_deg = 10.0")
+    cfg.write_text(cfg.read_text() + f"\n[part]\norigin_m = {origin.tolist()}\nyaw_deg = 30.0\n")
+    r = plan_posture(cfg)
+    assert np.allclose(r["bore"]["point_m"], p, atol=1e-12)
+    assert r["measured"] is not None
+    assert r["recommended"]["critical_depth_mm"] == pytest.approx(
+        paper_result["recommended"]["critical_depth_mm"], rel=1e-9)
