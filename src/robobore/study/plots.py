@@ -60,22 +60,34 @@ def parity_figure(cmp: Comparison) -> Any:
         ax.plot([0, hi], [0, hi], color="0.4", lw=1, label="simulated = measured")
         ax.fill_between([0, hi], [0, 0.8 * hi], [0, 1.2 * hi], color="0.9", label="±20 %")
         if pts["stable"][0]:
-            ax.scatter(*pts["stable"], s=14, c="k", label="stable", zorder=3)
-        if pts["vibratory"][0]:
-            ax.scatter(*pts["vibratory"], s=46, c="tab:red", marker="D", label="vibratory",
+            ax.scatter(*pts["stable"], s=14, c="k", label="stable (paper's criterion)",
                        zorder=3)
+        if pts["vibratory"][0]:
+            ax.scatter(*pts["vibratory"], s=46, c="tab:red", marker="D",
+                       label="vibratory (paper's criterion)", zorder=3)
         if pts["unknown"][0]:
             ax.scatter(*pts["unknown"], s=20, c="tab:blue", marker="s", label="not classified",
                        zorder=3)
         ax.set_xlim(0, hi)
         ax.set_ylim(0, hi)
-        ax.set_xlabel(f"measured {_LABEL[q]}")
-        ax.set_ylabel("simulated")
+        ax.set_xlabel(f"measured {_LABEL[q]}", fontsize=8)
+        ax.set_ylabel(f"simulated {_LABEL[q]}", fontsize=8)
         ax.set_aspect("equal")
-        ax.legend(fontsize=7, loc="upper left")
     if not qs:
         axes[0][0].text(0.5, 0.5, "no amplitude to compare", ha="center", va="center")
-    fig.tight_layout()
+    # one legend for all panels, below them: it never hides a point
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    for ax in axes[0][1:]:
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    if handles:
+        fig.legend(handles, labels, loc="lower center", ncol=min(5, len(labels)), fontsize=8,
+                   frameon=False, bbox_to_anchor=(0.5, -0.02))
+        fig.tight_layout(rect=(0, 0.08, 1, 1))
+    else:
+        fig.tight_layout()
     return fig
 
 
@@ -179,7 +191,7 @@ def trend_figure(records: list[tuple[dict[str, Any], dict[str, Any]]], x: str,
     ax.scatter([], [], s=40, c="tab:red", marker="D", label="vibratory")
     ax.set_xlabel(FACTOR_LABEL.get(x, x))
     ax.set_ylabel(_LABEL.get(quantity, quantity))
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
