@@ -24,35 +24,17 @@ from typing import Any
 
 import numpy as np
 
+from robobore.study.plots import MARKS as _ALL_MARKS
+from robobore.study.plots import verdict_class
 from robobore.study.report import Report
+
+#: Marks of the paper report (every result there carries the verdicts by cause).
+MARKS = {k: _ALL_MARKS[k] for k in ("ok", "rough", "chatter")}
 
 _SYS_STYLE = {("robot", 0.0): ("robot, no foot", "tab:blue"),
               ("machine_tool", 0.0): ("machine tool (stiff, assumed)", "tab:green")}
 _FACTORS = (("speed_rpm", "spindle speed n [r/min]"), ("feed_mm_per_rev", "feed f [mm/r]"),
             ("depth_of_cut_mm", "depth of cut ap [mm]"))
-
-
-#: Marker per verdict class (see module doc): scatter keyword arguments and legend label.
-MARKS: dict[str, tuple[dict[str, Any], str]] = {
-    "ok": (dict(s=14, c="k", marker="o"), "no chatter, Ra within tolerance"),
-    "rough": (dict(s=40, facecolors="none", edgecolors="tab:orange", marker="s",
-                   linewidths=1.4), "rough only (Ra > tol., no chatter; paper: vibratory)"),
-    "chatter": (dict(s=44, c="tab:red", marker="D"), "chatter (vibration grows)"),
-}
-
-
-def verdict_class(summary: dict[str, Any] | None) -> str | None:
-    """``"chatter"``, ``"rough"`` (paper's criterion vibratory without chatter), ``"ok"``, or
-    None when the summary has no verdict."""
-    if not summary:
-        return None
-    if summary.get("chatter") is True:
-        return "chatter"
-    if summary.get("stable") is False or summary.get("surface_finish_ok") is False:
-        return "rough"
-    if summary.get("chatter") is False or summary.get("stable") is True:
-        return "ok"
-    return None
 
 
 def _verdict_text(summary: dict[str, Any] | None) -> str:
