@@ -323,3 +323,26 @@ def test_synthetic_measured_is_reproducible(tmp_path):
     assert a == b
     assert a.startswith("# SYNTHETIC")
     assert len([ln for ln in a.splitlines() if ln and not ln.startswith("#")]) == 1 + 4
+
+
+def test_deepest_cut_roughness_is_after_form_removal():
+    """The bundled study's deepest cut without foot (300 r/min, 0.15 mm/r, ap 0.3 mm): the
+    tool drifts as the chatter grows, a taper of tens of um/mm that made Ra ~96 um when
+    the form was left in; Ra after removing the least-squares line is ~11 um. The cut is
+    chatter (its feed amplitude grows) and rough."""
+    cfg, raw, path = pp.load_paper_config()
+    eq = pp.build_equivalent(pp.identify_stiffness(cfg, path), pp.identify_modes(cfg, path),
+                             cfg.pressure_foot)
+    coeffs = pp.load_or_calibrate(cfg, raw, path, True, 1)
+    model = pp.dynamics_model(cfg, eq, coeffs, "robot")
+    from robobore.study.runners import boring_runner
+
+    ds = boring_runner({"speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.3,
+                        "pressure_MPa": 0.0}, {"model": model})
+    assert int(ds["chatter"]) == 1 and int(ds["surface_finish_ok"]) == 0
+    fa = ds["feed_amplitude"].values
+    assert fa[-1] > 20 * fa[1]
+    slope = float(ds["form_slope_um_per_mm"])
+    ra, ra_form = float(ds["roughness_Ra_um"]), float(ds["roughness_Ra_with_form_um"])
+    assert abs(slope) > 30.0
+    assert ra_form > 5 * ra and 3.0 < ra < 30.0

@@ -44,7 +44,7 @@ def plot_frf_fit(an: ModalAnalysis, path: str | Path, output: int = 0,
     fig, ax = plt.subplots(nrow, 1, sharex=True, figsize=(8, 2.4 * nrow))
     ax[0].semilogy(f[keep], np.abs(h), "k", lw=1, label="measured")
     ax[0].semilogy(fit.frequency_Hz, np.abs(hs), "r--", lw=1,
-                   label=f"synthesised (fit {fit.fit_percent[output, input]:.1f} %)")
+                   label=f"synthesised (fit {fit.fit_percent[output, input]:.3f} %)")
     for m in an.result.modes:
         for a in ax:
             a.axvline(m.frequency_Hz, color="0.8", lw=0.6, zorder=0)

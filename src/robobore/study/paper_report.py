@@ -269,7 +269,8 @@ def _mode_rows(modes: list[dict[str, Any]]) -> list[dict[str, Any]]:
         k = (m.get("modal_stiffness_N_per_m") or {}).get(key) if key else None
         mpc = m.get("mpc")
         out.append({"mode": i + 1, "f [Hz]": m["frequency_Hz"],
-                    "zeta [%]": 100 * m["damping_ratio"], "MPC": mpc,
+                    "zeta [%]": 100 * m["damping_ratio"],
+                    "MPC": None if mpc is None else f"{mpc:.7f}",
                     "1 - MPC": None if mpc is None else f"{1.0 - mpc:.2e}",
                     "direction": d,
                     "modal mass [kg]": mass,
@@ -512,7 +513,7 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                       "mean [%]": None if s.get("mean_rel_error") is None
                       else 100 * s["mean_rel_error"]})
         rep.add_table(g, caption=f"Relative error per group (groups from the "
-                      f"{cmp.group_source} stable flag)")
+                      f"{cmp.group_source} stable flag: the paper's criterion)")
         a = cmp.agreement
         rep.add_key_values({"conditions with both flags": a.get("n"),
                             "agree": a.get("agree"),
