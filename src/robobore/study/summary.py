@@ -27,9 +27,11 @@ feed_amplitude_growth  --      last / first revolution amplitude of the feed-dir
 =====================  ======  ==================================================================
 
 Each is optional (a runner that does not compute a quantity leaves it out); a present value
-must be finite and >= 0 (amplitudes), or a boolean (``stable``: bool, 0/1, or the strings
-"true"/"false"). "Amplitude" is whatever the runner documents as the paper's "average
-amplitude" (the paper's Figs. 9 and 10); the measured CSV must use the same definition.
+must be finite and >= 0 (amplitudes), or a boolean (``stable`` and the verdict flags: bool,
+0/1, or the strings "true"/"false"); ``roughness_Ra_um`` and ``feed_amplitude_growth`` are
+left out when not finite (a run too short to measure a growth). "Amplitude" is whatever the
+runner documents as the paper's "average amplitude" (the paper's Figs. 9 and 10); the
+measured CSV must use the same definition.
 
 The same summary as JSON (what ``robobore simulate`` style commands print) nests the forces:
 ``{"force_amplitude_N": {"x": .., "y": .., "z": ..}, "feed_amplitude_um": .., "stable": ..}``;
