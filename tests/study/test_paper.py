@@ -346,3 +346,48 @@ def test_deepest_cut_roughness_is_after_form_removal():
     ra, ra_form = float(ds["roughness_Ra_um"]), float(ds["roughness_Ra_with_form_um"])
     assert abs(slope) > 30.0
     assert ra_form > 5 * ra and 3.0 < ra < 30.0
+
+
+def test_report_figures_units_legends_and_log_scale(small_run):
+    """Every axis of the paper figures carries a unit; legends sit outside the data (figure
+    legends or anchored outside the axes); the feed amplitude is on a log axis and a zero
+    amplitude is drawn on the bottom edge, not confused with a small one."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from robobore.study import paper_report as pr
+    from robobore.study.store import ResultsStore
+
+    res, out, cfg_path = small_run
+    cfg, _, _ = pp.load_paper_config(cfg_path)
+    base = {k: float(v) for k, v in cfg.study.base.items()}
+    store = ResultsStore(out / "sweep")
+    rows = [{**rec.condition, "system": rec.condition.get("system", "robot"),
+             "summary": rec.summary, "key": rec.key} for rec in store.records()]
+    # the stored condition has no system key for the machine tool: take it from the file
+    for r in rows:
+        r["system"] = store.load(r["key"]).attrs.get("system", "robot")
+    zero = dict(rows[0])
+    zero["summary"] = {**zero["summary"], "feed_amplitude_um": 0.0}
+    rows_z = [zero, *rows[1:]]
+    ds = store.load(rows[0]["key"])
+    figs = [pr.fig_trends(rows_z, base), pr.fig_force_half_rev(ds, "t"),
+            pr.fig_surface([("a", ds)]), pr.fig_feed_amplitude_time([("a", ds)])]
+    for fig in figs:
+        for ax in fig.axes:
+            for lab in (ax.get_xlabel(), ax.get_ylabel()):
+                if lab:
+                    assert "[" in lab and "]" in lab, lab
+            leg = ax.get_legend()
+            if leg is not None:  # anchored outside the axes box
+                bb = leg.get_bbox_to_anchor().transformed(ax.transAxes.inverted())
+                assert bb.x0 >= 1.0 or bb.y1 <= 0.0, lab
+    trends = figs[0]
+    feed_axes = [ax for ax in trends.axes if "feed amplitude" in ax.get_ylabel()]
+    assert feed_axes and all(ax.get_yscale() == "log" for ax in feed_axes)
+    assert trends.legends  # one figure legend below the panels
+    assert any("= 0" in t.get_text() for t in trends.legends[0].get_texts())
+    for fig in figs:
+        plt.close(fig)
