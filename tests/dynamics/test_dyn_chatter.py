@@ -35,3 +35,119 @@ def test_vibration_growth_of_growing_and_periodic_motion():
     assert vibration_growth(periodic, s) < 1e-6
     grow = np.column_stack([np.exp(t / (5.0 * s)) * np.sin(0.37 * t), 0 * t, 0 * t])
     assert vibration_growth(grow, s) > 10
+
+
+# ----------------------------------------------------------------------------- verdicts
+def _cut(X: np.ndarray, ns: int, z: np.ndarray, h: np.ndarray, area: np.ndarray | None = None,
+         speed_rpm: float = 600.0):
+    """A Dataset with the fields :func:`classify` reads, from a constructed displacement
+    ``X`` (n, 3) [m] sampled ``ns`` per revolution (one insert) and a surface profile."""
+    import xarray as xr
+
+    from robobore.dynamics.timedomain import roughness
+
+    r = roughness(z, h)
+    n = X.shape[0]
+    area = np.full((n, 1), 1e-8) if area is None else area
+    return xr.Dataset(
+        {"displacement": (("time", "axis"), X), "chip_area": (("time", "insert"), area)},
+        attrs={"samples_per_rev": ns, "n_inserts": 1, "dt_s": 60.0 / (speed_rpm * ns),
+               "speed_rpm": speed_rpm, "diverged": 0, "Ra_m": r["Ra_m"], "Rz_m": r["Rz_m"],
+               "form_slope_um_per_mm": r["form_slope_um_per_mm"]})
+
+
+def _cusps(feed_m: float, nose_m: float, n_pass: int = 40, n: int = 4000):
+    """Ideal feed marks of a round nose: envelope of circles every ``feed_m``."""
+    zk = np.arange(n_pass) * feed_m
+    z = np.linspace(zk[2], zk[-3], n)
+    h = np.max([-(nose_m - np.sqrt(np.maximum(nose_m**2 - (z - c) ** 2, 0.0)))
+                for c in zk], axis=0)
+    return z, h
+
+
+NS = 64
+
+
+def _steady(revs: int = 40, amp: float = 2e-6) -> np.ndarray:
+    t = np.arange(revs * NS)
+    return np.column_stack([amp * np.cos(2 * np.pi * t / NS), amp * np.sin(2 * np.pi * t / NS),
+                            0.3 * amp * np.sin(4 * np.pi * t / NS)])
+
+
+def test_verdict_growing_oscillation_is_chatter():
+    """A non-harmonic oscillation growing 20x over the run on top of the forced motion:
+    chatter, at its own frequency (7.3 x the spindle frequency), mostly non-harmonic."""
+    from robobore.dynamics.chatter import classify
+
+    revs = 40
+    t = np.arange(revs * NS)
+    g = 1e-7 * np.exp(np.log(20.0) * t / t[-1]) * np.sin(2 * np.pi * 7.3 * t / NS)
+    X = _steady(revs) + np.column_stack([g, 0.5 * g, g])
+    z, h = _cusps(0.1e-3, 0.4e-3)
+    v = classify(_cut(X, NS, z, h), ra_tolerance_m=1.6e-6)
+    assert v.chatter
+    assert v.feed_amplitude_growth > 10 and v.radial_amplitude_growth > 10
+    assert v.chatter_frequency_Hz == pytest.approx(7.3 * 600 / 60, rel=0.02)
+    assert v.surface_finish == "ok" and v.paper_stable  # smooth surface: paper says stable
+
+
+def test_verdict_steady_oscillation_is_not_chatter():
+    """A large forced (spindle-periodic) motion plus a decaying transient: not chatter,
+    whatever its size."""
+    from robobore.dynamics.chatter import classify
+
+    revs = 40
+    t = np.arange(revs * NS)
+    tr = 5e-6 * np.exp(-t / (3.0 * NS)) * np.sin(2 * np.pi * 3.1 * t / NS)
+    X = _steady(revs, amp=50e-6) + np.column_stack([tr, tr, tr])
+    z, h = _cusps(0.1e-3, 0.4e-3)
+    v = classify(_cut(X, NS, z, h), ra_tolerance_m=1.6e-6)
+    assert not v.chatter and v.chatter_frequency_Hz is None
+    assert v.feed_amplitude_growth < 1 and v.vibration_growth < 1
+    assert not v.tool_leaves_cut
+
+
+def test_verdict_pure_taper_is_not_rough():
+    """A smooth but tapered bore (71 um/mm): form, not roughness; Ra ~ 0 after removal while
+    the raw mean deviation is tens of um."""
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.timedomain import roughness
+
+    z = np.linspace(0.0, 4e-3, 2000)
+    h = 71e-6 / 1e-3 * z
+    r = roughness(z, h)
+    assert r["Ra_m"] < 1e-12 and r["form_slope_um_per_mm"] == pytest.approx(71.0, rel=1e-9)
+    assert np.mean(np.abs(h - h.mean())) > 50e-6
+    v = classify(_cut(_steady(), NS, z, h), ra_tolerance_m=1.6e-6)
+    assert v.surface_finish == "ok" and v.paper_stable and not v.chatter
+
+
+def test_verdict_feed_marks_only_rough_not_chatter():
+    """Feed marks of a 0.4 mm nose at 0.3 mm/r, no vibration: Ra = 0.0321 f^2 / r (the
+    classical cusp formula) = 7.2 um > 1.6 um, with or without a superposed taper: rough
+    by the finish verdict and 'vibratory' by the paper's criterion, but not chatter."""
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.timedomain import roughness
+
+    f, r = 0.3e-3, 0.4e-3
+    z, h = _cusps(f, r)
+    ra = roughness(z, h)["Ra_m"]
+    assert ra == pytest.approx(0.0321 * f**2 / r, rel=0.03)
+    assert roughness(z, h + 71e-3 * z)["Ra_m"] == pytest.approx(ra, rel=1e-6)
+    v = classify(_cut(_steady(), NS, z, h), ra_tolerance_m=1.6e-6)
+    assert not v.chatter
+    assert v.surface_finish == "rough" and not v.paper_stable
+    assert v.verdicts() == {"chatter": False, "surface_finish": "rough",
+                            "tool_leaves_cut": False, "paper_criterion": "vibratory"}
+
+
+def test_verdict_tool_leaves_cut():
+    from robobore.dynamics.chatter import classify
+
+    X = _steady()
+    area = np.full((X.shape[0], 1), 1e-8)
+    area[-NS:-NS + 5] = 0.0
+    z, h = _cusps(0.1e-3, 0.4e-3)
+    v = classify(_cut(X, NS, z, h, area=area))
+    assert v.tool_leaves_cut and 0 < v.tool_left_cut_fraction < 0.02
+    assert v.surface_finish is None  # no tolerance given

@@ -5,6 +5,12 @@
 ``robobore simulate boring --json``; :func:`lobes` returns the ``robobore lobes --json``
 contents. Conditions given as arguments override the config (speed, depth, feed, foot
 pressure), so a sweep needs only one config file.
+
+The summary's verdicts (:mod:`robobore.dynamics.chatter`): ``chatter`` (the vibration
+grows), ``surface_finish`` ("ok" / "rough": Ra after form removal against
+``ra_tolerance_um``; None without a tolerance), ``tool_leaves_cut``, and ``stable``: the
+paper's criterion (vibratory when Ra exceeds the tolerance or the run diverged), also under
+``verdicts["paper_criterion"]``.
 """
 
 from __future__ import annotations
@@ -101,15 +107,24 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
     s = summarize(ds)
     out: dict[str, Any] = {
-        "stable": v.stable,
+        "stable": v.paper_stable,
+        "verdicts": v.verdicts(),
+        "chatter": v.chatter,
+        "surface_finish": v.surface_finish,
+        "tool_leaves_cut": v.tool_leaves_cut,
         "chatter_frequency_Hz": v.chatter_frequency_Hz,
         "vibration_growth": v.vibration_growth,
+        "feed_amplitude_growth": v.feed_amplitude_growth,
+        "radial_amplitude_growth": v.radial_amplitude_growth,
         "force_mean_N": s["force_mean_N"],
         "force_amplitude_N": s["force_amplitude_N"],
         "feed_amplitude_um": s["feed_amplitude_m"] * 1e6,
         "nonharmonic_energy_ratio": v.nonharmonic_energy_ratio,
         "roughness_Ra_um": ds.attrs["Ra_m"] * 1e6,
         "roughness_Rz_um": ds.attrs["Rz_m"] * 1e6,
+        "roughness_Ra_with_form_um": ds.attrs["Ra_with_form_m"] * 1e6,
+        "form_slope_um_per_mm": ds.attrs["form_slope_um_per_mm"],
+        "ra_tolerance_um": tol,
         "tool_left_cut_fraction": v.tool_left_cut_fraction,
         "reasons": list(v.reasons),
         "diverged": bool(ds.attrs["diverged"]),

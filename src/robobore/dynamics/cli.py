@@ -129,7 +129,8 @@ def simulate_boring_cmd(
     plot: Path | None = typer.Option(None, "--plot", help="Write PNG plots into this folder."),
     as_json: bool = JSON_OPTION,
 ) -> None:
-    """Time-domain boring simulation with regeneration; stable / vibratory verdict."""
+    """Time-domain boring simulation with regeneration; chatter, surface-finish,
+    tool-leaves-cut and paper's-criterion verdicts."""
     from robobore.dynamics.api import run_boring
     from robobore.dynamics.config import load_dynamics_config
     from robobore.io.results import write_netcdf
@@ -179,13 +180,23 @@ def simulate_boring_cmd(
         result["plots"] = [str(p) for p in plot_simulation(ds, plot)]
 
     def render(r: dict[str, Any]) -> None:
-        rows = [("verdict", "stable" if r["stable"] else "VIBRATORY"),
+        fin = {None: "no tolerance", "ok": "ok", "rough": "ROUGH"}[r["surface_finish"]]
+        rows = [("chatter (vibration grows)", "CHATTER" if r["chatter"] else "no"),
+                ("surface finish (Ra, form removed)", fin),
+                ("tool leaves the cut", "YES" if r["tool_leaves_cut"] else "no"),
+                ("paper's criterion (Ra > tolerance)",
+                 "stable" if r["stable"] else "VIBRATORY"),
                 ("chatter frequency (Hz)", r["chatter_frequency_Hz"]),
-                ("vibration growth", r["vibration_growth"]),
+                ("vibration growth (envelope, feed, radial)",
+                 f"{fmt(r['vibration_growth'])} / {fmt(r['feed_amplitude_growth'])} / "
+                 f"{fmt(r['radial_amplitude_growth'])}"),
                 *[(f"mean force {a} (N)", r["force_mean_N"][a]) for a in "xyz"],
                 *[(f"force amplitude {a} (N)", r["force_amplitude_N"][a]) for a in "xyz"],
                 ("feed amplitude (um)", r["feed_amplitude_um"]),
-                ("Ra / Rz (um)", f"{fmt(r['roughness_Ra_um'])} / {fmt(r['roughness_Rz_um'])}"),
+                ("Ra / Rz, form removed (um)",
+                 f"{fmt(r['roughness_Ra_um'])} / {fmt(r['roughness_Rz_um'])}"),
+                ("Ra with form (um), taper (um/mm)",
+                 f"{fmt(r['roughness_Ra_with_form_um'])}, {fmt(r['form_slope_um_per_mm'])}"),
                 ("samples per revolution", r["samples_per_rev"])]
         for why in r["reasons"]:
             rows.append(("reason", why))

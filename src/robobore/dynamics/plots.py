@@ -71,7 +71,7 @@ def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
     axs[2].set_ylabel("rotational acc. [m/s^2]")
     axs[2].set_xlabel("time [s]")
     for a in axs[:2]:
-        a.legend(fontsize=8, loc="upper right")
+        a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle(f"n = {ds.attrs['speed_rpm']:.0f} r/min, a = {ds.attrs['depth_m'] * 1e3:.4g} mm")
     fig.tight_layout()
     p = out / "simulation_signals.png"
@@ -82,10 +82,16 @@ def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
     fig, axs = plt.subplots(1, 2, figsize=(10, 3.8))
     z = ds["surface_z"].values
     h = ds["surface_profile"].values
-    axs[0].plot((z - z[0]) * 1e3, (h - np.nanmean(h)) * 1e6, lw=0.8)
+    ok = np.isfinite(h)
+    if ok.sum() >= 3:  # the form (least-squares line) removed, as for Ra and Rz
+        zc = z[ok] - z[ok].mean()
+        res = h[ok] - np.polyval(np.polyfit(zc, h[ok], 1), zc)
+        axs[0].plot((z[ok] - z[ok][0]) * 1e3, res * 1e6, lw=0.8)
     axs[0].set_xlabel("position along the feed [mm]")
-    axs[0].set_ylabel("surface height [um]")
-    axs[0].set_title(f"Ra = {ds.attrs['Ra_m'] * 1e6:.3g} um, Rz = {ds.attrs['Rz_m'] * 1e6:.3g} um")
+    axs[0].set_ylabel("surface height, form removed [um]")
+    axs[0].set_title(f"Ra = {ds.attrs['Ra_m'] * 1e6:.3g} um, Rz = {ds.attrs['Rz_m'] * 1e6:.3g} um "
+                     f"(taper {ds.attrs.get('form_slope_um_per_mm', float('nan')):.3g} um/mm "
+                     "removed)", fontsize=9)
     X = ds["displacement"].values
     n0 = int(0.7 * X.shape[0])
     x = X[n0:] - X[n0:].mean(axis=0)
@@ -95,7 +101,7 @@ def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
     fmax = max(5 * float(ds.attrs["speed_rpm"]) / 60 * int(ds.attrs["n_inserts"]), 1.0)
     axs[1].set_xlim(0, fmax)
     axs[1].set_xlabel("frequency [Hz]")
-    axs[1].set_ylabel("displacement PSD [a.u.]")
+    axs[1].set_ylabel("|FFT|^2 of displacement, Hann [m^2]")
     fig.tight_layout()
     p = out / "simulation_surface_spectrum.png"
     save_figure(fig, p, dpi=110)

@@ -28,7 +28,8 @@ tool (x horizontal, y vertical, z feed) [N], tool-point displacement [m] and acc
 acceleration of the tool point resolved on the rotating insert's radial and tangential
 directions, i.e. what an accelerometer fixed to the bar would read without the constant
 centripetal term), the chip area, the feed-direction amplitude per revolution, the machined
-surface profile along the feed at one angle and its roughness (Ra, Rz).
+surface profile along the feed at one angle and its roughness (Ra, Rz) after removing the
+form (a least-squares line along the bore: a taper or a drifting tool is form, not roughness).
 """
 
 from __future__ import annotations
@@ -384,11 +385,48 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     prof_z, prof_r, ra, rz = surface_profile(X, area, Ns, N, process, insert_profile)
     ds_out["surface_profile"] = (("surface_z",), prof_r, {
         "units": "m", "long_name": "machined surface height along the feed at angle 0 "
-                                   "(positive into the material)"})
+                                   "(positive into the material; form not removed)"})
     ds_out = ds_out.assign_coords(surface_z=("surface_z", prof_z, {"units": "m"}))
-    ds_out.attrs["Ra_m"] = ra
-    ds_out.attrs["Rz_m"] = rz
+    rough = roughness(prof_z, prof_r)
+    ds_out.attrs["Ra_m"] = rough["Ra_m"]
+    ds_out.attrs["Rz_m"] = rough["Rz_m"]
+    ds_out.attrs["Ra_with_form_m"] = ra
+    ds_out.attrs["Rz_with_form_m"] = rz
+    ds_out.attrs["form_slope_um_per_mm"] = rough["form_slope_um_per_mm"]
     return ds_out
+
+
+#: Degree of the least-squares polynomial removed from the profile before Ra/Rz (1: a line,
+#: i.e. offset and taper; the nominal form of a straight bore wall along its axis).
+FORM_DEGREE = 1
+
+
+def roughness(z: np.ndarray, height: np.ndarray, form_degree: int = FORM_DEGREE
+              ) -> dict[str, float]:
+    """Ra and Rz of a profile after removing its form [m].
+
+    The form is the least-squares polynomial of degree ``form_degree`` of ``height`` against
+    ``z`` (ISO 4287 primary profile: the nominal form is removed by least squares before the
+    roughness parameters; a straight bore's form is a line, so the default removes the offset
+    and any taper). ``Ra`` is the mean absolute deviation of the residual, ``Rz`` its
+    peak-to-valley over the evaluation length (single evaluation length, no cut-off filter).
+    ``form_slope_um_per_mm``: the fitted line's slope (taper) [um/mm]. Non-finite heights
+    (no pass cut there) are left out; fewer than ``form_degree + 2`` finite points give NaN.
+    """
+    z = np.asarray(z, float)
+    h = np.asarray(height, float)
+    ok = np.isfinite(h) & np.isfinite(z)
+    nan = {"Ra_m": math.nan, "Rz_m": math.nan, "form_slope_um_per_mm": math.nan}
+    if ok.sum() < form_degree + 2:
+        return nan
+    zz, hh = z[ok], h[ok]
+    zc = zz - zz.mean()
+    span = float(np.ptp(zc)) or 1.0
+    coef = np.polynomial.polynomial.polyfit(zc / span, hh, form_degree)
+    resid = hh - np.polynomial.polynomial.polyval(zc / span, coef)
+    slope = float(coef[1] / span) if form_degree >= 1 else 0.0  # m/m at the centre
+    return {"Ra_m": float(np.mean(np.abs(resid))), "Rz_m": float(resid.max() - resid.min()),
+            "form_slope_um_per_mm": slope * 1e3}
 
 
 def surface_profile(X: np.ndarray, area: np.ndarray, Ns: int, N: int, process: CuttingProcess,
@@ -398,7 +436,8 @@ def surface_profile(X: np.ndarray, area: np.ndarray, Ns: int, N: int, process: C
     With an insert: each pass that cut leaves the nose profile at its axial position
     ``z_k = k f_z + dz_k`` and radius ``dr_k`` (radial displacement at that instant); the
     surface is the envelope ``max_k (dr_k - drop(z - z_k))``. Returns ``(z, height, Ra, Rz)``
-    with Ra the mean absolute deviation and Rz the peak-to-valley over the evaluation length.
+    with Ra the mean absolute deviation from the mean and Rz the peak-to-valley over the
+    evaluation length, form included (:func:`roughness` removes the form).
     """
     spp = Ns // N
     idx_all = np.arange(0, X.shape[0], spp)
@@ -449,4 +488,4 @@ def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, 
 
 __all__ = ["simulate", "SimulationSettings", "modal_zoh", "auto_samples_per_rev",
            "periodic_start", "forced_response",
-           "surface_profile", "summarize"]
+           "surface_profile", "roughness", "summarize", "FORM_DEGREE"]

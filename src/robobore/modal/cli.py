@@ -33,7 +33,7 @@ def _render_modes(res: dict[str, Any]) -> None:
     for k, m in enumerate(res["modes"]):
         mass = m.get("modal_mass_kg", {}).get(m["dominant_input"])
         t.add_row(str(k + 1), f"{m['frequency_Hz']:.4f}", f"{100 * m['damping_ratio']:.3f}",
-                  f"{m['mpc']:.3f}", m["dominant_input"], fmt(mass), str(m["cluster_size"]),
+                  f"{m['mpc']:.7f}", m["dominant_input"], fmt(mass), str(m["cluster_size"]),
                   fmt(m["cmif_support"]))
     stdout.print(t)
     st = res["stabilisation"]

@@ -43,12 +43,12 @@ def plot_frf_fit(an: ModalAnalysis, path: str | Path, output: int = 0,
     fig, ax = plt.subplots(nrow, 1, sharex=True, figsize=(8, 2.4 * nrow))
     ax[0].semilogy(f[keep], np.abs(h), "k", lw=1, label="measured")
     ax[0].semilogy(fit.frequency_Hz, np.abs(hs), "r--", lw=1,
-                   label=f"synthesised (fit {fit.fit_percent[output, input]:.1f} %)")
+                   label=f"synthesised (fit {fit.fit_percent[output, input]:.3f} %)")
     for m in an.result.modes:
         for a in ax:
             a.axvline(m.frequency_Hz, color="0.8", lw=0.6, zorder=0)
     ax[0].set_ylabel(f"|H| ({FRF_UNITS[d.frf_type]})")
-    ax[0].legend(loc="best", fontsize=8)
+    ax[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax[0].set_title(f"FRF {d.output_names[output]} / {d.input_names[input]}")
     ax[1].plot(f[keep], np.degrees(np.angle(h)), "k", lw=1)
     ax[1].plot(fit.frequency_Hz, np.degrees(np.angle(hs)), "r--", lw=1)
@@ -56,7 +56,7 @@ def plot_frf_fit(an: ModalAnalysis, path: str | Path, output: int = 0,
     if d.coherence is not None:
         ax[2].plot(f, d.coherence[output, input], "b", lw=1)
         ax[2].set_ylim(0, 1.05)
-        ax[2].set_ylabel("coherence")
+        ax[2].set_ylabel("coherence (-)")
     ax[-1].set_xlabel("frequency (Hz)")
     out = _save(fig, Path(path))
     plt.close(fig)
@@ -74,7 +74,7 @@ def plot_cmif(an: ModalAnalysis, path: str | Path) -> Path:
         ax.axvline(m.frequency_Hz, color="r", lw=0.6, ls=":")
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel(f"singular value ({FRF_UNITS[an.data.frf_type]})")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.set_title("Complex mode indicator function")
     out = _save(fig, Path(path))
     plt.close(fig)
@@ -102,7 +102,7 @@ def plot_stabilisation(an: ModalAnalysis, path: str | Path) -> Path:
     ax2.semilogy(an.cmif.frequency_Hz, an.cmif.values[0], "k", lw=0.8, alpha=0.6)
     if an.cmif.values.shape[0] > 1:
         ax2.semilogy(an.cmif.frequency_Hz, an.cmif.values[1], "0.5", lw=0.6, alpha=0.5)
-    ax2.set_ylabel("CMIF")
+    ax2.set_ylabel(f"CMIF, singular value ({FRF_UNITS[an.data.frf_type]})")
     ax.set_title("Stabilisation diagram (pLSCF) over the CMIF")
     out = _save(fig, Path(path))
     plt.close(fig)

@@ -150,39 +150,153 @@ class ModalTruth:
                    d.get("description", ""))
 
 
-def robot_boring_truth() -> ModalTruth:
-    """Ground truth of the bundled SYNTHETIC robotic-boring hammer test.
+#: The virtual robot of the bundled example (shared with the virtual campaign,
+#: :mod:`robobore.robot.campaign`): robot, test posture (the paper's boring posture), tool
+#: point in the flange frame, modal frequencies (undamped, Hz) and damping ratios.
+EXAMPLE_ROBOT = "irb6600-175-2.55"
+EXAMPLE_POSTURE_DEG = (-48.38, 54.82, 6.86, -54.16, 107.43, -21.95)
+EXAMPLE_TCP_M = (0.0, 0.0, 0.0)
+EXAMPLE_FREQUENCIES_HZ = (6.9, 16.8, 24.6, 25.34, 47.5)
+EXAMPLE_DAMPING_RATIOS = (0.035, 0.028, 0.020, 0.022, 0.050)
+#: Share of the tool-point static compliance C_dd (d = X, Y, Z) carried by the two local
+#: modes 4 (spindle housing) and 5 (wrist), with the sign of their tool-point shape.
+LOCAL_MODE_SHARES = ((0.003, 0.006, -0.006), (0.003, 0.003, 0.002))
+#: Shapes of modes 1-5 at the spindle housing (x, y) and the wrist (x, z), as multiples of
+#: the dominant tool-point value of modes 1-3 (modes 1-3: relative to their own dominant
+#: value; modes 4-5, local modes: relative to the mean of the three dominant values).
+_OTHER_RATIOS = np.array([
+    [0.667, 0.125, 0.107, 0.667, -0.556],  # spindle_x
+    [0.111, 0.688, 0.214, 0.778, -0.667],  # spindle_y
+    [0.333, 0.063, 0.036, -0.333, 0.889],  # wrist_x
+    [0.028, 0.094, 0.429, -0.444, 0.333],  # wrist_z
+])
 
-    Five modes ``[6.9, 16.8, 24.6, 25.34, 47.5]`` Hz with damping ``[0.035, 0.028, 0.020,
-    0.022, 0.050]`` (modes 1-2 near the 400 and 1000 r/min resonances of the paper; modes 3-4
-    a close pair 3.0 % apart). Seven accelerometers: ``tool_x/y/z`` at the tool point (boring
-    frame X horizontal, Y vertical, Z bore axis), ``spindle_x/y`` on the spindle housing,
-    ``wrist_x/z`` on the robot wrist. Three hammer inputs at the tool point in X, Y, Z.
 
-    Tool-point mode shapes (mass-normalised, 1/sqrt(kg); effective modal mass = 1/phi^2):
-    mode 1 is dominated by X, mode 2 by Y, mode 3 by Z (see the README table).
+def tool_point_compliance(joint_stiffness_Nm_per_rad: Any = None,
+                          posture_deg: Any = EXAMPLE_POSTURE_DEG, robot: str = EXAMPLE_ROBOT,
+                          tcp_m: Any = EXAMPLE_TCP_M) -> np.ndarray:
+    """Translational static compliance at the tool point, boring frame, 3x3 [m/N].
+
+    ``C = R^T (J diag(1/k) J^T)_tt R`` with the geometric Jacobian at ``posture_deg``,
+    the joint stiffness (default: the virtual campaign's ground truth,
+    :data:`robobore.robot.campaign.IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD`) and ``R`` the
+    boring frame (:func:`robobore.robot.stiffness.process_frame`). ``1 / C_dd`` is the
+    directional stiffness of :func:`robobore.robot.stiffness.directional_stiffness_xyz`.
     """
-    # columns: modes 1..5; rows: tool_x, tool_y, tool_z (tool point, boring frame)
-    tool = np.array([
-        [0.180, 0.030, 0.025, 0.090, 0.060],
-        [0.025, 0.160, 0.040, 0.110, 0.070],
-        [0.015, 0.030, 0.140, -0.080, 0.050],
-    ])
-    other = np.array([
-        [0.120, 0.020, 0.015, 0.060, -0.050],  # spindle_x
-        [0.020, 0.110, 0.030, 0.070, -0.060],  # spindle_y
-        [0.060, 0.010, 0.005, -0.030, 0.080],  # wrist_x
-        [0.005, 0.015, 0.060, -0.040, 0.030],  # wrist_z
-    ])
+    from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
+    from robobore.robot.kinematics import fk_jacobian, get_robot
+    from robobore.robot.stiffness import compliance_matrix, process_frame
+
+    k = (IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD if joint_stiffness_Nm_per_rad is None
+         else joint_stiffness_Nm_per_rad)
+    rob = get_robot(robot)
+    T, J = fk_jacobian(rob, np.radians(np.asarray(posture_deg, float)), tcp_m)
+    R = process_frame(T[:3, :3], "boring")
+    C = compliance_matrix(J, k)[:3, :3]
+    return R.T @ C @ R
+
+
+def _rotation(v: np.ndarray) -> np.ndarray:
+    """Rotation matrix of the rotation vector ``v`` (Rodrigues)."""
+    th = float(np.linalg.norm(v))
+    if th == 0.0:
+        return np.eye(3)
+    a = v / th
+    W = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(th) * W + (1 - np.cos(th)) * (W @ W)
+
+
+def _most_diagonal_factor(S: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """``A`` with ``A A^T = S`` whose diagonal carries the largest smallest share
+    ``min_d A_dd^2 / C_dd``: ``A = S^(1/2) Q`` over rotations ``Q`` (orthogonal Procrustes
+    start, then Nelder-Mead on the rotation vector; deterministic)."""
+    from scipy.optimize import minimize
+
+    w, V = np.linalg.eigh(S)
+    Sh = (V * np.sqrt(w)) @ V.T
+    D = np.diag(np.sqrt(np.diag(C)))
+    U, _, Vt = np.linalg.svd(Sh.T @ D)
+    Q0 = U @ Vt
+    if np.linalg.det(Q0) < 0:
+        Q0 = Q0 @ np.diag([1.0, 1.0, -1.0])
+
+    def share(v: np.ndarray) -> float:
+        A = Sh @ Q0 @ _rotation(v)
+        return -float(np.min(np.diag(A) ** 2 / np.diag(C)))
+
+    res = minimize(share, np.zeros(3), method="Nelder-Mead",
+                   options={"xatol": 1e-10, "fatol": 1e-13, "maxiter": 4000})
+    A = Sh @ Q0 @ _rotation(res.x)
+    return A * np.sign(np.diag(A))[None, :]
+
+
+def robot_boring_truth(joint_stiffness_Nm_per_rad: Any = None,
+                       posture_deg: Any = EXAMPLE_POSTURE_DEG,
+                       robot: str = EXAMPLE_ROBOT, tcp_m: Any = EXAMPLE_TCP_M) -> ModalTruth:
+    """Ground truth of the bundled SYNTHETIC robotic-boring hammer test: the modes of the
+    same virtual robot as the bundled stiffness campaign.
+
+    Five modes ``[6.9, 16.8, 24.6, 25.34, 47.5]`` Hz, damping ``[0.035, 0.028, 0.020, 0.022,
+    0.050]`` (modes 1-2 near the paper's resonances at 400 and 1000 r/min; 3-4 a close pair
+    3.0 % apart). Seven accelerometers ``tool_x/y/z`` (boring frame X horizontal, Y vertical,
+    Z bore axis), ``spindle_x/y``, ``wrist_x/z``; three hammer inputs at the tool point.
+
+    Stiffness and mass model (one robot): the static compliance of the modal model at the
+    tool point, ``sum_r phi_r phi_r^T / w_r^2``, EQUALS the campaign robot's compliance
+    ``C`` (:func:`tool_point_compliance`: the joint stiffness through the Jacobian at the test
+    posture), so the hammer test's driving-point static stiffness ``1 / H_dd(0)`` is the
+    campaign's directional stiffness in every direction. Modes 4 and 5 are local modes
+    (spindle housing, wrist) carrying the small shares :data:`LOCAL_MODE_SHARES` of ``C_dd``
+    at the tool; modes 1-3 carry the rest, ``S = C - sum_{4,5} phi phi^T / w^2``, with
+    tool-point shapes ``Phi_3 = A Omega`` (``Omega = diag(w_1..w_3)``), ``A A^T = S``, ``A``
+    the factor whose diagonal is largest (:func:`_most_diagonal_factor`): mode 1 is mostly
+    X, mode 2 Y, mode 3 Z. The implied tool-point mass matrix of modes 1-3 is
+    ``M = Phi_3^-T Phi_3^-1`` (``Phi_3^T K Phi_3 = Omega^2`` with ``K = S^-1``). The tool
+    point of this robot is coupled (compliance correlation X-Z 0.44 at this posture), so no
+    single mode carries all of a direction's compliance: the dominant mode's own modal
+    stiffness ``w_r^2 / phi_dr^2`` is the directional stiffness divided by its share (the
+    README gives the values). Spindle and wrist shapes: :data:`_OTHER_RATIOS`.
+    """
+    f = np.asarray(EXAMPLE_FREQUENCIES_HZ, float)
+    w = 2 * np.pi * f
+    C = tool_point_compliance(joint_stiffness_Nm_per_rad, posture_deg, robot, tcp_m)
+    c = np.diag(C)
+    local = np.array(LOCAL_MODE_SHARES, float).T  # (3 directions, 2 modes), signed shares
+    a45 = np.sign(local) * np.sqrt(np.abs(local) * c[:, None])  # shape / w [m/sqrt(N)..]
+    S = C - a45 @ a45.T
+    if np.linalg.eigvalsh(S).min() <= 0:
+        raise InputError("the local modes take more than the tool-point compliance",
+                         field="LOCAL_MODE_SHARES", value=LOCAL_MODE_SHARES,
+                         expected="small shares of the compliance")
+    A = _most_diagonal_factor(S, C)
+    tool = np.column_stack([A * w[:3][None, :], a45 * w[3:][None, :]])
+    dom = np.diag(tool[:, :3])
+    scale = np.concatenate([dom, np.full(2, dom.mean())])
+    other = _OTHER_RATIOS * scale[None, :]
     phi_out = np.vstack([tool, other])
     return ModalTruth(
-        np.array([6.9, 16.8, 24.6, 25.34, 47.5]),
-        np.array([0.035, 0.028, 0.020, 0.022, 0.050]),
-        phi_out, tool.copy(),
+        f, np.asarray(EXAMPLE_DAMPING_RATIOS, float), phi_out, tool.copy(),
         ("tool_x", "tool_y", "tool_z", "spindle_x", "spindle_y", "wrist_x", "wrist_z"),
         ("hammer_x", "hammer_y", "hammer_z"),
-        "SYNTHETIC robotic boring system (robobore.modal.virtual.robot_boring_truth)",
+        "SYNTHETIC robotic boring system: the virtual campaign robot "
+        "(robobore.modal.virtual.robot_boring_truth)",
     )
+
+
+def truth_table(truth: ModalTruth | None = None) -> dict[str, Any]:
+    """Stiffness figures of a tool-point truth (hammer inputs at the tool X, Y, Z):
+    driving-point static stiffness ``1 / H_dd(0)`` [N/m] per direction, each mode's
+    driving-point modal mass ``1 / phi^2`` [kg] and stiffness ``w^2 / phi^2`` [N/m], and the
+    share of ``H_dd(0)`` carried by each mode."""
+    t = truth or robot_boring_truth()
+    w = 2 * np.pi * t.frequencies_Hz
+    phi = np.real(t.phi_in)  # (3 directions, n_modes)
+    comp = phi**2 / w[None, :] ** 2
+    return {"static_stiffness_N_per_m": dict(zip("xyz", (1 / comp.sum(axis=1)).tolist(),
+                                                 strict=True)),
+            "modal_mass_kg": (1 / phi**2).tolist(),
+            "modal_stiffness_N_per_m": (w[None, :] ** 2 / phi**2).tolist(),
+            "compliance_share": (comp / comp.sum(axis=1, keepdims=True)).tolist()}
 
 
 def hammer_pulse(n: int, fs: float, t_peak_s: float, width_s: float, peak_N: float
@@ -272,4 +386,5 @@ def simulate_hammer_test(truth: ModalTruth, *, n_hits: int = 5, sample_rate_Hz: 
 
 
 __all__ = ["ModalTruth", "robot_boring_truth", "simulate_hammer_test", "hammer_pulse",
-           "TIP_WIDTH_S"]
+           "TIP_WIDTH_S", "tool_point_compliance", "truth_table", "EXAMPLE_POSTURE_DEG",
+           "EXAMPLE_FREQUENCIES_HZ", "EXAMPLE_DAMPING_RATIOS", "LOCAL_MODE_SHARES"]

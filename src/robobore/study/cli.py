@@ -223,8 +223,11 @@ def _render_paper(res: dict[str, Any]) -> None:
         ("report", res["report"]),
         ("conditions", res["conditions"]),
         ("computed", res["computed"]),
-        ("stable", res["stable"]),
-        ("vibratory", res["vibratory"]),
+        ("chatter (vibration grows)", res.get("chatter")),
+        ("rough (Ra, form removed, > tolerance)", res.get("rough")),
+        ("tool leaves the cut", res.get("tool_leaves_cut")),
+        ("stable, paper's criterion", res["stable"]),
+        ("vibratory, paper's criterion", res["vibratory"]),
         ("failed", len(res["failed"])),
         ("force coefficients", res.get("coefficients_mode")),
         ("wall time, s", res["wall_time_s"]),
@@ -249,11 +252,11 @@ def _render_paper(res: dict[str, Any]) -> None:
                       _pct(s.get("max_rel_error")), _pct(s.get("mean_rel_error")))
         stdout.print(t)
     t = Table(title="the paper's findings, checked on our results", header_style="bold")
-    for c in ("paper's finding", "our result", "agrees"):
+    for c in ("paper's finding", "checked by", "our result", "agrees"):
         t.add_column(c)
     for c in res["qualitative_checks"]:
-        t.add_row(c["finding"], c["ours"], {True: "yes", False: "[red]NO[/]", None: "n/a"}[
-            c["agrees"]])
+        t.add_row(c["finding"], c.get("verdict", ""), c["ours"],
+                  {True: "yes", False: "[red]NO[/]", None: "n/a"}[c["agrees"]])
     stdout.print(t)
 
 

@@ -199,7 +199,9 @@ def identify_stiffness(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
 
 
 def identify_modes(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
-    """The ``n_modes`` best-supported modes of the hammer test (modal JSON contract)."""
+    """The ``n_modes`` best-supported modes of the hammer test (modal JSON contract), and
+    under ``"analysis"`` the :class:`~robobore.modal.identify.ModalAnalysis` (not JSON: the
+    report draws its stabilisation diagram and FRF fit)."""
     from robobore.modal.example import example_path
     from robobore.modal.frf import FRFData, estimate_frf
     from robobore.modal.identify import identify_modes as _identify
@@ -223,7 +225,7 @@ def identify_modes(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
             "modal_stiffness_N_per_m", "cluster_size", "shape")
     modes = [{k: m[k] for k in keep if k in m} for m in d["modes"]]
     return {"modes": modes, "source": str(path), "synthetic": synthetic,
-            "fit_percent": d.get("fit_percent")}
+            "fit_percent": d.get("fit_percent"), "analysis": an}
 
 
 def build_equivalent(stiffness: dict[str, Any], modes: dict[str, Any],
@@ -407,7 +409,10 @@ def series(rows: list[dict[str, Any]], cfg: PaperConfig, vary: str, system: str,
 def qualitative_checks(rows: list[dict[str, Any]], cfg: PaperConfig) -> list[dict[str, Any]]:
     """The paper's qualitative findings, checked on our results (computed, never assumed).
 
-    Each check: ``finding`` (the paper's), ``ours`` (what our results show), ``agrees``.
+    Each check: ``finding`` (the paper's), ``verdict`` (what decides "vibrating": the chatter
+    verdict, the paper's roughness criterion, or the amplitudes), ``ours`` (what our results
+    show), ``agrees``. Findings about vibrating / not vibrating are checked twice, against the
+    chatter verdict and, separately, against the paper's criterion.
     """
     out: list[dict[str, Any]] = []
     p_foot = cfg.pressure_foot.pressure_MPa
@@ -423,30 +428,35 @@ def qualitative_checks(rows: list[dict[str, Any]], cfg: PaperConfig) -> list[dic
         ok = rho_a is not None and rho_f is not None and rho_a > 0.5 and rho_f > 0.5
         out.append({
             "finding": f"vibration grows with {names[vary][0]} (paper, robot without foot)",
+            "verdict": "amplitudes",
             "ours": (f"rank correlation with {names[vary][0]}: feed amplitude "
                      f"{_f(rho_a)}, X force amplitude {_f(rho_f)} ({len(s)} levels)"),
             "agrees": bool(ok) if rho_a is not None else None})
-    for vary in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm"):
-        s = series(rows, cfg, vary, "robot", 0.0)
-        vib = [r[vary] for r in s if r["summary"].get("stable") is False]
-        onset = min(vib) if vib else None
-        name, unit = names[vary]
-        po = paper_onset[vary]
-        levels = [r[vary] for r in s]
-        if onset is None:
-            ours = f"no vibratory level of {name} in {_lv(levels)} {unit}"
-            agrees = False
-        else:
-            above = [r for r in s if r[vary] >= onset]
-            mono = all(r["summary"].get("stable") is False for r in above)
-            ours = (f"first vibratory {name}: {onset:g} {unit}"
-                    + ("" if mono else " (not vibratory at every higher level)"))
-            # agreement: our onset falls between the level below the paper's and the paper's
-            below = [v for v in levels if v < po]
-            lo = max(below) if below else -math.inf
-            agrees = lo < onset <= po * 1.0000001 and mono
-        out.append({"finding": f"vibratory from {name} >= {po:g} {unit} (paper, onset)",
-                    "ours": ours, "agrees": agrees})
+    for verdict in VERDICTS:
+        vname = VERDICT_NAMES[verdict].format(tol=cfg.study.ra_tolerance_um)
+        word = "chattering" if verdict == "chatter" else "vibratory"
+        for vary in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm"):
+            s = series(rows, cfg, vary, "robot", 0.0)
+            vib = [r[vary] for r in s if vibrates(r["summary"], verdict) is True]
+            onset = min(vib) if vib else None
+            name, unit = names[vary]
+            po = paper_onset[vary]
+            levels = [r[vary] for r in s]
+            if onset is None:
+                ours = f"no {word} level of {name} in {_lv(levels)} {unit}"
+                agrees = False
+            else:
+                above = [r for r in s if r[vary] >= onset]
+                mono = all(vibrates(r["summary"], verdict) is True for r in above)
+                ours = (f"first {word} {name}: {onset:g} {unit}"
+                        + ("" if mono else f" (not {word} at every higher level)"))
+                # agreement: our onset falls between the level below the paper's and the
+                # paper's
+                below = [v for v in levels if v < po]
+                lo = max(below) if below else -math.inf
+                agrees = lo < onset <= po * 1.0000001 and mono
+            out.append({"finding": f"vibratory from {name} >= {po:g} {unit} (paper, onset)",
+                        "verdict": vname, "ours": ours, "agrees": agrees})
     pairs = []
     by = {(r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]): r for r in rows
           if r["system"] == "robot" and r["pressure_MPa"] == 0.0 and r.get("summary")}
@@ -465,20 +475,26 @@ def qualitative_checks(rows: list[dict[str, Any]], cfg: PaperConfig) -> list[dic
         med = float(np.median(ratio)) if ratio else None
         out.append({"finding": f"the pressure foot ({p_foot:g} MPa) reduces the feed "
                                "(vibration) amplitude",
+                    "verdict": "amplitudes",
                     "ours": (f"feed amplitude lower with the foot in {lower}/{len(pairs)} "
                              f"conditions (median ratio with/without {_f(med)})"),
                     "agrees": lower >= 0.8 * len(pairs)})
         out.append({"finding": f"the pressure foot ({p_foot:g} MPa) reduces the cutting-force "
                                "amplitude",
+                    "verdict": "amplitudes",
                     "ours": f"X force amplitude lower with the foot in {lower_f}/{len(pairs)} "
                             "conditions",
                     "agrees": lower_f >= 0.8 * len(pairs)})
-        vib0 = sum(1 for a, _ in pairs if a.get("stable") is False)
-        vib1 = sum(1 for _, b in pairs if b.get("stable") is False)
-        out.append({"finding": "the pressure foot suppresses vibration (fewer vibratory cuts)",
-                    "ours": f"vibratory: {vib0} without the foot, {vib1} with it "
-                            f"(of {len(pairs)})",
-                    "agrees": vib1 <= vib0})
+        for verdict in VERDICTS:
+            word = "chattering" if verdict == "chatter" else "vibratory"
+            vib0 = sum(1 for a, _ in pairs if vibrates(a, verdict) is True)
+            vib1 = sum(1 for _, b in pairs if vibrates(b, verdict) is True)
+            out.append({"finding": "the pressure foot suppresses vibration (fewer vibratory "
+                                   "cuts)",
+                        "verdict": VERDICT_NAMES[verdict].format(tol=cfg.study.ra_tolerance_um),
+                        "ours": f"{word}: {vib0} without the foot, {vib1} with it "
+                                f"(of {len(pairs)})",
+                        "agrees": vib1 <= vib0})
     mt = {(r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]): r for r in rows
           if r["system"] == "machine_tool" and r.get("summary")}
     if mt:
@@ -489,16 +505,38 @@ def qualitative_checks(rows: list[dict[str, Any]], cfg: PaperConfig) -> list[dic
                 continue
             n += 1
             lower += r["summary"]["feed_amplitude_um"] <= b["summary"]["feed_amplitude_um"]
-        vib = sum(1 for r in mt.values() if r["summary"].get("stable") is False)
+        vibs = {v: sum(1 for r in mt.values() if vibrates(r["summary"], v) is True)
+                for v in VERDICTS}
         out.append({"finding": "a (stiff) machine tool vibrates less than the robot",
+                    "verdict": "feed amplitude",
                     "ours": f"machine tool feed amplitude <= robot's in {lower}/{n} conditions; "
-                            f"machine tool vibratory in {vib}/{len(mt)}",
+                            f"machine tool chattering in {vibs['chatter']}/{len(mt)}, "
+                            f"vibratory by the paper's criterion in {vibs['paper']}/{len(mt)}",
                     "agrees": lower >= 0.8 * n if n else None})
     return out
 
 
+#: The verdicts the paper's findings are checked against (:func:`vibrates`).
+VERDICTS = ("chatter", "paper")
+VERDICT_NAMES = {"chatter": "chatter (vibration grows)",
+                 "paper": "paper's criterion (Ra > {tol:g} um)"}
+
+
+def vibrates(summary: dict[str, Any] | None, verdict: str) -> bool | None:
+    """Whether a condition's summary counts as vibrating under ``verdict``: ``"chatter"``
+    (the vibration grows, :mod:`robobore.dynamics.chatter`) or ``"paper"`` (the paper's
+    criterion, the summary's ``stable`` flag: Ra above the tolerance). None when unknown."""
+    if not summary:
+        return None
+    if verdict == "chatter":
+        v = summary.get("chatter")
+        return None if v is None else bool(v)
+    st = summary.get("stable")
+    return None if st is None else not st
+
+
 def _f(v: float | None) -> str:
-    return "n/a" if v is None or not math.isfinite(v) else f"{v:.2f}"
+    return "n/a" if v is None or not math.isfinite(v) else f"{v:.3g}"
 
 
 def _lv(levels: list[float]) -> str:
@@ -531,8 +569,21 @@ def results_dataset(rows: list[dict[str, Any]]) -> Any:
         "stable": ("condition", col(lambda r: {True: 1, False: 0}.get(
             (r.get("summary") or {}).get("stable"), -1), np.int8)),
         "done": ("condition", col(lambda r: 1 if r.get("summary") else 0, np.int8)),
+        **{name: ("condition", col(lambda r, name=name: {True: 1, False: 0}.get(
+            (r.get("summary") or {}).get(name), -1), np.int8))
+           for name in ("chatter", "surface_finish_ok", "tool_leaves_cut")},
+        "roughness_Ra_um": ("condition", sv("roughness_Ra_um")),
+        "feed_amplitude_growth": ("condition", sv("feed_amplitude_growth")),
     }, coords={"condition": np.arange(n)})
-    ds["stable"].attrs["meaning"] = "1 stable, 0 vibratory, -1 not computed"
+    ds["stable"].attrs["meaning"] = ("the paper's criterion (Ra after form removal within the "
+                                     "tolerance): 1 stable, 0 vibratory, -1 not computed")
+    ds["chatter"].attrs["meaning"] = "1 the vibration grows (chatter), 0 not, -1 not computed"
+    ds["surface_finish_ok"].attrs["meaning"] = ("1 Ra (form removed) within the tolerance, "
+                                                "0 above, -1 not computed")
+    ds["tool_leaves_cut"].attrs["meaning"] = "1 an insert leaves the cut, 0 not, -1 unknown"
+    ds["roughness_Ra_um"].attrs.update(units="um", long_name="Ra after form removal")
+    ds["feed_amplitude_growth"].attrs["long_name"] = (
+        "last / first revolution amplitude of the feed-direction regenerative displacement")
     for q, u in (("force_amplitude_x_N", "N"), ("feed_amplitude_um", "um")):
         ds[q].attrs["units"] = u
     return ds
@@ -637,6 +688,11 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
                                                         "depth_of_cut_mm", "pressure_MPa")},
                         "error": r.get("error")} for r in rows if not r["summary"]],
             "stable": n_stable, "vibratory": n_vib,
+            "stable_vibratory_by": "the paper's criterion (Ra > tolerance)",
+            "chatter": sum(1 for r in done if r["summary"].get("chatter") is True),
+            "rough": sum(1 for r in done if r["summary"].get("surface_finish_ok") is False),
+            "tool_leaves_cut": sum(1 for r in done
+                                   if r["summary"].get("tool_leaves_cut") is True),
             "fast": fast, "workers": nw, "synthetic_inputs": True,
             "config": str(cfg_path), "out": str(outdir),
             "sweep": outcome.to_dict(),

@@ -4,10 +4,16 @@
 labels), the stiffness and mode tables, the equivalent model (with / without the foot, and
 what the paper's c = 23.7 N s/m implies), the FE calibration (points, fit, coefficients),
 figures like the paper's (force over half a revolution; feed amplitude over time; force and
-feed amplitude against speed, feed and depth for robot and machine tool with stable /
-vibratory marked; force and rotational acceleration as vibration develops; machined
-surface stable vs vibratory; lobes with the swept conditions), the comparison with the
-measured CSV, and the qualitative checks against the paper (disagreements stated).
+feed amplitude against speed, feed and depth for robot and machine tool with each point
+marked by its verdict; force and rotational acceleration as chatter develops; machined
+surface, form removed; lobes with the swept conditions), the stabilisation diagram and an
+FRF fit of the hammer test, the comparison with the measured CSV, and the qualitative checks
+against the paper, each made with the chatter verdict and, separately, with the paper's
+roughness criterion (disagreements stated).
+
+Point marks (:data:`MARKS`, every figure and the tables): red diamond = chatter (the
+vibration grows); orange open square = rough only (Ra after form removal above the
+tolerance without chatter: the paper's criterion calls it "vibratory"); black dot = neither.
 """
 
 from __future__ import annotations
@@ -18,12 +24,29 @@ from typing import Any
 
 import numpy as np
 
+from robobore.study.plots import MARKS as _ALL_MARKS
+from robobore.study.plots import verdict_class
 from robobore.study.report import Report
+
+#: Marks of the paper report (every result there carries the verdicts by cause).
+MARKS = {k: _ALL_MARKS[k] for k in ("ok", "rough", "chatter")}
 
 _SYS_STYLE = {("robot", 0.0): ("robot, no foot", "tab:blue"),
               ("machine_tool", 0.0): ("machine tool (stiff, assumed)", "tab:green")}
 _FACTORS = (("speed_rpm", "spindle speed n [r/min]"), ("feed_mm_per_rev", "feed f [mm/r]"),
             ("depth_of_cut_mm", "depth of cut ap [mm]"))
+
+
+def _verdict_text(summary: dict[str, Any] | None) -> str:
+    if not summary:
+        return "FAILED"
+    return {"chatter": "CHATTER", "rough": "rough", "ok": "ok", None: "n/a"}[
+        verdict_class(summary)]
+
+
+def _cond(r: dict[str, Any]) -> str:
+    return (f"n = {r['speed_rpm']:g} r/min, f = {r['feed_mm_per_rev']:g} mm/r, "
+            f"ap = {r['depth_of_cut_mm']:g} mm")
 
 
 def _plt() -> Any:
@@ -59,7 +82,7 @@ def fig_force_half_rev(ds: Any, title: str) -> Any:
     half = max(2, ns // 2)
     seg = F[n - half:]
     ang = np.linspace(0.0, 180.0, seg.shape[0], endpoint=False)
-    fig, ax = plt.subplots(figsize=(6.0, 3.4))
+    fig, ax = plt.subplots(figsize=(7.4, 3.4))
     for i, (lab, c) in enumerate((("X horizontal", "tab:blue"), ("Y vertical", "tab:orange"),
                                   ("Z feed", "tab:green"))):
         ax.plot(ang, seg[:, i], color=c, label=lab)
@@ -67,7 +90,7 @@ def fig_force_half_rev(ds: Any, title: str) -> Any:
     ax.set_ylabel("force on the tool [N]")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.tight_layout()
     return fig
 
@@ -81,7 +104,7 @@ def fig_feed_amplitude_time(items: list[tuple[str, Any]]) -> Any:
         z = np.asarray(ds["displacement"].values, float)[:, 2] * 1e6
         t = np.asarray(ds["time"].values, float)
         ax.plot(t, z, lw=0.6, color="tab:blue")
-        ax.set_ylabel("Z [um]")
+        ax.set_ylabel("feed-direction\ndisplacement Z [um]", fontsize=8)
         ax.set_title(lab, fontsize=8)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
@@ -90,14 +113,19 @@ def fig_feed_amplitude_time(items: list[tuple[str, Any]]) -> Any:
 
 
 def fig_trends(rows: list[dict[str, Any]], base: dict[str, float]) -> Any:
-    """Average force amplitude and feed amplitude vs speed, feed, depth (paper Figs. 9-10)."""
+    """Average force amplitude and feed amplitude vs speed, feed, depth (paper Figs. 9-10).
+
+    The feed amplitude spans many decades (a stiff machine tool's is 1e-7 um): it is drawn on
+    a log axis; a value of exactly zero cannot be, and is drawn as a hollow triangle on the
+    bottom edge (labelled "= 0")."""
     plt = _plt()
     fig, axes = plt.subplots(2, 3, figsize=(13.0, 6.6))
     groups = sorted({(r["system"], r["pressure_MPa"]) for r in rows})
+    zero_drawn = False
     for j, (f, flab) in enumerate(_FACTORS):
         others = [k for k, _ in _FACTORS if k != f]
         for i, (q, qlab) in enumerate((("force", "mean XY force amplitude [N]"),
-                                       ("feed_amplitude_um", "feed amplitude [um]"))):
+                                       ("feed_amplitude_um", "feed amplitude [um] (log)"))):
             ax = axes[i, j]
             for g in groups:
                 lab, col = _label(*g)
@@ -113,24 +141,37 @@ def fig_trends(rows: list[dict[str, Any]], base: dict[str, float]) -> Any:
                                 + r["summary"]["force_amplitude_y_N"]) for r in sel]
                 else:
                     y = [r["summary"]["feed_amplitude_um"] for r in sel]
-                ax.plot(x, y, "-", color=col, lw=1.2, label=lab)
-                st = [(a, b) for a, b, r in zip(x, y, sel, strict=True)
-                      if r["summary"].get("stable") is not False]
-                vb = [(a, b) for a, b, r in zip(x, y, sel, strict=True)
-                      if r["summary"].get("stable") is False]
-                if st:
-                    ax.scatter(*zip(*st, strict=True), s=12, c="k", zorder=3)
-                if vb:
-                    ax.scatter(*zip(*vb, strict=True), s=40, c="tab:red", marker="D", zorder=3)
+                pos = [(a, b) for a, b in zip(x, y, strict=True) if q == "force" or b > 0]
+                if pos:
+                    ax.plot(*zip(*pos, strict=True), "-", color=col, lw=1.2,
+                            label=lab if (i, j) == (0, 0) else None)
+                for cls, (kw, _) in MARKS.items():
+                    pts = [(a, b) for a, b, r in zip(x, y, sel, strict=True)
+                           if verdict_class(r["summary"]) == cls and (q == "force" or b > 0)]
+                    if pts:
+                        ax.scatter(*zip(*pts, strict=True), zorder=3, **kw)
+                zeros = [a for a, b in zip(x, y, strict=True) if q != "force" and b <= 0]
+                if zeros:
+                    zero_drawn = True
+                    ax.scatter(zeros, [0.0] * len(zeros), marker="v", s=30, facecolors="none",
+                               edgecolors=col, zorder=4, clip_on=False,
+                               transform=ax.get_xaxis_transform())
             ax.set_xlabel(flab)
             ax.set_ylabel(qlab)
             if q == "feed_amplitude_um":
-                ax.set_yscale("symlog", linthresh=0.01)
-            ax.grid(alpha=0.3)
-    axes[0, 0].scatter([], [], s=12, c="k", label="stable")
-    axes[0, 0].scatter([], [], s=40, c="tab:red", marker="D", label="vibratory")
-    axes[0, 0].legend(fontsize=7)
-    fig.tight_layout()
+                ax.set_yscale("log")
+            ax.grid(alpha=0.3, which="both" if q == "force" else "major")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    for kw, lab in MARKS.values():
+        handles.append(axes[0, 0].scatter([], [], **kw))
+        labels.append(lab)
+    if zero_drawn:
+        handles.append(axes[0, 0].scatter([], [], marker="v", s=30, facecolors="none",
+                                          edgecolors="k"))
+        labels.append("feed amplitude = 0 (bottom edge)")
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False,
+               bbox_to_anchor=(0.5, -0.01))
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     return fig
 
 
@@ -139,11 +180,11 @@ def fig_vibration_develops(ds: Any, title: str) -> Any:
     plt = _plt()
     t = np.asarray(ds["time"].values, float)
     F = np.asarray(ds["force"].values, float)
-    fig, axes = plt.subplots(2, 1, figsize=(6.6, 4.6), sharex=True)
+    fig, axes = plt.subplots(2, 1, figsize=(7.8, 4.6), sharex=True)
     for i, lab in enumerate(("X", "Y", "Z")):
         axes[0].plot(t, F[:, i], lw=0.6, label=lab)
-    axes[0].set_ylabel("force [N]")
-    axes[0].legend(fontsize=7, ncol=3)
+    axes[0].set_ylabel("force on the tool [N]")
+    axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     axes[0].set_title(title, fontsize=9)
     if "rotational_acceleration" in ds:
         A = np.asarray(ds["rotational_acceleration"].values, float)
@@ -151,7 +192,8 @@ def fig_vibration_develops(ds: Any, title: str) -> Any:
             ["radial", "tangential"]
         for i in range(A.shape[1]):
             axes[1].plot(t, A[:, i], lw=0.6, label=names[i])
-        axes[1].legend(fontsize=7)
+        axes[1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                       frameon=False)
     axes[1].set_ylabel("rotational acceleration [m/s^2]")
     axes[1].set_xlabel("time [s]")
     for ax in axes:
@@ -161,17 +203,27 @@ def fig_vibration_develops(ds: Any, title: str) -> Any:
 
 
 def fig_surface(items: list[tuple[str, Any]]) -> Any:
-    """Machined-surface profile along the bore axis, stable vs vibratory (paper Fig. 12)."""
+    """Machined-surface profile along the bore axis after removing its form (least-squares
+    line: offset and taper), as Ra is computed (paper Fig. 12 kind)."""
+    from robobore.dynamics.timedomain import roughness
+
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(6.6, 3.2))
+    fig, ax = plt.subplots(figsize=(7.6, 3.4))
     for lab, ds in items:
-        z = np.asarray(ds["surface_z"].values, float) * 1e3
-        r = np.asarray(ds["surface_profile"].values, float) * 1e6
-        ax.plot(z - z[0], r - np.mean(r), lw=0.8,
-                label=f"{lab}: Ra {float(ds['roughness_Ra_um']):.2f} um")
+        z = np.asarray(ds["surface_z"].values, float)
+        r = np.asarray(ds["surface_profile"].values, float)
+        ok = np.isfinite(r)
+        if ok.sum() < 3:
+            continue
+        zc = z[ok] - z[ok].mean()
+        coef = np.polyfit(zc, r[ok], 1)
+        res = (r[ok] - np.polyval(coef, zc)) * 1e6
+        ra = roughness(z, r)["Ra_m"] * 1e6
+        ax.plot((z[ok] - z[ok][0]) * 1e3, res, lw=0.8,
+                label=f"{lab}: Ra {ra:.3g} um (taper {coef[0] * 1e3:.3g} um/mm removed)")
     ax.set_xlabel("position along the bore axis [mm]")
-    ax.set_ylabel("surface height (mean removed) [um]")
-    ax.legend(fontsize=7)
+    ax.set_ylabel("surface height, form removed [um]")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
@@ -180,7 +232,7 @@ def fig_surface(items: list[tuple[str, Any]]) -> Any:
 def fig_lobes(lobes: dict[str, Any], rows: list[dict[str, Any]], base: dict[str, float]) -> Any:
     """Stability lobes (critical depth vs speed) with the swept conditions at the base feed."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(6.8, 4.0))
+    fig, ax = plt.subplots(figsize=(9.6, 4.0))
     cols = ["tab:blue", "tab:orange"]
     ymax = 0.0
     for (lab, d), c in zip(lobes.items(), cols, strict=False):
@@ -192,25 +244,58 @@ def fig_lobes(lobes: dict[str, Any], rows: list[dict[str, Any]], base: dict[str,
             ymax = max(ymax, float(np.percentile(fin, 90)))
     pts = [r for r in rows if r["system"] == "robot" and r.get("summary")
            and math.isclose(r["feed_mm_per_rev"], base["feed_mm_per_rev"])]
-    for p, mk in ((0.0, "o"),):
-        sel = [r for r in pts if r["pressure_MPa"] == p]
-        st = [r for r in sel if r["summary"].get("stable") is True]
-        vb = [r for r in sel if r["summary"].get("stable") is False]
-        if st:
-            ax.scatter([r["speed_rpm"] for r in st], [r["depth_of_cut_mm"] for r in st],
-                       c="k", s=16, marker=mk, zorder=3, label="swept, stable (no foot)")
-        if vb:
-            ax.scatter([r["speed_rpm"] for r in vb], [r["depth_of_cut_mm"] for r in vb],
-                       c="tab:red", s=44, marker="D", zorder=3,
-                       label="swept, vibratory (no foot)")
+    sel = [r for r in pts if r["pressure_MPa"] == 0.0]
+    for cls, (kw, lab) in MARKS.items():
+        pc = [r for r in sel if verdict_class(r["summary"]) == cls]
+        if pc:
+            ax.scatter([r["speed_rpm"] for r in pc], [r["depth_of_cut_mm"] for r in pc],
+                       zorder=3, label=f"swept, no foot: {lab}", **kw)
     dmax = max([r["depth_of_cut_mm"] for r in pts] + [0.0])
     ax.set_ylim(0, max(ymax, 1.3 * dmax, 1e-3))
     ax.set_xlabel("spindle speed n [r/min]")
     ax.set_ylabel("critical depth of cut [mm]")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
+
+
+def _mode_rows(modes: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    out = []
+    for i, m in enumerate(modes):
+        d = m.get("direction")
+        key = f"hammer_{d}" if d else None
+        mass = (m.get("modal_mass_kg") or {}).get(key) if key else None
+        k = (m.get("modal_stiffness_N_per_m") or {}).get(key) if key else None
+        mpc = m.get("mpc")
+        out.append({"mode": i + 1, "f [Hz]": m["frequency_Hz"],
+                    "zeta [%]": 100 * m["damping_ratio"],
+                    "MPC": None if mpc is None else f"{mpc:.7f}",
+                    "1 - MPC": None if mpc is None else f"{1.0 - mpc:.2e}",
+                    "direction": d,
+                    "modal mass [kg]": mass,
+                    "modal stiffness [N/um]": None if k is None else k * 1e-6})
+    return out
+
+
+def _modal_figures(rep: Report, an: Any) -> None:
+    """Stabilisation diagram and the driving-point FRF fit of the hammer test's first input."""
+    import tempfile
+
+    from robobore.modal.plots import plot_frf_fit, plot_stabilisation
+
+    with tempfile.TemporaryDirectory() as tmp:
+        p = plot_stabilisation(an, Path(tmp) / "stab.png")
+        rep.add_image_png(p.read_bytes(), "Stabilisation diagram of the hammer test (pLSCF "
+                          "model order against frequency, symbols by stability status) over "
+                          "the CMIF; dashed lines: the selected modes.")
+        d = an.data
+        for j in range(d.n_inputs):
+            o = j if j < d.n_outputs else 0
+            p = plot_frf_fit(an, Path(tmp) / f"frf{j}.png", o, j)
+            rep.add_image_png(p.read_bytes(), f"Measured FRF {d.output_names[o]} / "
+                              f"{d.input_names[j]} and the identified modal model (LSFD "
+                              "synthesis).")
 
 
 def _eq_rows(eq: dict[str, Any]) -> list[dict[str, Any]]:
@@ -241,7 +326,11 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     rep.add_key_values({
         "config": str(cfg_path),
         "conditions simulated": f"{summary['computed']} of {summary['conditions']}",
-        "stable / vibratory": f"{summary['stable']} / {summary['vibratory']}",
+        "chatter (vibration grows)": summary.get("chatter"),
+        "rough (Ra after form removal > tolerance)": summary.get("rough"),
+        "tool leaves the cut": summary.get("tool_leaves_cut"),
+        "stable / vibratory by the paper's criterion (Ra > "
+        f"{cfg.study.ra_tolerance_um:g} um)": f"{summary['stable']} / {summary['vibratory']}",
         "force coefficients": summary.get("coefficients_mode"),
         "robobore version": summary.get("robobore_version"),
     }, caption="Run")
@@ -253,8 +342,15 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     dis = [c for c in checks if c["agrees"] is False]
     if dis:
         rep.add_note("Our model DISAGREES with the paper on: "
-                     + "; ".join(c["finding"] for c in dis) + " (details in 'Paper's "
-                     "findings').")
+                     + "; ".join(f"{c['finding']} [by {c.get('verdict', '')}]" for c in dis)
+                     + " (details in 'Paper's findings').")
+    rep.add_text("Verdicts: 'chatter' = the vibration grows over the revolutions (regenerative "
+                 "envelope and per-revolution feed/radial amplitude, docs/process.md); "
+                 "'rough' = Ra of the machined profile after removing its form (least-squares "
+                 f"line) above {cfg.study.ra_tolerance_um:g} um; the paper's criterion calls "
+                 "a cut 'vibratory' when it is rough (feed marks alone can make it so). "
+                 "Figures mark chatter with red diamonds, rough-only cuts with orange open "
+                 "squares, the rest with black dots.")
 
     # ---------------------------------------------------------------- robot
     rep.add_section("Robot stiffness")
@@ -279,10 +375,12 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     rep.add_text(f"The {len(modes['modes'])} best-supported modes of the hammer test "
                  f"{modes['source']}" + (" (SYNTHETIC)" if modes["synthetic"] else "")
                  + " (pLSCF + LSFD, automatic selection).")
-    rep.add_table([{"mode": i + 1, "f [Hz]": m["frequency_Hz"], "zeta [%]":
-                    100 * m["damping_ratio"], "MPC": m.get("mpc"),
-                    "direction": m.get("direction")} for i, m in enumerate(modes["modes"])],
-                  caption="Identified modes")
+    rep.add_table(_mode_rows(modes["modes"]), caption="Identified modes (MPC as estimated by "
+                  "LSFD; 1 - MPC shows how far from a real mode; modal mass and stiffness at "
+                  "the driving point of the mode's direction)")
+    an = modes.get("analysis")
+    if an is not None:
+        _modal_figures(rep, an)
 
     rep.add_section("Equivalent model")
     rep.add_text("Paper eq. 1-3: per direction k from the robot stiffness, f_n and zeta from the "
@@ -330,9 +428,7 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     rb = _base_key(rows, base, "robot", 0.0)
     if rb is not None:
         ds = store.load(rb["key"])
-        fig = fig_force_half_rev(ds, f"robot, no foot, n = {base['speed_rpm']:g} r/min, "
-                                     f"f = {base['feed_mm_per_rev']:g} mm/r, "
-                                     f"ap = {base['depth_of_cut_mm']:g} mm")
+        fig = fig_force_half_rev(ds, f"robot, no foot, {_cond(rb)}")
         rep.add_figure(fig, "Force components over half a revolution at the base condition "
                        "(paper Fig. 7 kind): X and Y rotate with the bar, Z (feed) is nearly "
                        "constant.")
@@ -341,14 +437,16 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     for g in sorted({(r["system"], r["pressure_MPa"]) for r in rows}):
         r = _base_key(rows, base, *g)
         if r is not None:
-            items.append((_label(*g)[0] + " (base condition)", store.load(r["key"])))
+            items.append((f"{_label(*g)[0]}, base condition {_cond(r)} "
+                          f"[{_verdict_text(r['summary'])}]", store.load(r["key"])))
     robot0 = [r for r in rows if r["system"] == "robot" and r["pressure_MPa"] == 0.0
               and r.get("summary")]
-    vib = [r for r in robot0 if r["summary"].get("stable") is False]
+    vib = [r for r in robot0 if verdict_class(r["summary"]) == "chatter"]
+    if not vib:
+        vib = [r for r in robot0 if verdict_class(r["summary"]) == "rough"]
     worst = max(vib, key=lambda r: r["summary"]["feed_amplitude_um"]) if vib else None
     if worst is not None:
-        items.append((f"robot, no foot, vibratory: n = {worst['speed_rpm']:g}, "
-                      f"f = {worst['feed_mm_per_rev']:g}, ap = {worst['depth_of_cut_mm']:g}",
+        items.append((f"robot, no foot, {_cond(worst)} [{_verdict_text(worst['summary'])}]",
                       store.load(worst["key"])))
     if items:
         fig = fig_feed_amplitude_time(items)
@@ -358,37 +456,42 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     fig = fig_trends(rows, base)
     rep.add_figure(fig, "Average force amplitude (mean of X and Y) and feed amplitude against "
                    "speed, feed and depth of cut, one factor at a time around the base "
-                   "condition (paper Figs. 9-10 kind); black dots stable, red diamonds "
-                   "vibratory.")
+                   "condition (paper Figs. 9-10 kind); red diamonds chatter, orange squares "
+                   "rough only (the paper's 'vibratory' without chatter), black dots neither.")
     plt.close(fig)
     if worst is not None:
         ds = store.load(worst["key"])
-        fig = fig_vibration_develops(ds, f"robot, no foot, n = {worst['speed_rpm']:g} r/min, "
-                                         f"f = {worst['feed_mm_per_rev']:g} mm/r, "
-                                         f"ap = {worst['depth_of_cut_mm']:g} mm (vibratory)")
+        fig = fig_vibration_develops(ds, f"robot, no foot, {_cond(worst)} "
+                                         f"[{_verdict_text(worst['summary'])}]")
         rep.add_figure(fig, "Force and rotational acceleration as the vibration develops "
                        f"(paper Fig. 11 kind). Classification: {ds.attrs.get('reasons', '')}.")
         plt.close(fig)
-    st = [r for r in robot0 if r["summary"].get("stable") is True]
+    st = [r for r in robot0 if verdict_class(r["summary"]) == "ok"]
+    rough = [r for r in robot0 if verdict_class(r["summary"]) == "rough"]
     surf = []
-    if rb is not None and rb["summary"].get("stable") is True:
-        surf.append(("stable (base)", store.load(rb["key"])))
+    if rb is not None and verdict_class(rb["summary"]) == "ok":
+        surf.append((f"ok, base {_cond(rb)}", store.load(rb["key"])))
     elif st:
-        surf.append(("stable", store.load(st[0]["key"])))
-    if worst is not None:
-        surf.append(("vibratory", store.load(worst["key"])))
+        surf.append((f"ok, {_cond(st[0])}", store.load(st[0]["key"])))
+    if rough:
+        r1 = max(rough, key=lambda r: r["feed_mm_per_rev"])
+        surf.append((f"rough only, {_cond(r1)}", store.load(r1["key"])))
+    if worst is not None and worst not in rough:
+        surf.append((f"{_verdict_text(worst['summary'])}, {_cond(worst)}",
+                     store.load(worst["key"])))
     if surf:
         fig = fig_surface(surf)
-        rep.add_figure(fig, "Machined surface along the bore axis, stable vs vibratory "
-                       "(paper Fig. 12 kind).")
+        rep.add_figure(fig, "Machined surface along the bore axis after removing its form "
+                       "(least-squares line), as Ra is computed (paper Fig. 12 kind): a cut "
+                       "without vibration, one made rough by its feed marks alone, and the "
+                       "strongest chatter.")
         plt.close(fig)
     if lobes:
         fig = fig_lobes(lobes, rows, base)
         rep.add_figure(fig, "Stability lobe diagram of the robot at the base feed, with the "
-                       "swept conditions (speed and depth series). The lobes are the linear "
-                       "regenerative limit; the time-domain classification also flags "
-                       "roughness above the tolerance and forced resonance, so points can be "
-                       "vibratory below the lobes.")
+                       "swept conditions (speed and depth series) marked by their verdict. "
+                       "The lobes are the linear regenerative limit, comparable with the "
+                       "chatter verdict; rough-only points can lie below the lobes.")
         plt.close(fig)
 
     # ---------------------------------------------------------------- comparison
@@ -410,7 +513,7 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                       "mean [%]": None if s.get("mean_rel_error") is None
                       else 100 * s["mean_rel_error"]})
         rep.add_table(g, caption=f"Relative error per group (groups from the "
-                      f"{cmp.group_source} stable flag)")
+                      f"{cmp.group_source} stable flag: the paper's criterion)")
         a = cmp.agreement
         rep.add_key_values({"conditions with both flags": a.get("n"),
                             "agree": a.get("agree"),
@@ -437,13 +540,17 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     rep.add_section("Paper's findings")
     rep.add_text("Each qualitative finding of the paper is checked on our results (computed "
                  "from the sweep, not written by hand).")
-    rep.add_table([{"paper's finding": c["finding"], "our result": c["ours"],
+    rep.add_text("Findings about vibrating or not are checked twice: with the chatter "
+                 "verdict (does the vibration grow) and, separately, with the paper's own "
+                 "criterion (Ra above the tolerance); the 'checked by' column says which.")
+    rep.add_table([{"paper's finding": c["finding"], "checked by": c.get("verdict", ""),
+                    "our result": c["ours"],
                     "agrees": {True: "yes", False: "NO", None: "n/a"}[c["agrees"]]}
                    for c in checks], caption="Qualitative checks")
     for c in checks:
         if c["agrees"] is False:
-            rep.add_note(f"Disagreement: the paper finds '{c['finding']}'; our model gives "
-                         f"{c['ours']}.")
+            rep.add_note(f"Disagreement ({c.get('verdict', '')}): the paper finds "
+                         f"'{c['finding']}'; our model gives {c['ours']}.")
 
     rep.add_section("All conditions")
     rep.add_table([{"system": r["system"], "n [r/min]": r["speed_rpm"],
@@ -453,8 +560,18 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                     "Fy amp [N]": (r["summary"] or {}).get("force_amplitude_y_N"),
                     "Fz amp [N]": (r["summary"] or {}).get("force_amplitude_z_N"),
                     "feed amp [um]": (r["summary"] or {}).get("feed_amplitude_um"),
-                    "stable": (r["summary"] or {}).get("stable", "FAILED")}
-                   for r in rows], caption="Summary per condition")
+                    "feed amp growth": (r["summary"] or {}).get("feed_amplitude_growth"),
+                    "Ra, form removed [um]": (r["summary"] or {}).get("roughness_Ra_um"),
+                    "verdict": _verdict_text(r["summary"]),
+                    "chatter": (r["summary"] or {}).get("chatter"),
+                    "leaves cut": (r["summary"] or {}).get("tool_leaves_cut"),
+                    "paper's criterion": (None if not r["summary"]
+                                          or r["summary"].get("stable") is None
+                                          else ("stable" if r["summary"]["stable"]
+                                                else "vibratory"))}
+                   for r in rows], caption="Summary per condition (verdict: CHATTER = the "
+                  "vibration grows; rough = Ra above the tolerance without chatter; the "
+                  "paper's criterion is Ra alone)")
     rep.add_text("Files: results.nc (all conditions), sweep/results/<key>.nc (one condition "
                  "each, time histories decimated), paper_summary.json, equivalent_model.json, "
                  "coefficients.json.")
@@ -462,4 +579,4 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
 
 
 __all__ = ["build_report", "fig_force_half_rev", "fig_feed_amplitude_time", "fig_trends",
-           "fig_vibration_develops", "fig_surface", "fig_lobes"]
+           "fig_vibration_develops", "fig_surface", "fig_lobes", "verdict_class", "MARKS"]

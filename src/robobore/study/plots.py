@@ -1,7 +1,10 @@
 """Figures and report sections of the study stage (matplotlib, Agg backend).
 
-Stable conditions are drawn as small black dots and vibratory ones as larger red markers
-(the paper's Fig. 10 convention).
+Each condition is marked by its verdict (:func:`verdict_class`, :data:`MARKS`): red diamond =
+chatter (the vibration grows), orange open square = rough only (the paper's criterion says
+"vibratory": Ra above the tolerance, without chatter), black dot = neither. Results without the
+verdicts by cause (other runners, measured data) are marked by their ``stable`` flag alone:
+red diamond = vibratory.
 
 * :func:`parity_figure`: simulated against measured amplitudes;
 * :func:`trend_figure`: a summary quantity against one factor (speed, feed, depth of cut),
@@ -28,6 +31,33 @@ _LABEL = {
     "force_amplitude_z_N": "force amplitude Z (feed) [N]",
     "feed_amplitude_um": "feed-direction amplitude [µm]",
 }
+
+
+#: Marker per verdict class: scatter keyword arguments and legend label.
+MARKS: dict[str, tuple[dict[str, Any], str]] = {
+    "ok": (dict(s=14, c="k", marker="o"), "no chatter, Ra within tolerance"),
+    "rough": (dict(s=40, facecolors="none", edgecolors="tab:orange", marker="s",
+                   linewidths=1.4), "rough only (Ra > tol., no chatter; paper: vibratory)"),
+    "chatter": (dict(s=44, c="tab:red", marker="D"), "chatter (vibration grows)"),
+    "vibratory": (dict(s=44, c="tab:red", marker="D"), "vibratory (stable flag)"),
+    "stable": (dict(s=14, c="k", marker="o"), "stable (stable flag)"),
+}
+
+
+def verdict_class(summary: dict[str, Any] | None) -> str | None:
+    """``"chatter"``, ``"rough"`` (the paper's criterion vibratory without chatter) or
+    ``"ok"`` for a summary with the verdicts by cause; ``"vibratory"`` / ``"stable"`` for
+    one with the ``stable`` flag only; None without either."""
+    if not summary:
+        return None
+    if "chatter" in summary:
+        if summary["chatter"] is True:
+            return "chatter"
+        if summary.get("stable") is False or summary.get("surface_finish_ok") is False:
+            return "rough"
+        return "ok"
+    st = summary.get("stable")
+    return None if st is None else ("stable" if st else "vibratory")
 
 
 def _pyplot() -> Any:
@@ -60,22 +90,34 @@ def parity_figure(cmp: Comparison) -> Any:
         ax.plot([0, hi], [0, hi], color="0.4", lw=1, label="simulated = measured")
         ax.fill_between([0, hi], [0, 0.8 * hi], [0, 1.2 * hi], color="0.9", label="±20 %")
         if pts["stable"][0]:
-            ax.scatter(*pts["stable"], s=14, c="k", label="stable", zorder=3)
-        if pts["vibratory"][0]:
-            ax.scatter(*pts["vibratory"], s=46, c="tab:red", marker="D", label="vibratory",
+            ax.scatter(*pts["stable"], s=14, c="k", label="stable (paper's criterion)",
                        zorder=3)
+        if pts["vibratory"][0]:
+            ax.scatter(*pts["vibratory"], s=46, c="tab:red", marker="D",
+                       label="vibratory (paper's criterion)", zorder=3)
         if pts["unknown"][0]:
             ax.scatter(*pts["unknown"], s=20, c="tab:blue", marker="s", label="not classified",
                        zorder=3)
         ax.set_xlim(0, hi)
         ax.set_ylim(0, hi)
-        ax.set_xlabel(f"measured {_LABEL[q]}")
-        ax.set_ylabel("simulated")
+        ax.set_xlabel(f"measured {_LABEL[q]}", fontsize=8)
+        ax.set_ylabel(f"simulated {_LABEL[q]}", fontsize=8)
         ax.set_aspect("equal")
-        ax.legend(fontsize=7, loc="upper left")
     if not qs:
         axes[0][0].text(0.5, 0.5, "no amplitude to compare", ha="center", va="center")
-    fig.tight_layout()
+    # one legend for all panels, below them: it never hides a point
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    for ax in axes[0][1:]:
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    if handles:
+        fig.legend(handles, labels, loc="lower center", ncol=min(5, len(labels)), fontsize=8,
+                   frameon=False, bbox_to_anchor=(0.5, -0.02))
+        fig.tight_layout(rect=(0, 0.08, 1, 1))
+    else:
+        fig.tight_layout()
     return fig
 
 
@@ -161,25 +203,24 @@ def trend_figure(records: list[tuple[dict[str, Any], dict[str, Any]]], x: str,
     levels = sorted({float(c[series]) for c, _ in rows})
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, lv in enumerate(levels):
-        pts = [(float(c[x]), float(s[quantity]), s.get("stable"))
+        pts = [(float(c[x]), float(s[quantity]), verdict_class(s))
                for c, s in rows if float(c[series]) == lv]
         xs = sorted({p[0] for p in pts})
         means = [sum(p[1] for p in pts if p[0] == xv) / sum(1 for p in pts if p[0] == xv)
                  for xv in xs]
         ax.plot(xs, means, "-", color=colours[i % len(colours)], lw=1.3,
                 label=SERIES_LABEL.get(series, series + " = {:g}").format(lv))
-        st = [p for p in pts if p[2] is not False]
-        vib = [p for p in pts if p[2] is False]
-        if st:
-            ax.scatter([p[0] for p in st], [p[1] for p in st], s=12, c="k", zorder=3)
-        if vib:
-            ax.scatter([p[0] for p in vib], [p[1] for p in vib], s=40, c="tab:red",
-                       marker="D", zorder=3)
-    ax.scatter([], [], s=12, c="k", label="stable")
-    ax.scatter([], [], s=40, c="tab:red", marker="D", label="vibratory")
+        for cls, (kw, _) in MARKS.items():
+            pc = [p for p in pts if p[2] == cls]
+            if pc:
+                ax.scatter([p[0] for p in pc], [p[1] for p in pc], zorder=3, **kw)
+    present = {verdict_class(s) for _, s in rows}
+    for cls, (kw, lab) in MARKS.items():
+        if cls in present:
+            ax.scatter([], [], label=lab, **kw)
     ax.set_xlabel(FACTOR_LABEL.get(x, x))
     ax.set_ylabel(_LABEL.get(quantity, quantity))
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
@@ -187,7 +228,7 @@ def trend_figure(records: list[tuple[dict[str, Any], dict[str, Any]]], x: str,
 
 def stability_map_figure(records: list[tuple[dict[str, Any], dict[str, Any]]],
                          pressure_MPa: float | None = None, ax: Any = None) -> Any:
-    """Depth of cut against speed for the swept conditions, stable/vibratory marked
+    """Depth of cut against speed for the swept conditions, each marked by its verdict
     (conditions with the given foot pressure, or all). Returns the figure; overlay a
     stability lobe diagram on ``fig.axes[0]``."""
     plt = _pyplot()
@@ -197,22 +238,19 @@ def stability_map_figure(records: list[tuple[dict[str, Any], dict[str, Any]]],
         fig = ax.figure
     fixed = None if pressure_MPa is None else {"pressure_MPa": pressure_MPa}
     rows = [(c, s) for c, s in records if _matches(c, fixed)]
-    groups = {
-        "stable": ([c for c, s in rows if s.get("stable") is True], dict(s=14, c="k")),
-        "vibratory": ([c for c, s in rows if s.get("stable") is False],
-                      dict(s=44, c="tab:red", marker="D")),
-        "not classified": ([c for c, s in rows if s.get("stable") is None],
-                           dict(s=20, c="tab:blue", marker="s")),
-    }
-    for name, (cs, style) in groups.items():
+    groups = {cls: ([c for c, s in rows if verdict_class(s) == cls], kw, lab)
+              for cls, (kw, lab) in MARKS.items()}
+    groups["not classified"] = ([c for c, s in rows if verdict_class(s) is None],
+                                dict(s=20, c="tab:blue", marker="s"), "not classified")
+    for cs, style, lab in groups.values():
         if cs:
             ax.scatter([c["speed_rpm"] for c in cs], [c["depth_of_cut_mm"] for c in cs],
-                       label=name, zorder=3, **style)
+                       label=lab, zorder=3, **style)
     ax.set_xlabel(FACTOR_LABEL["speed_rpm"])
     ax.set_ylabel(FACTOR_LABEL["depth_of_cut_mm"])
     if pressure_MPa is not None:
-        ax.set_title(f"P = {pressure_MPa:g} MPa", fontsize=9)
-    ax.legend(fontsize=7)
+        ax.set_title(f"foot pressure P = {pressure_MPa:g} MPa", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
@@ -237,8 +275,12 @@ def sweep_report(store: Any, keys: list[str] | None = None, title: str = "Sweep 
     runners = sorted({r.runner or "?" for r in recs})
     rep.add_key_values({"conditions": n_keys, "finished": len(recs), "failed": len(failed),
                         "runner": ", ".join(runners),
-                        "stable": sum(1 for _, s in records if s.get("stable") is True),
-                        "vibratory": sum(1 for _, s in records if s.get("stable") is False)},
+                        "chatter (vibration grows)": sum(1 for _, s in records
+                                                         if s.get("chatter") is True),
+                        "stable, stable flag (paper's criterion)":
+                            sum(1 for _, s in records if s.get("stable") is True),
+                        "vibratory, stable flag (paper's criterion)":
+                            sum(1 for _, s in records if s.get("stable") is False)},
                        caption="Sweep status")
     if any("demo" == r for r in runners):
         rep.add_note("These results come from the DEMO runner (single-DOF regenerative toy), "
@@ -259,8 +301,9 @@ def sweep_report(store: Any, keys: list[str] | None = None, title: str = "Sweep 
         rep.add_section("Stable and vibratory conditions")
         for p in pressures:
             fig = stability_map_figure(records, p)
-            rep.add_figure(fig, f"Swept conditions at P = {p:g} MPa: small black dots stable, "
-                           "red diamonds vibratory.")
+            rep.add_figure(fig, f"Swept conditions at foot pressure P = {p:g} MPa, each "
+                           "marked by its verdict (red diamonds chatter or, without the "
+                           "verdicts by cause, vibratory; orange squares rough only).")
             plt.close(fig)
     quantities = [q for q in AMPLITUDE_QUANTITIES
                   if any(s.get(q) is not None for _, s in records)]
@@ -280,12 +323,13 @@ def sweep_report(store: Any, keys: list[str] | None = None, title: str = "Sweep 
             plt.close(fig)
     rep.add_section("All conditions")
     rep.add_table([{**{f: c[f] for f in CONDITION_FIELDS}, "posture": c.get("posture"),
-                    **{q: s.get(q) for q in (*AMPLITUDE_QUANTITIES, "stable")}}
+                    **{q: s.get(q) for q in (*AMPLITUDE_QUANTITIES, "stable", "chatter",
+                                             "roughness_Ra_um")}}
                    for c, s in records], caption="Summary per condition", max_rows=max_rows)
     return rep
 
 
 __all__ = [
     "parity_figure", "trend_figure", "stability_map_figure", "comparison_report",
-    "sweep_report",
+    "sweep_report", "verdict_class", "MARKS",
 ]

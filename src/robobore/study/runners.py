@@ -17,10 +17,12 @@ time series are decimated to about this many samples per revolution and stored a
 (the full-rate simulation is summarised before decimation, so the summary is exact).
 
 The Dataset carries the summary contract of :mod:`robobore.study.summary` as 0-d
-variables (``force_amplitude_{x,y,z}_N``, ``feed_amplitude_um``, ``stable`` as int8 0/1),
-the force / displacement / rotational-acceleration histories (boring frame), the feed
-amplitude per revolution, the machined-surface profile, and in the attributes the
-classification (reasons, vibration growth, chatter frequency, Ra, Rz, mean forces).
+variables (``force_amplitude_{x,y,z}_N``, ``feed_amplitude_um``, ``stable`` (the paper's
+criterion) as int8 0/1), the verdicts by cause (``chatter``, ``surface_finish_ok``,
+``tool_leaves_cut`` as int8 0/1, ``roughness_Ra_um`` after form removal,
+``feed_amplitude_growth``), the force / displacement / rotational-acceleration histories
+(boring frame), the feed amplitude per revolution, the machined-surface profile, and in the
+attributes the reasons, chatter frequency and mean forces.
 """
 
 from __future__ import annotations
@@ -109,9 +111,19 @@ def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
         ds[f"force_mean_{ax}_N"] = xr.DataArray(float(r["force_mean_N"][ax]))
     ds["feed_amplitude_um"] = xr.DataArray(float(r["feed_amplitude_um"]))
     ds["stable"] = xr.DataArray(np.int8(1 if r["stable"] else 0))
+    ds["stable"].attrs["meaning"] = "the paper's criterion: Ra (form removed) <= tolerance"
+    ds["chatter"] = xr.DataArray(np.int8(1 if r["chatter"] else 0))
+    ds["tool_leaves_cut"] = xr.DataArray(np.int8(1 if r["tool_leaves_cut"] else 0))
+    if r["surface_finish"] is not None:
+        ds["surface_finish_ok"] = xr.DataArray(np.int8(1 if r["surface_finish"] == "ok"
+                                                       else 0))
     ds["roughness_Ra_um"] = xr.DataArray(float(r["roughness_Ra_um"]))
     ds["roughness_Rz_um"] = xr.DataArray(float(r["roughness_Rz_um"]))
+    ds["roughness_Ra_with_form_um"] = xr.DataArray(float(r["roughness_Ra_with_form_um"]))
+    ds["form_slope_um_per_mm"] = xr.DataArray(float(r["form_slope_um_per_mm"]))
     ds["vibration_growth"] = xr.DataArray(float(r["vibration_growth"]))
+    ds["feed_amplitude_growth"] = xr.DataArray(float(r["feed_amplitude_growth"]))
+    ds["radial_amplitude_growth"] = xr.DataArray(float(r["radial_amplitude_growth"]))
     attrs = {k: v for k, v in full.attrs.items() if isinstance(v, str | int | float)}
     attrs.update({
         "system": system,

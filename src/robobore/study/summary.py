@@ -11,13 +11,27 @@ force_amplitude_x_N    N       average cutting-force amplitude, horizontal X (bo
 force_amplitude_y_N    N       average cutting-force amplitude, vertical Y
 force_amplitude_z_N    N       average cutting-force amplitude, feed Z
 feed_amplitude_um      um      average vibration amplitude of the tool in the feed direction Z
-stable                 --      true = stable boring, false = vibratory (chatter)
+stable                 --      the paper's criterion: true = stable, false = vibratory (Ra above
+                               the tolerance, or the run diverged; a roughness criterion)
+=====================  ======  ==================================================================
+
+Verdicts by cause (optional, from the time-domain runner; :mod:`robobore.dynamics.chatter`):
+
+=====================  ======  ==================================================================
+chatter                --      true = the vibration grows (regenerative chatter) or diverged
+surface_finish_ok      --      Ra (form removed) within the tolerance
+tool_leaves_cut        --      an insert leaves the material during the cut
+roughness_Ra_um        um      Ra of the machined profile after removing its form (line)
+feed_amplitude_growth  --      last / first revolution amplitude of the feed-direction
+                               regenerative displacement (> 1: it grows)
 =====================  ======  ==================================================================
 
 Each is optional (a runner that does not compute a quantity leaves it out); a present value
-must be finite and >= 0 (amplitudes), or a boolean (``stable``: bool, 0/1, or the strings
-"true"/"false"). "Amplitude" is whatever the runner documents as the paper's "average
-amplitude" (the paper's Figs. 9 and 10); the measured CSV must use the same definition.
+must be finite and >= 0 (amplitudes), or a boolean (``stable`` and the verdict flags: bool,
+0/1, or the strings "true"/"false"); ``roughness_Ra_um`` and ``feed_amplitude_growth`` are
+left out when not finite (a run too short to measure a growth). "Amplitude" is whatever the
+runner documents as the paper's "average amplitude" (the paper's Figs. 9 and 10); the
+measured CSV must use the same definition.
 
 The same summary as JSON (what ``robobore simulate`` style commands print) nests the forces:
 ``{"force_amplitude_N": {"x": .., "y": .., "z": ..}, "feed_amplitude_um": .., "stable": ..}``;
@@ -38,8 +52,13 @@ AMPLITUDE_QUANTITIES: dict[str, str] = {
     "force_amplitude_z_N": "N",
     "feed_amplitude_um": "um",
 }
-#: Every summary quantity, amplitudes then the stability flag.
+#: Every summary quantity, amplitudes then the stability flag (the paper's criterion).
 SUMMARY_QUANTITIES: tuple[str, ...] = (*AMPLITUDE_QUANTITIES, "stable")
+#: Boolean verdicts by cause (optional).
+VERDICT_FLAGS: tuple[str, ...] = ("chatter", "surface_finish_ok", "tool_leaves_cut")
+#: Numbers behind the verdicts (optional, finite and >= 0 when present).
+VERDICT_VALUES: dict[str, str] = {"roughness_Ra_um": "um", "feed_amplitude_growth": "-"}
+_BOOL_KEYS = ("stable", *VERDICT_FLAGS)
 
 _TRUE = {"true", "1", "yes"}
 _FALSE = {"false", "0", "no"}
@@ -111,13 +130,25 @@ def summarise(ds: Any, source: str | None = None) -> dict[str, Any]:
             raise DataError("summary value out of range", file=source, field=name, value=v,
                             expected=f"a finite number >= 0 in {unit}")
         out[name] = f
-    present, v = _scalar(ds, "stable")
-    if present:
-        b = parse_bool(v)
-        if b is None:
-            raise DataError("summary value is not a boolean", file=source, field="stable",
-                            value=v, expected="true or false")
-        out["stable"] = b
+    for name in _BOOL_KEYS:
+        present, v = _scalar(ds, name)
+        if present:
+            b = parse_bool(v)
+            if b is None:
+                raise DataError("summary value is not a boolean", file=source, field=name,
+                                value=v, expected="true or false")
+            out[name] = b
+    for name, unit in VERDICT_VALUES.items():
+        present, v = _scalar(ds, name)
+        if not present:
+            continue
+        try:
+            f = float(v)
+        except (TypeError, ValueError):
+            raise DataError("summary value is not a number", file=source, field=name, value=v,
+                            expected=f"a finite number >= 0 ({unit})") from None
+        if math.isfinite(f) and f >= 0:
+            out[name] = f
     return out
 
 
@@ -160,13 +191,15 @@ def summary_attrs(summary: dict[str, Any]) -> dict[str, Any]:
     "true"/"false", since netCDF attributes cannot hold booleans)."""
     out: dict[str, Any] = {}
     for k, v in summary.items():
-        out[k] = ("true" if v else "false") if k == "stable" else float(v)
+        out[k] = ("true" if v else "false") if k in _BOOL_KEYS else float(v)
     return out
 
 
 __all__ = [
     "AMPLITUDE_QUANTITIES",
     "SUMMARY_QUANTITIES",
+    "VERDICT_FLAGS",
+    "VERDICT_VALUES",
     "parse_bool",
     "summarise",
     "summary_to_json",
