@@ -24,13 +24,13 @@ from robobore.errors import ConfigError
 from robobore.io.config import validate_model
 
 
-def _config(config: str | Path | dict[str, Any] | DynamicsConfig
+def _config(config: str | Path | dict[str, Any] | DynamicsConfig, **model_files: Any
             ) -> tuple[DynamicsConfig, dict[str, Any], str | None]:
     if isinstance(config, DynamicsConfig):
         return config.model_copy(deep=True), config.model_dump(), None
     if isinstance(config, dict):
         return validate_model(DynamicsConfig, config), config, None
-    cfg, raw = load_dynamics_config(config)
+    cfg, raw = load_dynamics_config(config, **model_files)
     return cfg, raw, str(config)
 
 
@@ -63,6 +63,11 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         if cfg.equivalent is None:
             raise ConfigError("a foot pressure needs an [equivalent] section", file=src,
                               field="pressure_MPa", value=pressure_MPa)
+        if cfg.equivalent.foot_included:
+            raise ConfigError("the equivalent model already includes a pressure foot", file=src,
+                              field="pressure_MPa", value=pressure_MPa,
+                              expected="the model without the foot (model equivalent without "
+                                       "--foot-pressure-MPa) to set the pressure here")
         foot = cfg.equivalent.pressure_foot or PressureFootCfg()
         cfg.equivalent = cfg.equivalent.model_copy(update={
             "pressure_foot": None if pressure_MPa == 0 else foot.model_copy(
@@ -115,8 +120,11 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
 
 
 def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
-          method: str = "frequency") -> dict[str, Any]:
-    """Lobes of a config (``robobore lobes --json`` contents, without notes)."""
+          method: str = "semidiscretization", progress=None) -> dict[str, Any]:
+    """Lobes of a config (``robobore lobes --json`` contents, without notes).
+
+    ``method``: ``"semidiscretization"`` (default; includes the rotating bar's periodic
+    directions and depth modulation) or ``"frequency"`` (zero-order, fast)."""
     import numpy as np
 
     from robobore.dynamics import stability
@@ -130,7 +138,7 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     if method == "frequency":
         res = stability.lobes_frequency_domain(st, pr, speeds)
     elif method == "semidiscretization":
-        res = stability.lobes_semidiscretization(st, pr, speeds)
+        res = stability.lobes_semidiscretization(st, pr, speeds, progress=progress)
     else:
         raise ConfigError("unknown method", field="method", value=method,
                           expected="frequency or semidiscretization")

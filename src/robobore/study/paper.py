@@ -103,7 +103,7 @@ class LobesSection(_Strict):
     speed_min_rpm: float = Field(150.0, gt=0)
     speed_max_rpm: float = Field(1100.0, gt=0)
     count: int = Field(200, ge=10, le=5000)
-    method: Literal["frequency", "semidiscretization"] = "frequency"
+    method: Literal["frequency", "semidiscretization"] = "semidiscretization"
 
 
 class MaterialSection(_Strict):
