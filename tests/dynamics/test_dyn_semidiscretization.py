@@ -194,3 +194,41 @@ def test_model_given_twice_is_refused(tmp_path):
     r = runner.invoke(app, ["lobes", str(EX / "boring_paper.toml"), "--stiffness-file", str(s),
                             "--modes-file", str(m)])
     assert r.exit_code == 2 and "given twice" in r.output
+
+
+@pytest.mark.parametrize("scale", [0.1, 3.0, 100.0, 1.0e4])
+def test_step_matrices_batch_equal_the_augmented_exponential(scale):
+    """The numba Taylor/doubling step matrices equal scipy's expm of the augmented matrix
+    (Van Loan) to 1e-12 relative, from small to large ``||L dt||``."""
+    from robobore.dynamics.stability import _step_matrices, _step_matrices_batch
+
+    rng = np.random.default_rng(7)
+    L = rng.standard_normal((20, 6, 6)) * scale
+    ref = _step_matrices(L, 1e-3)
+    out = [np.empty_like(L) for _ in range(3)]
+    _step_matrices_batch(L, 1e-3, *out)
+    for a, b in zip(ref, out, strict=True):
+        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a))
+
+
+def test_arpack_and_dense_spectral_radius_agree():
+    """Large monodromy matrices go to ARPACK: the spectral radius equals the dense one."""
+    from robobore.dynamics import stability as S
+
+    st = ToolPointStructure.from_modes([
+        {"frequency_Hz": 7.0, "damping_ratio": 0.035, "stiffness_N_per_m": 1.6e6,
+         "direction": [1, 0, 0]},
+        {"frequency_Hz": 25.0, "damping_ratio": 0.02, "stiffness_N_per_m": 1.2e6,
+         "direction": [0, 1, 0]}])
+    pr = boring_process(BoringInsert(nose_radius_m=0.4e-3), ti64_coefficients(30.0), 1e-4,
+                        1.5e-4)
+    old = S.DENSE_EIG_MAX
+    try:
+        for depth in (2e-5, 1e-4, 3e-4):
+            S.DENSE_EIG_MAX = 10_000
+            dense = monodromy_spectral_radius(st, pr, 200.0, depth)
+            S.DENSE_EIG_MAX = 10
+            sparse = monodromy_spectral_radius(st, pr, 200.0, depth)
+            assert sparse == pytest.approx(dense, rel=1e-8)
+    finally:
+        S.DENSE_EIG_MAX = old

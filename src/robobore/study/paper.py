@@ -339,7 +339,8 @@ def build_plan(cfg: PaperConfig, robot_model: dict[str, Any],
     for system, model, c in runs:
         cond = Condition.from_dict(c)
         key = condition_key(cond, RUNNER, model, posture)
-        ctx = {"model": model, "runner_options": opts, "postures": {"paper": posture},
+        ctx = {"model": model, "runner_options": {**opts, "system": system},
+               "postures": {"paper": posture},
                "posture": posture, "seed": condition_seed(0, key), "key": key,
                "sweep": cfg.study.name}
         items.append(SweepItem(key=key, condition=cond.to_dict(), context=ctx))
