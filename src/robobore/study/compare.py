@@ -253,9 +253,10 @@ def compare(measured: MeasuredTable,
             raise DataError(
                 "two simulated results for one condition "
                 f"({', '.join(f'{f}={cond[f]}' for f in CONDITION_FIELDS)}): the results "
-                "hold more than one model for it",
-                expected="one simulated result per condition: compare one system at a time "
-                         "(robobore compare --system NAME) or one sweep per results folder",
+                "hold more than one model or posture for it",
+                expected="one simulated result per condition: one system at a time "
+                         "(robobore compare --system NAME), a posture column in the CSV when "
+                         "they differ by posture, or one sweep per results folder",
             )
         sims[k] = (cond, summ)
 
