@@ -19,6 +19,7 @@ from robobore.dynamics.config import (
     build_process,
     build_structure,
     load_dynamics_config,
+    resolve_model_files,
 )
 from robobore.errors import ConfigError
 from robobore.io.config import validate_model
@@ -29,6 +30,8 @@ def _config(config: str | Path | dict[str, Any] | DynamicsConfig, **model_files:
     if isinstance(config, DynamicsConfig):
         return config.model_copy(deep=True), config.model_dump(), None
     if isinstance(config, dict):
+        # [model] file names of a dict config are relative to the working directory
+        config = resolve_model_files(config, Path.cwd() / "<config dict>", **model_files)
         return validate_model(DynamicsConfig, config), config, None
     cfg, raw = load_dynamics_config(config, **model_files)
     return cfg, raw, str(config)

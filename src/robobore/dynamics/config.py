@@ -112,7 +112,8 @@ class EquivalentCfg(_Strict):
     damping_N_s_per_m: float | None = Field(None, ge=0)
     pressure_foot: PressureFootCfg | None = None
     note: str = ""
-    # columns: directions of the x, y, z units in the boring frame (None: along X, Y, Z)
+    # rotation R, listed by rows, whose columns are the directions of the x, y, z units in
+    # the boring frame (as `frame` of `model equivalent --json`); None: along X, Y, Z
     frame: list[list[float]] | None = None
     # the stiffness/frequency/damping already include a pressure foot (equivalent JSON)
     foot_included: bool = False
