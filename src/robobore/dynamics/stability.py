@@ -603,47 +603,78 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
 
     The stability indicator ``rho(a) - 1`` is evaluated on the geometric grid of
     :func:`depth_scan_grid` from the bottom up; between the last stable and the first unstable
-    grid depth the crossing is bisected (geometric midpoint) to a relative width ``tol``.
-    Returns ``inf`` when no grid depth up to ``depth_hi_m`` is unstable (stable up to that
-    depth) and 0 when the system is unstable already at ``depth_hi_m * 1e-3 * 10**-decades``
-    (an instability that does not need the cut, e.g. negative process stiffness). A spectral
-    radius that overflows or is not a number counts as unstable. Never raises for a valid
-    structure and process."""
+    grid depth the crossing is narrowed to a relative width ``tol`` by a bracketing root search
+    on ``log rho`` over ``log a`` (Illinois false position, a bisection step whenever a value is
+    not finite or the bracket shrank by less than half). Returns ``inf`` when no grid depth up
+    to ``depth_hi_m`` is unstable (stable up to that depth) and 0 when the system is unstable
+    already at ``depth_hi_m * 1e-3 * 10**-decades`` (an instability that does not need the
+    cut, e.g. the depth-modulation stiffness). A spectral radius that overflows or is not a
+    number counts as unstable. Never raises for a valid structure and process."""
     steps = steps or auto_steps(structure, process, speed_rpm)
     parts = _deflection_parts(structure, process, speed_rpm) if about_deflected else None
 
-    def unstable(b: float) -> bool:
+    def rho(b: float) -> float:
         r = _rho(structure, process, speed_rpm, b, steps, include_process_stiffness,
                  about_deflected, parts)
-        return not (r < 1.0)  # NaN / inf count as unstable
+        return r if r == r else math.inf  # NaN counts as unstable
 
     with _limits(1):
-        return _scan(unstable, depth_hi_m, tol, decades, ratio)
+        return _scan(rho, depth_hi_m, tol, decades, ratio)
 
 
-def _scan(unstable, depth_hi_m: float, tol: float, decades: float, ratio: float) -> float:
-    """First crossing of ``unstable(depth)`` on the scan grid, bisected (see the caller)."""
+def _scan(rho, depth_hi_m: float, tol: float, decades: float, ratio: float) -> float:
+    """First crossing of ``rho(depth) = 1`` on the scan grid, then narrowed (see the caller)."""
     grid = depth_scan_grid(depth_hi_m, decades, ratio)
-    lo = hi = None
-    if unstable(float(grid[0])):
+    r = rho(float(grid[0]))
+    if r >= 1.0:
         floor = float(grid[0]) * 1e-3
-        if unstable(floor):
+        r_floor = rho(floor)
+        if r_floor >= 1.0:
             return 0.0
-        lo, hi = floor, float(grid[0])
+        lo, r_lo, hi, r_hi = floor, r_floor, float(grid[0]), r
     else:
+        lo = hi = None
+        r_prev = r
         for a0, a1 in zip(grid[:-1], grid[1:], strict=True):
-            if unstable(float(a1)):
-                lo, hi = float(a0), float(a1)
+            r1 = rho(float(a1))
+            if r1 >= 1.0:
+                lo, r_lo, hi, r_hi = float(a0), r_prev, float(a1), r1
                 break
+            r_prev = r1
         if lo is None:
             return math.inf
-    while hi / lo - 1.0 > tol:
-        mid = math.sqrt(lo * hi)
-        if unstable(mid):
-            hi = mid
+    # Illinois false position on f = log rho over x = log a; f(x0) < 0 <= f(x1)
+    x0, x1 = math.log(lo), math.log(hi)
+    f0 = math.log(max(r_lo, 1e-300))
+    f1 = math.log(r_hi) if math.isfinite(r_hi) else math.inf
+    side = 0
+    width_tol = math.log1p(tol)
+    while x1 - x0 > width_tol:
+        w = x1 - x0
+        if math.isfinite(f1) and f1 > f0:
+            x = x1 - f1 * w / (f1 - f0)
+            x = min(max(x, x0 + 0.01 * w), x1 - 0.01 * w)
         else:
-            lo = mid
-    return math.sqrt(lo * hi)
+            x = 0.5 * (x0 + x1)
+        rx = rho(math.exp(x))
+        if rx >= 1.0:
+            x1, f1 = x, (math.log(rx) if math.isfinite(rx) else math.inf)
+            if side == -1 and math.isfinite(f0):
+                f0 *= 0.5
+            side = -1
+        else:
+            x0, f0 = x, math.log(max(rx, 1e-300))
+            if side == 1 and math.isfinite(f1):
+                f1 *= 0.5
+            side = 1
+        if x1 - x0 > 0.5 * w:  # slow progress: bisect once
+            xm = 0.5 * (x0 + x1)
+            rm = rho(math.exp(xm))
+            if rm >= 1.0:
+                x1, f1, side = xm, (math.log(rm) if math.isfinite(rm) else math.inf), -1
+            else:
+                x0, f0, side = xm, math.log(max(rm, 1e-300)), 1
+    return math.exp(0.5 * (x0 + x1))
 
 
 def lobes_semidiscretization(structure: ToolPointStructure, process: CuttingProcess,
