@@ -232,3 +232,31 @@ def test_arpack_and_dense_spectral_radius_agree():
             assert sparse == pytest.approx(dense, rel=1e-8)
     finally:
         S.DENSE_EIG_MAX = old
+
+
+def test_unconditionally_stable_is_reported_with_its_limit(tmp_path):
+    """A mode orthogonal to the chip normal cannot regenerate: no critical depth at any speed;
+    the CLI says "unconditionally stable up to 50 mm" and the JSON gives nulls and the limit."""
+    p = tmp_path / "c.toml"
+    p.write_text("""
+[structure]
+modes = [ { frequency_Hz = 250.0, damping_ratio = 0.05, stiffness_N_per_m = 5e9,
+            direction = [1.0, 0.0, 0.0] } ]
+[process]
+cutting_coefficient_N_per_m2 = 1.0e9
+force_direction = [1.0, 0.0, 0.0]
+chip_normal = [0.0, 1.0, 0.0]
+feed_mm_per_rev = 0.1
+[speed_rpm]
+min = 2000.0
+max = 3000.0
+count = 5
+""")
+    r = runner.invoke(app, ["lobes", str(p), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["critical_depth_mm"] == [None] * 5 and d["absolute_limit_mm"] is None
+    assert d["depth_scan_max_mm"] == pytest.approx(50.0) and d["stable_speeds"] == 5
+    assert "unconditionally stable up to 50 mm" in d["notes"][0]
+    r = runner.invoke(app, ["lobes", str(p)])
+    assert r.exit_code == 0 and "none up to 50" in r.output

@@ -122,8 +122,10 @@ def lobes_cmd(
                 ("speeds (r/min)", f"{speeds[0]:g} .. {speeds[-1]:g} ({speeds.size})"),
                 ("absolute limit (mm)", r["absolute_limit_mm"] if math.isfinite(
                     r["absolute_limit_mm"]) else f"none up to {r.get('depth_scan_max_mm')} mm"),
-                ("lowest critical depth (mm) at r/min", f"{fmt(d[i])} at {speeds[i]:.0f}"),
-                ("best pocket (mm) at r/min", f"{fmt(d[j])} at {speeds[j]:.0f}"),
+                ("lowest critical depth (mm) at r/min", f"{fmt(d[i])} at {speeds[i]:.0f}"
+                 if np.isfinite(d).any() else "none (stable at every speed)"),
+                ("best pocket (mm) at r/min", f"{fmt(d[j])} at {speeds[j]:.0f}"
+                 if np.isfinite(d).any() else "none (stable at every speed)"),
                 ("mode-coupling limit (mm)", r["mode_coupling_limit_mm"])]
         if "plot" in r:
             rows.append(("plot", r["plot"]))
