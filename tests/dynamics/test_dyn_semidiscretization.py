@@ -239,9 +239,11 @@ def test_unconditionally_stable_is_reported_with_its_limit(tmp_path):
     the CLI says "unconditionally stable up to 50 mm" and the JSON gives nulls and the limit."""
     p = tmp_path / "c.toml"
     p.write_text("""
-[structure]
-modes = [ { frequency_Hz = 250.0, damping_ratio = 0.05, stiffness_N_per_m = 5e9,
-            direction = [1.0, 0.0, 0.0] } ]
+[[structure.modes]]
+frequency_Hz = 250.0
+damping_ratio = 0.05
+stiffness_N_per_m = 5e9
+direction = [1.0, 0.0, 0.0]
 [process]
 cutting_coefficient_N_per_m2 = 1.0e9
 force_direction = [1.0, 0.0, 0.0]
