@@ -493,7 +493,12 @@ def _spectral_radius(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m:
     def dense() -> float:
         U = np.empty((n, n))
         _propagate(Phi, P0, P1, r, m, np.eye(n), U)
-        return float(np.max(np.abs(np.linalg.eigvals(U))))
+        if not np.all(np.isfinite(U)):  # overflow far beyond the limit: unstable
+            return math.inf
+        try:
+            return float(np.max(np.abs(np.linalg.eigvals(U))))
+        except np.linalg.LinAlgError:  # no convergence of the dense solver: counted unstable
+            return math.inf
 
     if n <= DENSE_EIG_MAX:
         return dense()
@@ -510,7 +515,7 @@ def _spectral_radius(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m:
     try:
         ev = eigs(op, k=4, which="LM", tol=1e-9, ncv=min(n - 1, 20), maxiter=50 * n, v0=v0,
                   return_eigenvectors=False)
-    except (ArpackNoConvergence, ArpackError):
+    except (ArpackNoConvergence, ArpackError, ValueError, np.linalg.LinAlgError):
         return dense()
     return float(np.max(np.abs(ev)))
 
