@@ -128,10 +128,12 @@ def progress_bar(
 ) -> Iterator[Callable[[int], None]]:
     """A rich progress bar on stderr; yields ``advance(n)``.
 
-    Disabled (a no-op) when ``enabled`` is false, e.g. under ``--json`` output to a pipe;
-    the bar goes to stderr so JSON on stdout stays clean either way.
+    The bar goes to stderr, so JSON on stdout stays clean either way. ``enabled`` false
+    (commands pass ``not as_json``) keeps the bar only while stderr is a terminal: ``--json``
+    in a terminal still shows progress of a long run, while a redirected or piped stderr
+    (scripts, logs, tests) gets nothing.
     """
-    if not enabled:
+    if not enabled and not stderr.is_terminal:
         yield lambda n=1: None
         return
     prog = Progress(

@@ -38,7 +38,7 @@ def _write(tmp_path, text, name="c.toml"):
 
 def test_lobes_contract_json(tmp_path):
     p = _write(tmp_path, CONTRACT)
-    r = runner.invoke(app, ["lobes", str(p), "--json"])
+    r = runner.invoke(app, ["lobes", str(p), "--json", "--method", "frequency"])
     assert r.exit_code == 0, r.output
     d = json.loads(r.stdout)
     assert len(d["speed_rpm"]) == 601 and len(d["critical_depth_mm"]) == 601
@@ -155,7 +155,7 @@ def test_api_run_boring_overrides():
     assert more_feed["force_amplitude_N"]["x"] > base["force_amplitude_N"]["x"]
     assert foot["feed_amplitude_um"] < base["feed_amplitude_um"]
     assert base["speed_rpm"] == 300.0 and base["depth_mm"] == 0.05
-    d = lobes(EX / "lobes_single_point.toml")
+    d = lobes(EX / "lobes_single_point.toml", method="frequency")
     assert len(d["critical_depth_mm"]) == 601
 
 

@@ -71,7 +71,7 @@ def test_frequency_domain_vs_semidiscretization_two_modes():
     pr = single_point_process(1e9, [np.cos(a), np.sin(a), 0], [np.cos(b), np.sin(b), 0], 1e-4)
     sp = np.array([3000.0, 4500.0, 5250.0, 6000.0, 8250.0, 9000.0, 10500.0, 12000.0])
     fd = lobes_frequency_domain(st, pr, sp)
-    sd = lobes_semidiscretization(st, pr, sp, guesses_m=fd.critical_depth_m)
+    sd = lobes_semidiscretization(st, pr, sp)
     assert np.allclose(sd.critical_depth_m, fd.critical_depth_m, rtol=0.02)
 
 

@@ -273,3 +273,66 @@ def test_synthetic_measurements_round_trip_through_the_comparison(tmp_path):
     assert again.read_text() == p.read_text()  # deterministic for a seed
     flipped = synthetic_measured_csv(sims, tmp_path / "m3.csv", flip_stable=1.0, seed=1)
     assert compare(read_measured_csv(flipped), sims).agreement["rate"] == 0.0
+
+
+def _system_store(root, systems):
+    """A store like the paper job's: the same condition simulated for several systems, each
+    result labelled by ``runner_options.system`` in its stored config."""
+    import numpy as np
+    import xarray as xr
+
+    from robobore.study.store import ResultsStore
+
+    st = ResultsStore(root)
+    cond = {"speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.05,
+            "pressure_MPa": 0.0, "posture": "paper"}
+    for i, (name, fx) in enumerate(systems.items()):
+        ds = xr.Dataset({"x": ("t", np.arange(5.0)), "force_amplitude_x_N": ((), fx),
+                         "stable": ((), True)})
+        st.write_result(f"k{i}", cond, ds, runner="boring",
+                        config={"runner_options": {"system": name}} if name else None)
+    return st
+
+
+def test_compare_tells_systems_apart_in_one_store(tmp_path):
+    """The paper's store holds robot and machine-tool results for the same condition: compare
+    takes the robot by default, the other with ``--system``, and reads the paper's output
+    folder (its ``sweep`` store) as well as the store itself."""
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+    from robobore.study.compare import compare_results
+
+    _system_store(tmp_path / "out" / "sweep", {"robot": 110.0, "machine_tool": 50.0})
+    csv = tmp_path / "m.csv"
+    csv.write_text(f"{HEAD},force_amplitude_x_N,stable\n300,0.15,0.05,0,100,true\n")
+    c = compare_results(csv, tmp_path / "out")
+    assert c.system == "robot" and c.systems == ("machine_tool", "robot")
+    assert c.groups["stable"]["max_rel_error"] == pytest.approx(0.1)
+    c = compare_results(csv, tmp_path / "out" / "sweep", system="machine_tool")
+    assert c.groups["stable"]["max_rel_error"] == pytest.approx(0.5)
+    with pytest.raises(DataError, match="no results of this system"):
+        compare_results(csv, tmp_path / "out", system="lathe")
+    r = CliRunner().invoke(app, ["compare", str(csv), str(tmp_path / "out"), "--system",
+                                 "machine_tool", "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["system"] == "machine_tool"
+
+
+def test_unlabelled_duplicates_name_the_choices(tmp_path):
+    """Two unlabelled results for one condition (no system to choose): the error asks for one
+    system, a posture column or one sweep per folder, naming no wrong cause."""
+    from robobore.study.compare import compare_results
+
+    st = _system_store(tmp_path / "s", {"": 110.0})
+    import numpy as np
+    import xarray as xr
+
+    st.write_result("k9", {"speed_rpm": 300.0, "feed_mm_per_rev": 0.15,
+                           "depth_of_cut_mm": 0.05, "pressure_MPa": 0.0, "posture": "other"},
+                    xr.Dataset({"x": ("t", np.arange(5.0)), "force_amplitude_x_N": ((), 1.0),
+                                "stable": ((), True)}), runner="boring")
+    csv = tmp_path / "m.csv"
+    csv.write_text(f"{HEAD},force_amplitude_x_N\n300,0.15,0.05,0,100\n")
+    with pytest.raises(DataError, match="more than one model or posture"):
+        compare_results(csv, tmp_path / "s")

@@ -25,19 +25,25 @@ from robobore.dynamics.config import (
     build_process,
     build_structure,
     load_dynamics_config,
+    resolve_model_files,
 )
 from robobore.errors import ConfigError
 from robobore.io.config import validate_model
 
 
-def _config(config: str | Path | dict[str, Any] | DynamicsConfig, source: str | None = None
+def _config(config: str | Path | dict[str, Any] | DynamicsConfig, source: str | None = None,
+            **model_files: Any
             ) -> tuple[DynamicsConfig, dict[str, Any], str | None]:
     if isinstance(config, DynamicsConfig):
         return config.model_copy(deep=True), config.model_dump(), source
     if isinstance(config, dict):
+        # [model] file names of a dict config are relative to its source file's folder when
+        # one is named, else to the working directory
+        base = Path(source) if source else Path.cwd() / "<config dict>"
+        config = resolve_model_files(config, base, **model_files)
         return (validate_model(DynamicsConfig, config, source=source or "<config>"), config,
                 source)
-    cfg, raw = load_dynamics_config(config)
+    cfg, raw = load_dynamics_config(config, **model_files)
     return cfg, raw, str(config)
 
 
@@ -73,6 +79,11 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         if cfg.equivalent is None:
             raise ConfigError("a foot pressure needs an [equivalent] section", file=src,
                               field="pressure_MPa", value=pressure_MPa)
+        if cfg.equivalent.foot_included:
+            raise ConfigError("the equivalent model already includes a pressure foot", file=src,
+                              field="pressure_MPa", value=pressure_MPa,
+                              expected="the model without the foot (model equivalent without "
+                                       "--foot-pressure-MPa) to set the pressure here")
         foot = cfg.equivalent.pressure_foot or PressureFootCfg()
         cfg.equivalent = cfg.equivalent.model_copy(update={
             "pressure_foot": None if pressure_MPa == 0 else foot.model_copy(
@@ -140,8 +151,11 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
 
 
 def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
-          method: str = "frequency") -> dict[str, Any]:
-    """Lobes of a config (``robobore lobes --json`` contents, without notes)."""
+          method: str = "semidiscretization", progress=None) -> dict[str, Any]:
+    """Lobes of a config (``robobore lobes --json`` contents, without notes).
+
+    ``method``: ``"semidiscretization"`` (default; includes the rotating bar's periodic
+    directions and depth modulation) or ``"frequency"`` (zero-order, fast)."""
     import numpy as np
 
     from robobore.dynamics import stability
@@ -155,7 +169,7 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     if method == "frequency":
         res = stability.lobes_frequency_domain(st, pr, speeds)
     elif method == "semidiscretization":
-        res = stability.lobes_semidiscretization(st, pr, speeds)
+        res = stability.lobes_semidiscretization(st, pr, speeds, progress=progress)
     else:
         raise ConfigError("unknown method", field="method", value=method,
                           expected="frequency or semidiscretization")

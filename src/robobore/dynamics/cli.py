@@ -28,13 +28,32 @@ def _read_json(path: Path, what: str) -> dict[str, Any]:
     return load_json(path, f"{what} file", "a JSON object (as written by robobore --json)")
 
 
+# ----------------------------------------------------------------------------- model files
+STIFFNESS_FILE_OPTION = typer.Option(
+    None, "--stiffness-file",
+    help="Joint-stiffness JSON of `robobore identify stiffness --json` (with --modes-file); "
+         "the robot model, instead of [structure]/[equivalent] in the TOML.")
+MODES_FILE_OPTION = typer.Option(
+    None, "--modes-file", help="Modes JSON of `robobore identify modes --json` (with "
+                               "--stiffness-file).")
+EQUIVALENT_FILE_OPTION = typer.Option(
+    None, "--equivalent-file", help="Equivalent-model JSON of `robobore model equivalent "
+                                    "--json` (instead of the two files above).")
+
+
 # ----------------------------------------------------------------------------- lobes
 @handle_errors
 def lobes_cmd(
-    config: Path = typer.Argument(..., help="TOML config ([structure]/[equivalent] + "
-                                            "[process] or boring sections, [speed_rpm])."),
-    method: str = typer.Option("frequency", "--method",
-                               help="frequency (zero-order, fast) or semidiscretization."),
+    config: Path = typer.Argument(..., help="TOML config ([structure]/[equivalent] or [model] "
+                                            "files or the file options, + [process] or "
+                                            "boring sections, [speed_rpm])."),
+    method: str = typer.Option("semidiscretization", "--method",
+                               help="semidiscretization (default; periodic directions and "
+                                    "depth modulation of the rotating bar) or frequency "
+                                    "(zero-order, fast)."),
+    stiffness_file: Path | None = STIFFNESS_FILE_OPTION,
+    modes_file: Path | None = MODES_FILE_OPTION,
+    equivalent_file: Path | None = EQUIVALENT_FILE_OPTION,
     plot: Path | None = typer.Option(None, "--plot", help="Write lobes.png into this folder."),
     as_json: bool = JSON_OPTION,
 ) -> None:
@@ -46,7 +65,7 @@ def lobes_cmd(
     from robobore.io.outputs import check_output_dir
 
     check_output_dir(plot, "--plot", "lobes.png")
-    cfg, _ = load_dynamics_config(config)
+    cfg, _ = load_dynamics_config(config, stiffness_file, modes_file, equivalent_file)
     src = str(config)
     st = build_structure(cfg, src)
     pr = build_process(cfg, src)
@@ -64,12 +83,22 @@ def lobes_cmd(
                          "the depth-modulation stiffness is not in the frequency-domain "
                          "solution -- cross-check with --method semidiscretization")
     else:
-        fd = None
-        if pr.overlap in (0.0, 1.0):
-            fd = stability.lobes_frequency_domain(st, pr, speeds).critical_depth_m
         with progress_bar("semi-discretisation", speeds.size, not as_json) as adv:
-            res = stability.lobes_semidiscretization(st, pr, speeds, progress=adv,
-                                                     guesses_m=fd)
+            res = stability.lobes_semidiscretization(st, pr, speeds, progress=adv)
+        n_stable = int(np.sum(~np.isfinite(res.critical_depth_m)))
+        top = res.depth_scan_max_m * 1e3
+        if res.unconditionally_stable:
+            notes.append(f"unconditionally stable up to {top:g} mm at every speed (the top of "
+                         "the depth scan)")
+        elif n_stable:
+            notes.append(f"stable up to {top:g} mm (the top of the depth scan) at {n_stable} "
+                         f"of {speeds.size} speeds")
+        zero = speeds[res.critical_depth_m == 0.0]
+        if zero.size:
+            notes.append(f"unstable at vanishing depth at {zero.size} speed(s) "
+                         f"({zero.min():.0f}-{zero.max():.0f} r/min): an instability that does "
+                         "not need the regenerative cut (the rotating bar's depth-modulation "
+                         "stiffness, parametric); critical depth 0")
     mc = stability.mode_coupling_limit(st, pr)
     out = res.to_dict()
     out["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
@@ -89,9 +118,12 @@ def lobes_cmd(
         j = int(np.nanargmax(np.where(np.isfinite(d), d, np.nan))) if np.isfinite(d).any() else 0
         rows = [("method", res.method), ("process", pr.label),
                 ("speeds (r/min)", f"{speeds[0]:g} .. {speeds[-1]:g} ({speeds.size})"),
-                ("absolute limit (mm)", r["absolute_limit_mm"]),
-                ("lowest critical depth (mm) at r/min", f"{fmt(d[i])} at {speeds[i]:.0f}"),
-                ("best pocket (mm) at r/min", f"{fmt(d[j])} at {speeds[j]:.0f}"),
+                ("absolute limit (mm)", r["absolute_limit_mm"] if math.isfinite(
+                    r["absolute_limit_mm"]) else f"none up to {r.get('depth_scan_max_mm')} mm"),
+                ("lowest critical depth (mm) at r/min", f"{fmt(d[i])} at {speeds[i]:.0f}"
+                 if np.isfinite(d).any() else "none (stable at every speed)"),
+                ("best pocket (mm) at r/min", f"{fmt(d[j])} at {speeds[j]:.0f}"
+                 if np.isfinite(d).any() else "none (stable at every speed)"),
                 ("mode-coupling limit (mm)", r["mode_coupling_limit_mm"])]
         if "plot" in r:
             rows.append(("plot", r["plot"]))
@@ -112,6 +144,9 @@ def stability_plot(res, plot_dir: Path, curves, label: str) -> Path:
 @handle_errors
 def simulate_boring_cmd(
     config: Path = typer.Argument(..., help="TOML config (as for `robobore lobes`)."),
+    stiffness_file: Path | None = STIFFNESS_FILE_OPTION,
+    modes_file: Path | None = MODES_FILE_OPTION,
+    equivalent_file: Path | None = EQUIVALENT_FILE_OPTION,
     speed_rpm: float | None = typer.Option(None, "--speed-rpm",
                                            help="Spindle speed [r/min] (default [cutting])."),
     depth_mm: float | None = typer.Option(None, "--depth-mm",
@@ -135,7 +170,7 @@ def simulate_boring_cmd(
     from robobore.dynamics.config import load_dynamics_config
     from robobore.io.results import write_netcdf
 
-    cfg, raw = load_dynamics_config(config)
+    cfg, raw = load_dynamics_config(config, stiffness_file, modes_file, equivalent_file)
     if speed_rpm is None and cfg.cutting is None:
         raise ConfigError("no spindle speed", field="--speed-rpm",
                           expected="--speed-rpm N (r/min) or a [cutting] section")

@@ -31,6 +31,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from robobore.errors import ConfigError
@@ -111,6 +112,11 @@ class EquivalentCfg(_Strict):
     damping_N_s_per_m: float | None = Field(None, ge=0)
     pressure_foot: PressureFootCfg | None = None
     note: str = ""
+    # rotation R, listed by rows, whose columns are the directions of the x, y, z units in
+    # the boring frame (as `frame` of `model equivalent --json`); None: along X, Y, Z
+    frame: list[list[float]] | None = None
+    # the stiffness/frequency/damping already include a pressure foot (equivalent JSON)
+    foot_included: bool = False
 
     @field_validator("stiffness_N_per_m", "frequency_Hz")
     @classmethod
@@ -124,6 +130,9 @@ class EquivalentCfg(_Strict):
     def _damping(self):
         if (self.damping_ratio is None) == (self.damping_N_s_per_m is None):
             raise ValueError("give exactly one of damping_ratio or damping_N_s_per_m")
+        if self.foot_included and self.pressure_foot is not None:
+            raise ValueError("the model already includes a pressure foot; remove "
+                             "pressure_foot (or use the model without the foot)")
         return self
 
     def to_model(self):
@@ -133,6 +142,7 @@ class EquivalentCfg(_Strict):
             self.stiffness_N_per_m.model_dump(), self.frequency_Hz.model_dump(),
             damping_ratio=None if self.damping_ratio is None else self.damping_ratio.model_dump(),
             damping_N_s_per_m=self.damping_N_s_per_m,
+            frame=None if self.frame is None else np.asarray(self.frame, float),
             foot=None if self.pressure_foot is None else self.pressure_foot.to_foot(),
             notes=(self.note,) if self.note else ())
 
@@ -225,7 +235,18 @@ class SimulationCfg(_Strict):
     ra_tolerance_um: float | None = Field(None, gt=0)
 
 
+class ModelFilesCfg(_Strict):
+    """``[model]``: the robot from identification outputs; paths relative to the TOML."""
+
+    stiffness_file: str | None = None   # robobore identify stiffness --json
+    modes_file: str | None = None       # robobore identify modes --json
+    equivalent_file: str | None = None  # robobore model equivalent --json
+    assign: list[int] | None = Field(None, min_length=3, max_length=3)  # modes for x, y, z
+    damping_N_s_per_m: float | None = Field(None, ge=0)
+
+
 class DynamicsConfig(_Strict):
+    model: ModelFilesCfg | None = None
     structure: StructureCfg | None = None
     equivalent: EquivalentCfg | None = None
     process: ProcessCfg | None = None
@@ -252,9 +273,117 @@ class DynamicsConfig(_Strict):
         return self.process is None
 
 
-def load_dynamics_config(path: str | Path) -> tuple[DynamicsConfig, dict[str, Any]]:
-    """Read and validate a config file; returns the model and the raw dict (for provenance)."""
-    raw = load_toml(path)
+def _read_json_file(path: Path, what: str, source: str) -> dict[str, Any]:
+    import json
+
+    if not path.is_file():
+        raise ConfigError(f"{what} file not found", file=str(path),
+                          expected=f"an existing JSON file (named in {source})")
+    try:
+        d = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"not valid JSON: {exc}", file=str(path)) from None
+    if not isinstance(d, dict):
+        raise ConfigError("not a JSON object", file=str(path),
+                          expected=f"the JSON object written by {what}")
+    return d
+
+
+def resolve_model_files(raw: dict[str, Any], path: str | Path,
+                        stiffness_file: str | Path | None = None,
+                        modes_file: str | Path | None = None,
+                        equivalent_file: str | Path | None = None) -> dict[str, Any]:
+    """Replace the robot model given as identification outputs by an ``[equivalent]`` section.
+
+    The files come from the options (paths as given) or from ``[model]`` in the TOML (paths
+    relative to the TOML): a joint-stiffness JSON (``robobore identify stiffness --json``) and
+    a modes JSON (``robobore identify modes --json``), combined as ``robobore model
+    equivalent`` does (modes assigned by direction, or ``assign``), or one equivalent-model
+    JSON (``robobore model equivalent --json``). The TOML may then hold only the process; an
+    ``[equivalent]`` there may carry only ``pressure_foot``/``note``. Returns a new raw dict
+    (``[model]`` with the resolved absolute paths, ``[equivalent]`` with the values used)."""
+    from robobore.equivalent import EquivalentModel
+
+    src = str(path)
+    base = Path(path).resolve().parent
+    sec = raw.get("model")
+    mcfg = (validate_model(ModelFilesCfg, sec, source=f"{src} [model]")
+            if isinstance(sec, dict) else ModelFilesCfg())
+    if sec is not None and not isinstance(sec, dict):
+        raise ConfigError("must be a table", file=src, field="model",
+                          expected="[model] with stiffness_file/modes_file/equivalent_file")
+
+    def pick(opt, key):
+        if opt is not None:
+            return Path(opt).resolve(), f"--{key.replace('_', '-')}"
+        v = getattr(mcfg, key)
+        return (None, None) if v is None else ((base / Path(v)).resolve(), f"model.{key}")
+
+    sf, sf_where = pick(stiffness_file, "stiffness_file")
+    mf, mf_where = pick(modes_file, "modes_file")
+    ef, ef_where = pick(equivalent_file, "equivalent_file")
+    if sf is None and mf is None and ef is None:
+        return raw
+    if ef is not None and (sf is not None or mf is not None):
+        raise ConfigError("give either an equivalent-model file or a stiffness file and a "
+                          "modes file, not both", file=src, field=ef_where,
+                          expected="--equivalent-file, or --stiffness-file with --modes-file")
+    if ef is None and (sf is None or mf is None):
+        missing = "modes_file" if mf is None else "stiffness_file"
+        raise ConfigError("a stiffness file needs a modes file and the other way round",
+                          file=src, field=missing.replace("_", "-"),
+                          expected="both --stiffness-file (identify stiffness --json) and "
+                                   "--modes-file (identify modes --json), or [model] keys")
+    eq_raw = raw.get("equivalent")
+    extra: dict[str, Any] = {}
+    if eq_raw is not None:
+        if not isinstance(eq_raw, dict) or set(eq_raw) - {"pressure_foot", "note"}:
+            raise ConfigError("the robot model is given twice (identification files and "
+                              "[equivalent] values)", file=src, field="equivalent",
+                              expected="[equivalent] with only pressure_foot/note, or no "
+                                       "model files")
+        extra = dict(eq_raw)
+    try:
+        if ef is not None:
+            em = EquivalentModel.from_dict(_read_json_file(ef, "model equivalent --json", src))
+            files = {"equivalent_file": str(ef)}
+        else:
+            em = EquivalentModel.from_stiffness_and_modes(
+                _read_json_file(sf, "identify stiffness --json", src),
+                _read_json_file(mf, "identify modes --json", src),
+                None if mcfg.assign is None else dict(zip("xyz", mcfg.assign, strict=True)),
+                damping_N_s_per_m=mcfg.damping_N_s_per_m)
+            files = {"stiffness_file": str(sf), "modes_file": str(mf)}
+    except ConfigError as exc:
+        if exc.file is not None:
+            raise
+        where = str(ef) if ef is not None else f"{sf} + {mf}"
+        raise ConfigError(exc.message, file=where, field=exc.field, value=exc.value,
+                          expected=exc.expected) from None
+    eq: dict[str, Any] = {"stiffness_N_per_m": dict(em.stiffness_N_per_m),
+                          "frequency_Hz": dict(em.frequency_Hz),
+                          "damping_ratio": dict(em.damping_ratio),
+                          "frame": [list(r) for r in em.frame],
+                          "foot_included": em.foot is not None,
+                          "note": "; ".join(["from " + ", ".join(files.values()),
+                                             *em.notes])}
+    eq.update(extra)
+    out = dict(raw)
+    out["model"] = {**(sec if isinstance(sec, dict) else {}), **files}
+    out["equivalent"] = eq
+    return out
+
+
+def load_dynamics_config(path: str | Path, stiffness_file: str | Path | None = None,
+                         modes_file: str | Path | None = None,
+                         equivalent_file: str | Path | None = None,
+                         ) -> tuple[DynamicsConfig, dict[str, Any]]:
+    """Read and validate a config file; returns the model and the raw dict (for provenance).
+
+    The robot may come from identification outputs (options or ``[model]``), see
+    :func:`resolve_model_files`; the raw dict then holds the ``[equivalent]`` values used."""
+    raw = resolve_model_files(load_toml(path), path, stiffness_file, modes_file,
+                              equivalent_file)
     cfg = validate_model(DynamicsConfig, raw, source=path)
     return cfg, raw
 
@@ -315,5 +444,5 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
                           trailing_edge=cut.trailing_edge)
 
 
-__all__ = ["DynamicsConfig", "load_dynamics_config", "build_structure", "build_process",
-           "build_coefficients"]
+__all__ = ["DynamicsConfig", "load_dynamics_config", "resolve_model_files", "build_structure",
+           "build_process", "build_coefficients"]

@@ -168,6 +168,10 @@ def _render_compare(res: dict[str, Any]) -> None:
                   _pct(s["max_rel_error"]), _pct(s["mean_rel_error"]))
     stdout.print(g)
     a = res["agreement"]
+    if len(res.get("systems_in_store", [])) > 1:
+        stdout.print(f"[dim]note: compared the {res['system']} results; the store also holds "
+                     + ", ".join(x for x in res["systems_in_store"] if x != res["system"])
+                     + " (--system NAME)[/]")
     stdout.print(kv_table("stable / vibratory agreement", [
         ("conditions with both flags", a["n"]), ("agree", a["agree"]),
         ("agreement rate", None if a["rate"] is None else f"{100 * a['rate']:.1f} %"),
@@ -183,8 +187,12 @@ def _render_compare(res: dict[str, Any]) -> None:
 
 def compare_cmd(
     measured: Path = typer.Argument(..., help="Measured CSV (see docs/study.md for columns)."),
-    results: Path = typer.Argument(..., help="Results store folder written by 'robobore sweep'."),
+    results: Path = typer.Argument(..., help="Results store folder written by 'robobore sweep',"
+                                             " or the output folder of 'robobore paper'."),
     report: Path | None = typer.Option(None, "--report", help="Also write an HTML report here."),
+    system: str | None = typer.Option(
+        None, "--system", help="Simulated system to compare when the results hold several "
+                               "(robobore paper: robot, machine_tool; default robot)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Compare measurements with a sweep's results: relative errors, groups, agreement."""
@@ -192,7 +200,7 @@ def compare_cmd(
     from robobore.study.compare import compare_results
 
     check_output_file(report, "--report", "the HTML report")
-    cmp = compare_results(measured, results)
+    cmp = compare_results(measured, results, system)
     res = cmp.to_dict()
     res["measured"] = str(measured)
     res["results"] = str(results)

@@ -208,9 +208,12 @@ class Comparison:
     unmatched_measured: tuple[dict[str, Any], ...] = field(default_factory=tuple)
     undefined: tuple[dict[str, Any], ...] = field(default_factory=tuple)
     quantities: tuple[str, ...] = field(default_factory=tuple)
+    system: str | None = None  # the simulated system compared (e.g. "robot")
+    systems: tuple[str, ...] = field(default_factory=tuple)  # systems in the results store
 
     def to_dict(self) -> dict[str, Any]:
         return {
+            "system": self.system, "systems_in_store": list(self.systems),
             "quantities": list(self.quantities), "group_source": self.group_source,
             "groups": self.groups, "agreement": self.agreement, "conditions": list(self.rows),
             "unmatched_measured": list(self.unmatched_measured), "undefined": list(self.undefined),
@@ -249,9 +252,11 @@ def compare(measured: MeasuredTable,
         if k in sims:
             raise DataError(
                 "two simulated results for one condition "
-                f"({', '.join(f'{f}={cond[f]}' for f in CONDITION_FIELDS)}"
-                f"{'' if measured.has_posture else '; add a posture column to the CSV'})",
-                expected="one simulated result per condition (one sweep per results folder)",
+                f"({', '.join(f'{f}={cond[f]}' for f in CONDITION_FIELDS)}): the results "
+                "hold more than one model or posture for it",
+                expected="one simulated result per condition: one system at a time "
+                         "(robobore compare --system NAME), a posture column in the CSV when "
+                         "they differ by posture, or one sweep per results folder",
             )
         sims[k] = (cond, summ)
 
@@ -331,17 +336,78 @@ def compare(measured: MeasuredTable,
     )
 
 
-def compare_results(measured_csv: str | Path, results_dir: str | Path) -> Comparison:
-    """Compare a measured CSV with every finished condition of a results store."""
+#: label of results whose store does not name the simulated system (``robobore sweep``)
+UNLABELLED = "sweep"
+
+
+def result_system(path: str | Path) -> str:
+    """The simulated system of a stored result: ``runner_options.system`` of its stored config
+    (``robobore paper`` labels ``robot`` and ``machine_tool``), else :data:`UNLABELLED`."""
+    import json
+
+    import netCDF4
+
+    try:
+        with netCDF4.Dataset(path) as nc:
+            text = nc.getncattr("robobore_config") if "robobore_config" in nc.ncattrs() else ""
+    except OSError as exc:
+        raise DataError(f"cannot read result file ({exc})", file=str(path)) from None
+    try:
+        cfg = json.loads(text) if text else {}
+    except ValueError:
+        cfg = {}
+    opts = cfg.get("runner_options") if isinstance(cfg, dict) else None
+    label = opts.get("system") if isinstance(opts, dict) else None
+    return str(label) if label else UNLABELLED
+
+
+def resolve_store_dir(results_dir: str | Path) -> Path:
+    """The results store in ``results_dir``: the folder itself or, for the output folder of
+    ``robobore paper``, its ``sweep`` store."""
+    p = Path(results_dir)
+    if not (p / "store.json").is_file() and (p / "sweep" / "store.json").is_file():
+        return p / "sweep"
+    return p
+
+
+def compare_results(measured_csv: str | Path, results_dir: str | Path,
+                    system: str | None = None) -> Comparison:
+    """Compare a measured CSV with the finished conditions of a results store.
+
+    ``results_dir``: a store (``robobore sweep``) or the output folder of ``robobore paper``
+    (its ``sweep`` store). A store may hold several simulated systems (the paper's robot and
+    machine tool, told apart by :func:`result_system`); ``system`` chooses one, and by
+    default the robot is compared when the store holds it next to others."""
     from robobore.study.store import ResultsStore
 
     table = read_measured_csv(measured_csv)
-    store = ResultsStore.open_existing(results_dir)
-    sims = [(r.condition, r.summary) for r in store.records()]
-    if not sims:
-        raise DataError("the results store has no finished condition", file=str(results_dir),
-                        expected="a folder with results written by 'robobore sweep'")
-    return compare(table, sims)
+    store_dir = resolve_store_dir(results_dir)
+    store = ResultsStore.open_existing(store_dir)
+    by_system: dict[str, list[tuple[dict[str, Any], dict[str, Any]]]] = {}
+    for r in store.records():
+        by_system.setdefault(result_system(r.path), []).append((r.condition, r.summary))
+    if not by_system:
+        raise DataError("the results store has no finished condition", file=str(store_dir),
+                        expected="a folder with results written by 'robobore sweep' or "
+                                 "'robobore paper'")
+    systems = tuple(sorted(by_system))
+    if system is not None:
+        if system not in by_system:
+            raise DataError("no results of this system in the store", file=str(store_dir),
+                            field="--system", value=system,
+                            expected=f"one of {', '.join(systems)}")
+        chosen = system
+    elif len(systems) == 1:
+        chosen = systems[0]
+    elif "robot" in by_system:
+        chosen = "robot"
+    else:
+        raise DataError("the store holds results of several systems", file=str(store_dir),
+                        field="--system", expected=f"--system with one of {', '.join(systems)}")
+    cmp = compare(table, by_system[chosen])
+    from dataclasses import replace
+
+    return replace(cmp, system=chosen, systems=systems)
 
 
 __all__ = [
@@ -353,4 +419,6 @@ __all__ = [
     "read_measured_csv",
     "compare",
     "compare_results",
+    "result_system",
+    "resolve_store_dir",
 ]

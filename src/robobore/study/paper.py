@@ -104,7 +104,7 @@ class LobesSection(_Strict):
     speed_min_rpm: float = Field(150.0, gt=0)
     speed_max_rpm: float = Field(1100.0, gt=0)
     count: int = Field(200, ge=10, le=5000)
-    method: Literal["frequency", "semidiscretization"] = "frequency"
+    method: Literal["frequency", "semidiscretization"] = "semidiscretization"
 
 
 class MaterialSection(_Strict):
@@ -352,7 +352,8 @@ def build_plan(cfg: PaperConfig, robot_model: dict[str, Any],
     for system, model, c in runs:
         cond = Condition.from_dict(c)
         key = condition_key(cond, RUNNER, model, posture)
-        ctx = {"model": model, "runner_options": opts, "postures": {"paper": posture},
+        ctx = {"model": model, "runner_options": {**opts, "system": system},
+               "postures": {"paper": posture},
                "posture": posture, "seed": condition_seed(0, key), "key": key,
                "sweep": cfg.study.name}
         items.append(SweepItem(key=key, condition=cond.to_dict(), context=ctx))
