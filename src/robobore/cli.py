@@ -60,8 +60,16 @@ def _root(
     version: bool = typer.Option(
         False, "--version", callback=_version_callback, is_eager=True, help="Show the version."
     ),
+    no_range_check: bool = typer.Option(
+        False, "--no-range-check",
+        help="Accept values outside their plausible range (docs/inputs.md), with a warning; "
+        "recorded in the configs' provenance."),
 ) -> None:
     """robobore command line."""
+    if no_range_check:
+        from robobore.io.ranges import set_enabled
+
+        set_enabled(False)
 
 
 def _build() -> None:

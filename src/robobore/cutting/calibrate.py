@@ -118,6 +118,9 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
         if "calibration" not in data:
             cal.pop(k, None)
     cfg = validate_model(CalibrationConfig, cal, source=source)
+    from robobore.material.library import resolve_material_name
+
+    cfg.material = resolve_material_name(cfg.material, source, "material.name")
     smallest = min(cfg.uncut_chip_thickness_um)
     if cfg.fe.element_size_um > smallest / 3 + 1e-9:
         raise ConfigError("FE element too large for the thinnest chip", file=source,

@@ -22,7 +22,8 @@ Boring (rotating bar): instead of ``[process]`` give ``[insert]``, ``[bore]``, `
 and optionally ``[coefficients]``; instead of (or besides) ``[structure]`` an ``[equivalent]``
 section (per-direction stiffness, frequency and damping, optional ``[equivalent.pressure_foot]``).
 Optional ``[simulation]`` (revolutions, samples per revolution, roughness tolerance).
-Human units are in the key names and converted to SI here, once.
+Human units are in the key names and converted to SI here, once. ``[coefficients] file`` is
+resolved against the config file's folder (:mod:`robobore.io.paths`).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
+from robobore.io.paths import resolve_config_path
 
 
 def _unit(v: list[float], tol: float = 0.01) -> list[float]:
@@ -256,6 +258,13 @@ def load_dynamics_config(path: str | Path) -> tuple[DynamicsConfig, dict[str, An
     """Read and validate a config file; returns the model and the raw dict (for provenance)."""
     raw = load_toml(path)
     cfg = validate_model(DynamicsConfig, raw, source=path)
+    if cfg.coefficients is not None and cfg.coefficients.file is not None:
+        # the one rule (robobore.io.paths): relative to the config's folder; the absolute
+        # path goes into the config recorded in the results
+        f = str(resolve_config_path(cfg.coefficients.file, path, "coefficients.file",
+                                    what="coefficients file"))
+        cfg.coefficients.file = f
+        raw = {**raw, "coefficients": {**raw["coefficients"], "file": f}}
     return cfg, raw
 
 
@@ -284,10 +293,8 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
                                                     30.0 if vc is None else vc)
         return forces.ti64_coefficients(vc)
     if c.file is not None:
-        p = Path(c.file)
-        if not p.is_absolute() and source is not None:
-            p = Path(source).parent / p
-        return forces.load_coefficients(p)
+        return forces.load_coefficients(resolve_config_path(c.file, source, "coefficients.file",
+                                                            what="coefficients file"))
     d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
     d["provenance"] = c.provenance
     return forces.CuttingCoefficients.from_dict(d, source=source)

@@ -157,7 +157,36 @@ def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict
         raise ConfigError("lobe speed range empty", file=str(p), field="lobes.speed_max_rpm",
                           value=cfg.lobes.speed_max_rpm,
                           expected=f"> speed_min_rpm = {cfg.lobes.speed_min_rpm} r/min")
+    raw = _resolve_files(cfg, raw, p)
+    # the [calibration] section is validated even when --fast does not run it
+    from robobore.cutting.calibrate import calibration_from_mapping
+
+    calibration_from_mapping({"calibration": raw.get("calibration", {}),
+                              "insert": raw.get("insert", {}),
+                              "material": raw.get("material", {})}, source=str(p))
     return cfg, raw, p
+
+
+def _resolve_files(cfg: PaperConfig, raw: dict[str, Any], p: Path) -> dict[str, Any]:
+    """Files named in the config, resolved against its folder (robobore.io.paths); the
+    absolute paths replace the names in ``cfg`` and in the raw config kept as provenance."""
+    from robobore.io.paths import names_a_path, resolve_config_path
+
+    for sec, key, must, what in (("robot", "campaign", True, "campaign CSV"),
+                                 ("modal", "file", True, "hammer-test file"),
+                                 ("coefficients", "file", False, "coefficients file"),
+                                 ("measured", "file", True, "measured CSV")):
+        v = getattr(getattr(cfg, sec), key)
+        if v is None:
+            continue
+        a = str(resolve_config_path(v, p, f"{sec}.{key}", must_exist=must, what=what))
+        setattr(getattr(cfg, sec), key, a)
+        raw = {**raw, sec: {**raw.get(sec, {}), key: a}}
+    if names_a_path(cfg.robot.name):
+        a = str(resolve_config_path(cfg.robot.name, p, "robot.name", what="robot file"))
+        cfg.robot.name = a
+        raw = {**raw, "robot": {**raw.get("robot", {}), "name": a}}
+    return raw
 
 
 def _resolve(base: Path, name: str | None) -> Path | None:
@@ -254,7 +283,9 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
             raise ConfigError("stored coefficients file not found", file=str(cfg_path),
                               field="coefficients.file", value=str(p),
                               expected="a JSON file written by 'robobore calibrate forces'")
-        data = json.loads(p.read_text())
+        from robobore.cutting.forces import read_coefficients_file
+
+        data = read_coefficients_file(p)  # clear errors for a corrupt file; ranges checked
         data["file"] = str(p)
         data["mode"] = "stored (--fast)"
         return data

@@ -422,8 +422,13 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
 
 
 def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
-    """Validate a config dict (as read from TOML)."""
-    return check_config(validate_model(FEConfig, data, source=source or "<config>"), source)
+    """Validate a config dict (as read from TOML); a material file named in it is resolved
+    against the config file's folder (robobore.io.paths)."""
+    from robobore.material.library import resolve_material_name
+
+    cfg = validate_model(FEConfig, data, source=source or "<config>")
+    cfg.material.name = resolve_material_name(cfg.material.name, source)
+    return check_config(cfg, source)
 
 
 def load_fe_config(path: str | Path) -> FEConfig:
