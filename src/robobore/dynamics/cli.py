@@ -46,19 +46,23 @@ def lobes_cmd(
     import numpy as np
 
     from robobore.dynamics import stability
-    from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+    from robobore.dynamics.config import (
+        build_process,
+        build_structure,
+        load_dynamics_config,
+        speed_range,
+    )
 
     cfg, _ = load_dynamics_config(config)
     src = str(config)
     st = build_structure(cfg, src)
     pr = build_process(cfg, src)
-    sp = cfg.speed_rpm
-    speeds = (np.linspace(100.0, 3000.0, 300) if sp is None
-              else np.linspace(sp.min, sp.max, sp.count))
+    sp, default_note = speed_range(cfg)
+    speeds = np.linspace(sp.min, sp.max, sp.count)
     if method not in ("frequency", "semidiscretization"):
         raise ConfigError("unknown method", field="--method", value=method,
                           expected="frequency or semidiscretization")
-    notes = []
+    notes = [] if default_note is None else [default_note]
     if method == "frequency":
         res = stability.lobes_frequency_domain(st, pr, speeds)
         if pr.rotating:

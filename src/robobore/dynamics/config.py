@@ -22,6 +22,8 @@ Boring (rotating bar): instead of ``[process]`` give ``[insert]``, ``[bore]``, `
 and optionally ``[coefficients]``; instead of (or besides) ``[structure]`` an ``[equivalent]``
 section (per-direction stiffness, frequency and damping, optional ``[equivalent.pressure_foot]``).
 Optional ``[simulation]`` (revolutions, samples per revolution, roughness tolerance).
+Without ``[speed_rpm]`` the lobes use :data:`DEFAULT_SPEED_RPM` (100 .. 3000 r/min, 300
+speeds) and say so in their notes.
 Human units are in the key names and converted to SI here, once. ``[coefficients] file`` is
 resolved against the config file's folder (:mod:`robobore.io.paths`).
 """
@@ -163,6 +165,20 @@ class SpeedCfg(_Strict):
         if self.max <= self.min:
             raise ValueError("max must be larger than min (r/min)")
         return self
+
+
+#: The speed range of ``robobore lobes`` when the config has no ``[speed_rpm]`` section
+#: (r/min): 100 .. 3000 r/min, 300 speeds -- robotic boring's range; the command says so.
+DEFAULT_SPEED_RPM = SpeedCfg(min=100.0, max=3000.0, count=300)
+
+
+def speed_range(cfg: DynamicsConfig) -> tuple[SpeedCfg, str | None]:
+    """The ``[speed_rpm]`` section, or :data:`DEFAULT_SPEED_RPM` and a note saying so."""
+    if cfg.speed_rpm is not None:
+        return cfg.speed_rpm, None
+    d = DEFAULT_SPEED_RPM
+    return d, (f"no [speed_rpm] section: the default range {d.min:g} .. {d.max:g} r/min "
+               f"({d.count} speeds) is used")
 
 
 class InsertCfg(_Strict):
@@ -323,4 +339,4 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
 
 
 __all__ = ["DynamicsConfig", "load_dynamics_config", "build_structure", "build_process",
-           "build_coefficients"]
+           "build_coefficients", "DEFAULT_SPEED_RPM", "speed_range"]

@@ -71,15 +71,19 @@ class Range:
             return True
         return self.lo <= x <= self.hi
 
-    def describe(self) -> str:
+    def bounds(self) -> str:
+        """The range in words with its unit (``"magnitude 0 .. 50 m"``)."""
         unit = "" if self.unit == "-" else f" {self.unit}"
+        text = f"{self.lo:g} .. {self.hi:g}{unit}"
         if self.signed:
-            text = f"|value| in {self.lo:g} .. {self.hi:g}{unit}"
-        else:
-            text = f"{self.lo:g} .. {self.hi:g}{unit}"
+            text = "magnitude " + text
         if self.zero_ok and self.lo > 0:
-            text += " (or 0)"
-        return f"{text} ({self.quantity})"
+            text += ", or 0"
+        return text
+
+    def describe(self) -> str:
+        """The range and the quantity, as error messages give it."""
+        return f"{self.bounds()} ({self.quantity})"
 
     def slip_hint(self, v: float) -> str | None:
         for factor, words in self.slips:
@@ -166,8 +170,7 @@ RANGES: dict[str, Range] = {
     "temperature_K": Range("temperature", "K", 1.0, 5000.0,
                            examples="room 293 K; titanium melts at 1873 K"),
     "density_kg_m3": Range("density", "kg/m^3", 100.0, 3e4,
-                           slips=((1e3, "looks like g/cm^3 times 1e6; expected kg/m^3"),
-                                  (1e-3, "looks like g/cm^3; expected kg/m^3")),
+                           slips=((1e-3, "looks like g/cm^3; expected kg/m^3"),),
                            examples="metals 1700 .. 20000 kg/m^3"),
     "heat_capacity_J_kgK": Range("specific heat", "J/(kg K)", 10.0, 1e4,
                                  slips=((1e-3, "looks like kJ/(kg K); expected J/(kg K)"),)),
@@ -377,7 +380,7 @@ def range_table() -> list[dict[str, str]]:
     rows = []
     for key, r in RANGES.items():
         rows.append({"key": key, "quantity": r.quantity, "unit": r.unit,
-                     "range": r.describe().rsplit(" (", 1)[0],
+                     "range": r.bounds(),
                      "slips": "; ".join(w for _, w in r.slips), "examples": r.examples})
     return rows
 
