@@ -102,6 +102,15 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
     """
     from robobore.io.config import validate_model
 
+    if "calibration" in data:  # a typo'd section is an error, not ignored
+        from robobore.study.paper import PaperConfig  # a paper config is a calibration config
+
+        known = {"calibration", "insert", "material", "range_check", *PaperConfig.model_fields}
+        extra = sorted(set(data) - known)
+        if extra:
+            raise ConfigError("unknown section (a typo?)", file=source, field=extra[0],
+                              expected="the sections [calibration], [insert], [material] (or "
+                              "those of a paper config)")
     cal = dict(data.get("calibration", data))
     ins = data.get("insert", {}) if "calibration" in data else {}
     mat = data.get("material", {}) if "calibration" in data else {}

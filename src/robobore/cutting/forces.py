@@ -115,7 +115,8 @@ def read_coefficients_file(path: str | Path) -> dict[str, Any]:
             with p.open("rb") as fh:
                 data = tomllib.load(fh)
     except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"cannot parse: {exc}", file=str(p)) from None
+        raise ConfigError(f"cannot parse: {exc}", file=str(p),
+                          expected="a JSON or TOML coefficients file") from None
     except UnicodeDecodeError as exc:
         raise ConfigError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
                           expected="a UTF-8 JSON or TOML file") from None

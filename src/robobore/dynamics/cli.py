@@ -27,9 +27,15 @@ def _read_json(path: Path, what: str) -> dict[str, Any]:
     if not path.is_file():
         raise ConfigError(f"{what} file not found", file=str(path), expected="a JSON file")
     try:
-        return json.loads(path.read_text())
+        return json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
-        raise ConfigError(f"not valid JSON: {exc}", file=str(path)) from None
+        raise ConfigError(f"not valid JSON: {exc}", file=str(path),
+                          expected=f"a {what} JSON object") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(path),
+                          expected=f"a UTF-8 {what} JSON file") from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read: {exc.strerror or exc}", file=str(path)) from None
 
 
 # ----------------------------------------------------------------------------- lobes
@@ -161,6 +167,13 @@ def simulate_boring_cmd(
                                          <= 10.0):
         raise ConfigError("pressure out of range", field="--pressure-MPa", value=pressure_MPa,
                           expected="0 .. 10 MPa")
+    from robobore.io.ranges import check_value
+
+    for opt, v, name in (("--speed-rpm", speed_rpm, "speed_rpm"), ("--depth-mm", depth_mm,
+                         "depth_mm"), ("--feed-mm-per-rev", feed_mm_per_rev, "feed_mm_per_rev"),
+                         ("--pressure-MPa", pressure_MPa, "pressure_MPa")):
+        if v is not None:  # plausible ranges with unit-slip hints (robobore.io.ranges)
+            check_value(v, name, field=opt, kind=ConfigError)
     if out is not None and out.suffix != ".nc":
         raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
                           expected="a path ending in .nc")
@@ -258,9 +271,16 @@ def equivalent_cmd(
         foot = PressureFoot(pressure_Pa=foot_pressure_MPa * 1e6,
                             piston_area_m2=math.pi * (foot_piston_diameter_mm * 1e-3 / 2) ** 2,
                             normal_stiffness_N_per_m=foot_normal_stiffness_N_per_m)
-    em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
-                                                  damping_N_s_per_m=damping_N_s_per_m,
-                                                  foot=foot)
+    try:
+        em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
+                                                      damping_N_s_per_m=damping_N_s_per_m,
+                                                      foot=foot)
+    except ConfigError as exc:  # name the JSON file the bad key came from
+        src = modes_file if (exc.field or "").startswith("modes") else stiffness_file
+        if exc.file is not None or src is None:
+            raise
+        raise ConfigError(exc.message, file=str(src), field=exc.field, value=exc.value,
+                          expected=exc.expected) from None
     result = em.to_dict()
     result["table"] = em.table()
     result["tool_point_modes"] = em.tool_point_modes()

@@ -36,7 +36,8 @@ def load_toml(path: str | Path) -> dict[str, Any]:
         with p.open("rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"not valid TOML: {exc}", file=str(p)) from None
+        raise ConfigError(f"not valid TOML: {exc}", file=str(p),
+                          expected="a TOML file (key = value lines, [section] headers)") from None
     except UnicodeDecodeError as exc:
         raise ConfigError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
                           expected="a UTF-8 TOML file") from None
@@ -130,14 +131,43 @@ def validate_model(model: type[M], data: dict[str, Any], source: str | Path = "<
             msg = e.get("msg", "invalid")
             inp = e.get("input")
             shown = "" if isinstance(inp, dict) else f" (got {inp!r})"
-            lines.append(f"[{_loc(e)}] {msg}{shown}")
+            note = ""
+            if e.get("type") == "extra_forbidden":
+                keys = _keys_at(model, e.get("loc", ())[:-1])
+                msg = "unknown key (a typo?)"
+                note = f" -- the keys here: {', '.join(keys)}" if keys else ""
+            elif e.get("type") == "missing":
+                msg, shown = "required key missing", ""
+            lines.append(f"[{_loc(e) or 'top level'}] {msg}{shown}{note}")
         first = errs[0] if errs else {}
         first_in = first.get("input")
+        kind = first.get("type")
+        expected = {"extra_forbidden": "only the documented keys",
+                    "missing": "every required key"}.get(str(kind))
         # every line already shows its value: the structured ``value`` is set afterwards so
         # that the message does not repeat the first one
-        err = ConfigError("; ".join(lines), file=str(source), field=_loc(first) or None)
+        err = ConfigError("; ".join(lines), file=str(source), field=_loc(first) or None,
+                          expected=expected)
         err.value = None if isinstance(first_in, dict) else first_in
         raise err from None
+
+
+def _keys_at(model: Any, loc: tuple[Any, ...]) -> list[str]:
+    """The keys of the (sub-)model at ``loc`` (for "unknown key" messages)."""
+    cur = model
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        if not (isinstance(cur, type) and issubclass(cur, BaseModel)) or \
+                part not in cur.model_fields:
+            return []
+        ann = cur.model_fields[part].annotation
+        options = list(get_args(ann)) if get_origin(ann) in (Union, UnionType, list) else [ann]
+        cur = next((a for a in options if isinstance(a, type) and issubclass(a, BaseModel)),
+                   None)
+    if isinstance(cur, type) and issubclass(cur, BaseModel):
+        return [f.alias or n for n, f in cur.model_fields.items()]
+    return []
 
 
 def load_config(model: type[M], path: str | Path) -> M:

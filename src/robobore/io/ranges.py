@@ -109,7 +109,7 @@ RANGES: dict[str, Range] = {
     "length_um": Range("small length", "um", 0.0, 1e5, signed=True,
                        slips=((1e3, "looks like nm; expected um"),),
                        examples="edge radii, element sizes, amplitudes: 0.1 .. 1000 um"),
-    "depth_mm": Range("depth of cut", "mm", 0.0, 50.0,
+    "depth_mm": Range("depth of cut", "mm", 0.0, 20.0,
                       slips=((1e3, "looks like um; expected mm"),),
                       examples="boring: 0.01 .. 5 mm"),
     "feed_mm_per_rev": Range("feed per revolution", "mm/r", 0.0, 5.0,
@@ -196,6 +196,7 @@ BY_NAME: dict[str, str] = {
     "feed_mm_per_rev": "feed_mm_per_rev", "speed_rpm": "speed_rpm",
     "coherence": "coherence", "mpc": "ratio",
     "damping_ratio": "damping_ratio", "contact_damping_ratio": "damping_ratio",
+    "damping_ratios": "damping_ratio",
     "pressure_MPa": "pressure_MPa", "modal_mass_kg": "modal_mass_kg",
     "E": "modulus_Pa", "Kte_N_per_m": "edge_coefficient_N_per_m",
     "Kre_N_per_m": "edge_coefficient_N_per_m", "Kfe_N_per_m": "edge_coefficient_N_per_m",
@@ -283,7 +284,10 @@ def check_value(value: Any, name: str, *, file: str | None = None, row: int | No
     if rng is None or rng.contains(v):
         return v
     hint = rng.slip_hint(v)
-    msg = "value out of the plausible range" + (f" ({hint})" if hint else "")
+    if v < 0 and not rng.signed:
+        msg = "a negative value where a positive quantity is expected"
+    else:
+        msg = "value out of the plausible range" + (f" ({hint})" if hint else "")
     if allowed or not enabled():
         why = "allowed by [range_check]" if allowed else "range check off"
         loc = ", ".join(str(x) for x in (file, None if row is None else f"row {row}",

@@ -105,6 +105,20 @@ def read_uff(path: str | Path, frf_type: str | None = None) -> HammerRecords | F
                     value=sorted(ftypes), expected="dataset 58 func_type 1 (time) or 4 (FRF)")
 
 
+def _finite(r: dict[str, Any], p: str) -> None:
+    """A record's samples must be finite numbers (a NaN is not a measurement)."""
+    a = np.asarray(r["data"])
+    if not np.issubdtype(a.dtype, np.number):
+        raise DataError("record samples are not numbers", file=p,
+                        field=f"record {r.get('id2', '')}", value=str(a.dtype),
+                        expected="numeric samples")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise DataError("non-finite sample", file=p, field=f"record {r.get('id2', '')}",
+                        value=f"sample {i}: {a[i]!r}", expected="finite numbers")
+
+
 def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> HammerRecords:
     forces = [r for r in recs if int(r.get("ordinate_spec_data_type", 0)) == SPEC_FORCE]
     resps = [r for r in recs if int(r.get("ordinate_spec_data_type", 0)) != SPEC_FORCE]
@@ -133,6 +147,7 @@ def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> Hamm
     # Nyquist frequency within the plausible frequency range (a time axis scaled by 1e3..)
     check_value(0.5 / dt, "nyquist_Hz", file=p, field="abscissa_inc (as Nyquist frequency)")
     for r in recs:
+        _finite(r, p)
         if len(r["data"]) != n or not np.isclose(float(r["abscissa_inc"]), dt):
             raise DataError("time records differ in length or sampling", file=p,
                             field=f"record {r.get('id2', '')}",
@@ -209,6 +224,7 @@ def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
     frf_type = check_frf_type(frf_type, file=p)
     H = np.full((len(outputs), len(inputs), x.size), np.nan + 0j)
     for r in recs:
+        _finite(r, p)
         xr = np.asarray(r["x"], float)
         if xr.size != x.size or not np.allclose(xr, x):
             raise DataError("FRF records have different frequency axes", file=p,
