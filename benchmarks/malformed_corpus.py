@@ -390,7 +390,7 @@ def build_corpus(workdir: Path) -> list[Case]:
     cases.append(Case("UFF (identify modes)", "control: unchanged", {"hammer.uff": uff}, ufa,
                       False, ("hammer.uff",), control=True))
     for desc, blob, must in [
-        ("truncated at 50 %", uff[: len(uff) // 2], False),
+        ("truncated at 50 %", uff[: len(uff) // 2], True),
         ("truncated at 3 %", uff[: len(uff) // 33], True),
         ("UTF-16 encoded", uff.decode("latin-1").encode("utf-16"), True),
         ("binary junk", os.urandom(2000), True),
@@ -566,8 +566,10 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
     else:
         line = next((ln for ln in err.splitlines() if "error" in ln.lower()), err.strip())
         # the file, or the option with or without its dashes
-        named = any(n in line or n.lstrip("-").replace("-", "_") in line for n in c.names)
-        says = ("expected" in line.lower()) or ("got" in line)
+        named = any(n.lower() in line.lower()
+                    or n.lstrip("-").replace("-", "_").lower() in line.lower()
+                    for n in c.names)
+        says = any(w in line.lower() for w in ("expected", "got", "missing", "give "))
         c.outcome = "clear" if named and says else "vague"
         if c.control:
             c.outcome = "rejected"

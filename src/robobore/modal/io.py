@@ -65,6 +65,17 @@ def _uff_sets(path: Path, need: int = 58) -> list[dict[str, Any]]:
     p = Path(path)
     if not p.is_file():
         raise DataError("file not found", file=str(p), expected="a UFF (.uff/.unv) file")
+    try:  # a universal file ends with the "-1" delimiter of its last dataset; without it
+        # the file is cut short and the reader would silently drop the last records
+        with p.open("rb") as fh:
+            fh.seek(max(p.stat().st_size - 64, 0))
+            tail = fh.read().rstrip()
+    except OSError as exc:
+        raise DataError(f"cannot read: {exc.strerror or exc}", file=str(p)) from None
+    if not tail.endswith(b"-1"):
+        raise DataError("truncated or not a universal file: it does not end with the "
+                        "dataset delimiter '-1'", file=str(p),
+                        expected="a complete UFF file (every dataset closed by '    -1')")
     try:
         uff = pyuff.UFF(str(p))
         types = list(uff.get_set_types())

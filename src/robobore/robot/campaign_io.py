@@ -148,7 +148,8 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
     try:
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise DataError(f"not UTF-8 text ({exc.reason})", file=str(p)) from None
+        raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
+                        expected="a UTF-8 CSV file") from None
     return parse_campaign_text(text, source=str(p), robot=robot)
 
 
