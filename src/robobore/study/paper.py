@@ -87,7 +87,8 @@ class RobotSection(_Strict):
 
 class ModalSection(_Strict):
     file: str | None = None  # None: bundled SYNTHETIC hammer test
-    band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0])
+    band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0], min_length=2,
+                                 max_length=2, description="analysis band [lo, hi], Hz")
     n_modes: int = Field(5, ge=3, le=50)
     max_order: int = Field(40, ge=4, le=200)
 
@@ -153,6 +154,9 @@ def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict
     if any(v < 0 for v in cfg.study.pressure_MPa) or not cfg.study.pressure_MPa:
         raise ConfigError("bad foot pressures", file=str(p), field="study.pressure_MPa",
                           value=cfg.study.pressure_MPa, expected="a list of values >= 0 MPa")
+    if not 0.0 <= cfg.modal.band_Hz[0] < cfg.modal.band_Hz[1]:
+        raise ConfigError("empty analysis band", file=str(p), field="modal.band_Hz",
+                          value=cfg.modal.band_Hz, expected="[lo, hi] with 0 <= lo < hi (Hz)")
     if cfg.lobes.speed_max_rpm <= cfg.lobes.speed_min_rpm:
         raise ConfigError("lobe speed range empty", file=str(p), field="lobes.speed_max_rpm",
                           value=cfg.lobes.speed_max_rpm,
