@@ -419,3 +419,17 @@ def test_cli_no_range_check_option(tmp_path, monkeypatch):
     finally:
         ranges.set_enabled(True)
     assert "range_check" not in load_toml(tmp_path / "l.toml")
+
+
+def test_sweep_coefficients_file_is_config_relative(tmp_path, monkeypatch):
+    from robobore.study.conditions import load_sweep_config
+
+    coef = (DATA / "paper_example" / "tc4_fe_coefficients.json").read_text()
+    cfgdir = _stray_setup(tmp_path, monkeypatch, "coef.json", coef, "{}")
+    text = (EX / "sweep_demo.toml").read_text().split("[model]")[0]
+    text += ('[model]\nsystem = "robot"\n[model.dynamics.coefficients]\nfile = "coef.json"\n'
+             '[postures.paper]\njoints_deg = [0, 0, 0, 0, 0, 0]\n')
+    (cfgdir / "s.toml").write_text(text)
+    cfg, _ = load_sweep_config(cfgdir / "s.toml")
+    assert cfg.model["dynamics"]["coefficients"]["file"] == str(
+        (cfgdir / "coef.json").resolve())
