@@ -203,3 +203,60 @@ def _property(name: str, n: int):
 def test_corrupted_input_gives_result_or_error_naming_the_file(name, tmp_path_factory):
     n = 8 if name == "uff" else 30
     _property(name, n)(tmp_path_factory)
+
+
+# ----------------------------------------------------------------------------- unit slips
+_CAMP = DATA / "campaign_irb6600" / "campaign.csv"
+_LINES = _CAMP.read_text().splitlines()
+_HEAD = _LINES[0].split(",")
+_POS = [c for c in _HEAD if c.endswith("_m")]
+
+
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(row=st.integers(1, len(_LINES) - 1), col=st.sampled_from(_POS))
+def test_campaign_position_in_mm_is_never_silent(tmp_path, row, col):
+    """A laser-tracker or load-point position given in mm (x 1e3) in a metre column is an
+    error naming the file, the row and the column -- whichever cell it is."""
+    from robobore.errors import DataError
+    from robobore.robot.campaign_io import read_campaign
+
+    lines = list(_LINES)
+    cells = lines[row].split(",")
+    j = _HEAD.index(col)
+    v = float(cells[j]) * 1e3
+    cells[j] = repr(v)
+    lines[row] = ",".join(cells)
+    p = tmp_path / "campaign.csv"
+    p.write_text("\n".join(lines) + "\n")
+    if abs(v) <= 50.0:  # a position within 5 cm of the base: mm and m overlap
+        return
+    with pytest.raises(DataError) as ei:
+        read_campaign(p)
+    m = str(ei.value)
+    assert "campaign.csv" in m and f"row {row}" in m and col in m and "looks like mm" in m
+
+
+_TC4 = (PKG / "material" / "library" / "tc4.toml").read_text()
+_TC4_KEYS = re.findall(r"^(\w+) = (-?[\d.]+)", _TC4, flags=re.M)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(i=st.integers(0, len(_TC4_KEYS) - 1), factor=st.sampled_from([1e3, 1e6, 1e9]))
+def test_material_constant_slipped_by_1e3_or_more_is_refused(tmp_path, i, factor):
+    """Every constant of the bundled material, multiplied by 1e3, 1e6 or 1e9, is refused
+    (except those that are 0, and the reference strain rate, whose plausible range spans
+    1e-6 .. 1e6 1/s in published fits)."""
+    from robobore.errors import ConfigError
+    from robobore.material import load_material
+
+    key, val = _TC4_KEYS[i]
+    text = re.sub(rf"^{key} = {re.escape(val)}", f"{key} = {float(val) * factor!r}", _TC4,
+                  count=1, flags=re.M)
+    p = tmp_path / "m.toml"
+    p.write_text(text)
+    if float(val) == 0.0 or key == "eps_dot0_per_s":
+        return
+    with pytest.raises(ConfigError, match=rf"m\.toml.*{key}"):
+        load_material(p)

@@ -180,7 +180,21 @@ RANGES: dict[str, Range] = {
     "jc_C": Range("Johnson-Cook strain-rate constant C", "-", 0.0, 1.0),
     "jc_m": Range("Johnson-Cook thermal exponent m", "-", 0.0, 5.0),
     "jc_eps0": Range("Johnson-Cook reference strain rate", "1/s", 1e-6, 1e6),
-    "damage_D": Range("Johnson-Cook damage constant", "-", 0.0, 100.0, signed=True),
+    "damage_D1": Range("Johnson-Cook damage constant D1", "-", 0.0, 5.0, signed=True,
+                       examples="Ti-6Al-4V -0.09; "
+                       "4340 steel 0.05, Armco iron -2.20, OFHC copper 0.54 (Johnson & Cook 1985)"),
+    "damage_D2": Range("Johnson-Cook damage constant D2", "-", 0.0, 20.0, signed=True,
+                       examples="Ti-6Al-4V 0.25; "
+                       "4340 steel 3.44, Armco iron 5.43, OFHC copper 4.89"),
+    "damage_D3": Range("Johnson-Cook damage constant D3", "-", 0.0, 20.0, signed=True,
+                       examples="Ti-6Al-4V -0.5; "
+                       "4340 steel -2.12, Armco iron -0.47, OFHC copper -3.03"),
+    "damage_D4": Range("Johnson-Cook damage constant D4", "-", 0.0, 1.0, signed=True,
+                       examples="Ti-6Al-4V 0.014; "
+                       "4340 steel 0.002, Armco iron 0.016, OFHC copper 0.014"),
+    "damage_D5": Range("Johnson-Cook damage constant D5", "-", 0.0, 50.0, signed=True,
+                       examples="Ti-6Al-4V 3.87; "
+                       "4340 steel 0.61, Armco iron 0.63, OFHC copper 1.12"),
     "poisson": Range("Poisson's ratio", "-", 0.0, 0.5),
     "modal_mass_kg": Range("modal mass", "kg", 0.0, 1e6),
 }
@@ -189,7 +203,7 @@ RANGES: dict[str, Range] = {
 BY_NAME: dict[str, str] = {
     "johnson_cook.n": "jc_n", "johnson_cook.C": "jc_C", "johnson_cook.m": "jc_m",
     "johnson_cook.eps_dot0_per_s": "jc_eps0",
-    **{f"damage.D{i}": "damage_D" for i in range(1, 6)},
+    **{f"damage.D{i}": f"damage_D{i}" for i in range(1, 6)},
     "elastic.nu": "poisson", "thermal.taylor_quinney": "ratio",
     "d_m": "length_m", "a_m": "length_m", "tcp_m": "length_m",
     "depth_mm": "depth_mm", "depth_of_cut_mm": "depth_mm",
