@@ -165,9 +165,16 @@ def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict
     # the [calibration] section is validated even when --fast does not run it
     from robobore.cutting.calibrate import calibration_from_mapping
 
-    calibration_from_mapping({"calibration": raw.get("calibration", {}),
-                              "insert": raw.get("insert", {}),
-                              "material": raw.get("material", {})}, source=str(p))
+    try:
+        calibration_from_mapping({"calibration": raw.get("calibration", {}),
+                                  "insert": raw.get("insert", {}),
+                                  "material": raw.get("material", {})}, source=str(p))
+    except ConfigError as exc:  # keys of the calibration model: name them in the file's terms
+        f = exc.field or ""
+        if f and not f.startswith(("calibration", "insert", "material")):
+            raise ConfigError(exc.message, file=exc.file, field=f"calibration.{f}",
+                              value=exc.value, expected=exc.expected) from None
+        raise
     return cfg, raw, p
 
 
