@@ -433,3 +433,22 @@ def test_sweep_coefficients_file_is_config_relative(tmp_path, monkeypatch):
     cfg, _ = load_sweep_config(cfgdir / "s.toml")
     assert cfg.model["dynamics"]["coefficients"]["file"] == str(
         (cfgdir / "coef.json").resolve())
+
+
+def test_uff_frf_frequency_axis_scaled_by_1e9_refused(tmp_path):
+    from dataclasses import replace
+
+    from robobore.modal.example import example_path
+    from robobore.modal.frf import estimate_frf
+    from robobore.modal.io import load_input, write_uff_frf
+
+    frf = estimate_frf(load_input(example_path())).frf
+    good = write_uff_frf(frf, tmp_path / "frf.uff")
+    load_input(good)  # the clean file reads
+    bad = write_uff_frf(replace(frf, frequency_Hz=frf.frequency_Hz * 1e9), tmp_path / "b.uff")
+    with pytest.raises(DataError, match=r"b\.uff.*frequency axis"):
+        load_input(bad)
+    text = (tmp_path / "frf.uff").read_bytes()
+    (tmp_path / "t.uff").write_bytes(text[: len(text) // 2])
+    with pytest.raises(DataError, match=r"t\.uff.*truncated"):
+        load_input(tmp_path / "t.uff")
