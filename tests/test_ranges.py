@@ -452,3 +452,38 @@ def test_uff_frf_frequency_axis_scaled_by_1e9_refused(tmp_path):
     (tmp_path / "t.uff").write_bytes(text[: len(text) // 2])
     with pytest.raises(DataError, match=r"t\.uff.*truncated"):
         load_input(tmp_path / "t.uff")
+
+
+def test_paper_band_and_corrupt_stored_coefficients(tmp_path):
+    """Two of the issue's tracebacks: band_Hz = [3] and a corrupt coefficients JSON under
+    --fast are clear errors naming the file."""
+    from robobore.study.paper import load_or_calibrate, load_paper_config
+
+    src = DATA / "paper_example"
+    text = (src / "paper.toml").read_text()
+    assert "band_Hz = [3.0, 60.0]" in text
+    shutil.copy(src / "measured_synthetic.csv", tmp_path)
+    (tmp_path / "paper.toml").write_text(text.replace("band_Hz = [3.0, 60.0]", "band_Hz = [3]"))
+    shutil.copy(src / "tc4_fe_coefficients.json", tmp_path)
+    with pytest.raises(ConfigError, match=r"paper\.toml.*modal\.band_Hz"):
+        load_paper_config(tmp_path / "paper.toml")
+    (tmp_path / "paper.toml").write_text(text)
+    cfg, raw, p = load_paper_config(tmp_path / "paper.toml")
+    (tmp_path / "tc4_fe_coefficients.json").write_text('{"coefficients": {"Ktc_N_per_m2": ')
+    with pytest.raises(ConfigError, match=r"tc4_fe_coefficients\.json.*cannot parse"):
+        load_or_calibrate(cfg, raw, p, True, 1)
+    (tmp_path / "tc4_fe_coefficients.json").write_text("[]")
+    with pytest.raises(ConfigError, match=r"tc4_fe_coefficients\.json.*not a table"):
+        load_or_calibrate(cfg, raw, p, True, 1)
+
+
+def test_robot_file_lengths_in_mm_refused(tmp_path):
+    from robobore.robot.kinematics import load_robot_file
+
+    src = ROOT / "src" / "robobore" / "robot" / "library" / "irb6600-175-2.55.toml"
+    text = src.read_text()
+    assert "d_m = [0.780, 0.0, 0.0, 1.142, 0.0, 0.200]" in text
+    (tmp_path / "r.toml").write_text(text.replace("d_m = [0.780, 0.0, 0.0, 1.142, 0.0, 0.200]",
+                                                  "d_m = [780.0, 0.0, 0.0, 1142.0, 0.0, 200.0]"))
+    with pytest.raises(ConfigError, match=r"r\.toml.*d_m\.0.*looks like mm; expected m"):
+        load_robot_file(tmp_path / "r.toml")
