@@ -65,11 +65,19 @@ def _root(
     debug: bool = typer.Option(
         False, "--debug", help="Show the Python traceback of an error (for bug reports)."
     ),
+    no_range_check: bool = typer.Option(
+        False, "--no-range-check",
+        help="Accept values outside their plausible range (docs/inputs.md), with a warning; "
+        "recorded in the configs' provenance."),
 ) -> None:
     """robobore command line."""
     from robobore.clitools import DEBUG
 
     DEBUG["on"] = debug
+    if no_range_check:
+        from robobore.io.ranges import set_enabled
+
+        set_enabled(False)
 
 
 def _build() -> None:

@@ -8,6 +8,7 @@ progress bar on stderr for anything slow, and a one-line error (exit code 2) for
 from __future__ import annotations
 
 import functools
+import math
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
@@ -174,4 +175,10 @@ def parse_floats(text: str, n: int | None, option: str, unit: str) -> list[float
             value=text,
             expected=f"{n} comma-separated numbers in {unit}",
         )
+    from robobore.io.ranges import check_value
+
+    for v in vals:  # NaN refused; plausible range of the option's unit (io.ranges)
+        if not math.isinf(v):
+            check_value(v, option.lstrip("-").replace("-", "_"), field=option,
+                        kind=ConfigError)
     return vals

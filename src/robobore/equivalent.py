@@ -45,12 +45,26 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import ConfigError
+from robobore.io.ranges import check_value
 
 AXES = ("x", "y", "z")
 _AXIS_VEC = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 
+def _xyz(d: Any, key: str) -> dict[str, Any]:
+    """The ``{"x", "y", "z"}`` table under ``key`` (a list or number there is an error)."""
+    v = d.get(key) if isinstance(d, dict) else None
+    if not isinstance(v, dict):
+        raise ConfigError("not a table over x, y, z", field=key,
+                          value=v if not isinstance(v, dict | list) else type(v).__name__,
+                          expected='{"x": .., "y": .., "z": ..}')
+    return v
+
+
 def _positive(name: str, value: Any, unit: str) -> float:
+    if isinstance(value, bool):
+        raise ConfigError("a boolean where a number is expected", field=name, value=value,
+                          expected=f"a positive number in {unit}")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -59,10 +73,13 @@ def _positive(name: str, value: Any, unit: str) -> float:
     if not math.isfinite(v) or v <= 0.0:
         raise ConfigError("must be positive and finite", field=name, value=value,
                           expected=f"a positive number in {unit}")
-    return v
+    return check_value(v, name, kind=ConfigError)  # plausible range of the unit
 
 
 def _nonneg(name: str, value: Any, unit: str) -> float:
+    if isinstance(value, bool):
+        raise ConfigError("a boolean where a number is expected", field=name, value=value,
+                          expected=f"a number >= 0 in {unit}")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -71,7 +88,7 @@ def _nonneg(name: str, value: Any, unit: str) -> float:
     if not math.isfinite(v) or v < 0.0:
         raise ConfigError("must be >= 0 and finite", field=name, value=value,
                           expected=f"a number >= 0 in {unit}")
-    return v
+    return check_value(v, name, kind=ConfigError)  # plausible range of the unit
 
 
 @dataclass(frozen=True)
@@ -258,10 +275,7 @@ class EquivalentModel:
             except (KeyError, TypeError):
                 raise ConfigError("missing key", field="directional_stiffness_N_per_m",
                                   expected='{"x": .., "y": .., "z": ..} in N/m') from None
-            if not isinstance(ks, dict):
-                raise ConfigError("not a table of x, y, z values",
-                                  field="directional_stiffness_N_per_m", value=ks,
-                                  expected='{"x": .., "y": .., "z": ..} in N/m')
+            ks = _xyz(stiffness, "directional_stiffness_N_per_m")
         try:
             ml = modes["modes"]
         except (KeyError, TypeError):
@@ -273,6 +287,10 @@ class EquivalentModel:
         if len(ml) < 1:
             raise ConfigError("no modes given", field="modes", expected="at least one mode")
         for i, md in enumerate(ml):
+            if not isinstance(md, dict):
+                raise ConfigError("mode is not a table", field=f"modes[{i}]",
+                                  value=type(md).__name__,
+                                  expected='{"frequency_Hz": .., "damping_ratio": ..}')
             _positive(f"modes[{i}].frequency_Hz", md.get("frequency_Hz"), "Hz")
             _nonneg(f"modes[{i}].damping_ratio", md.get("damping_ratio", 0.0), "(ratio)")
         if R is not None:  # compare mode directions with the principal axes
@@ -345,10 +363,11 @@ class EquivalentModel:
         for key in ("stiffness_N_per_m", "frequency_Hz", "damping_ratio"):
             if key not in d:
                 raise ConfigError("missing key", field=key, expected="a dict over x, y, z")
-        k = {a: _positive(f"stiffness_N_per_m.{a}", d["stiffness_N_per_m"].get(a), "N/m")
+        k = {a: _positive(f"stiffness_N_per_m.{a}", _xyz(d, "stiffness_N_per_m").get(a), "N/m")
              for a in AXES}
-        f = {a: _positive(f"frequency_Hz.{a}", d["frequency_Hz"].get(a), "Hz") for a in AXES}
-        z = {a: _nonneg(f"damping_ratio.{a}", d["damping_ratio"].get(a), "(ratio)")
+        f = {a: _positive(f"frequency_Hz.{a}", _xyz(d, "frequency_Hz").get(a), "Hz")
+             for a in AXES}
+        z = {a: _nonneg(f"damping_ratio.{a}", _xyz(d, "damping_ratio").get(a), "(ratio)")
              for a in AXES}
         frame = d.get("frame", np.eye(3).tolist())
         foot = None if d.get("foot") is None else PressureFoot.from_dict(d["foot"])

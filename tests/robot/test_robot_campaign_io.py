@@ -41,6 +41,8 @@ def _join(header, rows):
 # --- property tests ---------------------------------------------------------------------------
 
 finite = st.floats(-1e4, 1e4, allow_nan=False, allow_infinity=False)
+#: positions within the plausible range of robobore.io.ranges (|x| <= 50 m)
+position = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
 
 @st.composite
@@ -54,8 +56,8 @@ def campaigns(draw):
     pr = []
     for p in range(n_p):
         qp = [draw(st.floats(-170, 170, allow_nan=False)) for _ in range(6)]
-        lpp = [draw(finite) for _ in range(3)]
-        off = np.array([draw(finite) for _ in range(3)])
+        lpp = [draw(position) for _ in range(3)]
+        off = np.array([draw(position) for _ in range(3)])
         for s in range(n_s):
             Fs = [0.0, 0.0, 0.0] if s == 0 else [draw(finite) for _ in range(3)]
             ps = draw(st.floats(0, 1, allow_nan=False))

@@ -84,7 +84,7 @@ def test_campaign_then_identify_then_stiffness_chain(tmp_path):
     (["robot", "fk", "--joints-deg", "0,85,0,0,0,0"], "joint 2"),
     (["robot", "fk", "--joints-deg", "0,1,2"], "--joints-deg"),
     (["robot", "stiffness", "--joints-deg", PAPER, "--joint-stiffness-Nm-per-rad",
-      "1,2,3,4,5,-6"], "positive"),
+      "1e6,2e6,3e6,4e6,5e6,-6e6"], "positive"),
     (["identify", "stiffness"], "no campaign file"),
 ])
 def test_errors_exit_2_with_one_line(args, needle):

@@ -142,6 +142,12 @@ def test_missing_file_and_non_utf8(tmp_path):
 
 finite_pos = st.floats(min_value=1e-6, max_value=1e6, allow_nan=False, allow_infinity=False)
 finite_nonneg = st.floats(min_value=0, max_value=1e6, allow_nan=False, allow_infinity=False)
+
+
+def _upto(hi, lo=1e-6):  # within the plausible range of robobore.io.ranges
+    return st.floats(min_value=lo, max_value=hi, allow_nan=False, allow_infinity=False)
+
+
 QUANTS = ["force_amplitude_x_N", "force_amplitude_y_N", "force_amplitude_z_N",
           "feed_amplitude_um", "stable"]
 
@@ -150,7 +156,7 @@ QUANTS = ["force_amplitude_x_N", "force_amplitude_y_N", "force_amplitude_z_N",
 def tables(draw):
     quants = draw(st.lists(st.sampled_from(QUANTS), min_size=1, max_size=5, unique=True))
     n = draw(st.integers(1, 8))
-    conds = draw(st.lists(st.tuples(finite_pos, finite_pos, finite_pos, finite_nonneg),
+    conds = draw(st.lists(st.tuples(_upto(1e5), _upto(5.0), _upto(20.0), _upto(50.0, 0.0)),
                           min_size=n, max_size=n,
                           unique_by=lambda t: tuple(float(f"{v:.9g}") for v in t)))
     rows = []
@@ -158,7 +164,7 @@ def tables(draw):
         vals = {}
         for q in quants:
             if draw(st.booleans()):  # some cells left empty (= not measured)
-                vals[q] = draw(st.booleans()) if q == "stable" else draw(finite_nonneg)
+                vals[q] = draw(st.booleans()) if q == "stable" else draw(_upto(1e5, 0.0))
         rows.append((c, vals))
     return quants, rows
 

@@ -102,6 +102,15 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
     """
     from robobore.io.config import validate_model
 
+    if "calibration" in data:  # a typo'd section is an error, not ignored
+        from robobore.study.paper import PaperConfig  # a paper config is a calibration config
+
+        known = {"calibration", "insert", "material", "range_check", *PaperConfig.model_fields}
+        extra = sorted(set(data) - known)
+        if extra:
+            raise ConfigError("unknown section (a typo?)", file=source, field=extra[0],
+                              expected="the sections [calibration], [insert], [material] (or "
+                              "those of a paper config)")
     cal = dict(data.get("calibration", data))
     ins = data.get("insert", {}) if "calibration" in data else {}
     mat = data.get("material", {}) if "calibration" in data else {}
@@ -118,6 +127,9 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
         if "calibration" not in data:
             cal.pop(k, None)
     cfg = validate_model(CalibrationConfig, cal, source=source)
+    from robobore.material.library import resolve_material_name
+
+    cfg.material = resolve_material_name(cfg.material, source, "material.name")
     smallest = min(cfg.uncut_chip_thickness_um)
     if cfg.fe.element_size_um > smallest / 3 + 1e-9:
         raise ConfigError("FE element too large for the thinnest chip", file=source,

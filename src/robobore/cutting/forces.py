@@ -45,6 +45,7 @@ import numpy as np
 
 from robobore.cutting.geometry import BoringInsert, EdgeElements, edge_elements
 from robobore.errors import ConfigError
+from robobore.io.ranges import check_value
 
 COEFF_DIR = Path(__file__).with_name("coefficients")
 DUCOBU_FILE = COEFF_DIR / "ti64_orthogonal_cutting_forces.json"
@@ -91,17 +92,17 @@ class CuttingCoefficients:
                     raise ConfigError("missing key", file=source, field=key,
                                       expected="a number in N/m^2")
                 continue
-            try:
-                vals[short] = float(d[key])
-            except (TypeError, ValueError):
-                raise ConfigError("not a number", file=source, field=key, value=d[key],
-                                  expected="a number") from None
+            # a number (never a boolean), finite, within the plausible range of its unit
+            # (robobore.io.ranges: N/mm^2 for N/m^2 is refused with a hint)
+            vals[short] = check_value(d[key], key, file=source, field=key, kind=ConfigError)
         vals.setdefault("Krc", 0.0)
         return cls(**vals, provenance=str(d.get("provenance", source or "user")))
 
 
-def load_coefficients(path: str | Path) -> CuttingCoefficients:
-    """Load a coefficient file (TOML or JSON, keys as :meth:`CuttingCoefficients.to_dict`)."""
+def read_coefficients_file(path: str | Path) -> dict[str, Any]:
+    """The content of a coefficient file (TOML or JSON) as a dict, its coefficients checked
+    (:meth:`CuttingCoefficients.from_dict`); unreadable, non-UTF-8 or unparsable files and a
+    top level that is not a table are a ConfigError naming the file."""
     p = Path(path)
     if not p.is_file():
         raise ConfigError("coefficient file not found", file=str(p),
@@ -114,9 +115,23 @@ def load_coefficients(path: str | Path) -> CuttingCoefficients:
         from robobore.io.config import load_toml
 
         data = load_toml(p)
+    if not isinstance(data, dict):
+        raise ConfigError("not a table of coefficients", file=str(p), value=type(data).__name__,
+                          expected='an object {"coefficients": {"Ktc_N_per_m2": ..., ...}}')
+    inner = data.get("coefficients", data)
+    if not isinstance(inner, dict):
+        raise ConfigError("not a table of coefficients", file=str(p), field="coefficients",
+                          value=type(inner).__name__, expected='{"Ktc_N_per_m2": ..., ...}')
+    CuttingCoefficients.from_dict(inner, source=str(p))
+    return data
+
+
+def load_coefficients(path: str | Path) -> CuttingCoefficients:
+    """Load a coefficient file (TOML or JSON, keys as :meth:`CuttingCoefficients.to_dict`)."""
+    data = read_coefficients_file(path)
     if "coefficients" in data and isinstance(data["coefficients"], dict):
         data = data["coefficients"]
-    return CuttingCoefficients.from_dict(data, source=str(p))
+    return CuttingCoefficients.from_dict(data, source=str(path))
 
 
 # ---------------------------------------------------------------------------- fitting

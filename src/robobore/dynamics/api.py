@@ -163,9 +163,10 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     cfg, _, src = _config(config)
     st = build_structure(cfg, src)
     pr = build_process(cfg, src)
-    sp = cfg.speed_rpm
-    speeds = (np.linspace(100.0, 3000.0, 300) if sp is None
-              else np.linspace(sp.min, sp.max, sp.count))
+    from robobore.dynamics.config import speed_range
+
+    sp, default_note = speed_range(cfg)  # DEFAULT_SPEED_RPM without [speed_rpm]
+    speeds = np.linspace(sp.min, sp.max, sp.count)
     if method == "frequency":
         res = stability.lobes_frequency_domain(st, pr, speeds)
     elif method == "semidiscretization":
@@ -176,6 +177,8 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     d = res.to_dict()
     mc = stability.mode_coupling_limit(st, pr)
     d["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
+    if default_note is not None:
+        d["speed_note"] = default_note
     return d
 
 

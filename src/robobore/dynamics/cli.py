@@ -61,7 +61,12 @@ def lobes_cmd(
     import numpy as np
 
     from robobore.dynamics import stability
-    from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+    from robobore.dynamics.config import (
+        build_process,
+        build_structure,
+        load_dynamics_config,
+        speed_range,
+    )
     from robobore.io.outputs import check_output_dir
 
     check_output_dir(plot, "--plot", "lobes.png")
@@ -69,13 +74,12 @@ def lobes_cmd(
     src = str(config)
     st = build_structure(cfg, src)
     pr = build_process(cfg, src)
-    sp = cfg.speed_rpm
-    speeds = (np.linspace(100.0, 3000.0, 300) if sp is None
-              else np.linspace(sp.min, sp.max, sp.count))
+    sp, default_note = speed_range(cfg)
+    speeds = np.linspace(sp.min, sp.max, sp.count)
     if method not in ("frequency", "semidiscretization"):
         raise ConfigError("unknown method", field="--method", value=method,
                           expected="frequency or semidiscretization")
-    notes = []
+    notes = [] if default_note is None else [default_note]
     if method == "frequency":
         res = stability.lobes_frequency_domain(st, pr, speeds)
         if pr.rotating:
@@ -191,6 +195,13 @@ def simulate_boring_cmd(
                                          <= 10.0):
         raise ConfigError("pressure out of range", field="--pressure-MPa", value=pressure_MPa,
                           expected="0 .. 10 MPa")
+    from robobore.io.ranges import check_value
+
+    for opt, v, name in (("--speed-rpm", speed_rpm, "speed_rpm"), ("--depth-mm", depth_mm,
+                         "depth_mm"), ("--feed-mm-per-rev", feed_mm_per_rev, "feed_mm_per_rev"),
+                         ("--pressure-MPa", pressure_MPa, "pressure_MPa")):
+        if v is not None:  # plausible ranges with unit-slip hints (robobore.io.ranges)
+            check_value(v, name, field=opt, kind=ConfigError)
     if out is not None and out.suffix != ".nc":
         raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
                           expected="a path ending in .nc")
@@ -307,12 +318,12 @@ def equivalent_cmd(
         em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
                                                       damping_N_s_per_m=damping_N_s_per_m,
                                                       foot=foot)
-    except ConfigError as exc:  # name the file the bad key came from
+    except ConfigError as exc:  # name the JSON file the bad key came from
         src = modes_file if (exc.field or "").startswith("modes") else stiffness_file
-        if exc.file is None and src is not None:
-            raise ConfigError(exc.message, file=str(src), field=exc.field, value=exc.value,
-                              expected=exc.expected) from None
-        raise
+        if exc.file is not None or src is None:
+            raise
+        raise ConfigError(exc.message, file=str(src), field=exc.field, value=exc.value,
+                          expected=exc.expected) from None
     result = em.to_dict()
     result["table"] = em.table()
     result["tool_point_modes"] = em.tool_point_modes()

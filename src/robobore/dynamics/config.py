@@ -22,7 +22,10 @@ Boring (rotating bar): instead of ``[process]`` give ``[insert]``, ``[bore]``, `
 and optionally ``[coefficients]``; instead of (or besides) ``[structure]`` an ``[equivalent]``
 section (per-direction stiffness, frequency and damping, optional ``[equivalent.pressure_foot]``).
 Optional ``[simulation]`` (revolutions, samples per revolution, roughness tolerance).
-Human units are in the key names and converted to SI here, once.
+Without ``[speed_rpm]`` the lobes use :data:`DEFAULT_SPEED_RPM` (100 .. 3000 r/min, 300
+speeds) and say so in their notes.
+Human units are in the key names and converted to SI here, once. ``[coefficients] file`` is
+resolved against the config file's folder (:mod:`robobore.io.paths`).
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
+from robobore.io.paths import resolve_config_path
 
 
 def _unit(v: list[float], tol: float = 0.01) -> list[float]:
@@ -173,6 +177,20 @@ class SpeedCfg(_Strict):
         return self
 
 
+#: The speed range of ``robobore lobes`` when the config has no ``[speed_rpm]`` section
+#: (r/min): 100 .. 3000 r/min, 300 speeds -- robotic boring's range; the command says so.
+DEFAULT_SPEED_RPM = SpeedCfg(min=100.0, max=3000.0, count=300)
+
+
+def speed_range(cfg: DynamicsConfig) -> tuple[SpeedCfg, str | None]:
+    """The ``[speed_rpm]`` section, or :data:`DEFAULT_SPEED_RPM` and a note saying so."""
+    if cfg.speed_rpm is not None:
+        return cfg.speed_rpm, None
+    d = DEFAULT_SPEED_RPM
+    return d, (f"no [speed_rpm] section: the default range {d.min:g} .. {d.max:g} r/min "
+               f"({d.count} speeds) is used")
+
+
 class InsertCfg(_Strict):
     nose_radius_mm: float = Field(0.4, gt=0, le=10)
     approach_angle_deg: float = Field(90.0, gt=0, le=90)
@@ -274,19 +292,12 @@ class DynamicsConfig(_Strict):
 
 
 def _read_json_file(path: Path, what: str, source: str) -> dict[str, Any]:
-    import json
+    from robobore.io.readers import load_json
 
     if not path.is_file():
         raise ConfigError(f"{what} file not found", file=str(path),
                           expected=f"an existing JSON file (named in {source})")
-    try:
-        d = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"not valid JSON: {exc}", file=str(path)) from None
-    if not isinstance(d, dict):
-        raise ConfigError("not a JSON object", file=str(path),
-                          expected=f"the JSON object written by {what}")
-    return d
+    return load_json(path, f"{what} file", f"the JSON object written by {what}")
 
 
 def resolve_model_files(raw: dict[str, Any], path: str | Path,
@@ -385,6 +396,13 @@ def load_dynamics_config(path: str | Path, stiffness_file: str | Path | None = N
     raw = resolve_model_files(load_toml(path), path, stiffness_file, modes_file,
                               equivalent_file)
     cfg = validate_model(DynamicsConfig, raw, source=path)
+    if cfg.coefficients is not None and cfg.coefficients.file is not None:
+        # the one rule (robobore.io.paths): relative to the config's folder; the absolute
+        # path goes into the config recorded in the results
+        f = str(resolve_config_path(cfg.coefficients.file, path, "coefficients.file",
+                                    what="coefficients file"))
+        cfg.coefficients.file = f
+        raw = {**raw, "coefficients": {**raw["coefficients"], "file": f}}
     return cfg, raw
 
 
@@ -413,10 +431,8 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
                                                     30.0 if vc is None else vc)
         return forces.ti64_coefficients(vc)
     if c.file is not None:
-        p = Path(c.file)
-        if not p.is_absolute() and source is not None:
-            p = Path(source).parent / p
-        return forces.load_coefficients(p)
+        return forces.load_coefficients(resolve_config_path(c.file, source, "coefficients.file",
+                                                            what="coefficients file"))
     d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
     d["provenance"] = c.provenance
     return forces.CuttingCoefficients.from_dict(d, source=source)
@@ -445,4 +461,4 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
 
 
 __all__ = ["DynamicsConfig", "load_dynamics_config", "resolve_model_files", "build_structure",
-           "build_process", "build_coefficients"]
+           "build_process", "build_coefficients", "DEFAULT_SPEED_RPM", "speed_range"]

@@ -4,7 +4,8 @@ A material file has the tables ``[johnson_cook]`` (A_MPa, B_MPa, n, C, m, eps_do
 T_room_K, T_melt_K; optional hardening_strain_limit), ``[damage]`` (D1..D5), ``[elastic]``
 (E_GPa, nu) and ``[thermal]`` (rho_kg_m3, cp_J_kgK, k_W_mK, taylor_quinney). Bundled files live in
 ``robobore/material/library/``; :func:`load_material` takes a bundled name (``"TC4"``) or a
-path to a TOML file.
+path to a TOML file; a relative path is resolved against the folder of the config file that
+names it (``source``), never the current directory.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
+from robobore.io.paths import config_dir, names_a_path, resolve_config_path
 from robobore.material import johnson_cook as jc
 
 
@@ -173,11 +175,21 @@ def load_material(name_or_path: str | Path, *, source: str | None = None,
     return mat
 
 
+def resolve_material_name(name: str | Path, source: str | None = None,
+                          field: str = "material.name") -> str:
+    """A material named in the config ``source``: a bundled name stays as it is; a path (it
+    ends in ``.toml``, has a folder part, or is a file next to the config) becomes the
+    absolute path, resolved against the config file's folder (:mod:`robobore.io.paths`)."""
+    s = str(name)
+    if names_a_path(s) or (s and (config_dir(source) / s).is_file()):
+        return str(resolve_config_path(s, source, field, what="material file"))
+    return s
+
+
 def _load_material(name_or_path: str | Path, *, source: str | None, field: str) -> Material:
-    s = str(name_or_path)
-    p = Path(s)
-    if s.lower().endswith(".toml") or p.is_file():
-        return _from_file_data(load_toml(p), str(p))
+    s = resolve_material_name(name_or_path, source, field)
+    if Path(s).is_absolute():
+        return _from_file_data(load_toml(s), s)
     lib = resources.files("robobore.material") / "library" / f"{s.lower()}.toml"
     if not lib.is_file():
         raise ConfigError("unknown material", file=source, field=field, value=s,

@@ -76,7 +76,7 @@ def modes_cmd(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
-    from robobore.errors import ConfigError
+    from robobore.errors import ConfigError, IdentificationError, NumericalError
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
@@ -111,8 +111,11 @@ def modes_cmd(
             raise ConfigError("--exp-window-tau-s applies to time records only",
                               field="--exp-window-tau-s", value=exp_window_tau_s,
                               expected="no window option for FRF input")
-        an = identify_modes(data, band_Hz=band_hz, n_modes=modes, approx_Hz=approx,
-                            max_order=max_order)
+        try:
+            an = identify_modes(data, band_Hz=band_hz, n_modes=modes, approx_Hz=approx,
+                                max_order=max_order)
+        except (IdentificationError, NumericalError) as exc:  # say which data it was
+            raise type(exc)(f"{input_file}: {exc}") from None
         advance(1)
         res = an.result.to_dict()
         res["source"] = str(input_file)

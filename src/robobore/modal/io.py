@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import DataError
+from robobore.io.ranges import check_array, check_value
 from robobore.io.results import atomic_write_bytes
 from robobore.modal.frf import FRFData, HammerRecords, check_frf_type
 
@@ -63,6 +64,17 @@ def _uff_sets(path: Path, need: int = 58) -> list[dict[str, Any]]:
     p = Path(path)
     if not p.is_file():
         raise DataError("file not found", file=str(p), expected="a UFF (.uff/.unv) file")
+    try:  # a universal file ends with the "-1" delimiter of its last dataset; without it
+        # the file is cut short and the reader would silently drop the last records
+        with p.open("rb") as fh:
+            fh.seek(max(p.stat().st_size - 64, 0))
+            tail = fh.read().rstrip()
+    except OSError as exc:
+        raise DataError(f"cannot read: {exc.strerror or exc}", file=str(p)) from None
+    if not tail.endswith(b"-1"):
+        raise DataError("truncated or not a universal file: it does not end with the "
+                        "dataset delimiter '-1'", file=str(p),
+                        expected="a complete UFF file (every dataset closed by '    -1')")
     try:
         uff = pyuff.UFF(str(p))
         types = list(uff.get_set_types())
@@ -103,6 +115,20 @@ def read_uff(path: str | Path, frf_type: str | None = None) -> HammerRecords | F
                     value=sorted(ftypes), expected="dataset 58 func_type 1 (time) or 4 (FRF)")
 
 
+def _finite(r: dict[str, Any], p: str) -> None:
+    """A record's samples must be finite numbers (a NaN is not a measurement)."""
+    a = np.asarray(r["data"])
+    if not np.issubdtype(a.dtype, np.number):
+        raise DataError("record samples are not numbers", file=p,
+                        field=f"record {r.get('id2', '')}", value=str(a.dtype),
+                        expected="numeric samples")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise DataError("non-finite sample", file=p, field=f"record {r.get('id2', '')}",
+                        value=f"sample {i}: {a[i]!r}", expected="finite numbers")
+
+
 def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> HammerRecords:
     forces = [r for r in recs if int(r.get("ordinate_spec_data_type", 0)) == SPEC_FORCE]
     resps = [r for r in recs if int(r.get("ordinate_spec_data_type", 0)) != SPEC_FORCE]
@@ -128,7 +154,10 @@ def _read_time(p: str, recs: list[dict[str, Any]], lf: float, ff: float) -> Hamm
     if not dt > 0:
         raise DataError("abscissa increment must be > 0", file=p, field="abscissa_inc",
                         value=dt, expected="sampling interval in s")
+    # Nyquist frequency within the plausible frequency range (a time axis scaled by 1e3..)
+    check_value(0.5 / dt, "nyquist_Hz", file=p, field="abscissa_inc (as Nyquist frequency)")
     for r in recs:
+        _finite(r, p)
         if len(r["data"]) != n or not np.isclose(float(r["abscissa_inc"]), dt):
             raise DataError("time records differ in length or sampling", file=p,
                             field=f"record {r.get('id2', '')}",
@@ -194,6 +223,7 @@ def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
     outputs = sorted({(int(r["rsp_node"]), int(r["rsp_dir"])) for r in recs})
     inputs = sorted({(int(r["ref_node"]), int(r["ref_dir"])) for r in recs})
     x = np.asarray(recs[0]["x"], float)
+    check_array(x, "frequency_Hz", file=p, field="abscissa (frequency axis)")
     if frf_type is None:
         specs = {int(r.get("ordinate_spec_data_type", 0)) for r in recs}
         if len(specs) != 1 or next(iter(specs)) not in FRF_TYPE_BY_SPEC:
@@ -204,6 +234,7 @@ def _read_frf(p: str, recs: list[dict[str, Any]], lf: float, ff: float,
     frf_type = check_frf_type(frf_type, file=p)
     H = np.full((len(outputs), len(inputs), x.size), np.nan + 0j)
     for r in recs:
+        _finite(r, p)
         xr = np.asarray(r["x"], float)
         if xr.size != x.size or not np.allclose(xr, x):
             raise DataError("FRF records have different frequency axes", file=p,
@@ -340,26 +371,40 @@ def load_npz(path: str | Path) -> FRFData:
 
 def _npz_frf(z: Any, p: Path) -> FRFData:
     with z:
-        for key in ("frequency_Hz", "frf", "frf_type"):
-            if key not in z.files:
-                raise DataError("NPZ file lacks a required array", file=str(p), field=key,
-                                value=sorted(z.files),
-                                expected="arrays frequency_Hz (Hz), frf (complex), frf_type")
-        names = {k: tuple(str(v) for v in z[k]) for k in ("output_names", "input_names")
-                 if k in z.files}
-        coh = z["coherence"] if "coherence" in z.files else None
-        dofs = {}
-        for k in ("output_dofs", "input_dofs"):
-            if k in z.files:
-                a = np.asarray(z[k])
-                if a.ndim != 2 or a.shape[1:] != (2,) or not np.issubdtype(a.dtype, np.integer):
-                    raise DataError("DOF array has the wrong shape or type", file=str(p),
-                                    field=k, value=f"shape {a.shape}, {a.dtype}",
-                                    expected="integers of shape (n, 2): node, direction")
-                dofs[k] = tuple((int(u), int(v)) for u, v in a)
-        return FRFData(z["frequency_Hz"], z["frf"], str(z["frf_type"]), coh,
-                       names.get("output_names", ()), names.get("input_names", ()),
-                       source=str(p), **dofs)
+        try:
+            return _npz_frf(z, p)
+        except DataError:
+            raise
+        except (ValueError, OSError, EOFError) as exc:  # pickled / truncated arrays
+            raise DataError(f"cannot read an array of the NPZ file ({exc})", file=str(p),
+                            expected="plain numeric arrays (no pickled objects)") from None
+
+
+def _npz_frf(z: Any, p: Path) -> FRFData:
+    for key in ("frequency_Hz", "frf", "frf_type"):
+        if key not in z.files:
+            raise DataError("NPZ file lacks a required array", file=str(p), field=key,
+                            value=sorted(z.files),
+                            expected="arrays frequency_Hz (Hz), frf (complex), frf_type")
+    names = {k: tuple(str(v) for v in z[k]) for k in ("output_names", "input_names")
+             if k in z.files}
+    coh = z["coherence"] if "coherence" in z.files else None
+    # plausible ranges: frequency axis in Hz (not scaled), coherence within 0..1
+    check_array(z["frequency_Hz"], "frequency_Hz", file=str(p))
+    if coh is not None:
+        check_array(coh, "coherence", file=str(p))
+    dofs = {}
+    for k in ("output_dofs", "input_dofs"):
+        if k in z.files:
+            a = np.asarray(z[k])
+            if a.ndim != 2 or a.shape[1:] != (2,) or not np.issubdtype(a.dtype, np.integer):
+                raise DataError("DOF array has the wrong shape or type", file=str(p),
+                                field=k, value=f"shape {a.shape}, {a.dtype}",
+                                expected="integers of shape (n, 2): node, direction")
+            dofs[k] = tuple((int(u), int(v)) for u, v in a)
+    return FRFData(z["frequency_Hz"], z["frf"], str(z["frf_type"]), coh,
+                   names.get("output_names", ()), names.get("input_names", ()),
+                   source=str(p), **dofs)
 
 
 def save_npz(data: FRFData, path: str | Path) -> Path:

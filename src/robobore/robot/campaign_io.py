@@ -14,8 +14,9 @@ non-integer load steps, duplicate (posture, load step, reflector) rows, joint an
 load point that differ between the rows of one (posture, load step), joint angles that change
 between load steps of a posture (> ``Q_TOL_DEG``), a non-zero force at step 0, a posture
 without a step 0, a loaded step whose reflectors differ from its reference, fewer than 3 or
-collinear reflectors and (when a robot is given) joints outside their limits. Nothing is
-dropped silently.
+collinear reflectors, values outside the plausible range of their unit
+(:mod:`robobore.io.ranges`: positions in mm in the ``*_m`` columns, ...) and (when a robot
+is given) joints outside their limits. Nothing is dropped silently.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from robobore.errors import DataError
+from robobore.io.ranges import check_value
 from robobore.robot.campaign import Campaign, _collinear
 
 Q_COLS = tuple(f"q{i}_deg" for i in range(1, 7))
@@ -59,7 +61,7 @@ def _num(cell: str, *, file: str, row: int, col: str) -> float:
     if not math.isfinite(v):
         raise DataError("not a finite number", file=file, row=row, field=col, value=cell,
                         expected=f"a finite number in {UNITS.get(col, '')}".strip())
-    return v
+    return check_value(v, col, file=file, row=row)  # plausible range per unit (io.ranges)
 
 
 def parse_campaign_text(text: str, source: str = "<campaign>", robot=None) -> Campaign:
@@ -146,7 +148,8 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
     try:
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise DataError(f"not UTF-8 text ({exc.reason})", file=str(p)) from None
+        raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
+                        expected="a UTF-8 CSV file") from None
     return parse_campaign_text(text, source=str(p), robot=robot)
 
 

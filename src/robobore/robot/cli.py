@@ -431,6 +431,9 @@ def identify_stiffness_cmd(
                               expected="a campaign CSV path, or --example")
         path = campaign
         rb = _robot(robot, robot_file, default=None)
+    if sigma_um is not None and not (math.isfinite(sigma_um) and 0.0 < sigma_um <= 1e4):
+        raise ConfigError("tracker noise out of range", field="--sigma-um", value=sigma_um,
+                          expected="0 < sigma <= 10000 um (1-sigma per coordinate)")
     camp = read_campaign(path, robot=rb)
     res = identify_joint_stiffness(camp, rb, sigma_m=None if sigma_um is None else
                                    sigma_um * 1e-6, cond_limit=cond_limit,

@@ -95,7 +95,9 @@ def _parse_number(cell: str, *, source: str, row: int, col: str, unit: str,
     if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         raise DataError("number out of range", file=source, row=row, field=col, value=cell,
                         expected=expected)
-    return v
+    from robobore.io.ranges import check_value
+
+    return check_value(v, col, file=source, row=row)  # plausible range (unit slips)
 
 
 def parse_measured_csv(text: str, source: str = "<measured>") -> MeasuredTable:

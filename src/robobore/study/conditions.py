@@ -292,6 +292,16 @@ def expand_conditions(cfg: SweepConfig, source: str | Path = "<config>") -> list
 def load_sweep_config(path: str | Path) -> tuple[SweepConfig, list[Condition]]:
     """Read a sweep TOML file; returns the validated config and its conditions."""
     cfg = validate_model(SweepConfig, load_toml(path), source=path)
+    coef = (cfg.model.get("dynamics") or {}).get("coefficients") if isinstance(
+        cfg.model.get("dynamics"), dict) else None
+    if isinstance(coef, dict) and isinstance(coef.get("file"), str):
+        # the one rule (robobore.io.paths): relative to the sweep config's folder, not the
+        # workers' current directory; the absolute path is part of the condition keys
+        from robobore.io.paths import resolve_config_path
+
+        coef["file"] = str(resolve_config_path(coef["file"], path,
+                                               "model.dynamics.coefficients.file",
+                                               what="coefficients file"))
     return cfg, expand_conditions(cfg, source=path)
 
 

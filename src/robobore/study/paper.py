@@ -88,7 +88,7 @@ class RobotSection(_Strict):
 class ModalSection(_Strict):
     file: str | None = None  # None: bundled SYNTHETIC hammer test
     band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0], min_length=2,
-                                 max_length=2)  # [low, high] in Hz
+                                 max_length=2, description="analysis band [lo, hi], Hz")
     n_modes: int = Field(5, ge=3, le=50)
     max_order: int = Field(40, ge=4, le=200)
 
@@ -154,11 +154,50 @@ def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict
     if any(v < 0 for v in cfg.study.pressure_MPa) or not cfg.study.pressure_MPa:
         raise ConfigError("bad foot pressures", file=str(p), field="study.pressure_MPa",
                           value=cfg.study.pressure_MPa, expected="a list of values >= 0 MPa")
+    if not 0.0 <= cfg.modal.band_Hz[0] < cfg.modal.band_Hz[1]:
+        raise ConfigError("empty analysis band", file=str(p), field="modal.band_Hz",
+                          value=cfg.modal.band_Hz, expected="[lo, hi] with 0 <= lo < hi (Hz)")
     if cfg.lobes.speed_max_rpm <= cfg.lobes.speed_min_rpm:
         raise ConfigError("lobe speed range empty", file=str(p), field="lobes.speed_max_rpm",
                           value=cfg.lobes.speed_max_rpm,
                           expected=f"> speed_min_rpm = {cfg.lobes.speed_min_rpm} r/min")
+    raw = _resolve_files(cfg, raw, p)
+    # the [calibration] section is validated even when --fast does not run it
+    from robobore.cutting.calibrate import calibration_from_mapping
+
+    try:
+        calibration_from_mapping({"calibration": raw.get("calibration", {}),
+                                  "insert": raw.get("insert", {}),
+                                  "material": raw.get("material", {})}, source=str(p))
+    except ConfigError as exc:  # keys of the calibration model: name them in the file's terms
+        f = exc.field or ""
+        if f and not f.startswith(("calibration", "insert", "material")):
+            raise ConfigError(exc.message, file=exc.file, field=f"calibration.{f}",
+                              value=exc.value, expected=exc.expected) from None
+        raise
     return cfg, raw, p
+
+
+def _resolve_files(cfg: PaperConfig, raw: dict[str, Any], p: Path) -> dict[str, Any]:
+    """Files named in the config, resolved against its folder (robobore.io.paths); the
+    absolute paths replace the names in ``cfg`` and in the raw config kept as provenance."""
+    from robobore.io.paths import names_a_path, resolve_config_path
+
+    for sec, key, must, what in (("robot", "campaign", True, "campaign CSV"),
+                                 ("modal", "file", True, "hammer-test file"),
+                                 ("coefficients", "file", False, "coefficients file"),
+                                 ("measured", "file", True, "measured CSV")):
+        v = getattr(getattr(cfg, sec), key)
+        if v is None:
+            continue
+        a = str(resolve_config_path(v, p, f"{sec}.{key}", must_exist=must, what=what))
+        setattr(getattr(cfg, sec), key, a)
+        raw = {**raw, sec: {**raw.get(sec, {}), key: a}}
+    if names_a_path(cfg.robot.name):
+        a = str(resolve_config_path(cfg.robot.name, p, "robot.name", what="robot file"))
+        cfg.robot.name = a
+        raw = {**raw, "robot": {**raw.get("robot", {}), "name": a}}
+    return raw
 
 
 def _resolve(base: Path, name: str | None) -> Path | None:
@@ -257,17 +296,9 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
             raise ConfigError("stored coefficients file not found", file=str(cfg_path),
                               field="coefficients.file", value=str(p),
                               expected="a JSON file written by 'robobore calibrate forces'")
-        from robobore.io.readers import load_json
+        from robobore.cutting.forces import read_coefficients_file
 
-        data = load_json(p, "coefficients file", "a JSON object written by 'robobore "
-                         f"calibrate forces' (named by [coefficients] file in {cfg_path})")
-        if not isinstance(data.get("coefficients"), dict):
-            raise ConfigError("not a coefficients file (no 'coefficients' table)", file=str(p),
-                              field="coefficients",
-                              expected="a JSON object written by 'robobore calibrate forces'")
-        from robobore.cutting.forces import CuttingCoefficients
-
-        CuttingCoefficients.from_dict(data["coefficients"], source=str(p))  # checked up front
+        data = read_coefficients_file(p)  # clear errors for a corrupt file; ranges checked
         data["file"] = str(p)
         data["mode"] = "stored (--fast)"
         return data

@@ -56,6 +56,7 @@ from robobore.cutting.geometry import BoringInsert, chip_area
 from robobore.errors import ConfigError, NumericalError
 from robobore.io.config import load_toml, validate_model
 from robobore.material import Material, load_material
+from robobore.material.library import resolve_material_name
 
 __all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "BoringMesh",
            "build_boring_mesh", "BoringSetup", "setup_boring", "simulate_boring",
@@ -224,6 +225,7 @@ class BoringFEConfig(_Strict):
 def parse_boring_config(data: dict[str, Any], source: str | None = None) -> BoringFEConfig:
     """Validate a config dict (from TOML) and the cross-field rules."""
     cfg = validate_model(BoringFEConfig, data, source=source)
+    cfg.material.name = resolve_material_name(cfg.material.name, source)  # config-relative
     ap_um = cfg.cut.depth_of_cut_mm * 1e3
     le = cfg.mesh.element_size_um
     if le > ap_um / 3.0 + 1e-9:

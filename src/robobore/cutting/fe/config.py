@@ -422,10 +422,14 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
 
 
 def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
-    """Validate a config dict (as read from TOML)."""
-    cfg = check_config(validate_model(FEConfig, data, source=source or "<config>"), source)
+    """Validate a config dict (as read from TOML); a material file named in it is resolved
+    against the config file's folder (robobore.io.paths)."""
     from robobore.io.memory import check_fe2d
+    from robobore.material.library import resolve_material_name
 
+    cfg = validate_model(FEConfig, data, source=source or "<config>")
+    cfg.material.name = resolve_material_name(cfg.material.name, source)
+    cfg = check_config(cfg, source)
     check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg
 
