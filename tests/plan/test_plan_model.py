@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+from robobore.errors import InputError
 from robobore.plan.model import PoseModel, ToolBody, calibrate
 from robobore.robot.kinematics import LinkInertia, Robot, fk, get_robot
 
@@ -212,3 +213,38 @@ def test_modal_frf_vs_direct_solve_with_joint_dampers(rb):
     Gd = np.stack([Jv @ np.linalg.solve(np.diag(K6) - wi ** 2 * M + 1j * wi * np.diag(C), Jv.T)
                    for wi in w], axis=-1)
     assert np.abs(G - Gd).max() <= 0.01 * np.abs(Gd).max()
+
+
+def test_link_bending_model_consistent_and_optional():
+    """Joints + link beams (VJM): the modal static limit equals the compliance, which equals
+    the identification basis sum; negligible link compliance gives the joint-only model."""
+    from robobore.plan import synthetic as S
+    from robobore.plan.model import LinkBending, compliance_basis, redundancy
+
+    rb = get_robot("irb6600-175-2.55")
+    q = PAPER_Q
+    cb = np.array([1 / 4.5e7, 1 / 2.2e7, 1 / 1.2e7, 1 / 1.2e7])
+    lb = (LinkBending(2, tuple(cb[:2]), 1e-4), LinkBending(4, tuple(cb[2:]), 1e-4))
+    m = PoseModel(rb, S.TRUTH_JOINT_K, S.TRUTH_JOINT_C, tool=S.TOOL, link_bending=lb)
+    # lower-arm in-plane tip rotation is axis 3's screw, forearm bending one is axis 5's
+    assert m.n_dof == 12 and redundancy(rb, lb)[0].shape == (12, 14)
+    pm = m.modes(q)
+    w = 2 * np.pi * pm.frequency_Hz[0]
+    static = np.einsum("ja,jb,j->ab", pm.u[0], pm.u[0], 1 / w ** 2)
+    assert np.allclose(static, pm.compliance[0], rtol=1e-8, atol=1e-16)
+    B = compliance_basis(rb, q, (0, 0, 0), (2, 4))[0]
+    C6 = np.einsum("k,kab->ab", np.r_[1 / S.TRUTH_JOINT_K, cb], B)
+    R = pm.R[0]
+    assert np.allclose(R.T @ C6[:3, :3] @ R, pm.compliance[0], rtol=1e-9, atol=1e-16)
+    assert np.all(pm.damping_ratio > 0)
+    tiny = tuple(LinkBending(li, (1e-15, 1e-15)) for li in (2, 4))
+    m0 = PoseModel(rb, S.TRUTH_JOINT_K, S.TRUTH_JOINT_C, tool=S.TOOL)
+    m1 = PoseModel(rb, S.TRUTH_JOINT_K, S.TRUTH_JOINT_C, tool=S.TOOL, link_bending=tiny)
+    p0, p1 = m0.modes(q), m1.modes(q)
+    assert np.allclose(p1.frequency_Hz[0, :6], p0.frequency_Hz[0], rtol=1e-6)
+    assert np.allclose(p1.compliance[0], p0.compliance[0], rtol=1e-6)
+    # bending lowers the frequencies and softens the tool point
+    assert np.all(pm.frequency_Hz[0, :6] < p0.frequency_Hz[0])
+    assert np.all(np.diag(pm.compliance[0]) > np.diag(p0.compliance[0]))
+    with pytest.raises(InputError):
+        PoseModel(rb, S.TRUTH_JOINT_K, S.TRUTH_JOINT_C, link_bending=(LinkBending(2, (-1, 0)),))

@@ -220,6 +220,198 @@ def mass_matrix(robot: Robot, Q_rad: Any, mass: np.ndarray, com: np.ndarray,
     return M[0] if single else M
 
 
+@dataclass(frozen=True)
+class LinkBending:
+    """Bending compliance of one link (virtual-joint method, Euler-Bernoulli beam).
+
+    ``link``: the link, 1-based (link i moves with joint i); the beam runs from the origin of
+    D-H frame i-1 to the origin of frame i (length ``sqrt(a_i^2 + d_i^2)``, the lower arm
+    ``a_2`` and the forearm ``d_4`` of the IRB 6600). ``compliance_per_Nm2`` = ``(1/EI_1,
+    1/EI_2)`` for bending with the tip deflecting along the two normals ``t_1``, ``t_2`` of
+    the beam (``t_1``: the joint axis ``z_{i-1}`` made normal to the beam, or the frame's x
+    axis where ``z_{i-1}`` runs along the beam; ``t_2 = e x t_1`` with ``e`` the beam
+    direction). A value 0 is a rigid plane. ``damping_s``: the beam's damper is
+    ``damping_s`` times its stiffness block.
+    """
+
+    link: int
+    compliance_per_Nm2: tuple[float, float]
+    damping_s: float = 0.0
+
+
+def link_frames(robot: Robot, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """World rotations (n, nj + 1, 3, 3) and origins (n, nj + 1, 3) of the D-H frames
+    (row 0 the base) for postures Q (n, nj)."""
+    d, a, al, off = robot.dh_arrays
+    n, nj = Q.shape
+    R = np.empty((n, nj + 1, 3, 3))
+    O = np.empty((n, nj + 1, 3))
+    R[:, 0] = robot.base[:3, :3]
+    O[:, 0] = robot.base[:3, 3]
+    for i in range(nj):
+        th = Q[:, i] + off[i]
+        ct, st = np.cos(th), np.sin(th)
+        ca, sa = math.cos(al[i]), math.sin(al[i])
+        A = np.zeros((n, 3, 3))
+        A[:, 0, 0], A[:, 0, 1], A[:, 0, 2] = ct, -st * ca, st * sa
+        A[:, 1, 0], A[:, 1, 1], A[:, 1, 2] = st, ct * ca, -ct * sa
+        A[:, 2, 1], A[:, 2, 2] = sa, ca
+        p = np.stack([a[i] * ct, a[i] * st, np.full(n, d[i])], axis=-1)
+        R[:, i + 1] = R[:, i] @ A
+        O[:, i + 1] = O[:, i] + np.einsum("nij,nj->ni", R[:, i], p)
+    return R, O
+
+
+def beam_geometry(robot: Robot, lb: LinkBending) -> tuple[float, np.ndarray, np.ndarray]:
+    """(length L, beam direction e, normals (t_1, t_2) as rows) in D-H frame ``lb.link``
+    (constant: the frame turns with the beam)."""
+    nj = robot.n_joints
+    if not 1 <= lb.link <= nj:
+        raise InputError("link bending: no such link", field="link_bending.link",
+                         value=lb.link, expected=f"1..{nj}")
+    d, a, al, _ = robot.dh_arrays
+    i = lb.link - 1
+    ca, sa = math.cos(al[i]), math.sin(al[i])
+    rxm = np.array([[1.0, 0.0, 0.0], [0.0, ca, sa], [0.0, -sa, ca]])  # Rot_x(-alpha)
+    v = rxm @ np.array([a[i], 0.0, d[i]])
+    L = float(np.linalg.norm(v))
+    if L < 1e-6:
+        raise InputError("link bending on a link of zero length", field="link_bending.link",
+                         value=lb.link, expected="a link with a_i or d_i > 0")
+    e = v / L
+    t1 = None
+    for cand in (rxm @ np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]),
+                 np.array([0.0, 1.0, 0.0])):
+        w = cand - (cand @ e) * e
+        if np.linalg.norm(w) > 0.5:
+            t1 = w / np.linalg.norm(w)
+            break
+    assert t1 is not None
+    return L, e, np.stack([t1, np.cross(e, t1)])
+
+
+def _planes(bending: tuple[LinkBending, ...]) -> list[tuple[LinkBending, int]]:
+    """The compliant bending planes (1/EI > 0): (link bending, plane 0 or 1)."""
+    return [(lb, k) for lb in bending for k in range(2) if lb.compliance_per_Nm2[k] > 0]
+
+
+def beam_block(L: float) -> np.ndarray:
+    """Tip compliance of a cantilever per unit 1/EI in (deflection along t, rotation about
+    e x t) under (force along t, moment about e x t): ``[[L^3/3, L^2/2], [L^2/2, L]]``."""
+    return np.array([[L ** 3 / 3, L ** 2 / 2], [L ** 2 / 2, L]])
+
+
+def elastic_screws(robot: Robot, Q: np.ndarray, bending: tuple[LinkBending, ...]
+                   ) -> dict[str, Any]:
+    """Screws of every elastic coordinate (joints, then per bending link and plane the tip
+    deflection and the tip rotation): angular part ``w`` (n, ndof, 3), a point on the axis
+    ``p`` (n, ndof, 3), translational part ``v0`` (n, ndof, 3) (the velocity of a point x is
+    ``v0 + w x (x - p)``), ``first_body`` (ndof,) the first link (0-based) each moves, the
+    frames, and per plane its beam length and its compliance 1/EI."""
+    R, O = link_frames(robot, Q)
+    n, nj = Q.shape
+    planes = _planes(bending)
+    ndof = nj + 2 * len(planes)
+    w = np.zeros((n, ndof, 3))
+    p = np.zeros((n, ndof, 3))
+    v0 = np.zeros((n, ndof, 3))
+    first = np.zeros(ndof, dtype=np.int64)
+    w[:, :nj] = R[:, :nj, :, 2]
+    p[:, :nj] = O[:, :nj]
+    first[:nj] = np.arange(nj)
+    lengths, comp = [], []
+    for j, (lb, k) in enumerate(planes):
+        L, e, T = beam_geometry(robot, lb)
+        Rl = R[:, lb.link]
+        t = Rl @ T[k]
+        r = Rl @ np.cross(e, T[k])
+        a_, b_ = nj + 2 * j, nj + 2 * j + 1
+        v0[:, a_] = t
+        w[:, b_] = r
+        p[:, b_] = O[:, lb.link]
+        first[a_] = first[b_] = lb.link  # 0-based index of the next link: distal bodies only
+        lengths.append(L)
+        comp.append(float(lb.compliance_per_Nm2[k]))
+    return {"w": w, "p": p, "v0": v0, "first_body": first, "R": R, "O": O,
+            "plane_length_m": np.array(lengths), "plane_compliance": np.array(comp),
+            "planes": planes}
+
+
+def _point_jacobian(sc: dict[str, Any], x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Translational (n, 3, ndof) and angular (n, 3, ndof) Jacobian of points x (n, 3)."""
+    Jv = sc["v0"] + np.cross(sc["w"], x[:, None, :] - sc["p"])
+    return np.swapaxes(Jv, 1, 2), np.swapaxes(sc["w"], 1, 2)
+
+
+def redundancy(robot: Robot, bending: tuple[LinkBending, ...]
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Map ``P`` (n_red, ndof) from the elastic coordinates to independent motion
+    coordinates, and the kept coordinates (n_red,). A bending plane whose tip rotation
+    turns about the next joint's axis (the lower arm's in-plane bending and axis 3, the
+    forearm's bending and axis 5) moves every body exactly as that joint does: the two
+    springs act in series and only their sum ``theta + s beta`` is a coordinate (the tip
+    rotation carries no mass of its own). Found on the screws at a generic posture (the
+    coincidence is structural)."""
+    nj = robot.n_joints
+    qg = np.array([[0.31, -0.23, 0.41, 0.53, 0.67, 0.71, 0.2, 0.3][:nj]]) if nj <= 8 else \
+        np.full((1, nj), 0.3)
+    sc = elastic_screws(robot, qg, bending)
+    w, p, v0 = sc["w"][0], sc["p"][0], sc["v0"][0]
+    lin = v0 - np.cross(w, p)  # velocity of the point at the origin
+    scr = np.concatenate([w, lin], axis=1)
+    ndof = scr.shape[0]
+    P = np.eye(ndof)
+    drop = []
+    for j in range(nj, ndof):
+        for i in range(nj):
+            for sgn in (1.0, -1.0):
+                if np.allclose(scr[j], sgn * scr[i], atol=1e-9 * (1 + np.abs(scr[i]).max())):
+                    P[i, j] = sgn
+                    drop.append(j)
+                    break
+            if drop and drop[-1] == j:
+                break
+    keep = [k for k in range(ndof) if k not in drop]
+    return P[keep], np.array(keep, dtype=np.int64)
+
+
+def elastic_matrices(robot: Robot, bending: tuple[LinkBending, ...], k_joint: np.ndarray,
+                     c_joint: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Stiffness and damping matrices (ndof, ndof) of joints + bending planes."""
+    nj = robot.n_joints
+    planes = _planes(bending)
+    K = np.zeros((nj + 2 * len(planes), nj + 2 * len(planes)))
+    C = np.zeros_like(K)
+    K[:nj, :nj] = np.diag(k_joint)
+    C[:nj, :nj] = np.diag(c_joint)
+    for j, (lb, k) in enumerate(planes):
+        L = beam_geometry(robot, lb)[0]
+        s = slice(nj + 2 * j, nj + 2 * j + 2)
+        Kb = np.linalg.inv(beam_block(L)) / float(lb.compliance_per_Nm2[k])
+        K[s, s] = Kb
+        C[s, s] = lb.damping_s * Kb
+    return K, C
+
+
+def compliance_basis(robot: Robot, Q: np.ndarray, tcp_m: Any,
+                     bending_links: tuple[int, ...] = ()) -> np.ndarray:
+    """6x6 tool-point compliance per unit parameter, (n, nj + 2 len(bending_links), 6, 6):
+    ``C6 = sum_i (1/k_i) B_i + sum_planes (1/EI) B_plane`` (rows: translation, rotation;
+    for identification: the compliance is linear in the joint and link compliances)."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    bend = tuple(LinkBending(int(li), (1.0, 1.0)) for li in bending_links)
+    sc = elastic_screws(robot, Q, bend)
+    T, _ = fk_jacobian(robot, Q, tcp_m)
+    Jv, Jw = _point_jacobian(sc, T[:, :3, 3])
+    J = np.concatenate([Jv, Jw], axis=1)  # (n, 6, ndof)
+    nj = robot.n_joints
+    out = [np.einsum("na,nb->nab", J[:, :, i], J[:, :, i]) for i in range(nj)]
+    for j in range(len(sc["planes"])):
+        G = J[:, :, nj + 2 * j: nj + 2 * j + 2]
+        out.append(np.einsum("nai,ij,nbj->nab", G, beam_block(sc["plane_length_m"][j]), G))
+    return np.stack(out, axis=1)
+
+
 def boring_frames(T: np.ndarray) -> np.ndarray:
     """Boring frames (n, 3, 3) for tool transforms (n, 4, 4); see process_frame."""
     return np.stack([process_frame(t[:3, :3], "boring") for t in T])
@@ -289,6 +481,30 @@ class PoseModel:
     tcp_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     link_scale: np.ndarray | None = None
     robot_file: str | None = None
+    link_bending: tuple[LinkBending, ...] = ()
+
+    @property
+    def n_dof(self) -> int:
+        """Elastic coordinates: the joints plus two per compliant bending plane."""
+        if not _planes(self.link_bending):
+            return self.robot.n_joints
+        return int(redundancy(self.robot, self.link_bending)[1].size)
+
+    def reduced_matrices(self) -> dict[str, np.ndarray]:
+        """Stiffness and damping in the independent coordinates ``y = P x``: springs in
+        series add compliances, ``K_y = (P K^-1 P^T)^-1``; dampers by the quasi-static force
+        path, ``C_y = K_y P K^-1 C K^-1 P^T K_y``; ``X = K^-1 P^T K_y`` maps y-shapes to
+        element deflections."""
+        P, keep = redundancy(self.robot, self.link_bending)
+        K, C = elastic_matrices(self.robot, self.link_bending, self.k_Nm_per_rad,
+                                self.c_Nms_per_rad)
+        Ki = np.linalg.inv(K)
+        Ky = np.linalg.inv(P @ Ki @ P.T)
+        Ky = 0.5 * (Ky + Ky.T)
+        X = Ki @ P.T @ Ky
+        Cy = X.T @ C @ X
+        return {"P": P, "keep": keep, "K": K, "C": C, "Ky": Ky, "Cy": 0.5 * (Cy + Cy.T),
+                "X": X, "Cyinv": P @ Ki @ P.T}
 
     def __post_init__(self) -> None:
         nj = self.robot.n_joints
@@ -303,6 +519,15 @@ class PoseModel:
         if self.link_scale is None:
             object.__setattr__(self, "link_scale", np.ones(nj))
         link_arrays(self.robot, file=self.robot_file)  # inertial data present?
+        for lb in self.link_bending:
+            c = np.asarray(lb.compliance_per_Nm2, float)
+            if c.shape != (2,) or not np.all(np.isfinite(c)) or np.any(c < 0) \
+                    or not np.isfinite(lb.damping_s) or lb.damping_s < 0:
+                raise InputError("link bending compliance must be two values >= 0 and a "
+                                 "damping >= 0", field=f"link_bending.link{lb.link}",
+                                 value=c.tolist(), expected="1/EI in 1/(N m^2), >= 0; "
+                                 "damping_s in s, >= 0")
+            beam_geometry(self.robot, lb)
 
     def inertial_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         m, c, inertia = link_arrays(self.robot, file=self.robot_file)
@@ -318,14 +543,11 @@ class PoseModel:
     def modes(self, Q_rad: Any, frame: str | np.ndarray = "boring") -> PostureModes:
         """Modes, tool-point modal vectors and compliance at postures Q (n, nj) or (nj,)."""
         Q = np.atleast_2d(np.asarray(Q_rad, float))
-        M = self.mass_matrix(Q)
         T, J = fk_jacobian(self.robot, Q, self.tcp_m)
-        if isinstance(frame, str) and frame == "boring":
-            R = boring_frames(T)
-        elif isinstance(frame, str):
-            R = np.stack([process_frame(t[:3, :3], frame) for t in T])
-        else:
-            R = np.broadcast_to(np.asarray(frame, float), (Q.shape[0], 3, 3))
+        R = self._frames(T, Q, frame)
+        if _planes(self.link_bending):
+            return self._modes_elastic(Q, T, R)
+        M = self.mass_matrix(Q)
         kis = 1.0 / np.sqrt(self.k_Nm_per_rad)
         A = M * kis[None, :, None] * kis[None, None, :]
         mu, V = np.linalg.eigh(A)  # mu = 1 / w^2, ascending -> w descending
@@ -341,6 +563,67 @@ class PoseModel:
         u = np.einsum("nab,nbi,nij->nja", np.swapaxes(R, 1, 2), Jv, phi)
         Cq = np.einsum("nai,i,nbi->nab", np.einsum("nba,nbi->nai", R, Jv),
                        1.0 / self.k_Nm_per_rad, np.einsum("nba,nbi->nai", R, Jv))
+        return PostureModes(w / (2 * np.pi), zeta, u, phi, Cq, np.asarray(R), T)
+
+    @staticmethod
+    def _frames(T: np.ndarray, Q: np.ndarray, frame: str | np.ndarray) -> np.ndarray:
+        if isinstance(frame, str) and frame == "boring":
+            return boring_frames(T)
+        if isinstance(frame, str):
+            return np.stack([process_frame(t[:3, :3], frame) for t in T])
+        return np.broadcast_to(np.asarray(frame, float), (Q.shape[0], 3, 3))
+
+    def elastic_mass_matrix(self, Q: np.ndarray) -> np.ndarray:
+        """Mass matrix (n, n_dof, n_dof) over the independent joint and bending coordinates
+        (:meth:`reduced_matrices`): every link moves rigidly with the joints before it and
+        with the bending of the links before it (a link's own mass stays on its proximal
+        joint: lumped masses of the virtual-joint method)."""
+        m, c, inertia = self.inertial_arrays()
+        keep = redundancy(self.robot, self.link_bending)[1]
+        sc = self._screws(Q, keep)
+        R, O = sc["R"], sc["O"]
+        n = Q.shape[0]
+        M = np.zeros((n, keep.size, keep.size))
+        for b in range(self.robot.n_joints):
+            x = O[:, b + 1] + np.einsum("nij,j->ni", R[:, b + 1], c[b])
+            Jv, Jw = _point_jacobian(sc, x)
+            mask = (sc["first_body"] <= b).astype(float)
+            Jv = Jv * mask
+            Jw = Jw * mask
+            Iw = R[:, b + 1] @ inertia[b] @ np.swapaxes(R[:, b + 1], 1, 2)
+            M += m[b] * np.einsum("nai,naj->nij", Jv, Jv) + \
+                np.einsum("nai,nab,nbj->nij", Jw, Iw, Jw)
+        return M
+
+    def _screws(self, Q: np.ndarray, keep: np.ndarray) -> dict[str, Any]:
+        sc = elastic_screws(self.robot, Q, self.link_bending)
+        for key in ("w", "p", "v0"):
+            sc[key] = sc[key][:, keep]
+        sc["first_body"] = sc["first_body"][keep]
+        return sc
+
+    def _modes_elastic(self, Q: np.ndarray, T: np.ndarray, R: np.ndarray) -> PostureModes:
+        """Modes with link bending: ``K_y phi = w^2 M phi`` in the independent coordinates
+        (Cholesky ``K_y = L L^T``; ``L^-1 M L^-T`` symmetric); ``phi`` (n, n_dof, n_dof)
+        holds the shapes in those coordinates."""
+        rm = self.reduced_matrices()
+        M = self.elastic_mass_matrix(Q)
+        Lc = np.linalg.cholesky(rm["Ky"])
+        Li = np.linalg.inv(Lc)
+        A = Li[None] @ M @ Li.T[None]
+        mu, V = np.linalg.eigh(A)
+        mu, V = mu[:, ::-1], V[:, :, ::-1]
+        if np.any(mu <= 0):
+            raise InputError("the mass matrix is not positive definite at a posture",
+                             expected="positive link masses/inertias")
+        w = 1.0 / np.sqrt(mu)
+        phi = (Li.T[None] @ V) * w[:, None, :]
+        zeta = np.einsum("nij,ik,nkj->nj", phi, rm["Cy"], phi) / (2 * w)
+        sc = self._screws(Q, rm["keep"])
+        Jv, _ = _point_jacobian(sc, T[:, :3, 3])
+        Jp = np.einsum("nba,nbi->nai", R, Jv)  # process frame
+        u = np.einsum("nai,nij->nja", Jp, phi)
+        Cq = np.einsum("nai,ij,nbj->nab", Jp, rm["Cyinv"], Jp)
         return PostureModes(w / (2 * np.pi), zeta, u, phi, Cq, np.asarray(R), T)
 
     def equivalent(self, q_rad: Any):
@@ -408,18 +691,29 @@ def fit_joint_damping(phi: np.ndarray, w: np.ndarray, zeta: np.ndarray, k: np.nd
     coefficient (``r_i = 1``) instead of an arbitrary value, so that modes it dominates at
     other postures stay damped.
     """
+    G = (phi ** 2).T * k[None, :]  # (m, nj): 2 zeta w = G beta_i
+    return fit_proportional_damping(G, w, zeta, regularisation) * k
+
+
+def fit_proportional_damping(G: np.ndarray, w: np.ndarray, zeta: np.ndarray,
+                             regularisation: float = 0.01) -> np.ndarray:
+    """Stiffness-proportional damping coefficients ``beta_i >= 0`` [s] of elastic elements
+    (damper = ``beta_i`` times the element's stiffness) from ``2 zeta_j w_j = sum_i G_ji
+    beta_i``, ``G_ji = phi_j^T K_i phi_j`` the modal strain energy of element i in mode j;
+    ``beta_i = r_i beta`` with the common ``beta`` and a pull ``r_i -> 1`` (see
+    :func:`fit_joint_damping`)."""
     from scipy.optimize import lsq_linear
 
     y = 2 * zeta * w
-    G = (phi ** 2).T * k[None, :]  # (m, nj): 2 zeta w = G beta_i
+    ne = G.shape[1]
     if not np.any(y > 0):
-        return np.zeros(k.size)
+        return np.zeros(ne)
     gs = G.sum(axis=1)
     beta = float(np.sum(gs * y) / np.sum(gs * gs))
-    A = np.vstack([G * beta / y[:, None], regularisation * np.eye(k.size)])
-    b = np.concatenate([np.ones(y.size), regularisation * np.ones(k.size)])
+    A = np.vstack([G * beta / y[:, None], regularisation * np.eye(ne)])
+    b = np.concatenate([np.ones(y.size), regularisation * np.ones(ne)])
     r = lsq_linear(A, b, bounds=(0.0, np.inf)).x
-    return r * beta * k
+    return r * beta
 
 
 def calibrate(model: PoseModel, q_meas_rad: Any, frequency_Hz: Any, damping_ratio: Any, *,
@@ -464,13 +758,29 @@ def calibrate(model: PoseModel, q_meas_rad: Any, frequency_Hz: Any, damping_rati
     pm = m1.modes(q)
     sel = list(pick)
     w = 2 * np.pi * pm.frequency_Hz[0, sel]
-    c = fit_joint_damping(pm.phi[0][:, sel], w, z_id, model.k_Nm_per_rad,
-                          damping_regularisation)
-    m2 = replace(m1, c_Nms_per_rad=c)
+    if m1.n_dof == nj:
+        c = fit_joint_damping(pm.phi[0][:, sel], w, z_id, model.k_Nm_per_rad,
+                              damping_regularisation)
+        m2 = replace(m1, c_Nms_per_rad=c)
+    else:  # joints and bending links: stiffness-proportional dampers per element
+        rm = m1.reduced_matrices()
+        ph = rm["X"] @ pm.phi[0][:, sel]  # element deflections of the matched modes
+        K = rm["K"]
+        G = [ph[i] ** 2 * m1.k_Nm_per_rad[i] for i in range(nj)]
+        j = nj
+        for lb in m1.link_bending:
+            s_ = slice(j, j + 2 * len(_planes((lb,))))
+            G.append(np.einsum("ij,ik,kj->j", ph[s_], K[s_, s_], ph[s_]))
+            j = s_.stop
+        beta = fit_proportional_damping(np.array(G).T, w, z_id, damping_regularisation)
+        lbs = tuple(replace(lb, damping_s=float(b)) for lb, b in
+                    zip(m1.link_bending, beta[nj:], strict=True))
+        m2 = replace(m1, c_Nms_per_rad=beta[:nj] * m1.k_Nm_per_rad, link_bending=lbs)
     pm2 = m2.modes(q)
     return Calibration(m2, nm, f_id, pm2.frequency_Hz[0, sel], z_id,
                        pm2.damping_ratio[0, sel], f0_all[sel], tuple(pick))
 
 
-__all__ = ["ToolBody", "PoseModel", "PostureModes", "Calibration", "calibrate",
+__all__ = ["ToolBody", "PoseModel", "PostureModes", "Calibration", "calibrate", "LinkBending",
+           "compliance_basis", "elastic_screws", "elastic_matrices", "link_frames", "redundancy",
            "link_arrays", "mass_matrix", "boring_frames"]

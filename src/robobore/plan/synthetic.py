@@ -280,46 +280,63 @@ def validation_postures(n: int = 24, seed: int = 11, margin: float = 0.05) -> np
     return np.array(out[:n])
 
 
-def identify_from_truth(truth: TruthRobot, campaign: np.ndarray
-                        ) -> tuple[np.ndarray, np.ndarray]:
+def identify_from_truth(truth: TruthRobot, campaign: np.ndarray,
+                        bending_links: tuple[int, ...] = ()
+                        ) -> tuple[np.ndarray, np.ndarray] | tuple[np.ndarray, np.ndarray,
+                                                                   np.ndarray]:
     """Joint stiffnesses fitted to the truth's 6x6 tool compliance over the campaign (NNLS on
-    the joint compliances 1/k; rotations scaled by 1 m). Returns (k, relative residual)."""
+    the joint compliances 1/k; rotations scaled by 1 m). Returns (k, relative residual).
+
+    With ``bending_links`` (1-based links, e.g. ``(2, 4)``) the fit also has the bending
+    compliances 1/EI of those links as Euler-Bernoulli beams (virtual-joint method,
+    :func:`robobore.plan.model.compliance_basis`: the compliance stays linear in the
+    unknowns); returns (k, relative residual, 1/EI per link and plane (n_links, 2))."""
     from scipy.optimize import nnls
 
-    from robobore.robot.kinematics import jacobian
+    from robobore.plan.model import compliance_basis
 
+    nj = truth.robot.n_joints
+    iu = np.triu_indices(6)
+    B = compliance_basis(truth.robot, campaign, truth.tcp_m, tuple(bending_links))
     rows, rhs = [], []
-    S = np.diag([1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
-    for q in campaign:
+    for i, q in enumerate(campaign):
         ev = truth.evaluate(q)
-        Jr = S @ jacobian(truth.robot, q, truth.tcp_m)
-        C = S @ ev["compliance6"] @ S
-        iu = np.triu_indices(6)
-        rows.append(np.stack([np.outer(Jr[:, i], Jr[:, i])[iu] for i in range(6)], axis=1))
-        rhs.append(C[iu])
+        rows.append(B[i][:, iu[0], iu[1]].T)
+        rhs.append(ev["compliance6"][iu])
     Amat = np.vstack(rows)
     b = np.concatenate(rhs)
     scale = np.abs(Amat).max(axis=0)
     c, res = nnls(Amat / scale, b)
     c = c / scale
-    return 1.0 / c, np.array([res / np.linalg.norm(b)])
+    rel = np.array([res / np.linalg.norm(b)])
+    if not bending_links:
+        return 1.0 / c, rel
+    return 1.0 / c[:nj], rel, c[nj:].reshape(-1, 2)
 
 
 def run_validation(n_heldout: int = 24, f_max_Hz: float = 60.0,
-                   bend_scale: float = 1.0) -> dict[str, Any]:
+                   bend_scale: float = 1.0, link_bending: bool = False) -> dict[str, Any]:
     """Identify + calibrate at the paper's posture, predict at held-out postures; errors.
 
     ``bend_scale`` multiplies the truth's bending springs (0.5: links twice as flexible, a
-    sensitivity case)."""
-    from robobore.plan.model import calibrate
+    sensitivity case). ``link_bending``: the planner's model also has the lower arm and the
+    forearm as Euler-Bernoulli beams (:class:`robobore.plan.model.LinkBending`), their
+    compliances identified with the joint compliances from the same campaign."""
+    from robobore.plan.model import LinkBending, calibrate
 
     robot = get_robot("irb6600-175-2.55")
     truth = TruthRobot(robot, bend_scale=bend_scale)
-    k_id, res = identify_from_truth(truth, campaign_postures())
+    bend: tuple[LinkBending, ...] = ()
+    if link_bending:
+        k_id, res, cb = identify_from_truth(truth, campaign_postures(), (2, 4))
+        bend = (LinkBending(2, (float(cb[0, 0]), float(cb[0, 1]))),
+                LinkBending(4, (float(cb[1, 0]), float(cb[1, 1]))))
+    else:
+        k_id, res = identify_from_truth(truth, campaign_postures())
     q0 = np.radians(PAPER_Q_DEG)
     ev0 = truth.evaluate(q0)
     sel = ev0["frequency_Hz"] < f_max_Hz
-    model = PoseModel(robot, k_id, np.zeros(6), tool=TOOL)
+    model = PoseModel(robot, k_id, np.zeros(6), tool=TOOL, link_bending=bend)
     cal = calibrate(model, q0, ev0["frequency_Hz"][sel], ev0["damping_ratio"][sel])
     Q = validation_postures(n_heldout)
     pm = cal.model.modes(Q)
@@ -339,6 +356,10 @@ def run_validation(n_heldout: int = 24, f_max_Hz: float = 60.0,
     return {
         "synthetic": True,
         "bend_scale": bend_scale,
+        "model_link_bending": link_bending,
+        "identified_bending_EI_Nm2": {f"link{lb.link}": [float(1 / c) if c > 0 else None
+                                                         for c in lb.compliance_per_Nm2]
+                                      for lb in bend},
         "truth_bending_stiffness_Nm_per_rad": (bend_scale * TRUTH_BEND_K).tolist(),
         "bending_share_heldout_range": [float(bshare.min()), float(bshare.max())],
         "heldout_within_5_percent": {
