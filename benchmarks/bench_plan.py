@@ -85,6 +85,22 @@ def main() -> None:
     t2 = time.perf_counter()
     print(f"2880 postures: modes {t1 - t0:.2f} s, critical depth {t2 - t1:.2f} s, "
           f"total {t2 - t0:.2f} s ({2880 / (t2 - t0):.0f} postures/s)")
+    # the same with link bending (lower arm and forearm as beams: 12 coordinates)
+    from dataclasses import replace
+
+    from robobore.plan.model import LinkBending
+
+    mb = replace(model, link_bending=(LinkBending(2, (1 / 5.7e7, 1 / 7.2e7)),
+                                      LinkBending(4, (1 / 1.6e7, 1 / 1.6e7))))
+    t0 = time.perf_counter()
+    pm = mb.modes(Q)
+    t1 = time.perf_counter()
+    critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u,
+                         process.mean_directional_matrix(), 150.0, 1100.0, 1)
+    t2 = time.perf_counter()
+    print(f"2880 postures with link bending ({mb.n_dof} coordinates): modes {t1 - t0:.2f} s, "
+          f"critical depth {t2 - t1:.2f} s, total {t2 - t0:.2f} s "
+          f"({2880 / (t2 - t0):.0f} postures/s)")
     print(f"load average after: {_load()}")
 
 

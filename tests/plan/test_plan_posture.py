@@ -253,3 +253,32 @@ def test_part_frame_placement_gives_the_same_bore(ident, tmp_path, paper_result)
     assert r["measured"] is not None
     assert r["recommended"]["critical_depth_mm"] == pytest.approx(
         paper_result["recommended"]["critical_depth_mm"], rel=1e-9)
+
+
+def test_link_bending_data_flow_through_the_plan(ident, tmp_path):
+    """Optional link compliance (VJM beams): more coordinates, modes and a softer tool point
+    than the joint-only model with the same joint stiffness; reported in the calibration."""
+    lb = ('posture_deg = [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95]\n'
+          'link_bending = [{link = 2, EI_Nm2 = [5.7e7, 7.2e7]}, '
+          '{link = 4, EI_Nm2 = [1.6e7, 1.6e7]}]')
+    step = "rotation_step_deg = 30.0"
+    r0 = plan_posture(write_config(tmp_path / "a", ident, rotation_step_deg=step))
+    r1 = plan_posture(write_config(tmp_path / "b", ident, posture_deg=lb,
+                                   rotation_step_deg=step))
+    assert [d["link"] for d in r1["calibration"]["link_bending"]] == [2, 4]
+    assert r0["calibration"]["link_bending"] == []
+    k0, k1 = (r["recommended"]["directional_stiffness_N_per_m"] for r in (r0, r1))
+    assert all(k1[a] < k0[a] for a in "xyz")
+    assert len(r1["recommended"]["modes"]) == 12 and len(r0["recommended"]["modes"]) == 6
+
+
+def test_link_bending_bad_input(ident, tmp_path):
+    bad = ('posture_deg = [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95]\n'
+           'link_bending = [{link = 2, EI_Nm2 = [0.0, 7.2e7]}]')
+    cfg = write_config(tmp_path, ident, posture_deg=bad)
+    msg = _err(cfg)
+    assert str(cfg) in msg and "identification.link_bending[0].EI_Nm2" in msg and "N m^2" in msg
+    bad = ('posture_deg = [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95]\n'
+           'link_bending = [{link = 5, EI_Nm2 = [1e7, 1e7]}]')
+    msg = _err(write_config(tmp_path / "z", ident, posture_deg=bad))
+    assert "identification.link_bending[0].link" in msg and "zero length" in msg

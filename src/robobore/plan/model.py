@@ -666,6 +666,10 @@ class Calibration:
             "model_mode_of_identified": [int(i) + 1 for i in self.model_modes],
             "link_scale": [float(v) for v in self.model.link_scale],
             "joint_damping_Nms_per_rad": [float(v) for v in self.model.c_Nms_per_rad],
+            "link_bending": [{"link": lb.link,
+                              "EI_Nm2": [float(1 / c) if c > 0 else None
+                                         for c in lb.compliance_per_Nm2],
+                              "damping_s": lb.damping_s} for lb in self.model.link_bending],
             "identified_frequency_Hz": self.identified_frequency_Hz.tolist(),
             "model_frequency_Hz": self.model_frequency_Hz.tolist(),
             "uncalibrated_frequency_Hz": self.uncalibrated_frequency_Hz.tolist(),

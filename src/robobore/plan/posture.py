@@ -54,10 +54,16 @@ class RobotCfg(_Strict):
     name: str = "irb6600-175-2.55"
 
 
+class LinkBendingCfg(_Strict):
+    link: int
+    EI_Nm2: list[float]
+
+
 class IdentificationCfg(_Strict):
     joint_stiffness: str
     modes: str
     posture_deg: list[float] | None = None
+    link_bending: list[LinkBendingCfg] = Field(default_factory=list)
 
 
 class ToolCfg(_Strict):
@@ -157,6 +163,7 @@ class PlanInputs:
     stiffness_file: Path | None
     modes_file: Path | None
     synthetic: bool = False
+    link_bending: tuple[Any, ...] = ()
 
 
 def _resolve(base: Path, name: str) -> Path:
@@ -281,7 +288,37 @@ def load_plan_config(path: str | Path) -> PlanInputs:
     check_joint_limits(robot, np.radians(qm), file=f)
     synthetic = bool(sdata.get("synthetic", False)) or bool(mdata.get("synthetic", False))
     return PlanInputs(cfg, raw, p, robot, np.asarray(js.k_Nm_per_rad, float), fz[:, 0],
-                      fz[:, 1], np.radians(qm), tcp, point, axis, sfile, mfile, synthetic)
+                      fz[:, 1], np.radians(qm), tcp, point, axis, sfile, mfile, synthetic,
+                      _link_bending(cfg, robot, f))
+
+
+def _link_bending(cfg: PlanConfig, robot: Any, f: str) -> tuple[Any, ...]:
+    """``[[identification.link_bending]]``: optional beam compliance of long links."""
+    from robobore.plan.model import LinkBending, beam_geometry
+
+    out, seen = [], set()
+    for i, lb in enumerate(cfg.identification.link_bending):
+        key = f"identification.link_bending[{i}]"
+        if not 1 <= lb.link <= robot.n_joints or lb.link in seen:
+            raise InputError("link bending: no such link, or given twice", file=f,
+                             field=f"{key}.link", value=lb.link,
+                             expected=f"a link number 1..{robot.n_joints}, once")
+        ei = np.asarray(lb.EI_Nm2, float)
+        if ei.shape != (2,) or not np.all(np.isfinite(ei)) or np.any(ei <= 0):
+            raise InputError("link bending stiffness must be two positive values", file=f,
+                             field=f"{key}.EI_Nm2", value=lb.EI_Nm2,
+                             expected="[EI_1, EI_2] in N m^2 (> 0; e.g. 1e6..1e9 for an "
+                                      "industrial robot's arm)")
+        item = LinkBending(int(lb.link), (float(1 / ei[0]), float(1 / ei[1])))
+        try:
+            beam_geometry(robot, item)
+        except InputError:
+            raise InputError("link bending on a link of zero length", file=f,
+                             field=f"{key}.link", value=lb.link,
+                             expected="a link with a_i or d_i > 0 (a beam)") from None
+        seen.add(lb.link)
+        out.append(item)
+    return tuple(out)
 
 
 # ----------------------------------------------------------------------------- candidates
@@ -435,7 +472,7 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
     from robobore.plan.chatter import critical_depth_range
 
     n = cand.q_rad.shape[0]
-    nj = robot.n_joints
+    nj = model.n_dof
     out = {"frequency_Hz": np.empty((n, nj)), "damping_ratio": np.empty((n, nj)),
            "stiffness_N_per_m": np.empty((n, 3)), "critical_depth_m": np.empty(n),
            "chatter_frequency_Hz": np.empty(n), "critical_speed_rpm": np.empty(n),
@@ -505,6 +542,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     cfg, robot, f = inp.cfg, inp.robot, str(inp.path)
     tool = ToolBody(cfg.tool.mass_kg, tuple(cfg.tool.com_m), tuple(cfg.tool.inertia_kg_m2))
     model0 = PoseModel(robot, inp.k_Nm_per_rad, np.zeros(robot.n_joints), tool=tool,
+                       link_bending=inp.link_bending,
                        tcp_m=tuple(inp.tcp_m), robot_file=robot.file or None)
     cal = calibrate(model0, inp.q_meas_rad, inp.modes_f_Hz, inp.modes_zeta)
     model = cal.model
@@ -626,6 +664,7 @@ def results_dataset(result: dict[str, Any]) -> Any:
     A = result["_arrays"]
     cand, ev = A["cand"], A["ev"]
     n, nj = cand.q_rad.shape
+    nm = ev["frequency_Hz"].shape[1]
     ds = xr.Dataset(
         {
             "joints": (("candidate", "joint"), np.degrees(cand.q_rad), {"units": "deg"}),
@@ -645,7 +684,7 @@ def results_dataset(result: dict[str, Any]) -> Any:
                           {"name": result["criterion"], "units": result["criterion_unit"]}),
         },
         coords={"candidate": np.arange(n), "joint": np.arange(1, nj + 1),
-                "mode": np.arange(1, nj + 1), "axis": ["x", "y", "z"]},
+                "mode": np.arange(1, nm + 1), "axis": ["x", "y", "z"]},
         attrs={"recommended_candidate": A["best"],
                "measured_candidate": -1 if A["measured"] is None else A["measured"],
                "criterion": result["criterion"], "robot": result["robot"],
