@@ -34,6 +34,14 @@ links; then the joint dampers ``c_i >= 0`` from ``2 zeta_j w_j = sum_i c_i phi_i
 bounded least squares, pulled towards a common stiffness-proportional damping
 (:func:`fit_joint_damping`) so that joints the measured modes do not move stay damped.
 The fitted factors and the residuals are reported.
+
+Optional link compliance (:class:`LinkBending`, virtual-joint method: Pashkevich, Klimchik &
+Chablat, Mech. Mach. Theory 44(5), 2009): a long link as an Euler-Bernoulli beam whose tip
+deflects and turns in two bending planes; two coordinates per plane move the links beyond
+it, tip rotations on the next joint's axis are merged with that joint (springs in series,
+:func:`redundancy`), and the modes, damping, compliance and FRFs are computed over the
+independent coordinates (:meth:`PoseModel.reduced_matrices`). The tool compliance stays
+linear in the joint and link compliances (:func:`compliance_basis`) for identification.
 """
 
 from __future__ import annotations
@@ -420,9 +428,10 @@ def boring_frames(T: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class PostureModes:
     """Modal results for n postures (SI). Shapes: ``frequency_Hz``, ``damping_ratio``
-    (n, nj) ascending; ``u`` (n, nj, 3) tool-point modal translations of the mass-normalised
-    modes in the process frame [m / sqrt(kg m^2)-units of the joint coordinates]; ``phi``
-    (n, nj, nj) mass-normalised joint-space shapes (mode index second); ``compliance``
+    (n, nm) ascending (nm: the joints, plus the independent bending coordinates of a model
+    with link bending); ``u`` (n, nm, 3) tool-point modal translations of the mass-normalised
+    modes in the process frame; ``phi`` (n, nm, nm) mass-normalised shapes in the model's
+    coordinates (mode index second); ``compliance``
     (n, 3, 3) static tool-point compliance [m/N] in the process frame; ``R`` (n, 3, 3)
     process frames; ``T`` (n, 4, 4) tool transforms."""
 

@@ -16,9 +16,10 @@ Ground truth (documented, generated here; nothing is measured):
 So the truth has 10 degrees of freedom, posture-dependent link compliance that joint springs
 cannot represent exactly, and a mass distribution different from the library's estimates.
 
-What the planner's model sees (:func:`identify_from_truth`): joint stiffnesses fitted, like a
-stiffness campaign does, by non-negative least squares of the 6x6 tool-point compliance
-(translations in m/N, rotations scaled by 1 m) over ``campaign`` postures; and the truth's
+What the planner's model sees (:func:`identify_from_truth`): joint stiffnesses (and, with
+``link_bending=True``, the bending compliances of the lower arm and the forearm as
+Euler-Bernoulli beams) fitted, like a stiffness campaign does, by non-negative least squares
+of the 6x6 tool-point compliance over ``campaign`` postures; and the truth's
 modes below 60 Hz at the measured posture, as a hammer test would give them. It then
 calibrates the library-based model there (:func:`robobore.plan.model.calibrate`) and
 predicts at held-out postures (:func:`validation_postures`).
