@@ -228,6 +228,12 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
     assert p.mesh.frame == "tool" and p.contact.friction_velocity == "sliding"
     m = cal.fe_model_description(c)
     assert m["validated_physics"] and "validated model" in m["validation"]
+    # the departures from the checked domain are named: rake 7, 20 um, 0.2 mm, h 90, vc 37.7
+    out = " | ".join(m["outside_validation"])
+    for words in ("uncut_chip_thickness_um 90 outside", "cutting_speed_m_per_min 37.7",
+                  "rake_deg 7", "element_size_um 20", "length_mm 0.2"):
+        assert words in out
+    assert "edge_radius_um" not in out and "material" not in out
     assert not cal.fe_model_description(_full({**_FULL, "parameters": "a_priori"}))[
         "validated_physics"]
 

@@ -448,6 +448,9 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
             f"OLS fit "
             f"Fc = Kte + Ktc h, Ff = Kfe + Kfc h over h = {hs} um x vc = {vs} m/min; "
             f"rake {cfg.rake_deg:g} deg, edge radius {cfg.edge_radius_um:g} um; {mapping}")
+    if model["outside_validation"]:
+        prov += "; FE tests outside the model's validated domain: " + "; ".join(
+            model["outside_validation"])
     warnings = fit_warnings(fit_c, fit_f)
     if warnings:
         prov += "; WARNING: " + "; ".join(warnings)
@@ -493,6 +496,39 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
     }
 
 
+#: where the validated model was checked against measured forces (docs/fe.md, "Model choice":
+#: ../shared/data/ti64_orthogonal_cutting_forces.json, TC4)
+VALIDATION_DOMAIN = {"uncut_chip_thickness_um": (40.0, 80.0),
+                     "cutting_speed_m_per_min": (5.0, 30.0), "rake_deg": 15.0,
+                     "edge_radius_um": 20.0, "element_size_um": 10.0, "length_mm": 0.3,
+                     "material": "TC4"}
+
+
+def _departures(cfg: CalibrationConfig, c: Any) -> list[str]:
+    """How the virtual tests leave the validated model's checked domain (in words)."""
+    d = VALIDATION_DOMAIN
+    out = []
+    for key, vals in (("uncut_chip_thickness_um", cfg.uncut_chip_thickness_um),
+                      ("cutting_speed_m_per_min", cfg.cutting_speed_m_per_min)):
+        lo, hi = d[key]
+        off = [v for v in vals if not lo <= v <= hi]
+        if off:
+            out.append(f"{key} {', '.join(f'{v:g}' for v in off)} outside the validated "
+                       f"{lo:g}-{hi:g}")
+    for key, val in (("rake_deg", cfg.rake_deg), ("edge_radius_um", cfg.edge_radius_um)):
+        if val != d[key]:
+            out.append(f"{key} {val:g} (validated at {d[key]:g})")
+    if c.mesh.element_size_um > d["element_size_um"]:
+        out.append(f"element_size_um {c.mesh.element_size_um:g} coarser than the validated "
+                   f"{d['element_size_um']:g}")
+    if c.cut.length_mm < d["length_mm"]:
+        out.append(f"length_mm {c.cut.length_mm:g} shorter than the validated "
+                   f"{d['length_mm']:g}")
+    if cfg.material != d["material"]:
+        out.append(f"material {cfg.material} (validated on {d['material']})")
+    return out
+
+
 def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
     """The FE model of the virtual tests in words, with its validation status: whether its
     physics (frame, friction, material, conduction) are the engine's validated defaults."""
@@ -519,6 +555,7 @@ def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
                   "not the engine's validated model (docs/fe.md, 'Model choice')")
     return {"source": cfg.fe_config_source or "fe shorthand (workpiece frame, a-priori)",
             "summary": summary, "validation": validation, "validated_physics": same,
+            "outside_validation": _departures(cfg, c),
             "config": None if cfg.fe_config is None else cfg.fe_config}
 
 
