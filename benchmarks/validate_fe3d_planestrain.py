@@ -41,15 +41,17 @@ def main() -> None:
     from robobore.cutting.fe.solver import simulate_orthogonal
     from robobore.io.results import atomic_write_text
 
-    d = {"material": {"name": "TC4"},
+    d = {"parameters": "a_priori", "material": {"name": "TC4"},
          "tool": {"rake_deg": a.rake, "clearance_deg": a.clearance,
                   "edge_radius_um": a.edge_um},
          "cut": {"uncut_chip_thickness_um": a.h_um, "cutting_speed_m_per_min": a.vc,
                  "length_mm": a.length_mm, "width_mm": 1.0},
          "contact": {"friction": "table"},
-         "mesh": {"element_size_um": a.element_um, "separation": "node_split",
+         "mesh": {"frame": "workpiece", "element_size_um": a.element_um,
+                  "separation": "node_split",
                   "separation_height_um": 5.0},
-         "solver": {"mass_scaling": 100.0, "hourglass_stiffness": a.hourglass[0],
+         "solver": {"mass_scaling": 100.0, "heat_conduction": False,
+                    "hourglass_stiffness": a.hourglass[0],
                     "hourglass_viscous": a.hourglass[1]}}
     cfg = parse_config(d)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cpus")

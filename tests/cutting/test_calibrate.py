@@ -197,3 +197,93 @@ def test_stored_coefficients_reproduce_fe_cutting_forces_within_5_percent():
     c = load_coefficients(STORED)
     assert c.Ktc > 0 and "FE-calibrated" in c.provenance
     assert data["material"] == "TC4" and data["robobore_version"]
+
+
+# --- the FE model as a full FE config (calibration.fe_config) --------------------------------
+
+_FULL = {"cut": {"length_mm": 0.2}, "mesh": {"element_size_um": 20.0}}
+
+
+def _full(fe_config, tmp_path=None, **kw):
+    d = {"calibration": {"uncut_chip_thickness_um": [60.0, 90.0],
+                         "cutting_speed_m_per_min": [37.7], "fe_config": fe_config, **kw},
+         "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 6.0},
+         "material": {"name": "TC4"}}
+    src = None if tmp_path is None else str(tmp_path / "cal.toml")
+    return cal.calibration_from_mapping(d, source=src or "cal.toml")
+
+
+def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
+    from robobore.cutting.fe.config import parse_config
+
+    c = _full(_FULL)
+    assert c.fe_config_source == "inline"
+    d = cal.fe_config_dict(c, 90.0, 37.7)
+    assert d["cut"] == {"length_mm": 0.2, "uncut_chip_thickness_um": 90.0,
+                        "cutting_speed_m_per_min": 37.7}
+    assert d["tool"] == {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 6.0}
+    assert d["mesh"] == {"element_size_um": 20.0} and d["material"] == {"name": "TC4"}
+    p = parse_config(d)
+    # everything else is the engine's default: the validated model
+    assert p.mesh.frame == "tool" and p.contact.friction_velocity == "sliding"
+    m = cal.fe_model_description(c)
+    assert m["validated_physics"] and "validated model" in m["validation"]
+    # the departures from the checked domain are named: rake 7, 20 um, 0.2 mm, h 90, vc 37.7
+    out = " | ".join(m["outside_validation"])
+    for words in ("uncut_chip_thickness_um 90 outside", "cutting_speed_m_per_min 37.7",
+                  "rake_deg 7", "element_size_um 20", "length_mm 0.2"):
+        assert words in out
+    assert "edge_radius_um" not in out and "material" not in out
+    assert not cal.fe_model_description(_full({**_FULL, "parameters": "a_priori"}))[
+        "validated_physics"]
+
+
+def test_full_fe_config_from_a_file_next_to_the_config(tmp_path):
+    (tmp_path / "sub").mkdir()
+    f = tmp_path / "sub" / "fe.toml"
+    f.write_text('[cut]\nlength_mm = 0.2\n[mesh]\nelement_size_um = 20.0\n'
+                 '[contact]\nfriction = "rech2013"\n')
+    c = _full("sub/fe.toml", tmp_path)
+    assert c.fe_config_source == str(f.resolve())
+    assert c.fe_config["contact"] == {"friction": "rech2013"}
+    with pytest.raises(ConfigError, match="not found") as e:
+        _full("nope.toml", tmp_path)
+    assert e.value.field == "calibration.fe_config"
+
+
+@pytest.mark.parametrize("fe_config, kw, field, words", [
+    ({**_FULL, "mesh": {"element_size_um": 25.0}}, {}, "mesh.element_size_um", "h 60 um"),
+    ({**_FULL, "contact": {"frcition": 0.3}}, {}, "contact.frcition", "grid point"),
+    ({**_FULL, "tool": {"rake_deg": 15.0}}, {}, "tool.rake_deg", "insert"),
+    ({**_FULL, "material": {"name": "TC5"}}, {}, "material.name", "material"),
+    (_FULL, {"fe": {"length_mm": 0.5}}, "calibration.fe", "once"),
+    (3, {}, "calibration.fe_config", "bad FE config"),
+])
+def test_full_fe_config_errors_before_any_run(monkeypatch, fe_config, kw, field, words):
+    def no_run(*a, **k):
+        raise AssertionError("an FE run started before the config error was found")
+
+    monkeypatch.setattr(cal, "run_fe_point", no_run)
+    with pytest.raises(ConfigError, match=words) as e:
+        _full(fe_config, **kw)
+    assert e.value.field == field
+
+
+def test_full_fe_config_grid_runs_and_is_cached(tmp_path, monkeypatch):
+    calls = []
+
+    def fake(fe_cfg):
+        calls.append(fe_cfg)
+        h = fe_cfg["cut"]["uncut_chip_thickness_um"] * 1e-6
+        return {"cutting_force_N_per_mm": (30e3 + 1.6e9 * h) * 1e-3,
+                "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
+
+    monkeypatch.setattr(cal, "run_fe_point", fake)
+    cache = ResultCache(tmp_path / "cache")
+    r = cal.calibrate_forces(_full(_FULL), cache=cache)
+    assert len(calls) == 2 and r["fe_settings"] is None
+    assert r["fe_model"]["source"] == "inline" and r["fe_model"]["validated_physics"]
+    assert "tool-frame model" in r["coefficients"]["provenance"]
+    assert r["coefficients"]["Ktc_N_per_m2"] == pytest.approx(1.6e9, rel=1e-9)
+    cal.calibrate_forces(_full({**_FULL, "parameters": "a_priori"}), cache=cache)
+    assert len(calls) == 4

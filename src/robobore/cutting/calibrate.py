@@ -13,6 +13,14 @@ boring model takes one set of coefficients). Standard errors come from the resid
 ``cov = s^2 (A^T A)^-1``, ``s^2 = RSS / (n - 2)``. Per-speed fits are reported too so that a
 speed effect is visible.
 
+The FE model of the virtual tests is a full FE orthogonal config (``fe_config``: a TOML file,
+resolved next to the calibration config, or an inline table; everything ``robobore fe
+orthogonal`` accepts): each virtual test overrides only its uncut chip thickness and cutting
+speed, and runs at the insert's own rake angle, edge radius and clearance. An FE config whose
+``[tool]`` gives another rake or edge radius than the insert is refused. Without
+``fe_config`` the ``fe`` table is a shorthand of a few settings for the workpiece-frame model
+with the a-priori parameters (:class:`FESettings`).
+
 Orthogonal -> insert: the FE tests use the insert's own rake angle and edge radius, so for a
 zero-inclination insert the orthogonal coefficients apply unchanged to each edge element
 (the thrust acts normal to the local edge, as in ``cutting/forces.py``) and ``Krc = Kre = 0``.
@@ -54,8 +62,9 @@ class _Strict(BaseModel):
 
 
 class FESettings(_Strict):
-    """FE settings of the virtual tests (see docs/fe.md; coarse but within the engine's
-    checks: element size <= h/3)."""
+    """Shorthand FE settings of the virtual tests when no ``fe_config`` is given: the
+    workpiece-frame model with the a-priori parameters (see docs/fe.md; coarse but within the
+    engine's checks: element size <= h/3)."""
 
     length_mm: float = Field(0.4, gt=0, le=10, description="length of cut, mm")
     element_size_um: float = Field(20.0, gt=0, le=200, description="element size, um")
@@ -79,6 +88,11 @@ class CalibrationConfig(_Strict):
     uncut_chip_thickness_um: list[float] = Field(min_length=2)
     cutting_speed_m_per_min: list[float] = Field(min_length=1)
     fe: FESettings = FESettings()
+    #: the full FE config of the virtual tests (resolved: a file's content or the inline
+    #: table, with the insert's tool and the material filled in); None: the ``fe`` shorthand
+    fe_config: dict[str, Any] | None = None
+    #: where ``fe_config`` came from: the resolved file path, or "inline"
+    fe_config_source: str | None = None
 
     @field_validator("uncut_chip_thickness_um", "cutting_speed_m_per_min")
     @classmethod
@@ -112,6 +126,7 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
                               expected="the sections [calibration], [insert], [material] (or "
                               "those of a paper config)")
     cal = dict(data.get("calibration", data))
+    user_fe = "fe" in cal
     ins = data.get("insert", {}) if "calibration" in data else {}
     mat = data.get("material", {}) if "calibration" in data else {}
     for k in ("rake_deg", "edge_radius_um", "inclination_deg"):
@@ -126,16 +141,93 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
     for k in ("insert", "material"):
         if "calibration" not in data:
             cal.pop(k, None)
+    prefix = "calibration." if "calibration" in data else ""
+    fe_full = cal.pop("fe_config", None)
+    cal.pop("fe_config_source", None)
+    if fe_full is not None and user_fe:
+        raise ConfigError("give the FE model once", file=source, field=f"{prefix}fe",
+                          value=cal["fe"], expected=f"either {prefix}fe_config (a full FE "
+                          f"config) or the {prefix}fe shorthand, not both")
     cfg = validate_model(CalibrationConfig, cal, source=source)
     from robobore.material.library import resolve_material_name
 
     cfg.material = resolve_material_name(cfg.material, source, "material.name")
+    if fe_full is not None:
+        full, src = _resolve_fe_config(fe_full, source, f"{prefix}fe_config")
+        cfg = cfg.model_copy(update={"fe_config": _with_insert(cfg, full, source, prefix, src),
+                                     "fe_config_source": src})
+        _check_grid(cfg, source, f"{prefix}fe_config")
+        return cfg
     smallest = min(cfg.uncut_chip_thickness_um)
     if cfg.fe.element_size_um > smallest / 3 + 1e-9:
         raise ConfigError("FE element too large for the thinnest chip", file=source,
                           field="calibration.fe.element_size_um", value=cfg.fe.element_size_um,
                           expected=f"<= h/3 = {smallest / 3:.4g} um (FE engine check)")
     return cfg
+
+
+def _resolve_fe_config(value: Any, source: str | None, field: str) -> tuple[dict[str, Any], str]:
+    """The FE config of ``fe_config``: a TOML file path (relative to the calibration config's
+    folder) or an inline table; returns (a fresh dict, its source)."""
+    import copy
+
+    from robobore.io.config import load_toml
+
+    if isinstance(value, dict):
+        return copy.deepcopy(value), "inline"
+    if not isinstance(value, str) or not value.strip():
+        raise ConfigError("bad FE config", file=source, field=field, value=value,
+                          expected="a path to an FE orthogonal config TOML (relative to this "
+                          "file) or an inline table")
+    from robobore.io.paths import resolve_config_path
+
+    p = resolve_config_path(value, source, field, what="FE config file")
+    return load_toml(p), str(p)
+
+
+def _with_insert(cfg: CalibrationConfig, full: dict[str, Any], source: str | None,
+                 prefix: str, src: str) -> dict[str, Any]:
+    """The FE config at the insert's rake, edge radius and clearance and the calibration's
+    material; a different rake, edge radius or material in the FE config is an error."""
+    tool = full.get("tool", {})
+    if not isinstance(tool, dict):
+        raise ConfigError("[tool] must be a table", file=src, field="tool", value=tool,
+                          expected="a table (or nothing: the insert's values are used)")
+    insert = {"rake_deg": cfg.rake_deg, "edge_radius_um": cfg.edge_radius_um,
+              "clearance_deg": cfg.fe.clearance_deg}
+    for k in ("rake_deg", "edge_radius_um"):
+        if k in tool and float(tool[k]) != float(insert[k]):
+            raise ConfigError("the FE config's tool differs from the insert", file=src,
+                              field=f"tool.{k}", value=tool[k],
+                              expected=f"the insert's {k} = {insert[k]:g} (the virtual tests "
+                              "run at the insert's own edge; or leave the key out)")
+    clear = tool.get("clearance_deg", insert["clearance_deg"])
+    full["tool"] = {**tool, "rake_deg": insert["rake_deg"],
+                    "edge_radius_um": insert["edge_radius_um"], "clearance_deg": clear}
+    mat = full.get("material", {})
+    if isinstance(mat, dict):
+        name = mat.get("name")
+        if name is not None and str(name) != cfg.material:
+            raise ConfigError("the FE config's material differs from the calibration's",
+                              file=src, field="material.name", value=name,
+                              expected=f"{cfg.material!r} (the {prefix}material or "
+                              "[material] name), or leave the key out")
+        full["material"] = {**mat, "name": cfg.material}
+    return full
+
+
+def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
+    """Every virtual test's config passes the engine's checks (before any run)."""
+    from robobore.cutting.fe.config import parse_config
+
+    for h in cfg.uncut_chip_thickness_um:
+        for v in cfg.cutting_speed_m_per_min:
+            try:
+                parse_config(fe_config_dict(cfg, h, v), cfg.fe_config_source)
+            except ConfigError as exc:
+                raise ConfigError(f"{field} at the grid point h {h:g} um, vc {v:g} m/min: "
+                                  f"{exc.message}", file=exc.file or source, field=exc.field,
+                                  value=exc.value, expected=exc.expected) from None
 
 
 def load_calibration_config(path: str | Path) -> CalibrationConfig:
@@ -146,8 +238,13 @@ def load_calibration_config(path: str | Path) -> CalibrationConfig:
 
 def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> dict[str, Any]:
     """The FE engine's config (``robobore fe orthogonal`` contract) of one grid point."""
+    if cfg.fe_config is not None:
+        from robobore.cutting.fe.validate import point_config
+
+        return point_config(cfg.fe_config, h_um, vc_m_per_min)
     fe = cfg.fe
     return {
+        "parameters": "a_priori",
         "material": {"name": cfg.material},
         "tool": {"rake_deg": cfg.rake_deg, "clearance_deg": fe.clearance_deg,
                  "edge_radius_um": cfg.edge_radius_um},
@@ -155,10 +252,11 @@ def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> 
                 "cutting_speed_m_per_min": float(vc_m_per_min),
                 "length_mm": fe.length_mm, "width_mm": 1.0},
         "contact": {"friction": fe.friction, "shear_limit_MPa": fe.shear_limit_MPa},
-        "mesh": {"element_size_um": fe.element_size_um, "separation": fe.separation,
+        "mesh": {"frame": "workpiece", "element_size_um": fe.element_size_um,
+                 "separation": fe.separation,
                  **({} if fe.separation_height_um is None
                     else {"separation_height_um": fe.separation_height_um})},
-        "solver": {"mass_scaling": fe.mass_scaling,
+        "solver": {"mass_scaling": fe.mass_scaling, "heat_conduction": False,
                    "steady_window_fraction": fe.steady_window_fraction},
     }
 
@@ -354,10 +452,14 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
                    f"beta = {math.degrees(op.friction_angle_rad):.1f} deg; edge terms kept")
     hs = ", ".join(f"{x:g}" for x in cfg.uncut_chip_thickness_um)
     vs = ", ".join(f"{x:g}" for x in cfg.cutting_speed_m_per_min)
-    prov = (f"FE-calibrated ({cfg.material}; robobore {__version__} 2D FE, "
-            f"{cfg.fe.element_size_um:g} um elements, {cfg.fe.length_mm:g} mm cut): OLS fit "
+    model = fe_model_description(cfg)
+    prov = (f"FE-calibrated ({cfg.material}; robobore {__version__} 2D FE, {model['summary']}): "
+            f"OLS fit "
             f"Fc = Kte + Ktc h, Ff = Kfe + Kfc h over h = {hs} um x vc = {vs} m/min; "
             f"rake {cfg.rake_deg:g} deg, edge radius {cfg.edge_radius_um:g} um; {mapping}")
+    if model["outside_validation"]:
+        prov += "; FE tests outside the model's validated domain: " + "; ".join(
+            model["outside_validation"])
     warnings = fit_warnings(fit_c, fit_f)
     if warnings:
         prov += "; WARNING: " + "; ".join(warnings)
@@ -393,13 +495,77 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
         "insert": {"rake_deg": cfg.rake_deg, "edge_radius_um": cfg.edge_radius_um,
                    "inclination_deg": cfg.inclination_deg,
                    "clearance_deg": cfg.fe.clearance_deg},
-        "fe_settings": cfg.fe.model_dump(mode="json"),
+        "fe_settings": None if cfg.fe_config is not None else cfg.fe.model_dump(mode="json"),
+        "fe_model": model,
         "grid": {"uncut_chip_thickness_um": cfg.uncut_chip_thickness_um,
                  "cutting_speed_m_per_min": cfg.cutting_speed_m_per_min},
         "robobore_version": __version__,
         "fe_engine_revision": FE_ENGINE_REVISION,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
+
+
+#: where the validated model was checked against measured forces (docs/fe.md, "Model choice":
+#: ../shared/data/ti64_orthogonal_cutting_forces.json, TC4)
+VALIDATION_DOMAIN = {"uncut_chip_thickness_um": (40.0, 80.0),
+                     "cutting_speed_m_per_min": (5.0, 30.0), "rake_deg": 15.0,
+                     "edge_radius_um": 20.0, "element_size_um": 10.0, "length_mm": 0.3,
+                     "material": "TC4"}
+
+
+def _departures(cfg: CalibrationConfig, c: Any) -> list[str]:
+    """How the virtual tests leave the validated model's checked domain (in words)."""
+    d = VALIDATION_DOMAIN
+    out = []
+    for key, vals in (("uncut_chip_thickness_um", cfg.uncut_chip_thickness_um),
+                      ("cutting_speed_m_per_min", cfg.cutting_speed_m_per_min)):
+        lo, hi = d[key]
+        off = [v for v in vals if not lo <= v <= hi]
+        if off:
+            out.append(f"{key} {', '.join(f'{v:g}' for v in off)} outside the validated "
+                       f"{lo:g}-{hi:g}")
+    for key, val in (("rake_deg", cfg.rake_deg), ("edge_radius_um", cfg.edge_radius_um)):
+        if val != d[key]:
+            out.append(f"{key} {val:g} (validated at {d[key]:g})")
+    if c.mesh.element_size_um > d["element_size_um"]:
+        out.append(f"element_size_um {c.mesh.element_size_um:g} coarser than the validated "
+                   f"{d['element_size_um']:g}")
+    if c.cut.length_mm < d["length_mm"]:
+        out.append(f"length_mm {c.cut.length_mm:g} shorter than the validated "
+                   f"{d['length_mm']:g}")
+    if cfg.material != d["material"]:
+        out.append(f"material {cfg.material} (validated on {d['material']})")
+    return out
+
+
+def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
+    """The FE model of the virtual tests in words, with its validation status: whether its
+    physics (frame, friction, material, conduction) are the engine's validated defaults."""
+    from robobore.cutting.fe.config import parse_config
+
+    h0, v0 = cfg.uncut_chip_thickness_um[0], cfg.cutting_speed_m_per_min[0]
+    c = parse_config(fe_config_dict(cfg, h0, v0))
+    ref = parse_config({k: c.model_dump()[k] for k in ("tool", "cut")} |
+                       {"mesh": {"element_size_um": c.mesh.element_size_um}})
+    same = (c.mesh.frame == ref.mesh.frame
+            and c.contact.model_dump() == ref.contact.model_dump()
+            and c.material.model_dump() == ref.material.model_dump()
+            and c.parameters == ref.parameters
+            and c.solver.heat_conduction == ref.solver.heat_conduction
+            and c.tool_support is None)
+    law = c.friction_law()
+    summary = (f"{c.mesh.frame}-frame model, {c.mesh.element_size_um:g} um elements, "
+               f"{c.cut.length_mm:g} mm of {'tool travel' if c.mesh.frame == 'tool' else 'cut'}, "
+               f"friction {law}, parameters {c.parameters}")
+    validation = ("the engine's validated model (docs/fe.md, 'Model choice': Fc within 10 % "
+                  "and Ff within 25 % of the nine measured Ti6Al4V points, h 40-80 um, "
+                  "vc 5-30 m/min, 10 um elements; CALIBRATED friction law and hardening "
+                  "hold chosen on those points)" if same else
+                  "not the engine's validated model (docs/fe.md, 'Model choice')")
+    return {"source": cfg.fe_config_source or "fe shorthand (workpiece frame, a-priori)",
+            "summary": summary, "validation": validation, "validated_physics": same,
+            "outside_validation": _departures(cfg, c),
+            "config": None if cfg.fe_config is None else cfg.fe_config}
 
 
 #: A fit is flagged when it misses an FE point by more than this (issue 6 acceptance: 5 %).
@@ -461,4 +627,4 @@ def predicted_forces(data: dict[str, Any]) -> list[dict[str, float]]:
 __all__ = ["FESettings", "CalibrationConfig", "calibration_from_mapping",
            "load_calibration_config", "fe_config_dict", "run_fe_point", "run_grid",
            "fit_edge_model", "fit_warnings", "FIT_TOLERANCE", "calibrate",
-           "calibrate_forces", "predicted_forces", "FE_NAMESPACE"]
+           "calibrate_forces", "predicted_forces", "FE_NAMESPACE", "fe_model_description"]

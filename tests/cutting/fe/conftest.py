@@ -30,14 +30,15 @@ def edge_band_dict(**sections) -> dict:
     """A short cut on the edge-refined mesh (node splitting 5 um, 5 um band, h 30 um,
     0.04 mm), as a fresh dict; ``sections`` (e.g. ``mesh={...}``) update its tables."""
     d = {
+        "parameters": "a_priori",
         "material": {"name": "TC4"},
         "tool": {"rake_deg": 7.0, "clearance_deg": 7.0, "edge_radius_um": 20.0},
         "cut": {"uncut_chip_thickness_um": 30.0, "cutting_speed_m_per_min": 37.7,
                 "length_mm": 0.04, "width_mm": 1.0},
         "contact": {"friction": 0.2},
-        "mesh": {"element_size_um": 10.0, "separation": "node_split",
+        "mesh": {"frame": "workpiece", "element_size_um": 10.0, "separation": "node_split",
                  "separation_height_um": 5.0, "edge_element_um": 5.0},
-        "solver": {"mass_scaling": 100.0},
+        "solver": {"mass_scaling": 100.0, "heat_conduction": False},
     }
     for sec, kv in sections.items():
         d[sec].update(kv)

@@ -18,12 +18,13 @@ from robobore.cutting.fe.solver import simulate_orthogonal
 
 FC_MEAS, FF_MEAS, R_MEAS = 118.23, 50.3, 1.23
 BASE = {
+    "parameters": "a_priori",
     "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
     "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
             "length_mm": 0.3, "width_mm": 1.0},
     "contact": {"friction": 0.18},
-    "mesh": {"element_size_um": 20.0},
-    "solver": {"mass_scaling": 100.0, "n_samples": 150},
+    "mesh": {"element_size_um": 20.0, "frame": "workpiece"},
+    "solver": {"mass_scaling": 100.0, "n_samples": 150, "heat_conduction": False},
 }
 SUPPORT = {"stiffness_N_per_m": 1.0e7, "damping_N_s_per_m": 95.0, "mass_kg": 0.0025}
 

@@ -55,7 +55,8 @@ SCRIPT = PRELUDE + textwrap.dedent("""
         "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
                 "length_mm": 0.06, "width_mm": 1.0},
         "contact": {"friction": "table", "friction_velocity": "sliding"},
-        "mesh": {"element_size_um": 15.0, "separation": "node_split",
+        "parameters": "a_priori",
+        "mesh": {"frame": "workpiece", "element_size_um": 15.0, "separation": "node_split",
                  "separation_height_um": 5.0},
         "solver": {"mass_scaling": 100.0, "heat_conduction": True,
                    "conduction_interval": 4},
@@ -120,8 +121,8 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
     d["cut"]["length_mm"] = 0.004
     d["mesh"]["element_size_um"] = 20.0
     d["mesh"]["edge_element_um"] = 10.0
-    d["solver"].update(heat_conduction=True, conduction_interval=4)
-    d["contact"]["friction_velocity"] = "sliding"
+    d.setdefault("solver", {}).update(heat_conduction=True, conduction_interval=4)
+    d.setdefault("contact", {})["friction_velocity"] = "sliding"
     d["tool_support"] = {"stiffness_N_per_m": [2e7, 2e7],
                          "damping_N_s_per_m": [200.0, 200.0], "mass_kg": [0.05, 0.05]}
     s = setup_orthogonal(parse_config(d))
@@ -188,7 +189,7 @@ def test_cli_rejects_unknown_device_and_rezoning_on_gpu(tmp_path):
     assert r.exit_code == 2
     assert "unknown device" in r.output and "tpu" in r.output
     f = tmp_path / "rz.toml"
-    f.write_text(EXAMPLE.read_text() + "rezone_interval = 50\n")
+    f.write_text(EXAMPLE.read_text() + "[solver]\nrezone_interval = 50\n")
     r = CliRunner().invoke(app, ["fe", "orthogonal", str(f), "--json", "--device", "gpu"])
     assert r.exit_code == 2
     assert "solver.rezone_interval" in r.output

@@ -134,7 +134,8 @@ def test_sliding_friction_is_refused_by_the_3d_slab():
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
                                 "length_mm": 0.05},
                         "contact": {"friction": "table", "friction_velocity": "sliding"},
-                        "mesh": {"element_size_um": 20, "separation": "node_split"}})
+                        "mesh": {"element_size_um": 20, "separation": "node_split",
+                                 "frame": "workpiece"}})
     with pytest.raises(ConfigError, match="friction_velocity"):
         setup_slab3(cfg)
 

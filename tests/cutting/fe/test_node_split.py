@@ -106,9 +106,10 @@ def test_pairs_release_at_the_tool_edge():
         "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
         "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
                 "length_mm": 0.06},
-        "mesh": {"element_size_um": 20.0, "separation": "node_split",
+        "parameters": "a_priori",
+        "mesh": {"frame": "workpiece", "element_size_um": 20.0, "separation": "node_split",
                  "separation_height_um": 5.0},
-        "solver": {"mass_scaling": 100.0},
+        "solver": {"mass_scaling": 100.0, "heat_conduction": False},
     })
     s = setup_orthogonal(cfg)
     st = s.state
@@ -139,5 +140,5 @@ def test_separation_height_must_be_positive(bad):
             "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
             "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
                     "length_mm": 0.06},
-            "mesh": {"element_size_um": 20.0, "separation": "node_split",
-                     "separation_height_um": bad}})
+            "mesh": {"frame": "workpiece", "element_size_um": 20.0,
+                     "separation": "node_split", "separation_height_um": bad}})

@@ -161,7 +161,8 @@ def _short_cut_cfg(**contact):
         "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
                 "length_mm": 0.05},
         "contact": {"friction": 0.18, **contact},
-        "mesh": {"element_size_um": 15.0, "separation": "node_split",
+        "parameters": "a_priori",
+        "mesh": {"frame": "workpiece", "element_size_um": 15.0, "separation": "node_split",
                  "separation_height_um": 5.0},
         "solver": {"mass_scaling": 100.0, "heat_conduction": True},
     })

@@ -21,14 +21,14 @@ from robobore.cutting.fe.slab3d import simulate_slab3
 from robobore.cutting.fe.solver import simulate_orthogonal
 from robobore.errors import ConfigError
 
-CFG = {"material": {"name": "TC4"},
+CFG = {"parameters": "a_priori", "material": {"name": "TC4"},
        "tool": {"rake_deg": 7.0, "clearance_deg": 7.0, "edge_radius_um": 20.0},
        "cut": {"uncut_chip_thickness_um": 40.0, "cutting_speed_m_per_min": 80.0,
                "length_mm": 0.1, "width_mm": 1.0},
        "contact": {"friction": "table"},
-       "mesh": {"element_size_um": 10.0, "separation": "node_split",
+       "mesh": {"frame": "workpiece", "element_size_um": 10.0, "separation": "node_split",
                 "separation_height_um": 5.0},
-       "solver": {"mass_scaling": 100.0}}
+       "solver": {"mass_scaling": 100.0, "heat_conduction": False}}
 
 
 def test_slab_forces_match_2d_engine():
@@ -42,6 +42,6 @@ def test_slab_forces_match_2d_engine():
 
 
 def test_slab_needs_node_splitting():
-    d = {**CFG, "mesh": {"element_size_um": 10.0}}
+    d = {**CFG, "mesh": {"frame": "workpiece", "element_size_um": 10.0}}
     with pytest.raises(ConfigError, match="mesh.separation"):
         simulate_slab3(parse_config(d))

@@ -403,7 +403,7 @@ class BoringSetup:
 def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     """Mesh, insert, support and state for ``cfg``."""
     mat = load_material(cfg.material.name, source=source,
-                        hardening_strain_limit=cfg.material.hardening_strain_limit)
+                        hardening_strain_limit=cfg.material.strain_limit())
     ins = cfg.insert.to_insert()
     ap = cfg.cut.depth_of_cut_mm * 1e-3
     f = cfg.cut.feed_mm_per_rev * 1e-3

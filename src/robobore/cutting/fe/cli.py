@@ -1,5 +1,6 @@
 """CLI commands of the FE stage (registered by ``robobore.cli``): ``robobore fe orthogonal``
-(``--device cpu|gpu``) and, from :mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
+(``--device cpu|gpu``), ``robobore fe validate`` (:mod:`robobore.cutting.fe.validate`) and, from
+:mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
 
 from __future__ import annotations
 
@@ -126,9 +127,136 @@ def _plot_forces(res, path: Path) -> Path:
     return path
 
 
+def validate_cmd(
+    config: Path = typer.Argument(..., help="FE orthogonal-cutting config (TOML)."),
+    measured: Path = typer.Option(..., "--measured", help="Measured-forces file (JSON; format "
+                                  "in docs/fe.md, robobore fe validate)."),
+    as_json: bool = JSON_OPTION,
+    points: str | None = typer.Option(None, "--points", help="Only these conditions, "
+                                      "h_um:vc_m_per_min pairs, e.g. 60:30,40:5 (a condition "
+                                      "the file does not hold is a prediction)."),
+    out: Path | None = typer.Option(None, "--out", help="Folder of the per-point results "
+                                    "(reused on a rerun: an interrupted validation resumes); "
+                                    "default ./fe_validate_<config name>."),
+    plot: Path | None = typer.Option(None, "--plot", help="Write a simulated-vs-measured "
+                                     "picture (PNG) here."),
+    device: str = typer.Option("cpu", "--device", help="cpu (default) or gpu (numba-cuda)."),
+) -> None:
+    """Run the config at every measured condition (uncut chip thickness and cutting speed
+    replaced per point) and compare Fc, Ff and chip ratio with the measurement."""
+    run_validate_cli(config, measured, as_json, points, out, plot, device)
+
+
+@handle_errors
+def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu") -> None:
+    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.validate import parse_points, read_measured, run_validation
+    from robobore.io.config import load_toml
+
+    base = load_toml(config)
+    parse_config(base, str(config))  # the base config's own errors first
+    meas = read_measured(measured)
+    pts = None if points is None else parse_points(points)
+    out = Path(f"fe_validate_{Path(config).stem}") if out is None else out
+    total = 1000
+    with progress_bar("FE validation", total, enabled=not as_json) as advance:
+        done = [0]
+
+        def prog(frac: float) -> None:
+            n = int(frac * total)
+            if n > done[0]:
+                advance(n - done[0])
+                done[0] = n
+
+        result = run_validation(base, meas, source=str(config), points=pts, out_dir=out,
+                                device=device, progress=prog)
+    result["measured_file"] = str(measured)
+    if plot is not None:
+        result.setdefault("files", {})["png_validation"] = str(
+            _plot_validation(result, Path(plot) / "fe_validation.png"))
+
+    def render(r: dict) -> None:
+        from rich.table import Table
+
+        t = Table(title="FE validation (err % = simulated / measured - 1)")
+        for c in ("h um", "vc m/min", "Fc meas", "Fc sim", "err %", "Ff meas", "Ff sim",
+                  "err %", "r meas", "r sim", "err %"):
+            t.add_column(c, justify="right")
+
+        def f(v, fm=".1f"):
+            return "-" if v is None else format(v, fm)
+
+        def e(v):
+            return "-" if v is None else f"{100 * v:+.1f}"
+
+        for p in r["points"]:
+            m, re_ = p["measured"], p["relative_error"]
+            t.add_row(f(p["uncut_chip_thickness_um"], "g"), f(p["cutting_speed_m_per_min"], "g"),
+                      f(m["cutting_force_N_per_mm"]), f(p["cutting_force_N_per_mm"]),
+                      e(re_["cutting_force"]), f(m["feed_force_N_per_mm"]),
+                      f(p["feed_force_N_per_mm"]), e(re_["feed_force"]),
+                      f(m["chip_ratio"], ".2f"), f(p["chip_ratio"], ".2f"), e(re_["chip_ratio"]))
+        stdout.print(t)
+        s = r["summary"]
+        rows = []
+        for key, label in (("cutting_force", "Fc"), ("feed_force", "Ff"),
+                           ("chip_ratio", "chip ratio")):
+            mx, mn = s["max_abs_error"][key], s["mean_abs_error"][key]
+            rows.append((f"{label}: mean / max |error| [%] ({s['n_measured'][key]} points)",
+                         "-" if mx is None else f"{100 * mn:.1f} / {100 * mx:.1f}"))
+        rows.append(("points reused from the results folder",
+                     sum(1 for p in r["points"] if p["reused"])))
+        rows.append(("config", r["config"]))
+        rows.append(("measured file", r["measured_file"]))
+        rows.append(("results folder", r["out_dir"]))
+        stdout.print(kv_table("Summary", rows))
+        for k, v in r.get("files", {}).items():
+            stdout.print(f"{k}: {v}")
+
+    emit(result, as_json, render)
+
+
+def _plot_validation(result: dict, path: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(9, 4), dpi=120)
+    for ax, key, label, band in ((axes[0], "cutting_force_N_per_mm", "Fc [N/mm]", 0.10),
+                                 (axes[1], "feed_force_N_per_mm", "Ff [N/mm]", 0.25)):
+        pts = [(p["measured"][key], p[key], p) for p in result["points"]
+               if p["measured"][key] is not None and p[key] is not None]
+        if pts:
+            xs = [a for a, _, _ in pts]
+            lo, hi = 0.0, 1.15 * max(max(xs), max(b for _, b, _ in pts))
+            ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+            ax.fill_between([lo, hi], [lo * (1 - band), hi * (1 - band)],
+                            [lo * (1 + band), hi * (1 + band)], color="0.9",
+                            label=f"+-{100 * band:.0f} %")
+            for a, b, p in pts:
+                ax.plot(a, b, "o", color="C0")
+                ax.annotate(f"{p['uncut_chip_thickness_um']:g}/{p['cutting_speed_m_per_min']:g}",
+                            (a, b), fontsize=6, xytext=(3, 3), textcoords="offset points")
+            ax.set_xlim(lo, hi)
+            ax.set_ylim(lo, hi)
+            ax.legend(fontsize=7)
+        ax.set_xlabel(f"measured {label}")
+        ax.set_ylabel(f"simulated {label}")
+    fig.suptitle("FE validation (labels: h um / vc m/min)", fontsize=9)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.stem + ".tmp.png")
+    fig.savefig(tmp)
+    plt.close(fig)
+    tmp.replace(path)
+    return path
+
+
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add this stage's commands to the shared command groups."""
     from robobore.cutting.fe.cli_boring import register_boring
 
     groups["fe"].command("orthogonal")(orthogonal_cmd)
+    groups["fe"].command("validate")(validate_cmd)
     register_boring(groups)

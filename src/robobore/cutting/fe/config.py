@@ -1,8 +1,12 @@
 """The FE orthogonal-cutting config (TOML) as a pydantic model, with documented defaults.
 
-Human units in the key names (um, mm, m/min, deg, MPa); :meth:`FEConfig.si` gives SI values.
-Only the contract keys are required (see ``examples/fe_orthogonal.toml``); every other key
-has the default documented on its field.
+Human units in the key names (um, mm, m/min, deg, MPa). Only the contract keys are required
+(tool, cut, mesh.element_size_um; see ``examples/fe_orthogonal.toml``); every other key has
+the default documented on its field. The defaults are the validated model (docs/fe.md,
+"Model choice"): the tool-frame ALE mesh, heat conduction, mass scaling 100 (30 / vc)^2, the
+CALIBRATED friction law ``rech2013_calibrated`` and the bundled material's CALIBRATED
+hardening hold (TC4: plastic strain 0.6). ``parameters = "a_priori"`` is the one switch back
+to the source's values (friction law ``rech2013``, plain Johnson-Cook hardening).
 """
 
 from __future__ import annotations
@@ -11,10 +15,23 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    field_validator,
+    model_validator,
+)
 
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
+from robobore.material.friction import (
+    A_PRIORI_LAW,
+    CALIBRATED_LAW,
+    friction_law,
+    friction_laws,
+)
 
 #: Coulomb friction coefficient vs cutting speed [m/min] for Ti6Al4V on uncoated WC
 #: (Rech et al. 2013, as used by Ducobu, Pantale et al. 2022; see
@@ -34,9 +51,23 @@ class MaterialSection(_Strict):
     #: bundled material name (e.g. "TC4") or a path to a material TOML file
     name: str = "TC4"
     #: plastic strain beyond which the Johnson-Cook hardening term B eps^n is held at its
-    #: value (replaces the material file's ``hardening_strain_limit``). None: the file's
-    #: (the bundled TC4: none, the plain law)
-    hardening_strain_limit: float | None = Field(default=None, gt=0.0)
+    #: value (replaces the material file's ``hardening_strain_limit``); "none": the plain
+    #: law. None: the file's (the bundled TC4: 0.6, CALIBRATED), or "none" with
+    #: ``parameters = "a_priori"``
+    hardening_strain_limit: float | Literal["none"] | None = None
+
+    @field_validator("hardening_strain_limit")
+    @classmethod
+    def _hold(cls, v: Any) -> Any:
+        if isinstance(v, float) and not v > 0.0:
+            raise ValueError('must be > 0 (a plastic strain), or "none" for the plain law')
+        return v
+
+    def strain_limit(self) -> float | None:
+        """The value for :func:`robobore.material.load_material`: None (the file's), a
+        plastic strain, or inf (the plain law)."""
+        v = self.hardening_strain_limit
+        return float("inf") if v == "none" else v
 
 
 class ToolSection(_Strict):
@@ -54,10 +85,16 @@ class CutSection(_Strict):
 
 
 class ContactSection(_Strict):
-    #: Coulomb coefficient, or "table" for the Rech et al. 2013 mu(vc) table
-    friction: float | Literal["table"] = "table"
-    #: cap on the contact shear stress [MPa] (Ducobu/Pantale model input: 576 MPa)
-    shear_limit_MPa: float = Field(default=576.0, gt=0.0)
+    #: the friction: a bundled friction law by name (robobore/material/friction_laws.toml:
+    #: "rech2013_calibrated", CALIBRATED, or "rech2013", A-PRIORI; the law gives the table,
+    #: the velocity it is read at and the shear cap, the last two overridable by their
+    #: keys), "table" (the friction_table_* keys, or without them the Rech et al. 2013
+    #: table at the cutting speed), or a constant Coulomb coefficient. None: the law of
+    #: ``parameters`` (the FE config's top-level key)
+    friction: float | str | None = None
+    #: cap on the contact shear stress [MPa]. None: the friction law's (rech2013: 576 MPa,
+    #: the Ducobu/Pantale model input; rech2013_calibrated: 5000, no cap), else 576
+    shear_limit_MPa: float | None = Field(default=None, gt=0.0)
     #: penalty factor: normal stiffness = factor * nodal mass / dt^2 (0 < factor <= 0.5)
     penalty_factor: float = Field(default=0.1, gt=0.0, le=0.5)
     #: thermal contact with the tool, used with ``solver.heat_conduction`` (adiabatic runs
@@ -82,7 +119,8 @@ class ContactSection(_Strict):
     #: speed relative to the tool (the chip's speed ~vc / r up the rake, ~0 in the stagnation
     #: zone at the edge): how a tribometer's mu(sliding velocity) is read, as Abaqus'
     #: slip-rate-dependent friction; constant beyond the table's ends. 2D engine only
-    friction_velocity: Literal["cutting_speed", "sliding"] = "cutting_speed"
+    #: None: the friction law's, else "cutting_speed"
+    friction_velocity: Literal["cutting_speed", "sliding"] | None = None
     #: the friction table's velocities [m/min], increasing, 2..8 points; None: the Rech et
     #: al. 2013 table (FRICTION_TABLE_VC_M_MIN). Give friction_table_mu with it
     friction_table_velocity_m_per_min: list[float] | None = None
@@ -93,20 +131,46 @@ class ContactSection(_Strict):
     #: from step to step; the filtered speed is the material's mean sliding speed there)
     sliding_filter_um: float = Field(default=1.0, gt=0.0, le=1000.0)
 
+    #: the bundled friction law the table came from (None: "table" or a constant)
+    _law: str | None = PrivateAttr(default=None)
+
     @field_validator("friction")
     @classmethod
     def _mu(cls, v: Any) -> Any:
         if isinstance(v, float) and not (0.0 <= v <= 2.0):
             raise ValueError("friction coefficient must be within 0..2")
+        if isinstance(v, str) and v != "table" and v not in friction_laws():
+            raise ValueError(f"unknown friction {v!r}: expected a Coulomb coefficient "
+                             f'0..2, "table" or a friction law, one of {sorted(friction_laws())}')
         return v
 
     @model_validator(mode="after")
     def _table(self) -> ContactSection:
+        fs = set(self.model_fields_set)
         v, mu = self.friction_table_velocity_m_per_min, self.friction_table_mu
         if (v is None) != (mu is None):
             raise ValueError("friction_table_velocity_m_per_min and friction_table_mu go "
                              "together: give both or neither")
-        table_keys = v is not None or self.friction_velocity != "cutting_speed"
+        if self.friction is None:
+            self.friction = CALIBRATED_LAW
+        if isinstance(self.friction, str) and self.friction != "table":
+            if v is not None:
+                raise ValueError(f"friction = {self.friction!r} is a friction law with its "
+                                 'own table: give friction = "table" with a user table')
+            law = friction_law(self.friction)
+            self._law = law.name
+            self.friction = "table"
+            v = self.friction_table_velocity_m_per_min = list(law.velocity_m_per_min)
+            mu = self.friction_table_mu = list(law.mu)
+            if self.friction_velocity is None:
+                self.friction_velocity = law.read_at
+            if self.shear_limit_MPa is None:
+                self.shear_limit_MPa = law.shear_limit_MPa
+        if self.shear_limit_MPa is None:
+            self.shear_limit_MPa = 576.0
+        table_keys = v is not None or "friction_velocity" in fs
+        if self.friction_velocity is None:
+            self.friction_velocity = "cutting_speed"
         if self.friction != "table" and table_keys:
             raise ValueError(f"friction = {self.friction!r} is a constant coefficient: the "
                              "friction table keys (friction_table_*, friction_velocity) need "
@@ -170,7 +234,7 @@ class MeshSection(_Strict):
     #: no separation criterion and no erosion; see robobore.cutting.fe.toolframe). With
     #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
     #: round the edge (default element_size_um / 4), and the separation keys are not used
-    frame: Literal["workpiece", "tool"] = "workpiece"
+    frame: Literal["workpiece", "tool"] = "tool"
     #: tool frame: chip thickness / h of the pre-shaped chip the run starts from (the
     #: chip's shape then follows from the flow)
     initial_chip_ratio: float = Field(default=1.6, ge=1.0, le=5.0)
@@ -203,8 +267,10 @@ class MeshSection(_Strict):
 
 class SolverSection(_Strict):
     #: density factor applied to the inertial (not the thermal) mass: time step grows by
-    #: sqrt(mass_scaling); 1 = none
-    mass_scaling: float = Field(default=1.0, ge=1.0, le=1e6)
+    #: sqrt(mass_scaling); 1 = none. None: the validation protocol's 100 (30 / vc)^2 with vc
+    #: in m/min (at least 1), which keeps vc / (scaled wave speed) and hence the steps per
+    #: mm of cut the same at every speed
+    mass_scaling: float | None = Field(default=None, ge=1.0, le=1e6)
     #: fraction of the stable time step (element length / dilatational wave speed)
     cfl: float = Field(default=0.8, gt=0.0, le=1.0)
     #: element formulation: "q4r" (one-point quad with Flanagan-Belytschko hourglass
@@ -250,7 +316,7 @@ class SolverSection(_Strict):
     #: heat conduction between workpiece elements (finite volumes on the deformed mesh,
     #: explicit, every ``conduction_interval`` steps); the tool and free surfaces are
     #: adiabatic. False: adiabatic heating only
-    heat_conduction: bool = False
+    heat_conduction: bool = True
     conduction_interval: int = Field(default=10, ge=1, le=10000)
     #: number of force/tool samples over the whole run
     n_samples: int = Field(default=400, ge=10, le=100000)
@@ -286,7 +352,22 @@ class ToolSupport(_Strict):
         return self
 
 
+#: the friction law each ``parameters`` value selects when ``contact.friction`` is not given
+PARAMETER_SETS = {"calibrated": CALIBRATED_LAW, "a_priori": A_PRIORI_LAW}
+
+
+def auto_mass_scaling(cutting_speed_m_per_min: float) -> float:
+    """The default mass scaling: 100 (30 / vc)^2, at least 1 (vc in m/min)."""
+    return max(1.0, 100.0 * (30.0 / cutting_speed_m_per_min) ** 2)
+
+
 class FEConfig(_Strict):
+    #: "calibrated" (default): the validated model's CALIBRATED choices -- friction law
+    #: "rech2013_calibrated" and the material file's hardening hold; "a_priori": the
+    #: source's values, nothing chosen against measured forces -- friction law "rech2013"
+    #: and the plain Johnson-Cook law. Explicit contact.friction and
+    #: material.hardening_strain_limit keys win over either
+    parameters: Literal["calibrated", "a_priori"] = "calibrated"
     material: MaterialSection = MaterialSection()
     tool: ToolSection
     cut: CutSection
@@ -294,6 +375,29 @@ class FEConfig(_Strict):
     mesh: MeshSection
     solver: SolverSection = SolverSection()
     tool_support: ToolSupport | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _parameter_set(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        params = data.get("parameters", "calibrated")
+        if not isinstance(data.get("solver", {}), BaseModel):
+            data = {**data, "solver": dict(data.get("solver", {}))}
+        contact = data.get("contact", {})
+        if params in PARAMETER_SETS and isinstance(contact, dict) and "friction" not in contact:
+            data = {**data, "contact": {**contact, "friction": PARAMETER_SETS[params]}}
+        mat = data.get("material", {})
+        if params == "a_priori" and isinstance(mat, dict) and \
+                "hardening_strain_limit" not in mat:
+            data = {**data, "material": {**mat, "hardening_strain_limit": "none"}}
+        return data
+
+    @model_validator(mode="after")
+    def _mass_scaling(self) -> FEConfig:
+        if self.solver.mass_scaling is None:
+            self.solver.mass_scaling = auto_mass_scaling(self.cut.cutting_speed_m_per_min)
+        return self
 
     def friction_coefficient(self) -> float:
         """Coulomb coefficient used (the value given, or the table at the cutting speed).
@@ -311,7 +415,9 @@ class FEConfig(_Strict):
         c = self.contact
         if c.friction != "table":
             return f"Coulomb {float(c.friction):g}"
-        src = "Rech et al. 2013" if c.friction_table_velocity_m_per_min is None else "user"
+        law = c._law
+        src = (f"law {law} ({friction_law(law).status})" if law is not None else
+               "Rech et al. 2013" if c.friction_table_velocity_m_per_min is None else "user")
         arg = "each node's sliding speed" if c.friction_velocity == "sliding" else \
             "the cutting speed"
         return f"Coulomb, {src} table at {arg}"

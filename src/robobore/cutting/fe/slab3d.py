@@ -48,13 +48,16 @@ class SlabSetup:
 
 def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
                 ahead: float = 0.1e-3) -> SlabSetup:
-    """3D plane-strain slab of the 2D config ``cfg`` (node splitting only)."""
+    """3D plane-strain slab of the 2D config ``cfg`` (workpiece frame, node splitting only)."""
+    if cfg.mesh.frame != "workpiece":
+        raise ConfigError("the 3D slab cross-check is a workpiece-frame model",
+                          field="mesh.frame", value=cfg.mesh.frame, expected='"workpiece"')
     if cfg.mesh.separation != "node_split":
         raise ConfigError("the 3D slab cross-check needs node splitting",
                           field="mesh.separation", value=cfg.mesh.separation,
                           expected="node_split")
     mat = load_material(cfg.material.name,
-                        hardening_strain_limit=cfg.material.hardening_strain_limit)
+                        hardening_strain_limit=cfg.material.strain_limit())
     h = cfg.cut.uncut_chip_thickness_um * 1e-6
     le = cfg.mesh.element_size_um * 1e-6
     L = cfg.cut.length_mm * 1e-3

@@ -399,7 +399,7 @@ def _m_or_none(um: float | None) -> float | None:
 def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     """Build mesh, tool and state for the orthogonal-cutting model of ``cfg``."""
     mat = load_material(cfg.material.name, source=source,
-                        hardening_strain_limit=cfg.material.hardening_strain_limit)
+                        hardening_strain_limit=cfg.material.strain_limit())
     h = cfg.cut.uncut_chip_thickness_um * 1e-6
     le = cfg.mesh.element_size_um * 1e-6
     L = cfg.cut.length_mm * 1e-3
