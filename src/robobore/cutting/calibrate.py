@@ -226,7 +226,9 @@ def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
                 parse_config(fe_config_dict(cfg, h, v), cfg.fe_config_source)
             except ConfigError as exc:
                 raise ConfigError(f"{field} at the grid point h {h:g} um, vc {v:g} m/min: "
-                                  f"{exc.message}", file=exc.file or source, field=exc.field,
+                                  f"{exc.message}",
+                                  file=source if exc.file in (None, "inline") else exc.file,
+                                  field=exc.field,
                                   value=exc.value, expected=exc.expected) from None
 
 

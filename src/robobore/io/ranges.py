@@ -197,12 +197,16 @@ RANGES: dict[str, Range] = {
                        "4340 steel 0.61, Armco iron 0.63, OFHC copper 1.12"),
     "poisson": Range("Poisson's ratio", "-", 0.0, 0.5),
     "modal_mass_kg": Range("modal mass", "kg", 0.0, 1e6),
+    "plastic_strain": Range("plastic strain", "-", 0.0, 50.0,
+                            examples="hardening hold of the bundled TC4 0.6; strains in a "
+                            "secondary shear zone reach 5-10"),
 }
 
 #: Exact names (last key component, or ``section.name``) and their quantity.
 BY_NAME: dict[str, str] = {
     "johnson_cook.n": "jc_n", "johnson_cook.C": "jc_C", "johnson_cook.m": "jc_m",
     "johnson_cook.eps_dot0_per_s": "jc_eps0",
+    "hardening_strain_limit": "plastic_strain",
     **{f"damage.D{i}": f"damage_D{i}" for i in range(1, 6)},
     "elastic.nu": "poisson", "thermal.taylor_quinney": "ratio",
     "d_m": "length_m", "a_m": "length_m", "tcp_m": "length_m",

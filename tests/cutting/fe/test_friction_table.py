@@ -61,7 +61,7 @@ def _cfg(**contact):
     ({"friction_table_velocity_m_per_min": [10, 5], "friction_table_mu": [0.3, 0.2]},
      "increasing"),
     ({"friction_table_velocity_m_per_min": [-1, 5], "friction_table_mu": [0.3, 0.2]},
-     "increasing"),
+     "increasing|negative value"),
     ({"friction_table_velocity_m_per_min": [0, 5], "friction_table_mu": [0.3, 2.5]}, "0..2"),
     ({"sliding_filter_um": 2.0}, "not used"),
     ({"friction_velocity": "sliding", "sliding_filter_um": 0.0}, "greater than 0"),
