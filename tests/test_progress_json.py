@@ -30,3 +30,20 @@ def test_json_to_a_pipe_prints_no_bar(monkeypatch):
 
 def test_table_output_keeps_the_bar(monkeypatch):
     assert "working" in _run(monkeypatch, terminal=True, enabled=True)
+
+
+def test_fraction_progress_advances_to_the_fraction_and_never_back(monkeypatch):
+    steps: list[int] = []
+
+    class _Bar:
+        def __enter__(self):
+            return lambda n=1: steps.append(n)
+
+        def __exit__(self, *exc):
+            return False
+
+    monkeypatch.setattr(clitools, "progress_bar", lambda desc, total, enabled: _Bar())
+    with clitools.fraction_progress("FE", enabled=True) as prog:
+        for frac in (0.1, 0.05, 0.5, 0.5, 1.0, 1.3):
+            prog(frac)
+    assert steps == [100, 400, 500]

@@ -151,6 +151,24 @@ def progress_bar(
         yield lambda n=1: prog.advance(task, n)
 
 
+@contextmanager
+def fraction_progress(description: str, enabled: bool = True
+                      ) -> Iterator[Callable[[float], None]]:
+    """:func:`progress_bar` for work that reports the fraction done (0..1); yields
+    ``progress(frac)``, which advances the bar to that fraction (never back)."""
+    total = 1000
+    with progress_bar(description, total, enabled) as advance:
+        done = [0]
+
+        def progress(frac: float) -> None:
+            n = min(total, int(frac * total))
+            if n > done[0]:
+                advance(n - done[0])
+                done[0] = n
+
+        yield progress
+
+
 def parse_floats(text: str, n: int | None, option: str, unit: str) -> list[float]:
     """Parse a comma-separated list of numbers given on the command line.
 

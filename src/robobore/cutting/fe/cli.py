@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from robobore.clitools import JSON_OPTION, emit, handle_errors, kv_table, progress_bar, stdout
+from robobore.clitools import JSON_OPTION, emit, fraction_progress, handle_errors, kv_table, stdout
 
 _KEYS = [
     ("cutting_force_N_per_mm", "cutting force Fc [N/mm]"),
@@ -61,16 +61,7 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
     check_output_dir(plot, "--plot", "the PNG pictures")
     cfg = load_fe_config(config)
     check_device(device, cfg, str(config))
-    total = 1000
-    with progress_bar("FE cutting", total, enabled=not as_json) as advance:
-        done = [0]
-
-        def prog(frac: float) -> None:
-            n = int(frac * total)
-            if n > done[0]:
-                advance(n - done[0])
-                done[0] = n
-
+    with fraction_progress("FE cutting", enabled=not as_json) as prog:
         res = simulate_orthogonal(cfg, source=str(config), progress=prog, device=device)
     files = {}
     if out is not None:
@@ -158,16 +149,7 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
     meas = read_measured(measured)
     pts = None if points is None else parse_points(points)
     out = Path(f"fe_validate_{Path(config).stem}") if out is None else out
-    total = 1000
-    with progress_bar("FE validation", total, enabled=not as_json) as advance:
-        done = [0]
-
-        def prog(frac: float) -> None:
-            n = int(frac * total)
-            if n > done[0]:
-                advance(n - done[0])
-                done[0] = n
-
+    with fraction_progress("FE validation", enabled=not as_json) as prog:
         result = run_validation(base, meas, source=str(config), points=pts, out_dir=out,
                                 device=device, progress=prog)
     result["measured_file"] = str(measured)

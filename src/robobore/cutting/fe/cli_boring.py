@@ -9,7 +9,7 @@ from pathlib import Path
 
 import typer
 
-from robobore.clitools import JSON_OPTION, emit, handle_errors, kv_table, progress_bar, stdout
+from robobore.clitools import JSON_OPTION, emit, fraction_progress, handle_errors, kv_table, stdout
 
 _ROWS = [
     ("force_rotating_N", "force on the tool, rotating frame (tangential, radial, feed) [N]"),
@@ -74,16 +74,7 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
 
     check_output_dir(vtk, "--vtk", "the VTU meshes")
     cfg = load_boring_config(config)
-    total = 1000
-    with progress_bar("FE boring (3D)", total, enabled=not as_json) as advance:
-        done = [0]
-
-        def prog(frac: float) -> None:
-            n = int(frac * total)
-            if n > done[0]:
-                advance(n - done[0])
-                done[0] = n
-
+    with fraction_progress("FE boring (3D)", enabled=not as_json) as prog:
         res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
     result = dict(res.summary)
     result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients)
