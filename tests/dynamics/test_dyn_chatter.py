@@ -151,3 +151,24 @@ def test_verdict_tool_leaves_cut():
     v = classify(_cut(X, NS, z, h, area=area))
     assert v.tool_leaves_cut and 0 < v.tool_left_cut_fraction < 0.02
     assert v.surface_finish is None  # no tolerance given
+
+
+def test_amplitude_growth_ignores_the_entry_transient_and_beats():
+    """A large entry transient that decays, then slow exponential growth (3.5 %/rev, as in
+    the bundled study's radial chatter at 800 r/min): growth > 1; the decaying transient
+    followed by a slowly decaying vibration: not growth."""
+    from robobore.dynamics.chatter import amplitude_growth
+
+    ns, revs = 120, 60
+    t = np.arange(revs * ns) / ns  # revolutions
+    transient = 15e-6 * np.exp(-t / 2.0) * np.sin(2 * np.pi * 1.3 * t)
+    growing = 4e-6 * np.exp(0.035 * t) * np.sin(2 * np.pi * 0.55 * t)
+    X = np.column_stack([transient + growing, 0.5 * (transient + growing),
+                         0.2 * (transient + growing)])
+    ag = amplitude_growth(X, ns, ns)
+    assert ag["radial"] > 2 and ag["feed"] > 2
+    decaying = 4e-6 * np.exp(-0.01 * t) * np.sin(2 * np.pi * 0.55 * t)
+    X = np.column_stack([transient + decaying, transient + decaying,
+                         0.2 * (transient + decaying)])
+    ag = amplitude_growth(X, ns, ns)
+    assert ag["radial"] < 1 and ag["feed"] < 1

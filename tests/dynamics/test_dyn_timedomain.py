@@ -283,5 +283,7 @@ def test_robot_boring_semidiscretization_vs_time_domain(speed):
     b = critical_depth_semidiscretization(st, pr, speed)
     lo = classify(simulate(st, pr, SimulationSettings(speed, 0.9 * b, 150)))
     hi = classify(simulate(st, pr, SimulationSettings(speed, 1.1 * b, 150)))
-    assert lo.chatter is False and lo.vibration_growth < 0.1
+    # growth is measured from the quietest delay of the first half (chatter.vibration_growth):
+    # 0.9 x decays to a fifth or less over the second half, 1.1 x grows fivefold or more
+    assert lo.chatter is False and lo.vibration_growth < 0.25
     assert hi.chatter and hi.vibration_growth > 5

@@ -224,11 +224,11 @@ def test_paper_verdicts_by_cause(small_run):
     n_chatter = n_rough_only = 0
     for key in store.done_keys():
         ds = store.load(key)
-        fa = ds["feed_amplitude"].values
         if int(ds["chatter"]):
             n_chatter += 1
-            assert fa[-1] > 2 * fa[1], key
-            assert float(ds["feed_amplitude_growth"]) > 1
+            # the regenerative feed and radial amplitudes grow (fitted over the run)
+            assert float(ds["feed_amplitude_growth"]) > 1, key
+            assert float(ds["vibration_growth"]) > 1, key
         elif int(ds["stable"]) == 0:
             n_rough_only += 1
             assert float(ds["roughness_Ra_um"]) > 1.6
@@ -325,15 +325,24 @@ def test_synthetic_measured_is_reproducible(tmp_path):
     assert len([ln for ln in a.splitlines() if ln and not ln.startswith("#")]) == 1 + 4
 
 
+#: The workpiece-frame FE calibration the bundled example used before it calibrated from the
+#: validated model (feed force 55-70 % low): with it the deepest cut of the study chatters
+#: and drifts, the case that showed Ra ~96 um with the form left in.
+_LOW_FEED_COEFFICIENTS = {"Ktc_N_per_m2": 1576371394.969606, "Krc_N_per_m2": 0.0,
+                          "Kfc_N_per_m2": 93781277.00977457, "Kte_N_per_m": 20900.608960639354,
+                          "Kre_N_per_m": 0.0, "Kfe_N_per_m": 27338.193228954256}
+
+
 def test_deepest_cut_roughness_is_after_form_removal():
-    """The bundled study's deepest cut without foot (300 r/min, 0.15 mm/r, ap 0.3 mm): the
-    tool drifts as the chatter grows, a taper of tens of um/mm that made Ra ~96 um when
-    the form was left in; Ra after removing the least-squares line is ~11 um. The cut is
-    chatter (its feed amplitude grows) and rough."""
+    """The study's deepest cut without foot (300 r/min, 0.15 mm/r, ap 0.3 mm) with the
+    low-feed-force coefficients above: the tool drifts as the chatter grows, a taper of tens
+    of um/mm that made Ra ~96 um when the form was left in; Ra after removing the
+    least-squares line is ~10 um. The cut is chatter (its feed amplitude grows) and rough."""
     cfg, raw, path = pp.load_paper_config()
     eq = pp.build_equivalent(pp.identify_stiffness(cfg, path), pp.identify_modes(cfg, path),
                              cfg.pressure_foot)
-    coeffs = pp.load_or_calibrate(cfg, raw, path, True, 1)
+    coeffs = dict(pp.load_or_calibrate(cfg, raw, path, True, 1))
+    coeffs["coefficients"] = dict(_LOW_FEED_COEFFICIENTS, provenance="test")
     model = pp.dynamics_model(cfg, eq, coeffs, "robot")
     from robobore.study.runners import boring_runner
 

@@ -6,11 +6,13 @@ A cut gets separate, named verdicts (:func:`classify`, :class:`ChatterVerdict`):
   revolutions. Two measures must both exceed ``growth_limit`` (default 1): the envelope of
   the regenerative displacement ``|r(t) - r(t - tau)|`` (``tau`` = insert pitch; a stable
   process settles on a motion that repeats every pitch, so this decays) over the last delay
-  period divided by that over the first (:func:`vibration_growth`), and the growth of the
-  per-revolution amplitude of that displacement in the feed (Z) or radial (XY) direction,
-  last revolution over the first whole one (:func:`amplitude_growth`). A run that diverged
-  (tool-point displacement above the divergence limit) is chatter. A cut whose amplitude
-  does not grow is not chatter, however rough. Reported with it: the chatter frequency
+  period divided by the smallest per-delay envelope of the first half of the run
+  (:func:`vibration_growth`: the decay of the entry transient neither hides growth after it
+  nor counts as growth, and vibration that grew and saturated reads as grown), and the same
+  growth of the per-revolution amplitude of that displacement in the feed (Z) or radial (XY)
+  direction (:func:`amplitude_growth`). A run that diverged (tool-point displacement above
+  the divergence limit) is chatter. A cut whose amplitude does not grow is not chatter,
+  however rough. Reported with it: the chatter frequency
   (largest spectral peak away from the tooth-passing harmonics ``k N n / 60``, in the last
   ``tail_fraction`` of the run) and the non-harmonic energy fraction of the displacement
   (:func:`harmonic_analysis`).
@@ -38,8 +40,12 @@ import xarray as xr
 
 
 def vibration_growth(displacement: np.ndarray, samples_per_delay: int) -> float:
-    """Envelope ratio (last / first delay period) of ``|r(t) - r(t - tau)|``.
+    """Growth of the envelope of ``|r(t) - r(t - tau)|``: its maximum over the last delay
+    period over the smallest per-delay maximum of the first half of the run.
 
+    Measured from the quietest point of the first half, not from the first delay, so that
+    the decay of the entry transient does not hide growth that follows it, and vibration
+    that grew and then saturated (the tool leaving the cut) still reads as grown.
     ``displacement``: (n_samples, 3) [m]. Returns 0 when the last envelope is at round-off
     level (:data:`ROUNDOFF`), i.e. the motion repeats every delay.
     """
@@ -48,7 +54,15 @@ def vibration_growth(displacement: np.ndarray, samples_per_delay: int) -> float:
     if X.shape[0] < 3 * s:
         return math.nan
     d = np.linalg.norm(X[s:] - X[:-s], axis=1)
-    return _ratio(d[:s].max(), d[-s:].max(), X)
+    return _growth(d, s, X)
+
+
+def _growth(d: np.ndarray, period: int, X: np.ndarray) -> float:
+    """Last period's maximum of ``d`` over the smallest period maximum of the first half."""
+    n = d.shape[0] // period
+    peaks = d[:n * period].reshape(n, period).max(axis=1)
+    first_half = peaks[:max(1, n // 2)]
+    return _ratio(float(first_half.min()), float(d[-period:].max()), X)
 
 
 #: Relative floor of the regenerative displacement: below ``ROUNDOFF x max |displacement|``
@@ -95,9 +109,9 @@ def amplitude_growth(displacement: np.ndarray, samples_per_rev: int,
     """Growth of the per-revolution amplitude of the regenerative displacement.
 
     ``max |r(t) - r(t - tau)|`` per revolution for the feed (Z) and radial (X, Y) parts of
-    ``displacement`` (n_samples, 3) [m], last revolution over the first whole one (the one
-    starting after the first delay). Returns ``{"feed", "radial"}``; NaN with fewer than 3
-    revolutions, 0 when the last amplitude is at round-off level.
+    ``displacement`` (n_samples, 3) [m]: the last revolution's over the smallest of the first
+    half of the run (as :func:`vibration_growth`). Returns ``{"feed", "radial"}``; NaN with
+    fewer than 3 revolutions, 0 when the last amplitude is at round-off level.
     """
     X = np.asarray(displacement, float)
     ns, s = int(samples_per_rev), int(samples_per_delay)
@@ -107,7 +121,7 @@ def amplitude_growth(displacement: np.ndarray, samples_per_rev: int,
     D = X[s:revs * ns] - X[:revs * ns - s]
     out = {}
     for name, d in (("feed", np.abs(D[:, 2])), ("radial", np.linalg.norm(D[:, :2], axis=1))):
-        out[name] = _ratio(d[:ns].max(), d[-ns:].max(), X)
+        out[name] = _growth(d, ns, X)
     return out
 
 
