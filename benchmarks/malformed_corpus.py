@@ -2,6 +2,15 @@
 whose commands run FE simulations or the whole paper study, through their parse step).
 
     python benchmarks/malformed_corpus.py [--out /tmp/corpus] [--timeout 60] [--workers 2]
+                                          [--only TEXT]
+
+The cases come from two generators: this module corrupts every bundled example input (the
+list below), and ``benchmarks/malformed_corpus_more.py`` adds the output paths (files where
+folders are expected, folders that cannot be created), huge requests (size guards),
+encodings and corrupt files on each reader, partial failures (exit code) and durability
+(a sweep killed at random points and resumed, a zero-byte result recomputed). ``fe`` and
+``calibrate`` commands run with the FE time stepping replaced by a stub (see ``NO_FE``): no
+case runs an FE simulation.
 
 Each case is generated from a bundled example input by a documented corruption: a unit slip
 on one key or column (m given in mm, N/m in N/um, N/m^2 in N/mm^2, a damping ratio in
@@ -58,6 +67,25 @@ PARSE = {
     "sweep": "from robobore.study.conditions import load_sweep_config as f",
     "measured": "from robobore.study.compare import read_measured_csv as f",
 }
+#: ``fe`` / ``calibrate`` commands with the FE time stepping replaced by a stub: the stub
+#: reads the material file as the run's set-up does first (``setup_orthogonal``,
+#: ``simulate_boring``), then stops the process. The corpus never runs an FE simulation, and
+#: a case that would start one is reported (it must be refused before that).
+NO_FE = ("import sys\n"
+         "import robobore.cutting.calibrate as c\n"
+         "import robobore.cutting.fe.boring3d as b\n"
+         "import robobore.cutting.fe.solver as s\n"
+         "from robobore.material import load_material\n"
+         "def _stub(cfg=None, *a, source=None, **k):\n"
+         "    m = getattr(cfg, 'material', None)\n"
+         "    if m is not None:\n"
+         "        load_material(m.name, source=source)\n"
+         "    print('corpus: an FE simulation would start here', file=sys.stderr)\n"
+         "    sys.exit(97)\n"
+         "s.simulate_orthogonal = b.simulate_boring = c.run_fe_point = c.run_grid = _stub\n"
+         "sys.argv[0] = 'robobore'\n"
+         "from robobore.cli import main\n"
+         "main()\n")
 DRIVER = ("import sys\nfrom robobore.errors import RoboboreError\n{imp}\ntry:\n    f(sys.argv[1])\n"
           "except RoboboreError as e:\n    print('error:', e, file=sys.stderr); sys.exit(2)\n")
 
@@ -73,6 +101,8 @@ class Case:
     cwd_files: dict[str, bytes] = field(default_factory=dict)  # stray files in the cwd
     same_as: str | None = None  # stray-file cases: the clean run's stdout must match
     control: bool = False
+    pattern: str | None = None  # a regular expression the error must match (instead of names)
+    mode: str = "error"  # error | partial | script (malformed_corpus_more)
     outcome: str = ""
     rc: int | None = None
     stderr_tail: str = ""
@@ -82,6 +112,8 @@ NUM = re.compile(r"(?<![A-Za-z_0-9.\"])-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?(?![A-Za-
 
 
 def _cli(*args: str) -> list[str]:
+    if args and args[0] in ("fe", "calibrate"):
+        return [sys.executable, "-c", NO_FE, *args]
     return [sys.executable, "-m", "robobore", *args]
 
 
@@ -450,7 +482,47 @@ def build_corpus(workdir: Path) -> list[Case]:
         cases.append(Case("command-line options", " ".join(args[1:] if args[0] != "simulate"
                                                            else args[3:]),
                           opt_files, _cli(*args, "--json"), True, (name,)))
+    cases += more_cases(workdir / "fixtures")
     return cases
+
+
+def _kind_of(desc: str, argv: list[str]) -> str:
+    """The input path a case of malformed_corpus_more exercises."""
+    head, _, rest = desc.partition(":")
+    if head == "out":
+        return "output paths (--out, --plot, --vtk, --report, OUT)"
+    if head == "size":
+        return "huge requests (size guards)"
+    if head == "fail":
+        return "partial failure (exit code)"
+    if head == "resume":
+        return "durability / resume"
+    r = rest.lower()
+    for words, kind in ((("npz",), "NPZ FRF (identify modes)"),
+                        (("uff", "hammer"), "UFF (identify modes)"),
+                        (("store",), "results store"),
+                        (("campaign", "measured", "csv"), "CSV files (campaign, measured)"),
+                        (("json", "coefficient", "stiffness", "modes", "equivalent"),
+                         "JSON files (coefficients, stiffness, modes)"),
+                        (("toml", "config", "material", "robot file", "band_hz", "fe "),
+                         "TOML files (encodings, corrupt)")):
+        if any(w in r for w in words):
+            return kind
+    return "other"
+
+
+def more_cases(fixtures: Path) -> list[Case]:
+    """The cases of benchmarks/malformed_corpus_more.py as :class:`Case` objects."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import malformed_corpus_more as more
+
+    out = []
+    for desc, argv, pattern, mode in more.build(fixtures):
+        argv = [str(a) for a in argv]
+        cmd = argv if mode == "script" else _cli(*argv)
+        out.append(Case(_kind_of(desc, argv), desc, {}, cmd, mode != "script", (),
+                        pattern=pattern, mode=mode))
+    return out
 
 
 def _replace_nth_number(blob: bytes, n: int, new: bytes) -> bytes:
@@ -556,8 +628,25 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
     err = p.stderr.decode(errors="replace")
     (d / "stdout").write_bytes(p.stdout)
     c.stderr_tail = err[-600:]
-    if "Traceback (most recent call last)" in err:
+    sout = p.stdout.decode(errors="replace")
+    if "Traceback (most recent call last)" in err + sout:
         c.outcome = "traceback"
+    elif c.mode == "script":  # a multi-step check: exit 0 and "OK" when right
+        ok = p.returncode == 0 and sout.strip().splitlines()[-1:][0].startswith("OK")
+        c.outcome = "ok" if ok else "silent"
+        c.stderr_tail = (sout + err)[-600:]
+    elif c.mode == "partial":  # a failed condition: exit 1, the failure named
+        named = re.search(c.pattern or "", sout + err, re.I) is not None
+        c.outcome = ("clear" if p.returncode == 1 and named else
+                     "silent" if p.returncode == 0 else "vague")
+        c.stderr_tail = (sout + err)[-600:]
+    elif c.pattern is not None and p.returncode != 0:
+        lines = [ln for ln in err.splitlines() if "error" in ln.lower()]
+        line = " ".join(lines) if lines else err.strip()
+        named = re.search(c.pattern, line, re.I) is not None and "<config>" not in line
+        says = any(w in line.lower() for w in ("expected", "got", "missing", "give ",
+                                                "cannot", "not ", "refus"))
+        c.outcome = "clear" if named and says else "vague"
     elif p.returncode == 0:
         if c.control or not c.must_fail:
             c.outcome = "ok"
@@ -581,11 +670,12 @@ def main() -> None:
     ap.add_argument("--out", default="/tmp/robobore-corpus")
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--only", default="", help="run only path kinds containing this text")
+    ap.add_argument("--only", default="",
+                    help="run only the cases whose input path or description contains this")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    cases = [c for c in build_corpus(out) if a.only in c.path_kind]
+    cases = [c for c in build_corpus(out) if a.only in c.path_kind or a.only in c.desc]
     t0 = time.perf_counter()
     with ThreadPoolExecutor(a.workers) as ex:
         done = list(ex.map(lambda ic: run_case(ic[0], ic[1], out, a.timeout), enumerate(cases)))

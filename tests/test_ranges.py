@@ -487,3 +487,69 @@ def test_robot_file_lengths_in_mm_refused(tmp_path):
                                                   "d_m = [780.0, 0.0, 0.0, 1142.0, 0.0, 200.0]"))
     with pytest.raises(ConfigError, match=r"r\.toml.*d_m\.0.*looks like mm; expected m"):
         load_robot_file(tmp_path / "r.toml")
+
+
+# ------------------------------------------------------------- single-number CLI options
+_EQ = ["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+       "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02"]
+
+
+@pytest.mark.parametrize("args,option,words", [
+    (["identify", "virtual-hammer-test", "{t}/h.uff", "--duration-s", "6000"], "--duration-s",
+     "looks like ms"),
+    (["identify", "virtual-hammer-test", "{t}/h.uff", "--sample-rate-hz", "nan"],
+     "--sample-rate-hz", "positive"),
+    (["identify", "virtual-hammer-test", "{t}/h.uff", "--seed", "-1"], "--seed", "0 .. "),
+    (["identify", "stiffness", "--example", "--cond-limit", "0.5"], "--cond-limit", "1 .. "),
+    (["identify", "stiffness", "--example", "--sigma-um", "nan"], "--sigma-um", "sigma"),
+    (["identify", "modes", "--example", "--band-hz", "3", "6e9"], "--band-hz", "Hz"),
+    (["identify", "modes", "--example", "--modes", "0"], "--modes", "1 .. 100"),
+    (["identify", "modes", "--example", "--max-order", "5000"], "--max-order", "1 .. 1000"),
+    (["identify", "modes", "--example", "--exp-window-tau-s", "inf"], "--exp-window-tau-s",
+     "finite"),
+    (["identify", "modes", "--example", "--approx-hz", "7,1.7e7"], "--approx-hz", "Hz"),
+    (["robot", "campaign", "{t}/c.csv", "--pressures-MPa", "0,0.3", "--piston-area-m2", "1667"],
+     "--piston-area-m2", "looks like mm^2"),
+    (["robot", "campaign", "{t}/c.csv", "--sigma-um", "-3"], "--sigma-um", "negative"),
+    ([*_EQ, "--foot-pressure-MPa", "0.3", "--foot-piston-diameter-mm", "50000"],
+     "--foot-piston-diameter-mm", "looks like um"),
+    ([*_EQ, "--foot-pressure-MPa", "0.3", "--foot-normal-stiffness-N-per-m", "3"],
+     "--foot-normal-stiffness-N-per-m", "looks like N/um"),
+    ([*_EQ, "--foot-pressure-MPa", "3e5"], "--foot-pressure-MPa", "MPa"),
+    ([*_EQ, "--damping-N-s-per-m", "nan"], "--damping-N-s-per-m", "finite"),
+])
+def test_single_number_options_are_range_checked(tmp_path, args, option, words):
+    """Physical single-number options are checked like file values: one line naming the
+    option, the value and the range with its unit (a unit-slip hint where it applies)."""
+    r = CliRunner().invoke(app, [a.replace("{t}", str(tmp_path)) for a in args])
+    assert r.exit_code == 2, r.output
+    assert "Traceback" not in r.output
+    assert f"'{option}'" in r.output and words in r.output, r.output
+
+
+def test_option_names_pick_the_range_of_their_unit():
+    from robobore.io.ranges import option_name, quantity_of
+
+    assert option_name("--sample-rate-hz") == "sample_rate_Hz"
+    assert option_name("--foot-pressure-MPa") == "foot_pressure_MPa"
+    assert option_name("--approx-hz") == "approx_Hz"
+    assert quantity_of(option_name("--piston-area-m2")).unit == "m^2"
+    assert quantity_of(option_name("--duration-s")).unit == "s"
+
+
+def test_robot_link_centre_of_mass_and_inertia_in_mm_refused(tmp_path):
+    from robobore.robot.kinematics import load_robot_file
+
+    src = (Path(__file__).resolve().parents[1] / "src/robobore/robot/library/"
+           "irb6600-175-2.55.toml").read_text()
+    for old, new, words in (("com_m = [-0.55, 0.0, 0.05]", "com_m = [-550.0, 0.0, 50.0]",
+                             "looks like mm"),
+                            ("inertia_kg_m2 = [4.4, 37.0, 37.5, 0.0, 0.0, 0.0]",
+                             "inertia_kg_m2 = [4.4e6, 3.7e7, 3.75e7, 0.0, 0.0, 0.0]",
+                             "looks like kg mm^2")):
+        assert old in src
+        p = tmp_path / "r.toml"
+        p.write_text(src.replace(old, new))
+        with pytest.raises(ConfigError) as e:
+            load_robot_file(p)
+        assert words in str(e.value) and str(p) in str(e.value)

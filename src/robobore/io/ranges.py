@@ -196,6 +196,25 @@ RANGES: dict[str, Range] = {
                        examples="Ti-6Al-4V 3.87; "
                        "4340 steel 0.61, Armco iron 0.63, OFHC copper 1.12"),
     "poisson": Range("Poisson's ratio", "-", 0.0, 0.5),
+    "inertia_kg_m2": Range("moment / product of inertia", "kg m^2", 0.0, 1e5, signed=True,
+                           slips=((1e6, "looks like kg mm^2; expected kg m^2"),),
+                           examples="robot links 0.01 .. 100 kg m^2, tools 1e-4 .. 1"),
+    "area_m2": Range("area", "m^2", 0.0, 100.0,
+                     slips=((1e6, "looks like mm^2; expected m^2"),
+                            (1e4, "looks like cm^2; expected m^2")),
+                     examples="pressure-foot pistons 1e-4 .. 1e-2 m^2"),
+    "time_s": Range("time", "s", 0.0, 1e5,
+                    slips=((1e3, "looks like ms; expected s"),),
+                    examples="hammer-test records 1 .. 60 s, windows 0.01 .. 10 s"),
+    "noise_um": Range("measurement noise (1-sigma)", "um", 0.0, 1e4,
+                      examples="laser trackers 5 .. 50 um per coordinate"),
+    "record_s": Range("record length", "s", 1e-3, 600.0,
+                      slips=((1e3, "looks like ms; expected s"),),
+                      examples="impact-hammer records 1 .. 60 s"),
+    "sample_rate_Hz": Range("sampling rate", "Hz", 1.0, 1e6,
+                            examples="hammer tests 256 Hz .. 102.4 kHz"),
+    "condition_limit": Range("condition-number limit", "-", 1.0, 1e16,
+                             examples="1e3 .. 1e12"),
     "modal_mass_kg": Range("modal mass", "kg", 0.0, 1e6),
 }
 
@@ -205,7 +224,10 @@ BY_NAME: dict[str, str] = {
     "johnson_cook.eps_dot0_per_s": "jc_eps0",
     **{f"damage.D{i}": f"damage_D{i}" for i in range(1, 6)},
     "elastic.nu": "poisson", "thermal.taylor_quinney": "ratio",
-    "d_m": "length_m", "a_m": "length_m", "tcp_m": "length_m",
+    "d_m": "length_m", "a_m": "length_m", "tcp_m": "length_m", "com_m": "length_m",
+    "duration_s": "time_s", "exp_window_tau_s": "time_s", "noise": "ratio",
+    "cond_limit": "condition_limit", "sample_rate_Hz": "sample_rate_Hz",
+    "record_duration_s": "record_s", "sigma_um": "noise_um",
     "depth_mm": "depth_mm", "depth_of_cut_mm": "depth_mm",
     "feed_mm_per_rev": "feed_mm_per_rev", "speed_rpm": "speed_rpm",
     "coherence": "coherence", "mpc": "ratio",
@@ -225,6 +247,7 @@ BY_SUFFIX: dict[str, str] = {
     "_MPa": "stress_MPa", "_GPa": "modulus_GPa", "_K": "temperature_K",
     "_kg_m3": "density_kg_m3", "_J_kgK": "heat_capacity_J_kgK", "_W_mK": "conductivity_W_mK",
     "_kg": "mass_kg", "_damping_ratio": "damping_ratio", "_fraction": "ratio",
+    "_kg_m2": "inertia_kg_m2", "_m2": "area_m2",
 }
 
 #: Key components that name a part of a quantity, not the quantity (``stiffness.x``).
@@ -265,6 +288,20 @@ def quantity_of(path: str | Iterable[Any]) -> Range | None:
             return None
         q = BY_SUFFIX[best]
     return RANGES[q]
+
+
+def option_name(option: str) -> str:
+    """The key name of a command-line option, with its unit suffix spelt as in
+    :data:`BY_SUFFIX` (``--sample-rate-hz`` -> ``sample_rate_Hz``,
+    ``--foot-pressure-MPa`` -> ``foot_pressure_MPa``), so that it picks its range."""
+    name = option.lstrip("-").replace("-", "_")
+    if quantity_of(name) is not None:
+        return name
+    low = name.lower()
+    for suf in sorted(BY_SUFFIX, key=len, reverse=True):
+        if low.endswith(suf.lower()) and len(name) > len(suf):
+            return name[: -len(suf)] + suf
+    return name
 
 
 def _error(kind: type[InputError], message: str, **kw: Any) -> InputError:
@@ -405,5 +442,6 @@ def range_table() -> list[dict[str, str]]:
 
 __all__ = ["Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning", "check_value",
            "check_array",
-           "check_tree", "quantity_of", "enabled", "set_enabled", "provenance", "range_table",
+           "check_tree", "quantity_of", "option_name", "enabled", "set_enabled", "provenance",
+           "range_table",
            "ENV_VAR", "OVERRIDE_KEY"]

@@ -15,7 +15,15 @@ from typing import Any
 
 import typer
 
-from robobore.clitools import JSON_OPTION, emit, handle_errors, parse_floats, progress_bar
+from robobore.clitools import (
+    JSON_OPTION,
+    check_count,
+    check_option,
+    emit,
+    handle_errors,
+    parse_floats,
+    progress_bar,
+)
 
 
 def _render_modes(res: dict[str, Any]) -> None:
@@ -89,6 +97,13 @@ def modes_cmd(
                           expected="a UFF/NPZ file path or the --example flag")
     check_output_dir(plot, "--plot", "the PNG plots")
     check_output_file(out, "--out", "the result JSON")
+    for v in band_hz or ():  # plausible ranges (robobore.io.ranges)
+        check_option(v, "--band-hz", "band_Hz")
+    check_count(modes, "--modes", 1, 100)
+    if max_order > 1000:  # (below 1: identify_modes says why)
+        raise ConfigError("max order too high", field="--max-order", value=max_order,
+                          expected="an integer 1 .. 1000 (the stabilisation diagram's orders)")
+    check_option(exp_window_tau_s, "--exp-window-tau-s")
     if example:
         input_file = example_path()
         if band_hz is None:
@@ -186,6 +201,9 @@ def virtual_test_cmd(
             raise ConfigError("noise must be a fraction in [0, 1)", field="--noise", value=noise,
                               expected="e.g. 0.01 for 1 % of RMS")
         _check_hammer_size(len(rows), hits, truth.phi_out.shape[0], sample_rate_hz, duration_s)
+        check_option(sample_rate_hz, "--sample-rate-hz", "sample_rate_Hz")
+        check_option(duration_s, "--duration-s", "record_duration_s")
+        check_count(seed, "--seed", 0, 2**32 - 1)
         settings = {"n_hits": hits, "sample_rate_Hz": sample_rate_hz, "duration_s": duration_s,
                     "tip": tip, "noise_force": noise, "noise_response": noise, "seed": seed,
                     "double_hits": dh}
