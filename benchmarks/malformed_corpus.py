@@ -478,6 +478,34 @@ def build_corpus(workdir: Path) -> list[Case]:
           "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02"], "--stiffness-N-per-m"),
         (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
           "6.9,16.8,24.6", "--damping-ratios", "3.5,2.8,2.0"], "--damping-ratios"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--duration-s", "6000"],
+         "--duration-s"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--noise", "1.5"], "--noise"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--seed", "-1"], "--seed"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--sample-rate-hz", "2e7"],
+         "--sample-rate-hz"),
+        (["identify", "stiffness", "--example", "--cond-limit", "0.5"], "--cond-limit"),
+        (["identify", "modes", "--example", "--modes", "0"], "--modes"),
+        (["identify", "modes", "--example", "--max-order", "5000"], "--max-order"),
+        (["identify", "modes", "--example", "--exp-window-tau-s", "inf"], "--exp-window-tau-s"),
+        (["identify", "modes", "--example", "--approx-hz", "7,1.7e7"], "--approx-hz"),
+        (["robot", "campaign", "{d}/c.csv", "--pressures-MPa", "0,0.3", "--piston-area-m2",
+          "1667"], "--piston-area-m2"),
+        (["robot", "campaign", "{d}/c.csv", "--sigma-um", "-3"], "--sigma-um"),
+        (["robot", "campaign", "{d}/c.csv", "--load-levels-N", "0,250e3,500e3"],
+         "--load-levels-N"),
+        (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+          "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02", "--foot-pressure-MPa",
+          "0.3", "--foot-piston-diameter-mm", "50000"], "--foot-piston-diameter-mm"),
+        (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+          "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02", "--foot-pressure-MPa",
+          "0.3", "--foot-normal-stiffness-N-per-m", "3"], "--foot-normal-stiffness-N-per-m"),
+        (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+          "6.9,16.8,24.6", "--damping-N-s-per-m", "nan"], "--damping-N-s-per-m"),
+        (["robot", "stiffness", "--joints-deg", "0,-20,20,0,30,0",
+          "--joint-stiffness-Nm-per-rad", "1e4,1e4,1e4,1e3,1e3,0.1"],
+         "--joint-stiffness-Nm-per-rad"),
+        (["paper", "--fast", "--out", "{d}/p", "--workers", "-1"], "--workers"),
     ]:
         cases.append(Case("command-line options", " ".join(args[1:] if args[0] != "simulate"
                                                            else args[3:]),
@@ -658,7 +686,8 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
         named = any(n.lower() in line.lower()
                     or n.lstrip("-").replace("-", "_").lower() in line.lower()
                     for n in c.names)
-        says = any(w in line.lower() for w in ("expected", "got", "missing", "give "))
+        says = any(w in line.lower() for w in ("expected", "got", "missing", "give ",
+                                                "should be"))
         c.outcome = "clear" if named and says else "vague"
         if c.control:
             c.outcome = "rejected"
