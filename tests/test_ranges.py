@@ -243,6 +243,14 @@ def test_no_bundled_or_shared_data_file_is_rejected():
     ti64_coefficients()
     for p in sorted(SHARED.glob("*.json")):
         ranges.check_tree(json.loads(p.read_text()), str(p), kind=DataError)
+    # the example identification outputs, through the commands that read them
+    pb = EX / "plan_paper_bore"
+    r = runner.invoke(app, ["robot", "stiffness", "--joints-deg", "0,-20,20,0,30,0",
+                            "--joint-stiffness-file", str(pb / "joint_stiffness.json")])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6",
+                            "--modes-file", str(pb / "modes.json")])
+    assert r.exit_code == 0, r.output
 
 
 # ----------------------------------------------------------------------------- paths
