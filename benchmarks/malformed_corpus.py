@@ -66,6 +66,7 @@ PARSE = {
     "material": "from robobore.material import load_material as f",
     "sweep": "from robobore.study.conditions import load_sweep_config as f",
     "measured": "from robobore.study.compare import read_measured_csv as f",
+    "plan": "from robobore.plan.posture import load_plan_config as f",
 }
 #: ``fe`` / ``calibrate`` commands with the FE time stepping replaced by a stub: the stub
 #: reads the material file as the run's set-up does first (``setup_orthogonal``,
@@ -368,6 +369,16 @@ def build_corpus(workdir: Path) -> list[Case]:
                         "irb6600-175-2.55.toml",
                         lambda f: _cli("robot", "fk", "--joints-deg", "0,10,10,0,30,0",
                                        "--robot-file", "{d}/" + f, "--json"))
+    plan_src = EX / "plan_paper_bore.toml"
+    plan_text = plan_src.read_text().replace(
+        "../src/robobore/data/paper_example/tc4_fe_coefficients.json", "tc4_fe_coefficients.json")
+    plan_tmp = workdir / "plan_paper_bore.toml"
+    workdir.mkdir(parents=True, exist_ok=True)
+    plan_tmp.write_text(plan_text)
+    cases += toml_cases("plan TOML (parse)", plan_tmp, lambda f: _parse("plan", f), extra={
+        "tc4_fe_coefficients.json": (pe / "tc4_fe_coefficients.json").read_bytes(),
+        **{f"plan_paper_bore/{n}": (EX / "plan_paper_bore" / n).read_bytes()
+           for n in ("joint_stiffness.json", "modes.json")}})
     # --- campaign CSV through identify stiffness
     cases += csv_cases("campaign CSV (identify stiffness)", DATA / "campaign_irb6600" /
                        "campaign.csv",
@@ -640,6 +651,7 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
         shutil.rmtree(d)
     (d / "cwd").mkdir(parents=True)
     for n, b in c.files.items():
+        (d / n).parent.mkdir(parents=True, exist_ok=True)
         (d / n).write_bytes(b)
     for n, b in c.cwd_files.items():
         (d / "cwd" / n).write_bytes(b)

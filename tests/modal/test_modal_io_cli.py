@@ -206,6 +206,7 @@ def test_cli_virtual_test_then_modes_table(tmp_path):
     (["--max-order", "0"], "max order"),
     (["--approx-hz", "7,abc"], "--approx-hz"),
     (["--approx-hz", "40"], "no stable pole cluster"),
+    (["--frf-type", "bogus"], "'--frf-type': unknown FRF type"),
 ])
 def test_cli_bad_options_exit_2(args, msg):
     r = runner.invoke(app, ["identify", "modes", "--example", *args])

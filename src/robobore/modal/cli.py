@@ -88,7 +88,13 @@ def modes_cmd(
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
-    from robobore.modal.frf import DoubleHitWarning, FRFData, LeakageWarning, estimate_frf
+    from robobore.modal.frf import (
+        FRF_TYPES,
+        DoubleHitWarning,
+        FRFData,
+        LeakageWarning,
+        estimate_frf,
+    )
     from robobore.modal.identify import identify_modes
     from robobore.modal.io import load_input
 
@@ -104,6 +110,9 @@ def modes_cmd(
         raise ConfigError("max order too high", field="--max-order", value=max_order,
                           expected="an integer 1 .. 1000 (the stabilisation diagram's orders)")
     check_option(exp_window_tau_s, "--exp-window-tau-s")
+    if frf_type is not None and frf_type.strip().lower() not in FRF_TYPES:
+        raise ConfigError("unknown FRF type", field="--frf-type", value=frf_type,
+                          expected="one of " + ", ".join(FRF_TYPES))
     if example:
         input_file = example_path()
         if band_hz is None:
