@@ -393,6 +393,25 @@ def build(W: Path) -> list[tuple[str, list, str, str]]:  # noqa: N803, PLR0915
         ("corrupt: lobes coefficients list", ["lobes", W / "lobes_coef_list.toml"], "coef_list"),
     ]
 
+    # ---- found while merging the corpora
+    (W / "sweep_empty_levels.toml").write_text(
+        '[sweep]\nname="e"\nrunner="demo"\n[grid]\nspeed_rpm=[]\nfeed_mm_per_rev=[0.1]\n'
+        'depth_of_cut_mm=[0.1]\n')
+    (W / "lobes_huge_count.toml").write_text(
+        (EX / "lobes_single_point.toml").read_text().replace("count = 601",
+                                                             "count = 1000000000"))
+    CASES += [
+        ("corrupt: sweep TOML with an empty level list", ["sweep", W / "sweep_empty_levels.toml",
+                                                          "--out", O / "se"],
+         "sweep_empty_levels.toml"),
+        ("size: lobes TOML with 1e9 speeds", ["lobes", W / "lobes_huge_count.toml"],
+         "lobes_huge_count.toml.*speed_rpm.count"),
+        ("corrupt: sweep --scheduler unreachable", ["sweep", EX / "sweep_demo.toml", "--out",
+                                                    O / "sx", "--scheduler", "tcp://127.0.0.1:1"],
+         "127.0.0.1:1"),
+        ("corrupt: identify modes --frf-type bogus", ["identify", "modes", "--example",
+                                                      "--frf-type", "bogus"], "--frf-type"),
+    ]
     return [(name, argv, must, "error") for name, argv, must in CASES if not
             name.startswith("fail:")] + \
         [(name, argv, must, "partial") for name, argv, must in CASES if

@@ -397,6 +397,16 @@ def test_sweep_config_ranges(tmp_path):
         load_sweep_config(tmp_path / "s.toml")
 
 
+def test_sweep_grid_errors_name_the_file(tmp_path):
+    from robobore.study.conditions import load_sweep_config
+
+    p = tmp_path / "e.toml"
+    p.write_text('[sweep]\nname = "e"\nrunner = "demo"\n[grid]\nspeed_rpm = []\n'
+                 'feed_mm_per_rev = [0.1]\ndepth_of_cut_mm = [0.1]\n')
+    with pytest.raises(ConfigError, match=r"e\.toml, field 'grid\.speed_rpm': empty list"):
+        load_sweep_config(p)
+
+
 def test_lobes_without_speed_section_says_which_range(tmp_path):
     text = (EX / "lobes_single_point.toml").read_text()
     text = text.split("[speed_rpm]")[0]
