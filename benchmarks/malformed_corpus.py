@@ -537,7 +537,8 @@ def _kind_of(desc: str, argv: list[str]) -> str:
     if head == "resume":
         return "durability / resume"
     r = rest.lower()
-    for words, kind in ((("npz",), "NPZ FRF (identify modes)"),
+    for words, kind in ((("--scheduler", "--frf-type"), "command-line options"),
+                        (("npz",), "NPZ FRF (identify modes)"),
                         (("uff", "hammer"), "UFF (identify modes)"),
                         (("store",), "results store"),
                         (("campaign", "measured", "csv"), "CSV files (campaign, measured)"),
@@ -638,6 +639,11 @@ def npz_cases(workdir: Path) -> list[Case]:
         ("truncated", good[: len(good) // 2]),
         ("not a zip", b"hello"),
         ("frf wrong shape", npz(frf=frf.frf[0])),
+        ("frf magnitudes only (real)", npz(frf=np.abs(frf.frf))),
+        ("frf all zero", npz(frf=np.zeros_like(frf.frf))),
+        ("two frequency lines", npz(frequency_Hz=frf.frequency_Hz[:2], frf=frf.frf[..., :2],
+                                    coherence=None if frf.coherence is None else
+                                    frf.coherence[..., :2])),
     ]:
         cases.append(Case("NPZ FRF (identify modes)", desc, {"frf.npz": blob}, argv, True,
                           ("frf.npz",)))

@@ -84,7 +84,7 @@ def modes_cmd(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
-    from robobore.errors import ConfigError, IdentificationError, NumericalError
+    from robobore.errors import ConfigError, IdentificationError, InputError, NumericalError
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
@@ -140,6 +140,11 @@ def modes_cmd(
                                 max_order=max_order)
         except (IdentificationError, NumericalError) as exc:  # say which data it was
             raise type(exc)(f"{input_file}: {exc}") from None
+        except InputError as exc:  # a band the data cannot give: name the data file
+            if exc.file is not None:
+                raise
+            raise type(exc)(exc.message, file=str(input_file), field=exc.field,
+                            value=exc.value, expected=exc.expected) from None
         advance(1)
         res = an.result.to_dict()
         res["source"] = str(input_file)
