@@ -408,7 +408,8 @@ def build_corpus(workdir: Path) -> list[Case]:
                          ("coefficients", [1, 2], "set")],
                         extra={"boring.toml": cfg.encode()}, names=("coef.json",))
     # --- modes / stiffness JSON through model equivalent
-    modes = {"modes": [{"frequency_Hz": 6.9, "damping_ratio": 0.035},
+    modes = {"band_Hz": [3.0, 60.0],
+             "modes": [{"frequency_Hz": 6.9, "damping_ratio": 0.035},
                        {"frequency_Hz": 16.8, "damping_ratio": 0.028},
                        {"frequency_Hz": 24.6, "damping_ratio": 0.020}]}
     stiff = {"directional_stiffness_N_per_m": {"x": 3.0e6, "y": 2.5e6, "z": 4.0e6}}
@@ -416,6 +417,7 @@ def build_corpus(workdir: Path) -> list[Case]:
               "{d}/modes.json", "--json")
     cases += json_cases("modes JSON (model equivalent)", "modes.json", modes, eq,
                         [("modes.0.damping_ratio", 100.0, "percent for a ratio"),
+                         ("modes.2.frequency_Hz", 1e3, "kHz for Hz"),
                          ("modes.1.frequency_Hz", 1e9, "axis x1e9"),
                          ("modes.0.damping_ratio", True, "set"),
                          ("modes.0", [1, 2], "set"),
