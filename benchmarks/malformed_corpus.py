@@ -386,6 +386,18 @@ def build_corpus(workdir: Path) -> list[Case]:
                                       "irb6600-175-2.55", "--json"),
                        {"x_m": (1e3, "mm for m"), "load_point_z_m": (1e3, "mm for m")},
                        ["y_m", "force_x_N", "q2_deg"])
+    camp_lines = (DATA / "campaign_irb6600" / "campaign.csv").read_text().splitlines()
+    camp_head = camp_lines[0].split(",")
+    kn = [camp_lines[0]]
+    for ln in camp_lines[1:]:
+        cells = ln.split(",")
+        for col in ("force_x_N", "force_y_N", "force_z_N"):
+            cells[camp_head.index(col)] = repr(float(cells[camp_head.index(col)]) / 1e3)
+        kn.append(",".join(cells))
+    cases.append(Case("campaign CSV (identify stiffness)", "all forces in kN (N / 1e3)",
+                      {"campaign.csv": ("\n".join(kn) + "\n").encode()},
+                      _cli("identify", "stiffness", "{d}/campaign.csv", "--robot",
+                           "irb6600-175-2.55", "--json"), True, ("campaign.csv",)))
     # --- measured CSV (parse; compare needs a store)
     cases += csv_cases("measured CSV (parse)", pe / "measured_synthetic.csv",
                        lambda f: _parse("measured", f),

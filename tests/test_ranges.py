@@ -154,6 +154,25 @@ def test_campaign_positions_in_mm_refused(tmp_path):
         read_campaign(p)
 
 
+def test_campaign_forces_in_kn_refused(tmp_path):
+    """Forces in kN in the *_N columns: every value is within the force range, but the
+    largest test force (1 N) cannot deflect a robot; silent before, a stiffness 1e3 low."""
+    from robobore.robot.campaign_io import F_COLS, read_campaign
+
+    lines = (DATA / "campaign_irb6600" / "campaign.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    out = [lines[0]]
+    for ln in lines[1:]:
+        cells = ln.split(",")
+        for col in F_COLS:
+            cells[head.index(col)] = repr(float(cells[head.index(col)]) / 1e3)
+        out.append(",".join(cells))
+    p = tmp_path / "camp.csv"
+    p.write_text("\n".join(out) + "\n")
+    with pytest.raises(DataError, match=r"camp\.csv, row \d+, field 'force_x_N'.*looks like kN"):
+        read_campaign(p)
+
+
 def test_coefficients_in_n_per_mm2_refused(tmp_path):
     from robobore.cutting.forces import load_coefficients
 
