@@ -550,6 +550,8 @@ def _kind_of(desc: str, argv: list[str]) -> str:
         return "partial failure (exit code)"
     if head == "resume":
         return "durability / resume"
+    if head == "slip":
+        return "process TOML (simulate boring)"
     r = rest.lower()
     for words, kind in ((("--scheduler", "--frf-type"), "command-line options"),
                         (("npz",), "NPZ FRF (identify modes)"),

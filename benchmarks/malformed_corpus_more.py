@@ -400,6 +400,14 @@ def build(W: Path) -> list[tuple[str, list, str, str]]:  # noqa: N803, PLR0915
     (W / "lobes_huge_count.toml").write_text(
         (EX / "lobes_single_point.toml").read_text().replace("count = 601",
                                                              "count = 1000000000"))
+    for i, (old, new) in enumerate((("edge_radius_um = 20.0", "edge_radius_um = 0.02"),
+                                    ("approach_angle_deg = 90.0", "approach_angle_deg = 1.5708"),
+                                    ("ra_tolerance_um = 1.6", "ra_tolerance_um = 0.0016"))):
+        assert old in bp, old
+        (W / f"boring_down{i}.toml").write_text(bp.replace(old, new))
+        CASES.append((f"slip: process TOML {new} (a unit slip downwards)",
+                      ["simulate", "boring", W / f"boring_down{i}.toml"],
+                      f"boring_down{i}.toml.*{old.split(' =')[0]}"))
     CASES += [
         ("corrupt: sweep TOML with an empty level list", ["sweep", W / "sweep_empty_levels.toml",
                                                           "--out", O / "se"],

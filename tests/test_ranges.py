@@ -426,6 +426,27 @@ def test_sweep_grid_errors_name_the_file(tmp_path):
         load_sweep_config(p)
 
 
+@pytest.mark.parametrize("old,new,words", [
+    ("edge_radius_um = 20.0", "edge_radius_um = 0.02", "looks like mm"),
+    ("approach_angle_deg = 90.0", "approach_angle_deg = 1.5708", "looks like radians"),
+    ("ra_tolerance_um = 1.6", "ra_tolerance_um = 0.0016", "looks like mm"),
+])
+def test_process_slips_downwards_refused(tmp_path, old, new, words):
+    from robobore.dynamics.config import load_dynamics_config
+
+    text = (EX / "boring_paper.toml").read_text()
+    assert old in text
+    p = tmp_path / "c.toml"
+    p.write_text(text.replace(old, new))
+    with pytest.raises(ConfigError) as e:
+        load_dynamics_config(p)
+    assert "c.toml" in str(e.value) and old.split(" =")[0] in str(e.value)
+    assert words in str(e.value)
+    p.write_text(text.replace(old, old.split(" =")[0] + " = 0.0")
+                 if "edge" in old else text)  # a sharp edge (0) is a model, not a slip
+    load_dynamics_config(p)
+
+
 def test_lobes_without_speed_section_says_which_range(tmp_path):
     text = (EX / "lobes_single_point.toml").read_text()
     text = text.split("[speed_rpm]")[0]
