@@ -365,6 +365,12 @@ def build_corpus(workdir: Path) -> list[Case]:
                         lambda f: _parse("sweep", f))
     cases += toml_cases("material TOML (parse)", PKG / "material" / "library" / "tc4.toml",
                         lambda f: _parse("material", f))
+    tc4_text = (PKG / "material" / "library" / "tc4.toml").read_text()
+    for old, new in (("A_MPa = 997.9", "A_MPa = 0.9979"), ("B_MPa = 653.1", "B_MPa = 0.6531")):
+        assert old in tc4_text, old
+        cases.append(Case("material TOML (parse)", f"{new} (GPa for MPa, a slip downwards)",
+                          {"tc4.toml": tc4_text.replace(old, new).encode()},
+                          _parse("material", "tc4.toml"), True, ("tc4.toml",)))
     cases += toml_cases("robot TOML (robot fk)", PKG / "robot" / "library" /
                         "irb6600-175-2.55.toml",
                         lambda f: _cli("robot", "fk", "--joints-deg", "0,10,10,0,30,0",

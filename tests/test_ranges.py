@@ -139,6 +139,16 @@ def test_material_nan_damage_constant_refused(tmp_path):
         load_material(p)
 
 
+def test_material_johnson_cook_stress_in_gpa_refused(tmp_path):
+    from robobore.material import load_material
+
+    src = ROOT / "src" / "robobore" / "material" / "library" / "tc4.toml"
+    p = tmp_path / "m.toml"
+    p.write_text(src.read_text().replace("A_MPa = 997.9", "A_MPa = 0.9979"))
+    with pytest.raises(ConfigError, match=r"m\.toml.*johnson_cook\.A_MPa.*looks like GPa"):
+        load_material(p)
+
+
 def test_campaign_positions_in_mm_refused(tmp_path):
     from robobore.robot.campaign_io import read_campaign
 

@@ -176,6 +176,10 @@ RANGES: dict[str, Range] = {
                                  slips=((1e-3, "looks like kJ/(kg K); expected J/(kg K)"),)),
     "conductivity_W_mK": Range("thermal conductivity", "W/(m K)", 0.01, 2000.0),
     "mass_kg": Range("mass", "kg", 0.0, 1e5, examples="tools, bars, robots"),
+    "jc_stress_MPa": Range("Johnson-Cook yield / hardening stress A, B", "MPa", 10.0, 1e4,
+                           slips=((1e6, "looks like Pa; expected MPa"),
+                                  (1e-3, "looks like GPa; expected MPa")),
+                           examples="Ti-6Al-4V A 998, B 653 MPa; steels A 200 .. 1500 MPa"),
     "jc_n": Range("Johnson-Cook hardening exponent n", "-", 0.0, 2.0),
     "jc_C": Range("Johnson-Cook strain-rate constant C", "-", 0.0, 1.0),
     "jc_m": Range("Johnson-Cook thermal exponent m", "-", 0.0, 5.0),
@@ -220,6 +224,7 @@ RANGES: dict[str, Range] = {
 
 #: Exact names (last key component, or ``section.name``) and their quantity.
 BY_NAME: dict[str, str] = {
+    "johnson_cook.A_MPa": "jc_stress_MPa", "johnson_cook.B_MPa": "jc_stress_MPa",
     "johnson_cook.n": "jc_n", "johnson_cook.C": "jc_C", "johnson_cook.m": "jc_m",
     "johnson_cook.eps_dot0_per_s": "jc_eps0",
     **{f"damage.D{i}": f"damage_D{i}" for i in range(1, 6)},
