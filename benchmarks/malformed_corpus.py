@@ -411,6 +411,18 @@ def build_corpus(workdir: Path) -> list[Case]:
                         "feed_mm_per_rev": (1e3, "um/r for mm/r"),
                         "pressure_MPa": (1e6, "Pa for MPa")},
                        ["force_amplitude_x_N", "speed_rpm"])
+    mlines = (pe / "measured_synthetic.csv").read_text().splitlines()
+    mhi = next(i for i, ln in enumerate(mlines) if ln and not ln.startswith("#"))
+    mhead = mlines[mhi].split(",")
+    for col in ("depth_of_cut_mm", "feed_mm_per_rev"):
+        ls = list(mlines)
+        cells = ls[mhi + 1].split(",")
+        cells[mhead.index(col)] = repr(float(cells[mhead.index(col)]) / 1e3)
+        ls[mhi + 1] = ",".join(cells)
+        cases.append(Case("measured CSV (parse)", f"unit slip {col} row 1 (m for mm, downwards)",
+                          {"measured_synthetic.csv": ("\n".join(ls) + "\n").encode()},
+                          _parse("measured", "measured_synthetic.csv"), True,
+                          ("measured_synthetic.csv",)))
     # --- coefficients JSON named by a process config
     coef = json.loads((pe / "tc4_fe_coefficients.json").read_text())
     cfg = (EX / "boring_paper.toml").read_text().replace('material = "TC4"',

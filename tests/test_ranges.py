@@ -50,6 +50,8 @@ CASES = [
     ("depth_mm", 0.05, 50.5, None),
     ("depth_of_cut_mm", 0.3, 300.0, "looks like um"),
     ("feed_mm_per_rev", 0.15, 150.0, "looks like um/r"),
+    ("feed_mm_per_rev", 0.15, 0.00015, "looks like m/r"),
+    ("depth_of_cut_mm", 0.05, 0.00005, "looks like m; expected mm"),
     ("speed_rpm", 300.0, 3e5, None),
     ("pressure_MPa", 0.3, 3e5, "looks like Pa"),
     ("cutting_speed_m_per_min", 37.7, 37700.0, None),
