@@ -51,6 +51,8 @@ CASES = [
     ("depth_of_cut_mm", 0.3, 300.0, "looks like um"),
     ("feed_mm_per_rev", 0.15, 150.0, "looks like um/r"),
     ("feed_mm_per_rev", 0.15, 0.00015, "looks like m/r"),
+    ("cut.cutting_speed_m_per_min", 30.0, 0.5, "looks like m/s"),
+    ("insert.edge_radius_um", 20.0, 0.02, "looks like mm; expected um"),
     ("depth_of_cut_mm", 0.05, 0.00005, "looks like m; expected mm"),
     ("speed_rpm", 300.0, 3e5, None),
     ("pressure_MPa", 0.3, 3e5, "looks like Pa"),
