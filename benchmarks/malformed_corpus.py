@@ -365,6 +365,14 @@ def build_corpus(workdir: Path) -> list[Case]:
                         lambda f: _parse("sweep", f))
     cases += toml_cases("material TOML (parse)", PKG / "material" / "library" / "tc4.toml",
                         lambda f: _parse("material", f))
+    fe_text = (EX / "fe_orthogonal.toml").read_text()
+    for old, new, why in (("cutting_speed_m_per_min = 30.0", "cutting_speed_m_per_min = 0.5",
+                           "m/s for m/min"),
+                          ("edge_radius_um = 20.0", "edge_radius_um = 0.02", "mm for um")):
+        assert old in fe_text, old
+        cases.append(Case("FE 2D TOML (parse)", f"{new} ({why}, a slip downwards)",
+                          {"fe_orthogonal.toml": fe_text.replace(old, new).encode()},
+                          _parse("fe", "fe_orthogonal.toml"), True, ("fe_orthogonal.toml",)))
     tc4_text = (PKG / "material" / "library" / "tc4.toml").read_text()
     for old, new in (("A_MPa = 997.9", "A_MPa = 0.9979"), ("B_MPa = 653.1", "B_MPa = 0.6531")):
         assert old in tc4_text, old
