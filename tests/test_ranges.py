@@ -625,3 +625,16 @@ def test_robot_link_centre_of_mass_and_inertia_in_mm_refused(tmp_path):
         with pytest.raises(ConfigError) as e:
             load_robot_file(p)
         assert words in str(e.value) and str(p) in str(e.value)
+
+
+def test_array_slip_hint_only_when_it_explains_the_whole_array():
+    """A frequency axis x1e9 is not 'uHz' just because its second line / 1e6 is in range;
+    an axis x1e3 (mHz) is named as such."""
+    import numpy as np
+
+    f = np.linspace(0.0, 128.0, 769)
+    with pytest.raises(DataError) as e:
+        ranges.check_array(f * 1e9, "frequency_Hz", file="x.npz")
+    assert "looks like" not in str(e.value) and "x.npz" in str(e.value)
+    with pytest.raises(DataError, match="looks like mHz"):
+        ranges.check_array(f * 1e3, "frequency_Hz", file="x.npz")

@@ -385,7 +385,19 @@ def check_array(values: Any, name: str, *, file: str | None = None, field: str |
         bad |= out
     if bad.any():
         i = int(np.argmax(bad))
-        check_value(float(a[i]), name, file=file, field=f"{field or name}[{i}]", kind=kind)
+        v = float(a[i])
+        where = f"{field or name}[{i}]"
+        if rng is None or not math.isfinite(v):
+            check_value(v, name, file=file, field=where, kind=kind)  # raises: not finite
+            return
+        if v < 0 and not rng.signed:
+            msg = "a negative value where a positive quantity is expected"
+        else:  # a unit slip is named only when it explains the whole array
+            hint = next((words for factor, words in rng.slips
+                         if all(rng.contains(x) for x in (a.min() / factor, a.max() / factor))),
+                        None)
+            msg = "value out of the plausible range" + (f" ({hint})" if hint else "")
+        raise kind(msg, file=file, field=where, value=v, expected=rng.describe())
 
 
 def _allow_list(data: Mapping[str, Any], file: str | None) -> tuple[str, ...]:
