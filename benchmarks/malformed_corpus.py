@@ -2,6 +2,15 @@
 whose commands run FE simulations or the whole paper study, through their parse step).
 
     python benchmarks/malformed_corpus.py [--out /tmp/corpus] [--timeout 60] [--workers 2]
+                                          [--only TEXT]
+
+The cases come from two generators: this module corrupts every bundled example input (the
+list below), and ``benchmarks/malformed_corpus_more.py`` adds the output paths (files where
+folders are expected, folders that cannot be created), huge requests (size guards),
+encodings and corrupt files on each reader, partial failures (exit code) and durability
+(a sweep killed at random points and resumed, a zero-byte result recomputed). ``fe`` and
+``calibrate`` commands run with the FE time stepping replaced by a stub (see ``NO_FE``): no
+case runs an FE simulation.
 
 Each case is generated from a bundled example input by a documented corruption: a unit slip
 on one key or column (m given in mm, N/m in N/um, N/m^2 in N/mm^2, a damping ratio in
@@ -57,7 +66,27 @@ PARSE = {
     "material": "from robobore.material import load_material as f",
     "sweep": "from robobore.study.conditions import load_sweep_config as f",
     "measured": "from robobore.study.compare import read_measured_csv as f",
+    "plan": "from robobore.plan.posture import load_plan_config as f",
 }
+#: ``fe`` / ``calibrate`` commands with the FE time stepping replaced by a stub: the stub
+#: reads the material file as the run's set-up does first (``setup_orthogonal``,
+#: ``simulate_boring``), then stops the process. The corpus never runs an FE simulation, and
+#: a case that would start one is reported (it must be refused before that).
+NO_FE = ("import sys\n"
+         "import robobore.cutting.calibrate as c\n"
+         "import robobore.cutting.fe.boring3d as b\n"
+         "import robobore.cutting.fe.solver as s\n"
+         "from robobore.material import load_material\n"
+         "def _stub(cfg=None, *a, source=None, **k):\n"
+         "    m = getattr(cfg, 'material', None)\n"
+         "    if m is not None:\n"
+         "        load_material(m.name, source=source)\n"
+         "    print('corpus: an FE simulation would start here', file=sys.stderr)\n"
+         "    sys.exit(97)\n"
+         "s.simulate_orthogonal = b.simulate_boring = c.run_fe_point = c.run_grid = _stub\n"
+         "sys.argv[0] = 'robobore'\n"
+         "from robobore.cli import main\n"
+         "main()\n")
 DRIVER = ("import sys\nfrom robobore.errors import RoboboreError\n{imp}\ntry:\n    f(sys.argv[1])\n"
           "except RoboboreError as e:\n    print('error:', e, file=sys.stderr); sys.exit(2)\n")
 
@@ -73,6 +102,8 @@ class Case:
     cwd_files: dict[str, bytes] = field(default_factory=dict)  # stray files in the cwd
     same_as: str | None = None  # stray-file cases: the clean run's stdout must match
     control: bool = False
+    pattern: str | None = None  # a regular expression the error must match (instead of names)
+    mode: str = "error"  # error | partial | script (malformed_corpus_more)
     outcome: str = ""
     rc: int | None = None
     stderr_tail: str = ""
@@ -82,6 +113,8 @@ NUM = re.compile(r"(?<![A-Za-z_0-9.\"])-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?(?![A-Za-
 
 
 def _cli(*args: str) -> list[str]:
+    if args and args[0] in ("fe", "calibrate"):
+        return [sys.executable, "-c", NO_FE, *args]
     return [sys.executable, "-m", "robobore", *args]
 
 
@@ -332,10 +365,34 @@ def build_corpus(workdir: Path) -> list[Case]:
                         lambda f: _parse("sweep", f))
     cases += toml_cases("material TOML (parse)", PKG / "material" / "library" / "tc4.toml",
                         lambda f: _parse("material", f))
+    fe_text = (EX / "fe_orthogonal.toml").read_text()
+    for old, new, why in (("cutting_speed_m_per_min = 30.0", "cutting_speed_m_per_min = 0.5",
+                           "m/s for m/min"),
+                          ("edge_radius_um = 20.0", "edge_radius_um = 0.02", "mm for um")):
+        assert old in fe_text, old
+        cases.append(Case("FE 2D TOML (parse)", f"{new} ({why}, a slip downwards)",
+                          {"fe_orthogonal.toml": fe_text.replace(old, new).encode()},
+                          _parse("fe", "fe_orthogonal.toml"), True, ("fe_orthogonal.toml",)))
+    tc4_text = (PKG / "material" / "library" / "tc4.toml").read_text()
+    for old, new in (("A_MPa = 997.9", "A_MPa = 0.9979"), ("B_MPa = 653.1", "B_MPa = 0.6531")):
+        assert old in tc4_text, old
+        cases.append(Case("material TOML (parse)", f"{new} (GPa for MPa, a slip downwards)",
+                          {"tc4.toml": tc4_text.replace(old, new).encode()},
+                          _parse("material", "tc4.toml"), True, ("tc4.toml",)))
     cases += toml_cases("robot TOML (robot fk)", PKG / "robot" / "library" /
                         "irb6600-175-2.55.toml",
                         lambda f: _cli("robot", "fk", "--joints-deg", "0,10,10,0,30,0",
                                        "--robot-file", "{d}/" + f, "--json"))
+    plan_src = EX / "plan_paper_bore.toml"
+    plan_text = plan_src.read_text().replace(
+        "../src/robobore/data/paper_example/tc4_fe_coefficients.json", "tc4_fe_coefficients.json")
+    plan_tmp = workdir / "plan_paper_bore.toml"
+    workdir.mkdir(parents=True, exist_ok=True)
+    plan_tmp.write_text(plan_text)
+    cases += toml_cases("plan TOML (parse)", plan_tmp, lambda f: _parse("plan", f), extra={
+        "tc4_fe_coefficients.json": (pe / "tc4_fe_coefficients.json").read_bytes(),
+        **{f"plan_paper_bore/{n}": (EX / "plan_paper_bore" / n).read_bytes()
+           for n in ("joint_stiffness.json", "modes.json")}})
     # --- campaign CSV through identify stiffness
     cases += csv_cases("campaign CSV (identify stiffness)", DATA / "campaign_irb6600" /
                        "campaign.csv",
@@ -343,6 +400,18 @@ def build_corpus(workdir: Path) -> list[Case]:
                                       "irb6600-175-2.55", "--json"),
                        {"x_m": (1e3, "mm for m"), "load_point_z_m": (1e3, "mm for m")},
                        ["y_m", "force_x_N", "q2_deg"])
+    camp_lines = (DATA / "campaign_irb6600" / "campaign.csv").read_text().splitlines()
+    camp_head = camp_lines[0].split(",")
+    kn = [camp_lines[0]]
+    for ln in camp_lines[1:]:
+        cells = ln.split(",")
+        for col in ("force_x_N", "force_y_N", "force_z_N"):
+            cells[camp_head.index(col)] = repr(float(cells[camp_head.index(col)]) / 1e3)
+        kn.append(",".join(cells))
+    cases.append(Case("campaign CSV (identify stiffness)", "all forces in kN (N / 1e3)",
+                      {"campaign.csv": ("\n".join(kn) + "\n").encode()},
+                      _cli("identify", "stiffness", "{d}/campaign.csv", "--robot",
+                           "irb6600-175-2.55", "--json"), True, ("campaign.csv",)))
     # --- measured CSV (parse; compare needs a store)
     cases += csv_cases("measured CSV (parse)", pe / "measured_synthetic.csv",
                        lambda f: _parse("measured", f),
@@ -350,6 +419,18 @@ def build_corpus(workdir: Path) -> list[Case]:
                         "feed_mm_per_rev": (1e3, "um/r for mm/r"),
                         "pressure_MPa": (1e6, "Pa for MPa")},
                        ["force_amplitude_x_N", "speed_rpm"])
+    mlines = (pe / "measured_synthetic.csv").read_text().splitlines()
+    mhi = next(i for i, ln in enumerate(mlines) if ln and not ln.startswith("#"))
+    mhead = mlines[mhi].split(",")
+    for col in ("depth_of_cut_mm", "feed_mm_per_rev"):
+        ls = list(mlines)
+        cells = ls[mhi + 1].split(",")
+        cells[mhead.index(col)] = repr(float(cells[mhead.index(col)]) / 1e3)
+        ls[mhi + 1] = ",".join(cells)
+        cases.append(Case("measured CSV (parse)", f"unit slip {col} row 1 (m for mm, downwards)",
+                          {"measured_synthetic.csv": ("\n".join(ls) + "\n").encode()},
+                          _parse("measured", "measured_synthetic.csv"), True,
+                          ("measured_synthetic.csv",)))
     # --- coefficients JSON named by a process config
     coef = json.loads((pe / "tc4_fe_coefficients.json").read_text())
     cfg = (EX / "boring_paper.toml").read_text().replace('material = "TC4"',
@@ -365,7 +446,8 @@ def build_corpus(workdir: Path) -> list[Case]:
                          ("coefficients", [1, 2], "set")],
                         extra={"boring.toml": cfg.encode()}, names=("coef.json",))
     # --- modes / stiffness JSON through model equivalent
-    modes = {"modes": [{"frequency_Hz": 6.9, "damping_ratio": 0.035},
+    modes = {"band_Hz": [3.0, 60.0],
+             "modes": [{"frequency_Hz": 6.9, "damping_ratio": 0.035},
                        {"frequency_Hz": 16.8, "damping_ratio": 0.028},
                        {"frequency_Hz": 24.6, "damping_ratio": 0.020}]}
     stiff = {"directional_stiffness_N_per_m": {"x": 3.0e6, "y": 2.5e6, "z": 4.0e6}}
@@ -373,6 +455,7 @@ def build_corpus(workdir: Path) -> list[Case]:
               "{d}/modes.json", "--json")
     cases += json_cases("modes JSON (model equivalent)", "modes.json", modes, eq,
                         [("modes.0.damping_ratio", 100.0, "percent for a ratio"),
+                         ("modes.2.frequency_Hz", 1e3, "kHz for Hz"),
                          ("modes.1.frequency_Hz", 1e9, "axis x1e9"),
                          ("modes.0.damping_ratio", True, "set"),
                          ("modes.0", [1, 2], "set"),
@@ -446,11 +529,82 @@ def build_corpus(workdir: Path) -> list[Case]:
           "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02"], "--stiffness-N-per-m"),
         (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
           "6.9,16.8,24.6", "--damping-ratios", "3.5,2.8,2.0"], "--damping-ratios"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--duration-s", "6000"],
+         "--duration-s"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--noise", "1.5"], "--noise"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--seed", "-1"], "--seed"),
+        (["identify", "virtual-hammer-test", "{d}/h.uff", "--sample-rate-hz", "2e7"],
+         "--sample-rate-hz"),
+        (["identify", "stiffness", "--example", "--cond-limit", "0.5"], "--cond-limit"),
+        (["identify", "modes", "--example", "--modes", "0"], "--modes"),
+        (["identify", "modes", "--example", "--max-order", "5000"], "--max-order"),
+        (["identify", "modes", "--example", "--exp-window-tau-s", "inf"], "--exp-window-tau-s"),
+        (["identify", "modes", "--example", "--approx-hz", "7,1.7e7"], "--approx-hz"),
+        (["robot", "campaign", "{d}/c.csv", "--pressures-MPa", "0,0.3", "--piston-area-m2",
+          "1667"], "--piston-area-m2"),
+        (["robot", "campaign", "{d}/c.csv", "--sigma-um", "-3"], "--sigma-um"),
+        (["robot", "campaign", "{d}/c.csv", "--load-levels-N", "0,250e3,500e3"],
+         "--load-levels-N"),
+        (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+          "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02", "--foot-pressure-MPa",
+          "0.3", "--foot-piston-diameter-mm", "50000"], "--foot-piston-diameter-mm"),
+        (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+          "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02", "--foot-pressure-MPa",
+          "0.3", "--foot-normal-stiffness-N-per-m", "3"], "--foot-normal-stiffness-N-per-m"),
+        (["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+          "6.9,16.8,24.6", "--damping-N-s-per-m", "nan"], "--damping-N-s-per-m"),
+        (["robot", "stiffness", "--joints-deg", "0,-20,20,0,30,0",
+          "--joint-stiffness-Nm-per-rad", "1e4,1e4,1e4,1e3,1e3,0.1"],
+         "--joint-stiffness-Nm-per-rad"),
+        (["paper", "--fast", "--out", "{d}/p", "--workers", "-1"], "--workers"),
     ]:
         cases.append(Case("command-line options", " ".join(args[1:] if args[0] != "simulate"
                                                            else args[3:]),
                           opt_files, _cli(*args, "--json"), True, (name,)))
+    cases += more_cases(workdir / "fixtures")
     return cases
+
+
+def _kind_of(desc: str, argv: list[str]) -> str:
+    """The input path a case of malformed_corpus_more exercises."""
+    head, _, rest = desc.partition(":")
+    if head == "out":
+        return "output paths (--out, --plot, --vtk, --report, OUT)"
+    if head == "size":
+        return "huge requests (size guards)"
+    if head == "fail":
+        return "partial failure (exit code)"
+    if head == "resume":
+        return "durability / resume"
+    if head == "slip":
+        return "process TOML (simulate boring)"
+    r = rest.lower()
+    for words, kind in ((("--scheduler", "--frf-type"), "command-line options"),
+                        (("npz",), "NPZ FRF (identify modes)"),
+                        (("uff", "hammer"), "UFF (identify modes)"),
+                        (("store",), "results store"),
+                        (("campaign", "measured", "csv"), "CSV files (campaign, measured)"),
+                        (("json", "coefficient", "stiffness", "modes", "equivalent"),
+                         "JSON files (coefficients, stiffness, modes)"),
+                        (("toml", "config", "material", "robot file", "band_hz", "fe "),
+                         "TOML files (encodings, corrupt)")):
+        if any(w in r for w in words):
+            return kind
+    return "other"
+
+
+def more_cases(fixtures: Path) -> list[Case]:
+    """The cases of benchmarks/malformed_corpus_more.py as :class:`Case` objects."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import malformed_corpus_more as more
+
+    out = []
+    for desc, argv, pattern, mode in more.build(fixtures):
+        argv = [str(a) for a in argv]
+        cmd = argv if mode == "script" else _cli(*argv)
+        out.append(Case(_kind_of(desc, argv), desc, {}, cmd, mode != "script", (),
+                        pattern=pattern, mode=mode))
+    return out
 
 
 def _replace_nth_number(blob: bytes, n: int, new: bytes) -> bytes:
@@ -527,6 +681,11 @@ def npz_cases(workdir: Path) -> list[Case]:
         ("truncated", good[: len(good) // 2]),
         ("not a zip", b"hello"),
         ("frf wrong shape", npz(frf=frf.frf[0])),
+        ("frf magnitudes only (real)", npz(frf=np.abs(frf.frf))),
+        ("frf all zero", npz(frf=np.zeros_like(frf.frf))),
+        ("two frequency lines", npz(frequency_Hz=frf.frequency_Hz[:2], frf=frf.frf[..., :2],
+                                    coherence=None if frf.coherence is None else
+                                    frf.coherence[..., :2])),
     ]:
         cases.append(Case("NPZ FRF (identify modes)", desc, {"frf.npz": blob}, argv, True,
                           ("frf.npz",)))
@@ -540,6 +699,7 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
         shutil.rmtree(d)
     (d / "cwd").mkdir(parents=True)
     for n, b in c.files.items():
+        (d / n).parent.mkdir(parents=True, exist_ok=True)
         (d / n).write_bytes(b)
     for n, b in c.cwd_files.items():
         (d / "cwd" / n).write_bytes(b)
@@ -556,8 +716,25 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
     err = p.stderr.decode(errors="replace")
     (d / "stdout").write_bytes(p.stdout)
     c.stderr_tail = err[-600:]
-    if "Traceback (most recent call last)" in err:
+    sout = p.stdout.decode(errors="replace")
+    if "Traceback (most recent call last)" in err + sout:
         c.outcome = "traceback"
+    elif c.mode == "script":  # a multi-step check: exit 0 and "OK" when right
+        ok = p.returncode == 0 and sout.strip().splitlines()[-1:][0].startswith("OK")
+        c.outcome = "ok" if ok else "silent"
+        c.stderr_tail = (sout + err)[-600:]
+    elif c.mode == "partial":  # a failed condition: exit 1, the failure named
+        named = re.search(c.pattern or "", sout + err, re.I) is not None
+        c.outcome = ("clear" if p.returncode == 1 and named else
+                     "silent" if p.returncode == 0 else "vague")
+        c.stderr_tail = (sout + err)[-600:]
+    elif c.pattern is not None and p.returncode != 0:
+        lines = [ln for ln in err.splitlines() if "error" in ln.lower()]
+        line = " ".join(lines) if lines else err.strip()
+        named = re.search(c.pattern, line, re.I) is not None and "<config>" not in line
+        says = any(w in line.lower() for w in ("expected", "got", "missing", "give ",
+                                                "cannot", "not ", "refus"))
+        c.outcome = "clear" if named and says else "vague"
     elif p.returncode == 0:
         if c.control or not c.must_fail:
             c.outcome = "ok"
@@ -569,7 +746,8 @@ def run_case(i: int, c: Case, out: Path, timeout: float) -> Case:
         named = any(n.lower() in line.lower()
                     or n.lstrip("-").replace("-", "_").lower() in line.lower()
                     for n in c.names)
-        says = any(w in line.lower() for w in ("expected", "got", "missing", "give "))
+        says = any(w in line.lower() for w in ("expected", "got", "missing", "give ",
+                                                "should be"))
         c.outcome = "clear" if named and says else "vague"
         if c.control:
             c.outcome = "rejected"
@@ -581,11 +759,12 @@ def main() -> None:
     ap.add_argument("--out", default="/tmp/robobore-corpus")
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--only", default="", help="run only path kinds containing this text")
+    ap.add_argument("--only", default="",
+                    help="run only the cases whose input path or description contains this")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    cases = [c for c in build_corpus(out) if a.only in c.path_kind]
+    cases = [c for c in build_corpus(out) if a.only in c.path_kind or a.only in c.desc]
     t0 = time.perf_counter()
     with ThreadPoolExecutor(a.workers) as ex:
         done = list(ex.map(lambda ic: run_case(ic[0], ic[1], out, a.timeout), enumerate(cases)))

@@ -122,3 +122,18 @@ def test_principal_frame_from_stiffness_matrix():
     D = em.directions()
     assert abs(D[0] @ R[:, 0]) == pytest.approx(1.0)
     assert np.allclose(em.tool_point_modes()[0]["direction"], D[0])
+
+
+def test_mode_outside_the_files_identification_band_is_refused():
+    """A modes JSON from `identify modes --json` carries its band: a mode far outside it is
+    a value scaled by hand (here kHz for Hz), not an identified mode."""
+    stiff = {"directional_stiffness_N_per_m": {"x": 3e6, "y": 2.5e6, "z": 4e6}}
+    modes = {"band_Hz": [3.0, 60.0],
+             "modes": [{"frequency_Hz": f, "damping_ratio": 0.03} for f in (6.9, 16.8, 24.6)]}
+    EquivalentModel.from_stiffness_and_modes(stiff, modes)
+    modes["modes"][1]["frequency_Hz"] = 16800.0
+    with pytest.raises(ConfigError, match=r"modes\[1\]\.frequency_Hz.*outside the band.*"
+                       r"3 \.\. 60 Hz"):
+        EquivalentModel.from_stiffness_and_modes(stiff, modes)
+    del modes["band_Hz"]  # no band recorded: only the general frequency range applies
+    EquivalentModel.from_stiffness_and_modes(stiff, modes)

@@ -464,3 +464,43 @@ def test_pickled_npz_refused_clearly(tmp_path):
     with pytest.raises(DataError) as e:
         load_npz(p)
     assert "pickled" in str(e.value) and str(p) in str(e.value)
+
+
+def test_sweep_scheduler_that_is_not_dask_is_one_clear_line(tmp_path):
+    """--scheduler pointing at a server that answers with something else than Dask's
+    protocol: one line naming the address, no traceback (nor one from the half-built
+    client's clean-up at exit)."""
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(4)
+    stop = threading.Event()
+
+    def serve():
+        srv.settimeout(0.2)
+        conns = []
+        while not stop.is_set():
+            try:
+                c, _ = srv.accept()
+            except OSError:
+                continue
+            c.sendall(b"\xff\x31\x7a\x00HTTP/1.1 400 Bad Request\r\n\r\n" * 4)
+            conns.append(c)
+        for c in conns:
+            c.close()
+
+    th = threading.Thread(target=serve, daemon=True)
+    th.start()
+    addr = f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    try:
+        r = _sub("sweep", EX / "sweep_demo.toml", "--out", tmp_path / "s", "--scheduler", addr,
+                 timeout=120)
+    finally:
+        stop.set()
+        th.join(5)
+        srv.close()
+    assert r.returncode == 2, r.stderr
+    assert "Traceback" not in r.stderr and "Exception ignored" not in r.stderr, r.stderr
+    assert addr in r.stderr and "scheduler" in r.stderr

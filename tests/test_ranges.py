@@ -50,6 +50,10 @@ CASES = [
     ("depth_mm", 0.05, 50.5, None),
     ("depth_of_cut_mm", 0.3, 300.0, "looks like um"),
     ("feed_mm_per_rev", 0.15, 150.0, "looks like um/r"),
+    ("feed_mm_per_rev", 0.15, 0.00015, "looks like m/r"),
+    ("cut.cutting_speed_m_per_min", 30.0, 0.5, "looks like m/s"),
+    ("insert.edge_radius_um", 20.0, 0.02, "looks like mm; expected um"),
+    ("depth_of_cut_mm", 0.05, 0.00005, "looks like m; expected mm"),
     ("speed_rpm", 300.0, 3e5, None),
     ("pressure_MPa", 0.3, 3e5, "looks like Pa"),
     ("cutting_speed_m_per_min", 37.7, 37700.0, None),
@@ -139,6 +143,16 @@ def test_material_nan_damage_constant_refused(tmp_path):
         load_material(p)
 
 
+def test_material_johnson_cook_stress_in_gpa_refused(tmp_path):
+    from robobore.material import load_material
+
+    src = ROOT / "src" / "robobore" / "material" / "library" / "tc4.toml"
+    p = tmp_path / "m.toml"
+    p.write_text(src.read_text().replace("A_MPa = 997.9", "A_MPa = 0.9979"))
+    with pytest.raises(ConfigError, match=r"m\.toml.*johnson_cook\.A_MPa.*looks like GPa"):
+        load_material(p)
+
+
 def test_campaign_positions_in_mm_refused(tmp_path):
     from robobore.robot.campaign_io import read_campaign
 
@@ -151,6 +165,25 @@ def test_campaign_positions_in_mm_refused(tmp_path):
     p = tmp_path / "camp.csv"
     p.write_text("\n".join(lines) + "\n")
     with pytest.raises(DataError, match=r"camp\.csv, row 1, field 'x_m'.*looks like mm"):
+        read_campaign(p)
+
+
+def test_campaign_forces_in_kn_refused(tmp_path):
+    """Forces in kN in the *_N columns: every value is within the force range, but the
+    largest test force (1 N) cannot deflect a robot; silent before, a stiffness 1e3 low."""
+    from robobore.robot.campaign_io import F_COLS, read_campaign
+
+    lines = (DATA / "campaign_irb6600" / "campaign.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    out = [lines[0]]
+    for ln in lines[1:]:
+        cells = ln.split(",")
+        for col in F_COLS:
+            cells[head.index(col)] = repr(float(cells[head.index(col)]) / 1e3)
+        out.append(",".join(cells))
+    p = tmp_path / "camp.csv"
+    p.write_text("\n".join(out) + "\n")
+    with pytest.raises(DataError, match=r"camp\.csv, row \d+, field 'force_x_N'.*looks like kN"):
         read_campaign(p)
 
 
@@ -243,6 +276,14 @@ def test_no_bundled_or_shared_data_file_is_rejected():
     ti64_coefficients()
     for p in sorted(SHARED.glob("*.json")):
         ranges.check_tree(json.loads(p.read_text()), str(p), kind=DataError)
+    # the example identification outputs, through the commands that read them
+    pb = EX / "plan_paper_bore"
+    r = runner.invoke(app, ["robot", "stiffness", "--joints-deg", "0,-20,20,0,30,0",
+                            "--joint-stiffness-file", str(pb / "joint_stiffness.json")])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6",
+                            "--modes-file", str(pb / "modes.json")])
+    assert r.exit_code == 0, r.output
 
 
 # ----------------------------------------------------------------------------- paths
@@ -389,6 +430,37 @@ def test_sweep_config_ranges(tmp_path):
         load_sweep_config(tmp_path / "s.toml")
 
 
+def test_sweep_grid_errors_name_the_file(tmp_path):
+    from robobore.study.conditions import load_sweep_config
+
+    p = tmp_path / "e.toml"
+    p.write_text('[sweep]\nname = "e"\nrunner = "demo"\n[grid]\nspeed_rpm = []\n'
+                 'feed_mm_per_rev = [0.1]\ndepth_of_cut_mm = [0.1]\n')
+    with pytest.raises(ConfigError, match=r"e\.toml, field 'grid\.speed_rpm': empty list"):
+        load_sweep_config(p)
+
+
+@pytest.mark.parametrize("old,new,words", [
+    ("edge_radius_um = 20.0", "edge_radius_um = 0.02", "looks like mm"),
+    ("approach_angle_deg = 90.0", "approach_angle_deg = 1.5708", "looks like radians"),
+    ("ra_tolerance_um = 1.6", "ra_tolerance_um = 0.0016", "looks like mm"),
+])
+def test_process_slips_downwards_refused(tmp_path, old, new, words):
+    from robobore.dynamics.config import load_dynamics_config
+
+    text = (EX / "boring_paper.toml").read_text()
+    assert old in text
+    p = tmp_path / "c.toml"
+    p.write_text(text.replace(old, new))
+    with pytest.raises(ConfigError) as e:
+        load_dynamics_config(p)
+    assert "c.toml" in str(e.value) and old.split(" =")[0] in str(e.value)
+    assert words in str(e.value)
+    p.write_text(text.replace(old, old.split(" =")[0] + " = 0.0")
+                 if "edge" in old else text)  # a sharp edge (0) is a model, not a slip
+    load_dynamics_config(p)
+
+
 def test_lobes_without_speed_section_says_which_range(tmp_path):
     text = (EX / "lobes_single_point.toml").read_text()
     text = text.split("[speed_rpm]")[0]
@@ -487,3 +559,82 @@ def test_robot_file_lengths_in_mm_refused(tmp_path):
                                                   "d_m = [780.0, 0.0, 0.0, 1142.0, 0.0, 200.0]"))
     with pytest.raises(ConfigError, match=r"r\.toml.*d_m\.0.*looks like mm; expected m"):
         load_robot_file(tmp_path / "r.toml")
+
+
+# ------------------------------------------------------------- single-number CLI options
+_EQ = ["model", "equivalent", "--stiffness-N-per-m", "3e6,2.5e6,4e6", "--frequencies-Hz",
+       "6.9,16.8,24.6", "--damping-ratios", "0.035,0.028,0.02"]
+
+
+@pytest.mark.parametrize("args,option,words", [
+    (["identify", "virtual-hammer-test", "{t}/h.uff", "--duration-s", "6000"], "--duration-s",
+     "looks like ms"),
+    (["identify", "virtual-hammer-test", "{t}/h.uff", "--sample-rate-hz", "nan"],
+     "--sample-rate-hz", "positive"),
+    (["identify", "virtual-hammer-test", "{t}/h.uff", "--seed", "-1"], "--seed", "0 .. "),
+    (["identify", "stiffness", "--example", "--cond-limit", "0.5"], "--cond-limit", "1 .. "),
+    (["identify", "stiffness", "--example", "--sigma-um", "nan"], "--sigma-um", "sigma"),
+    (["identify", "modes", "--example", "--band-hz", "3", "6e9"], "--band-hz", "Hz"),
+    (["identify", "modes", "--example", "--modes", "0"], "--modes", "1 .. 100"),
+    (["identify", "modes", "--example", "--max-order", "5000"], "--max-order", "1 .. 1000"),
+    (["identify", "modes", "--example", "--exp-window-tau-s", "inf"], "--exp-window-tau-s",
+     "finite"),
+    (["identify", "modes", "--example", "--approx-hz", "7,1.7e7"], "--approx-hz", "Hz"),
+    (["robot", "campaign", "{t}/c.csv", "--pressures-MPa", "0,0.3", "--piston-area-m2", "1667"],
+     "--piston-area-m2", "looks like mm^2"),
+    (["robot", "campaign", "{t}/c.csv", "--sigma-um", "-3"], "--sigma-um", "negative"),
+    ([*_EQ, "--foot-pressure-MPa", "0.3", "--foot-piston-diameter-mm", "50000"],
+     "--foot-piston-diameter-mm", "looks like um"),
+    ([*_EQ, "--foot-pressure-MPa", "0.3", "--foot-normal-stiffness-N-per-m", "3"],
+     "--foot-normal-stiffness-N-per-m", "looks like N/um"),
+    ([*_EQ, "--foot-pressure-MPa", "3e5"], "--foot-pressure-MPa", "MPa"),
+    ([*_EQ, "--damping-N-s-per-m", "nan"], "--damping-N-s-per-m", "finite"),
+])
+def test_single_number_options_are_range_checked(tmp_path, args, option, words):
+    """Physical single-number options are checked like file values: one line naming the
+    option, the value and the range with its unit (a unit-slip hint where it applies)."""
+    r = CliRunner().invoke(app, [a.replace("{t}", str(tmp_path)) for a in args])
+    assert r.exit_code == 2, r.output
+    assert "Traceback" not in r.output
+    assert f"'{option}'" in r.output and words in r.output, r.output
+
+
+def test_option_names_pick_the_range_of_their_unit():
+    from robobore.io.ranges import option_name, quantity_of
+
+    assert option_name("--sample-rate-hz") == "sample_rate_Hz"
+    assert option_name("--foot-pressure-MPa") == "foot_pressure_MPa"
+    assert option_name("--approx-hz") == "approx_Hz"
+    assert quantity_of(option_name("--piston-area-m2")).unit == "m^2"
+    assert quantity_of(option_name("--duration-s")).unit == "s"
+
+
+def test_robot_link_centre_of_mass_and_inertia_in_mm_refused(tmp_path):
+    from robobore.robot.kinematics import load_robot_file
+
+    src = (Path(__file__).resolve().parents[1] / "src/robobore/robot/library/"
+           "irb6600-175-2.55.toml").read_text()
+    for old, new, words in (("com_m = [-0.55, 0.0, 0.05]", "com_m = [-550.0, 0.0, 50.0]",
+                             "looks like mm"),
+                            ("inertia_kg_m2 = [4.4, 37.0, 37.5, 0.0, 0.0, 0.0]",
+                             "inertia_kg_m2 = [4.4e6, 3.7e7, 3.75e7, 0.0, 0.0, 0.0]",
+                             "looks like kg mm^2")):
+        assert old in src
+        p = tmp_path / "r.toml"
+        p.write_text(src.replace(old, new))
+        with pytest.raises(ConfigError) as e:
+            load_robot_file(p)
+        assert words in str(e.value) and str(p) in str(e.value)
+
+
+def test_array_slip_hint_only_when_it_explains_the_whole_array():
+    """A frequency axis x1e9 is not 'uHz' just because its second line / 1e6 is in range;
+    an axis x1e3 (mHz) is named as such."""
+    import numpy as np
+
+    f = np.linspace(0.0, 128.0, 769)
+    with pytest.raises(DataError) as e:
+        ranges.check_array(f * 1e9, "frequency_Hz", file="x.npz")
+    assert "looks like" not in str(e.value) and "x.npz" in str(e.value)
+    with pytest.raises(DataError, match="looks like mHz"):
+        ranges.check_array(f * 1e3, "frequency_Hz", file="x.npz")

@@ -193,10 +193,31 @@ def parse_floats(text: str, n: int | None, option: str, unit: str) -> list[float
             value=text,
             expected=f"{n} comma-separated numbers in {unit}",
         )
-    from robobore.io.ranges import check_value
+    from robobore.io.ranges import check_value, option_name
 
     for v in vals:  # NaN refused; plausible range of the option's unit (io.ranges)
         if not math.isinf(v):
-            check_value(v, option.lstrip("-").replace("-", "_"), field=option,
-                        kind=ConfigError)
+            check_value(v, option_name(option), field=option, kind=ConfigError)
     return vals
+
+
+def check_option(value: float | None, option: str, name: str | None = None) -> float | None:
+    """Range-check a single-number option (robobore.io.ranges): NaN, infinity and a value
+    outside the plausible range of its quantity (picked from ``name`` or the option's unit
+    suffix) are a ConfigError naming the option; ``None`` (not given) passes through."""
+    from robobore.errors import ConfigError
+    from robobore.io.ranges import check_value, option_name
+
+    if value is None:
+        return None
+    return check_value(value, name or option_name(option), field=option, kind=ConfigError)
+
+
+def check_count(value: int | None, option: str, lo: int, hi: int) -> int | None:
+    """Check an integer option against ``lo .. hi`` (a ConfigError naming the option)."""
+    from robobore.errors import ConfigError
+
+    if value is not None and not lo <= value <= hi:
+        raise ConfigError("out of range", field=option, value=value,
+                          expected=f"an integer {lo} .. {hi}")
+    return value

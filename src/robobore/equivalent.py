@@ -173,6 +173,22 @@ class DirectionUnit:
     damping_ratio: float
 
 
+def _check_modes_in_band(ml: list[dict[str, Any]], band: Any) -> None:
+    """Modes identified in a band (``band_Hz`` of ``robobore identify modes --json``) lie in
+    it: a frequency far outside is a value edited or scaled by hand (kHz for Hz)."""
+    if not (isinstance(band, list | tuple) and len(band) == 2
+            and all(isinstance(b, int | float) and not isinstance(b, bool) for b in band)):
+        return
+    lo, hi = float(min(band)), float(max(band))
+    for i, md in enumerate(ml):
+        f = float(md["frequency_Hz"])
+        if not lo * 0.9 <= f <= hi * 1.1:
+            hint = " (looks like kHz or a scaled value)" if f > hi * 1.1 else ""
+            raise ConfigError(f"mode frequency outside the band it was identified in{hint}",
+                              field=f"modes[{i}].frequency_Hz", value=f,
+                              expected=f"{lo:g} .. {hi:g} Hz (the file's band_Hz)")
+
+
 @dataclass(frozen=True)
 class EquivalentModel:
     """Per-direction equivalent model of the robot at the tool point (boring frame).
@@ -293,6 +309,7 @@ class EquivalentModel:
                                   expected='{"frequency_Hz": .., "damping_ratio": ..}')
             _positive(f"modes[{i}].frequency_Hz", md.get("frequency_Hz"), "Hz")
             _nonneg(f"modes[{i}].damping_ratio", md.get("damping_ratio", 0.0), "(ratio)")
+        _check_modes_in_band(ml, modes.get("band_Hz"))
         if R is not None:  # compare mode directions with the principal axes
             ml = [dict(md) for md in ml]
             for md in ml:

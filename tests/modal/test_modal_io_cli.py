@@ -206,6 +206,7 @@ def test_cli_virtual_test_then_modes_table(tmp_path):
     (["--max-order", "0"], "max order"),
     (["--approx-hz", "7,abc"], "--approx-hz"),
     (["--approx-hz", "40"], "no stable pole cluster"),
+    (["--frf-type", "bogus"], "'--frf-type': unknown FRF type"),
 ])
 def test_cli_bad_options_exit_2(args, msg):
     r = runner.invoke(app, ["identify", "modes", "--example", *args])
@@ -266,3 +267,25 @@ def test_cli_npz_input_and_exp_window(tmp_path):
     assert res["exp_window_tau_s"] == 1.0
     z = np.array([m["damping_ratio"] for m in res["modes"]])
     np.testing.assert_array_less(np.abs(z / truth.damping_ratios - 1), 0.10)
+
+
+@pytest.mark.parametrize("change,words", [
+    ("real", "the FRF array is real (magnitudes only?)"),
+    ("zero", "every FRF value is zero"),
+    ("two lines", "fewer than 8 frequency lines"),
+])
+def test_npz_frf_that_cannot_hold_modes_is_refused_naming_the_file(tmp_path, change, words):
+    frf = estimate_frf(load_input(example_path())).frf
+    f, h = frf.frequency_Hz, frf.frf
+    if change == "real":
+        h = np.abs(h)
+    elif change == "zero":
+        h = np.zeros_like(h)
+    else:
+        f, h = f[:2], h[..., :2]
+    p = tmp_path / "frf.npz"
+    np.savez(p, frequency_Hz=f, frf=h, frf_type=np.array(frf.frf_type))
+    r = runner.invoke(app, ["identify", "modes", str(p)])
+    assert r.exit_code == 2, r.output
+    line = " ".join(r.output.split())
+    assert str(p) in line and words in line, line

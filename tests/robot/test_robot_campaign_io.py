@@ -41,6 +41,7 @@ def _join(header, rows):
 # --- property tests ---------------------------------------------------------------------------
 
 finite = st.floats(-1e4, 1e4, allow_nan=False, allow_infinity=False)
+loaded = st.floats(10.0, 1e4, allow_nan=False, allow_infinity=False)
 #: positions within the plausible range of robobore.io.ranges (|x| <= 50 m)
 position = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -59,7 +60,8 @@ def campaigns(draw):
         lpp = [draw(position) for _ in range(3)]
         off = np.array([draw(position) for _ in range(3)])
         for s in range(n_s):
-            Fs = [0.0, 0.0, 0.0] if s == 0 else [draw(finite) for _ in range(3)]
+            # a loaded step's force reaches the campaign minimum (10 N, MIN_PEAK_FORCE_N)
+            Fs = [0.0, 0.0, 0.0] if s == 0 else [draw(loaded), draw(finite), draw(finite)]
             ps = draw(st.floats(0, 1, allow_nan=False))
             for r in range(n_r):
                 post.append(f"P{p}")

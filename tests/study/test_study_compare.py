@@ -156,7 +156,8 @@ QUANTS = ["force_amplitude_x_N", "force_amplitude_y_N", "force_amplitude_z_N",
 def tables(draw):
     quants = draw(st.lists(st.sampled_from(QUANTS), min_size=1, max_size=5, unique=True))
     n = draw(st.integers(1, 8))
-    conds = draw(st.lists(st.tuples(_upto(1e5), _upto(5.0), _upto(20.0), _upto(50.0, 0.0)),
+    conds = draw(st.lists(st.tuples(_upto(1e5), _upto(5.0, 1e-3), _upto(20.0, 1e-3),
+                                    _upto(50.0, 0.0)),
                           min_size=n, max_size=n,
                           unique_by=lambda t: tuple(float(f"{v:.9g}") for v in t)))
     rows = []

@@ -11,6 +11,7 @@ import typer
 
 from robobore.clitools import (
     JSON_OPTION,
+    check_option,
     emit,
     fmt,
     handle_errors,
@@ -302,6 +303,13 @@ def equivalent_cmd(
     else:
         raise ConfigError("no modes given", field="--modes-file",
                           expected="--modes-file FILE.json or --frequencies-Hz x,y,z")
+    check_option(damping_N_s_per_m, "--damping-N-s-per-m")  # plausible ranges (io.ranges)
+    check_option(foot_pressure_MPa, "--foot-pressure-MPa")
+    check_option(foot_piston_diameter_mm, "--foot-piston-diameter-mm")
+    check_option(foot_normal_stiffness_N_per_m, "--foot-normal-stiffness-N-per-m")
+    if foot_pressure_MPa is not None and not foot_piston_diameter_mm > 0:
+        raise ConfigError("no piston", field="--foot-piston-diameter-mm",
+                          value=foot_piston_diameter_mm, expected="a diameter > 0 mm")
     assignment = None
     if assign is not None:
         idx = parse_floats(assign, 3, "--assign", "0-based mode indices")

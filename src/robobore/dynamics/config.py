@@ -201,6 +201,24 @@ class InsertCfg(_Strict):
     edge_radius_um: float = Field(20.0, ge=0, le=200)
     n_inserts: int = Field(1, ge=1, le=12)
 
+    # unit slips downwards, which the upper bounds do not catch: an angle in radians, an
+    # edge radius in mm (a ground edge is 2 .. 100 um; 0 = sharp, the ideal edge)
+    @field_validator("approach_angle_deg")
+    @classmethod
+    def _kappa(cls, v: float) -> float:
+        if v < 5.0:
+            raise ValueError(f"approach angle {v:g} deg is below 5 deg (looks like radians; "
+                             "expected deg, boring inserts 45 .. 95 deg)")
+        return v
+
+    @field_validator("edge_radius_um")
+    @classmethod
+    def _edge(cls, v: float) -> float:
+        if 0.0 < v < 0.5:
+            raise ValueError(f"edge radius {v:g} um is below 0.5 um (looks like mm; expected "
+                             "um: ground edges 2 .. 100 um, or 0 for a sharp edge)")
+        return v
+
     def to_insert(self):
         from robobore.cutting.geometry import BoringInsert
 
@@ -250,7 +268,15 @@ class CoefficientsCfg(_Strict):
 class SimulationCfg(_Strict):
     revolutions: int = Field(150, ge=1, le=20000)
     samples_per_rev: int = Field(0, ge=0, le=200000)
-    ra_tolerance_um: float | None = Field(None, gt=0)
+    ra_tolerance_um: float | None = Field(None, gt=0, le=100)
+
+    @field_validator("ra_tolerance_um")
+    @classmethod
+    def _ra(cls, v: float | None) -> float | None:
+        if v is not None and v < 0.01:
+            raise ValueError(f"Ra tolerance {v:g} um is below 0.01 um (looks like mm; "
+                             "expected um: machined bores 0.1 .. 12.5 um)")
+        return v
 
 
 class ModelFilesCfg(_Strict):

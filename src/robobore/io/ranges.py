@@ -109,15 +109,18 @@ RANGES: dict[str, Range] = {
     "length_um": Range("small length", "um", 0.0, 1e5, signed=True,
                        slips=((1e3, "looks like nm; expected um"),),
                        examples="edge radii, element sizes, amplitudes: 0.1 .. 1000 um"),
-    "depth_mm": Range("depth of cut", "mm", 0.0, 20.0,
-                      slips=((1e3, "looks like um; expected mm"),),
+    "depth_mm": Range("depth of cut", "mm", 1e-3, 20.0, zero_ok=True,
+                      slips=((1e3, "looks like um; expected mm"),
+                             (1e-3, "looks like m; expected mm")),
                       examples="boring: 0.01 .. 5 mm"),
-    "feed_mm_per_rev": Range("feed per revolution", "mm/r", 0.0, 5.0,
-                             slips=((1e3, "looks like um/r; expected mm/r"),),
+    "feed_mm_per_rev": Range("feed per revolution", "mm/r", 1e-3, 5.0, zero_ok=True,
+                             slips=((1e3, "looks like um/r; expected mm/r"),
+                                    (1e-3, "looks like m/r; expected mm/r")),
                              examples="boring: 0.02 .. 0.6 mm/r"),
     "speed_rpm": Range("spindle speed", "r/min", 0.0, 1e5,
                        examples="robotic boring 100 .. 3000 r/min; HSM up to 60000"),
-    "speed_m_per_min": Range("cutting speed", "m/min", 0.0, 2000.0,
+    "speed_m_per_min": Range("cutting speed", "m/min", 1.0, 2000.0, zero_ok=True,
+                             slips=((1 / 60, "looks like m/s; expected m/min"),),
                              examples="titanium 20 .. 120 m/min; aluminium up to 2000"),
     "angle_deg": Range("angle", "deg", 0.0, 1000.0, signed=True,
                        examples="joint angles within their limits (+-300 deg at most)"),
@@ -176,6 +179,10 @@ RANGES: dict[str, Range] = {
                                  slips=((1e-3, "looks like kJ/(kg K); expected J/(kg K)"),)),
     "conductivity_W_mK": Range("thermal conductivity", "W/(m K)", 0.01, 2000.0),
     "mass_kg": Range("mass", "kg", 0.0, 1e5, examples="tools, bars, robots"),
+    "jc_stress_MPa": Range("Johnson-Cook yield / hardening stress A, B", "MPa", 10.0, 1e4,
+                           slips=((1e6, "looks like Pa; expected MPa"),
+                                  (1e-3, "looks like GPa; expected MPa")),
+                           examples="Ti-6Al-4V A 998, B 653 MPa; steels A 200 .. 1500 MPa"),
     "jc_n": Range("Johnson-Cook hardening exponent n", "-", 0.0, 2.0),
     "jc_C": Range("Johnson-Cook strain-rate constant C", "-", 0.0, 1.0),
     "jc_m": Range("Johnson-Cook thermal exponent m", "-", 0.0, 5.0),
@@ -196,6 +203,28 @@ RANGES: dict[str, Range] = {
                        examples="Ti-6Al-4V 3.87; "
                        "4340 steel 0.61, Armco iron 0.63, OFHC copper 1.12"),
     "poisson": Range("Poisson's ratio", "-", 0.0, 0.5),
+    "edge_radius_um": Range("cutting-edge radius", "um", 0.5, 500.0, zero_ok=True,
+                            slips=((1e-3, "looks like mm; expected um"),),
+                            examples="ground or honed edges 2 .. 100 um; 0 = sharp"),
+    "inertia_kg_m2": Range("moment / product of inertia", "kg m^2", 0.0, 1e5, signed=True,
+                           slips=((1e6, "looks like kg mm^2; expected kg m^2"),),
+                           examples="robot links 0.01 .. 100 kg m^2, tools 1e-4 .. 1"),
+    "area_m2": Range("area", "m^2", 0.0, 100.0,
+                     slips=((1e6, "looks like mm^2; expected m^2"),
+                            (1e4, "looks like cm^2; expected m^2")),
+                     examples="pressure-foot pistons 1e-4 .. 1e-2 m^2"),
+    "time_s": Range("time", "s", 0.0, 1e5,
+                    slips=((1e3, "looks like ms; expected s"),),
+                    examples="hammer-test records 1 .. 60 s, windows 0.01 .. 10 s"),
+    "noise_um": Range("measurement noise (1-sigma)", "um", 0.0, 1e4,
+                      examples="laser trackers 5 .. 50 um per coordinate"),
+    "record_s": Range("record length", "s", 1e-3, 600.0,
+                      slips=((1e3, "looks like ms; expected s"),),
+                      examples="impact-hammer records 1 .. 60 s"),
+    "sample_rate_Hz": Range("sampling rate", "Hz", 1.0, 1e6,
+                            examples="hammer tests 256 Hz .. 102.4 kHz"),
+    "condition_limit": Range("condition-number limit", "-", 1.0, 1e16,
+                             examples="1e3 .. 1e12"),
     "modal_mass_kg": Range("modal mass", "kg", 0.0, 1e6),
     "plastic_strain": Range("plastic strain", "-", 0.0, 50.0,
                             examples="hardening hold of the bundled TC4 0.6; strains in a "
@@ -204,12 +233,17 @@ RANGES: dict[str, Range] = {
 
 #: Exact names (last key component, or ``section.name``) and their quantity.
 BY_NAME: dict[str, str] = {
+    "johnson_cook.A_MPa": "jc_stress_MPa", "johnson_cook.B_MPa": "jc_stress_MPa",
     "johnson_cook.n": "jc_n", "johnson_cook.C": "jc_C", "johnson_cook.m": "jc_m",
     "johnson_cook.eps_dot0_per_s": "jc_eps0",
     "hardening_strain_limit": "plastic_strain",
     **{f"damage.D{i}": f"damage_D{i}" for i in range(1, 6)},
     "elastic.nu": "poisson", "thermal.taylor_quinney": "ratio",
-    "d_m": "length_m", "a_m": "length_m", "tcp_m": "length_m",
+    "d_m": "length_m", "a_m": "length_m", "tcp_m": "length_m", "com_m": "length_m",
+    "duration_s": "time_s", "exp_window_tau_s": "time_s", "noise": "ratio",
+    "cond_limit": "condition_limit", "edge_radius_um": "edge_radius_um",
+    "sample_rate_Hz": "sample_rate_Hz",
+    "record_duration_s": "record_s", "sigma_um": "noise_um",
     "depth_mm": "depth_mm", "depth_of_cut_mm": "depth_mm",
     "feed_mm_per_rev": "feed_mm_per_rev", "speed_rpm": "speed_rpm",
     "coherence": "coherence", "mpc": "ratio",
@@ -229,6 +263,7 @@ BY_SUFFIX: dict[str, str] = {
     "_MPa": "stress_MPa", "_GPa": "modulus_GPa", "_K": "temperature_K",
     "_kg_m3": "density_kg_m3", "_J_kgK": "heat_capacity_J_kgK", "_W_mK": "conductivity_W_mK",
     "_kg": "mass_kg", "_damping_ratio": "damping_ratio", "_fraction": "ratio",
+    "_kg_m2": "inertia_kg_m2", "_m2": "area_m2",
 }
 
 #: Key components that name a part of a quantity, not the quantity (``stiffness.x``).
@@ -269,6 +304,20 @@ def quantity_of(path: str | Iterable[Any]) -> Range | None:
             return None
         q = BY_SUFFIX[best]
     return RANGES[q]
+
+
+def option_name(option: str) -> str:
+    """The key name of a command-line option, with its unit suffix spelt as in
+    :data:`BY_SUFFIX` (``--sample-rate-hz`` -> ``sample_rate_Hz``,
+    ``--foot-pressure-MPa`` -> ``foot_pressure_MPa``), so that it picks its range."""
+    name = option.lstrip("-").replace("-", "_")
+    if quantity_of(name) is not None:
+        return name
+    low = name.lower()
+    for suf in sorted(BY_SUFFIX, key=len, reverse=True):
+        if low.endswith(suf.lower()) and len(name) > len(suf):
+            return name[: -len(suf)] + suf
+    return name
 
 
 def _error(kind: type[InputError], message: str, **kw: Any) -> InputError:
@@ -340,7 +389,19 @@ def check_array(values: Any, name: str, *, file: str | None = None, field: str |
         bad |= out
     if bad.any():
         i = int(np.argmax(bad))
-        check_value(float(a[i]), name, file=file, field=f"{field or name}[{i}]", kind=kind)
+        v = float(a[i])
+        where = f"{field or name}[{i}]"
+        if rng is None or not math.isfinite(v):
+            check_value(v, name, file=file, field=where, kind=kind)  # raises: not finite
+            return
+        if v < 0 and not rng.signed:
+            msg = "a negative value where a positive quantity is expected"
+        else:  # a unit slip is named only when it explains the whole array
+            hint = next((words for factor, words in rng.slips
+                         if all(rng.contains(x) for x in (a.min() / factor, a.max() / factor))),
+                        None)
+            msg = "value out of the plausible range" + (f" ({hint})" if hint else "")
+        raise kind(msg, file=file, field=where, value=v, expected=rng.describe())
 
 
 def _allow_list(data: Mapping[str, Any], file: str | None) -> tuple[str, ...]:
@@ -409,5 +470,6 @@ def range_table() -> list[dict[str, str]]:
 
 __all__ = ["Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning", "check_value",
            "check_array",
-           "check_tree", "quantity_of", "enabled", "set_enabled", "provenance", "range_table",
+           "check_tree", "quantity_of", "option_name", "enabled", "set_enabled", "provenance",
+           "range_table",
            "ENV_VAR", "OVERRIDE_KEY"]

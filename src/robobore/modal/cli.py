@@ -15,7 +15,15 @@ from typing import Any
 
 import typer
 
-from robobore.clitools import JSON_OPTION, emit, handle_errors, parse_floats, progress_bar
+from robobore.clitools import (
+    JSON_OPTION,
+    check_count,
+    check_option,
+    emit,
+    handle_errors,
+    parse_floats,
+    progress_bar,
+)
 
 
 def _render_modes(res: dict[str, Any]) -> None:
@@ -76,11 +84,17 @@ def modes_cmd(
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
-    from robobore.errors import ConfigError, IdentificationError, NumericalError
+    from robobore.errors import ConfigError, IdentificationError, InputError, NumericalError
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
-    from robobore.modal.frf import DoubleHitWarning, FRFData, LeakageWarning, estimate_frf
+    from robobore.modal.frf import (
+        FRF_TYPES,
+        DoubleHitWarning,
+        FRFData,
+        LeakageWarning,
+        estimate_frf,
+    )
     from robobore.modal.identify import identify_modes
     from robobore.modal.io import load_input
 
@@ -89,6 +103,16 @@ def modes_cmd(
                           expected="a UFF/NPZ file path or the --example flag")
     check_output_dir(plot, "--plot", "the PNG plots")
     check_output_file(out, "--out", "the result JSON")
+    for v in band_hz or ():  # plausible ranges (robobore.io.ranges)
+        check_option(v, "--band-hz", "band_Hz")
+    check_count(modes, "--modes", 1, 100)
+    if max_order > 1000:  # (below 1: identify_modes says why)
+        raise ConfigError("max order too high", field="--max-order", value=max_order,
+                          expected="an integer 1 .. 1000 (the stabilisation diagram's orders)")
+    check_option(exp_window_tau_s, "--exp-window-tau-s")
+    if frf_type is not None and frf_type.strip().lower() not in FRF_TYPES:
+        raise ConfigError("unknown FRF type", field="--frf-type", value=frf_type,
+                          expected="one of " + ", ".join(FRF_TYPES))
     if example:
         input_file = example_path()
         if band_hz is None:
@@ -116,6 +140,11 @@ def modes_cmd(
                                 max_order=max_order)
         except (IdentificationError, NumericalError) as exc:  # say which data it was
             raise type(exc)(f"{input_file}: {exc}") from None
+        except InputError as exc:  # a band the data cannot give: name the data file
+            if exc.file is not None:
+                raise
+            raise type(exc)(exc.message, file=str(input_file), field=exc.field,
+                            value=exc.value, expected=exc.expected) from None
         advance(1)
         res = an.result.to_dict()
         res["source"] = str(input_file)
@@ -186,6 +215,9 @@ def virtual_test_cmd(
             raise ConfigError("noise must be a fraction in [0, 1)", field="--noise", value=noise,
                               expected="e.g. 0.01 for 1 % of RMS")
         _check_hammer_size(len(rows), hits, truth.phi_out.shape[0], sample_rate_hz, duration_s)
+        check_option(sample_rate_hz, "--sample-rate-hz", "sample_rate_Hz")
+        check_option(duration_s, "--duration-s", "record_duration_s")
+        check_count(seed, "--seed", 0, 2**32 - 1)
         settings = {"n_hits": hits, "sample_rate_Hz": sample_rate_hz, "duration_s": duration_s,
                     "tip": tip, "noise_force": noise, "noise_response": noise, "seed": seed,
                     "double_hits": dh}

@@ -103,6 +103,9 @@ def check_frf_array(frf: np.ndarray, n_f: int, *, file: str | None = None,
         raise DataError("FRF has non-finite values (NaN/inf)", file=file,
                         field=f"{name}[output {o}, input {i}]", row=k + 1,
                         value=complex(h[o, i, k]), expected="finite complex FRF values")
+    if not np.any(h):
+        raise DataError("every FRF value is zero", file=file, field=name,
+                        expected="measured FRFs (a response to the hammer)")
     return h
 
 

@@ -386,6 +386,7 @@ def _npz_frf(z: Any, p: Path) -> FRFData:
             raise DataError("NPZ file lacks a required array", file=str(p), field=key,
                             value=sorted(z.files),
                             expected="arrays frequency_Hz (Hz), frf (complex), frf_type")
+    frf = z["frf"]
     names = {k: tuple(str(v) for v in z[k]) for k in ("output_names", "input_names")
              if k in z.files}
     coh = z["coherence"] if "coherence" in z.files else None
@@ -402,9 +403,14 @@ def _npz_frf(z: Any, p: Path) -> FRFData:
                                 field=k, value=f"shape {a.shape}, {a.dtype}",
                                 expected="integers of shape (n, 2): node, direction")
             dofs[k] = tuple((int(u), int(v)) for u, v in a)
-    return FRFData(z["frequency_Hz"], z["frf"], str(z["frf_type"]), coh,
+    data = FRFData(z["frequency_Hz"], frf, str(z["frf_type"]), coh,
                    names.get("output_names", ()), names.get("input_names", ()),
                    source=str(p), **dofs)
+    if not np.iscomplexobj(frf):  # (after the structural checks of FRFData)
+        raise DataError("the FRF array is real (magnitudes only?)", file=str(p), field="frf",
+                        value=str(frf.dtype), expected="complex FRF values (magnitude and "
+                        "phase), as numpy.savez writes a complex array")
+    return data
 
 
 def save_npz(data: FRFData, path: str | Path) -> Path:

@@ -15,8 +15,9 @@ load point that differ between the rows of one (posture, load step), joint angle
 between load steps of a posture (> ``Q_TOL_DEG``), a non-zero force at step 0, a posture
 without a step 0, a loaded step whose reflectors differ from its reference, fewer than 3 or
 collinear reflectors, values outside the plausible range of their unit
-(:mod:`robobore.io.ranges`: positions in mm in the ``*_m`` columns, ...) and (when a robot
-is given) joints outside their limits. Nothing is dropped silently.
+(:mod:`robobore.io.ranges`: positions in mm in the ``*_m`` columns, ...), a largest test
+force below ``MIN_PEAK_FORCE_N`` (forces in kN) and (when a robot is given) joints outside
+their limits. Nothing is dropped silently.
 """
 
 from __future__ import annotations
@@ -46,6 +47,10 @@ UNITS = {**{c: "deg" for c in Q_COLS}, **{c: "N" for c in F_COLS},
 Q_TOL_DEG = 0.01
 #: The force of the unloaded reference step must be below this (N).
 F0_TOL_N = 1e-6
+#: The largest test force of a campaign must reach this (N): below it a robot (tool-point
+#: stiffness 1e5 .. 1e8 N/m) deflects by less than a tracker's noise, and forces given in
+#: kN where N is expected are caught (stiffness campaigns load 100 .. 5000 N).
+MIN_PEAK_FORCE_N = 10.0
 
 
 def _num(cell: str, *, file: str, row: int, col: str) -> float:
@@ -230,6 +235,14 @@ def validate_campaign(c: Campaign, robot=None) -> None:
                     value=float(c.q_deg[ids[0], j]),
                     expected=f"{float(c.q_deg[i0, j])} deg (within {Q_TOL_DEG} deg; the "
                     "commanded posture is held while loading)")
+    fnorm = np.linalg.norm(c.force_N, axis=1)
+    if c.n_rows and float(fnorm.max()) < MIN_PEAK_FORCE_N:
+        i = int(np.argmax(fnorm))
+        raise DataError("the largest test force is too small to deflect a robot measurably "
+                        "(looks like kN; expected N)", file=src, row=c.row_number(i),
+                        field="force_x_N", value=float(fnorm[i]),
+                        expected=f"a largest force of at least {MIN_PEAK_FORCE_N:g} N "
+                        "(stiffness campaigns load 100 .. 5000 N)")
     if robot is not None:
         from robobore.robot.kinematics import check_joint_limits, get_robot
 

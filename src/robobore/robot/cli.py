@@ -14,6 +14,8 @@ import typer
 
 from robobore.clitools import (
     JSON_OPTION,
+    check_count,
+    check_option,
     emit,
     fmt,
     handle_errors,
@@ -336,6 +338,9 @@ def campaign_cmd(
     from robobore.robot.campaign_io import write_campaign
 
     check_output_file(out, "OUT", "the campaign CSV")
+    check_option(piston_area_m2, "--piston-area-m2")  # plausible ranges (robobore.io.ranges)
+    check_option(sigma_um, "--sigma-um")
+    check_count(seed, "--seed", 0, 2**32 - 1)
     rb = _robot(robot, robot_file)
     kw: dict[str, Any] = {"robot": str(robot_file) if robot_file else rb.name, "seed": seed}
     if joint_stiffness is not None:
@@ -434,6 +439,7 @@ def identify_stiffness_cmd(
     if sigma_um is not None and not (math.isfinite(sigma_um) and 0.0 < sigma_um <= 1e4):
         raise ConfigError("tracker noise out of range", field="--sigma-um", value=sigma_um,
                           expected="0 < sigma <= 10000 um (1-sigma per coordinate)")
+    check_option(cond_limit, "--cond-limit", "cond_limit")
     camp = read_campaign(path, robot=rb)
     res = identify_joint_stiffness(camp, rb, sigma_m=None if sigma_um is None else
                                    sigma_um * 1e-6, cond_limit=cond_limit,

@@ -240,7 +240,15 @@ def expand_conditions(cfg: SweepConfig, source: str | Path = "<config>") -> list
     Order: built-in levels, then the grid, then the explicit list. A sweep of more than
     :data:`MAX_SWEEP_CONDITIONS` conditions is refused before anything is expanded.
     """
-    n_grid = cfg.grid.count() if cfg.grid is not None else 0
+    try:
+        n_grid = cfg.grid.count() if cfg.grid is not None else 0
+        grid = cfg.grid.expand() if cfg.grid is not None and n_grid <= MAX_SWEEP_CONDITIONS \
+            else []
+    except ConfigError as exc:  # (the grid's own checks) name the config file
+        if exc.file is not None:
+            raise
+        raise ConfigError(exc.message, file=str(source), field=exc.field, value=exc.value,
+                          expected=exc.expected) from None
     if n_grid + len(cfg.conditions) > MAX_SWEEP_CONDITIONS:
         raise ConfigError(
             f"the sweep has {n_grid + len(cfg.conditions):.4g} conditions, more than the "
@@ -253,7 +261,7 @@ def expand_conditions(cfg: SweepConfig, source: str | Path = "<config>") -> list
         design = "ofat" if cfg.sweep.levels == "paper-ofat" else "grid"
         raw += [(f"sweep.levels[{i}]", d) for i, d in enumerate(paper_conditions(design))]
     if cfg.grid is not None:
-        raw += [(f"grid[{i}]", d) for i, d in enumerate(cfg.grid.expand())]
+        raw += [(f"grid[{i}]", d) for i, d in enumerate(grid)]
     raw += [(f"conditions.{i}", d) for i, d in enumerate(cfg.conditions)]
 
     out: list[Condition] = []

@@ -291,6 +291,19 @@ def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: 
     )
 
 
+def _forget_failed_client(exc: BaseException) -> None:
+    """Mark the half-built ``Client`` of a failed connection closed, so that its ``__del__``
+    does not try (30 s) to close a connection that never opened and print a traceback."""
+    from distributed import Client
+
+    tb = exc.__traceback__
+    while tb is not None:
+        obj = tb.tb_frame.f_locals.get("self")
+        if isinstance(obj, Client):
+            obj.status = "closed"
+        tb = tb.tb_next
+
+
 def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: str | None,
               workers: int, processes: bool, connect_timeout_s: float) -> None:
     from distributed import Client, LocalCluster, as_completed
@@ -303,10 +316,18 @@ def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: s
                 client = Client(scheduler, timeout=f"{connect_timeout_s}s",
                                 set_as_default=False)
             except (OSError, TimeoutError) as exc:
+                _forget_failed_client(exc)
                 raise RoboboreError(
                     f"cannot connect to the Dask scheduler at {scheduler!r} within "
                     f"{connect_timeout_s:g} s ({exc}); expected a running scheduler, e.g. "
                     "'dask scheduler' then 'dask worker ADDR'"
+                ) from None
+            except Exception as exc:  # something answers, but not as a Dask scheduler
+                _forget_failed_client(exc)
+                raise RoboboreError(
+                    f"the server at {scheduler!r} does not answer as a Dask scheduler "
+                    f"({type(exc).__name__}); expected the address of a running scheduler, "
+                    "e.g. 'dask scheduler' then 'dask worker ADDR'"
                 ) from None
         else:
             # processes: TCP on loopback only; threads: Dask's in-process transport
