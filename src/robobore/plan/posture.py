@@ -28,7 +28,6 @@ Config: see ``examples/plan_paper_bore.toml`` and docs/plan.md.
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from dataclasses import dataclass
@@ -40,6 +39,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from robobore.dynamics.config import CoefficientsCfg, InsertCfg
 from robobore.errors import ConfigError, DataError, InputError
+from robobore.io.readers import load_json
 
 POSITION_TOL_M = 1e-4
 AXIS_TOL_DEG = 0.05
@@ -136,13 +136,8 @@ def _read_json(path: Path, cfg_file: str, key: str) -> dict[str, Any]:
         raise ConfigError("file not found", file=cfg_file, field=key, value=str(path),
                           expected="a JSON file written by 'robobore identify ... --json' "
                                    "(paths relative to the config file's folder)")
-    try:
-        data = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise DataError(f"not valid JSON: {exc}", file=str(path)) from None
-    if not isinstance(data, dict):
-        raise DataError("expected a JSON object", file=str(path))
-    return data
+    return load_json(path, "identification file", "a JSON object written by 'robobore "
+                     "identify ... --json'", error=DataError)
 
 
 @dataclass

@@ -118,14 +118,9 @@ def summarise(ds: Any, source: str | None = None) -> dict[str, Any]:
     """
     out: dict[str, Any] = {}
     for name, unit in AMPLITUDE_QUANTITIES.items():
-        present, v = _scalar(ds, name)
-        if not present:
+        f, v = _number(ds, name, source, f"in {unit}")
+        if f is None:
             continue
-        try:
-            f = float(v)
-        except (TypeError, ValueError):
-            raise DataError("summary value is not a number", file=source, field=name, value=v,
-                            expected=f"a finite number >= 0 in {unit}") from None
         if not math.isfinite(f) or f < 0:
             raise DataError("summary value out of range", file=source, field=name, value=v,
                             expected=f"a finite number >= 0 in {unit}")
@@ -139,17 +134,24 @@ def summarise(ds: Any, source: str | None = None) -> dict[str, Any]:
                                 value=v, expected="true or false")
             out[name] = b
     for name, unit in VERDICT_VALUES.items():
-        present, v = _scalar(ds, name)
-        if not present:
-            continue
-        try:
-            f = float(v)
-        except (TypeError, ValueError):
-            raise DataError("summary value is not a number", file=source, field=name, value=v,
-                            expected=f"a finite number >= 0 ({unit})") from None
-        if math.isfinite(f) and f >= 0:
+        f, _ = _number(ds, name, source, f"({unit})")
+        if f is not None and math.isfinite(f) and f >= 0:  # a verdict value may be undefined
             out[name] = f
     return out
+
+
+def _number(ds: Any, name: str, source: str | None, unit_words: str
+            ) -> tuple[float | None, Any]:
+    """The summary quantity ``name`` as (float, stored value); (None, None) when absent; a
+    non-number is an error."""
+    present, v = _scalar(ds, name)
+    if not present:
+        return None, None
+    try:
+        return float(v), v
+    except (TypeError, ValueError):
+        raise DataError("summary value is not a number", file=source, field=name, value=v,
+                        expected=f"a finite number >= 0 {unit_words}") from None
 
 
 def summary_to_json(summary: dict[str, Any]) -> dict[str, Any]:

@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from robobore.errors import ConfigError, DataError
+from robobore.io.readers import load_json
 
 #: the measured quantities: file key -> (result key, relative-error key, unit)
 QUANTITIES = {
@@ -81,11 +82,8 @@ def read_measured(path: str | Path) -> list[MeasuredPoint]:
     if not p.is_file():
         raise DataError("measured-forces file not found", file=f,
                         expected="an existing JSON file (docs/fe.md, robobore fe validate)")
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise DataError(f"not valid JSON: {exc}", file=f,
-                        expected="a JSON file (docs/fe.md, robobore fe validate)") from None
+    data = load_json(p, "measured-forces file", "a JSON file (docs/fe.md, robobore fe "
+                     "validate)", kind=None, error=DataError)
     if not isinstance(data, dict) or not isinstance(data.get("measured"), dict):
         raise DataError("no 'measured' table", file=f, field="measured",
                         expected='{"measured": {"Fc": {h_um: {vc_m_per_min: value}}, ...}}')
