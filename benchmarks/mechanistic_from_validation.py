@@ -1,16 +1,20 @@
-"""Mechanistic coefficients fitted to the validated FE model's nine points, against their FE
-points and the measurements (issue 27's acceptance on the coefficients).
+"""Mechanistic coefficients calibrated from the validated FE model's nine points: the
+mechanistic orthogonal forces against their FE points and against the measurements, with
+leave-one-speed-out cross-validation (issue 27's acceptance on the coefficients).
 
 Reads the FE forces the validated model gave at the nine measured conditions (rows stored in
 benchmarks/measured/fe_validation_2026-11-23/calibrated_rech_x1.5_sliding_hardening0.6_nocap_*:
 the default model written out, 10 um elements, 0.3 mm, rake 15 deg, edge radius 20 um; the
 configs are the ones ``robobore fe validate examples/fe_orthogonal.toml`` runs, see
-tests/cutting/fe/test_validation_config.py), fits them with ``robobore.cutting.calibrate``
-(Fc = Kte + Ktc h, Ff = Kfe + Kfc h, pooled over the speeds, as ``robobore calibrate forces``),
-and prints per point: the fit against its FE point and against the measurement
-(../shared/data/ti64_orthogonal_cutting_forces.json). No FE is run.
+tests/cutting/fe/test_validation_config.py) and runs
+:func:`robobore.cutting.calibrate.mechanistic_check` on them: the calibration of ``robobore
+calibrate forces`` (pooled set + per-speed fits), the forces through the boring model's own
+coefficient path at each point's cutting speed (speed-dependent: per-speed fits interpolated
+linearly in ln(vc), held outside the calibrated speeds), compared with the FE point (target 5 %)
+and the measurement (../shared/data/ti64_orthogonal_cutting_forces.json; Fc 10 %, Ff 25 %).
+The pooled set (``speed_dependent = false``) is printed for comparison. No FE is run.
 
-    python benchmarks/mechanistic_from_validation.py [--data PATH]
+    python benchmarks/mechanistic_from_validation.py [--data PATH] [--json]
 """
 
 from __future__ import annotations
@@ -18,23 +22,27 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import time
 from pathlib import Path
 
 from robobore.cutting import calibrate as cal
+from robobore.cutting.fe.validate import read_measured
 
 ROOT = Path(__file__).resolve().parents[1]
 ROWS = ROOT / "benchmarks" / "measured" / "fe_validation_2026-11-23"
 DATA = ROOT.parent / "shared" / "data" / "ti64_orthogonal_cutting_forces.json"
+if not DATA.is_file():  # the same measured data, bundled with the package
+    DATA = ROOT / "src" / "robobore" / "cutting" / "coefficients" / DATA.name
 
 
-def fe_points() -> dict[tuple[float, float], tuple[float, float]]:
-    """(h, vc) -> (Fc, Ff) N/mm of the nine stored validation rows."""
+def fe_points(rows: Path = ROWS) -> dict[tuple[float, float], tuple[float, float]]:
+    """(h um, vc m/min) -> (Fc, Ff) N/mm of the nine stored validation rows."""
     out = {}
-    d = json.loads((ROWS / "calibrated_rech_x1.5_sliding_hardening0.6_nocap_5points.json")
+    d = json.loads((rows / "calibrated_rech_x1.5_sliding_hardening0.6_nocap_5points.json")
                    .read_text())
     for r in d["rows"]:
         out[(r["h_um"], r["vc_m_per_min"])] = (r["Fc_sim"], r["Ff_sim"])
-    txt = (ROWS / "calibrated_rech_x1.5_sliding_hardening0.6_nocap_4points.txt").read_text()
+    txt = (rows / "calibrated_rech_x1.5_sliding_hardening0.6_nocap_4points.txt").read_text()
     for line in txt.splitlines():
         m = re.match(r"\s*(\d+)\s+(\d+) \|\s*\S+\s+(\S+)\s+\S+ \|\s*\S+\s+(\S+)", line)
         if m:
@@ -42,12 +50,8 @@ def fe_points() -> dict[tuple[float, float], tuple[float, float]]:
     return out
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--data", type=Path, default=DATA)
-    a = ap.parse_args()
-    meas = json.loads(a.data.read_text())["measured"]
-    pts = fe_points()
+def validation_calibration(pts: dict[tuple[float, float], tuple[float, float]]):
+    """The calibration config (the validated FE model's insert and grid) and FE records."""
     hs = sorted({h for h, _ in pts})
     vs = sorted({v for _, v in pts})
     cfg = cal.calibration_from_mapping(
@@ -59,47 +63,69 @@ def main() -> None:
     recs = [{"h_um": h, "vc_m_per_min": v, "Fc_N_per_m": pts[(h, v)][0] * 1e3,
              "Ff_N_per_m": pts[(h, v)][1] * 1e3, "cached": True, "fe": {}}
             for h in hs for v in vs]
-    d = cal.calibrate(cfg, recs)
-    o = d["orthogonal"]
-    print(f"# pooled fit over {len(recs)} FE points: Ktc {o['Ktc_N_per_m2'] / 1e9:.4f} GPa, "
-          f"Kte {o['Kte_N_per_m'] / 1e3:.2f} N/mm, Kfc {o['Kfc_N_per_m2'] / 1e9:.4f} GPa, "
-          f"Kfe {o['Kfe_N_per_m'] / 1e3:.2f} N/mm; warnings: {d['warnings'] or 'none'}")
-    print(f"{'h':>4} {'vc':>4} | {'Fc fit':>7} {'Fc FE':>7} {'vs FE%':>7} {'Fc meas':>7} "
-          f"{'vs meas%':>8} | {'Ff fit':>6} {'Ff FE':>6} {'vs FE%':>7} {'Ff meas':>7} "
-          f"{'vs meas%':>8}")
-    worst = {"fe_c": 0.0, "fe_f": 0.0, "m_c": 0.0, "m_f": 0.0}
-    for h in hs:
-        for v in vs:
-            fc = (o["Kte_N_per_m"] + o["Ktc_N_per_m2"] * h * 1e-6) * 1e-3
-            ff = (o["Kfe_N_per_m"] + o["Kfc_N_per_m2"] * h * 1e-6) * 1e-3
-            fcf, fff = pts[(h, v)]
-            fcm, ffm = meas["Fc"][f"{h:g}"][f"{v:g}"], meas["Ff"][f"{h:g}"][f"{v:g}"]
-            e = (fc / fcf - 1, ff / fff - 1, fc / fcm - 1, ff / ffm - 1)
-            for k, x in zip(worst, e, strict=True):
-                worst[k] = max(worst[k], abs(x))
-            print(f"{h:4.0f} {v:4.0f} | {fc:7.1f} {fcf:7.1f} {100 * e[0]:+7.1f} {fcm:7.1f} "
-                  f"{100 * e[2]:+8.1f} | {ff:6.1f} {fff:6.1f} {100 * e[1]:+7.1f} {ffm:7.1f} "
-                  f"{100 * e[3]:+8.1f}")
-    # per-speed fits (the file's per_speed_fits; the boring model takes one set, so these
-    # show what a speed-dependent coefficient model would reach)
-    pw = {"fe_c": 0.0, "fe_f": 0.0, "m_c": 0.0, "m_f": 0.0}
-    for v in vs:
-        k = d["per_speed_fits"][f"{v:g}"]
-        for h in hs:
-            fc = (k["Kte_N_per_m"] + k["Ktc_N_per_m2"] * h * 1e-6) * 1e-3
-            ff = (k["Kfe_N_per_m"] + k["Kfc_N_per_m2"] * h * 1e-6) * 1e-3
-            fcf, fff = pts[(h, v)]
-            fcm, ffm = meas["Fc"][f"{h:g}"][f"{v:g}"], meas["Ff"][f"{h:g}"][f"{v:g}"]
-            for key, x in zip(pw, (fc / fcf - 1, ff / fff - 1, fc / fcm - 1, ff / ffm - 1),
-                              strict=True):
-                pw[key] = max(pw[key], abs(x))
-    print(f"# per-speed fits, max |error|: vs FE Fc {100 * pw['fe_c']:.1f} %, Ff "
-          f"{100 * pw['fe_f']:.1f} %; vs measured Fc {100 * pw['m_c']:.1f} %, Ff "
-          f"{100 * pw['m_f']:.1f} %")
-    print(f"# pooled fit, max |error|: fit vs FE Fc {100 * worst['fe_c']:.1f} %, Ff "
-          f"{100 * worst['fe_f']:.1f} % (target 5 %); fit vs measured Fc "
-          f"{100 * worst['m_c']:.1f} % (target 10 %), Ff "
-          f"{100 * worst['m_f']:.1f} % (target 25 %)")
+    return cfg, recs
+
+
+def _pct(x: float | None) -> str:
+    return "    -" if x is None else f"{100 * x:+6.1f}"
+
+
+def _table(rows: list[dict]) -> None:
+    print(f"{'h':>4} {'vc':>4} | {'Fc mech':>7} {'Fc FE':>7} {'vs FE%':>6} {'vs meas%':>8} | "
+          f"{'Ff mech':>7} {'Ff FE':>6} {'vs FE%':>6} {'vs meas%':>8}")
+    for r in rows:
+        print(f"{r['h_um']:4.0f} {r['vc_m_per_min']:4.0f} | {r['Fc_N_per_m'] / 1e3:7.1f} "
+              f"{r['Fc_fe_N_per_m'] / 1e3:7.1f} {_pct(r['error_vs_fe']['Fc'])} "
+              f"{_pct(r['error_vs_measured']['Fc']):>8} | {r['Ff_N_per_m'] / 1e3:7.1f} "
+              f"{r['Ff_fe_N_per_m'] / 1e3:6.1f} {_pct(r['error_vs_fe']['Ff'])} "
+              f"{_pct(r['error_vs_measured']['Ff']):>8}")
+
+
+def _summary(label: str, s: dict) -> None:
+    parts = []
+    for ref, name in (("error_vs_fe", "vs FE"), ("error_vs_measured", "vs measured")):
+        for q in ("Fc", "Ff"):
+            e = s[ref][q]
+            if e is not None:
+                parts.append(f"{name} {q} max {100 * e['max_abs']:.1f} % mean "
+                             f"{100 * e['mean_abs']:.1f} %")
+    print(f"# {label}: " + "; ".join(parts))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--data", type=Path, default=DATA)
+    ap.add_argument("--json", action="store_true", help="print the checks as JSON")
+    a = ap.parse_args()
+    measured = read_measured(a.data)
+    cfg, recs = validation_calibration(fe_points())
+    t0 = time.perf_counter()
+    dep = cal.mechanistic_check(cfg, recs, measured)
+    t_dep = time.perf_counter() - t0
+    pooled = cal.mechanistic_check(cfg, recs, measured, speed_dependent=False)
+    if a.json:
+        for r in (dep, pooled):
+            r.pop("coefficients")
+        print(json.dumps({"speed_dependent": dep, "pooled": pooled}, indent=1))
+        return
+    tol = dep["tolerances"]
+    print(f"# targets: vs FE {100 * tol['fe_point']:.0f} %; vs measured Fc "
+          f"{100 * tol['measured']['Fc']:.0f} %, Ff {100 * tol['measured']['Ff']:.0f} %")
+    print("# speed-dependent coefficients (per-speed fits at "
+          + ", ".join(f"{v:g}" for v in cfg.cutting_speed_m_per_min) + " m/min, linear in ln(vc))")
+    _table(dep["points"])
+    _summary("speed-dependent", dep["summary"])
+    print(f"# within all targets: {dep['passes']}")
+    print("# leave-one-speed-out cross-validation (calibrated from the other speeds)")
+    for c in dep["cross_validation"]:
+        print(f"## held out {c['held_out_m_per_min']:g} m/min, {c['kind']}")
+        _table(c["points"])
+        _summary(f"held out {c['held_out_m_per_min']:g} m/min", c["summary"])
+    _summary("pooled set (speed_dependent = false)", pooled["summary"])
+    print(f"# pooled set within all targets: {pooled['passes']}")
+    n = len(recs) + sum(len(c["points"]) for c in dep["cross_validation"])
+    print(f"# throughput: {n} point evaluations ({1 + len(dep['cross_validation'])} "
+          f"calibrations) in {t_dep * 1e3:.1f} ms = {n / t_dep:.0f} points/s")
 
 
 if __name__ == "__main__":

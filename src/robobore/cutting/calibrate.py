@@ -8,10 +8,14 @@ Budak, Altintas & Armarego 1996)::
 
     Fc = Kte + Ktc h        Ff = Kfe + Kfc h          [N/m of width]
 
-is fitted by ordinary least squares over all grid points (pooled over the speeds: the
-boring model takes one set of coefficients). Standard errors come from the residuals:
-``cov = s^2 (A^T A)^-1``, ``s^2 = RSS / (n - 2)``. Per-speed fits are reported too so that a
-speed effect is visible.
+is fitted by ordinary least squares over all grid points (the pooled set, ``coefficients``)
+and per cutting speed (``per_speed_fits``). Standard errors come from the residuals:
+``cov = s^2 (A^T A)^-1``, ``s^2 = RSS / (n - 2)``. With two or more speeds the boring model
+uses the per-speed fits interpolated linearly in ln(vc) at its cutting speed (held outside the
+calibrated speeds; :func:`robobore.cutting.forces.coefficients_at_speed`), unless the user
+forces the pooled set (``speed_dependent = false``). :func:`mechanistic_check` measures how
+well that reproduces the FE points and measured forces, with leave-one-speed-out
+cross-validation.
 
 The FE model of the virtual tests is a full FE orthogonal config (``fe_config``: a TOML file,
 resolved next to the calibration config, or an inline table; everything ``robobore fe
@@ -626,7 +630,115 @@ def predicted_forces(data: dict[str, Any]) -> list[dict[str, float]]:
     return out
 
 
+#: issue 27's tolerances on the mechanistic orthogonal forces: against the FE points they were
+#: calibrated on, and against the measured forces (the FE model's own validation targets)
+FE_POINT_TOLERANCE = 0.05
+MEASURED_TOLERANCE = {"Fc": 0.10, "Ff": 0.25}
+
+
+def mechanistic_orthogonal_forces(data: dict[str, Any], h_um: float, vc_m_per_min: float,
+                                  speed_dependent: bool = True) -> tuple[float, float]:
+    """Orthogonal forces (Fc, Ff) [N/m of width] of a coefficients-file content at uncut chip
+    thickness ``h_um`` and cutting speed ``vc_m_per_min``: the coefficients at vc through the
+    boring model's own path (:func:`robobore.cutting.forces.coefficients_at_speed`), then
+    ``Fc = Kte + Ktc h``, ``Ff = Kfe + Kfc h`` (a zero-inclination insert)."""
+    from robobore.cutting.forces import coefficients_at_speed
+
+    c = coefficients_at_speed(data, vc_m_per_min, speed_dependent=speed_dependent)
+    h = h_um * 1e-6
+    return c.Kte + c.Ktc * h, c.Kfe + c.Kfc * h
+
+
+def _point_errors(data: dict[str, Any], recs: list[dict[str, Any]],
+                  measured: dict[tuple[float, float], dict[str, float | None]],
+                  speed_dependent: bool) -> list[dict[str, Any]]:
+    out = []
+    for r in recs:
+        h, v = float(r["h_um"]), float(r["vc_m_per_min"])
+        fc, ff = mechanistic_orthogonal_forces(data, h, v, speed_dependent)
+        m = measured.get((h, v), {})
+        row: dict[str, Any] = {"h_um": h, "vc_m_per_min": v, "Fc_N_per_m": fc,
+                               "Ff_N_per_m": ff, "Fc_fe_N_per_m": r["Fc_N_per_m"],
+                               "Ff_fe_N_per_m": r["Ff_N_per_m"],
+                               "error_vs_fe": {"Fc": fc / r["Fc_N_per_m"] - 1,
+                                               "Ff": ff / r["Ff_N_per_m"] - 1},
+                               "error_vs_measured": {}}
+        for q, val in (("Fc", fc), ("Ff", ff)):
+            mv = m.get(q)
+            row["error_vs_measured"][q] = None if mv is None else val / (mv * 1e3) - 1
+        out.append(row)
+    return out
+
+
+def _error_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for ref in ("error_vs_fe", "error_vs_measured"):
+        out[ref] = {}
+        for q in ("Fc", "Ff"):
+            e = [abs(r[ref][q]) for r in rows if r[ref][q] is not None]
+            out[ref][q] = ({"max_abs": max(e), "mean_abs": float(np.mean(e)), "n": len(e)}
+                           if e else None)
+    return out
+
+
+def mechanistic_check(cfg: CalibrationConfig, records: list[dict[str, Any]],
+                      measured: list[Any] | None = None, *,
+                      speed_dependent: bool = True) -> dict[str, Any]:
+    """Calibrate coefficients from FE records and check the mechanistic orthogonal forces.
+
+    ``records``: FE points as :func:`run_grid` gives them (``h_um``, ``vc_m_per_min``,
+    ``Fc_N_per_m``, ``Ff_N_per_m``, ``fe``); ``measured``: measured points
+    (:func:`robobore.cutting.fe.validate.read_measured`, N/mm) or None. Returns
+
+    - ``coefficients``: the calibration (:func:`calibrate`),
+    - ``points``: per FE point the mechanistic forces at its (h, vc) through
+      :func:`mechanistic_orthogonal_forces` (speed-dependent unless ``speed_dependent`` is
+      False) and their signed relative errors against the FE point and the measurement,
+    - ``summary``: max and mean absolute error per reference and force,
+    - ``cross_validation``: with three or more calibrated speeds, leave one speed out:
+      calibrate from the others and predict the held-out speed's points (``kind``:
+      interpolation inside the remaining speeds, else extrapolation with the coefficients
+      held at the nearest calibrated speed), with the same errors and summary,
+    - ``passes``: whether every error is within :data:`FE_POINT_TOLERANCE` (FE) and
+      :data:`MEASURED_TOLERANCE` (measured).
+    """
+    meas: dict[tuple[float, float], dict[str, float | None]] = {}
+    for m in measured or []:
+        meas[(float(m.h_um), float(m.vc_m_per_min))] = {"Fc": m.Fc, "Ff": m.Ff}
+    data = calibrate(cfg, records)
+    rows = _point_errors(data, records, meas, speed_dependent)
+    summary = _error_summary(rows)
+    cv = []
+    speeds = list(cfg.cutting_speed_m_per_min)
+    if len(speeds) >= 3:
+        for v in speeds:
+            keep = [x for x in speeds if x != v]
+            sub = cfg.model_copy(update={"cutting_speed_m_per_min": keep})
+            train = [r for r in records if r["vc_m_per_min"] != v]
+            test = [r for r in records if r["vc_m_per_min"] == v]
+            d = calibrate(sub, train)
+            r = _point_errors(d, test, meas, speed_dependent)
+            lo, hi = min(keep), max(keep)
+            kind = ("interpolation" if lo < v < hi else
+                    f"extrapolation (held at {lo if v < lo else hi:g} m/min)")
+            cv.append({"held_out_m_per_min": v, "calibrated_m_per_min": keep, "kind": kind,
+                       "points": r, "summary": _error_summary(r)})
+
+    def ok(s: dict[str, Any]) -> bool:
+        fe, me = s["error_vs_fe"], s["error_vs_measured"]
+        return (all(fe[q] is None or fe[q]["max_abs"] <= FE_POINT_TOLERANCE
+                    for q in ("Fc", "Ff"))
+                and all(me[q] is None or me[q]["max_abs"] <= MEASURED_TOLERANCE[q]
+                        for q in ("Fc", "Ff")))
+
+    return {"coefficients": data, "speed_dependent": speed_dependent, "points": rows,
+            "summary": summary, "passes": ok(summary), "cross_validation": cv,
+            "tolerances": {"fe_point": FE_POINT_TOLERANCE, "measured": MEASURED_TOLERANCE}}
+
+
 __all__ = ["FESettings", "CalibrationConfig", "calibration_from_mapping",
            "load_calibration_config", "fe_config_dict", "run_fe_point", "run_grid",
            "fit_edge_model", "fit_warnings", "FIT_TOLERANCE", "calibrate",
-           "calibrate_forces", "predicted_forces", "FE_NAMESPACE", "fe_model_description"]
+           "calibrate_forces", "predicted_forces", "FE_NAMESPACE", "fe_model_description",
+           "mechanistic_orthogonal_forces", "mechanistic_check", "FE_POINT_TOLERANCE",
+           "MEASURED_TOLERANCE"]

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -65,6 +65,12 @@ class CuttingCoefficients:
     Kre: float = 0.0
     Kfe: float = 0.0
     provenance: str = "user"
+    #: plain-language warnings on how the set was chosen (a cutting speed outside the
+    #: calibrated speeds, a pooled set where per-speed fits exist); not part of the values
+    warnings: tuple[str, ...] = field(default=(), compare=False)
+    #: the cutting speed [m/min] a speed-dependent set was evaluated at (None: one set for
+    #: every speed)
+    speed_m_per_min: float | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         for name in _KEYS:
@@ -123,15 +129,166 @@ def read_coefficients_file(path: str | Path) -> dict[str, Any]:
         raise ConfigError("not a table of coefficients", file=str(p), field="coefficients",
                           value=type(inner).__name__, expected='{"Ktc_N_per_m2": ..., ...}')
     CuttingCoefficients.from_dict(inner, source=str(p))
+    read_per_speed_fits(data, str(p))
     return data
 
 
-def load_coefficients(path: str | Path) -> CuttingCoefficients:
-    """Load a coefficient file (TOML or JSON, keys as :meth:`CuttingCoefficients.to_dict`)."""
+#: the orthogonal coefficients of one per-speed fit (``per_speed_fits`` of a calibration file)
+PER_SPEED_KEYS = ("Ktc_N_per_m2", "Kte_N_per_m", "Kfc_N_per_m2", "Kfe_N_per_m")
+
+
+def read_per_speed_fits(data: dict[str, Any], source: str | None = None
+                        ) -> dict[float, dict[str, float]]:
+    """The ``per_speed_fits`` block of a coefficients file, checked: cutting speed [m/min] ->
+    ``{Ktc_N_per_m2, Kte_N_per_m, Kfc_N_per_m2, Kfe_N_per_m}``, sorted by speed ({} when the
+    file has none). Speeds are the block's keys (``"10"`` = 10 m/min): finite, positive,
+    distinct; the coefficients are numbers within their plausible ranges
+    (:mod:`robobore.io.ranges`) with ``Ktc > 0``. A malformed block is a ConfigError naming the
+    file, the key, the value and what is expected."""
+    block = data.get("per_speed_fits")
+    if block is None:
+        return {}
+    expected_block = ('a table {"<cutting speed in m/min>": {"Ktc_N_per_m2": .., '
+                      '"Kte_N_per_m": .., "Kfc_N_per_m2": .., "Kfe_N_per_m": ..}}')
+    if not isinstance(block, dict):
+        raise ConfigError("per-speed fits are not a table", file=source,
+                          field="per_speed_fits", value=type(block).__name__,
+                          expected=expected_block)
+    out: dict[float, dict[str, float]] = {}
+    for key, vals in block.items():
+        where = f"per_speed_fits.{key}"
+        try:
+            vc = float(key)
+        except (TypeError, ValueError):
+            raise ConfigError("per-speed fit key is not a cutting speed", file=source,
+                              field=where, value=key,
+                              expected="a cutting speed in m/min, e.g. \"10\"") from None
+        if not (math.isfinite(vc) and vc > 0):
+            raise ConfigError("per-speed fit at a non-positive or non-finite cutting speed",
+                              file=source, field=where, value=key,
+                              expected="a cutting speed > 0 m/min")
+        check_value(vc, "cutting_speed_m_per_min", file=source, field=where, kind=ConfigError)
+        if vc in out:
+            raise ConfigError("cutting speed listed twice in the per-speed fits", file=source,
+                              field=where, value=key, expected="distinct cutting speeds")
+        if not isinstance(vals, dict):
+            raise ConfigError("per-speed fit is not a table", file=source, field=where,
+                              value=type(vals).__name__, expected=expected_block)
+        fit: dict[str, float] = {}
+        for k in PER_SPEED_KEYS:
+            if k not in vals:
+                raise ConfigError("missing key in a per-speed fit", file=source,
+                                  field=f"{where}.{k}",
+                                  expected="a number in " + ("N/m^2" if k.endswith("m2")
+                                                             else "N/m"))
+            fit[k] = check_value(vals[k], k, file=source, field=f"{where}.{k}",
+                                 kind=ConfigError)
+        if fit["Ktc_N_per_m2"] <= 0:
+            raise ConfigError("tangential shearing coefficient must be positive", file=source,
+                              field=f"{where}.Ktc_N_per_m2", value=fit["Ktc_N_per_m2"],
+                              expected="> 0 N/m^2")
+        out[vc] = fit
+    return dict(sorted(out.items()))
+
+
+def _inclined(data: dict[str, Any], base: CuttingCoefficients) -> bool:
+    ins = data.get("insert")
+    incl = ins.get("inclination_deg", 0.0) if isinstance(ins, dict) else 0.0
+    return bool(base.Krc != 0.0 or base.Kre != 0.0
+                or (isinstance(incl, int | float) and incl != 0.0))
+
+
+def coefficients_at_speed(data: dict[str, Any], cutting_speed_m_per_min: float | None,
+                          *, speed_dependent: bool = True,
+                          source: str | None = None) -> CuttingCoefficients:
+    """The coefficients of a coefficients-file content at a cutting speed [m/min].
+
+    With per-speed fits at two or more speeds (``per_speed_fits``, written by ``robobore
+    calibrate forces`` over a grid of several speeds) and ``speed_dependent`` (the default):
+    each of Ktc, Kte, Kfc, Kfe interpolated linearly in ``ln(vc)`` between the calibrated
+    speeds, held at the end values outside the calibrated range (said in the provenance and
+    in ``warnings``). ``ln(vc)`` rather than ``vc`` (which :func:`ti64_coefficients` uses for
+    the measured fits): the strain-rate term of the flow stress is logarithmic, and it
+    predicts held-out FE points better (docs/process.md, "Speed-dependent coefficients").
+    Otherwise -- one calibrated speed, ``speed_dependent = False``, an unknown cutting speed,
+    or an inclined insert (the per-speed fits are orthogonal; the file's set went through
+    the orthogonal-to-oblique transformation) -- the file's pooled ``coefficients`` set.
+    """
+    inner = data.get("coefficients", data)
+    base = CuttingCoefficients.from_dict(inner, source=source)
+    fits = read_per_speed_fits(data, source)
+    if len(fits) < 2:
+        return base
+    speeds = np.array(list(fits))
+    rng = f"{speeds[0]:g}-{speeds[-1]:g} m/min"
+    why = None
+    if not speed_dependent:
+        why = "speed_dependent = false"
+    elif cutting_speed_m_per_min is None:
+        why = "cutting speed not known"
+    elif _inclined(data, base):
+        why = ("inclined insert: the per-speed fits are orthogonal, the set is the "
+               "orthogonal-to-oblique transform of the pooled fit")
+    if why is not None:
+        note = (f"pooled set over the calibrated speeds {rng} ({why}); the per-speed fits "
+                "are not used")
+        return CuttingCoefficients(base.Ktc, base.Krc, base.Kfc, base.Kte, base.Kre, base.Kfe,
+                                   provenance=base.provenance + "; " + note,
+                                   warnings=(note,) if speed_dependent else ())
+    vc = float(cutting_speed_m_per_min)
+    if not (math.isfinite(vc) and vc > 0):
+        raise ConfigError("cutting speed must be positive and finite", file=source,
+                          field="cutting_speed_m_per_min", value=vc, expected="> 0 m/min")
+    vq = float(np.clip(vc, speeds[0], speeds[-1]))
+    # linear in ln(vc): the strain-rate term of the flow stress is logarithmic in the rate
+    # (Johnson-Cook), and on the validated FE model's 5/10/30 m/min fits the 10 m/min points
+    # predicted from the 5 and 30 m/min fits miss their FE Fc by at most 1.6 % in ln(vc),
+    # 5.2 % linear in vc (benchmarks/mechanistic_from_validation.py, docs/process.md)
+    vals = {k: float(np.interp(math.log(vq), np.log(speeds), [fits[s][k] for s in fits]))
+            for k in PER_SPEED_KEYS}
+    at = ", ".join(f"{s:g}" for s in fits)
+    prov = (base.provenance + f"; speed-dependent: per-speed fits at {at} m/min "
+            f"interpolated linearly in ln(vc) at {vq:.4g} m/min")
+    warnings: tuple[str, ...] = ()
+    if vq != vc:
+        w = (f"cutting speed {vc:.4g} m/min outside the calibrated speeds {rng}: coefficients "
+             f"held at the {vq:g} m/min fit")
+        prov += "; " + w
+        warnings = (w,)
+    return CuttingCoefficients(Ktc=vals["Ktc_N_per_m2"], Krc=0.0, Kfc=vals["Kfc_N_per_m2"],
+                               Kte=vals["Kte_N_per_m"], Kre=0.0, Kfe=vals["Kfe_N_per_m"],
+                               provenance=prov, warnings=warnings, speed_m_per_min=vq)
+
+
+def inline_coefficients(data: dict[str, Any], speed_dependent: bool = True) -> dict[str, Any]:
+    """A coefficients-file content as the inline ``[coefficients]`` table of a dynamics
+    config: the pooled values and provenance, plus ``per_speed_fits`` when the file has fits
+    at two or more speeds (then the boring model evaluates them at each condition's speed;
+    with ``speed_dependent`` False the table says ``speed_dependent = false``)."""
+    inner = data.get("coefficients", data)
+    out = {k: v for k, v in inner.items() if k.startswith("K") or k == "provenance"}
+    fits = read_per_speed_fits(data)
+    if len(fits) >= 2:
+        base = CuttingCoefficients.from_dict(inner)
+        if _inclined(data, base):
+            out["provenance"] = str(out.get("provenance", "")) + (
+                "; pooled set over the calibrated speeds (inclined insert: the per-speed fits "
+                "are orthogonal)")
+        else:
+            out["per_speed_fits"] = {f"{v:g}": dict(f) for v, f in fits.items()}
+            if not speed_dependent:
+                out["speed_dependent"] = False
+    return out
+
+
+def load_coefficients(path: str | Path, cutting_speed_m_per_min: float | None = None, *,
+                      speed_dependent: bool = True) -> CuttingCoefficients:
+    """Load a coefficient file (TOML or JSON, keys as :meth:`CuttingCoefficients.to_dict`),
+    at a cutting speed [m/min] when the file has per-speed fits at several speeds
+    (:func:`coefficients_at_speed`)."""
     data = read_coefficients_file(path)
-    if "coefficients" in data and isinstance(data["coefficients"], dict):
-        data = data["coefficients"]
-    return CuttingCoefficients.from_dict(data, source=str(path))
+    return coefficients_at_speed(data, cutting_speed_m_per_min,
+                                 speed_dependent=speed_dependent, source=str(path))
 
 
 # ---------------------------------------------------------------------------- fitting
@@ -186,7 +343,7 @@ def ti64_coefficients(cutting_speed_m_per_min: float | None = 30.0) -> CuttingCo
             "forces (Ducobu et al., CIRP 2022; rake 15 deg, edge radius 20 um), "
             f"interpolated at vc = {vq:.3g} m/min" + note)
     return CuttingCoefficients(Ktc=vals["Ktc"], Krc=0.0, Kfc=vals["Kfc"], Kte=vals["Kte"],
-                               Kre=0.0, Kfe=vals["Kfe"], provenance=prov)
+                               Kre=0.0, Kfe=vals["Kfe"], provenance=prov, speed_m_per_min=vq)
 
 
 @dataclass(frozen=True)
@@ -267,7 +424,8 @@ def ti64_oblique_coefficients(insert: BoringInsert,
                                provenance=base.provenance + "; orthogonal-to-oblique with "
                                f"tau_s = {p.shear_stress_Pa / 1e6:.0f} MPa, "
                                f"beta = {math.degrees(p.friction_angle_rad):.1f} deg, "
-                               f"phi = {math.degrees(phi):.1f} deg")
+                               f"phi = {math.degrees(phi):.1f} deg",
+                               speed_m_per_min=base.speed_m_per_min)
 
 
 # ---------------------------------------------------------------------------- forces
@@ -341,7 +499,9 @@ def boring_forces(insert: BoringInsert, depth_m: float, feed_per_rev_m: float,
             "elements": el, "element_forces": ef}
 
 
-__all__ = ["CuttingCoefficients", "load_coefficients", "fit_linear_edge_model", "ducobu_fits",
+__all__ = ["CuttingCoefficients", "load_coefficients", "coefficients_at_speed",
+           "read_per_speed_fits", "inline_coefficients", "PER_SPEED_KEYS",
+           "fit_linear_edge_model", "ducobu_fits",
            "ti64_coefficients", "orthogonal_parameters_from_data", "orthogonal_to_oblique",
            "ti64_oblique_coefficients", "ElementForces", "element_forces",
            "rotating_to_boring", "boring_forces", "OrthogonalParameters"]

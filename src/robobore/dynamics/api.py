@@ -22,6 +22,7 @@ from typing import Any
 from robobore.dynamics.config import (
     DynamicsConfig,
     PressureFootCfg,
+    build_coefficients,
     build_process,
     build_structure,
     load_dynamics_config,
@@ -106,6 +107,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
     st = build_structure(cfg, src)
     pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None)
+    coef_warnings = list(build_coefficients(cfg, src).warnings) if cfg.is_boring else []
     try:
         ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
                       cfg.insert.to_insert() if cfg.is_boring else None)
@@ -143,6 +145,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         "revolutions_simulated": int(ds.attrs["revolutions"]),
         "samples_per_rev": int(ds.attrs["samples_per_rev"]), "process": pr.label,
         "model": "robobore.dynamics time-domain boring (regenerative, mechanistic forces)",
+        "coefficient_warnings": coef_warnings,
     }
     if return_dataset:
         out["dataset"] = ds
@@ -179,6 +182,12 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     d["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
     if default_note is not None:
         d["speed_note"] = default_note
+    if cfg.is_boring:
+        from robobore.dynamics.config import lobe_coefficient_note
+
+        note = lobe_coefficient_note(cfg, src)
+        if note is not None:
+            d["coefficient_note"] = note
     return d
 
 

@@ -81,6 +81,12 @@ def lobes_cmd(
         raise ConfigError("unknown method", field="--method", value=method,
                           expected="frequency or semidiscretization")
     notes = [] if default_note is None else [default_note]
+    if cfg.is_boring:
+        from robobore.dynamics.config import lobe_coefficient_note
+
+        cnote = lobe_coefficient_note(cfg, src)
+        if cnote is not None:
+            notes.append(cnote)
     if method == "frequency":
         res = stability.lobes_frequency_domain(st, pr, speeds)
         if pr.rotating:
@@ -247,6 +253,8 @@ def simulate_boring_cmd(
                 ("samples per revolution", r["samples_per_rev"])]
         for why in r["reasons"]:
             rows.append(("reason", why))
+        for w in r["coefficient_warnings"]:
+            rows.append(("warning (coefficients)", w))
         stdout.print(kv_table(f"boring simulation, n = {speed_rpm:g} r/min, "
                               f"a = {depth_mm:g} mm", rows))
 

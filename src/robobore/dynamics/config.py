@@ -253,12 +253,26 @@ class CoefficientsCfg(_Strict):
     Kre_N_per_m: float | None = None
     Kfe_N_per_m: float | None = None
     provenance: str = "config file"
+    #: a calibration's per-speed fits (``robobore.cutting.forces.read_per_speed_fits``:
+    #: "<vc m/min>" -> {Ktc_N_per_m2, Kte_N_per_m, Kfc_N_per_m2, Kfe_N_per_m}), inline with
+    #: the K values; from a ``file`` they are read from the file
+    per_speed_fits: dict[str, Any] | None = None
+    #: with per-speed fits at two or more speeds, evaluate them at the cutting speed pi D n
+    #: (linear in ln(vc), held outside the calibrated speeds); false: the pooled set
+    speed_dependent: bool = True
 
     @model_validator(mode="after")
     def _one(self):
         given = [self.material is not None, self.file is not None, self.Ktc_N_per_m2 is not None]
         if sum(given) != 1:
             raise ValueError("give exactly one of material, file or Ktc_N_per_m2 (+ others)")
+        if self.per_speed_fits is not None and self.Ktc_N_per_m2 is None:
+            raise ValueError("per_speed_fits go with inline Ktc_N_per_m2 (+ others); a "
+                             "coefficients file carries its own")
+        if self.material is not None and not self.speed_dependent:
+            raise ValueError("speed_dependent = false applies to calibrated coefficients (file "
+                             "or inline per_speed_fits); the measured TC4 default is always "
+                             "interpolated at the cutting speed")
         if self.material is not None and self.material.upper() not in ("TC4", "TI6AL4V",
                                                                          "TI-6AL-4V"):
             raise ValueError("unknown material; expected TC4")
@@ -444,13 +458,23 @@ def build_structure(cfg: DynamicsConfig, source: str | None = None):
     return ToolPointStructure.from_modes(modes, file=source)
 
 
+def cutting_speed_m_per_min(cfg: DynamicsConfig) -> float | None:
+    """The cutting speed pi D n [m/min] of a boring config (None without bore or cutting)."""
+    if cfg.bore is None or cfg.cutting is None:
+        return None
+    return math.pi * cfg.bore.diameter_mm * 1e-3 * cfg.cutting.speed_rpm
+
+
 def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
+    """The cutting coefficients of ``[coefficients]`` at the config's cutting speed pi D n:
+    the measured TC4 default interpolated at vc; a calibration (file, or inline values with
+    ``per_speed_fits``) with fits at several speeds evaluated at vc
+    (:func:`robobore.cutting.forces.coefficients_at_speed`; ``speed_dependent = false``: the
+    pooled set); inline values as given."""
     from robobore.cutting import forces
 
     c = cfg.coefficients
-    vc = None
-    if cfg.bore is not None and cfg.cutting is not None:
-        vc = math.pi * cfg.bore.diameter_mm * 1e-3 * cfg.cutting.speed_rpm
+    vc = cutting_speed_m_per_min(cfg)
     if c is None or c.material is not None:
         if c is not None and c.oblique:
             return forces.ti64_oblique_coefficients(cfg.insert.to_insert(),
@@ -458,10 +482,26 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
         return forces.ti64_coefficients(vc)
     if c.file is not None:
         return forces.load_coefficients(resolve_config_path(c.file, source, "coefficients.file",
-                                                            what="coefficients file"))
+                                                            what="coefficients file"),
+                                        vc, speed_dependent=c.speed_dependent)
     d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
     d["provenance"] = c.provenance
+    if c.per_speed_fits is not None:
+        data = {"coefficients": d, "per_speed_fits": c.per_speed_fits}
+        return forces.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
+                                            source=source)
     return forces.CuttingCoefficients.from_dict(d, source=source)
+
+
+def lobe_coefficient_note(cfg: DynamicsConfig, source: str | None = None) -> str | None:
+    """The note of a lobe diagram whose coefficients depend on the cutting speed: they are
+    evaluated once, at the ``[cutting]`` speed, not at each lobe speed (None otherwise)."""
+    c = build_coefficients(cfg, source)
+    if c.speed_m_per_min is None or cfg.cutting is None:
+        return None
+    return (f"cutting coefficients evaluated at the [cutting] speed {cfg.cutting.speed_rpm:g} "
+            f"r/min (vc {c.speed_m_per_min:.3g} m/min) and used at every lobe speed; they "
+            "depend on the cutting speed (the process is linearised once)")
 
 
 def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float | None = None):
@@ -487,4 +527,5 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
 
 
 __all__ = ["DynamicsConfig", "load_dynamics_config", "resolve_model_files", "build_structure",
-           "build_process", "build_coefficients", "DEFAULT_SPEED_RPM", "speed_range"]
+           "build_process", "build_coefficients", "cutting_speed_m_per_min",
+           "lobe_coefficient_note", "DEFAULT_SPEED_RPM", "speed_range"]

@@ -31,6 +31,7 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
                        coeffs: dict[str, Any]) -> dict[str, Any]:
     """Plan for the paper's bore (compact, JSON-ready); ``{"error": msg}`` when it cannot be
     made (for instance a robot without inertial data), so the report says why."""
+    from robobore.cutting.forces import inline_coefficients
     from robobore.plan.posture import PlanConfig, PlanInputs, run_plan, workspace_map
     from robobore.robot.kinematics import fk, get_robot
 
@@ -57,8 +58,7 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
             "cutting": {"speed_rpm": float(base["speed_rpm"]),
                         "feed_mm_per_rev": float(base["feed_mm_per_rev"]),
                         "depth_mm": float(base["depth_of_cut_mm"])},
-            "coefficients": {kk: v for kk, v in coeffs["coefficients"].items()
-                             if kk.startswith("K") or kk == "provenance"},
+            "coefficients": inline_coefficients(coeffs, cfg.coefficients.speed_dependent),
             "lobes": {"speed_min_rpm": cfg.lobes.speed_min_rpm,
                       "speed_max_rpm": cfg.lobes.speed_max_rpm},
             "workspace": {"dx_m": list(WORKSPACE_SHIFTS_M), "dy_m": list(WORKSPACE_SHIFTS_M),

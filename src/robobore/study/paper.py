@@ -113,6 +113,9 @@ class MaterialSection(_Strict):
 
 class CoefficientsSection(_Strict):
     file: str  # stored FE-calibrated coefficients (used by --fast)
+    #: per-speed fits at two or more speeds evaluated at each condition's cutting speed
+    #: (robobore.cutting.forces.coefficients_at_speed); false: the pooled set
+    speed_dependent: bool = True
 
 
 class MeasuredSection(_Strict):
@@ -310,13 +313,21 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
     return data
 
 
+def _inline_coefficients(cfg: PaperConfig, coeffs: dict[str, Any]) -> dict[str, Any]:
+    """The dynamics ``[coefficients]`` of the study: the pooled values, with the per-speed
+    fits when the calibration has two or more speeds."""
+    from robobore.cutting.forces import inline_coefficients
+
+    return inline_coefficients(coeffs, cfg.coefficients.speed_dependent)
+
+
 def dynamics_model(cfg: PaperConfig, eq: Any, coeffs: dict[str, Any],
                    system: str) -> dict[str, Any]:
     """The ``[model]`` of the boring runner for the robot (equivalent, no foot; the foot is
     set per condition) or the machine tool."""
     dyn: dict[str, Any] = {
         "insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
-        "coefficients": dict(coeffs["coefficients"]),
+        "coefficients": _inline_coefficients(cfg, coeffs),
         "simulation": {"revolutions": cfg.study.revolutions,
                        "ra_tolerance_um": cfg.study.ra_tolerance_um},
     }

@@ -609,7 +609,7 @@ def compare_with_mechanistic(result: BoringFEResult,
 
     s = result.setup
     coef = (ti64_coefficients(s.vc * 60.0) if coefficients is None
-            else load_coefficients(coefficients))
+            else load_coefficients(coefficients, s.vc * 60.0))
     mech = boring_forces(s.insert, s.ap, s.f, coef)
     fe = result.summary["force_rotating_N"]
     out: dict[str, Any] = {"coefficients": coef.provenance if hasattr(coef, "provenance")
