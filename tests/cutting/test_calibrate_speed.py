@@ -154,3 +154,36 @@ def test_calibrate_forces_over_several_speeds_writes_fits_the_loader_uses(tmp_pa
     pooled = load_coefficients(out, 40.0, speed_dependent=False)
     assert pooled.Ktc == pytest.approx(1.6e9, rel=1e-9)
     assert load_coefficients(out, 40.0).Ktc != pytest.approx(pooled.Ktc, rel=1e-3)
+
+
+def test_multi_speed_calibration_checks_the_per_speed_fits_and_the_cli_shows_them(
+        tmp_path, monkeypatch):
+    """With several speeds the fit warnings concern the per-speed fits (what the boring model
+    uses) plus the pooled set's miss; predicted_forces and the CLI table show the per-speed
+    fits. SYNTHETIC FE: the cutting force falls by 20 % from 40 to 160 m/min."""
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+
+    def fake(fe_cfg):
+        h = fe_cfg["cut"]["uncut_chip_thickness_um"] * 1e-6
+        f = 1 - 0.2 * math.log(fe_cfg["cut"]["cutting_speed_m_per_min"] / 40.0) / math.log(4)
+        return {"cutting_force_N_per_mm": (30e3 + 1.6e9 * h) * f * 1e-3,
+                "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
+
+    monkeypatch.setattr(cal, "run_fe_point", fake)
+    monkeypatch.setenv("ROBOBORE_CACHE_DIR", str(tmp_path / "cache"))
+    toml = tmp_path / "cal.toml"
+    toml.write_text('[calibration]\nuncut_chip_thickness_um = [60.0, 75.0, 90.0]\n'
+                    'cutting_speed_m_per_min = [40.0, 80.0, 160.0]\n'
+                    '[insert]\nrake_deg = 7.0\nedge_radius_um = 20.0\nclearance_deg = 7.0\n'
+                    '[material]\nname = "TC4"\n')
+    d = cal.calibrate_forces(cal.load_calibration_config(toml))
+    assert len(d["warnings"]) == 1 and "pooled set" in d["warnings"][0]
+    assert max(p["Fc_rel_error"] for p in cal.predicted_forces(d)) < 1e-9
+    res = CliRunner().invoke(app, ["calibrate", "forces", str(toml), "--workers", "1",
+                                   "--out", str(tmp_path / "c.json")])
+    assert res.exit_code == 0, res.output
+    assert "per-speed fits" in res.output and "pooled set" in res.output
+    assert load_coefficients(tmp_path / "c.json", 80.0).Ktc == pytest.approx(
+        1.6e9 * 0.9, rel=1e-9)

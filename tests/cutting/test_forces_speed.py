@@ -186,3 +186,23 @@ def test_speed_dependent_false_with_the_measured_default_is_refused(tmp_path):
     with pytest.raises(ConfigError) as e:
         load_dynamics_config(_dyn_config(tmp_path, 'material = "TC4"\nspeed_dependent = false'))
     assert "speed_dependent" in str(e.value)
+
+
+def test_simulate_reports_a_speed_outside_the_calibrated_range(tmp_path):
+    """run_boring (robobore simulate boring) lists the hold as a coefficients warning; inside
+    the calibrated speeds there is none. The lobes note names the [cutting] speed."""
+    from robobore.dynamics.api import run_boring
+    from robobore.dynamics.config import load_dynamics_config, lobe_coefficient_note
+
+    (tmp_path / "coef.json").write_text(json.dumps(_data(speeds=(10.0, 20.0))))
+    p = _dyn_config(tmp_path, 'file = "coef.json"')
+    r = run_boring(p, revolutions=4, samples_per_rev=64)  # 300 r/min, D 40 mm: 37.7 m/min
+    assert len(r["coefficient_warnings"]) == 1
+    assert "37.7 m/min outside the calibrated speeds 10-20" in r["coefficient_warnings"][0]
+    r2 = run_boring(p, speed_rpm=120.0, revolutions=4, samples_per_rev=64)  # 15.1 m/min
+    assert r2["coefficient_warnings"] == []
+    cfg, _ = load_dynamics_config(p)
+    assert "300 r/min (vc 37.7 m/min)" in lobe_coefficient_note(cfg)
+    (tmp_path / "one.json").write_text(json.dumps(_data(speeds=(20.0,))))
+    cfg1, _ = load_dynamics_config(_dyn_config(tmp_path, 'file = "one.json"'))
+    assert lobe_coefficient_note(cfg1) is None  # one set for every speed: nothing to say

@@ -418,12 +418,14 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
     fit_c = fit_edge_model(h, fc)
     fit_f = fit_edge_model(h, ff)
     per_speed = {}
+    per_speed_warnings = []
     for v in cfg.cutting_speed_m_per_min:
         sel = np.array([r["vc_m_per_min"] == v for r in records])
         if np.unique(h[sel]).size >= 2:
             a, b = fit_edge_model(h[sel], fc[sel]), fit_edge_model(h[sel], ff[sel])
             per_speed[f"{v:g}"] = {"Ktc_N_per_m2": a["Kc"], "Kte_N_per_m": a["Ke"],
                                    "Kfc_N_per_m2": b["Kc"], "Kfe_N_per_m": b["Ke"]}
+            per_speed_warnings += [f"at {v:g} m/min: {w}" for w in fit_warnings(a, b)]
     ktc, kte, kfc, kfe = fit_c["Kc"], fit_c["Ke"], fit_f["Kc"], fit_f["Ke"]
     if ktc <= 0:
         raise NumericalError("FE forces give a non-positive shearing coefficient Ktc",
@@ -466,7 +468,18 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
     if model["outside_validation"]:
         prov += "; FE tests outside the model's validated domain: " + "; ".join(
             model["outside_validation"])
-    warnings = fit_warnings(fit_c, fit_f)
+    if len(per_speed) >= 2:
+        # the boring model uses the per-speed fits (forces.coefficients_at_speed): they are
+        # the fits to check; the pooled set's miss matters with speed_dependent = false
+        warnings = per_speed_warnings
+        miss = max(fit_c["max_rel_residual"], fit_f["max_rel_residual"])
+        if miss > FIT_TOLERANCE:
+            warnings.append(f"the pooled set (used with speed_dependent = false) misses an FE "
+                            f"point by {100 * miss:.0f} % (> {100 * FIT_TOLERANCE:.0f} %): the "
+                            "FE forces depend on the cutting speed; the speed-dependent "
+                            "default uses the per-speed fits")
+    else:
+        warnings = fit_warnings(fit_c, fit_f)
     if warnings:
         prov += "; WARNING: " + "; ".join(warnings)
     coeff = CuttingCoefficients(Ktc=ktc, Krc=krc, Kfc=kfc, Kte=kte, Kre=0.0, Kfe=kfe,
@@ -615,10 +628,13 @@ def calibrate_forces(cfg: CalibrationConfig, *, out: str | Path | None = None,
 
 
 def predicted_forces(data: dict[str, Any]) -> list[dict[str, float]]:
-    """Forces the file's orthogonal fit gives at its FE points (N/m) with relative errors."""
-    o = data["orthogonal"]
+    """Forces the file's orthogonal fit gives at its FE points (N/m) with relative errors:
+    with per-speed fits at two or more speeds the fit at the point's speed (what the boring
+    model uses there), else the pooled fit."""
+    per = data.get("per_speed_fits") or {}
     out = []
     for p in data["fe_points"]:
+        o = per[f"{p['vc_m_per_min']:g}"] if len(per) >= 2 else data["orthogonal"]
         h = p["h_um"] * 1e-6
         fc = o["Kte_N_per_m"] + o["Ktc_N_per_m2"] * h
         ff = o["Kfe_N_per_m"] + o["Kfc_N_per_m2"] * h

@@ -497,11 +497,13 @@ def lobe_coefficient_note(cfg: DynamicsConfig, source: str | None = None) -> str
     """The note of a lobe diagram whose coefficients depend on the cutting speed: they are
     evaluated once, at the ``[cutting]`` speed, not at each lobe speed (None otherwise)."""
     c = build_coefficients(cfg, source)
-    if c.speed_m_per_min is None or cfg.cutting is None:
+    vc = cutting_speed_m_per_min(cfg)
+    if c.speed_m_per_min is None or cfg.cutting is None or vc is None:
         return None
     return (f"cutting coefficients evaluated at the [cutting] speed {cfg.cutting.speed_rpm:g} "
-            f"r/min (vc {c.speed_m_per_min:.3g} m/min) and used at every lobe speed; they "
-            "depend on the cutting speed (the process is linearised once)")
+            f"r/min (vc {vc:.3g} m/min) and used at every lobe speed; they depend on the "
+            "cutting speed (the process is linearised once)"
+            + "".join(f"; {w}" for w in c.warnings))
 
 
 def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float | None = None):

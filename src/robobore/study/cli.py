@@ -319,6 +319,18 @@ def _render_calibration(res: dict[str, Any]) -> None:
                   fmt(p["Fc_fit"] * 1e-3), _pct(p["Fc_rel_error"]), fmt(p["Ff_fe"] * 1e-3),
                   fmt(p["Ff_fit"] * 1e-3), _pct(p["Ff_rel_error"]))
     stdout.print(t)
+    per = res.get("per_speed_fits") or {}
+    if len(per) >= 2:  # what the boring model uses: these, interpolated at its cutting speed
+        t = Table(title="per-speed fits (used at the cutting speed: linear in ln(vc), held "
+                  "outside; speed_dependent = false: the pooled set below)",
+                  header_style="bold")
+        for col in ("vc [m/min]", "Ktc_N_per_m2", "Kte_N_per_m", "Kfc_N_per_m2",
+                    "Kfe_N_per_m"):
+            t.add_column(col, justify="right")
+        for v, k in per.items():
+            t.add_row(v, fmt(k["Ktc_N_per_m2"]), fmt(k["Kte_N_per_m"]),
+                      fmt(k["Kfc_N_per_m2"]), fmt(k["Kfe_N_per_m"]))
+        stdout.print(t)
     c, se = res["coefficients"], res["standard_errors"]
     stdout.print(kv_table("fitted coefficients (± standard error)", [
         (k, f"{fmt(c[k])} ± {fmt(se.get(k))}" if se.get(k) is not None else fmt(c[k]))
