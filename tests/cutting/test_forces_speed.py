@@ -201,6 +201,7 @@ def test_simulate_reports_a_speed_outside_the_calibrated_range(tmp_path):
     assert "37.7 m/min outside the calibrated speeds 10-20" in r["coefficient_warnings"][0]
     r2 = run_boring(p, speed_rpm=120.0, revolutions=4, samples_per_rev=64)  # 15.1 m/min
     assert r2["coefficient_warnings"] == []
+    assert "interpolated linearly in ln(vc) at 15.08 m/min" in r2["coefficients_provenance"]
     cfg, _ = load_dynamics_config(p)
     assert "300 r/min (vc 37.7 m/min)" in lobe_coefficient_note(cfg)
     (tmp_path / "one.json").write_text(json.dumps(_data(speeds=(20.0,))))

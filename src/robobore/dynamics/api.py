@@ -107,7 +107,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
     st = build_structure(cfg, src)
     pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None)
-    coef_warnings = list(build_coefficients(cfg, src).warnings) if cfg.is_boring else []
+    coef = build_coefficients(cfg, src) if cfg.is_boring else None
     try:
         ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
                       cfg.insert.to_insert() if cfg.is_boring else None)
@@ -145,7 +145,9 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         "revolutions_simulated": int(ds.attrs["revolutions"]),
         "samples_per_rev": int(ds.attrs["samples_per_rev"]), "process": pr.label,
         "model": "robobore.dynamics time-domain boring (regenerative, mechanistic forces)",
-        "coefficient_warnings": coef_warnings,
+        # the set used at this condition's cutting speed (speed-dependent coefficients)
+        "coefficients_provenance": None if coef is None else coef.provenance,
+        "coefficient_warnings": [] if coef is None else list(coef.warnings),
     }
     if return_dataset:
         out["dataset"] = ds

@@ -134,7 +134,9 @@ def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
         "nonharmonic_energy_ratio": float(r["nonharmonic_energy_ratio"]),
         "tool_left_cut_fraction": float(r["tool_left_cut_fraction"]),
         "model": r["model"],
-        "coefficients_provenance": str(cfg.get("coefficients", {}).get("provenance", "")),
+        "coefficients_provenance": str(r.get("coefficients_provenance")
+                                       or cfg.get("coefficients", {}).get("provenance", "")),
+        "coefficient_warnings": "; ".join(r.get("coefficient_warnings", [])),
     })
     ds.attrs = attrs
     return ds
