@@ -500,8 +500,9 @@ def lobe_coefficient_note(cfg: DynamicsConfig, source: str | None = None) -> str
     vc = cutting_speed_m_per_min(cfg)
     if c.speed_m_per_min is None or cfg.cutting is None or vc is None:
         return None
-    return (f"cutting coefficients evaluated at the [cutting] speed {cfg.cutting.speed_rpm:g} "
-            f"r/min (vc {vc:.3g} m/min) and used at every lobe speed; they depend on the "
+    return (f"cutting coefficients evaluated at the cutting section's speed "
+            f"{cfg.cutting.speed_rpm:g} r/min (vc {vc:.3g} m/min) and used at every lobe speed; "
+            "they depend on the "
             "cutting speed (the process is linearised once)"
             + "".join(f"; {w}" for w in c.warnings))
 
