@@ -132,14 +132,17 @@ FULL = {"cut": {"length_mm": 0.2}, "mesh": {"element_size_um": 20.0}}
      "plausible range"),
     ({"h": (60.0, 2500.0)}, "calibration.uncut_chip_thickness_um", "h 2500 um"),
     # element too coarse for the thinnest chip (the FE config's and the shorthand's)
-    ({"fe_config": FULL, "h": (45.0, 90.0)}, "mesh.element_size_um", "h 45 um"),
+    ({"fe_config": FULL, "h": (45.0, 90.0)}, "calibration.fe_config.mesh.element_size_um",
+     "h 45 um"),
     ({"element_size_um": 20.0, "h": (45.0, 90.0)}, "calibration.fe.element_size_um",
      "thinnest chip"),
     # a cut shorter than one element, in the FE config and in the shorthand
-    ({"fe_config": {**FULL, "cut": {"length_mm": 0.01}}}, "cut.length_mm", "too short"),
+    ({"fe_config": {**FULL, "cut": {"length_mm": 0.01}}}, "calibration.fe_config.cut.length_mm",
+     "too short"),
     ({"length_mm": 0.01}, "calibration.fe.length_mm", "too short"),
     # an unknown key in the inline FE base config
-    ({"fe_config": {**FULL, "solver": {"n_sample": 10}}}, "solver.n_sample", "grid point"),
+    ({"fe_config": {**FULL, "solver": {"n_sample": 10}}}, "calibration.fe_config.solver.n_sample",
+     "grid point"),
 ])
 def test_calibration_grid_errors_at_load(kw, field, words):
     with pytest.raises(ConfigError, match=words) as e:
@@ -176,4 +179,4 @@ def test_paper_config_with_a_bad_fe_base_config_fails_at_load(tmp_path):
             (tmp_path / f.name).symlink_to(f)
     with pytest.raises(ConfigError, match="elemnt") as e:
         pp.load_paper_config(c)
-    assert e.value.file == str(c) and "elemnt" in e.value.field
+    assert e.value.file == str(c) and e.value.field == "calibration.fe_config.mesh.elemnt"

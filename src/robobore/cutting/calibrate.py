@@ -233,8 +233,10 @@ _GRID_KEYS = {"cut.uncut_chip_thickness_um": "uncut_chip_thickness_um",
 
 
 def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
-    """Every virtual test's config passes the engine's checks (before any run). With the
-    ``fe`` shorthand, an error names the shorthand's key (``field`` = "calibration.fe")."""
+    """Every virtual test's config passes the engine's checks (before any run). An error
+    names the key as the user wrote it: the shorthand's (``calibration.fe.<key>``), the
+    inline table's (``calibration.fe_config.<key>``), the FE config file's own key (with that
+    file), or the grid's key for h and vc."""
     from robobore.cutting.fe.config import parse_config
 
     for h in cfg.uncut_chip_thickness_um:
@@ -248,12 +250,15 @@ def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
                 elif key in _GRID_KEYS:  # the grid's or the insert's own key
                     key = f"{field.rsplit('.', 1)[0]}.{_GRID_KEYS[key]}" if "." in field \
                         else _GRID_KEYS[key]
+                elif cfg.fe_config_source == "inline" and key:  # the key in this file
+                    key = f"{field}.{key}"
                 expected = exc.expected
                 if expected is None and exc.field in ("cut.uncut_chip_thickness_um",
                                                       "cut.cutting_speed_m_per_min"):
                     expected = _engine_range(exc.field)
+                msg = exc.message.removesuffix(f" (got {exc.value!r})")  # said once below
                 raise ConfigError(f"{field} at the grid point h {h:g} um, vc {v:g} m/min: "
-                                  f"{exc.message}",
+                                  f"{msg}",
                                   file=source if exc.file in (None, "inline", "<config>")
                                   else exc.file,
                                   field=key,
