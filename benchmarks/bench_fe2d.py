@@ -78,6 +78,10 @@ def main() -> None:
         d = cfg.model_dump(mode="json")
         d["mesh"] = {k: v for k, v in d["mesh"].items() if k not in ("edge_element_um",)}
         d["mesh"]["frame"] = "workpiece"
+        if cfg.contact._law is not None:  # the same friction law, by its name
+            d["contact"] = {k: v for k, v in d["contact"].items()
+                            if not k.startswith("friction_table_")}
+            d["contact"]["friction"] = cfg.contact._law
         from robobore.cutting.fe.config import parse_config
 
         ref = parse_config(d, "workpiece-frame reference")

@@ -312,7 +312,7 @@ def _eq_rows(eq: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def _pct(v: float | None) -> float | None:
-    return None if v is None else round(100.0 * v, 1)
+    return None if v is None else round(100.0 * v, 1) + 0.0  # no -0
 
 
 def force_model_fe_text(rep: Report, coeffs: dict[str, Any]) -> None:
