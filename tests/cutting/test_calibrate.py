@@ -252,8 +252,10 @@ def test_full_fe_config_from_a_file_next_to_the_config(tmp_path):
 
 
 @pytest.mark.parametrize("fe_config, kw, field, words", [
-    ({**_FULL, "mesh": {"element_size_um": 25.0}}, {}, "mesh.element_size_um", "h 60 um"),
-    ({**_FULL, "contact": {"frcition": 0.3}}, {}, "contact.frcition", "grid point"),
+    ({**_FULL, "mesh": {"element_size_um": 25.0}}, {},
+     "calibration.fe_config.mesh.element_size_um", "h 60 um"),
+    ({**_FULL, "contact": {"frcition": 0.3}}, {}, "calibration.fe_config.contact.frcition",
+     "grid point"),
     ({**_FULL, "tool": {"rake_deg": 15.0}}, {}, "tool.rake_deg", "insert"),
     ({**_FULL, "material": {"name": "TC5"}}, {}, "material.name", "material"),
     (_FULL, {"fe": {"length_mm": 0.5}}, "calibration.fe", "once"),

@@ -153,9 +153,11 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
                           value=cal["fe"], expected=f"either {prefix}fe_config (a full FE "
                           f"config) or the {prefix}fe shorthand, not both")
     cfg = validate_model(CalibrationConfig, cal, source=source)
-    from robobore.material.library import resolve_material_name
+    from robobore.material.library import load_material, resolve_material_name
 
-    cfg.material = resolve_material_name(cfg.material, source, "material.name")
+    mat_field = f"{prefix}material" if "material" in cal else "material.name"
+    cfg.material = resolve_material_name(cfg.material, source, mat_field)
+    load_material(cfg.material, source=source, field=mat_field)  # read and checked now
     if fe_full is not None:
         full, src = _resolve_fe_config(fe_full, source, f"{prefix}fe_config")
         cfg = cfg.model_copy(update={"fe_config": _with_insert(cfg, full, source, prefix, src),
@@ -167,6 +169,7 @@ def calibration_from_mapping(data: dict[str, Any], source: str | None = None
         raise ConfigError("FE element too large for the thinnest chip", file=source,
                           field="calibration.fe.element_size_um", value=cfg.fe.element_size_um,
                           expected=f"<= h/3 = {smallest / 3:.4g} um (FE engine check)")
+    _check_grid(cfg, source, f"{prefix}fe")
     return cfg
 
 
@@ -220,8 +223,24 @@ def _with_insert(cfg: CalibrationConfig, full: dict[str, Any], source: str | Non
     return full
 
 
+#: the FE engine's key of each ``fe`` shorthand setting (errors name the shorthand's key)
+_SHORTHAND_KEYS = {"cut.length_mm": "length_mm", "mesh.element_size_um": "element_size_um",
+                   "solver.mass_scaling": "mass_scaling", "contact.friction": "friction",
+                   "contact.shear_limit_MPa": "shear_limit_MPa",
+                   "tool.clearance_deg": "clearance_deg",
+                   "solver.steady_window_fraction": "steady_window_fraction",
+                   "mesh.separation": "separation",
+                   "mesh.separation_height_um": "separation_height_um"}
+_GRID_KEYS = {"cut.uncut_chip_thickness_um": "uncut_chip_thickness_um",
+              "cut.cutting_speed_m_per_min": "cutting_speed_m_per_min",
+              "tool.rake_deg": "rake_deg", "tool.edge_radius_um": "edge_radius_um"}
+
+
 def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
-    """Every virtual test's config passes the engine's checks (before any run)."""
+    """Every virtual test's config passes the engine's checks (before any run). An error
+    names the key as the user wrote it: the shorthand's (``calibration.fe.<key>``), the
+    inline table's (``calibration.fe_config.<key>``), the FE config file's own key (with that
+    file), or the grid's key for h and vc."""
     from robobore.cutting.fe.config import parse_config
 
     for h in cfg.uncut_chip_thickness_um:
@@ -229,11 +248,38 @@ def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
             try:
                 parse_config(fe_config_dict(cfg, h, v), cfg.fe_config_source)
             except ConfigError as exc:
+                key = exc.field
+                if cfg.fe_config is None and key in _SHORTHAND_KEYS:
+                    key = f"{field}.{_SHORTHAND_KEYS[key]}"
+                elif key in _GRID_KEYS:  # the grid's or the insert's own key
+                    key = f"{field.rsplit('.', 1)[0]}.{_GRID_KEYS[key]}" if "." in field \
+                        else _GRID_KEYS[key]
+                elif cfg.fe_config_source == "inline" and key:  # the key in this file
+                    key = f"{field}.{key}"
+                expected = exc.expected
+                if expected is None and exc.field in ("cut.uncut_chip_thickness_um",
+                                                      "cut.cutting_speed_m_per_min"):
+                    expected = _engine_range(exc.field)
+                msg = exc.message.removesuffix(f" (got {exc.value!r})")  # said once below
                 raise ConfigError(f"{field} at the grid point h {h:g} um, vc {v:g} m/min: "
-                                  f"{exc.message}",
-                                  file=source if exc.file in (None, "inline") else exc.file,
-                                  field=exc.field,
-                                  value=exc.value, expected=exc.expected) from None
+                                  f"{msg}",
+                                  file=source if exc.file in (None, "inline", "<config>")
+                                  else exc.file,
+                                  field=key,
+                                  value=exc.value, expected=expected) from None
+
+
+def _engine_range(key: str) -> str:
+    """The FE engine's accepted range of a ``cut`` key, in words."""
+    from robobore.cutting.fe.config import CutSection
+
+    name = key.split(".")[-1]
+    b = {k: getattr(m, k) for m in CutSection.model_fields[name].metadata
+         for k in ("gt", "ge", "lt", "le") if getattr(m, k, None) is not None}
+    sym = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
+    unit = "um" if name.endswith("_um") else "m/min"
+    return (" and ".join(f"{sym[k]} {v:g}" for k, v in b.items()) + f" {unit} (the FE "
+            f"engine's range of {key})")
 
 
 def load_calibration_config(path: str | Path) -> CalibrationConfig:

@@ -666,7 +666,9 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         modes = identify_modes(cfg, cfg_path)
         lap("modes", t)
         advance(1)
+    t = time.perf_counter()
     eq = build_equivalent(stiff, modes, cfg.pressure_foot)
+    lap("equivalent", t)
     t = time.perf_counter()
     n_fe = (len(cfg.calibration.get("uncut_chip_thickness_um", []))
             * len(cfg.calibration.get("cutting_speed_m_per_min", [])))
@@ -702,6 +704,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         lob = compute_lobes(cfg, robot_model)
         lap("lobes", t)
         advance(1)
+        t = time.perf_counter()
         cmp = None
         mpath = _resolve(cfg_path, cfg.measured.file)
         if mpath is not None:
@@ -711,6 +714,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
                     for r in rows if r["system"] == "robot" and r["summary"]]
             cmp = compare(table, sims)
         checks = qualitative_checks(rows, cfg)
+        lap("comparison", t)
         advance(1)
         t = time.perf_counter()
         ds = results_dataset(rows)

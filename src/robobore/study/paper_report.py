@@ -311,6 +311,88 @@ def _eq_rows(eq: dict[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
+def _pct(v: float | None) -> float | None:
+    return None if v is None else round(100.0 * v, 1) + 0.0  # no -0
+
+
+def force_model_fe_text(rep: Report, coeffs: dict[str, Any]) -> None:
+    """The FE model the coefficients were calibrated from (the coefficients file's
+    ``fe_model``, written by ``robobore calibrate forces``) and, as a list, how its virtual
+    tests depart from the validated configuration."""
+    m = coeffs.get("fe_model")
+    if not isinstance(m, dict):
+        rep.add_note("The coefficients file does not name the FE model it was calibrated "
+                     "from (no fe_model record): recalibrate with robobore calibrate forces.")
+        return
+    src = m.get("source")
+    src = "the calibration's inline fe_config table" if src == "inline" else src
+    rep.add_text(f"FE model of the virtual tests: {m.get('summary')} (FE config: {src}). "
+                 f"Validation status: {m.get('validation')}.")
+    out = m.get("outside_validation") or []
+    if out:
+        import html
+
+        rep.add_text("The calibration's FE tests depart from the validated configuration "
+                     "(the validation table below) in:")
+        rep.add_html("<ul>" + "".join(f"<li>{html.escape(str(x))}</li>" for x in out)
+                     + "</ul>")
+
+
+def force_model_validation(rep: Report, coeffs: dict[str, Any],
+                           record: str | Path | None = None) -> None:
+    """The validation table of the FE model the coefficients come from: the bundled record
+    of the default model (``robobore/data/fe_validation``) when the calibration ran the
+    validated physics on its material; otherwise a note that no validation applies."""
+    from robobore.cutting.calibrate import VALIDATION_DOMAIN
+    from robobore.cutting.fe.validate import bundled_validation_path, load_validation_record
+
+    m = coeffs.get("fe_model") if isinstance(coeffs.get("fe_model"), dict) else {}
+    mat = coeffs.get("material")
+    if not m.get("validated_physics") or mat != VALIDATION_DOMAIN["material"]:
+        rep.add_note("The FE model of these coefficients is not the engine's validated model "
+                     f"on its validated material ({VALIDATION_DOMAIN['material']}): no "
+                     "validation against measured forces applies to them (docs/fe.md, "
+                     "'Model choice').")
+        return
+    path = Path(record) if record is not None else bundled_validation_path()
+    if not path.is_file():
+        rep.add_note(f"The validation record of the default FE model ({path}) is missing "
+                     "from this installation: no validation table.")
+        return
+    val = load_validation_record(path)
+    rows = []
+    for pt in val["points"]:
+        ms, er = pt["measured"], pt["relative_error"]
+        rows.append({"h [um]": pt["uncut_chip_thickness_um"],
+                     "vc [m/min]": pt["cutting_speed_m_per_min"],
+                     "Fc meas [N/mm]": ms.get("cutting_force_N_per_mm"),
+                     "Fc sim [N/mm]": pt["cutting_force_N_per_mm"],
+                     "Fc err [%]": _pct(er.get("cutting_force")),
+                     "Ff meas [N/mm]": ms.get("feed_force_N_per_mm"),
+                     "Ff sim [N/mm]": pt["feed_force_N_per_mm"],
+                     "Ff err [%]": _pct(er.get("feed_force")),
+                     "chip ratio meas": ms.get("chip_ratio"),
+                     "chip ratio sim": pt["chip_ratio"],
+                     "chip ratio err [%]": _pct(er.get("chip_ratio"))})
+    rep.add_table(rows, caption="Validation of the FE model against measured orthogonal "
+                  "forces (err = simulated / measured - 1)", float_fmt="{:.4g}")
+    s = val["summary"]
+    parts = []
+    for key, label in (("cutting_force", "Fc"), ("feed_force", "Ff"),
+                       ("chip_ratio", "chip ratio")):
+        mx, mn = s["max_abs_error"].get(key), s["mean_abs_error"].get(key)
+        if mx is not None and mn is not None:
+            parts.append(f"{label} {100 * mx:.1f} / {100 * mn:.1f} %")
+    rep.add_text("Max / mean |error| over the points: " + ", ".join(parts) + ".")
+    rep.add_text(f"Source: {path.name} (robobore/data/fe_validation), the --json output of "
+                 f"robobore fe validate {val.get('config')} --measured "
+                 f"{Path(str(val.get('measured_file'))).name} (the engine's default model at "
+                 "its validated configuration). Its two CALIBRATED choices (friction law "
+                 "rech2013_calibrated, the hardening hold) were chosen on these same points, "
+                 "so the table shows how far the calibration reaches, not an independent "
+                 "validation.")
+
+
 def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict[str, Any],
                  eq: dict[str, Any], coeffs: dict[str, Any], rows: list[dict[str, Any]],
                  store: Any, lobes: dict[str, Any], cmp: Any, checks: list[dict[str, Any]],
@@ -400,6 +482,7 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     rep.add_section("Force model (FE-calibrated)")
     c = coeffs["coefficients"]
     rep.add_text(f"Coefficients: {coeffs.get('mode')}. {c.get('provenance', '')}")
+    force_model_fe_text(rep, coeffs)
     se = coeffs.get("standard_errors", {})
     rep.add_table([{"coefficient": k, "value": c[k], "standard error": se.get(k)}
                    for k in ("Ktc_N_per_m2", "Kte_N_per_m", "Kfc_N_per_m2", "Kfe_N_per_m",
@@ -417,11 +500,8 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                       caption="Virtual orthogonal cutting tests (2D FE) and the fit")
         for w in coeffs.get("warnings", []):
             rep.add_note("Calibration warning: " + w + ".")
-        rep.add_note("The 2D FE engine under-predicts the measured TC4 orthogonal forces of "
-                     "Ducobu et al. (with the example's 10 um elements and node splitting: "
-                     "-12 to -28 % cutting, -55 to -70 % feed force; the forces also depend "
-                     "on the engine's numerical erosion limits, see docs/fe.md); the "
-                     "FE-calibrated coefficients inherit that bias.")
+
+    force_model_validation(rep, coeffs)
 
     # ---------------------------------------------------------------- figures
     rep.add_section("Simulated boring: forces and vibration")

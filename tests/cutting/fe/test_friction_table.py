@@ -44,7 +44,7 @@ def test_friction_at_is_the_piecewise_linear_table():
 def _cfg(**contact):
     return {"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
             "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
-                    "length_mm": 0.01},
+                    "length_mm": 0.02},
             "contact": {"friction": "table", **contact},
             "mesh": {"element_size_um": 20, "frame": "tool", "edge_element_um": 5},
             "solver": {"mass_scaling": 100, "n_samples": 20}}

@@ -2,10 +2,10 @@
 errors, the per-point config (only h and vc replaced), the --json contract, the resume of an
 interrupted validation, and every input error found before the first FE run.
 
-The runs use a tiny tool-frame config (20 um elements, 5 um round the edge, 10 um of tool
-travel: about a second a point); the measured values are made-up numbers in the file format,
-so only the arithmetic of the comparison is checked here (the validation figures of the
-validated model are in docs/fe.md)."""
+The runs use a tiny tool-frame config (20 um elements, 5 um round the edge, 20 um of tool
+travel, one element: a few seconds a point); the measured values are made-up numbers in the
+file format, so only the arithmetic of the comparison is checked here (the validation figures
+of the validated model are in docs/fe.md)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ edge_radius_um = 20.0
 [cut]
 uncut_chip_thickness_um = 60.0
 cutting_speed_m_per_min = 30.0
-length_mm = 0.01
+length_mm = 0.02
 [mesh]
 element_size_um = 20.0
 edge_element_um = 5.0
@@ -80,6 +80,13 @@ def test_reader_points_and_missing_quantities(tmp_path):
     ({"units": {"Fc": "N"}, "measured": {"Fc": {"60": {"30": 100.0}}}}, "units.Fc", "unit"),
     ({"Fc": {}}, "measured", "no 'measured'"),
     ({"measured": {}}, "measured", "no measured point"),
+    # Fc and Ff at different speeds: a speed missing under one of them
+    ({"measured": {"Fc": {"60": {"30": 118.0, "10": 130.0}}, "Ff": {"60": {"30": 50.0}}}},
+     "measured.Ff.60", "missing cutting speed: Ff has no value at h 60 um, vc 10"),
+    ({"measured": {"Fc": {"60": {"30": 118.0}}, "Ff": {"60": {"30": 50.0}, "80": {"5": 9.0}}}},
+     "measured.Fc.80", "missing cutting speed: Fc has no value at h 80 um, vc 5"),
+    ({"measured": {"Fc": {"60": {"30": 118.0}}, "Ff": {"60": {"30": "50,3"}}}},
+     "measured.Ff.60.30", "finite number"),
 ])
 def test_bad_measured_file_names_file_key_value(tmp_path, measured, field, words):
     _, m = _files(tmp_path, measured)

@@ -226,6 +226,7 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
     """Validate a config dict (from TOML) and the cross-field rules."""
     cfg = validate_model(BoringFEConfig, data, source=source)
     cfg.material.name = resolve_material_name(cfg.material.name, source)  # config-relative
+    load_material(cfg.material.name, source=source)  # read and checked at load, not at run
     ap_um = cfg.cut.depth_of_cut_mm * 1e3
     le = cfg.mesh.element_size_um
     if le > ap_um / 3.0 + 1e-9:

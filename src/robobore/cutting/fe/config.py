@@ -79,8 +79,11 @@ class ToolSection(_Strict):
 class CutSection(_Strict):
     uncut_chip_thickness_um: float = Field(gt=0.0, le=2000.0)
     cutting_speed_m_per_min: float = Field(gt=0.0, le=2000.0)
+    #: length of cut simulated [mm] (the tool's travel in the tool frame); at least one
+    #: element (mesh.element_size_um)
     length_mm: float = Field(gt=0.0, le=50.0, description="length of cut simulated, mm")
-    #: width of cut [mm]; 2D results are per unit width, totals (tool support) use it
+    #: width of cut [mm]; 2D results are per unit width, totals (tool support) use it; at
+    #: least the uncut chip thickness (plane strain)
     width_mm: float = Field(default=1.0, gt=0.0)
 
 
@@ -424,7 +427,8 @@ class FEConfig(_Strict):
 
 
 def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
-    """Cross-field checks (element size vs chip thickness)."""
+    """Cross-field checks (element size vs chip thickness, cut length vs element size,
+    width vs chip thickness)."""
     h = cfg.cut.uncut_chip_thickness_um
     le = cfg.mesh.element_size_um
     if le > h / 3.0 + 1e-12:
@@ -432,6 +436,20 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           field="mesh.element_size_um", value=le,
                           expected=f"an element size in um at most uncut_chip_thickness_um/3 "
                           f"= {h / 3.0:.4g} um")
+    length_um = cfg.cut.length_mm * 1e3
+    if length_um < le - 1e-9:
+        raise ConfigError("cut too short for the mesh", file=source, field="cut.length_mm",
+                          value=cfg.cut.length_mm,
+                          expected=f"at least one element of cut, mesh.element_size_um = "
+                          f"{le:g} um = {le * 1e-3:.4g} mm (a shorter cut moves no material "
+                          "through an element of the cutting zone; a steady state takes many "
+                          "more: the validated runs cut 0.3 mm, 30 elements of 10 um)")
+    if cfg.cut.width_mm * 1e3 < h - 1e-9:
+        raise ConfigError("width of cut below the uncut chip thickness", file=source,
+                          field="cut.width_mm", value=cfg.cut.width_mm,
+                          expected=f"at least uncut_chip_thickness_um = {h:g} um = "
+                          f"{h * 1e-3:.4g} mm (the 2D model is plane strain: the width must "
+                          "exceed the chip thickness)")
     sh = cfg.mesh.separation_height_um
     if sh is not None and sh > h - le + 1e-12:
         raise ConfigError("separation line too high for the chip thickness", file=source,
@@ -531,10 +549,13 @@ def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
     """Validate a config dict (as read from TOML); a material file named in it is resolved
     against the config file's folder (robobore.io.paths)."""
     from robobore.io.memory import check_fe2d
-    from robobore.material.library import resolve_material_name
+    from robobore.material.library import load_material, resolve_material_name
 
     cfg = validate_model(FEConfig, data, source=source or "<config>")
     cfg.material.name = resolve_material_name(cfg.material.name, source)
+    # the material is read and checked now, not first when the run starts
+    load_material(cfg.material.name, source=source,
+                  hardening_strain_limit=cfg.material.strain_limit())
     cfg = check_config(cfg, source)
     check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg

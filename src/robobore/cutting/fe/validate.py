@@ -17,8 +17,9 @@ docs/fe.md "robobore fe validate")::
                   "Ff": {...}, "chip_ratio": {...}}}
 
 ``Fc`` and ``Ff`` are forces per mm of width [N/mm]; every quantity is optional, a point is a
-(h, vc) pair found under any of them. Everything is checked on read (:func:`read_measured`):
-errors name the file, the key path, the value and what is expected.
+(h, vc) pair found under any of them; a file that gives both forces gives them at the same
+points (a speed one of them lacks is an error). Everything is checked on read
+(:func:`read_measured`): errors name the file, the key path, the value and what is expected.
 
 Each point's result is written atomically to ``OUT/h<h>_vc<vc>.json`` with the full point
 config it ran; a rerun with the same ``OUT`` reuses a point whose stored config is the same
@@ -103,6 +104,7 @@ def read_measured(path: str | Path) -> list[MeasuredPoint]:
         raise DataError("unknown measured quantity", file=f, field=f"measured.{unknown[0]}",
                         value=unknown[0], expected=f"one of {list(QUANTITIES)}")
     values: dict[tuple[float, float], dict[str, float]] = {}
+    keys: dict[str, dict[float, str]] = {}  # quantity -> h -> the file's h key
     for q, by_h in meas.items():
         if not isinstance(by_h, dict):
             raise DataError("expected a table of uncut chip thicknesses", file=f,
@@ -111,6 +113,7 @@ def read_measured(path: str | Path) -> list[MeasuredPoint]:
         for hk, by_vc in by_h.items():
             field = f"measured.{q}.{hk}"
             h = _num(hk, f, field, "uncut chip thickness in um", *_H_RANGE)
+            keys.setdefault(q, {})[h] = hk
             if not isinstance(by_vc, dict) or not by_vc:
                 raise DataError("missing cutting speed: expected a table of cutting speeds",
                                 file=f, field=field, value=by_vc,
@@ -133,7 +136,29 @@ def read_measured(path: str | Path) -> list[MeasuredPoint]:
     if not values:
         raise DataError("no measured point", file=f, field="measured",
                         expected="at least one (h, vc) value")
+    _check_force_points(values, keys, f)
     return [MeasuredPoint(h, vc, **values[(h, vc)]) for h, vc in sorted(values)]
+
+
+def _check_force_points(values: dict[tuple[float, float], dict[str, float]],
+                        keys: dict[str, dict[float, str]], f: str) -> None:
+    """Fc and Ff, when the file gives both, are given at the same points (one dynamometer
+    measures both): a speed one of them lacks is a missing entry, not a partial point."""
+    if not {"Fc", "Ff"} <= set(keys):
+        return
+    at = {q: {hv for hv, d in values.items() if q in d} for q in ("Fc", "Ff")}
+    for q, other in (("Fc", "Ff"), ("Ff", "Fc")):
+        miss = sorted(at[other] - at[q])
+        if miss:
+            h, vc = miss[0]
+            hk = keys[q].get(h, keys[other][h])
+            have = sorted(v for hh, v in at[q] if hh == h)
+            raise DataError(f"missing cutting speed: {q} has no value at h {h:g} um, "
+                            f"vc {vc:g} m/min, where {other} has one", file=f,
+                            field=f"measured.{q}.{hk}",
+                            value=f"speeds {', '.join(f'{v:g}' for v in have) or 'none'}",
+                            expected=f"a {q} value at vc {vc:g} m/min (Fc and Ff at the same "
+                            "(h, vc) points; only chip_ratio may be partial)")
 
 
 def parse_points(text: str) -> list[tuple[float, float]]:
@@ -319,5 +344,45 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
+#: the bundled validation record of the default model: the ``--json`` output of
+#: ``robobore fe validate examples/fe_orthogonal.toml --measured
+#: ../shared/data/ti64_orthogonal_cutting_forces.json`` (robobore/data/fe_validation/README.md)
+BUNDLED_RECORD = "tc4_default_model.json"
+_POINT_KEYS = ("uncut_chip_thickness_um", "cutting_speed_m_per_min", "cutting_force_N_per_mm",
+               "feed_force_N_per_mm", "chip_ratio", "relative_error", "measured")
+
+
+def bundled_validation_path() -> Path:
+    """Path of the bundled validation record of the default FE model (TC4)."""
+    from importlib import resources
+
+    return Path(str(resources.files("robobore") / "data" / "fe_validation" / BUNDLED_RECORD))
+
+
+def load_validation_record(path: str | Path) -> dict[str, Any]:
+    """A validation record (the ``--json`` output of ``robobore fe validate``), checked:
+    ``points`` (each with the contract keys and ``measured``) and ``summary``; a missing or
+    malformed record is a :class:`DataError` naming the file and key."""
+    f = str(path)
+    data = load_json(Path(path), "FE validation record", "the --json output of robobore fe "
+                     "validate", kind=dict, error=DataError)
+    pts = data.get("points")
+    if not isinstance(pts, list) or not pts:
+        raise DataError("no validation points", file=f, field="points", value=pts,
+                        expected="a non-empty list of points (robobore fe validate --json)")
+    for i, pt in enumerate(pts):
+        miss = [k for k in _POINT_KEYS if not isinstance(pt, dict) or k not in pt]
+        if miss:
+            raise DataError("validation point lacks a key", file=f, row=i,
+                            field=f"points[{i}].{miss[0]}",
+                            expected=f"the keys {list(_POINT_KEYS)}")
+    summ = data.get("summary")
+    if not isinstance(summ, dict) or not {"max_abs_error", "mean_abs_error"} <= set(summ):
+        raise DataError("no summary", file=f, field="summary", value=summ,
+                        expected="{max_abs_error, mean_abs_error} per quantity")
+    return data
+
+
 __all__ = ["MeasuredPoint", "read_measured", "parse_points", "point_config", "run_validation",
-           "summarize", "QUANTITIES"]
+           "summarize", "QUANTITIES", "BUNDLED_RECORD", "bundled_validation_path",
+           "load_validation_record"]
