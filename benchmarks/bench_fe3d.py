@@ -4,8 +4,8 @@ Usage::
 
     python benchmarks/bench_fe3d.py speed [--elements 30000] [--steps 200]
     python benchmarks/bench_fe3d.py paper [--sizes 16.7 12.5] [--cut-mm 0.15]
-        [--mass-scaling 400] [--coefficients FILE] [--friction 0.3|table]
-        [--separation erosion_layer|node_split] [--out results.json]
+        [--mass-scaling 400] [--coefficients FILE] [--friction LAW|table|0.3]
+        [--separation erosion_layer|node_split] [--no-support] [--out results.json]
 
 ``speed`` prints element-updates per second of the full time step (nodes, contact, elements,
 tool) on a wall block of about ``--elements`` hexahedra, serial and parallel, with the load
@@ -13,10 +13,13 @@ average (the machine is shared: figures are noisy). ``paper`` runs
 ``examples/fe_boring_paper.toml`` (ap = 0.05 mm, f = 0.15 mm/r, n = 300 r/min, TC4; insert
 and bore diameter are documented assumptions) at each element size, compares the rotating-
 frame forces with the mechanistic model (default TC4 coefficients, or ``--coefficients``,
-e.g. the FE-calibrated file of a later step), reports the mesh-refinement change, then runs
-the finest mesh with the tool on a quasi-static 3-axis support (natural frequency 100 kHz,
-zeta 0.5) and compares the mean Z deflection with feed force / kZ. Results go to ``--out``
-(atomic JSON) when given.
+e.g. the bundled FE-calibrated ``src/robobore/data/paper_example/tc4_fe_coefficients.json``),
+reports the mesh-refinement change between successive meshes, then (unless
+``--no-support``) runs the finest mesh with the tool on a quasi-static 3-axis support
+(natural frequency 100 kHz, zeta 0.5) and compares the mean Z deflection with feed force /
+kZ. The physics is the example's, i.e. the engine's defaults (docs/fe3d.md, "Physics and
+validation"), unless ``--friction`` names another friction law, "table" or a constant.
+Results go to ``--out`` (atomic JSON) when given.
 """
 
 from __future__ import annotations
@@ -71,7 +74,8 @@ def speed(n_elements: int, steps: int) -> dict:
 
 
 def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None,
-          friction: str | None = None, separation: str | None = None) -> dict:
+          friction: str | None = None, separation: str | None = None,
+          support: bool = True) -> dict:
     from robobore.cutting.fe.boring3d import (
         compare_with_mechanistic,
         parse_boring_config,
@@ -81,7 +85,11 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
 
     base = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
     if friction is not None:
-        base["contact"]["friction"] = friction if friction == "table" else float(friction)
+        try:
+            value: str | float = float(friction)
+        except ValueError:
+            value = friction  # a friction law's name or "table"
+        base.setdefault("contact", {})["friction"] = value
     if separation is not None:
         base["mesh"]["separation"] = separation
     res: dict = {"runs": [], "cut_length_mm": cut_mm, "mass_scaling": ms}
@@ -105,10 +113,15 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
                "comparison": cmp_, "load": _load()}
         res["runs"].append(row)
         print(json.dumps(row, indent=1), flush=True)
+    for prev, row in zip(res["runs"], res["runs"][1:], strict=False):
+        a, b = prev["force_rotating_N"], row["force_rotating_N"]
+        row["change_from_previous_mesh"] = {k: (b[k] - a[k]) / abs(b[k]) for k in a}
     if len(res["runs"]) >= 2:
-        a, b = res["runs"][-2]["force_rotating_N"], res["runs"][-1]["force_rotating_N"]
-        res["refinement_change"] = {k: (b[k] - a[k]) / abs(b[k]) for k in a}
+        res["refinement_change"] = res["runs"][-1]["change_from_previous_mesh"]
         print("refinement change:", res["refinement_change"], flush=True)
+    _print_table(res["runs"])
+    if not support:
+        return res
     # tool on the quasi-static equivalent support (finest mesh)
     d = json.loads(json.dumps(base))
     d["mesh"]["element_size_um"] = sizes[-1]
@@ -127,6 +140,21 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
     return res
 
 
+def _print_table(runs: list[dict]) -> None:
+    """The validation table: per mesh, FE forces, difference from the model, change from the
+    previous mesh, energy error, wall time."""
+    comps = ("tangential", "radial", "feed")
+    print("element_um  hexahedra  steps  FE t/r/f [N]  vs model t/r/f [%]  "
+          "change t/r/f [%]  energy_err  wall_s")
+    for r in runs:
+        fe = "/".join(f"{r['force_rotating_N'][c]:.1f}" for c in comps)
+        vs = "/".join(f"{100 * r['comparison'][c]['relative_difference']:+.1f}" for c in comps)
+        ch = r.get("change_from_previous_mesh")
+        chs = "/".join(f"{100 * ch[c]:+.1f}" for c in comps) if ch else "-"
+        print(f"{r['element_size_um']:10.3g}  {r['n_elements']:9d}  {r['steps']:5d}  {fe}  "
+              f"{vs}  {chs}  {r['energy_error']:.3f}  {r['wall_time_s']:.0f}", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("mode", choices=["speed", "paper"])
@@ -137,15 +165,18 @@ def main() -> None:
     ap.add_argument("--mass-scaling", type=float, default=400.0)
     ap.add_argument("--coefficients", default=None)
     ap.add_argument("--friction", default=None,
-                    help='Coulomb coefficient or "table" (default: the example\'s 0.3)')
+                    help='a friction law, "table" or a Coulomb coefficient (default: the '
+                         "example's, i.e. the engine's default law)")
     ap.add_argument("--separation", choices=["erosion_layer", "node_split"], default=None)
+    ap.add_argument("--no-support", action="store_true",
+                    help="skip the run of the finest mesh on the quasi-static support")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     if a.mode == "speed":
         out = speed(a.elements, a.steps)
     else:
         out = paper(a.sizes, a.cut_mm, a.mass_scaling, a.coefficients, a.friction,
-                    a.separation)
+                    a.separation, support=not a.no_support)
     if a.out:
         from robobore.io.results import write_json
 

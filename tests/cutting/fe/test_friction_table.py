@@ -127,7 +127,8 @@ def test_the_engine_slides_against_the_table_at_the_sliding_speed():
         assert np.allclose(r[:, 1], mu_vc, atol=0.005)
 
 
-def test_sliding_friction_is_refused_by_the_3d_slab():
+def test_the_3d_slab_reads_the_table_at_the_sliding_speed():
+    from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.slab3d import setup_slab3
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
@@ -136,8 +137,12 @@ def test_sliding_friction_is_refused_by_the_3d_slab():
                         "contact": {"friction": "table", "friction_velocity": "sliding"},
                         "mesh": {"element_size_um": 20, "separation": "node_split",
                                  "frame": "workpiece"}})
-    with pytest.raises(ConfigError, match="friction_velocity"):
-        setup_slab3(cfg)
+    p = setup_slab3(cfg).state.prm
+    v, mu = cfg.contact.table()
+    assert p[K3.P_MUTAB_N] == v.size
+    np.testing.assert_array_equal(p[K3.P_MUTAB_V:K3.P_MUTAB_V + v.size], v / 60.0)
+    np.testing.assert_array_equal(p[K3.P_MUTAB_MU:K3.P_MUTAB_MU + v.size], mu)
+    assert p[K3.P_SLIP_TAU] == pytest.approx(cfg.contact.sliding_filter_um * 1e-6 / 0.5)
 
 
 def test_no_filter_time_constant_reads_the_raw_speed():

@@ -116,9 +116,13 @@ def test_cli_json_contract(tiny_run):
                 "friction_coefficient"):
         assert key in out
     assert out["device"] == "cpu"
-    # defaults: erosion layer, the Rech table at 300 r/min on a 40 mm bore (37.7 m/min)
+    # defaults: erosion layer; friction law rech2013_calibrated read at each node's sliding
+    # speed (nominal: the Rech table x 1.5 at 300 r/min on a 40 mm bore, 37.7 m/min)
     assert out["separation"] == "erosion_layer" and out["pairs_parted"] == 0
-    assert out["friction_coefficient"] == pytest.approx(0.1723, abs=1e-3)
+    assert out["friction_coefficient"] == pytest.approx(1.5 * 0.1723, abs=1e-3)
+    assert "rech2013_calibrated" in out["friction_law"] and "sliding" in out["friction_law"]
+    # the chip slides over the insert slower than the cutting speed (0.63 m/s)
+    assert 0.0 < out["sliding_speed_mean_m_per_s"] < 0.63 * 1.05
     assert all((d / "vtk" / f"boring_{n}.vtu").exists() for n in ("initial", "final"))
 
 

@@ -37,7 +37,13 @@ SCRIPT = textwrap.dedent("""
     spec.loader.exec_module(bench)
 
     def build():
-        return bench.small3d(n_samples=40)
+        # the default friction law (rech2013_calibrated: the table read at each contact
+        # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s
+        from robobore.cutting.fe.config import ContactSection
+        from robobore.cutting.fe.solver import apply_friction_settings
+        s = bench.small3d(n_samples=40)
+        apply_friction_settings(s.prm, ContactSection(), s.prm[K3.P_VC] * 60.0, K3)
+        return s
 
     a = build()
     b = build()
@@ -48,7 +54,9 @@ SCRIPT = textwrap.dedent("""
                       profile=prof)
     def rel(u, v):
         return float(np.max(np.abs(u - v)) / max(np.max(np.abs(u)), 1e-300))
-    out = {"steps": [na, nb], "contact": float(np.abs(a.cf).sum()),
+    out = {"steps": [na, nb], "contact": float(np.abs(a.cf[:, :3]).sum()),
+           "table": float(a.prm[K3.P_MUTAB_N]), "slide": float(np.max(a.cf[:, 3])),
+           "vslip": rel(a.cf[:, 3], b.cf[:, 3]),
            "x": rel(a.x, b.x), "vx": rel(a.vx, b.vx), "vy": rel(a.vy, b.vy),
            "sd": rel(a.sd, b.sd), "pres": rel(a.pres, b.pres), "eps_p": rel(a.eps_p, b.eps_p),
            "tool": rel(a.tool, b.tool), "ext": rel(a.en[K3.E_EXT:K3.E_EXT + 1],
@@ -78,8 +86,9 @@ def _simulator_usable() -> bool:
 @pytest.mark.skipif(not _simulator_usable(), reason="numba has no CUDA target/simulator")
 @pytest.mark.parametrize("path", ["persistent", "launch_per_kernel"])
 def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
-    """60 steps of a 24-element block cut by the insert on springs (contact, plasticity,
-    support, histories): the CUDA kernels run in numba's simulator agree with the CPU
+    """60 steps of a 24-element block cut by the insert on springs (contact with the
+    default friction law read at the filtered sliding speed, plasticity, support,
+    histories): the CUDA kernels run in numba's simulator agree with the CPU
     engine to 1e-9 relative (the CPU element is compiled with FMA/reassociation, so not
     bit-identical), both the persistent kernel (one cooperative launch per chunk, the
     default) and the fallback of one launch per kernel and step."""
@@ -92,7 +101,8 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
     r = json.loads(line[len("RESULT"):])
     assert r["steps"][0] == r["steps"][1]
     assert r["contact"] > 0, "the insert never touched the block"
-    for k in ("x", "vx", "vy", "sd", "pres", "eps_p", "tool", "ext", "hist_f"):
+    assert r["table"] == 6 and r["slide"] > 0, "friction not read at the sliding speed"
+    for k in ("x", "vx", "vy", "sd", "pres", "eps_p", "tool", "ext", "hist_f", "vslip"):
         assert r[k] < 1e-9, (k, r)
     if path == "launch_per_kernel":  # run with a per-kernel profile (benchmarks use it)
         assert r["profile"] == ["contact_sum", "elements", "finish", "nodes", "tool"], r

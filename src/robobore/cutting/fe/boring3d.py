@@ -41,8 +41,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.config import MaterialSection
-from robobore.cutting.fe.solver import apply_solver_settings
+from robobore.cutting.fe.config import PARAMETER_SETS, FEConfig, MaterialSection
+from robobore.cutting.fe.config import ContactSection as ContactSection2D
+from robobore.cutting.fe.solver import apply_friction_settings, apply_solver_settings
 from robobore.cutting.fe.solver3d import (
     FEState3,
     advance3,
@@ -97,30 +98,28 @@ class CutSection(_Strict):
     cut_length_mm: float = Field(default=0.3, gt=0.0, le=20.0)
 
 
-class ContactSection(_Strict):
-    #: Coulomb coefficient (the paper: 0.3), or "table": the 2D engine's Rech et al. (2013)
-    #: mu(vc) table at the run's cutting speed, what the FE calibration of the mechanistic
-    #: coefficients uses (:data:`robobore.cutting.fe.config.FRICTION_TABLE_MU`)
-    friction: float | Literal["table"] = "table"
-    #: cap on the contact shear stress [MPa]
-    shear_limit_MPa: float = Field(default=576.0, gt=0.0)
-    #: penalty factor: normal stiffness = factor * nodal mass / dt^2
-    penalty_factor: float = Field(default=0.1, gt=0.0, le=0.5)
+#: keys of the 2D engine's [contact] that the 3D model does not use: it is adiabatic (no
+#: thermal contact) and its contact law has no normal damping
+_CONTACT_2D_ONLY = ("thermal_conductance_W_per_m2K", "friction_heat_fraction",
+                    "normal_damping", "tool_temperature_K")
 
-    @field_validator("friction")
-    @classmethod
-    def _mu(cls, v: Any) -> Any:
-        if not isinstance(v, str) and not 0.0 <= v <= 2.0:
-            raise ValueError('friction must be in 0..2 or "table"')
-        return v
 
-    def coefficient(self, vc_m_per_min: float) -> float:
-        """Coulomb coefficient used at the cutting speed (the value given, or the table's)."""
-        if self.friction == "table":
-            from robobore.cutting.fe.config import FRICTION_TABLE_MU, FRICTION_TABLE_VC_M_MIN
+class ContactSection(ContactSection2D):
+    """The 2D engine's ``[contact]`` (:class:`robobore.cutting.fe.config.ContactSection`):
+    the same friction keys, values and defaults -- ``friction`` a bundled friction law
+    (default ``rech2013_calibrated``: the Rech et al. 2013 table x 1.5 read at each contact
+    node's filtered sliding speed, no shear cap), "table" or a constant Coulomb coefficient;
+    ``friction_velocity``, ``friction_table_*``, ``sliding_filter_um``, ``shear_limit_MPa``,
+    ``penalty_factor`` -- without the thermal keys and ``normal_damping`` (the 3D model is
+    adiabatic, its contact has no normal damping)."""
 
-            return float(np.interp(vc_m_per_min, FRICTION_TABLE_VC_M_MIN, FRICTION_TABLE_MU))
-        return float(self.friction)
+    @model_validator(mode="after")
+    def _no_2d_only(self) -> ContactSection:
+        bad = sorted(set(_CONTACT_2D_ONLY) & self.model_fields_set)
+        if bad:
+            raise ValueError(f"{', '.join(bad)}: not used by the 3D boring model (adiabatic, "
+                             "contact without normal damping); remove the key")
+        return self
 
 
 class MeshSection(_Strict):
@@ -213,6 +212,12 @@ class ToolSupportSection(_Strict):
 
 
 class BoringFEConfig(_Strict):
+    #: the 2D engine's switch (:class:`robobore.cutting.fe.config.FEConfig`): "calibrated"
+    #: (default) -- friction law "rech2013_calibrated" and the material file's hardening
+    #: hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;
+    #: "a_priori" -- friction law "rech2013" and the plain Johnson-Cook law. Explicit
+    #: contact.friction and material.hardening_strain_limit keys win over either
+    parameters: Literal["calibrated", "a_priori"] = "calibrated"
     material: MaterialSection = MaterialSection()
     insert: InsertSection = InsertSection()
     cut: CutSection
@@ -220,6 +225,27 @@ class BoringFEConfig(_Strict):
     mesh: MeshSection
     solver: SolverSection = SolverSection()
     tool_support: ToolSupportSection | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _parameter_set(cls, data: Any) -> Any:
+        # the 2D config's rule (FEConfig._parameter_set): the friction law and hardening of
+        # ``parameters`` where the keys are not given
+        if not isinstance(data, dict):
+            return data
+        params = data.get("parameters", "calibrated")
+        contact = data.get("contact", {})
+        if params in PARAMETER_SETS and isinstance(contact, dict) and "friction" not in contact:
+            data = {**data, "contact": {**contact, "friction": PARAMETER_SETS[params]}}
+        mat = data.get("material", {})
+        if params == "a_priori" and isinstance(mat, dict) and \
+                "hardening_strain_limit" not in mat:
+            data = {**data, "material": {**mat, "hardening_strain_limit": "none"}}
+        return data
+
+    def friction_law(self) -> str:
+        """The friction law in words (the 2D engine's :meth:`FEConfig.friction_law`)."""
+        return FEConfig.friction_law(self)  # type: ignore[arg-type]
 
 
 def parse_boring_config(data: dict[str, Any], source: str | None = None) -> BoringFEConfig:
@@ -420,9 +446,8 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
                              else None, chip_rows=cfg.mesh.chip_rows)
     s = cfg.solver
     p = apply_solver_settings(default_prm3(), s, K3)
-    p[K3.P_MU] = cfg.contact.coefficient(vc * 60.0)
+    apply_friction_settings(p, cfg.contact, vc * 60.0, K3)
     p[K3.P_GATE] = cfg.solver.separation_gate_um * 1e-6 if split else -1.0
-    p[K3.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
     p[K3.P_PEN] = cfg.contact.penalty_factor
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = ins.nose_radius_m
@@ -469,6 +494,15 @@ class BoringFEResult:
     summary: dict[str, Any]
     history: dict[str, np.ndarray]
     setup: BoringSetup
+
+
+def _mean_sliding_speed(st: FEState3) -> float | None:
+    """Mean filtered sliding speed [m/s] of the nodes in contact at the end of the run (None
+    without a friction table read at the sliding speed, or without contact)."""
+    inc = np.any(st.cf[:, :3] != 0.0, axis=1)
+    if st.prm[K3.P_MUTAB_N] <= 0.0 or not inc.any():
+        return None
+    return float(np.mean(st.cf[inc, 3]))
 
 
 def _mean_amp(v: np.ndarray) -> tuple[float, float]:
@@ -565,6 +599,8 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         "element_size_um": cfg.mesh.element_size_um,
         "cutting_speed_m_per_min": setup.vc * 60.0,
         "friction_coefficient": float(st.prm[K3.P_MU]),
+        "friction_law": cfg.friction_law(),
+        "sliding_speed_mean_m_per_s": _mean_sliding_speed(st),
         "separation": cfg.mesh.separation,
         "pairs_parted": int(np.sum((st.twin >= 0) & (st.tied == 0)) // 2),
         "eroded_damage": int(np.sum(st.alive == 0)),

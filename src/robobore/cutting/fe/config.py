@@ -121,7 +121,7 @@ class ContactSection(_Strict):
     #: "sliding" -- every node in contact, every step, uses the table at its own sliding
     #: speed relative to the tool (the chip's speed ~vc / r up the rake, ~0 in the stagnation
     #: zone at the edge): how a tribometer's mu(sliding velocity) is read, as Abaqus'
-    #: slip-rate-dependent friction; constant beyond the table's ends. 2D engine only
+    #: slip-rate-dependent friction; constant beyond the table's ends (2D and 3D engines).
     #: None: the friction law's, else "cutting_speed"
     friction_velocity: Literal["cutting_speed", "sliding"] | None = None
     #: the friction table's velocities [m/min], increasing, 2..8 points; None: the Rech et

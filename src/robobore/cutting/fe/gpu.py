@@ -149,7 +149,9 @@ def _kernels():
     sec = dev(K3.edge_section_py)
     gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg, edge_section=sec))
     cf3 = dev(K3.contact_force3_py)
-    node = dev(jc.rebind(K3.hex_node_py, insert_gap3=gap3, contact_force3=cf3))
+    fat3 = dev(K3.friction_at3_py)
+    node = dev(jc.rebind(K3.hex_node_py, insert_gap3=gap3, contact_force3=cf3,
+                         friction_at3=fat3))
     sup = dev(tool_support_step_py)
     kin = dev(K3.tool_kinematics_py)
     tstep = dev(jc.rebind(K3.tool_step_py, tool_kinematics=kin, tool_support_step=sup))

@@ -71,7 +71,15 @@ P_THETA0, P_SAMPLE_DT, P_TEND, P_EROSION = 33, 34, 35, 36
 P_PARALLEL = 37
 # node splitting: a tied pair parts within this distance of the insert [m]
 P_GATE = 38
-N_PRM = 39
+# friction vs sliding speed (the 2D engine's slots, kernels.P_MUTAB_N ...): number of table
+# points (0: the constant P_MU), MU_TABLE_MAX velocities [m/s], MU_TABLE_MAX coefficients,
+# and the time constant [s] of the filter on each node's sliding speed
+MU_TABLE_MAX = 8
+P_MUTAB_N = 39
+P_MUTAB_V = P_MUTAB_N + 1
+P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
+P_SLIP_TAU = P_MUTAB_MU + MU_TABLE_MAX
+N_PRM = P_SLIP_TAU + 1
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 
 

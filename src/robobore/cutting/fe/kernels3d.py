@@ -11,6 +11,9 @@ New scalar functions, written in the same device-ready style (``_py`` original +
 * :func:`contact_force3_py` -- the 2D contact law (:func:`physics.contact_force_py`: mass-
   proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
   tangential *vector*;
+* :func:`friction_at3_py` -- the 2D engine's friction table lookup
+  (:func:`robobore.cutting.fe.kernels.friction_at_py`, the same code re-bound to the 3D
+  parameter slots);
 * :func:`hex_node_py` -- gather, contact and central-difference update of one node.
 
 Energy indices, status codes and the energy-balance definition are the 2D engine's
@@ -31,10 +34,12 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe import kernels as _K2
 from robobore.cutting.fe.hex8 import (
     ERODE_ALL,
     ERODE_LAYER,
     ERODE_NONE,
+    MU_TABLE_MAX,
     N_PRM,
     P_BV1,
     P_BV2,
@@ -57,6 +62,9 @@ from robobore.cutting.fe.hex8 import (
     P_KZ,
     P_MS,
     P_MU,
+    P_MUTAB_MU,
+    P_MUTAB_N,
+    P_MUTAB_V,
     P_MX,
     P_MY,
     P_MZ,
@@ -67,6 +75,7 @@ from robobore.cutting.fe.hex8 import (
     P_RE,
     P_RN,
     P_SAMPLE_DT,
+    P_SLIP_TAU,
     P_SUPPORT,
     P_TANI,
     P_TAU,
@@ -102,10 +111,12 @@ from robobore.cutting.fe.kernels import (
     STATUS_OK,
 )
 from robobore.cutting.fe.physics import tool_gap, tool_support_step
+from robobore.material.johnson_cook import rebind
 
 __all__ = [
     "N_PRM", "P_CFL", "P_MS", "P_HGV", "P_HGS", "P_BV1", "P_BV2", "P_DIST", "P_DT_ERODE",
-    "P_DTMIN", "P_MU", "P_TAU", "P_PEN", "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR",
+    "P_DTMIN", "P_MU", "P_MUTAB_N", "P_MUTAB_V", "P_MUTAB_MU", "P_SLIP_TAU",
+    "P_TAU", "P_PEN", "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR",
     "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF", "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY",
     "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY", "P_MZ", "P_THETA0", "P_SAMPLE_DT",
     "P_TEND", "P_EROSION", "P_PARALLEL", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN",
@@ -234,17 +245,35 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
 insert_gap3 = njit(cache=True)(insert_gap3_py)
 contact_force3 = njit(cache=True)(contact_force3_py)
 
+if MU_TABLE_MAX != _K2.MU_TABLE_MAX:  # pragma: no cover - a guard on the shared slot layout
+    raise ImportError("hex8.MU_TABLE_MAX differs from kernels.MU_TABLE_MAX")
+#: Coulomb coefficient at a sliding speed [m/s]: the 2D engine's
+#: :func:`robobore.cutting.fe.kernels.friction_at_py` (the constant ``prm[P_MU]`` when
+#: ``prm[P_MUTAB_N]`` = 0, else the table, linear between its points, constant beyond its
+#: ends) reading the 3D engine's parameter slots
+friction_at3_py = rebind(_K2.friction_at_py, P_MU=P_MU, P_MUTAB_N=P_MUTAB_N,
+                         P_MUTAB_V=P_MUTAB_V, P_MUTAB_MU=P_MUTAB_MU)
+friction_at3 = njit(cache=False, inline="always")(friction_at3_py)
+
 
 def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs):
     """Gather element forces on node ``n``, add insert contact, advance v and x (one node).
 
-    Contact uses positions at step n and velocities at n-1/2 (as the 2D engine). ``cf[n]``
-    receives the contact force on the node [N]; ``fric`` (cumulative) frictional dissipation,
-    ``pen`` the current penalty energy, ``nwork`` (cumulative) the contact work [J]. A node
-    left without a live element is retired (its kinetic energy booked in ``ero_ke``).
+    Contact uses positions at step n and velocities at n-1/2 (as the 2D engine).
+    ``cf[n, 0:3]`` receives the contact force on the node [N] (``cf[n, 3]``: its filtered
+    sliding speed, kept from step to step; one (n, 4) array rather than two, see below);
+    ``fric`` (cumulative) frictional dissipation, ``pen`` the current penalty energy,
+    ``nwork`` (cumulative) the contact work [J]. A node left without a live element is
+    retired (its kinetic energy booked in ``ero_ke``).
     ``fixed[n]`` bit mask (1 x, 2 y, 4 z): that velocity component is held (prescribed).
     ``(cx, cy, cz)`` tool tip reference, ``(tvx, tvy, tvz)`` tool velocity (local frame).
+
+    Friction (the 2D engine's rule, :func:`kernels.quad_node_py`): the constant
+    ``prm[P_MU]``, or with a table (``prm[P_MUTAB_N]`` > 0) the table at the node's sliding
+    speed relative to the insert (the tangential part of its relative velocity), low-pass
+    filtered with the time constant ``prm[P_SLIP_TAU]`` and kept in ``cf[n, 3]`` [m/s]
+    (:func:`friction_at3_py`).
 
     Node splitting (the 2D engine's rule, :func:`kernels.node_update`): ``pairs[n]`` =
     (twin, tied); a node with ``twin >= 0`` and ``tied`` moves with its twin as one node --
@@ -320,8 +349,22 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
             vry = vy[n] - tvy
             vrz = vz[n] - tvz
             trib = (vsum / nlive) ** (2.0 / 3.0)
+            mu = prm[P_MU]
+            if prm[P_MUTAB_N] > 0.0:
+                # the sliding speed, filtered over the time constant prm[P_SLIP_TAU]: a
+                # contact node's velocity chatters from step to step, its mean is the
+                # material's sliding speed
+                vrn = vrx * gnx + vry * gny + vrz * gnz
+                sx = vrx - vrn * gnx
+                sy = vry - vrn * gny
+                sz = vrz - vrn * gnz
+                tau_s = prm[P_SLIP_TAU]
+                a = dt / tau_s if tau_s > dt else 1.0  # tau_s <= dt: no filter
+                vs = cf[n, 3] + a * (math.sqrt(sx * sx + sy * sy + sz * sz) - cf[n, 3])
+                cf[n, 3] = vs
+                mu = friction_at3(prm, vs)
             fcx, fcy, fcz, fn, ft, tx, ty, tz = contact_force3(
-                gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, prm[P_MU], prm[P_TAU], prm[P_PEN],
+                gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, mu, prm[P_TAU], prm[P_PEN],
                 dt, 0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy, 0.0 if (fb & 4) else fz)
             vt0 = vrx * tx + vry * ty + vrz * tz
             pen[n] = share * 0.5 * fn * (-gap)

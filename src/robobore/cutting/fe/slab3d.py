@@ -22,7 +22,11 @@ import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.config import FEConfig
-from robobore.cutting.fe.solver import apply_solver_settings, energy_error
+from robobore.cutting.fe.solver import (
+    apply_friction_settings,
+    apply_solver_settings,
+    energy_error,
+)
 from robobore.cutting.fe.solver3d import (
     FEState3,
     advance3,
@@ -85,13 +89,7 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     # parting line: double its nodes (not the fully fixed ones); the chip rows take the copies
     nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, n_dn)
     p = apply_solver_settings(default_prm3(), cfg.solver, K3)
-    if cfg.contact.friction_velocity != "cutting_speed":
-        raise ConfigError("friction by sliding speed is implemented in the 2D engine only",
-                          field="contact.friction_velocity",
-                          value=cfg.contact.friction_velocity,
-                          expected='"cutting_speed" for the 3D slab')
-    p[K3.P_MU] = cfg.friction_coefficient()
-    p[K3.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
+    apply_friction_settings(p, cfg.contact, cfg.cut.cutting_speed_m_per_min, K3)
     p[K3.P_PEN] = cfg.contact.penalty_factor
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = 1.0

@@ -375,6 +375,33 @@ def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
     return p
 
 
+def apply_friction_settings(p: np.ndarray, contact: Any, vc_m_per_min: float,
+                            kernels: Any) -> np.ndarray:
+    """Write the friction of a ``[contact]`` section into ``p`` (returned); shared by the 2D
+    and 3D engines.
+
+    ``contact`` is a :class:`robobore.cutting.fe.config.ContactSection` (or the 3D engine's,
+    built on it), ``vc_m_per_min`` the cutting speed, ``kernels`` the engine's kernel module (its
+    ``P_MU``, ``P_TAU``, ``P_MUTAB_*`` and ``P_SLIP_TAU`` slots). ``P_MU``: the constant, or
+    the table at the cutting speed; with ``friction_velocity = "sliding"`` the table goes into
+    the ``P_MUTAB_*`` slots (velocities in m/s) and every contact node reads it at its own
+    sliding speed, filtered over the time the tool takes to travel ``sliding_filter_um``.
+    """
+    k = kernels
+    if contact.friction == "table":
+        tv, tmu = contact.table()
+        p[k.P_MU] = float(np.interp(vc_m_per_min, tv, tmu))
+        if contact.friction_velocity == "sliding":
+            p[k.P_MUTAB_N] = tv.size
+            p[k.P_MUTAB_V:k.P_MUTAB_V + tv.size] = tv / 60.0
+            p[k.P_MUTAB_MU:k.P_MUTAB_MU + tv.size] = tmu
+            p[k.P_SLIP_TAU] = contact.sliding_filter_um * 1e-6 / (vc_m_per_min / 60.0)
+    else:
+        p[k.P_MU] = float(contact.friction)
+    p[k.P_TAU] = contact.shear_limit_MPa * 1e6
+    return p
+
+
 def _layer_offset(cfg: FEConfig, le: float) -> float:
     """Top of the separation layer above the cut line, in element sizes (see build_mesh)."""
     if cfg.mesh.separation_height_um is not None:
@@ -446,15 +473,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                           split_height=_split_height(cfg))
     s = cfg.solver
     p = apply_solver_settings(default_prm(), s, K)
-    mu = cfg.friction_coefficient()
-    p[K.P_MU] = mu
-    if cfg.contact.friction == "table" and cfg.contact.friction_velocity == "sliding":
-        tv, tmu = cfg.contact.table()
-        p[K.P_MUTAB_N] = tv.size
-        p[K.P_MUTAB_V:K.P_MUTAB_V + tv.size] = tv / 60.0
-        p[K.P_MUTAB_MU:K.P_MUTAB_MU + tv.size] = tmu
-        p[K.P_SLIP_TAU] = cfg.contact.sliding_filter_um * 1e-6 / vc
-    p[K.P_TAU] = cfg.contact.shear_limit_MPa * 1e6
+    apply_friction_settings(p, cfg.contact, cfg.cut.cutting_speed_m_per_min, K)
     p[K.P_PEN] = cfg.contact.penalty_factor
     nd = cfg.contact.normal_damping
     p[K.P_CDAMP] = (1.0 if cm.frame == "tool" else 0.0) if nd is None else nd
@@ -526,7 +545,8 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                                   value=k, expected=f"k < {0.25 * m / dt**2:.3g} N/m for "
                                   f"mass {m} kg and time step {dt:.3g} s")
     return CuttingSetup(cfg=cfg, material=mat, mesh=mesh, state=st, h=h, vc=vc, rake=rake,
-                        t_end=t_end, t_contact=t_contact, mu=mu, x_cut_start=x_cut_start)
+                        t_end=t_end, t_contact=t_contact, mu=float(p[K.P_MU]),
+                        x_cut_start=x_cut_start)
 
 
 def energy_error(en: np.ndarray) -> float:

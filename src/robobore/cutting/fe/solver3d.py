@@ -58,7 +58,7 @@ class FEState3:
     dte: np.ndarray
     plast: np.ndarray
     rate: np.ndarray
-    cf: np.ndarray
+    cf: np.ndarray  # (n, 4): contact force on the node [N], filtered sliding speed [m/s]
     fric: np.ndarray
     pen: np.ndarray
     ndead: np.ndarray
@@ -203,7 +203,7 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         layer=np.zeros(ne, np.bool_) if layer is None else np.asarray(layer, np.bool_).copy(),
         sd=z((ne, 6)), pres=z(ne), eps_p=z(ne),
         temp=np.full(ne, material.T_room), dmg=z(ne), qh=z((ne, 12)), vol0=vol, ie=z(ne),
-        hge=z(ne), fe=z((ne, 24)), dte=z(ne), plast=z(ne), rate=z(ne), cf=z((n, 3)),
+        hge=z(ne), fe=z((ne, 24)), dte=z(ne), plast=z(ne), rate=z(ne), cf=z((n, 4)),
         fric=z(n), pen=z(n), ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n),
         mat=material.to_array(), prm=prm, tool=tool, en=z(K3.N_EN),
         ist=np.zeros(K3.N_IST, np.int64), clock=z(3), hacc=z(K3.N_HIST),
