@@ -218,7 +218,7 @@ def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
     advance3_gpu = None
     if use_gpu:
         from robobore.cutting.fe.gpu import advance3_gpu
-    numba.set_num_threads(cpu_threads)
+    numba.set_num_threads(min(cpu_threads, numba.config.NUMBA_NUM_THREADS))
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
         st0 = setup_boring(parse_boring_config(_boring_dict(le, 400.0, 0.15, True))).state
@@ -291,7 +291,7 @@ def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
     advance_gpu = None
     if use_gpu:
         from robobore.cutting.fe.gpu2d import advance_gpu
-    numba.set_num_threads(cpu_threads)
+    numba.set_num_threads(min(cpu_threads, numba.config.NUMBA_NUM_THREADS))
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
         st0 = setup_orthogonal(_ortho_cfg(le, 1.0)).state
