@@ -118,7 +118,7 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
     from robobore.cutting.fe.solver import advance, setup_orthogonal
 
     d = tomllib.load(open(sys.argv[1], "rb"))
-    d["cut"]["length_mm"] = 0.004
+    d["cut"]["length_mm"] = 0.02  # one element: the shortest cut the config accepts
     d["mesh"]["element_size_um"] = 20.0
     d["mesh"]["edge_element_um"] = 10.0
     d.setdefault("solver", {}).update(heat_conduction=True, conduction_interval=4)
@@ -312,7 +312,7 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
 
     tf = Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml"
     d = tomllib.loads(tf.read_text())
-    d["cut"]["length_mm"] = 0.004
+    d["cut"]["length_mm"] = 0.02  # one element: the shortest cut the config accepts
     d["mesh"]["element_size_um"] = 20.0
     d["mesh"]["edge_element_um"] = 10.0
     st = setup_orthogonal(parse_config(d)).state
