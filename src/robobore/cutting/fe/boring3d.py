@@ -41,8 +41,8 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.config import PARAMETER_SETS, FEConfig, MaterialSection
 from robobore.cutting.fe.config import ContactSection as ContactSection2D
+from robobore.cutting.fe.config import FEConfig, MaterialSection, apply_parameter_set
 from robobore.cutting.fe.solver import apply_friction_settings, apply_solver_settings
 from robobore.cutting.fe.solver3d import (
     FEState3,
@@ -229,19 +229,9 @@ class BoringFEConfig(_Strict):
     @model_validator(mode="before")
     @classmethod
     def _parameter_set(cls, data: Any) -> Any:
-        # the 2D config's rule (FEConfig._parameter_set): the friction law and hardening of
-        # ``parameters`` where the keys are not given
-        if not isinstance(data, dict):
-            return data
-        params = data.get("parameters", "calibrated")
-        contact = data.get("contact", {})
-        if params in PARAMETER_SETS and isinstance(contact, dict) and "friction" not in contact:
-            data = {**data, "contact": {**contact, "friction": PARAMETER_SETS[params]}}
-        mat = data.get("material", {})
-        if params == "a_priori" and isinstance(mat, dict) and \
-                "hardening_strain_limit" not in mat:
-            data = {**data, "material": {**mat, "hardening_strain_limit": "none"}}
-        return data
+        # the 2D config's rule: the friction law and hardening of ``parameters`` where the
+        # keys are not given
+        return apply_parameter_set(data) if isinstance(data, dict) else data
 
     def friction_law(self) -> str:
         """The friction law in words (the 2D engine's :meth:`FEConfig.friction_law`)."""

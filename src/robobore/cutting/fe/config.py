@@ -364,6 +364,20 @@ def auto_mass_scaling(cutting_speed_m_per_min: float) -> float:
     return max(1.0, 100.0 * (30.0 / cutting_speed_m_per_min) ** 2)
 
 
+def apply_parameter_set(data: dict[str, Any]) -> dict[str, Any]:
+    """A raw config dict with the friction law and the hardening of its ``parameters`` set
+    ("calibrated", the default, or "a_priori") filled in where ``contact.friction`` and
+    ``material.hardening_strain_limit`` are not given (the 2D and the 3D boring configs)."""
+    params = data.get("parameters", "calibrated")
+    contact = data.get("contact", {})
+    if params in PARAMETER_SETS and isinstance(contact, dict) and "friction" not in contact:
+        data = {**data, "contact": {**contact, "friction": PARAMETER_SETS[params]}}
+    mat = data.get("material", {})
+    if params == "a_priori" and isinstance(mat, dict) and "hardening_strain_limit" not in mat:
+        data = {**data, "material": {**mat, "hardening_strain_limit": "none"}}
+    return data
+
+
 class FEConfig(_Strict):
     #: "calibrated" (default): the validated model's CALIBRATED choices -- friction law
     #: "rech2013_calibrated" and the material file's hardening hold; "a_priori": the
@@ -384,17 +398,9 @@ class FEConfig(_Strict):
     def _parameter_set(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             return data
-        params = data.get("parameters", "calibrated")
         if not isinstance(data.get("solver", {}), BaseModel):
             data = {**data, "solver": dict(data.get("solver", {}))}
-        contact = data.get("contact", {})
-        if params in PARAMETER_SETS and isinstance(contact, dict) and "friction" not in contact:
-            data = {**data, "contact": {**contact, "friction": PARAMETER_SETS[params]}}
-        mat = data.get("material", {})
-        if params == "a_priori" and isinstance(mat, dict) and \
-                "hardening_strain_limit" not in mat:
-            data = {**data, "material": {**mat, "hardening_strain_limit": "none"}}
-        return data
+        return apply_parameter_set(data)
 
     @model_validator(mode="after")
     def _mass_scaling(self) -> FEConfig:
