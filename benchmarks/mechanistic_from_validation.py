@@ -2,11 +2,10 @@
 mechanistic orthogonal forces against their FE points and against the measurements, with
 leave-one-speed-out cross-validation (issue 27's acceptance on the coefficients).
 
-Reads the FE forces the validated model gave at the nine measured conditions (rows stored in
-benchmarks/measured/fe_validation_2026-11-23/calibrated_rech_x1.5_sliding_hardening0.6_nocap_*:
-the default model written out, 10 um elements, 0.3 mm, rake 15 deg, edge radius 20 um; the
-configs are the ones ``robobore fe validate examples/fe_orthogonal.toml`` runs, see
-tests/cutting/fe/test_validation_config.py) and runs
+Reads the FE forces the validated model gave at the nine measured conditions (the bundled
+validation record data/fe_validation/tc4_default_model.json, the ``--json`` output of
+``robobore fe validate examples/fe_orthogonal.toml``: 10 um elements, 0.3 mm, rake 15 deg,
+edge radius 20 um; or ``--record`` another) and runs
 :func:`robobore.cutting.calibrate.mechanistic_check` on them: the calibration of ``robobore
 calibrate forces`` (pooled set + per-speed fits), the forces through the boring model's own
 coefficient path at each point's cutting speed (speed-dependent: per-speed fits interpolated
@@ -14,56 +13,29 @@ linearly in ln(vc), held outside the calibrated speeds), compared with the FE po
 and the measurement (../shared/data/ti64_orthogonal_cutting_forces.json; Fc 10 %, Ff 25 %).
 The pooled set (``speed_dependent = false``) is printed for comparison. No FE is run.
 
-    python benchmarks/mechanistic_from_validation.py [--data PATH] [--json]
+    python benchmarks/mechanistic_from_validation.py [--data PATH] [--record PATH] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import re
 import time
 from pathlib import Path
 
 from robobore.cutting import calibrate as cal
-from robobore.cutting.fe.validate import read_measured
+from robobore.cutting.fe.validate import (
+    bundled_validation_path,
+    load_validation_record,
+    read_measured,
+)
+from robobore.io.config import load_toml
 
 ROOT = Path(__file__).resolve().parents[1]
-ROWS = ROOT / "benchmarks" / "measured" / "fe_validation_2026-11-23"
+EXAMPLE = ROOT / "examples" / "fe_orthogonal.toml"
 DATA = ROOT.parent / "shared" / "data" / "ti64_orthogonal_cutting_forces.json"
 if not DATA.is_file():  # the same measured data, bundled with the package
     DATA = ROOT / "src" / "robobore" / "cutting" / "coefficients" / DATA.name
-
-
-def fe_points(rows: Path = ROWS) -> dict[tuple[float, float], tuple[float, float]]:
-    """(h um, vc m/min) -> (Fc, Ff) N/mm of the nine stored validation rows."""
-    out = {}
-    d = json.loads((rows / "calibrated_rech_x1.5_sliding_hardening0.6_nocap_5points.json")
-                   .read_text())
-    for r in d["rows"]:
-        out[(r["h_um"], r["vc_m_per_min"])] = (r["Fc_sim"], r["Ff_sim"])
-    txt = (rows / "calibrated_rech_x1.5_sliding_hardening0.6_nocap_4points.txt").read_text()
-    for line in txt.splitlines():
-        m = re.match(r"\s*(\d+)\s+(\d+) \|\s*\S+\s+(\S+)\s+\S+ \|\s*\S+\s+(\S+)", line)
-        if m:
-            out[(float(m[1]), float(m[2]))] = (float(m[3]), float(m[4]))
-    return out
-
-
-def validation_calibration(pts: dict[tuple[float, float], tuple[float, float]]):
-    """The calibration config (the validated FE model's insert and grid) and FE records."""
-    hs = sorted({h for h, _ in pts})
-    vs = sorted({v for _, v in pts})
-    cfg = cal.calibration_from_mapping(
-        {"calibration": {"uncut_chip_thickness_um": hs, "cutting_speed_m_per_min": vs,
-                         "fe_config": {"cut": {"length_mm": 0.3},
-                                       "mesh": {"element_size_um": 10.0}}},
-         "insert": {"rake_deg": 15.0, "edge_radius_um": 20.0, "clearance_deg": 2.0},
-         "material": {"name": "TC4"}}, source="mechanistic_from_validation")
-    recs = [{"h_um": h, "vc_m_per_min": v, "Fc_N_per_m": pts[(h, v)][0] * 1e3,
-             "Ff_N_per_m": pts[(h, v)][1] * 1e3, "cached": True, "fe": {}}
-            for h in hs for v in vs]
-    return cfg, recs
 
 
 def _pct(x: float | None) -> str:
@@ -95,10 +67,13 @@ def _summary(label: str, s: dict) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", type=Path, default=DATA)
+    ap.add_argument("--record", type=Path, default=bundled_validation_path(),
+                    help="FE validation record (robobore fe validate --json)")
     ap.add_argument("--json", action="store_true", help="print the checks as JSON")
     a = ap.parse_args()
     measured = read_measured(a.data)
-    cfg, recs = validation_calibration(fe_points())
+    cfg, recs = cal.validation_calibration(load_validation_record(a.record), load_toml(EXAMPLE),
+                                           source=str(EXAMPLE))
     t0 = time.perf_counter()
     dep = cal.mechanistic_check(cfg, recs, measured)
     t_dep = time.perf_counter() - t0

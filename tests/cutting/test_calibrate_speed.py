@@ -2,8 +2,9 @@
 (no FE run), and the speed-dependent calibration path of ``robobore calibrate forces``.
 
 The FE forces are the validated 2D model's at the nine measured Ti6Al4V conditions (h 40/60/80
-um x vc 5/10/30 m/min; rows in benchmarks/measured/fe_validation_2026-11-23/, the default model
-written out, 10 um elements); the measurements are the bundled Ducobu et al. (CIRP 2022) data.
+um x vc 5/10/30 m/min; the bundled validation record data/fe_validation/tc4_default_model.json,
+``robobore fe validate examples/fe_orthogonal.toml``, 10 um elements); the measurements are
+the bundled Ducobu et al. (CIRP 2022) data.
 Targets: the mechanistic orthogonal forces reproduce their FE points within 5 % and the
 measurements within Fc 10 % / Ff 25 % (the FE model's own validation targets).
 """
@@ -12,45 +13,28 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from pathlib import Path
 
 import pytest
 
 from robobore.cutting import calibrate as cal
-from robobore.cutting.fe.validate import read_measured
+from robobore.cutting.fe.validate import (
+    bundled_validation_path,
+    load_validation_record,
+    read_measured,
+)
 from robobore.cutting.forces import DUCOBU_FILE, load_coefficients
+from robobore.io.config import load_toml
 
-ROWS = (Path(__file__).resolve().parents[2] / "benchmarks" / "measured"
-        / "fe_validation_2026-11-23")
-STEM = "calibrated_rech_x1.5_sliding_hardening0.6_nocap_"
-
-
-def _fe_points() -> dict[tuple[float, float], tuple[float, float]]:
-    """(h um, vc m/min) -> (Fc, Ff) N/mm of the nine stored validation rows."""
-    out = {}
-    for r in json.loads((ROWS / f"{STEM}5points.json").read_text())["rows"]:
-        out[(r["h_um"], r["vc_m_per_min"])] = (r["Fc_sim"], r["Ff_sim"])
-    for line in (ROWS / f"{STEM}4points.txt").read_text().splitlines():
-        m = re.match(r"\s*(\d+)\s+(\d+) \|\s*\S+\s+(\S+)\s+\S+ \|\s*\S+\s+(\S+)", line)
-        if m:
-            out[(float(m[1]), float(m[2]))] = (float(m[3]), float(m[4]))
-    return out
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fe_orthogonal.toml"
 
 
 def _validation_grid():
-    pts = _fe_points()
-    assert len(pts) == 9
-    hs, vs = sorted({h for h, _ in pts}), sorted({v for _, v in pts})
-    cfg = cal.calibration_from_mapping(
-        {"calibration": {"uncut_chip_thickness_um": hs, "cutting_speed_m_per_min": vs,
-                         "fe_config": {"cut": {"length_mm": 0.3},
-                                       "mesh": {"element_size_um": 10.0}}},
-         "insert": {"rake_deg": 15.0, "edge_radius_um": 20.0, "clearance_deg": 2.0},
-         "material": {"name": "TC4"}}, source="test")
-    recs = [{"h_um": h, "vc_m_per_min": v, "Fc_N_per_m": pts[(h, v)][0] * 1e3,
-             "Ff_N_per_m": pts[(h, v)][1] * 1e3, "cached": True, "fe": {}}
-            for h in hs for v in vs]
+    """The bundled validation record of the default model (robobore fe validate
+    examples/fe_orthogonal.toml, nine points) as a calibration, without running the FE."""
+    rec = load_validation_record(bundled_validation_path())
+    cfg, recs = cal.validation_calibration(rec, load_toml(EXAMPLE), source=str(EXAMPLE))
+    assert len(recs) == 9
     return cfg, recs
 
 

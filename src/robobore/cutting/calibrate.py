@@ -743,6 +743,43 @@ def _error_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
+def validation_calibration(record: dict[str, Any], fe_config: dict[str, Any],
+                           source: str | None = None
+                           ) -> tuple[CalibrationConfig, list[dict[str, Any]]]:
+    """The FE points of a validation record as a calibration: (config, records).
+
+    ``record``: the ``--json`` output of ``robobore fe validate``
+    (:func:`robobore.cutting.fe.validate.load_validation_record`); ``fe_config``: the FE
+    config mapping it ran (its ``[tool]`` is the insert, its ``[material]`` the material).
+    The grid is the record's chip thicknesses x speeds (every combination must be in the
+    record); the records carry the simulated forces (N/m) as :func:`run_grid` gives them, so
+    :func:`calibrate` and :func:`mechanistic_check` fit them without running the FE.
+    """
+    pts = {(float(p["uncut_chip_thickness_um"]), float(p["cutting_speed_m_per_min"])):
+           (float(p["cutting_force_N_per_mm"]), float(p["feed_force_N_per_mm"]))
+           for p in record["points"]}
+    hs = sorted({h for h, _ in pts})
+    vs = sorted({v for _, v in pts})
+    missing = [f"{h:g}:{v:g}" for h in hs for v in vs if (h, v) not in pts]
+    if missing:
+        raise ConfigError("validation record is not a full grid of chip thicknesses x speeds",
+                          file=source, field="points", value=", ".join(missing),
+                          expected="every h_um:vc_m_per_min combination of the record")
+    tool = fe_config.get("tool", {})
+    cfg = calibration_from_mapping(
+        {"calibration": {"uncut_chip_thickness_um": hs, "cutting_speed_m_per_min": vs,
+                         "fe_config": {k: v for k, v in fe_config.items()
+                                       if k not in ("tool", "material")}},
+         "insert": {"rake_deg": tool.get("rake_deg"),
+                    "edge_radius_um": tool.get("edge_radius_um"),
+                    "clearance_deg": tool.get("clearance_deg")},
+         "material": fe_config.get("material", {"name": "TC4"})}, source=source)
+    recs = [{"h_um": h, "vc_m_per_min": v, "Fc_N_per_m": pts[(h, v)][0] * 1e3,
+             "Ff_N_per_m": pts[(h, v)][1] * 1e3, "cached": True, "fe": {}}
+            for h in hs for v in vs]
+    return cfg, recs
+
+
 def mechanistic_check(cfg: CalibrationConfig, records: list[dict[str, Any]],
                       measured: list[Any] | None = None, *,
                       speed_dependent: bool = True) -> dict[str, Any]:
@@ -802,5 +839,5 @@ __all__ = ["FESettings", "CalibrationConfig", "calibration_from_mapping",
            "load_calibration_config", "fe_config_dict", "run_fe_point", "run_grid",
            "fit_edge_model", "fit_warnings", "FIT_TOLERANCE", "calibrate",
            "calibrate_forces", "predicted_forces", "FE_NAMESPACE", "fe_model_description",
-           "mechanistic_orthogonal_forces", "mechanistic_check", "FE_POINT_TOLERANCE",
-           "MEASURED_TOLERANCE"]
+           "mechanistic_orthogonal_forces", "mechanistic_check", "validation_calibration",
+           "FE_POINT_TOLERANCE", "MEASURED_TOLERANCE"]
