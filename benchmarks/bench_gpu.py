@@ -159,6 +159,7 @@ def _boring_dict(le: float, ms: float, cut_mm: float, parallel):
     d["mesh"]["element_size_um"] = le
     d["cut"]["cut_length_mm"] = cut_mm
     d["solver"]["mass_scaling"] = ms
+    d.setdefault("contact", {})["friction"] = "table"
     if parallel is not None:
         d["solver"]["parallel"] = parallel
     return d

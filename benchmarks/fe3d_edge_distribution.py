@@ -47,7 +47,7 @@ def main() -> None:
     d["mesh"]["element_size_um"] = a.element_um
     d["cut"]["cut_length_mm"] = a.cut_mm
     d["solver"]["mass_scaling"] = a.mass_scaling
-    d["contact"]["friction"] = "table"
+    d.setdefault("contact", {})["friction"] = "table"
     cfg = parse_boring_config(d)
     setup = setup_boring(cfg)
     st = setup.state
