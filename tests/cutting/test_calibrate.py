@@ -113,10 +113,10 @@ def test_inclined_insert_uses_oblique_transformation():
     assert d0["coefficients"]["Kfc_N_per_m2"] == pytest.approx(0.4e9, rel=1e-6)
 
 
-def test_grid_is_cached(tmp_path, monkeypatch):
-    """FE results are cached by their inputs: a second run computes nothing; a changed FE
-    setting computes again."""
-    calls = []
+def _linear_fe(monkeypatch) -> list:
+    """Replace the FE point runner by an exactly linear one (Kte 30 N/mm, Ktc 1.6 GPa, Kfe
+    40 N/mm, Kfc 0.4 GPa); returns the list the FE configs it is called with land in."""
+    calls: list = []
 
     def fake(fe_cfg):
         calls.append(fe_cfg)
@@ -125,6 +125,13 @@ def test_grid_is_cached(tmp_path, monkeypatch):
                 "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
 
     monkeypatch.setattr(cal, "run_fe_point", fake)
+    return calls
+
+
+def test_grid_is_cached(tmp_path, monkeypatch):
+    """FE results are cached by their inputs: a second run computes nothing; a changed FE
+    setting computes again."""
+    calls = _linear_fe(monkeypatch)
     cache = ResultCache(tmp_path / "cache")
     cfg = _cfg()
     r1 = cal.calibrate_forces(cfg, cache=cache, out=tmp_path / "a.json")
@@ -272,15 +279,7 @@ def test_full_fe_config_errors_before_any_run(monkeypatch, fe_config, kw, field,
 
 
 def test_full_fe_config_grid_runs_and_is_cached(tmp_path, monkeypatch):
-    calls = []
-
-    def fake(fe_cfg):
-        calls.append(fe_cfg)
-        h = fe_cfg["cut"]["uncut_chip_thickness_um"] * 1e-6
-        return {"cutting_force_N_per_mm": (30e3 + 1.6e9 * h) * 1e-3,
-                "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
-
-    monkeypatch.setattr(cal, "run_fe_point", fake)
+    calls = _linear_fe(monkeypatch)
     cache = ResultCache(tmp_path / "cache")
     r = cal.calibrate_forces(_full(_FULL), cache=cache)
     assert len(calls) == 2 and r["fe_settings"] is None
