@@ -34,7 +34,7 @@ from robobore.errors import ConfigError
 #: copies taken for the output.
 FE2D_BYTES_PER_ELEMENT = 1500
 #: 3D explicit FE (robobore.cutting.fe.boring3d): bytes per hexahedral element at the peak
-#: (a set-up run of examples/fe_boring_paper.toml measures 830 bytes per element).
+#: (a set-up run of examples/fe_boring_paper.toml measures 910 bytes per element).
 FE3D_BYTES_PER_ELEMENT = 1500
 #: time-domain boring (robobore.dynamics.timedomain): float64 values held per time step:
 #: force, displacement and acceleration (3 each) and the chip area per insert, times three

@@ -38,11 +38,15 @@ SCRIPT = textwrap.dedent("""
 
     def build():
         # the default friction law (rech2013_calibrated: the table read at each contact
-        # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s
-        from robobore.cutting.fe.config import ContactSection
-        from robobore.cutting.fe.solver import apply_friction_settings
+        # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s, and
+        # heat conduction with the thermal contact every 3 steps (20 passes)
+        from robobore.cutting.fe.config import ContactSection, SolverSection
+        from robobore.cutting.fe.solver import apply_friction_settings, apply_thermal_settings
+        from robobore.material import load_material
         s = bench.small3d(n_samples=40)
         apply_friction_settings(s.prm, ContactSection(), s.prm[K3.P_VC] * 60.0, K3)
+        apply_thermal_settings(s.prm, SolverSection(conduction_interval=3), ContactSection(),
+                               load_material("TC4"), K3)
         return s
 
     a = build()
@@ -59,6 +63,11 @@ SCRIPT = textwrap.dedent("""
            "vslip": rel(a.cf[:, 3], b.cf[:, 3]),
            "x": rel(a.x, b.x), "vx": rel(a.vx, b.vx), "vy": rel(a.vy, b.vy),
            "sd": rel(a.sd, b.sd), "pres": rel(a.pres, b.pres), "eps_p": rel(a.eps_p, b.eps_p),
+           # temperature rise above room temperature (mat[TROOM])
+           "temp": rel(a.temp - a.mat[6], b.temp - b.mat[6]),
+           "heated": float(np.max(a.temp) - a.mat[6]),
+           "cond_t": [float(a.prm[K3.P_COND_T]), float(b.prm[K3.P_COND_T])],
+           "theat": rel(a.theat, b.theat),
            "tool": rel(a.tool, b.tool), "ext": rel(a.en[K3.E_EXT:K3.E_EXT + 1],
                                                   b.en[K3.E_EXT:K3.E_EXT + 1]),
            "hist_f": rel(np.nan_to_num(a.hist[:, K3.H_FX:K3.H_FZ + 1]),
@@ -102,10 +111,14 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
     assert r["steps"][0] == r["steps"][1]
     assert r["contact"] > 0, "the insert never touched the block"
     assert r["table"] == 6 and r["slide"] > 0, "friction not read at the sliding speed"
-    for k in ("x", "vx", "vy", "sd", "pres", "eps_p", "tool", "ext", "hist_f", "vslip"):
+    assert r["heated"] > 0.05, "no heat in the block"
+    assert r["cond_t"][0] > 0 and r["cond_t"][0] == r["cond_t"][1], "conduction passes differ"
+    for k in ("x", "vx", "vy", "sd", "pres", "eps_p", "tool", "ext", "hist_f", "vslip", "temp",
+              "theat"):
         assert r[k] < 1e-9, (k, r)
     if path == "launch_per_kernel":  # run with a per-kernel profile (benchmarks use it)
-        assert r["profile"] == ["contact_sum", "elements", "finish", "nodes", "tool"], r
+        assert r["profile"] == ["conduction", "contact_sum", "elements", "finish", "nodes",
+                                "tool"], r
 
 
 class _NoCooperative:

@@ -43,7 +43,11 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.config import ContactSection as ContactSection2D
 from robobore.cutting.fe.config import FEConfig, MaterialSection, apply_parameter_set
-from robobore.cutting.fe.solver import apply_friction_settings, apply_solver_settings
+from robobore.cutting.fe.solver import (
+    apply_friction_settings,
+    apply_solver_settings,
+    apply_thermal_settings,
+)
 from robobore.cutting.fe.solver3d import (
     FEState3,
     advance3,
@@ -98,10 +102,9 @@ class CutSection(_Strict):
     cut_length_mm: float = Field(default=0.3, gt=0.0, le=20.0)
 
 
-#: keys of the 2D engine's [contact] that the 3D model does not use: it is adiabatic (no
-#: thermal contact) and its contact law has no normal damping
-_CONTACT_2D_ONLY = ("thermal_conductance_W_per_m2K", "friction_heat_fraction",
-                    "normal_damping", "tool_temperature_K")
+#: keys of the 2D engine's [contact] that the 3D model does not use: its contact law has no
+#: normal damping
+_CONTACT_2D_ONLY = ("normal_damping",)
 
 
 class ContactSection(ContactSection2D):
@@ -110,15 +113,16 @@ class ContactSection(ContactSection2D):
     (default ``rech2013_calibrated``: the Rech et al. 2013 table x 1.5 read at each contact
     node's filtered sliding speed, no shear cap), "table" or a constant Coulomb coefficient;
     ``friction_velocity``, ``friction_table_*``, ``sliding_filter_um``, ``shear_limit_MPa``,
-    ``penalty_factor`` -- without the thermal keys and ``normal_damping`` (the 3D model is
-    adiabatic, its contact has no normal damping)."""
+    ``penalty_factor`` and the thermal contact (``thermal_conductance_W_per_m2K``,
+    ``friction_heat_fraction``, ``tool_temperature_K``, used with ``solver.heat_conduction``)
+    -- without ``normal_damping`` (the 3D contact has no normal damping)."""
 
     @model_validator(mode="after")
     def _no_2d_only(self) -> ContactSection:
         bad = sorted(set(_CONTACT_2D_ONLY) & self.model_fields_set)
         if bad:
-            raise ValueError(f"{', '.join(bad)}: not used by the 3D boring model (adiabatic, "
-                             "contact without normal damping); remove the key")
+            raise ValueError(f"{', '.join(bad)}: not used by the 3D boring model (its contact "
+                             "has no normal damping); remove the key")
         return self
 
 
@@ -171,6 +175,11 @@ class SolverSection(_Strict):
     energy_error_limit: float = Field(default=0.5, gt=0.0)
     #: node splitting: a tied pair parts within this distance of the insert [um]
     separation_gate_um: float = Field(default=0.0, ge=0.0)
+    #: heat conduction between the workpiece's elements and the thermal contact with the
+    #: insert (the 2D engine's model, :mod:`robobore.cutting.fe.thermal3d`), every
+    #: ``conduction_interval`` steps; false: adiabatic
+    heat_conduction: bool = True
+    conduction_interval: int = Field(default=10, ge=1, le=10000)
 
 
 def _triple(v: Any) -> list[float]:
@@ -450,6 +459,7 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     p[K3.P_VC] = vc
     p[K3.P_VF] = f * n_rps
     p[K3.P_RADIUS] = R
+    apply_thermal_settings(p, s, cfg.contact, mat, K3)
     gap0 = 0.5 * le
     x0 = -(ins.edge_radius_m + gap0)
     t_contact = gap0 / vc

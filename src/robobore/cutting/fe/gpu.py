@@ -8,8 +8,10 @@ and the shared material/contact/support functions (:mod:`robobore.material.johns
 ``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
 force total (one block, in the CPU's fixed lane order, so a run is reproducible bit for
 bit), the tool (one thread), elements (stable step by atomic min), and the step end (one
-thread: time, status, time-averaged histories). The loop stays on the device; the host only
-checks the status between chunks.
+thread: time, status, time-averaged histories); every ``solver.conduction_interval`` steps
+the heat conduction of :mod:`robobore.cutting.fe.thermal3d` adds five more (centroids, new
+temperatures, their copy, the insert's heat per node, then per element). The loop stays on
+the device; the host only checks the status between chunks.
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``, i.e.
 ``numba-cuda``). Importing this module never needs either; :func:`require_gpu` raises a
@@ -138,6 +140,7 @@ def _kernels():
     from numba import int64 as _int64
 
     from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe import thermal3d as T3
     from robobore.cutting.fe.hex8 import hex_element_py
     from robobore.cutting.fe.physics import tool_face_py, tool_gap_py, tool_support_step_py
     from robobore.material import johnson_cook as jc
@@ -156,6 +159,14 @@ def _kernels():
     kin = dev(K3.tool_kinematics_py)
     tstep = dev(jc.rebind(K3.tool_step_py, tool_kinematics=kin, tool_support_step=sup))
     lsum3 = dev(K3.lane_sum3_py)
+    th = {}
+    for name, func, deps in T3.DEVICE_FUNCTIONS:
+        th[name] = dev(jc.rebind(func, **{d: th[d] for d in deps}))
+    centroid3, conduct3 = th["hex_centroid3"], th["hex_conduct3"]
+    heat_node3, heat_elem3 = th["tool_heat_node3"], th["tool_heat_elem3"]
+    is_cond = dev(K3.is_conduction_step_py)
+    RHO, CP, KCOND = jc.RHO, jc.CP, jc.KCOND
+    P_COND_T, P_HC, P_FHEAT, P_TTOOL = K3.P_COND_T, K3.P_HC, K3.P_FHEAT, K3.P_TTOOL
     chunks = dev(chunk_list_py)
     LANES = K3.N_SUM_LANES
     float64 = _float64
@@ -239,6 +250,53 @@ def _kernels():
         if alive[e] == -2:
             red[R_BAD] = e
 
+    @cuda.jit
+    def k_centroids(conn, x, y, z, tbuf, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        centroid3(e, conn, x, y, z, tbuf)
+
+    @cuda.jit
+    def k_conduct(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat, prm, clock, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        dt_th = clock[0] + clock[1] - prm[P_COND_T]
+        conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[KCOND],
+                 mat[RHO] * mat[CP], dt_th)
+
+    @cuda.jit
+    def k_copy_temp(temp, tbuf, ist):
+        e = cuda.grid(1)
+        if e >= temp.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        temp[e] = tbuf[e, 3]
+
+    @cuda.jit
+    def k_heat_nodes(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
+                     temp, theat, mat, prm, clock, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        dt_th = clock[0] + clock[1] - prm[P_COND_T]
+        heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
+                   temp, theat, mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
+                   dt_th)
+
+    @cuda.jit
+    def k_heat_elems(conn, alive, temp, theat, mat, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        heat_elem3(e, conn, alive, temp, theat, mat[RHO] * mat[CP])
+
+    @cuda.jit
+    def k_cond_done(prm, clock, ist):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        prm[P_COND_T] = clock[0] + clock[1]
+
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red):
         # the step end (one thread): time, stable step, status, time-averaged histories
@@ -304,8 +362,8 @@ def _kernels():
     @cuda.jit
     def k_run(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
               sd, pres, eps_p, temp, dm, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
-              ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, erosion,
-              red, cflag, clist):
+              ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, enbr,
+              tbuf, theat, erosion, red, cflag, clist):
         # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
         # of the five kernels above separated by grid-wide barriers, so the host launches
         # once per chunk instead of five times per step. Same functions, same order, same
@@ -326,6 +384,9 @@ def _kernels():
             if ist[I_STATUS] != ST_OK:
                 return
             dt = clock[1]
+            # the step number, read before the step's first barrier (thread 0 moves it on
+            # after its last): every thread takes the same conduction branch below
+            step = ist[I_STEP]
             cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
             for n in range(tid, nn, nthr):
                 node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
@@ -367,19 +428,47 @@ def _kernels():
                 if alive[e] == -2:
                     red[R_BAD] = e
             grid.sync()
+            if is_cond(step, prm):
+                # conduction (thermal3d, the CPU's conduction_pass3): the phases of the five
+                # launches of the launch path, separated by barriers
+                dt_th = clock[0] + dt - prm[P_COND_T]
+                rcp = mat[RHO] * mat[CP]
+                for e in range(tid, ne, nthr):
+                    centroid3(e, conn, x, y, z, tbuf)
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf,
+                             mat[KCOND], rcp, dt_th)
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    temp[e] = tbuf[e, 3]
+                grid.sync()
+                if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+                    for n in range(tid, nn, nthr):
+                        heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs,
+                                   vol0, cf, fric, temp, theat, rcp, prm[P_HC], prm[P_FHEAT],
+                                   prm[P_TTOOL], dt_th)
+                    grid.sync()
+                    for e in range(tid, ne, nthr):
+                        heat_elem3(e, conn, alive, temp, theat, rcp)
+                    grid.sync()
+                if tid == 0:
+                    prm[P_COND_T] = clock[0] + dt
             if tid == 0:
                 finish(tool, prm, clock, ist, hacc, hist, en, red)
                 red[R_DTMIN] = 1e30
                 red[R_BAD] = -1.0
             grid.sync()
 
-    return k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run
+    return (k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run,
+            (k_centroids, k_conduct, k_copy_temp, k_heat_nodes, k_heat_elems, k_cond_done))
 
 
 #: arrays of FEState3 that the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "z", "vx", "vy", "vz", "alive", "sd", "pres", "eps_p", "temp", "dmg",
             "qh", "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
-            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist", "pairs")
+            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "prm",
+            "tbuf", "theat")
 
 
 def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
@@ -403,7 +492,8 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
 
     require_gpu()
-    k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run = _kernels()
+    k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_run, k_thermal = _kernels()
+    k_centroids, k_conduct, k_copy_temp, k_heat_nodes, k_heat_elems, k_cond_done = k_thermal
     st.prm[K3.P_TEND] = t_end
     st.ist[K3.I_STATUS] = K3.STATUS_OK
     g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _RUN_ARGS}
@@ -421,9 +511,11 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     tick = _ticker(profile)
     run = _persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
                           profile, persistent)
+    heat = st.prm[K3.P_HC] > 0.0 or st.prm[K3.P_FHEAT] > 0.0
     while True:
         if run is not None:
             run(chunk_steps)
+        step = int(st.ist[K3.I_STEP])  # the launch path: the host counts the steps
         for _ in range(0 if run is not None else chunk_steps):
             tick(None)
             k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
@@ -442,6 +534,23 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                                   g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                                   g["clock"], erosion, g["ist"], dred)
             tick("elements")
+            if K3.is_conduction_step_py(step, st.prm):
+                k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
+                k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
+                                        g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],
+                                        g["prm"], g["clock"], g["ist"])
+                k_copy_temp[ge, _THREADS](g["temp"], g["tbuf"], g["ist"])
+                if heat:
+                    k_heat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["ptr"],
+                                               g["nel"], g["ncorner"], g["alive"], g["enbr"],
+                                               g["pairs"], g["vol0"], g["cf"], g["fric"],
+                                               g["temp"], g["theat"], g["mat"], g["prm"],
+                                               g["clock"], g["ist"])
+                    k_heat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["theat"],
+                                               g["mat"], g["ist"])
+                k_cond_done[1, 1](g["prm"], g["clock"], g["ist"])
+                tick("conduction")
+            step += 1
             k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
                            g["en"], dred)
             tick("finish")
@@ -467,7 +576,8 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
 _RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
              "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
              "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
-             "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs")
+             "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "enbr", "tbuf",
+             "theat")
 
 
 def _persistent_run(kernel, args: list, n_nodes: int, profile, persistent: bool | None):

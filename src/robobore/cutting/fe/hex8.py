@@ -79,7 +79,14 @@ P_MUTAB_N = 39
 P_MUTAB_V = P_MUTAB_N + 1
 P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
 P_SLIP_TAU = P_MUTAB_MU + MU_TABLE_MAX
-N_PRM = P_SLIP_TAU + 1
+# heat conduction (the 2D engine's model, kernels.P_COND_EVERY ...): steps between
+# conduction passes (0: adiabatic), the time [s] of the last pass, the interface conductance
+# to the insert [W/(m^2 K)], the fraction of the frictional dissipation that heats the
+# workpiece, the insert's temperature [K]
+P_COND_EVERY = P_SLIP_TAU + 1
+P_COND_T, P_HC, P_FHEAT, P_TTOOL = P_COND_EVERY + 1, P_COND_EVERY + 2, P_COND_EVERY + 3, \
+    P_COND_EVERY + 4
+N_PRM = P_TTOOL + 1
 ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
 
 

@@ -45,6 +45,8 @@ from robobore.cutting.fe.hex8 import (
     P_BV2,
     P_CFL,
     P_CLR,
+    P_COND_EVERY,
+    P_COND_T,
     P_CX,
     P_CY,
     P_CZ,
@@ -52,7 +54,9 @@ from robobore.cutting.fe.hex8 import (
     P_DT_ERODE,
     P_DTMIN,
     P_EROSION,
+    P_FHEAT,
     P_GATE,
+    P_HC,
     P_HGS,
     P_HGV,
     P_KAPPA,
@@ -82,6 +86,7 @@ from robobore.cutting.fe.hex8 import (
     P_TEND,
     P_THETA0,
     P_TOOL,
+    P_TTOOL,
     P_VC,
     P_VF,
     hex_element,
@@ -111,6 +116,8 @@ from robobore.cutting.fe.kernels import (
     STATUS_OK,
 )
 from robobore.cutting.fe.physics import tool_gap, tool_support_step
+from robobore.cutting.fe.thermal3d import conduct3, conduct3_serial, tool_heat3, tool_heat3_serial
+from robobore.material import johnson_cook as jc
 from robobore.material.johnson_cook import rebind
 
 __all__ = [
@@ -120,8 +127,9 @@ __all__ = [
     "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF", "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY",
     "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY", "P_MZ", "P_THETA0", "P_SAMPLE_DT",
     "P_TEND", "P_EROSION", "P_PARALLEL", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN",
-    "N_IST", "STATUS_OK",
-    "insert_gap3_py", "insert_gap3", "contact_force3_py", "contact_force3", "hex_node_py",
+    "N_IST", "STATUS_OK", "P_COND_EVERY", "P_COND_T", "P_HC", "P_FHEAT", "P_TTOOL",
+    "is_conduction_step_py", "conduction_pass3", "insert_gap3_py", "insert_gap3",
+    "contact_force3_py", "contact_force3", "hex_node_py",
     "hex_node", "element_update3", "node_update3", "run_chunk3",
 ]
 
@@ -564,14 +572,50 @@ def contact_total3(cf):
     return fx, fy, fz, nc
 
 
+def is_conduction_step_py(step, prm):
+    """True where step number ``step`` (counted from 0) ends with a conduction pass."""
+    every = int(prm[P_COND_EVERY])
+    return every > 0 and step % every == 0
+
+
+is_conduction_step = njit(cache=True, inline="always")(is_conduction_step_py)
+
+
+@njit(cache=True)
+def conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
+                     tbuf, theat, mat, prm, t_end_step, par):
+    """Conduction and the thermal contact with the insert over the time since the last pass,
+    ``t_end_step - prm[P_COND_T]`` [s], which then moves to ``t_end_step``."""
+    dt_th = t_end_step - prm[P_COND_T]
+    rcp = mat[jc.RHO] * mat[jc.CP]
+    if par:
+        conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp, dt_th)
+    else:
+        conduct3_serial(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp,
+                        dt_th)
+    if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+        if par:
+            tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
+                       temp, theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
+        else:
+            tool_heat3_serial(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
+                              fric, temp, theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
+                              dt_th)
+    prm[P_COND_T] = t_end_step
+
+
 @njit(cache=True)
 def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
                sd, pres, eps_p, temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
-               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs):
+               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, enbr,
+               tbuf, theat):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
     STATUS_DONE at ``prm[P_TEND]``, or an instability status. Returns the steps taken.
+    Every ``prm[P_COND_EVERY]`` steps (0: adiabatic) heat conduction and the thermal contact
+    with the insert run over the time since the last pass (:mod:`~robobore.cutting.fe.
+    thermal3d`, :func:`conduction_pass3`).
     """
     erosion = int(prm[P_EROSION])
     par = prm[P_PARALLEL] > 0.5
@@ -598,6 +642,9 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
             element_update3_serial(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p,
                                    temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm,
                                    dt, erosion)
+        if is_conduction_step(ist[I_STEP], prm):
+            conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
+                             fric, temp, tbuf, theat, mat, prm, t + dt, par)
         dtmin = 1e30
         for e in range(ne):
             if dte[e] < dtmin:

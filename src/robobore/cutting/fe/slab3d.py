@@ -25,6 +25,7 @@ from robobore.cutting.fe.config import FEConfig
 from robobore.cutting.fe.solver import (
     apply_friction_settings,
     apply_solver_settings,
+    apply_thermal_settings,
     energy_error,
 )
 from robobore.cutting.fe.solver3d import (
@@ -90,6 +91,7 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, n_dn)
     p = apply_solver_settings(default_prm3(), cfg.solver, K3)
     apply_friction_settings(p, cfg.contact, cfg.cut.cutting_speed_m_per_min, K3)
+    apply_thermal_settings(p, cfg.solver, cfg.contact, mat, K3)
     p[K3.P_PEN] = cfg.contact.penalty_factor
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = 1.0

@@ -375,6 +375,21 @@ def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
     return p
 
 
+def apply_thermal_settings(p: np.ndarray, solver: Any, contact: Any, material: Material,
+                           kernels: Any) -> np.ndarray:
+    """Write the heat conduction (``solver.heat_conduction``, ``conduction_interval``) and the
+    thermal contact with the tool (``contact.thermal_conductance_W_per_m2K``,
+    ``friction_heat_fraction``, ``tool_temperature_K``; None: the material's room
+    temperature) into ``p`` (returned); shared by the 2D and 3D engines."""
+    k = kernels
+    p[k.P_COND_EVERY] = solver.conduction_interval if solver.heat_conduction else 0
+    p[k.P_HC] = contact.thermal_conductance_W_per_m2K
+    p[k.P_FHEAT] = contact.friction_heat_fraction
+    p[k.P_TTOOL] = (material.T_room if contact.tool_temperature_K is None
+                    else contact.tool_temperature_K)
+    return p
+
+
 def apply_friction_settings(p: np.ndarray, contact: Any, vc_m_per_min: float,
                             kernels: Any) -> np.ndarray:
     """Write the friction of a ``[contact]`` section into ``p`` (returned); shared by the 2D
@@ -507,11 +522,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     if s.edge_ale_interval > 0:
         p[K.P_RZ_EVERY] = s.edge_ale_interval
         p[K.P_RZ_MODE] = MODE_ROWS
-    p[K.P_COND_EVERY] = s.conduction_interval if s.heat_conduction else 0
-    cc = cfg.contact
-    p[K.P_HC] = cc.thermal_conductance_W_per_m2K
-    p[K.P_FHEAT] = cc.friction_heat_fraction
-    p[K.P_TTOOL] = mat.T_room if cc.tool_temperature_K is None else cc.tool_temperature_K
+    apply_thermal_settings(p, s, cfg.contact, mat, K)
     if s.separation_gate_um is not None:
         p[K.P_GATE] = s.separation_gate_um * 1e-6
     elif cfg.mesh.separation == "node_split":

@@ -16,6 +16,7 @@ import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.solver import drive_chunks, energy_error
+from robobore.cutting.fe.thermal3d import face_neighbours
 from robobore.errors import ConfigError
 from robobore.material import Material
 
@@ -75,6 +76,14 @@ class FEState3:
     #: node splitting, (n, 2) int64: partner node (-1: none) and whether the pair is still
     #: tied (one array: see :func:`kernels3d.hex_node_py`)
     pairs: np.ndarray
+    #: heat conduction (:mod:`robobore.cutting.fe.thermal3d`): the element across each face
+    #: (e, 6) int64 (-1 none, -(nb + 2) across a parting face); scratch (e, 4): centroid,
+    #: new temperature; per node (n, 3): frictional dissipation already turned into heat
+    #: [J], heat exchanged with the insert in the current pass [J], volume of the node's live
+    #: elements [m^3]
+    enbr: np.ndarray
+    tbuf: np.ndarray
+    theat: np.ndarray
 
     def kernel_args(self) -> tuple:
         """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
@@ -121,6 +130,7 @@ def default_prm3() -> np.ndarray:
     p[K3.P_KAPPA] = np.pi / 2
     p[K3.P_KEND] = np.radians(5.0)
     p[K3.P_RN] = 1e-3
+    p[K3.P_COND_EVERY] = 0  # adiabatic
     return p
 
 
@@ -192,9 +202,17 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
             tw[tw[tw >= 0]] != np.flatnonzero(tw >= 0)):
         raise ConfigError("twin must pair nodes symmetrically", field="twin",
                           value=str(tw.shape), expected=f"(n,) = ({n},), twin[twin[i]] = i")
+    try:
+        enbr = face_neighbours(conn, tw if twin is not None else None)
+    except ValueError as exc:
+        raise ConfigError(f"mesh is not a valid hexahedral mesh: {exc}", field="conn",
+                          value=f"{ne} elements", expected="each face shared by at most two "
+                          "hexahedra") from None
     tool = z(K3.N_TOOL)
     tool[K3.T_GX], tool[K3.T_GY], tool[K3.T_GZ] = tool_tip
     tool[K3.T_THETA] = prm[K3.P_THETA0]
+    if prm[K3.P_TTOOL] <= 0.0:
+        prm[K3.P_TTOOL] = material.T_room
     st = FEState3(
         x=nodes[:, 0].copy(), y=nodes[:, 1].copy(), z=nodes[:, 2].copy(), vx=z(n), vy=z(n),
         vz=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.int64).copy(), ptr=ptr,
@@ -208,7 +226,9 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         mat=material.to_array(), prm=prm, tool=tool, en=z(K3.N_EN),
         ist=np.zeros(K3.N_IST, np.int64), clock=z(3), hacc=z(K3.N_HIST),
         hist=np.full((max(1, n_samples), K3.N_HIST), np.nan),
-        pairs=np.ascontiguousarray(np.stack([tw, (tw >= 0).astype(np.int64)], axis=1)))
+        pairs=np.ascontiguousarray(np.stack([tw, (tw >= 0).astype(np.int64)], axis=1)),
+        enbr=enbr, tbuf=z((ne, 4)),
+        theat=z((n, 3)))
     init_forces3(st)
     return st
 
