@@ -34,7 +34,7 @@ step (the fallback path), whose host-side launch cost dominates small meshes.
 
 ``paper3d`` / ``ortho2d``: whole runs (the 3D paper condition of ``bench_fe3d.py paper``,
 the 2D contract config or, with ``--config``, any 2D config, the tool-frame ALE model's
-included (session 15); ``--length-mm`` /
+included; ``--length-mm`` /
 ``--element-um`` override the config's when given) on each device: forces, energy error,
 wall time and the relative force differences between the devices.
 """

@@ -10,8 +10,8 @@ r 0.4 mm, end-edge angle 5 deg). Coefficient sets: the default TC4 coefficients
 (``ti64_coefficients`` at the run's 37.7 m/min), the bundled FE calibration
 (``data/paper_example/tc4_fe_coefficients.json``) and every file given. For each:
 ``cutting.forces.boring_forces`` (tangential / radial / feed on the tool, N) with the trailing
-side of the nose (the default) and without it (``trailing_edge=False``), and the 3D FE
-forces of docs/fe3d.md ("Validation status" table) relative to the model, magnitudes.
+side of the nose (the default) and without it (``trailing_edge=False``), and the stored 3D
+FE forces ``FE_N`` relative to the model, magnitudes.
 No FE is run. Cheap (well under a second per set).
 """
 
@@ -24,7 +24,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: 3D FE rotating-frame forces [N] (t, r, f), docs/fe3d.md "Validation status" (bench_fe3d).
+#: 3D FE rotating-frame forces [N] (t, r, f) of ``bench_fe3d.py paper`` runs with the friction
+#: table at the cutting speed and the 576 MPa cap; the current engine's runs with that physics
+#: (benchmarks/measured/gpu_h100_2026-11-22/paper3d_refinement.json) differ by up to 11 %
+#: (the 10 um feed force), and the default physics' figures are in docs/fe3d.md.
 FE_N = {"5 um": (16.51, -7.00, -1.57), "6.25 um": (16.85, -8.02, -1.72),
         "10 um": (18.54, -9.25, -2.00)}
 

@@ -2,10 +2,10 @@
 possible starts, over states drawn from the range of a cut, and the compiled return's speed.
 
 The package solves q - 3 G d - sigma_y(eps_p + d, d / dt, T) = 0 by a safeguarded Newton
-method. Until session 14 it started at the perfectly plastic increment (q - sigma_y0) / (3 G);
-it now starts at the smaller of that and dt eps0 exp((q / sigma_y0 - 1) / C) (docs/fe.md,
-"A faster Johnson-Cook return"). This script runs the package's own ``jc_return_py`` as
-Python with a counting ``abs`` bound in (one call per iteration) and, for the previous
+method started at the smaller of the perfectly plastic increment (q - sigma_y0) / (3 G) and
+dt eps0 exp((q / sigma_y0 - 1) / C) (docs/fe.md, "Model"); the comparison start is the
+perfectly plastic increment alone. This script runs the package's own ``jc_return_py`` as
+Python with a counting ``abs`` bound in (one call per iteration) and, for the comparison
 start, a ``math.exp`` that answers infinity (``_solve``); it checks that the current start's
 root equals the compiled return's for every sample, and prints the mean and largest
 iteration counts of both starts and the compiled return's speed. TC4 constants of the

@@ -4,7 +4,7 @@ Every JSON row file written by ``validate_fe_orthogonal.py --json`` in a folder 
 ``benchmarks/measured/fe_validation_2026-11-23``) that holds the chosen point is read; each
 run is a dot at (cutting-force error, feed-force error) in per cent, labelled with its file
 name, and issue 5's acceptance box (|Fc error| <= 10 %, |Ff error| <= 35 %) is drawn. The
-picture shows which model settings reach the box at that point (docs/fe.md, sessions 13-16).
+picture shows which model settings reach the box at that point (docs/fe.md, "Limits").
 
     python benchmarks/plot_fe_error_plane.py [--dir DIR] [--point 60:5] [--out FILE.png]
 """

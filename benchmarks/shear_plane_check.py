@@ -1,7 +1,8 @@
 """Shear-plane check of the Johnson-Cook constants against the measured cutting tests.
 
-An analytical cross-check of the FE validation (docs/fe.md, session 15), independent of the
-FE engine: for every point of ``../shared/data/ti64_orthogonal_cutting_forces.json``
+An analytical cross-check of the FE validation (docs/fe.md, "Validation against the measured
+forces"), independent of the FE engine: for every point of
+``../shared/data/ti64_orthogonal_cutting_forces.json``
 
 1. **What the measurement implies.** The measured chip ratio r gives the shear angle
    (Merchant's geometry, rake alpha): tan(phi) = cos(alpha) / (r - sin(alpha)). The measured

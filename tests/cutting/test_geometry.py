@@ -158,7 +158,7 @@ def test_trailing_edge_limited_by_the_prebore_surface():
 
 
 def test_trailing_edge_switch_and_count():
-    """trailing_edge=False gives the leading edge only (the earlier model); n_trailing sets
+    """trailing_edge=False gives the leading edge only; n_trailing sets
     the count; a bad count names the field."""
     ins = BoringInsert()
     off = edge_elements(ins, 0.05e-3, 0.15e-3, 30, trailing_edge=False)

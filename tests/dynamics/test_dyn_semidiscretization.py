@@ -66,9 +66,9 @@ def test_lobes_of_the_identified_robot_in_one_command(tmp_path):
 
 def test_identified_robot_crossing_is_bracketed(tmp_path):
     """At the paper's speeds the returned depth separates stable (x 0.99) from unstable
-    (x 1.01) monodromy spectral radii on the identified example robot (the bundled campaign
-    gave 1.61 / 1.32 / 1.16 N/um when the earlier root bracket failed on it); a 0 is unstable
-    down to the scan floor, an inf stable at the scan top."""
+    (x 1.01) monodromy spectral radii on the identified example robot (the bundled campaign's,
+    1.61 / 1.32 / 1.16 N/um: a case whose crossing a careless root bracket misses); a 0 is
+    unstable down to the scan floor, an inf stable at the scan top."""
     from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
 
     s, m = _identified(tmp_path)

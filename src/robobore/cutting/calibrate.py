@@ -339,8 +339,9 @@ def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
 
 
 #: revision of the FE engine's physics in the cache key: bump it whenever a change of the
-#: engine changes its results for the same config, so that cached FE forces of the old engine
-#: are not reused. 2: the contact's stick/slip return mapping on the trial velocity (2026-11-22)
+#: engine changes its results for the same config, so that cached FE forces of another
+#: revision are not reused. Revision 2: the contact's stick/slip return mapping on the trial
+#: velocity
 FE_ENGINE_REVISION = 2
 
 

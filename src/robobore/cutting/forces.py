@@ -482,8 +482,8 @@ def boring_forces(insert: BoringInsert, depth_m: float, feed_per_rev_m: float,
     the inserts, equally spaced), rotating-frame totals per insert, chip area, and per-axis
     mean and amplitude (half peak-to-peak). ``trailing_edge`` (default True): edge forces
     also on the engaged trailing side of the nose
-    (:func:`robobore.cutting.geometry.edge_elements`); False gives the earlier
-    leading-edge-only model.
+    (:func:`robobore.cutting.geometry.edge_elements`); False gives the
+    leading edge only.
     """
     fz = feed_per_rev_m / insert.n_inserts
     el = edge_elements(insert, depth_m, fz, n_elements, trailing_edge=trailing_edge)

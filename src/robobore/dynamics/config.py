@@ -238,7 +238,7 @@ class CuttingCfg(_Strict):
     overlap_factor: float = Field(1.0, ge=0, le=1)
     depth_modulation: bool = True
     # edge (ploughing) force also on the engaged trailing side of the nose (from the tip to
-    # where it meets the previous pass); false: the earlier leading-edge-only model
+    # where it meets the previous pass); false: the leading edge only
     trailing_edge: bool = True
 
 

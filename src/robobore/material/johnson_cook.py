@@ -120,8 +120,8 @@ def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt, ehmax):
     flow stress to q, dt eps0 exp((q / sigma_y0 - 1) / C) (sigma_y0: the flow stress at
     eps_p and the reference rate). The first alone overestimates the root by orders of
     magnitude at cutting rates (it ignores the 20-30 % the rate term adds), which cost
-    ~10 safeguarded iterations a return; from the smaller bound Newton takes ~4 (session 14,
-    docs/fe.md).
+    ~10 safeguarded iterations a return; from the smaller bound Newton takes ~4
+    (``benchmarks/jc_return_iterations.py``; docs/fe.md, "Model").
     """
     # T is held over the increment: the thermal factor is evaluated once; each iteration
     # then costs one power and one logarithm (flow stress and its derivative share them)

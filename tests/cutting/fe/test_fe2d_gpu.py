@@ -217,9 +217,9 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
 
     The CPU engine is compiled afresh in the subprocess (its own NUMBA_CACHE_DIR): the
     machine code numba makes for ``kernels.element_update`` depends on what else the process
-    compiled before it (a CI run whose cache came from earlier tests gave the same element
-    a result 2e-13 apart after 40 steps -- session 11, found by swapping cache files one
-    function at a time), so bit-identity holds for a given compilation, not across them."""
+    compiled before it (with a cache filled by other tests the same element can give a result
+    2e-13 apart after 40 steps; swapping that function's cache files flips the comparison),
+    so bit-identity holds for a given compilation, not across them."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", NUMBA_NUM_THREADS="1",
                NUMBA_CACHE_DIR=str(tmp_path / "numba_cache"))
     p = subprocess.run([sys.executable, "-c", SCRIPT, path], env=env, capture_output=True,

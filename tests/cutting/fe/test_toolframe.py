@@ -182,7 +182,7 @@ def test_tool_frame_config_errors(patch, field):
 
 
 def test_tool_frame_on_gpu_needs_a_gpu():
-    """The tool-frame model runs on the GPU since session 15 (the simulator test in
+    """The tool-frame model runs on the GPU (the simulator test in
     test_fe2d_gpu.py); without a usable GPU --device gpu stops with the clear error."""
     from robobore.cutting.fe.gpu import cuda_available
     from robobore.cutting.fe.solver import check_device

@@ -248,7 +248,7 @@ class MeshSection(_Strict):
     #: tool frame: length [um] of the pre-shaped chip up the rake face, from where the rake
     #: face starts to the chip's top face (an outflow boundary); None: max(1.5 chip
     #: thicknesses, 80 um). It must exceed the tool-chip contact length: a chip that still
-    #: touches the rake at its top face is held there by the boundary (docs/fe.md, session 15)
+    #: touches the rake at its top face is held there by the boundary (docs/fe.md, "Mesh")
     chip_length_um: float | None = Field(default=None, gt=0.0)
     #: tool frame: depth [um] of the mesh's bottom below the cut line; the bottom is held
     #: fixed in the workpiece (a rigid base). None: max(2.5 h, 120 um)
@@ -317,8 +317,9 @@ class SolverSection(_Strict):
     #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
     erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
     #: heat conduction between workpiece elements (finite volumes on the deformed mesh,
-    #: explicit, every ``conduction_interval`` steps); the tool and free surfaces are
-    #: adiabatic. False: adiabatic heating only
+    #: explicit, every ``conduction_interval`` steps), with the thermal contact to the tool
+    #: (``contact.thermal_conductance_W_per_m2K``, ``friction_heat_fraction``); the other
+    #: free surfaces are adiabatic. False: adiabatic heating only
     heat_conduction: bool = True
     conduction_interval: int = Field(default=10, ge=1, le=10000)
     #: number of force/tool samples over the whole run

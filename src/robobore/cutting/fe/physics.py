@@ -1,4 +1,4 @@
-"""Scalar physics of the FE cutting engine, in one module (CPU now, GPU later).
+"""Scalar physics of the FE cutting engine, in one module (shared by the CPU and GPU engines).
 
 Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` versions:
 

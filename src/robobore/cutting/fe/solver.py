@@ -721,7 +721,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     }
     faces = hh[:, K.H_FX_RAKE:K.H_FX_RAKE + 6] * 1e-3
     has_faces = bool(win.any() and np.all(np.isfinite(faces[win])))
-    if has_faces:  # both engines (the GPU since session 15)
+    if has_faces:  # recorded by both devices
         fm = faces[win].mean(axis=0)
         summary["force_by_face_N_per_mm"] = {
             face: {"cutting": float(fm[2 * j]), "feed": float(fm[2 * j + 1])}

@@ -3,7 +3,8 @@ flows through it (``mesh.frame = "tool"``).
 
 Why. A Lagrangian mesh split at a fixed parting line deletes, by distortion erosion at the
 stagnation point, exactly the thin layer that the edge radius ploughs under itself (see
-docs/fe.md, sessions 6-8): the edge and flank forces -- most of the feed force -- are lost.
+docs/fe.md, "Tool-frame ALE model"): the edge and flank forces -- most of the feed force --
+are lost.
 With a mesh fixed relative to the tool no element is carried through the stagnation point:
 material enters ahead of the tool, divides round the edge wherever the flow divides (no
 separation criterion, no erosion) and leaves through the machined surface behind the flank
