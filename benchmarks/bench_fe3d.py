@@ -8,8 +8,10 @@ Usage::
         [--separation erosion_layer|node_split] [--no-support] [--out results.json]
 
 ``speed`` prints element-updates per second of the full time step (nodes, contact, elements,
-tool) on a wall block of about ``--elements`` hexahedra, serial and parallel, with the load
-average (the machine is shared: figures are noisy). ``paper`` runs
+tool, heat conduction every 10 steps) on a wall block of about ``--elements`` hexahedra,
+serial and parallel, each with the adiabatic model as the reference run in the same process
+(the ratio is the cost of conduction), with the load average (the machine is shared: figures
+are noisy). ``paper`` runs
 ``examples/fe_boring_paper.toml`` (ap = 0.05 mm, f = 0.15 mm/r, n = 300 r/min, TC4; insert
 and bore diameter are documented assumptions) at each element size, compares the rotating-
 frame forces with the mechanistic model (default TC4 coefficients, or ``--coefficients``,
@@ -50,26 +52,35 @@ def speed(n_elements: int, steps: int) -> dict:
     d["mesh"]["element_size_um"] = min(le, 16.6)
     out = {}
     for par in (False, True):
-        d["solver"]["parallel"] = par
-        s = setup_boring(parse_boring_config(d))
-        st = s.state
-        K3.run_chunk3(5, *st.kernel_args())  # compile / warm up
-        t0 = time.perf_counter()
-        c0 = time.process_time()
-        taken = K3.run_chunk3(steps, *st.kernel_args())
-        wall = time.perf_counter() - t0
-        cpu = time.process_time() - c0
-        rate = st.n_elements * taken / wall
-        per_cpu = st.n_elements * taken / cpu
-        key = "parallel" if par else "serial"
-        out[key] = {"elements": st.n_elements, "steps": int(taken), "wall_s": wall,
-                    "cpu_s": cpu, "element_updates_per_s": rate,
-                    "element_updates_per_cpu_s": per_cpu, "load": _load()}
-        # per CPU-second: what one core delivers when it actually runs (the shared machine
-        # gives this process only part of a core); x 2 estimates an unloaded 2-core machine
-        print(f"{key:8s}: {st.n_elements} elements x {taken} steps in {wall:.2f} s wall, "
-              f"{cpu:.2f} s CPU -> {rate / 1e6:.2f} M element-updates/s wall, "
-              f"{per_cpu / 1e6:.2f} M per CPU-second ({_load()})", flush=True)
+        for cond in (True, False):
+            d["solver"]["parallel"] = par
+            d["solver"]["heat_conduction"] = cond
+            s = setup_boring(parse_boring_config(d))
+            st = s.state
+            K3.run_chunk3(5, *st.kernel_args())  # compile / warm up
+            t0 = time.perf_counter()
+            c0 = time.process_time()
+            taken = K3.run_chunk3(steps, *st.kernel_args())
+            wall = time.perf_counter() - t0
+            cpu = time.process_time() - c0
+            rate = st.n_elements * taken / wall
+            per_cpu = st.n_elements * taken / cpu
+            key = ("parallel" if par else "serial") + ("" if cond else "_adiabatic")
+            out[key] = {"elements": st.n_elements, "steps": int(taken), "wall_s": wall,
+                        "cpu_s": cpu, "element_updates_per_s": rate,
+                        "element_updates_per_cpu_s": per_cpu, "load": _load()}
+            # per CPU-second: what one core delivers when it actually runs (the shared
+            # machine gives this process only part of a core); x 2 estimates an unloaded
+            # 2-core machine
+            print(f"{key:19s}: {st.n_elements} elements x {taken} steps in {wall:.2f} s wall, "
+                  f"{cpu:.2f} s CPU -> {rate / 1e6:.2f} M element-updates/s wall, "
+                  f"{per_cpu / 1e6:.2f} M per CPU-second ({_load()})", flush=True)
+        base = "parallel" if par else "serial"
+        ratio = (out[base]["element_updates_per_cpu_s"]
+                 / out[base + "_adiabatic"]["element_updates_per_cpu_s"])
+        out[base]["ratio_to_adiabatic"] = ratio
+        print(f"{base}: heat conduction (default) / adiabatic, per CPU-second: {ratio:.3f}",
+              flush=True)
     return out
 
 
