@@ -106,8 +106,8 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     revs = revolutions if revolutions is not None else cfg.simulation.revolutions
     nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
     st = build_structure(cfg, src)
-    pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None)
     coef = build_coefficients(cfg, src) if cfg.is_boring else None
+    pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None, coefficients=coef)
     try:
         ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
                       cfg.insert.to_insert() if cfg.is_boring else None)
@@ -167,7 +167,8 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
 
     cfg, _, src = _config(config)
     st = build_structure(cfg, src)
-    pr = build_process(cfg, src)
+    coef = build_coefficients(cfg, src) if cfg.is_boring else None
+    pr = build_process(cfg, src, coefficients=coef)
     from robobore.dynamics.config import speed_range
 
     sp, default_note = speed_range(cfg)  # DEFAULT_SPEED_RPM without [speed_rpm]
@@ -184,10 +185,10 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     d["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
     if default_note is not None:
         d["speed_note"] = default_note
-    if cfg.is_boring:
+    if coef is not None:
         from robobore.dynamics.config import lobe_coefficient_note
 
-        note = lobe_coefficient_note(cfg, src)
+        note = lobe_coefficient_note(cfg, coef)
         if note is not None:
             d["coefficient_note"] = note
     return d

@@ -63,6 +63,7 @@ def lobes_cmd(
 
     from robobore.dynamics import stability
     from robobore.dynamics.config import (
+        build_coefficients,
         build_process,
         build_structure,
         load_dynamics_config,
@@ -74,17 +75,18 @@ def lobes_cmd(
     cfg, _ = load_dynamics_config(config, stiffness_file, modes_file, equivalent_file)
     src = str(config)
     st = build_structure(cfg, src)
-    pr = build_process(cfg, src)
+    coef = build_coefficients(cfg, src) if cfg.is_boring else None
+    pr = build_process(cfg, src, coefficients=coef)
     sp, default_note = speed_range(cfg)
     speeds = np.linspace(sp.min, sp.max, sp.count)
     if method not in ("frequency", "semidiscretization"):
         raise ConfigError("unknown method", field="--method", value=method,
                           expected="frequency or semidiscretization")
     notes = [] if default_note is None else [default_note]
-    if cfg.is_boring:
+    if coef is not None:
         from robobore.dynamics.config import lobe_coefficient_note
 
-        cnote = lobe_coefficient_note(cfg, src)
+        cnote = lobe_coefficient_note(cfg, coef)
         if cnote is not None:
             notes.append(cnote)
     if method == "frequency":

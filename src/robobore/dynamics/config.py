@@ -493,10 +493,12 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
     return forces.CuttingCoefficients.from_dict(d, source=source)
 
 
-def lobe_coefficient_note(cfg: DynamicsConfig, source: str | None = None) -> str | None:
-    """The note of a lobe diagram whose coefficients depend on the cutting speed: they are
-    evaluated once, at the ``[cutting]`` speed, not at each lobe speed (None otherwise)."""
-    c = build_coefficients(cfg, source)
+def lobe_coefficient_note(cfg: DynamicsConfig, coefficients: Any = None,
+                          source: str | None = None) -> str | None:
+    """The note of a lobe diagram whose coefficients (``coefficients``, already built, or
+    None: :func:`build_coefficients`) depend on the cutting speed: they are evaluated once, at
+    the ``[cutting]`` speed, not at each lobe speed (None otherwise)."""
+    c = build_coefficients(cfg, source) if coefficients is None else coefficients
     vc = cutting_speed_m_per_min(cfg)
     if c.speed_m_per_min is None or cfg.cutting is None or vc is None:
         return None
@@ -507,8 +509,10 @@ def lobe_coefficient_note(cfg: DynamicsConfig, source: str | None = None) -> str
             + "".join(f"; {w}" for w in c.warnings))
 
 
-def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float | None = None):
-    """Process model: the ``[process]`` contract or the boring bar from insert + cutting."""
+def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float | None = None,
+                  coefficients: Any = None):
+    """Process model: the ``[process]`` contract or the boring bar from insert + cutting,
+    with ``coefficients`` (None: :func:`build_coefficients`)."""
     from robobore.dynamics.process import boring_process, single_point_process
 
     if cfg.process is not None:
@@ -522,7 +526,8 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
         raise ConfigError("nose radius too large for the bore", file=source,
                           field="insert.nose_radius_mm", value=cfg.insert.nose_radius_mm,
                           expected=f"< bore radius {cfg.bore.diameter_mm / 2} mm")
-    return boring_process(ins, build_coefficients(cfg, source),
+    coef = build_coefficients(cfg, source) if coefficients is None else coefficients
+    return boring_process(ins, coef,
                           cut.depth_mm * 1e-3 if depth_m is None else depth_m,
                           cut.feed_mm_per_rev * 1e-3, overlap=cut.overlap_factor,
                           depth_modulation=cut.depth_modulation,

@@ -313,21 +313,16 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
     return data
 
 
-def _inline_coefficients(cfg: PaperConfig, coeffs: dict[str, Any]) -> dict[str, Any]:
-    """The dynamics ``[coefficients]`` of the study: the pooled values, with the per-speed
-    fits when the calibration has two or more speeds."""
-    from robobore.cutting.forces import inline_coefficients
-
-    return inline_coefficients(coeffs, cfg.coefficients.speed_dependent)
-
-
 def dynamics_model(cfg: PaperConfig, eq: Any, coeffs: dict[str, Any],
                    system: str) -> dict[str, Any]:
     """The ``[model]`` of the boring runner for the robot (equivalent, no foot; the foot is
     set per condition) or the machine tool."""
+    from robobore.cutting.forces import inline_coefficients
+
     dyn: dict[str, Any] = {
         "insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
-        "coefficients": _inline_coefficients(cfg, coeffs),
+        # the pooled values, with the per-speed fits when the calibration has several speeds
+        "coefficients": inline_coefficients(coeffs, cfg.coefficients.speed_dependent),
         "simulation": {"revolutions": cfg.study.revolutions,
                        "ra_tolerance_um": cfg.study.ra_tolerance_um},
     }

@@ -42,7 +42,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.config import ContactSection as ContactSection2D
-from robobore.cutting.fe.config import FEConfig, MaterialSection, apply_parameter_set
+from robobore.cutting.fe.config import MaterialSection, apply_parameter_set
 from robobore.cutting.fe.solver import (
     apply_friction_settings,
     apply_solver_settings,
@@ -243,8 +243,8 @@ class BoringFEConfig(_Strict):
         return apply_parameter_set(data) if isinstance(data, dict) else data
 
     def friction_law(self) -> str:
-        """The friction law in words (the 2D engine's :meth:`FEConfig.friction_law`)."""
-        return FEConfig.friction_law(self)  # type: ignore[arg-type]
+        """The friction law in words (:meth:`ContactSection.law_description`)."""
+        return self.contact.law_description()
 
 
 def parse_boring_config(data: dict[str, Any], source: str | None = None) -> BoringFEConfig:

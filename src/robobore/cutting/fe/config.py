@@ -199,6 +199,26 @@ class ContactSection(_Strict):
         return (np.asarray(self.friction_table_velocity_m_per_min, float),
                 np.asarray(self.friction_table_mu, float))
 
+    def coefficient_at(self, vc_m_per_min: float) -> float:
+        """Coulomb coefficient at a cutting speed [m/min]: the constant given, or the table
+        there (with ``friction_velocity = "sliding"`` the nominal value: each contact node
+        then reads the table at its own sliding speed)."""
+        if self.friction == "table":
+            v, mu = self.table()
+            return float(np.interp(vc_m_per_min, v, mu))
+        return float(self.friction)
+
+    def law_description(self) -> str:
+        """The friction law in words (for summaries)."""
+        if self.friction != "table":
+            return f"Coulomb {float(self.friction):g}"
+        law = self._law
+        src = (f"law {law} ({friction_law(law).status})" if law is not None else
+               "Rech et al. 2013" if self.friction_table_velocity_m_per_min is None else "user")
+        arg = "each node's sliding speed" if self.friction_velocity == "sliding" else \
+            "the cutting speed"
+        return f"Coulomb, {src} table at {arg}"
+
 
 class MeshSection(_Strict):
     #: element size in the cutting zone and chip layer [um]; at most h/3
@@ -410,27 +430,12 @@ class FEConfig(_Strict):
         return self
 
     def friction_coefficient(self) -> float:
-        """Coulomb coefficient used (the value given, or the table at the cutting speed).
-
-        With ``contact.friction_velocity = "sliding"`` this is the table at the cutting speed
-        (nominal); each contact node then uses the table at its own sliding speed.
-        """
-        if self.contact.friction == "table":
-            v, mu = self.contact.table()
-            return float(np.interp(self.cut.cutting_speed_m_per_min, v, mu))
-        return float(self.contact.friction)
+        """Coulomb coefficient at the cutting speed (:meth:`ContactSection.coefficient_at`)."""
+        return self.contact.coefficient_at(self.cut.cutting_speed_m_per_min)
 
     def friction_law(self) -> str:
-        """The friction law in words (for summaries)."""
-        c = self.contact
-        if c.friction != "table":
-            return f"Coulomb {float(c.friction):g}"
-        law = c._law
-        src = (f"law {law} ({friction_law(law).status})" if law is not None else
-               "Rech et al. 2013" if c.friction_table_velocity_m_per_min is None else "user")
-        arg = "each node's sliding speed" if c.friction_velocity == "sliding" else \
-            "the cutting speed"
-        return f"Coulomb, {src} table at {arg}"
+        """The friction law in words (:meth:`ContactSection.law_description`)."""
+        return self.contact.law_description()
 
 
 def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:

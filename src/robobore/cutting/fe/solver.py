@@ -403,16 +403,13 @@ def apply_friction_settings(p: np.ndarray, contact: Any, vc_m_per_min: float,
     sliding speed, filtered over the time the tool takes to travel ``sliding_filter_um``.
     """
     k = kernels
-    if contact.friction == "table":
+    p[k.P_MU] = contact.coefficient_at(vc_m_per_min)
+    if contact.friction == "table" and contact.friction_velocity == "sliding":
         tv, tmu = contact.table()
-        p[k.P_MU] = float(np.interp(vc_m_per_min, tv, tmu))
-        if contact.friction_velocity == "sliding":
-            p[k.P_MUTAB_N] = tv.size
-            p[k.P_MUTAB_V:k.P_MUTAB_V + tv.size] = tv / 60.0
-            p[k.P_MUTAB_MU:k.P_MUTAB_MU + tv.size] = tmu
-            p[k.P_SLIP_TAU] = contact.sliding_filter_um * 1e-6 / (vc_m_per_min / 60.0)
-    else:
-        p[k.P_MU] = float(contact.friction)
+        p[k.P_MUTAB_N] = tv.size
+        p[k.P_MUTAB_V:k.P_MUTAB_V + tv.size] = tv / 60.0
+        p[k.P_MUTAB_MU:k.P_MUTAB_MU + tv.size] = tmu
+        p[k.P_SLIP_TAU] = contact.sliding_filter_um * 1e-6 / (vc_m_per_min / 60.0)
     p[k.P_TAU] = contact.shear_limit_MPa * 1e6
     return p
 

@@ -203,7 +203,7 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         raise ConfigError("twin must pair nodes symmetrically", field="twin",
                           value=str(tw.shape), expected=f"(n,) = ({n},), twin[twin[i]] = i")
     try:
-        enbr = face_neighbours(conn, tw if twin is not None else None)
+        enbr = face_neighbours(conn, tw)
     except ValueError as exc:
         raise ConfigError(f"mesh is not a valid hexahedral mesh: {exc}", field="conn",
                           value=f"{ne} elements", expected="each face shared by at most two "
