@@ -17,6 +17,7 @@ import numpy as np
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.solver import drive_chunks, energy_error
 from robobore.cutting.fe.thermal3d import face_neighbours
+from robobore.cutting.fe.threads import ThreadGovernor
 from robobore.errors import ConfigError
 from robobore.material import Material
 
@@ -252,17 +253,20 @@ def init_forces3(st: FEState3) -> float:
 
 def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              progress: Callable[[float], None] | None = None,
-             check: Callable[[FEState3], None] | None = None) -> int:
+             check: Callable[[FEState3], None] | None = None,
+             adaptive_threads: bool = True, governor: ThreadGovernor | None = None) -> int:
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
 
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
+    ``adaptive_threads``, ``governor``: see :func:`~robobore.cutting.fe.solver.drive_chunks`.
     """
     return drive_chunks(st, t_end, K3.run_chunk3, K3.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "
                         "scaling or a softer contact.penalty_factor",
-                        progress=progress, check=check)
+                        progress=progress, check=check, adaptive_threads=adaptive_threads,
+                        governor=governor)
 
 
 def box_mesh(nx: int, ny: int, nz: int, lx: float, ly: float, lz: float,
