@@ -219,7 +219,7 @@ def test_link_bending_model_consistent_and_optional():
     """Joints + link beams (VJM): the modal static limit equals the compliance, which equals
     the identification basis sum; negligible link compliance gives the joint-only model."""
     from robobore.plan import synthetic as S
-    from robobore.plan.model import LinkBending, compliance_basis, redundancy
+    from robobore.plan.bending import LinkBending, compliance_basis, redundancy
 
     rb = get_robot("irb6600-175-2.55")
     q = PAPER_Q

@@ -289,7 +289,7 @@ def load_plan_config(path: str | Path) -> PlanInputs:
 
 def _link_bending(cfg: PlanConfig, robot: Any, f: str) -> tuple[Any, ...]:
     """``[[identification.link_bending]]``: optional beam compliance of long links."""
-    from robobore.plan.model import LinkBending, beam_geometry
+    from robobore.plan.bending import LinkBending, beam_geometry
 
     out, seen = [], set()
     for i, lb in enumerate(cfg.identification.link_bending):
