@@ -263,10 +263,10 @@ def campaign_postures(n: int = 12, seed: int = 7) -> np.ndarray:
 def validation_postures(n: int = 24, seed: int = 11, margin: float = 0.05) -> np.ndarray:
     """Held-out postures (rad) over the workspace: uniform in q1 [-120, 120], q2 [-40, 70],
     q3 [-120, 40], q4 [-170, 170], q5 [25, 120], q6 [-180, 180] deg, keeping those at least
-    ``margin`` from a singularity (:func:`robobore.plan.posture.singularity_measure`; near a
+    ``margin`` from a singularity (:func:`robobore.plan.candidates.singularity_measure`; near a
     singularity the stiffness along the stretched direction comes from what the joint springs
     leave out, link flexibility, and a joint-spring model cannot predict it)."""
-    from robobore.plan.posture import singularity_measure
+    from robobore.plan.candidates import singularity_measure
     from robobore.robot.kinematics import jacobian
 
     robot = get_robot("irb6600-175-2.55")
