@@ -66,7 +66,7 @@ PARSE = {
     "material": "from robobore.material import load_material as f",
     "sweep": "from robobore.study.conditions import load_sweep_config as f",
     "measured": "from robobore.study.compare import read_measured_csv as f",
-    "plan": "from robobore.plan.posture import load_plan_config as f",
+    "plan": "from robobore.plan.config import load_plan_config as f",
 }
 #: ``fe`` / ``calibrate`` commands with the FE time stepping replaced by a stub: the stub
 #: reads the material file as the run's set-up does first (``setup_orthogonal``,

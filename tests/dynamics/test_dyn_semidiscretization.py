@@ -208,7 +208,7 @@ def test_model_given_twice_is_refused(tmp_path):
 def test_step_matrices_batch_equal_the_augmented_exponential(scale):
     """The numba Taylor/doubling step matrices equal scipy's expm of the augmented matrix
     (Van Loan) to 1e-12 relative, from small to large ``||L dt||``."""
-    from robobore.dynamics.stability import _step_matrices, _step_matrices_batch
+    from robobore.dynamics.semidiscretization import _step_matrices, _step_matrices_batch
 
     rng = np.random.default_rng(7)
     L = rng.standard_normal((20, 6, 6)) * scale
@@ -221,7 +221,7 @@ def test_step_matrices_batch_equal_the_augmented_exponential(scale):
 
 def test_arpack_and_dense_spectral_radius_agree():
     """Large monodromy matrices go to ARPACK: the spectral radius equals the dense one."""
-    from robobore.dynamics import stability as S
+    from robobore.dynamics import semidiscretization as S
 
     st = ToolPointStructure.from_modes([
         {"frequency_Hz": 7.0, "damping_ratio": 0.035, "stiffness_N_per_m": 1.6e6,

@@ -184,7 +184,7 @@ def test_critical_depth_matches_stability_module(rb, paper_process):
 
 def test_feed_amplitude_matches_forced_response(rb, paper_process):
     from robobore.dynamics.timedomain import forced_response
-    from robobore.plan.posture import feed_amplitude, nominal_force_basis
+    from robobore.plan.scoring import feed_amplitude, nominal_force_basis
 
     model = PoseModel(rb, K6, np.array([3000, 3000, 800, 150, 80, 30.0]), tool=TOOL)
     Q = PAPER_Q + np.random.default_rng(3).normal(0, 0.2, (3, 6))
@@ -219,7 +219,7 @@ def test_link_bending_model_consistent_and_optional():
     """Joints + link beams (VJM): the modal static limit equals the compliance, which equals
     the identification basis sum; negligible link compliance gives the joint-only model."""
     from robobore.plan import synthetic as S
-    from robobore.plan.model import LinkBending, compliance_basis, redundancy
+    from robobore.plan.bending import LinkBending, compliance_basis, redundancy
 
     rb = get_robot("irb6600-175-2.55")
     q = PAPER_Q

@@ -366,7 +366,7 @@ def test_report_figures_units_legends_and_log_scale(small_run):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from robobore.study import paper_report as pr
+    from robobore.study import paper_figures as pr
     from robobore.study.store import ResultsStore
 
     res, out, cfg_path = small_run

@@ -32,7 +32,8 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
     """Plan for the paper's bore (compact, JSON-ready); ``{"error": msg}`` when it cannot be
     made (for instance a robot without inertial data), so the report says why."""
     from robobore.cutting.forces import inline_coefficients
-    from robobore.plan.posture import PlanConfig, PlanInputs, run_plan, workspace_map
+    from robobore.plan.config import PlanConfig, PlanInputs
+    from robobore.plan.posture import run_plan, workspace_map
     from robobore.robot.kinematics import fk, get_robot
 
     t0 = time.perf_counter()

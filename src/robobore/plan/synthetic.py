@@ -263,10 +263,10 @@ def campaign_postures(n: int = 12, seed: int = 7) -> np.ndarray:
 def validation_postures(n: int = 24, seed: int = 11, margin: float = 0.05) -> np.ndarray:
     """Held-out postures (rad) over the workspace: uniform in q1 [-120, 120], q2 [-40, 70],
     q3 [-120, 40], q4 [-170, 170], q5 [25, 120], q6 [-180, 180] deg, keeping those at least
-    ``margin`` from a singularity (:func:`robobore.plan.posture.singularity_measure`; near a
+    ``margin`` from a singularity (:func:`robobore.plan.candidates.singularity_measure`; near a
     singularity the stiffness along the stretched direction comes from what the joint springs
     leave out, link flexibility, and a joint-spring model cannot predict it)."""
-    from robobore.plan.posture import singularity_measure
+    from robobore.plan.candidates import singularity_measure
     from robobore.robot.kinematics import jacobian
 
     robot = get_robot("irb6600-175-2.55")
@@ -290,11 +290,11 @@ def identify_from_truth(truth: TruthRobot, campaign: np.ndarray,
 
     With ``bending_links`` (1-based links, e.g. ``(2, 4)``) the fit also has the bending
     compliances 1/EI of those links as Euler-Bernoulli beams (virtual-joint method,
-    :func:`robobore.plan.model.compliance_basis`: the compliance stays linear in the
+    :func:`robobore.plan.bending.compliance_basis`: the compliance stays linear in the
     unknowns); returns (k, relative residual, 1/EI per link and plane (n_links, 2))."""
     from scipy.optimize import nnls
 
-    from robobore.plan.model import compliance_basis
+    from robobore.plan.bending import compliance_basis
 
     nj = truth.robot.n_joints
     iu = np.triu_indices(6)
@@ -321,7 +321,7 @@ def run_validation(n_heldout: int = 24, f_max_Hz: float = 60.0,
 
     ``bend_scale`` multiplies the truth's bending springs (0.5: links twice as flexible, a
     sensitivity case). ``link_bending``: the planner's model also has the lower arm and the
-    forearm as Euler-Bernoulli beams (:class:`robobore.plan.model.LinkBending`), their
+    forearm as Euler-Bernoulli beams (:class:`robobore.plan.bending.LinkBending`), their
     compliances identified with the joint compliances from the same campaign."""
     from robobore.plan.model import LinkBending, calibrate
 

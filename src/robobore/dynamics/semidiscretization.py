@@ -1,0 +1,439 @@
+"""Semi-discretisation stability solution: step matrices, monodromy, critical-depth scan.
+
+Semi-discretisation (Insperger & Stepan 2002, 2004; first-order interpolation of the delayed
+term, Insperger, Stepan & Turi 2008): the delay is split into ``r`` steps, the ODE is solved
+exactly over each step with the delayed state linearly interpolated; the monodromy matrix over
+one delay is the product of the step matrices; stable iff its spectral radius < 1.
+
+For the rotating boring bar with depth modulation the dynamics are linearised about the steady
+deflected path (:func:`deflected_depth_weights`). The lobe diagram built from the critical
+depths is :func:`robobore.dynamics.stability.lobes_semidiscretization`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+from scipy.linalg import expm
+
+from robobore.dynamics.process import CuttingProcess
+from robobore.dynamics.structure import ToolPointStructure
+
+try:  # a single BLAS thread: the many mid-size eigenproblems are slower multi-threaded
+    from threadpoolctl import threadpool_limits as blas_thread_limit
+except ImportError:  # pragma: no cover - optional
+    from contextlib import nullcontext as _null
+
+    def blas_thread_limit(*_a, **_k):  # type: ignore[no-redef]
+        """No-op stand-in for ``threadpoolctl.threadpool_limits`` when it is not installed."""
+        return _null()
+
+
+#: Depth range of the critical-depth scan [m]: the largest depth of cut a config accepts (50 mm)
+#: and four decades below it. "Unconditionally stable" means: no instability up to the top.
+DEPTH_SCAN_HI_M = 0.05
+DEPTH_SCAN_DECADES = 4.0
+#: Ratio between neighbouring depths of the scan grid (an unstable window narrower than this
+#: in depth can be missed between two grid points).
+DEPTH_SCAN_RATIO = 1.25
+#: Monodromy matrices up to this size are solved densely; larger ones by ARPACK (the few
+#: eigenvalues of largest modulus), falling back to the dense solver if ARPACK does not converge.
+DENSE_EIG_MAX = 120
+
+
+def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Phi = e^{L dt}, Gamma0 = int e^{L(dt-s)} ds, Gamma1 = int e^{L(dt-s)} s ds (Van Loan).
+
+    ``Lc`` is one (n, n) matrix or a stack (k, n, n); the result has the same leading shape.
+    Reference implementation (scipy's Pade expm of the augmented 3n x 3n matrix); the
+    monodromy uses :func:`_step_matrices_batch`, which tests compare with this one."""
+    n = Lc.shape[-1]
+    H = np.zeros(Lc.shape[:-2] + (3 * n, 3 * n))
+    H[..., :n, :n] = Lc
+    H[..., :n, n:2 * n] = np.eye(n)
+    H[..., n:2 * n, 2 * n:] = np.eye(n)
+    E = expm(H * dt)
+    return E[..., :n, :n], E[..., :n, n:2 * n], E[..., :n, 2 * n:]
+
+
+@nb.njit(cache=True)
+def _matmul_into(A, B, out):  # pragma: no cover - numba
+    n = A.shape[0]
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += A[i, k] * B[k, j]
+            out[i, j] = acc
+
+
+@nb.njit(cache=True)
+def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+
+    Taylor series of degree 16 on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2`` (truncation
+    below 1e-18 relative), then ``s`` doublings: ``Phi(2h) = Phi^2``,
+    ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the integral at h)."""
+    k_n, n, _ = L.shape
+    T = np.empty((n, n))
+    A = np.empty((n, n))
+    W1 = np.empty((n, n))
+    W2 = np.empty((n, n))
+    W3 = np.empty((n, n))
+    for q in range(k_n):
+        nrm = 0.0
+        for j in range(n):
+            c = 0.0
+            for i in range(n):
+                c += abs(L[q, i, j])
+            nrm = max(nrm, c)
+        nrm *= dt
+        s = 0
+        if nrm > 0.5:
+            s = int(math.ceil(math.log2(nrm / 0.5)))
+        h = dt / 2.0**s
+        for i in range(n):
+            for j in range(n):
+                A[i, j] = L[q, i, j] * h
+                T[i, j] = 1.0 if i == j else 0.0  # (A)^m / m! accumulated as T
+                Phi[q, i, j] = T[i, j]
+                G0[q, i, j] = T[i, j] * h
+                G1[q, i, j] = T[i, j] * h * h * 0.5
+        for m in range(1, 17):
+            _matmul_into(T, A, W1)  # T <- T A / m  (= A^m / m!)
+            for i in range(n):
+                for j in range(n):
+                    T[i, j] = W1[i, j] / m
+            c0 = h / (m + 1)                  # A^m/(m+1)! = (A^m/m!) / (m+1)
+            c1 = h * h / ((m + 1) * (m + 2))  # A^m/(m+2)! = (A^m/m!) / ((m+1)(m+2))
+            for i in range(n):
+                for j in range(n):
+                    Phi[q, i, j] += T[i, j]
+                    G0[q, i, j] += c0 * T[i, j]
+                    G1[q, i, j] += c1 * T[i, j]
+        for _ in range(s):
+            _matmul_into(Phi[q], G1[q], W1)
+            _matmul_into(Phi[q], G0[q], W2)
+            _matmul_into(Phi[q], Phi[q], W3)
+            for i in range(n):
+                for j in range(n):
+                    G1[q, i, j] = W1[i, j] + h * G0[q, i, j] + G1[q, i, j]
+                    G0[q, i, j] = W2[i, j] + G0[q, i, j]
+                    Phi[q, i, j] = W3[i, j]
+            h *= 2.0
+
+
+def deflected_depth_weights(structure: ToolPointStructure, process: CuttingProcess,
+                            speed_rpm: float, theta: np.ndarray,
+                            depth_m: float | None = None) -> np.ndarray | None:
+    """Actual/nominal depth of each insert along the steady deflected path, shape (n, N).
+
+    The steady deflection is ``r(a) = a r_1 + r_0``: ``r_1`` from the force that scales with
+    the depth, ``r_0`` from the depth-independent edge force on the trailing side of the nose
+    (``process.edge_fixed_m``). The ratio ``1 + e_r . r(a) / a`` is evaluated at ``depth_m``;
+    without it (or without such edge lengths) only ``r_1`` counts, which does not depend on
+    the depth. ``None`` for fixed-direction processes or without depth modulation (no such
+    effect)."""
+    parts = _deflection_parts(structure, process, speed_rpm)
+    return None if parts is None else _deflected_weights(parts, process, theta, depth_m)
+
+
+def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
+                      speed_rpm: float) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """Steady deflection per unit depth ``r_1`` and the depth-independent ``r_0`` (or None),
+    each (720, 3) over one revolution; ``None`` when there is no depth modulation."""
+    if not process.rotating or not np.any(process.depth_direction):
+        return None
+    from robobore.dynamics.timedomain import forced_response
+
+    Ns = 720
+    rp = forced_response(structure, process, speed_rpm, 1.0, Ns)  # (Ns,3), a = 1 m
+    if np.any(process.edge_fixed_m):
+        r0 = forced_response(structure, process, speed_rpm, 0.0, Ns)  # fixed edge force only
+        return rp - r0, r0
+    return rp, None
+
+
+def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
+                       depth_m: float | None) -> np.ndarray:
+    rp, r0 = parts
+    if r0 is not None and depth_m is not None and depth_m > 0.0:
+        rp = rp + r0 / depth_m
+    ang = 2 * np.pi * np.arange(rp.shape[0]) / rp.shape[0]
+    th = np.mod(np.atleast_1d(theta), 2 * np.pi)
+    r = np.column_stack([np.interp(th, ang, rp[:, k], period=2 * np.pi) for k in range(3)])
+    N = process.n_inserts
+    w = np.empty((th.size, N))
+    for p in range(N):
+        B = process.basis(th + 2 * np.pi * p / N)  # (n,3,3)
+        w[:, p] = 1.0 + np.einsum("k,nki,ni->n", process.depth_direction, B, r)
+    return np.clip(w, 0.0, None)
+
+
+def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: np.ndarray,
+                include_process_stiffness: bool = True, insert_weights=None):
+    D = structure.directions  # (m,3)
+    minv = 1.0 / structure.modal_mass
+    A = process.directional_matrix(theta, insert_weights)  # (n,3,3)
+    W = minv[None, :, None] * np.einsum("jo,noi,ki->njk", D, A, D)
+    if include_process_stiffness:
+        P = process.process_stiffness(theta)
+        Pm = minv[None, :, None] * np.einsum("jo,noi,ki->njk", D, P, D)
+    else:
+        Pm = np.zeros_like(W)
+    return W, Pm
+
+
+@nb.njit(cache=True)
+def _propagate(Phi, P0, P1, r, m, Z, out):  # pragma: no cover - numba
+    """Apply the monodromy (``r`` semi-discretisation steps over one delay) to the columns of Z.
+
+    State ``z_i = [x_i (2m), q_{i-1}, ..., q_{i-r}]`` with ``q = x[:m]`` (modal displacements);
+    step ``i`` (coefficients ``Phi[i % k]``, ``P0``, ``P1``; ``k`` = 1 for constant ones)::
+
+        x_{i+1} = Phi_i x_i + P0_i q_{i-r} + P1_i q_{i-r+1}
+
+    ``Z``: (n, c) initial states; ``out`` (n, c) receives ``z_r`` = [x_r, q_{r-1}, ..., q_0].
+    The delayed values live in a buffer indexed by time (no shifting), so one column costs
+    O(r m^2) and the whole matrix O(r m^2 n)."""
+    n2 = 2 * m
+    c = Z.shape[1]
+    k = Phi.shape[0]
+    Q = np.empty((2 * r, m, c))  # Q[j + r] = q_j, j = -r .. r-1
+    for s in range(1, r + 1):
+        for a in range(m):
+            for col in range(c):
+                Q[r - s, a, col] = Z[n2 + (s - 1) * m + a, col]
+    x = np.empty((n2, c))
+    xn = np.empty((n2, c))
+    for a in range(n2):
+        for col in range(c):
+            x[a, col] = Z[a, col]
+    for i in range(r):
+        for a in range(m):
+            for col in range(c):
+                Q[i + r, a, col] = x[a, col]
+        p = i % k
+        for a in range(n2):
+            for col in range(c):
+                xn[a, col] = 0.0
+            for b in range(n2):
+                w = Phi[p, a, b]
+                for col in range(c):
+                    xn[a, col] += w * x[b, col]
+            for b in range(m):
+                w0 = P0[p, a, b]
+                w1 = P1[p, a, b]
+                for col in range(c):
+                    xn[a, col] += w0 * Q[i, b, col] + w1 * Q[i + 1, b, col]
+        x, xn = xn, x
+    for a in range(n2):
+        for col in range(c):
+            out[a, col] = x[a, col]
+    for s in range(1, r + 1):
+        for a in range(m):
+            for col in range(c):
+                out[n2 + (s - 1) * m + a, col] = Q[2 * r - s, a, col]
+
+
+def _spectral_radius(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m: int) -> float:
+    """Spectral radius of the monodromy matrix of :func:`_propagate` (dimension 2m + r m)."""
+    n = 2 * m + r * m
+
+    def dense() -> float:
+        U = np.empty((n, n))
+        _propagate(Phi, P0, P1, r, m, np.eye(n), U)
+        if not np.all(np.isfinite(U)):  # overflow far beyond the limit: unstable
+            return math.inf
+        try:
+            return float(np.max(np.abs(np.linalg.eigvals(U))))
+        except np.linalg.LinAlgError:  # no convergence of the dense solver: counted unstable
+            return math.inf
+
+    if n <= DENSE_EIG_MAX:
+        return dense()
+    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, LinearOperator, eigs
+
+    buf = np.empty((n, 1))
+
+    def mv(v: np.ndarray) -> np.ndarray:
+        _propagate(Phi, P0, P1, r, m, np.ascontiguousarray(v, float).reshape(n, 1), buf)
+        return buf[:, 0].copy()
+
+    op = LinearOperator((n, n), matvec=mv, dtype=float)
+    v0 = np.random.default_rng(12345).standard_normal(n)  # deterministic start vector
+    try:
+        ev = eigs(op, k=4, which="LM", tol=1e-9, ncv=min(n - 1, 20), maxiter=50 * n, v0=v0,
+                  return_eigenvectors=False)
+    except (ArpackNoConvergence, ArpackError, ValueError, np.linalg.LinAlgError):
+        return dense()
+    return float(np.max(np.abs(ev)))
+
+
+def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingProcess,
+                              speed_rpm: float, depth_m: float, steps: int = 0,
+                              include_process_stiffness: bool = True,
+                              about_deflected: bool = True) -> float:
+    """Spectral radius of the semi-discretised monodromy matrix over one delay (< 1: stable).
+
+    ``steps`` per delay (0: :func:`auto_steps`). ``about_deflected``: for the rotating bar
+    with depth modulation, linearise about the steady deflected path (each insert's actual
+    depth along the forced response, :func:`deflected_depth_weights`) rather than the
+    undeflected nominal cut. ``inf`` when the step matrices overflow (far beyond the limit)."""
+    steps = steps or auto_steps(structure, process, speed_rpm)
+    with blas_thread_limit(1):
+        return _rho(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
+                    about_deflected)
+
+
+def _rho(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
+         about_deflected, parts=False):
+    with np.errstate(over="ignore", invalid="ignore"):
+        rho = _monodromy(structure, process, speed_rpm, depth_m, steps,
+                         include_process_stiffness, about_deflected, parts)
+    return rho if math.isfinite(rho) else math.inf
+
+
+def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
+               about_deflected=True, parts=False):
+    """``parts``: :func:`_deflection_parts` at this speed (``False``: compute them here)."""
+    m = structure.n_modes
+    tau = 60.0 / (process.n_inserts * speed_rpm)
+    dt = tau / steps
+    om = structure.omega
+    base = np.zeros((2 * m, 2 * m))
+    base[:m, m:] = np.eye(m)
+    base[m:, :m] = -np.diag(om**2)
+    base[m:, m:] = -np.diag(2 * structure.damping_ratio * om)
+    constant = (not process.rotating) or process.n_inserts == 0
+    n_th = 1 if constant else steps
+    # coefficient angle at the middle of each step (delay = one insert pitch)
+    theta = (np.arange(n_th) + 0.5) * dt * 2 * np.pi * speed_rpm / 60.0
+    wts = None
+    if about_deflected:
+        if parts is False:
+            parts = _deflection_parts(structure, process, speed_rpm)
+        if parts is not None:
+            wts = _deflected_weights(parts, process, theta, depth_m)
+    W, Pm = _modal_mats(structure, process, theta, include_process_stiffness, wts)
+    L = np.broadcast_to(base, (n_th, 2 * m, 2 * m)).copy()
+    L[:, m:, :m] += -depth_m * W + Pm
+    Phi, G0, G1 = np.empty_like(L), np.empty_like(L), np.empty_like(L)
+    _step_matrices_batch(L, float(dt), Phi, G0, G1)
+    if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0)) and np.all(np.isfinite(G1))):
+        return math.inf
+    Rq = np.zeros((n_th, 2 * m, m))
+    Rq[:, m:, :] = process.overlap * depth_m * W
+    P1 = (G1 / dt) @ Rq             # multiplies q_{i-r+1}
+    P0 = (G0 - G1 / dt) @ Rq        # multiplies q_{i-r}
+    return _spectral_radius(np.ascontiguousarray(Phi), np.ascontiguousarray(P0),
+                            np.ascontiguousarray(P1), int(steps), int(m))
+
+
+def auto_steps(structure: ToolPointStructure, process: CuttingProcess, speed_rpm: float,
+               per_cycle: int = 20, lo: int = 30, hi: int = 400) -> int:
+    """Semi-discretisation steps per delay: ``per_cycle`` steps per period of the highest mode."""
+    tau = 60.0 / (process.n_inserts * speed_rpm)
+    return int(min(hi, max(lo, math.ceil(per_cycle * structure.frequency_Hz.max() * tau))))
+
+
+def depth_scan_grid(depth_hi_m: float = DEPTH_SCAN_HI_M, decades: float = DEPTH_SCAN_DECADES,
+                    ratio: float = DEPTH_SCAN_RATIO) -> np.ndarray:
+    """Geometric depth grid [m] of the critical-depth scan: ``depth_hi_m * 10**-decades`` up to
+    ``depth_hi_m``, neighbouring depths ``ratio`` apart."""
+    n = int(math.ceil(decades * math.log(10.0) / math.log(ratio))) + 1
+    return np.geomspace(depth_hi_m * 10.0 ** (-decades), depth_hi_m, n)
+
+
+def critical_depth_semidiscretization(structure: ToolPointStructure, process: CuttingProcess,
+                                      speed_rpm: float,
+                                      depth_hi_m: float = DEPTH_SCAN_HI_M,
+                                      steps: int = 0, tol: float = 1e-3,
+                                      include_process_stiffness: bool = True,
+                                      about_deflected: bool = True,
+                                      decades: float = DEPTH_SCAN_DECADES,
+                                      ratio: float = DEPTH_SCAN_RATIO) -> float:
+    """Critical depth [m] at one speed: the first depth at which the monodromy spectral radius
+    reaches 1.
+
+    The stability indicator ``rho(a) - 1`` is evaluated on the geometric grid of
+    :func:`depth_scan_grid` from the bottom up; between the last stable and the first unstable
+    grid depth the crossing is narrowed to a relative width ``tol`` by a bracketing root search
+    on ``log rho`` over ``log a`` (Illinois false position, a bisection step whenever a value is
+    not finite or the bracket shrank by less than half). Returns ``inf`` when no grid depth up
+    to ``depth_hi_m`` is unstable (stable up to that depth) and 0 when the system is unstable
+    already at ``depth_hi_m * 1e-3 * 10**-decades`` (an instability that does not need the
+    cut, e.g. the depth-modulation stiffness). A spectral radius that overflows or is not a
+    number counts as unstable. Never raises for a valid structure and process."""
+    steps = steps or auto_steps(structure, process, speed_rpm)
+    parts = _deflection_parts(structure, process, speed_rpm) if about_deflected else None
+
+    def rho(b: float) -> float:
+        r = _rho(structure, process, speed_rpm, b, steps, include_process_stiffness,
+                 about_deflected, parts)
+        return r if r == r else math.inf  # NaN counts as unstable
+
+    with blas_thread_limit(1):
+        return _scan(rho, depth_hi_m, tol, decades, ratio)
+
+
+def _scan(rho, depth_hi_m: float, tol: float, decades: float, ratio: float) -> float:
+    """First crossing of ``rho(depth) = 1`` on the scan grid, then narrowed (see the caller)."""
+    grid = depth_scan_grid(depth_hi_m, decades, ratio)
+    r = rho(float(grid[0]))
+    if r >= 1.0:
+        floor = float(grid[0]) * 1e-3
+        r_floor = rho(floor)
+        if r_floor >= 1.0:
+            return 0.0
+        lo, r_lo, hi, r_hi = floor, r_floor, float(grid[0]), r
+    else:
+        lo = hi = None
+        r_prev = r
+        for a0, a1 in zip(grid[:-1], grid[1:], strict=True):
+            r1 = rho(float(a1))
+            if r1 >= 1.0:
+                lo, r_lo, hi, r_hi = float(a0), r_prev, float(a1), r1
+                break
+            r_prev = r1
+        if lo is None:
+            return math.inf
+    # Illinois false position on f = log rho over x = log a; f(x0) < 0 <= f(x1)
+    x0, x1 = math.log(lo), math.log(hi)
+    f0 = math.log(max(r_lo, 1e-300))
+    f1 = math.log(r_hi) if math.isfinite(r_hi) else math.inf
+    side = 0
+    width_tol = math.log1p(tol)
+    while x1 - x0 > width_tol:
+        w = x1 - x0
+        if math.isfinite(f1) and f1 > f0:
+            x = x1 - f1 * w / (f1 - f0)
+            x = min(max(x, x0 + 0.01 * w), x1 - 0.01 * w)
+        else:
+            x = 0.5 * (x0 + x1)
+        rx = rho(math.exp(x))
+        if rx >= 1.0:
+            x1, f1 = x, (math.log(rx) if math.isfinite(rx) else math.inf)
+            if side == -1 and math.isfinite(f0):
+                f0 *= 0.5
+            side = -1
+        else:
+            x0, f0 = x, math.log(max(rx, 1e-300))
+            if side == 1 and math.isfinite(f1):
+                f1 *= 0.5
+            side = 1
+        if x1 - x0 > 0.5 * w:  # slow progress: bisect once
+            xm = 0.5 * (x0 + x1)
+            rm = rho(math.exp(xm))
+            if rm >= 1.0:
+                x1, f1, side = xm, (math.log(rm) if math.isfinite(rm) else math.inf), -1
+            else:
+                x0, f0, side = xm, math.log(max(rm, 1e-300)), 1
+    return math.exp(0.5 * (x0 + x1))
+
+
+__all__ = ["DEPTH_SCAN_HI_M", "DEPTH_SCAN_DECADES", "DEPTH_SCAN_RATIO", "DENSE_EIG_MAX",
+           "blas_thread_limit", "depth_scan_grid", "auto_steps", "deflected_depth_weights",
+           "monodromy_spectral_radius", "critical_depth_semidiscretization"]
