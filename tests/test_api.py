@@ -339,6 +339,27 @@ def test_config_foot_applies_to_a_model_without_one(chain):
                             method="frequency")
 
 
+def test_process_takes_the_cutting_stage_objects(chain):
+    from robobore.cutting.forces import read_coefficients_file
+
+    em = chain["robot"]
+    ref = api.stability_lobes(_process(), em, method="frequency")
+    # one calibrated speed: the file's content, its set at any speed and the table agree
+    for coef in (read_coefficients_file(api.bundled_coefficients_path()),
+                 api.cutting_coefficients(37.7)):
+        got = api.stability_lobes({**_process(), "coefficients": coef}, em, method="frequency")
+        np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
+    # a different set gives different lobes (the coefficients are used)
+    k = api.cutting_coefficients(37.7)
+    from dataclasses import replace
+
+    got = api.stability_lobes({**_process(), "coefficients": replace(k, Ktc=2 * k.Ktc)}, em,
+                              method="frequency")
+    assert np.median(got["critical_depth_mm"]) < np.median(ref["critical_depth_mm"])
+    with pytest.raises(ConfigError):
+        api.stability_lobes({**_process(), "coefficients": 3.0}, em, method="frequency")
+
+
 def test_bundled_coefficients_are_the_stored_calibration():
     c = api.bundled_coefficients()
     assert c["Ktc_N_per_m2"] > 0 and c["Kfc_N_per_m2"] > 0 and "FE" in c["provenance"]

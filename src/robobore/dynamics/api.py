@@ -7,7 +7,9 @@ contents. Conditions given as arguments override the config (speed, depth, feed,
 pressure), so a sweep needs only one config file. Both take the robot as the
 equivalent-model stage's object (``equivalent=``, an
 :class:`~robobore.equivalent.EquivalentModel` or its dict form) when the config holds only
-the process.
+the process; a dict config's ``coefficients`` may be the cutting stage's
+:class:`~robobore.cutting.forces.CuttingCoefficients` or a coefficients-file content
+(:func:`robobore.dynamics.config.with_coefficients`).
 
 The summary's verdicts (:mod:`robobore.dynamics.chatter`): ``chatter`` (the vibration
 grows), ``surface_finish`` ("ok" / "rough": Ra after form removal against
@@ -30,6 +32,7 @@ from robobore.dynamics.config import (
     build_structure,
     load_dynamics_config,
     resolve_model_files,
+    with_coefficients,
     with_equivalent,
 )
 from robobore.errors import ConfigError, InputError
@@ -46,6 +49,7 @@ def _config(config: str | Path | dict[str, Any] | DynamicsConfig, source: str | 
     if isinstance(config, dict):
         if equivalent is not None:
             config = with_equivalent(config, equivalent, source)
+        config = with_coefficients(config)
         # [model] file names of a dict config are relative to its source file's folder when
         # one is named, else to the working directory
         base = Path(source) if source else Path.cwd() / "<config dict>"

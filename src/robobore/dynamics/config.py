@@ -406,6 +406,25 @@ def with_equivalent(raw: dict[str, Any], equivalent: Any, source: str | None = N
     return out
 
 
+def with_coefficients(raw: dict[str, Any]) -> dict[str, Any]:
+    """``raw`` with a ``coefficients`` entry given as the cutting stage's result turned into
+    the ``[coefficients]`` table: a :class:`~robobore.cutting.forces.CuttingCoefficients`
+    (its values, used as given at every speed) or a coefficients-file content (the output of
+    ``robobore calibrate forces``, :func:`~robobore.cutting.forces.read_coefficients_file`:
+    :func:`~robobore.cutting.forces.inline_coefficients`, per-speed fits included). A table
+    of the section's own keys is left as it is."""
+    c = raw.get("coefficients")
+    if c is None or (isinstance(c, dict) and not isinstance(c.get("coefficients"), dict)):
+        return raw
+    from robobore.cutting.forces import CuttingCoefficients, inline_coefficients
+
+    if isinstance(c, CuttingCoefficients):
+        return {**raw, "coefficients": c.to_dict()}
+    if isinstance(c, dict):
+        return {**raw, "coefficients": inline_coefficients(c)}
+    return raw
+
+
 def resolve_model_files(raw: dict[str, Any], path: str | Path,
                         stiffness_file: str | Path | None = None,
                         modes_file: str | Path | None = None,
@@ -604,6 +623,6 @@ def build_process(cfg: DynamicsConfig, source: str | None = None, depth_m: float
 
 
 __all__ = ["DynamicsConfig", "load_dynamics_config", "resolve_model_files", "build_structure",
-           "equivalent_arg", "equivalent_section", "with_equivalent",
+           "equivalent_arg", "equivalent_section", "with_equivalent", "with_coefficients",
            "build_process", "build_coefficients", "cutting_speed_m_per_min",
            "lobe_coefficient_note", "DEFAULT_SPEED_RPM", "speed_range"]
