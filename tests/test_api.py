@@ -247,6 +247,12 @@ def test_equivalent_model_of_a_wrong_type_is_an_input_error(chain, stiffness, mo
     assert e.value.field == field
 
 
+def test_joint_stiffness_alone_is_not_a_tool_point_stiffness(chain):
+    with pytest.raises(InputError) as e:
+        EquivalentModel.from_stiffness_and_modes(chain["joints"].joint, chain["modes"])
+    assert e.value.field == "stiffness" and "need a posture" in str(e.value)
+
+
 def test_equivalent_dict_path_errors_are_unchanged():
     with pytest.raises(ConfigError) as e:
         EquivalentModel.from_stiffness_and_modes({"x": 1e6, "y": 1e6}, {"modes": []})

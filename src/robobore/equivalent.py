@@ -106,13 +106,16 @@ def _stiffness_contract(stiffness: Any) -> Any:
             return {"directional_stiffness_N_per_m": stiffness}
         return stiffness
     from robobore.robot.identify import StiffnessIdentification
-    from robobore.robot.stiffness import StiffnessResult
+    from robobore.robot.stiffness import JointStiffness, StiffnessResult
 
     if isinstance(stiffness, StiffnessIdentification):
         return dict(stiffness.directional)
     if isinstance(stiffness, StiffnessResult):
         return {"directional_stiffness_N_per_m": dict(stiffness.directional_stiffness_N_per_m)}
-    raise InputError("not a robot stiffness", field="stiffness", value=type(stiffness).__name__,
+    hint = (" (joint stiffnesses need a posture: robobore.robot.stiffness.stiffness_at)"
+            if isinstance(stiffness, JointStiffness) else "")
+    raise InputError(f"not a robot stiffness{hint}", field="stiffness",
+                     value=type(stiffness).__name__,
                      expected="a StiffnessIdentification, a StiffnessResult, a dict with "
                               "directional_stiffness_N_per_m or {x, y, z} in N/m")
 
