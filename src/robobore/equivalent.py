@@ -8,11 +8,18 @@ Y vertical, Z feed), by one mass-spring-damper unit::
     c_d = 2 zeta_d sqrt(k_d m_d)                   (from a modal damping ratio)
     zeta_d = c_d / (2 sqrt(k_d m_d))               (from a given damping coefficient)
 
-Inputs are plain numbers or the JSON contracts of the other stages:
+Inputs are plain numbers, the other stages' result objects or their JSON contracts:
 
-* robot stiffness: ``{"directional_stiffness_N_per_m": {"x": .., "y": .., "z": ..}}``
+* robot stiffness: ``{"directional_stiffness_N_per_m": {"x": .., "y": .., "z": ..}}`` (the
+  JSON of ``robobore identify stiffness``), the ``{"x", "y", "z"}`` table of
+  :func:`robobore.robot.stiffness.directional_stiffness_xyz`, a
+  :class:`~robobore.robot.identify.StiffnessIdentification` (its directional stiffness at the
+  campaign's first posture) or a :class:`~robobore.robot.stiffness.StiffnessResult` of
+  ``stiffness_at`` (its ``directional_stiffness_N_per_m``)
 * modal analysis: ``{"modes": [{"frequency_Hz": .., "damping_ratio": .., "mpc": ..,
-  optional "direction": [3] or "x"/"y"/"z", optional "shape": [3]}]}``
+  optional "direction": [3] or "x"/"y"/"z", optional "shape": [3]}]}`` (the JSON of
+  ``robobore identify modes``), a :class:`~robobore.modal.identify.ModalResult` or a
+  :class:`~robobore.modal.identify.ModalAnalysis` (its ``result``)
 
 How modes are assigned to X, Y, Z (:meth:`EquivalentModel.from_stiffness_and_modes`):
 
@@ -44,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from robobore.errors import ConfigError
+from robobore.errors import ConfigError, InputError
 from robobore.io.ranges import check_value
 
 AXES = ("x", "y", "z")
@@ -89,6 +96,42 @@ def _nonneg(name: str, value: Any, unit: str) -> float:
         raise ConfigError("must be >= 0 and finite", field=name, value=value,
                           expected=f"a number >= 0 in {unit}")
     return check_value(v, name, kind=ConfigError)  # plausible range of the unit
+
+
+def _stiffness_contract(stiffness: Any) -> Any:
+    """The robot-stiffness JSON contract of ``stiffness`` (module docstring); a dict other
+    than the ``{"x", "y", "z"}`` table is returned as it is."""
+    if isinstance(stiffness, dict):
+        if set(stiffness) == set(AXES):  # directional_stiffness_xyz's table
+            return {"directional_stiffness_N_per_m": stiffness}
+        return stiffness
+    from robobore.robot.identify import StiffnessIdentification
+    from robobore.robot.stiffness import JointStiffness, StiffnessResult
+
+    if isinstance(stiffness, StiffnessIdentification):
+        return dict(stiffness.directional)
+    if isinstance(stiffness, StiffnessResult):
+        return {"directional_stiffness_N_per_m": dict(stiffness.directional_stiffness_N_per_m)}
+    hint = (" (joint stiffnesses need a posture: robobore.robot.stiffness.stiffness_at)"
+            if isinstance(stiffness, JointStiffness) else "")
+    raise InputError(f"not a robot stiffness{hint}", field="stiffness",
+                     value=type(stiffness).__name__,
+                     expected="a StiffnessIdentification, a StiffnessResult, a dict with "
+                              "directional_stiffness_N_per_m or {x, y, z} in N/m")
+
+
+def _modes_contract(modes: Any) -> Any:
+    """The modal JSON contract of ``modes`` (module docstring); a dict as it is."""
+    if isinstance(modes, dict):
+        return modes
+    from robobore.modal.identify import ModalAnalysis, ModalResult
+
+    if isinstance(modes, ModalAnalysis):
+        modes = modes.result
+    if isinstance(modes, ModalResult):
+        return modes.to_dict()
+    raise InputError("not identified modes", field="modes", value=type(modes).__name__,
+                     expected='a ModalResult, a ModalAnalysis or a dict with "modes"')
 
 
 @dataclass(frozen=True)
@@ -268,19 +311,22 @@ class EquivalentModel:
     @classmethod
     def from_stiffness_and_modes(
         cls,
-        stiffness: dict[str, Any],
-        modes: dict[str, Any],
+        stiffness: Any,
+        modes: Any,
         assignment: dict[str, int] | None = None,
         damping_N_s_per_m: float | None = None,
         foot: PressureFoot | None = None,
     ) -> EquivalentModel:
-        """Build from the robot-stiffness and modal JSON contracts (see module docstring).
+        """Build from the robot-stiffness and modal stages' results or their JSON contracts
+        (see module docstring; an object and its dict form give the same model).
 
         If ``stiffness`` carries a full ``"stiffness_matrix_N_per_m"`` (3x3, boring frame),
         the units act along its principal directions (:func:`principal_frame`, equal-mass
         assumption of the paper) with the principal stiffnesses, and mode directions are
         compared with those principal axes.
         """
+        stiffness = _stiffness_contract(stiffness)
+        modes = _modes_contract(modes)
         R = None
         if isinstance(stiffness, dict) and "stiffness_matrix_N_per_m" in stiffness:
             kp, R = principal_frame(np.asarray(stiffness["stiffness_matrix_N_per_m"], float))

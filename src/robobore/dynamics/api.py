@@ -4,7 +4,12 @@
 :class:`~robobore.dynamics.config.DynamicsConfig`) and returns the same JSON-ready summary as
 ``robobore simulate boring --json``; :func:`lobes` returns the ``robobore lobes --json``
 contents. Conditions given as arguments override the config (speed, depth, feed, foot
-pressure), so a sweep needs only one config file.
+pressure), so a sweep needs only one config file. Both take the robot as the
+equivalent-model stage's object (``equivalent=``, an
+:class:`~robobore.equivalent.EquivalentModel` or its dict form) when the config holds only
+the process; a dict config's ``coefficients`` may be the cutting stage's
+:class:`~robobore.cutting.forces.CuttingCoefficients` or a coefficients-file content
+(:func:`robobore.dynamics.config.with_coefficients`).
 
 The summary's verdicts (:mod:`robobore.dynamics.chatter`): ``chatter`` (the vibration
 grows), ``surface_finish`` ("ok" / "rough": Ra after form removal against
@@ -27,24 +32,34 @@ from robobore.dynamics.config import (
     build_structure,
     load_dynamics_config,
     resolve_model_files,
+    with_coefficients,
+    with_equivalent,
 )
-from robobore.errors import ConfigError
+from robobore.errors import ConfigError, InputError
 from robobore.io.config import validate_model
 
 
 def _config(config: str | Path | dict[str, Any] | DynamicsConfig, source: str | None = None,
-            **model_files: Any
+            equivalent: Any = None, **model_files: Any
             ) -> tuple[DynamicsConfig, dict[str, Any], str | None]:
     if isinstance(config, DynamicsConfig):
-        return config.model_copy(deep=True), config.model_dump(), source
+        if equivalent is None:
+            return config.model_copy(deep=True), config.model_dump(), source
+        config = config.model_dump()
     if isinstance(config, dict):
+        if equivalent is not None:
+            config = with_equivalent(config, equivalent, source)
+        config = with_coefficients(config)
         # [model] file names of a dict config are relative to its source file's folder when
         # one is named, else to the working directory
         base = Path(source) if source else Path.cwd() / "<config dict>"
         config = resolve_model_files(config, base, **model_files)
         return (validate_model(DynamicsConfig, config, source=source or "<config>"), config,
                 source)
-    cfg, raw = load_dynamics_config(config, **model_files)
+    if not isinstance(config, str | Path):
+        raise InputError("not a process config", field="config", value=type(config).__name__,
+                         expected="a TOML path, a config dict or a DynamicsConfig")
+    cfg, raw = load_dynamics_config(config, equivalent=equivalent, **model_files)
     return cfg, raw, str(config)
 
 
@@ -52,11 +67,14 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
                speed_rpm: float | None = None, depth_mm: float | None = None,
                feed_mm_per_rev: float | None = None, pressure_MPa: float | None = None,
                revolutions: int | None = None, samples_per_rev: int | None = None,
-               return_dataset: bool = False, source: str | None = None) -> dict[str, Any]:
+               return_dataset: bool = False, source: str | None = None,
+               equivalent: Any = None) -> dict[str, Any]:
     """Simulate one condition; returns the summary dict (and ``"dataset"`` if asked).
 
     ``source`` names where a dict or model config came from (a file, a section), for error
-    messages.
+    messages. ``equivalent``: the robot as the equivalent-model stage's
+    :class:`~robobore.equivalent.EquivalentModel` (or its dict form), when the config holds
+    only the process (:func:`robobore.dynamics.config.with_equivalent`).
 
     ``pressure_MPa`` (boring configs with an ``[equivalent]`` section) replaces the pressure
     foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
@@ -64,7 +82,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     from robobore.dynamics.chatter import classify
     from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
 
-    cfg, raw, src = _config(config, source)
+    cfg, raw, src = _config(config, source, equivalent)
     if cfg.cutting is not None:
         upd = {}
         if speed_rpm is not None:
@@ -156,16 +174,19 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
 
 
 def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
-          method: str = "semidiscretization", progress=None) -> dict[str, Any]:
+          method: str = "semidiscretization", progress=None,
+          equivalent: Any = None) -> dict[str, Any]:
     """Lobes of a config (``robobore lobes --json`` contents, without notes).
 
     ``method``: ``"semidiscretization"`` (default; includes the rotating bar's periodic
-    directions and depth modulation) or ``"frequency"`` (zero-order, fast)."""
+    directions and depth modulation) or ``"frequency"`` (zero-order, fast). ``equivalent``:
+    the robot as an :class:`~robobore.equivalent.EquivalentModel` (or its dict form) for a
+    config that holds only the process, as in :func:`run_boring`."""
     import numpy as np
 
     from robobore.dynamics import stability
 
-    cfg, _, src = _config(config)
+    cfg, _, src = _config(config, equivalent=equivalent)
     st = build_structure(cfg, src)
     coef = build_coefficients(cfg, src) if cfg.is_boring else None
     pr = build_process(cfg, src, coefficients=coef)

@@ -23,7 +23,7 @@ import numpy as np
 
 from robobore.errors import InputError
 from robobore.modal.cmif import CMIF, cmif
-from robobore.modal.frf import FRFData
+from robobore.modal.frf import FRFData, FRFEstimate, HammerRecords
 from robobore.modal.lsfd import LSFDResult, lsfd, mpc, normalise_shape
 from robobore.modal.plscf import PLSCFResult, plscf
 from robobore.modal.stabilization import StabilisationDiagram, select_poles, stabilisation
@@ -179,6 +179,18 @@ class ModalAnalysis:
     lsfd: LSFDResult
 
 
+def _frf_arg(data: Any) -> FRFData:
+    """The FRFs of ``data``: an FRFData, or an FRFEstimate's ``frf``; else InputError."""
+    if isinstance(data, FRFData):
+        return data
+    if isinstance(data, FRFEstimate):
+        return data.frf
+    hint = (" (time records: estimate the FRFs first, robobore.modal.estimate_frf)"
+            if isinstance(data, HammerRecords) else "")
+    raise InputError(f"not FRFs{hint}", field="data", value=type(data).__name__,
+                     expected="an FRFData or the FRFEstimate of estimate_frf")
+
+
 def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
                    n_modes: int | None = None, approx_Hz: list[float] | None = None,
                    max_order: int = 40, min_order: int = 1, freq_tol: float = 0.01,
@@ -188,7 +200,8 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
 
     Parameters
     ----------
-    data: FRFs ``(n_outputs, n_inputs, n_f)``.
+    data: FRFs ``(n_outputs, n_inputs, n_f)``: an :class:`FRFData` or the FRF stage's
+        result (:class:`~robobore.modal.frf.FRFEstimate` of ``estimate_frf``; its ``frf``).
     band_Hz: analysis band ``(lo, hi)`` in Hz; default all lines > 0 Hz.
     n_modes: keep the ``n_modes`` best-supported modes; approx_Hz: or one mode near each
         of these frequencies (Hz); neither: every mode stable over ``min_fraction`` of the
@@ -196,6 +209,7 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
     max_order: highest pLSCF order (``max_order * n_inputs`` poles).
     freq_tol, damp_tol, mac_tol: stabilisation criteria.
     """
+    data = _frf_arg(data)
     if approx_Hz is not None and n_modes is not None:
         raise InputError("give either a number of modes or approximate frequencies",
                          field="modes/approx_Hz", value=(n_modes, approx_Hz),

@@ -44,7 +44,36 @@ from robobore.robot.kinematics import Robot, fk_jacobian, get_robot, jacobian_de
 FRAMES = ("tool", "base", "boring")
 
 
+def joint_stiffness_arg(k: Any, name: str = "joint_stiffness") -> Any:
+    """The joint stiffnesses the stage accepts, as a :class:`JointStiffness` or an array.
+
+    Accepts the identification stage's object (:class:`~robobore.robot.identify.
+    StiffnessIdentification`: its ``joint``), a :class:`JointStiffness`, their dict form
+    (the JSON of ``robobore identify stiffness`` or :meth:`JointStiffness.to_dict`) or
+    numbers (n,) in N m/rad (returned unchanged). Anything else is an :class:`InputError`
+    naming the argument ``name``.
+    """
+    if isinstance(k, JointStiffness):
+        return k
+    if isinstance(k, dict):
+        return JointStiffness.from_dict(k)
+    if isinstance(k, str | bytes) or k is None:
+        raise InputError("not joint stiffnesses", field=name, value=k,
+                         expected="a StiffnessIdentification, a JointStiffness, its dict "
+                                  "form or n numbers in N m/rad")
+    from robobore.robot.identify import StiffnessIdentification
+
+    if isinstance(k, StiffnessIdentification):
+        return k.joint
+    if isinstance(k, list | tuple | np.ndarray) or np.isscalar(k):
+        return k
+    raise InputError("not joint stiffnesses", field=name, value=type(k).__name__,
+                     expected="a StiffnessIdentification, a JointStiffness, its dict form "
+                              "or n numbers in N m/rad")
+
+
 def _k_array(k: Any, n: int) -> np.ndarray:
+    k = joint_stiffness_arg(k)
     if isinstance(k, JointStiffness):
         k = k.as_array()
     arr = np.asarray(k, float).reshape(-1)
@@ -179,8 +208,9 @@ def directional_stiffness_xyz(
     """Directional stiffness ``{"x", "y", "z"}`` [N/m] along the process-frame axes.
 
     The public entry point for the equivalent-model stage. ``q_rad`` (n_joints,), joint
-    stiffness (n,) in N m/rad or a :class:`JointStiffness`, ``tcp_m`` the tool point in the
-    flange frame [m], ``frame`` see :func:`process_frame`.
+    stiffness (n,) in N m/rad, a :class:`JointStiffness`, the identification's
+    ``StiffnessIdentification`` or their dict form (:func:`joint_stiffness_arg`), ``tcp_m``
+    the tool point in the flange frame [m], ``frame`` see :func:`process_frame`.
 
     A :class:`JointStiffness` with unidentified joints (``None``) is accepted when those joints
     do not move the tool point along the requested axis (e.g. joint 6 for a tool point on the
@@ -189,6 +219,7 @@ def directional_stiffness_xyz(
     robot = get_robot(robot)
     T, J = fk_jacobian(robot, np.asarray(q_rad, float), tcp_m)
     R = process_frame(T[:3, :3], frame)
+    joint_stiffness = joint_stiffness_arg(joint_stiffness)
     if isinstance(joint_stiffness, JointStiffness):
         ks = joint_stiffness.k_Nm_per_rad
     else:
@@ -272,7 +303,9 @@ def stiffness_at(
     tcp_m: Any = None,
     wrench: Any = None,
 ) -> StiffnessResult:
-    """All stiffness quantities at one posture (see module docstring)."""
+    """All stiffness quantities at one posture (see module docstring).
+
+    ``k_Nm_per_rad``: any form :func:`joint_stiffness_arg` accepts, every joint identified."""
     robot = get_robot(robot)
     q = np.asarray(q_rad, float)
     k = _k_array(k_Nm_per_rad, robot.n_joints)
@@ -406,4 +439,5 @@ __all__ = [
     "stiffness_at",
     "StiffnessResult",
     "JointStiffness",
+    "joint_stiffness_arg",
 ]
