@@ -18,7 +18,7 @@ import pytest
 from robobore.cutting import calibrate as cal
 from robobore.cutting.forces import load_coefficients
 from robobore.errors import ConfigError
-from robobore.study.cache import ResultCache
+from robobore.io.cache import ResultCache
 from robobore.study.paper import example_config_path, example_dir
 
 STORED = example_dir() / "tc4_fe_coefficients.json"

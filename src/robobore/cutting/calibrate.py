@@ -34,7 +34,7 @@ shear angle and friction angle of the orthogonal fit (:func:`orthogonal_paramete
 shear angle from the FE chip ratio when the FE gives one, else Merchant's
 ``phi = pi/4 - (beta - alpha)/2``).
 
-FE results are cached (:class:`robobore.study.cache.ResultCache`, namespace
+FE results are cached (:class:`robobore.io.cache.ResultCache`, namespace
 ``fe-orthogonal``) keyed by the full FE input (every setting) + package version.
 
 The saved file (JSON) is read by :func:`robobore.cutting.forces.load_coefficients`: the
@@ -367,7 +367,7 @@ def run_grid(cfg: CalibrationConfig, *, cache: Any | None = None, workers: int =
     ``h_um, vc_m_per_min, Fc_N_per_m, Ff_N_per_m, cached, fe`` (the FE summary)."""
     import json
 
-    from robobore.study.cache import ResultCache
+    from robobore.io.cache import ResultCache
 
     cache = cache if cache is not None else ResultCache()
     points = [(h, v) for h in cfg.uncut_chip_thickness_um for v in cfg.cutting_speed_m_per_min]
