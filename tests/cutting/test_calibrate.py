@@ -19,7 +19,7 @@ from robobore.cutting import calibrate as cal
 from robobore.cutting.forces import load_coefficients
 from robobore.errors import ConfigError
 from robobore.io.cache import ResultCache
-from robobore.study.paper import example_config_path, example_dir
+from robobore.study.paper import PaperConfig, example_config_path, example_dir
 
 STORED = example_dir() / "tc4_fe_coefficients.json"
 
@@ -142,7 +142,9 @@ def test_grid_is_cached(tmp_path, monkeypatch):
     cal.calibrate_forces(_cfg(fe={"length_mm": 0.5}), cache=cache)
     assert len(calls) == 8
     # a new engine revision (physics changed) does not reuse the old engine's forces
-    monkeypatch.setattr(cal, "FE_ENGINE_REVISION", cal.FE_ENGINE_REVISION + 1)
+    import robobore.cutting.fe as fe
+
+    monkeypatch.setattr(fe, "FE_ENGINE_REVISION", fe.FE_ENGINE_REVISION + 1)
     r3 = cal.calibrate_forces(cfg, cache=cache)
     assert len(calls) == 12 and r3["fe_cached_points"] == 0
 
@@ -157,8 +159,23 @@ def test_bad_config_names_field():
     assert "uncut_chip_thickness_um" in str(e.value)
 
 
+def test_sections_beside_the_calibration_are_those_the_caller_names():
+    """A paper config's sections are accepted when its reader names them; a typo is not."""
+    d = {"calibration": {"uncut_chip_thickness_um": [60.0, 90.0],
+                         "cutting_speed_m_per_min": [40.0]},
+         "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0}, "study": {}}
+    with pytest.raises(ConfigError) as e:
+        cal.calibration_from_mapping(d, source="t.toml")
+    assert "study" in str(e.value) and "t.toml" in str(e.value)
+    c = cal.calibration_from_mapping(d, source="t.toml", other_sections=PaperConfig.model_fields)
+    assert c.uncut_chip_thickness_um == [60.0, 90.0]
+    with pytest.raises(ConfigError, match="studdy"):
+        cal.calibration_from_mapping({**d, "studdy": {}}, source="t.toml",
+                                     other_sections=PaperConfig.model_fields)
+
+
 def test_example_config_is_valid():
-    c = cal.load_calibration_config(example_config_path())
+    c = cal.load_calibration_config(example_config_path(), other_sections=PaperConfig.model_fields)
     assert c.rake_deg == 7.0 and c.material == "TC4"
 
 

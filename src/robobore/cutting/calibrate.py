@@ -47,7 +47,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from datetime import UTC, datetime
 from pathlib import Path
@@ -109,21 +109,20 @@ class CalibrationConfig(_Strict):
         return [float(x) for x in v]
 
 
-def calibration_from_mapping(data: dict[str, Any], source: str | None = None
-                             ) -> CalibrationConfig:
+def calibration_from_mapping(data: dict[str, Any], source: str | None = None,
+                             other_sections: Collection[str] = ()) -> CalibrationConfig:
     """Calibration config from a TOML mapping.
 
     Accepts either a file with a ``[calibration]`` table (and optionally ``[insert]``
     (rake_deg, edge_radius_um, inclination_deg, clearance_deg) and ``[material] name``, which
     fill the calibration's insert and material when it does not give them), or the
-    calibration keys at top level.
+    calibration keys at top level. ``other_sections``: the further top-level sections of a
+    config that holds a calibration (a paper config's); any other section is refused.
     """
     from robobore.io.config import validate_model
 
     if "calibration" in data:  # a typo'd section is an error, not ignored
-        from robobore.study.paper import PaperConfig  # a paper config is a calibration config
-
-        known = {"calibration", "insert", "material", "range_check", *PaperConfig.model_fields}
+        known = {"calibration", "insert", "material", "range_check", *other_sections}
         extra = sorted(set(data) - known)
         if extra:
             raise ConfigError("unknown section (a typo?)", file=source, field=extra[0],
@@ -282,10 +281,14 @@ def _engine_range(key: str) -> str:
             f"engine's range of {key})")
 
 
-def load_calibration_config(path: str | Path) -> CalibrationConfig:
+def load_calibration_config(path: str | Path, other_sections: Collection[str] = ()
+                            ) -> CalibrationConfig:
+    """The calibration config of a TOML file (``other_sections``: see
+    :func:`calibration_from_mapping`)."""
     from robobore.io.config import load_toml
 
-    return calibration_from_mapping(load_toml(path), source=str(path))
+    return calibration_from_mapping(load_toml(path), source=str(path),
+                                    other_sections=other_sections)
 
 
 def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> dict[str, Any]:
@@ -338,20 +341,14 @@ def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-#: revision of the FE engine's physics in the cache key: bump it whenever a change of the
-#: engine changes its results for the same config, so that cached FE forces of another
-#: revision are not reused. Revision 2: the contact's stick/slip return mapping on the trial
-#: velocity
-FE_ENGINE_REVISION = 2
-
-
 def fe_cache_inputs(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     """Cache key inputs: the full FE config after defaults (a changed default changes the
-    key) and :data:`FE_ENGINE_REVISION`."""
+    key) and the engine's :data:`robobore.cutting.fe.FE_ENGINE_REVISION`."""
+    from robobore.cutting import fe
     from robobore.cutting.fe.config import parse_config
 
     return {"fe_config": parse_config(fe_cfg).model_dump(mode="json"),
-            "engine_revision": FE_ENGINE_REVISION}
+            "engine_revision": fe.FE_ENGINE_REVISION}
 
 
 def _limit_numba_threads(n: int) -> None:
@@ -453,6 +450,7 @@ def fit_edge_model(h_m: np.ndarray, force_N_per_m: np.ndarray) -> dict[str, floa
 def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str, Any]:
     """Fit the coefficients to FE records (:func:`run_grid`) and build the file's content."""
     from robobore import __version__
+    from robobore.cutting import fe
     from robobore.cutting.forces import (
         CuttingCoefficients,
         orthogonal_parameters_from_data,
@@ -566,7 +564,7 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
         "grid": {"uncut_chip_thickness_um": cfg.uncut_chip_thickness_um,
                  "cutting_speed_m_per_min": cfg.cutting_speed_m_per_min},
         "robobore_version": __version__,
-        "fe_engine_revision": FE_ENGINE_REVISION,
+        "fe_engine_revision": fe.FE_ENGINE_REVISION,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
 

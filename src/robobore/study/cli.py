@@ -355,11 +355,12 @@ def calibrate_forces_cmd(
     from robobore.clitools import progress_bar
     from robobore.cutting.calibrate import calibrate_forces, load_calibration_config
     from robobore.io.outputs import check_output_file
-    from robobore.study.paper import example_config_path
+    from robobore.study.paper import PaperConfig, example_config_path
 
     check_output_file(out, "--out", "the coefficients JSON")
     path = config if config is not None else example_config_path()
-    cfg = load_calibration_config(path)
+    # a paper config holds a calibration: its other sections are accepted
+    cfg = load_calibration_config(path, other_sections=PaperConfig.model_fields)
     n = len(cfg.uncut_chip_thickness_um) * len(cfg.cutting_speed_m_per_min)
     with progress_bar("FE virtual cutting tests", total=n,
                       enabled=sys.stderr.isatty() and not as_json) as advance:
