@@ -42,7 +42,8 @@ JSON_OPTION = typer.Option(False, "--json", help="Print machine-readable JSON on
 DEBUG = {"on": False}
 
 
-def _print_error(text: str) -> None:
+def print_error(text: str) -> None:
+    """``error: <text>`` on stderr, on one line."""
     # soft_wrap: one line whatever the terminal width (paths stay copyable, and the
     # message does not break where a long temporary path happens to end)
     stderr.print(f"[bold red]error:[/] {escape(text)}", highlight=False, markup=True,
@@ -73,14 +74,14 @@ def handle_errors(func: F) -> F:
                 import traceback
 
                 traceback.print_exc()
-            _print_error(str(exc))
+            print_error(str(exc))
             raise typer.Exit(code=2) from None
         except OSError as exc:
             if DEBUG["on"]:
                 import traceback
 
                 traceback.print_exc()
-            _print_error(os_error_text(exc))
+            print_error(os_error_text(exc))
             raise typer.Exit(code=2) from None
 
     return wrapper  # type: ignore[return-value]
