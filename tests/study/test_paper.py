@@ -206,8 +206,25 @@ def small_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("paper")
     cfg = _small_config(tmp)
     out = tmp / "out"
-    res = pp.run_paper(cfg, out, fast=True, workers=0)
+    res = pp.run_paper(cfg, out, fast=True, workers=0,
+                       progress=lambda *a: PROGRESS_CALLS.append(a))
     return res, out, cfg
+
+
+#: the ``progress(task, done, total)`` calls of the ``small_run`` study
+PROGRESS_CALLS: list[tuple] = []
+
+
+def test_paper_reports_progress_through_the_callback(small_run):
+    """Each stage reports ``(task, done, total)`` from 0 to its total, in order (no FE
+    calibration stage with ``fast``)."""
+    tasks = list(dict.fromkeys(c[0] for c in PROGRESS_CALLS))
+    assert len(tasks) == 3 and tasks[1].startswith("sweep ")
+    assert tasks[0] == "identify robot and modes" and tasks[2] == "lobes, comparison, report"
+    for task in tasks:
+        mine = [c for c in PROGRESS_CALLS if c[0] == task]
+        assert mine[0][1] == 0 and mine[-1][1] == mine[-1][2] > 0
+        assert [c[1] for c in mine] == sorted(c[1] for c in mine)
 
 
 def test_paper_verdicts_by_cause(small_run):

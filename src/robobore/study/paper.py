@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -288,7 +289,8 @@ def build_equivalent(stiffness: dict[str, Any], modes: dict[str, Any],
 
 
 def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fast: bool,
-                      workers: int, progress: Any = None) -> dict[str, Any]:
+                      workers: int, progress: Callable[[int], None] | None = None
+                      ) -> dict[str, Any]:
     """The coefficients file content: stored (``fast``) or freshly FE-calibrated (cached FE)."""
     from robobore.cutting.calibrate import calibrate_forces, calibration_from_mapping
 
@@ -627,12 +629,31 @@ def results_dataset(rows: list[dict[str, Any]]) -> Any:
     return ds
 
 
+def _stage(progress: Callable[[str, int, int], None] | None, task: str,
+           total: int) -> Callable[[int], None]:
+    """``advance(n)`` of one stage, reported as ``progress(task, done, total)`` (done 0 now)."""
+    done = [0]
+
+    def advance(n: int) -> None:
+        done[0] += n
+        if progress is not None:
+            progress(task, done[0], total)
+
+    advance(0)
+    return advance
+
+
 def run_paper(config: str | Path | None = None, out: str | Path = "paper-results", *,
-              fast: bool = False, workers: int | None = None, progress: bool = False,
+              fast: bool = False, workers: int | None = None,
+              progress: Callable[[str, int, int], None] | None = None,
               browser_check: bool = False) -> dict[str, Any]:
-    """Run the whole study (see module doc); returns the JSON summary (also written)."""
+    """Run the whole study (see module doc); returns the JSON summary (also written).
+
+    ``progress(task, done, total)``, if given, is called as each stage advances; the stages
+    in order: "identify robot and modes", "FE force calibration" (not with ``fast``),
+    "sweep <name>" (:func:`robobore.study.sweep.run_sweep`), "lobes, comparison, report".
+    """
     from robobore import __version__
-    from robobore.clitools import progress_bar
     from robobore.io.results import write_json, write_netcdf
     from robobore.study.compare import compare, read_measured_csv
     from robobore.study.paper_report import build_report
@@ -651,25 +672,23 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     def lap(name: str, t: float) -> None:
         timings[name] = time.perf_counter() - t
 
-    # successive bars (rich allows one live display at a time; the sweep has its own)
-    with progress_bar("identify robot and modes", total=2, enabled=progress) as advance:
-        t = time.perf_counter()
-        stiff = identify_stiffness(cfg, cfg_path)
-        lap("stiffness", t)
-        advance(1)
-        t = time.perf_counter()
-        modes = identify_modes(cfg, cfg_path)
-        lap("modes", t)
-        advance(1)
+    advance = _stage(progress, "identify robot and modes", 2)
+    t = time.perf_counter()
+    stiff = identify_stiffness(cfg, cfg_path)
+    lap("stiffness", t)
+    advance(1)
+    t = time.perf_counter()
+    modes = identify_modes(cfg, cfg_path)
+    lap("modes", t)
+    advance(1)
     t = time.perf_counter()
     eq = build_equivalent(stiff, modes, cfg.pressure_foot)
     lap("equivalent", t)
     t = time.perf_counter()
     n_fe = (len(cfg.calibration.get("uncut_chip_thickness_um", []))
             * len(cfg.calibration.get("cutting_speed_m_per_min", [])))
-    with progress_bar("FE force calibration", total=n_fe, enabled=progress and not fast
-                      ) as advance:
-        coeffs = load_or_calibrate(cfg, raw, cfg_path, fast, max(nw, 1), progress=advance)
+    advance = None if fast else _stage(progress, "FE force calibration", n_fe)
+    coeffs = load_or_calibrate(cfg, raw, cfg_path, fast, max(nw, 1), progress=advance)
     lap("force_calibration", t)
     write_json(outdir / "coefficients.json", {k: v for k, v in coeffs.items()
                                               if k not in ("file",)})
@@ -694,77 +713,77 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
             f = store.failure(m["key"]) or {}
             r["error"] = f.get("error", "not computed")
         rows.append(r)
-    with progress_bar("lobes, comparison, report", total=3, enabled=progress) as advance:
-        t = time.perf_counter()
-        lob = compute_lobes(cfg, robot_model)
-        lap("lobes", t)
-        advance(1)
-        t = time.perf_counter()
-        cmp = None
-        mpath = _resolve(cfg_path, cfg.measured.file)
-        if mpath is not None:
-            table = read_measured_csv(mpath)
-            sims = [({k: r[k] for k in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm",
-                                        "pressure_MPa", "posture")}, r["summary"])
-                    for r in rows if r["system"] == "robot" and r["summary"]]
-            cmp = compare(table, sims)
-        checks = qualitative_checks(rows, cfg)
-        lap("comparison", t)
-        advance(1)
-        t = time.perf_counter()
-        ds = results_dataset(rows)
-        write_netcdf(ds, outdir / "results.nc", config=raw)
-        eq_json = {k: (v.to_dict() if hasattr(v, "to_dict") else v) for k, v in eq.items()}
-        write_json(outdir / "equivalent_model.json", eq_json)
-        from robobore.plan.paper import paper_posture_plan
+    advance = _stage(progress, "lobes, comparison, report", 3)
+    t = time.perf_counter()
+    lob = compute_lobes(cfg, robot_model)
+    lap("lobes", t)
+    advance(1)
+    t = time.perf_counter()
+    cmp = None
+    mpath = _resolve(cfg_path, cfg.measured.file)
+    if mpath is not None:
+        table = read_measured_csv(mpath)
+        sims = [({k: r[k] for k in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm",
+                                    "pressure_MPa", "posture")}, r["summary"])
+                for r in rows if r["system"] == "robot" and r["summary"]]
+        cmp = compare(table, sims)
+    checks = qualitative_checks(rows, cfg)
+    lap("comparison", t)
+    advance(1)
+    t = time.perf_counter()
+    ds = results_dataset(rows)
+    write_netcdf(ds, outdir / "results.nc", config=raw)
+    eq_json = {k: (v.to_dict() if hasattr(v, "to_dict") else v) for k, v in eq.items()}
+    write_json(outdir / "equivalent_model.json", eq_json)
+    from robobore.plan.paper import paper_posture_plan
 
-        summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs)
-        done = [r for r in rows if r["summary"]]
-        n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
-        n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
-        summary: dict[str, Any] = {
-            "report": str(outdir / "report.html"),
-            "conditions": len(rows), "computed": len(done),
-            "failed": [{"key": r["key"], "system": r["system"],
-                        "condition": {k: r[k] for k in ("speed_rpm", "feed_mm_per_rev",
-                                                        "depth_of_cut_mm", "pressure_MPa")},
-                        "error": r.get("error")} for r in rows if not r["summary"]],
-            "stable": n_stable, "vibratory": n_vib,
-            "stable_vibratory_by": "the paper's criterion (Ra > tolerance)",
-            "chatter": sum(1 for r in done if r["summary"].get("chatter") is True),
-            "rough": sum(1 for r in done if r["summary"].get("surface_finish_ok") is False),
-            "tool_leaves_cut": sum(1 for r in done
-                                   if r["summary"].get("tool_leaves_cut") is True),
-            "fast": fast, "workers": nw, "synthetic_inputs": True,
-            "config": str(cfg_path), "out": str(outdir),
-            "sweep": outcome.to_dict(),
-            "directional_stiffness_N_per_m": stiff["directional_stiffness_N_per_m"],
-            "modes_Hz": [m["frequency_Hz"] for m in modes["modes"]],
-            "equivalent_model": {"without_foot": eq["without_foot"].table(),
-                                 "with_foot": eq["with_foot"].table()},
-            "coefficients": coeffs["coefficients"],
-            "coefficients_mode": coeffs.get("mode"),
-            "comparison": None if cmp is None else {"groups": cmp.groups,
-                                                    "agreement": cmp.agreement},
-            "qualitative_checks": checks,
-            "robobore_version": __version__,
-            "posture_plan": summary_posture,
-        }
-        rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
-                           rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,
-                           summary=summary)
-        rep.write(outdir / "report.html")
-        lap("report", t)
-        if browser_check:
-            from robobore.study.browser import check_html_in_browser
+    summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs)
+    done = [r for r in rows if r["summary"]]
+    n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
+    n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
+    summary: dict[str, Any] = {
+        "report": str(outdir / "report.html"),
+        "conditions": len(rows), "computed": len(done),
+        "failed": [{"key": r["key"], "system": r["system"],
+                    "condition": {k: r[k] for k in ("speed_rpm", "feed_mm_per_rev",
+                                                    "depth_of_cut_mm", "pressure_MPa")},
+                    "error": r.get("error")} for r in rows if not r["summary"]],
+        "stable": n_stable, "vibratory": n_vib,
+        "stable_vibratory_by": "the paper's criterion (Ra > tolerance)",
+        "chatter": sum(1 for r in done if r["summary"].get("chatter") is True),
+        "rough": sum(1 for r in done if r["summary"].get("surface_finish_ok") is False),
+        "tool_leaves_cut": sum(1 for r in done
+                               if r["summary"].get("tool_leaves_cut") is True),
+        "fast": fast, "workers": nw, "synthetic_inputs": True,
+        "config": str(cfg_path), "out": str(outdir),
+        "sweep": outcome.to_dict(),
+        "directional_stiffness_N_per_m": stiff["directional_stiffness_N_per_m"],
+        "modes_Hz": [m["frequency_Hz"] for m in modes["modes"]],
+        "equivalent_model": {"without_foot": eq["without_foot"].table(),
+                             "with_foot": eq["with_foot"].table()},
+        "coefficients": coeffs["coefficients"],
+        "coefficients_mode": coeffs.get("mode"),
+        "comparison": None if cmp is None else {"groups": cmp.groups,
+                                                "agreement": cmp.agreement},
+        "qualitative_checks": checks,
+        "robobore_version": __version__,
+        "posture_plan": summary_posture,
+    }
+    rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
+                       rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,
+                       summary=summary)
+    rep.write(outdir / "report.html")
+    lap("report", t)
+    if browser_check:
+        from robobore.study.browser import check_html_in_browser
 
-            chk = check_html_in_browser(outdir / "report.html")
-            summary["browser_check"] = {"ok": chk.ok}
-        timings["total"] = time.perf_counter() - t0
-        summary["timings_s"] = timings
-        summary["wall_time_s"] = timings["total"]
-        write_json(outdir / "paper_summary.json", summary)
-        advance(1)
+        chk = check_html_in_browser(outdir / "report.html")
+        summary["browser_check"] = {"ok": chk.ok}
+    timings["total"] = time.perf_counter() - t0
+    summary["timings_s"] = timings
+    summary["wall_time_s"] = timings["total"]
+    write_json(outdir / "paper_summary.json", summary)
+    advance(1)
     return summary
 
 
