@@ -45,7 +45,7 @@ def _fe_boring(p: Path):
 
 
 def _calibration(p: Path):
-    from robobore.cutting.calibrate import load_calibration_config
+    from robobore.cutting.calibration_config import load_calibration_config
 
     load_calibration_config(p)
 

@@ -382,7 +382,7 @@ def test_material_missing_file_names_config_and_key(tmp_path, monkeypatch):
 
 
 def test_calibration_material_file_is_config_relative(tmp_path, monkeypatch):
-    from robobore.cutting.calibrate import load_calibration_config
+    from robobore.cutting.calibration_config import load_calibration_config
 
     cfgdir = _fe_material_case(tmp_path, monkeypatch)
     text = (EX / "calibration_boring_chip.toml").read_text()

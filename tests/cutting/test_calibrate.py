@@ -16,6 +16,8 @@ import numpy as np
 import pytest
 
 from robobore.cutting import calibrate as cal
+from robobore.cutting import calibration_config as calcfg
+from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.forces import load_coefficients
 from robobore.errors import ConfigError
 from robobore.io.cache import ResultCache
@@ -30,7 +32,7 @@ def _cfg(**kw):
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 7.0},
          "material": {"name": "TC4"}}
     d["calibration"].update(kw)
-    return cal.calibration_from_mapping(d, source="test.toml")
+    return calcfg.calibration_from_mapping(d, source="test.toml")
 
 
 def test_fit_exact_linear_data():
@@ -124,7 +126,7 @@ def _linear_fe(monkeypatch) -> list:
         return {"cutting_force_N_per_mm": (30e3 + 1.6e9 * h) * 1e-3,
                 "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
 
-    monkeypatch.setattr(cal, "run_fe_point", fake)
+    monkeypatch.setattr(calruns, "run_fe_point", fake)
     return calls
 
 
@@ -165,17 +167,18 @@ def test_sections_beside_the_calibration_are_those_the_caller_names():
                          "cutting_speed_m_per_min": [40.0]},
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0}, "study": {}}
     with pytest.raises(ConfigError) as e:
-        cal.calibration_from_mapping(d, source="t.toml")
+        calcfg.calibration_from_mapping(d, source="t.toml")
     assert "study" in str(e.value) and "t.toml" in str(e.value)
-    c = cal.calibration_from_mapping(d, source="t.toml", other_sections=PaperConfig.model_fields)
+    c = calcfg.calibration_from_mapping(d, source="t.toml", other_sections=PaperConfig.model_fields)
     assert c.uncut_chip_thickness_um == [60.0, 90.0]
     with pytest.raises(ConfigError, match="studdy"):
-        cal.calibration_from_mapping({**d, "studdy": {}}, source="t.toml",
+        calcfg.calibration_from_mapping({**d, "studdy": {}}, source="t.toml",
                                      other_sections=PaperConfig.model_fields)
 
 
 def test_example_config_is_valid():
-    c = cal.load_calibration_config(example_config_path(), other_sections=PaperConfig.model_fields)
+    c = calcfg.load_calibration_config(example_config_path(),
+                                       other_sections=PaperConfig.model_fields)
     assert c.rake_deg == 7.0 and c.material == "TC4"
 
 
@@ -187,10 +190,10 @@ def test_boring_chip_calibration_example_is_valid():
     from robobore.cutting.fe.config import parse_config
 
     path = Path(__file__).parents[2] / "examples" / "calibration_boring_chip.toml"
-    c = cal.load_calibration_config(path)
+    c = calcfg.load_calibration_config(path)
     assert c.fe.separation == "node_split"
     for h in c.uncut_chip_thickness_um:
-        parse_config(cal.fe_config_dict(c, h, c.cutting_speed_m_per_min[0]))
+        parse_config(calcfg.fe_config_dict(c, h, c.cutting_speed_m_per_min[0]))
 
 
 def test_fit_warnings_flag_bad_fits():
@@ -234,7 +237,7 @@ def _full(fe_config, tmp_path=None, **kw):
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 6.0},
          "material": {"name": "TC4"}}
     src = None if tmp_path is None else str(tmp_path / "cal.toml")
-    return cal.calibration_from_mapping(d, source=src or "cal.toml")
+    return calcfg.calibration_from_mapping(d, source=src or "cal.toml")
 
 
 def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
@@ -242,7 +245,7 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
 
     c = _full(_FULL)
     assert c.fe_config_source == "inline"
-    d = cal.fe_config_dict(c, 90.0, 37.7)
+    d = calcfg.fe_config_dict(c, 90.0, 37.7)
     assert d["cut"] == {"length_mm": 0.2, "uncut_chip_thickness_um": 90.0,
                         "cutting_speed_m_per_min": 37.7}
     assert d["tool"] == {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 6.0}
@@ -250,7 +253,7 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
     p = parse_config(d)
     # everything else is the engine's default: the validated model
     assert p.mesh.frame == "tool" and p.contact.friction_velocity == "sliding"
-    m = cal.fe_model_description(c)
+    m = calcfg.fe_model_description(c)
     assert m["validated_physics"] and "validated model" in m["validation"]
     # the departures from the checked domain are named: rake 7, 20 um, 0.2 mm, h 90, vc 37.7
     out = " | ".join(m["outside_validation"])
@@ -258,7 +261,7 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
                   "rake_deg 7", "element_size_um 20", "length_mm 0.2"):
         assert words in out
     assert "edge_radius_um" not in out and "material" not in out
-    assert not cal.fe_model_description(_full({**_FULL, "parameters": "a_priori"}))[
+    assert not calcfg.fe_model_description(_full({**_FULL, "parameters": "a_priori"}))[
         "validated_physics"]
 
 
@@ -289,7 +292,7 @@ def test_full_fe_config_errors_before_any_run(monkeypatch, fe_config, kw, field,
     def no_run(*a, **k):
         raise AssertionError("an FE run started before the config error was found")
 
-    monkeypatch.setattr(cal, "run_fe_point", no_run)
+    monkeypatch.setattr(calruns, "run_fe_point", no_run)
     with pytest.raises(ConfigError, match=words) as e:
         _full(fe_config, **kw)
     assert e.value.field == field

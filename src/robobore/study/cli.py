@@ -362,7 +362,8 @@ def calibrate_forces_cmd(
 ) -> None:
     """FE-calibrated mechanistic coefficients: 2D FE over h x vc, least-squares fit."""
     from robobore.clitools import progress_bar
-    from robobore.cutting.calibrate import calibrate_forces, load_calibration_config
+    from robobore.cutting.calibrate import calibrate_forces
+    from robobore.cutting.calibration_config import load_calibration_config
     from robobore.io.outputs import check_output_file
     from robobore.study.paper import PaperConfig, example_config_path
 

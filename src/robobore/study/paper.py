@@ -167,7 +167,7 @@ def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict
                           expected=f"> speed_min_rpm = {cfg.lobes.speed_min_rpm} r/min")
     raw = _resolve_files(cfg, raw, p)
     # the [calibration] section is validated even when --fast does not run it
-    from robobore.cutting.calibrate import calibration_from_mapping
+    from robobore.cutting.calibration_config import calibration_from_mapping
 
     try:
         calibration_from_mapping({"calibration": raw.get("calibration", {}),
@@ -292,7 +292,8 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
                       workers: int, progress: Callable[[int], None] | None = None
                       ) -> dict[str, Any]:
     """The coefficients file content: stored (``fast``) or freshly FE-calibrated (cached FE)."""
-    from robobore.cutting.calibrate import calibrate_forces, calibration_from_mapping
+    from robobore.cutting.calibrate import calibrate_forces
+    from robobore.cutting.calibration_config import calibration_from_mapping
 
     if fast:
         p = _resolve(cfg_path, cfg.coefficients.file)
