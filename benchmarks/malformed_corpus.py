@@ -62,7 +62,7 @@ PARSE = {
     "fe": "from robobore.cutting.fe.config import load_fe_config as f",
     "fe_boring": "from robobore.cutting.fe.boring3d import load_boring_config as f",
     "calibration": "from robobore.cutting.calibration_config import load_calibration_config as f",
-    "paper": "from robobore.study.paper import load_paper_config as f",
+    "paper": "from robobore.study.paper_config import load_paper_config as f",
     "material": "from robobore.material import load_material as f",
     "sweep": "from robobore.study.conditions import load_sweep_config as f",
     "measured": "from robobore.study.compare import read_measured_csv as f",

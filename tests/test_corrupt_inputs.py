@@ -57,7 +57,7 @@ def _sweep(p: Path):
 
 
 def _paper(p: Path):
-    from robobore.study.paper import load_paper_config
+    from robobore.study.paper_config import load_paper_config
 
     load_paper_config(p)
 

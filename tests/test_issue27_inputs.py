@@ -168,7 +168,7 @@ def test_fe_base_config_file_unknown_key_names_that_file(tmp_path):
 def test_paper_config_with_a_bad_fe_base_config_fails_at_load(tmp_path):
     """The paper study checks its [calibration] FE model when its config is read (even under
     --fast, which does not run it), before identification, sweep or FE."""
-    from robobore.study import paper as pp
+    from robobore.study import paper_config as pp
 
     text = (pp.example_dir() / "paper.toml").read_text()
     assert "mesh = { element_size_um = 20.0 }" in text

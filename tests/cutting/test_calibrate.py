@@ -21,7 +21,7 @@ from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.forces import load_coefficients
 from robobore.errors import ConfigError
 from robobore.io.cache import ResultCache
-from robobore.study.paper import PaperConfig, example_config_path, example_dir
+from robobore.study.paper_config import PaperConfig, example_config_path, example_dir
 
 STORED = example_dir() / "tc4_fe_coefficients.json"
 

@@ -365,7 +365,7 @@ def calibrate_forces_cmd(
     from robobore.cutting.calibrate import calibrate_forces
     from robobore.cutting.calibration_config import load_calibration_config
     from robobore.io.outputs import check_output_file
-    from robobore.study.paper import PaperConfig, example_config_path
+    from robobore.study.paper_config import PaperConfig, example_config_path
 
     check_output_file(out, "--out", "the coefficients JSON")
     path = config if config is not None else example_config_path()
