@@ -176,6 +176,27 @@ def test_sections_beside_the_calibration_are_those_the_caller_names():
                                      other_sections=PaperConfig.model_fields)
 
 
+def test_cli_reads_the_paper_config_as_a_calibration_config(tmp_path, monkeypatch):
+    """``robobore calibrate forces`` (default: the bundled paper config) accepts the paper
+    config's other sections; a misspelt section is refused (FE runs replaced)."""
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+
+    calls = _linear_fe(monkeypatch)
+    monkeypatch.setenv("ROBOBORE_CACHE_DIR", str(tmp_path / "cache"))
+    r = CliRunner().invoke(app, ["calibrate", "forces", "--workers", "1", "--json"])
+    assert r.exit_code == 0, r.output
+    c = calcfg.load_calibration_config(example_config_path(),
+                                       other_sections=PaperConfig.model_fields)
+    assert len(calls) == len(c.uncut_chip_thickness_um) * len(c.cutting_speed_m_per_min)
+    assert json.loads(r.stdout)["orthogonal"]["Ktc_N_per_m2"] == pytest.approx(1.6e9, rel=1e-9)
+    bad = tmp_path / "paper.toml"
+    bad.write_text(example_config_path().read_text().replace("[lobes]", "[lobbes]"))
+    r = CliRunner().invoke(app, ["calibrate", "forces", str(bad), "--workers", "1"])
+    assert r.exit_code == 2 and "lobbes" in r.output
+
+
 def test_example_config_is_valid():
     c = calcfg.load_calibration_config(example_config_path(),
                                        other_sections=PaperConfig.model_fields)
