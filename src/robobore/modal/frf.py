@@ -43,7 +43,7 @@ FRF_TYPES = ("accelerance", "mobility", "receptance")
 RESPONSE_QUANTITIES = {"acceleration": "accelerance", "velocity": "mobility",
                        "displacement": "receptance"}
 #: power of j omega that turns a receptance into each FRF type
-FRF_TYPE_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+FRF_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 FRF_UNITS = {"receptance": "m/N", "mobility": "m/s/N", "accelerance": "m/s^2/N"}
 
 
@@ -255,7 +255,7 @@ def convert_frf(frf: np.ndarray, frequency_Hz: np.ndarray, from_type: str,
     conversion that divides requires all frequencies > 0 (InputError otherwise).
     """
     a, b = check_frf_type(from_type), check_frf_type(to_type)
-    k = FRF_TYPE_POWER[b] - FRF_TYPE_POWER[a]
+    k = FRF_POWER[b] - FRF_POWER[a]
     jw = 2j * np.pi * np.asarray(frequency_Hz, float)
     if k < 0 and np.any(jw == 0):
         raise InputError("cannot convert at 0 Hz (division by j*omega)", field="frequency_Hz",
@@ -632,7 +632,7 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
 
 
 __all__ = [
-    "FRF_TYPES", "FRF_TYPE_POWER", "FRF_UNITS", "FRFData", "HammerRecords", "HitCheck",
+    "FRF_TYPES", "FRF_POWER", "FRF_UNITS", "FRFData", "HammerRecords", "HitCheck",
     "FRFEstimate",
     "DoubleHitWarning", "LeakageWarning", "record_decay_ratio", "estimate_frf", "convert_frf",
     "check_hit", "force_window",

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robobore.errors import IdentificationError
-from robobore.modal.frf import FRF_TYPE_POWER, FRFData
+from robobore.modal.frf import FRF_POWER, FRFData
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,7 @@ def lsfd(data: FRFData, poles: np.ndarray, participation: np.ndarray,
     L = np.asarray(participation, complex).reshape(poles.size, ni)
     nm = poles.size
     jw = 2j * np.pi * f
-    c = jw ** FRF_TYPE_POWER[data.frf_type]
+    c = jw ** FRF_POWER[data.frf_type]
     B = _basis(jw, poles, L, c)  # (ni, nf, 2nm)
     ncol = 2 * nm + (2 * ni if residuals else 0)
     A = np.zeros((ni, nf, ncol), complex)
