@@ -80,3 +80,21 @@ def test_stage_progress_gives_each_task_its_own_bar_one_at_a_time(monkeypatch):
                       ("close", "a"), ("open", "b", 5), ("advance", "b", 3), ("close", "b"),
                       ("open", "c", 1), ("advance", "c", 1), ("close", "c"),
                       ("open", "d", 4), ("close", "d")]
+
+
+def test_stage_progress_draws_the_rich_bars_on_a_terminal(monkeypatch):
+    buf = io.StringIO()
+    monkeypatch.setattr(clitools, "stderr", Console(file=buf, force_terminal=True, width=80))
+    with clitools.stage_progress(enabled=False) as progress:  # --json on a terminal
+        for i in range(3):
+            progress("identify robot and modes", i, 2)
+        progress("sweep demo", 0, 1)
+        progress("sweep demo", 1, 1)
+    out = buf.getvalue()
+    assert "identify robot and modes" in out and "sweep demo" in out
+    buf.truncate(0)
+    monkeypatch.setattr(clitools, "stderr", Console(file=buf, force_terminal=False, width=80))
+    with clitools.stage_progress(enabled=False) as progress:  # --json to a pipe: no bar
+        progress("sweep demo", 0, 1)
+        progress("sweep demo", 1, 1)
+    assert buf.getvalue() == ""
