@@ -61,8 +61,8 @@ PKG = ROOT / "src" / "robobore"
 PARSE = {
     "fe": "from robobore.cutting.fe.config import load_fe_config as f",
     "fe_boring": "from robobore.cutting.fe.boring3d import load_boring_config as f",
-    "calibration": "from robobore.cutting.calibrate import load_calibration_config as f",
-    "paper": "from robobore.study.paper import load_paper_config as f",
+    "calibration": "from robobore.cutting.calibration_config import load_calibration_config as f",
+    "paper": "from robobore.study.paper_config import load_paper_config as f",
     "material": "from robobore.material import load_material as f",
     "sweep": "from robobore.study.conditions import load_sweep_config as f",
     "measured": "from robobore.study.compare import read_measured_csv as f",
@@ -74,6 +74,7 @@ PARSE = {
 #: a case that would start one is reported (it must be refused before that).
 NO_FE = ("import sys\n"
          "import robobore.cutting.calibrate as c\n"
+         "import robobore.cutting.calibration_runs as r\n"
          "import robobore.cutting.fe.boring3d as b\n"
          "import robobore.cutting.fe.solver as s\n"
          "from robobore.material import load_material\n"
@@ -83,7 +84,7 @@ NO_FE = ("import sys\n"
          "        load_material(m.name, source=source)\n"
          "    print('corpus: an FE simulation would start here', file=sys.stderr)\n"
          "    sys.exit(97)\n"
-         "s.simulate_orthogonal = b.simulate_boring = c.run_fe_point = c.run_grid = _stub\n"
+         "s.simulate_orthogonal = b.simulate_boring = r.run_fe_point = c.run_grid = _stub\n"
          "sys.argv[0] = 'robobore'\n"
          "from robobore.cli import main\n"
          "main()\n")

@@ -45,7 +45,7 @@ def _fe_boring(p: Path):
 
 
 def _calibration(p: Path):
-    from robobore.cutting.calibrate import load_calibration_config
+    from robobore.cutting.calibration_config import load_calibration_config
 
     load_calibration_config(p)
 
@@ -57,7 +57,7 @@ def _sweep(p: Path):
 
 
 def _paper(p: Path):
-    from robobore.study.paper import load_paper_config
+    from robobore.study.paper_config import load_paper_config
 
     load_paper_config(p)
 

@@ -15,7 +15,8 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting import calibrate as cal
+from robobore.cutting import calibration_config as calcfg
+from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.fe.boring3d import parse_boring_config
 from robobore.cutting.fe.config import load_fe_config, parse_config
 from robobore.errors import ConfigError
@@ -31,7 +32,7 @@ def _no_run(*a, **k):
 
 @pytest.fixture(autouse=True)
 def _never_run(monkeypatch):
-    monkeypatch.setattr(cal, "run_fe_point", _no_run)
+    monkeypatch.setattr(calruns, "run_fe_point", _no_run)
     monkeypatch.setattr("robobore.cutting.fe.solver.simulate_orthogonal", _no_run)
 
 
@@ -83,7 +84,7 @@ def test_calibration_config_reads_its_material_file_at_load(tmp_path):
                  "[calibration]\nuncut_chip_thickness_um = [60.0, 90.0]\n"
                  "cutting_speed_m_per_min = [37.7]\n")
     with pytest.raises(ConfigError) as e:
-        cal.load_calibration_config(c)
+        calcfg.load_calibration_config(c)
     assert e.value.file == str(m) and e.value.field == "johnson_cook.A_MPa"
 
 
@@ -117,7 +118,7 @@ def _cal(fe_config=None, h=(60.0, 90.0), vc=(37.7,), **fe):
                          **({} if fe_config is None else {"fe_config": fe_config}),
                          **({"fe": fe} if fe else {})},
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0}, "material": {"name": "TC4"}}
-    return cal.calibration_from_mapping(d, source="cal.toml")
+    return calcfg.calibration_from_mapping(d, source="cal.toml")
 
 
 FULL = {"cut": {"length_mm": 0.2}, "mesh": {"element_size_um": 20.0}}
@@ -158,7 +159,7 @@ def test_fe_base_config_file_unknown_key_names_that_file(tmp_path):
     c.write_text("[insert]\nrake_deg = 7.0\n[calibration]\nuncut_chip_thickness_um = [60, 90]\n"
                  'cutting_speed_m_per_min = [37.7]\nfe_config = "fe_base.toml"\n')
     with pytest.raises(ConfigError, match="grid point") as e:
-        cal.load_calibration_config(c)
+        calcfg.load_calibration_config(c)
     assert e.value.file == str(fe.resolve()) and e.value.field == "mesh.size"
     r = CliRunner().invoke(app, ["calibrate", "forces", str(c), "--json"])
     assert r.exit_code == 2 and "mesh.size" in r.output and "Traceback" not in r.output
@@ -167,7 +168,7 @@ def test_fe_base_config_file_unknown_key_names_that_file(tmp_path):
 def test_paper_config_with_a_bad_fe_base_config_fails_at_load(tmp_path):
     """The paper study checks its [calibration] FE model when its config is read (even under
     --fast, which does not run it), before identification, sweep or FE."""
-    from robobore.study import paper as pp
+    from robobore.study import paper_config as pp
 
     text = (pp.example_dir() / "paper.toml").read_text()
     assert "mesh = { element_size_um = 20.0 }" in text

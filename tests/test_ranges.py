@@ -382,7 +382,7 @@ def test_material_missing_file_names_config_and_key(tmp_path, monkeypatch):
 
 
 def test_calibration_material_file_is_config_relative(tmp_path, monkeypatch):
-    from robobore.cutting.calibrate import load_calibration_config
+    from robobore.cutting.calibration_config import load_calibration_config
 
     cfgdir = _fe_material_case(tmp_path, monkeypatch)
     text = (EX / "calibration_boring_chip.toml").read_text()
@@ -392,7 +392,7 @@ def test_calibration_material_file_is_config_relative(tmp_path, monkeypatch):
 
 
 def test_paper_files_are_config_relative(tmp_path, monkeypatch):
-    from robobore.study.paper import load_paper_config
+    from robobore.study.paper_config import load_paper_config
 
     src = DATA / "paper_example"
     cfgdir = _stray_setup(tmp_path, monkeypatch, "measured_synthetic.csv",
@@ -408,7 +408,7 @@ def test_paper_files_are_config_relative(tmp_path, monkeypatch):
 
 
 def test_paper_typo_in_calibration_refused_even_for_fast(tmp_path):
-    from robobore.study.paper import load_paper_config
+    from robobore.study.paper_config import load_paper_config
 
     src = DATA / "paper_example"
     text = (src / "paper.toml").read_text()
@@ -529,7 +529,8 @@ def test_uff_frf_frequency_axis_scaled_by_1e9_refused(tmp_path):
 def test_paper_band_and_corrupt_stored_coefficients(tmp_path):
     """Two of the issue's tracebacks: band_Hz = [3] and a corrupt coefficients JSON under
     --fast are clear errors naming the file."""
-    from robobore.study.paper import load_or_calibrate, load_paper_config
+    from robobore.study.paper import load_or_calibrate
+    from robobore.study.paper_config import load_paper_config
 
     src = DATA / "paper_example"
     text = (src / "paper.toml").read_text()

@@ -96,7 +96,7 @@ def main() -> None:  # console-script entry point
     ``handle_errors``) is still one line on stderr and exit code 2, not a traceback."""
     import sys
 
-    from robobore.clitools import DEBUG, _print_error, os_error_text
+    from robobore.clitools import DEBUG, os_error_text, print_error
     from robobore.errors import RoboboreError
 
     try:
@@ -104,7 +104,7 @@ def main() -> None:  # console-script entry point
     except (RoboboreError, OSError) as exc:
         if DEBUG["on"] or "--debug" in sys.argv[1:]:
             raise
-        _print_error(os_error_text(exc) if isinstance(exc, OSError) else str(exc))
+        print_error(os_error_text(exc) if isinstance(exc, OSError) else str(exc))
         sys.exit(2)
 
 

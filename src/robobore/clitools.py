@@ -42,7 +42,8 @@ JSON_OPTION = typer.Option(False, "--json", help="Print machine-readable JSON on
 DEBUG = {"on": False}
 
 
-def _print_error(text: str) -> None:
+def print_error(text: str) -> None:
+    """``error: <text>`` on stderr, on one line."""
     # soft_wrap: one line whatever the terminal width (paths stay copyable, and the
     # message does not break where a long temporary path happens to end)
     stderr.print(f"[bold red]error:[/] {escape(text)}", highlight=False, markup=True,
@@ -73,14 +74,14 @@ def handle_errors(func: F) -> F:
                 import traceback
 
                 traceback.print_exc()
-            _print_error(str(exc))
+            print_error(str(exc))
             raise typer.Exit(code=2) from None
         except OSError as exc:
             if DEBUG["on"]:
                 import traceback
 
                 traceback.print_exc()
-            _print_error(os_error_text(exc))
+            print_error(os_error_text(exc))
             raise typer.Exit(code=2) from None
 
     return wrapper  # type: ignore[return-value]
@@ -167,6 +168,38 @@ def fraction_progress(description: str, enabled: bool = True
                 done[0] = n
 
         yield progress
+
+
+@contextmanager
+def stage_progress(enabled: bool = True) -> Iterator[Callable[[str, int, int], None]]:
+    """Progress bars for library code that reports ``progress(task, done, total)`` (the sweep,
+    the paper study): yields that callback. Each ``task`` gets its own :func:`progress_bar`
+    (one at a time: a new task closes the previous bar), advanced to ``done`` of ``total``
+    and closed when ``done`` reaches ``total``."""
+    state: dict[str, Any] = {"task": None, "bar": None, "advance": None, "done": 0}
+
+    def close() -> None:
+        if state["bar"] is not None:
+            bar, state["bar"] = state["bar"], None
+            bar.__exit__(None, None, None)
+
+    def progress(task: str, done: int, total: int) -> None:
+        if task != state["task"]:
+            close()
+            bar = progress_bar(task, total, enabled)
+            state.update(task=task, bar=bar, advance=bar.__enter__(), done=0)
+        if state["bar"] is None:  # this task's bar is finished
+            return
+        if done > state["done"]:
+            state["advance"](done - state["done"])
+            state["done"] = done
+        if done >= total:
+            close()
+
+    try:
+        yield progress
+    finally:
+        close()
 
 
 def parse_floats(text: str, n: int | None, option: str, unit: str) -> list[float]:

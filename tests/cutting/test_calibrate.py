@@ -16,10 +16,12 @@ import numpy as np
 import pytest
 
 from robobore.cutting import calibrate as cal
+from robobore.cutting import calibration_config as calcfg
+from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.forces import load_coefficients
 from robobore.errors import ConfigError
-from robobore.study.cache import ResultCache
-from robobore.study.paper import example_config_path, example_dir
+from robobore.io.cache import ResultCache
+from robobore.study.paper_config import PaperConfig, example_config_path, example_dir
 
 STORED = example_dir() / "tc4_fe_coefficients.json"
 
@@ -30,7 +32,7 @@ def _cfg(**kw):
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 7.0},
          "material": {"name": "TC4"}}
     d["calibration"].update(kw)
-    return cal.calibration_from_mapping(d, source="test.toml")
+    return calcfg.calibration_from_mapping(d, source="test.toml")
 
 
 def test_fit_exact_linear_data():
@@ -124,7 +126,7 @@ def _linear_fe(monkeypatch) -> list:
         return {"cutting_force_N_per_mm": (30e3 + 1.6e9 * h) * 1e-3,
                 "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
 
-    monkeypatch.setattr(cal, "run_fe_point", fake)
+    monkeypatch.setattr(calruns, "run_fe_point", fake)
     return calls
 
 
@@ -142,7 +144,9 @@ def test_grid_is_cached(tmp_path, monkeypatch):
     cal.calibrate_forces(_cfg(fe={"length_mm": 0.5}), cache=cache)
     assert len(calls) == 8
     # a new engine revision (physics changed) does not reuse the old engine's forces
-    monkeypatch.setattr(cal, "FE_ENGINE_REVISION", cal.FE_ENGINE_REVISION + 1)
+    import robobore.cutting.fe as fe
+
+    monkeypatch.setattr(fe, "FE_ENGINE_REVISION", fe.FE_ENGINE_REVISION + 1)
     r3 = cal.calibrate_forces(cfg, cache=cache)
     assert len(calls) == 12 and r3["fe_cached_points"] == 0
 
@@ -157,8 +161,45 @@ def test_bad_config_names_field():
     assert "uncut_chip_thickness_um" in str(e.value)
 
 
+def test_sections_beside_the_calibration_are_those_the_caller_names():
+    """A paper config's sections are accepted when its reader names them; a typo is not."""
+    d = {"calibration": {"uncut_chip_thickness_um": [60.0, 90.0],
+                         "cutting_speed_m_per_min": [40.0]},
+         "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0}, "study": {}}
+    with pytest.raises(ConfigError) as e:
+        calcfg.calibration_from_mapping(d, source="t.toml")
+    assert "study" in str(e.value) and "t.toml" in str(e.value)
+    c = calcfg.calibration_from_mapping(d, source="t.toml", other_sections=PaperConfig.model_fields)
+    assert c.uncut_chip_thickness_um == [60.0, 90.0]
+    with pytest.raises(ConfigError, match="studdy"):
+        calcfg.calibration_from_mapping({**d, "studdy": {}}, source="t.toml",
+                                     other_sections=PaperConfig.model_fields)
+
+
+def test_cli_reads_the_paper_config_as_a_calibration_config(tmp_path, monkeypatch):
+    """``robobore calibrate forces`` (default: the bundled paper config) accepts the paper
+    config's other sections; a misspelt section is refused (FE runs replaced)."""
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+
+    calls = _linear_fe(monkeypatch)
+    monkeypatch.setenv("ROBOBORE_CACHE_DIR", str(tmp_path / "cache"))
+    r = CliRunner().invoke(app, ["calibrate", "forces", "--workers", "1", "--json"])
+    assert r.exit_code == 0, r.output
+    c = calcfg.load_calibration_config(example_config_path(),
+                                       other_sections=PaperConfig.model_fields)
+    assert len(calls) == len(c.uncut_chip_thickness_um) * len(c.cutting_speed_m_per_min)
+    assert json.loads(r.stdout)["orthogonal"]["Ktc_N_per_m2"] == pytest.approx(1.6e9, rel=1e-9)
+    bad = tmp_path / "paper.toml"
+    bad.write_text(example_config_path().read_text().replace("[lobes]", "[lobbes]"))
+    r = CliRunner().invoke(app, ["calibrate", "forces", str(bad), "--workers", "1"])
+    assert r.exit_code == 2 and "lobbes" in r.output
+
+
 def test_example_config_is_valid():
-    c = cal.load_calibration_config(example_config_path())
+    c = calcfg.load_calibration_config(example_config_path(),
+                                       other_sections=PaperConfig.model_fields)
     assert c.rake_deg == 7.0 and c.material == "TC4"
 
 
@@ -170,10 +211,10 @@ def test_boring_chip_calibration_example_is_valid():
     from robobore.cutting.fe.config import parse_config
 
     path = Path(__file__).parents[2] / "examples" / "calibration_boring_chip.toml"
-    c = cal.load_calibration_config(path)
+    c = calcfg.load_calibration_config(path)
     assert c.fe.separation == "node_split"
     for h in c.uncut_chip_thickness_um:
-        parse_config(cal.fe_config_dict(c, h, c.cutting_speed_m_per_min[0]))
+        parse_config(calcfg.fe_config_dict(c, h, c.cutting_speed_m_per_min[0]))
 
 
 def test_fit_warnings_flag_bad_fits():
@@ -217,7 +258,7 @@ def _full(fe_config, tmp_path=None, **kw):
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 6.0},
          "material": {"name": "TC4"}}
     src = None if tmp_path is None else str(tmp_path / "cal.toml")
-    return cal.calibration_from_mapping(d, source=src or "cal.toml")
+    return calcfg.calibration_from_mapping(d, source=src or "cal.toml")
 
 
 def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
@@ -225,7 +266,7 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
 
     c = _full(_FULL)
     assert c.fe_config_source == "inline"
-    d = cal.fe_config_dict(c, 90.0, 37.7)
+    d = calcfg.fe_config_dict(c, 90.0, 37.7)
     assert d["cut"] == {"length_mm": 0.2, "uncut_chip_thickness_um": 90.0,
                         "cutting_speed_m_per_min": 37.7}
     assert d["tool"] == {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 6.0}
@@ -233,7 +274,7 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
     p = parse_config(d)
     # everything else is the engine's default: the validated model
     assert p.mesh.frame == "tool" and p.contact.friction_velocity == "sliding"
-    m = cal.fe_model_description(c)
+    m = calcfg.fe_model_description(c)
     assert m["validated_physics"] and "validated model" in m["validation"]
     # the departures from the checked domain are named: rake 7, 20 um, 0.2 mm, h 90, vc 37.7
     out = " | ".join(m["outside_validation"])
@@ -241,7 +282,7 @@ def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
                   "rake_deg 7", "element_size_um 20", "length_mm 0.2"):
         assert words in out
     assert "edge_radius_um" not in out and "material" not in out
-    assert not cal.fe_model_description(_full({**_FULL, "parameters": "a_priori"}))[
+    assert not calcfg.fe_model_description(_full({**_FULL, "parameters": "a_priori"}))[
         "validated_physics"]
 
 
@@ -272,7 +313,7 @@ def test_full_fe_config_errors_before_any_run(monkeypatch, fe_config, kw, field,
     def no_run(*a, **k):
         raise AssertionError("an FE run started before the config error was found")
 
-    monkeypatch.setattr(cal, "run_fe_point", no_run)
+    monkeypatch.setattr(calruns, "run_fe_point", no_run)
     with pytest.raises(ConfigError, match=words) as e:
         _full(fe_config, **kw)
     assert e.value.field == field

@@ -18,6 +18,8 @@ from pathlib import Path
 import pytest
 
 from robobore.cutting import calibrate as cal
+from robobore.cutting import calibration_config as calcfg
+from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.fe.validate import (
     bundled_validation_path,
     load_validation_record,
@@ -85,7 +87,7 @@ def test_cross_validation_recovers_a_ln_vc_ground_truth():
         f = 1 - 0.1 * math.log(vc / 10.0)
         return 1.6e9 * f, 30e3 * f, 0.4e9 * f, 40e3 * f
 
-    cfg = cal.calibration_from_mapping(
+    cfg = calcfg.calibration_from_mapping(
         {"calibration": {"uncut_chip_thickness_um": [40.0, 60.0, 80.0],
                          "cutting_speed_m_per_min": [10.0, 20.0, 40.0],
                          "fe": {"element_size_um": 10.0}},
@@ -121,8 +123,8 @@ def test_calibrate_forces_over_several_speeds_writes_fits_the_loader_uses(tmp_pa
         return {"cutting_force_N_per_mm": (kte + ktc * h) * 1e-3,
                 "feed_force_N_per_mm": (kfe + kfc * h) * 1e-3, "chip_ratio": None}
 
-    monkeypatch.setattr(cal, "run_fe_point", fake)
-    cfg = cal.calibration_from_mapping(
+    monkeypatch.setattr(calruns, "run_fe_point", fake)
+    cfg = calcfg.calibration_from_mapping(
         {"calibration": {"uncut_chip_thickness_um": [60.0, 90.0],
                          "cutting_speed_m_per_min": [40.0, 80.0, 160.0]},
          "insert": {"rake_deg": 7.0, "edge_radius_um": 20.0, "clearance_deg": 7.0},
@@ -155,14 +157,14 @@ def test_multi_speed_calibration_checks_the_per_speed_fits_and_the_cli_shows_the
         return {"cutting_force_N_per_mm": (30e3 + 1.6e9 * h) * f * 1e-3,
                 "feed_force_N_per_mm": (40e3 + 0.4e9 * h) * 1e-3, "chip_ratio": None}
 
-    monkeypatch.setattr(cal, "run_fe_point", fake)
+    monkeypatch.setattr(calruns, "run_fe_point", fake)
     monkeypatch.setenv("ROBOBORE_CACHE_DIR", str(tmp_path / "cache"))
     toml = tmp_path / "cal.toml"
     toml.write_text('[calibration]\nuncut_chip_thickness_um = [60.0, 75.0, 90.0]\n'
                     'cutting_speed_m_per_min = [40.0, 80.0, 160.0]\n'
                     '[insert]\nrake_deg = 7.0\nedge_radius_um = 20.0\nclearance_deg = 7.0\n'
                     '[material]\nname = "TC4"\n')
-    d = cal.calibrate_forces(cal.load_calibration_config(toml))
+    d = cal.calibrate_forces(calcfg.load_calibration_config(toml))
     assert len(d["warnings"]) == 1 and "pooled set" in d["warnings"][0]
     assert max(p["Fc_rel_error"] for p in cal.predicted_forces(d)) < 1e-9
     res = CliRunner().invoke(app, ["calibrate", "forces", str(toml), "--workers", "1",

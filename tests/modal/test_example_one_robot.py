@@ -17,10 +17,11 @@ from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
 from robobore.robot.kinematics import get_robot
 from robobore.robot.stiffness import directional_stiffness_xyz
 from robobore.study import paper as pp
+from robobore.study import paper_config as pc
 
 
 def test_truth_static_stiffness_is_the_campaign_robot():
-    cfg, _, _ = pp.load_paper_config()
+    cfg, _, _ = pc.load_paper_config()
     k_dir = directional_stiffness_xyz(get_robot(cfg.robot.name),
                                       np.radians(cfg.robot.posture_deg),
                                       IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD,
@@ -45,7 +46,7 @@ def test_identification_recovers_one_robot():
     agrees with the campaign's identified directional stiffness within 10 % (measured:
     -1.4, -0.8, -1.2 %), so does the modal stiffness of the direction's own mode (+8.8, +9.4,
     +8.9 %), and the identified values match the ground truth within 3 %."""
-    cfg, _, path = pp.load_paper_config()
+    cfg, _, path = pc.load_paper_config()
     st = pp.identify_stiffness(cfg, path)["directional_stiffness_N_per_m"]
     modes = pp.identify_modes(cfg, path)["modes"]
     truth = truth_table(robot_boring_truth())

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from robobore.plan.paper import add_posture_section, paper_posture_plan
-from robobore.study.paper import identify_modes, identify_stiffness, load_paper_config
+from robobore.study.paper import identify_modes, identify_stiffness
+from robobore.study.paper_config import load_paper_config
 from robobore.study.report import Report
 
 

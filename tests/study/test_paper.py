@@ -17,10 +17,13 @@ import pytest
 
 from robobore.errors import ConfigError
 from robobore.study import paper as pp
+from robobore.study import paper_config as pc
+from robobore.study import paper_synthetic
+from robobore.study.paper_checks import qualitative_checks
 from robobore.study.runners import boring_runner
 from robobore.study.summary import summarise
 
-EX = pp.example_dir()
+EX = pc.example_dir()
 
 
 def _small_config(tmp_path: Path, extra: str = "", drop: tuple[str, ...] = ()) -> Path:
@@ -52,7 +55,7 @@ def _small_config(tmp_path: Path, extra: str = "", drop: tuple[str, ...] = ()) -
 
 
 def _dyn_model(coeffs: dict, system: str = "machine_tool", k: float = 1e10) -> dict:
-    cfg, _, _ = pp.load_paper_config()
+    cfg, _, _ = pc.load_paper_config()
     dyn = {"insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
            "coefficients": coeffs, "simulation": {"revolutions": 30}}
     dirs = {"x": [1.0, 0, 0], "y": [0, 1.0, 0], "z": [0, 0, 1.0]}
@@ -74,7 +77,7 @@ def test_boring_runner_uses_the_coefficients():
             "pressure_MPa": 0.0, "posture": "paper"}
     ds = boring_runner(cond, {"model": _dyn_model(stored)})
     s = summarise(ds)
-    cfg, _, _ = pp.load_paper_config()
+    cfg, _, _ = pc.load_paper_config()
     ref = boring_forces(cfg.insert.to_insert(), 0.1e-3, 0.15e-3,
                         load_coefficients(EX / "tc4_fe_coefficients.json"))
     for i, ax in enumerate("xy"):
@@ -120,7 +123,7 @@ def test_boring_runner_is_registered():
 def test_study_conditions_of_the_example():
     """OFAT around the base: 7 speeds + 7 feeds + 6 depths - 2 repeats of the base = 18 per
     pressure (the levels of docs/study.md), 36 for the robot."""
-    cfg, _, _ = pp.load_paper_config()
+    cfg, _, _ = pc.load_paper_config()
     conds = pp.study_conditions(cfg)
     assert len(conds) == 36
     assert {c["pressure_MPa"] for c in conds} == {0.0, 0.3}
@@ -131,13 +134,13 @@ def test_study_conditions_of_the_example():
 def test_bad_paper_config(tmp_path):
     p = _small_config(tmp_path, extra="\n[unknown]\nx = 1\n")
     with pytest.raises(ConfigError) as e:
-        pp.load_paper_config(p)
+        pc.load_paper_config(p)
     assert "unknown" in str(e.value)
     p2 = tmp_path / "b.toml"
     p2.write_text((EX / "paper.toml").read_text().replace("diameter_mm = 40.0",
                                                           "diameter_mm = -4.0"))
     with pytest.raises(ConfigError) as e:
-        pp.load_paper_config(p2)
+        pc.load_paper_config(p2)
     assert "bore.diameter_mm" in str(e.value)
 
 
@@ -163,11 +166,11 @@ def _rows(depth_amp, feed_amp, foot_factor):
 def test_qualitative_checks_are_computed_not_assumed():
     """Same checker, two data sets: paper-like results agree, reversed trends and a foot
     that amplifies vibration are reported as disagreements."""
-    cfg, _, _ = pp.load_paper_config()
+    cfg, _, _ = pc.load_paper_config()
     good = {c["finding"]: c["agrees"]
-            for c in pp.qualitative_checks(_rows([0.2, 1.5, 3, 6], [0.1, 1.2, 2], 0.1), cfg)}
+            for c in qualitative_checks(_rows([0.2, 1.5, 3, 6], [0.1, 1.2, 2], 0.1), cfg)}
     bad = {c["finding"]: c["agrees"]
-           for c in pp.qualitative_checks(_rows([6, 3, 1.5, 0.2], [2, 1.2, 0.1], 3.0), cfg)}
+           for c in qualitative_checks(_rows([6, 3, 1.5, 0.2], [2, 1.2, 0.1], 3.0), cfg)}
     grow_d = "vibration grows with depth of cut (paper, robot without foot)"
     grow_f = "vibration grows with feed (paper, robot without foot)"
     foot = "the pressure foot (0.3 MPa) reduces the feed (vibration) amplitude"
@@ -178,14 +181,14 @@ def test_qualitative_checks_are_computed_not_assumed():
     # chatter verdict (onset 0.2 mm here: disagrees), each row saying which
     onset = "vibratory from depth of cut >= 0.1 mm (paper, onset)"
     by = {(c["finding"], c["verdict"]): c
-          for c in pp.qualitative_checks(_rows([0.2, 1.5, 3, 6], [0.1, 1.2, 2], 0.1), cfg)}
+          for c in qualitative_checks(_rows([0.2, 1.5, 3, 6], [0.1, 1.2, 2], 0.1), cfg)}
     paper_v = "paper's criterion (Ra > 1.6 um)"
     chat_v = "chatter (vibration grows)"
     assert by[(onset, paper_v)]["agrees"] is True
     assert by[(onset, chat_v)]["agrees"] is False
     assert "first chattering depth of cut: 0.2 mm" in by[(onset, chat_v)]["ours"]
     bad_by = {(c["finding"], c["verdict"]): c["agrees"] for c in
-              pp.qualitative_checks(_rows([6, 3, 1.5, 0.2], [2, 1.2, 0.1], 3.0), cfg)}
+              qualitative_checks(_rows([6, 3, 1.5, 0.2], [2, 1.2, 0.1], 3.0), cfg)}
     assert bad_by[(onset, paper_v)] is False
     assert "0.1" in by[(foot, "amplitudes")]["ours"]  # median ratio 0.1, not printed as 0.10/0.00
 
@@ -206,8 +209,25 @@ def small_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("paper")
     cfg = _small_config(tmp)
     out = tmp / "out"
-    res = pp.run_paper(cfg, out, fast=True, workers=0)
+    res = pp.run_paper(cfg, out, fast=True, workers=0,
+                       progress=lambda *a: PROGRESS_CALLS.append(a))
     return res, out, cfg
+
+
+#: the ``progress(task, done, total)`` calls of the ``small_run`` study
+PROGRESS_CALLS: list[tuple] = []
+
+
+def test_paper_reports_progress_through_the_callback(small_run):
+    """Each stage reports ``(task, done, total)`` from 0 to its total, in order (no FE
+    calibration stage with ``fast``)."""
+    tasks = list(dict.fromkeys(c[0] for c in PROGRESS_CALLS))
+    assert len(tasks) == 3 and tasks[1].startswith("sweep ")
+    assert tasks[0] == "identify robot and modes" and tasks[2] == "lobes, comparison, report"
+    for task in tasks:
+        mine = [c for c in PROGRESS_CALLS if c[0] == task]
+        assert mine[0][1] == 0 and mine[-1][1] == mine[-1][2] > 0
+        assert [c[1] for c in mine] == sorted(c[1] for c in mine)
 
 
 def test_paper_verdicts_by_cause(small_run):
@@ -318,8 +338,8 @@ def test_synthetic_measured_is_reproducible(tmp_path):
     cfg = _small_config(tmp_path, drop=())
     text = cfg.read_text().replace("pressure_MPa = [0.0, 0.3]", "pressure_MPa = [0.3]")
     cfg.write_text(text)
-    a = pp.make_synthetic_measured(cfg, tmp_path / "a.csv").read_text()
-    b = pp.make_synthetic_measured(cfg, tmp_path / "b.csv").read_text()
+    a = paper_synthetic.make_synthetic_measured(cfg, tmp_path / "a.csv").read_text()
+    b = paper_synthetic.make_synthetic_measured(cfg, tmp_path / "b.csv").read_text()
     assert a == b
     assert a.startswith("# SYNTHETIC")
     assert len([ln for ln in a.splitlines() if ln and not ln.startswith("#")]) == 1 + 4
@@ -338,7 +358,7 @@ def test_deepest_cut_roughness_is_after_form_removal():
     low-feed-force coefficients above: the tool drifts as the chatter grows, a taper of tens
     of um/mm that made Ra ~96 um when the form was left in; Ra after removing the
     least-squares line is ~10 um. The cut is chatter (its feed amplitude grows) and rough."""
-    cfg, raw, path = pp.load_paper_config()
+    cfg, raw, path = pc.load_paper_config()
     eq = pp.build_equivalent(pp.identify_stiffness(cfg, path), pp.identify_modes(cfg, path),
                              cfg.pressure_foot)
     coeffs = dict(pp.load_or_calibrate(cfg, raw, path, True, 1))
@@ -370,7 +390,7 @@ def test_report_figures_units_legends_and_log_scale(small_run):
     from robobore.study.store import ResultsStore
 
     res, out, cfg_path = small_run
-    cfg, _, _ = pp.load_paper_config(cfg_path)
+    cfg, _, _ = pc.load_paper_config(cfg_path)
     base = {k: float(v) for k, v in cfg.study.base.items()}
     store = ResultsStore(out / "sweep")
     rows = [{**rec.condition, "system": rec.condition.get("system", "robot"),

@@ -13,11 +13,11 @@ import pytest
 
 from robobore.cutting.fe.validate import bundled_validation_path, load_validation_record
 from robobore.errors import DataError
-from robobore.study import paper as pp
+from robobore.study import paper_config as pc
 from robobore.study.paper_report import force_model_fe_text, force_model_validation
 from robobore.study.report import Report
 
-COEFFS = json.loads((pp.example_dir() / "tc4_fe_coefficients.json").read_text())
+COEFFS = json.loads((pc.example_dir() / "tc4_fe_coefficients.json").read_text())
 
 
 def _section(coeffs: dict, record=None) -> str:

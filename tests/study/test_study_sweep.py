@@ -44,6 +44,19 @@ def test_serial_and_dask_threads_store_identical_results(tmp_path):
     assert len((tmp_path / "dask" / "summary.csv").read_text().splitlines()) == 13
 
 
+def test_progress_is_reported_through_the_callback(tmp_path):
+    """``progress(task, done, total)``: done 0 first, then once per finished condition; a
+    resumed sweep reports only what is left."""
+    plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(200, 400),
+                                           feeds=(0.1,), depths=(0.05,)))
+    calls: list[tuple] = []
+    run_sweep(plan, tmp_path / "s", workers=0, progress=lambda *a: calls.append(a))
+    assert calls == [("sweep t", 0, 2), ("sweep t", 1, 2), ("sweep t", 2, 2)]
+    calls.clear()
+    run_sweep(plan, tmp_path / "s", workers=0, progress=lambda *a: calls.append(a))
+    assert calls == [("sweep t", 0, 0)]
+
+
 def test_failures_are_recorded_and_retried_only_they(tmp_path):
     marks = tmp_path / "marks"
     cfg = write_sweep_toml(tmp_path / "c.toml", runner_options=(

@@ -17,13 +17,9 @@ forces the pooled set (``speed_dependent = false``). :func:`mechanistic_check` m
 well that reproduces the FE points and measured forces, with leave-one-speed-out
 cross-validation.
 
-The FE model of the virtual tests is a full FE orthogonal config (``fe_config``: a TOML file,
-resolved next to the calibration config, or an inline table; everything ``robobore fe
-orthogonal`` accepts): each virtual test overrides only its uncut chip thickness and cutting
-speed, and runs at the insert's own rake angle, edge radius and clearance. An FE config whose
-``[tool]`` gives another rake or edge radius than the insert is refused. Without
-``fe_config`` the ``fe`` table is a shorthand of a few settings for the workpiece-frame model
-with the a-priori parameters (:class:`FESettings`).
+The calibration config (grid, insert, material, the FE model of the virtual tests) is
+:mod:`robobore.cutting.calibration_config`; the virtual tests run, cached, in
+:mod:`robobore.cutting.calibration_runs`.
 
 Orthogonal -> insert: the FE tests use the insert's own rake angle and edge radius, so for a
 zero-inclination insert the orthogonal coefficients apply unchanged to each edge element
@@ -34,9 +30,6 @@ shear angle and friction angle of the orthogonal fit (:func:`orthogonal_paramete
 shear angle from the FE chip ratio when the FE gives one, else Merchant's
 ``phi = pi/4 - (beta - alpha)/2``).
 
-FE results are cached (:class:`robobore.study.cache.ResultCache`, namespace
-``fe-orthogonal``) keyed by the full FE input (every setting) + package version.
-
 The saved file (JSON) is read by :func:`robobore.cutting.forces.load_coefficients`: the
 ``coefficients`` table holds the ``CuttingCoefficients`` keys; the other tables hold the
 provenance (material, insert, FE settings, grid, version, FE forces, fit residuals).
@@ -45,376 +38,21 @@ provenance (material, insert, FE settings, grid, version, FE forces, fit residua
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from robobore.cutting.calibration_config import (
+    CalibrationConfig,
+    calibration_from_mapping,
+    fe_model_description,
+)
+from robobore.cutting.calibration_runs import run_grid
 from robobore.errors import ConfigError, NumericalError
-
-FE_NAMESPACE = "fe-orthogonal"
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class FESettings(_Strict):
-    """Shorthand FE settings of the virtual tests when no ``fe_config`` is given: the
-    workpiece-frame model with the a-priori parameters (see docs/fe.md; coarse but within the
-    engine's checks: element size <= h/3)."""
-
-    length_mm: float = Field(0.4, gt=0, le=10, description="length of cut, mm")
-    element_size_um: float = Field(20.0, gt=0, le=200, description="element size, um")
-    mass_scaling: float = Field(100.0, ge=1, le=1e6)
-    friction: float | Literal["table"] = "table"
-    shear_limit_MPa: float = Field(576.0, gt=0)
-    clearance_deg: float = Field(7.0, gt=0, le=30)
-    steady_window_fraction: float = Field(0.5, gt=0, le=1)
-    #: the engine's mesh.separation and mesh.separation_height_um (docs/fe.md)
-    separation: Literal["node_split", "erosion_layer"] = "erosion_layer"
-    separation_height_um: float | None = Field(None, ge=0)
-
-
-class CalibrationConfig(_Strict):
-    """What to calibrate: material, insert edge, grid and FE settings."""
-
-    material: str = "TC4"
-    rake_deg: float = Field(7.0, ge=-30, le=40, description="insert rake angle, deg")
-    edge_radius_um: float = Field(20.0, ge=0, le=200, description="edge radius, um")
-    inclination_deg: float = Field(0.0, ge=-30, le=30, description="inclination, deg")
-    uncut_chip_thickness_um: list[float] = Field(min_length=2)
-    cutting_speed_m_per_min: list[float] = Field(min_length=1)
-    fe: FESettings = FESettings()
-    #: the full FE config of the virtual tests (resolved: a file's content or the inline
-    #: table, with the insert's tool and the material filled in); None: the ``fe`` shorthand
-    fe_config: dict[str, Any] | None = None
-    #: where ``fe_config`` came from: the resolved file path, or "inline"
-    fe_config_source: str | None = None
-
-    @field_validator("uncut_chip_thickness_um", "cutting_speed_m_per_min")
-    @classmethod
-    def _pos(cls, v: list[float]) -> list[float]:
-        for x in v:
-            if not (math.isfinite(x) and x > 0):
-                raise ValueError(f"value {x} must be positive and finite")
-        if len(set(v)) != len(v):
-            raise ValueError("levels must be distinct")
-        return [float(x) for x in v]
-
-
-def calibration_from_mapping(data: dict[str, Any], source: str | None = None
-                             ) -> CalibrationConfig:
-    """Calibration config from a TOML mapping.
-
-    Accepts either a file with a ``[calibration]`` table (and optionally ``[insert]``
-    (rake_deg, edge_radius_um, inclination_deg, clearance_deg) and ``[material] name``, which
-    fill the calibration's insert and material when it does not give them), or the
-    calibration keys at top level.
-    """
-    from robobore.io.config import validate_model
-
-    if "calibration" in data:  # a typo'd section is an error, not ignored
-        from robobore.study.paper import PaperConfig  # a paper config is a calibration config
-
-        known = {"calibration", "insert", "material", "range_check", *PaperConfig.model_fields}
-        extra = sorted(set(data) - known)
-        if extra:
-            raise ConfigError("unknown section (a typo?)", file=source, field=extra[0],
-                              expected="the sections [calibration], [insert], [material] (or "
-                              "those of a paper config)")
-    cal = dict(data.get("calibration", data))
-    user_fe = "fe" in cal
-    ins = data.get("insert", {}) if "calibration" in data else {}
-    mat = data.get("material", {}) if "calibration" in data else {}
-    for k in ("rake_deg", "edge_radius_um", "inclination_deg"):
-        if k in ins and k not in cal:
-            cal[k] = ins[k]
-    if "clearance_deg" in ins:
-        fe = dict(cal.get("fe", {}))
-        fe.setdefault("clearance_deg", ins["clearance_deg"])
-        cal["fe"] = fe
-    if isinstance(mat, dict) and "name" in mat and "material" not in cal:
-        cal["material"] = mat["name"]
-    for k in ("insert", "material"):
-        if "calibration" not in data:
-            cal.pop(k, None)
-    prefix = "calibration." if "calibration" in data else ""
-    fe_full = cal.pop("fe_config", None)
-    cal.pop("fe_config_source", None)
-    if fe_full is not None and user_fe:
-        raise ConfigError("give the FE model once", file=source, field=f"{prefix}fe",
-                          value=cal["fe"], expected=f"either {prefix}fe_config (a full FE "
-                          f"config) or the {prefix}fe shorthand, not both")
-    cfg = validate_model(CalibrationConfig, cal, source=source)
-    from robobore.material.library import load_material, resolve_material_name
-
-    mat_field = f"{prefix}material" if "material" in cal else "material.name"
-    cfg.material = resolve_material_name(cfg.material, source, mat_field)
-    load_material(cfg.material, source=source, field=mat_field)  # read and checked now
-    if fe_full is not None:
-        full, src = _resolve_fe_config(fe_full, source, f"{prefix}fe_config")
-        cfg = cfg.model_copy(update={"fe_config": _with_insert(cfg, full, source, prefix, src),
-                                     "fe_config_source": src})
-        _check_grid(cfg, source, f"{prefix}fe_config")
-        return cfg
-    smallest = min(cfg.uncut_chip_thickness_um)
-    if cfg.fe.element_size_um > smallest / 3 + 1e-9:
-        raise ConfigError("FE element too large for the thinnest chip", file=source,
-                          field="calibration.fe.element_size_um", value=cfg.fe.element_size_um,
-                          expected=f"<= h/3 = {smallest / 3:.4g} um (FE engine check)")
-    _check_grid(cfg, source, f"{prefix}fe")
-    return cfg
-
-
-def _resolve_fe_config(value: Any, source: str | None, field: str) -> tuple[dict[str, Any], str]:
-    """The FE config of ``fe_config``: a TOML file path (relative to the calibration config's
-    folder) or an inline table; returns (a fresh dict, its source)."""
-    import copy
-
-    from robobore.io.config import load_toml
-
-    if isinstance(value, dict):
-        return copy.deepcopy(value), "inline"
-    if not isinstance(value, str) or not value.strip():
-        raise ConfigError("bad FE config", file=source, field=field, value=value,
-                          expected="a path to an FE orthogonal config TOML (relative to this "
-                          "file) or an inline table")
-    from robobore.io.paths import resolve_config_path
-
-    p = resolve_config_path(value, source, field, what="FE config file")
-    return load_toml(p), str(p)
-
-
-def _with_insert(cfg: CalibrationConfig, full: dict[str, Any], source: str | None,
-                 prefix: str, src: str) -> dict[str, Any]:
-    """The FE config at the insert's rake, edge radius and clearance and the calibration's
-    material; a different rake, edge radius or material in the FE config is an error."""
-    tool = full.get("tool", {})
-    if not isinstance(tool, dict):
-        raise ConfigError("[tool] must be a table", file=src, field="tool", value=tool,
-                          expected="a table (or nothing: the insert's values are used)")
-    insert = {"rake_deg": cfg.rake_deg, "edge_radius_um": cfg.edge_radius_um,
-              "clearance_deg": cfg.fe.clearance_deg}
-    for k in ("rake_deg", "edge_radius_um"):
-        if k in tool and float(tool[k]) != float(insert[k]):
-            raise ConfigError("the FE config's tool differs from the insert", file=src,
-                              field=f"tool.{k}", value=tool[k],
-                              expected=f"the insert's {k} = {insert[k]:g} (the virtual tests "
-                              "run at the insert's own edge; or leave the key out)")
-    clear = tool.get("clearance_deg", insert["clearance_deg"])
-    full["tool"] = {**tool, "rake_deg": insert["rake_deg"],
-                    "edge_radius_um": insert["edge_radius_um"], "clearance_deg": clear}
-    mat = full.get("material", {})
-    if isinstance(mat, dict):
-        name = mat.get("name")
-        if name is not None and str(name) != cfg.material:
-            raise ConfigError("the FE config's material differs from the calibration's",
-                              file=src, field="material.name", value=name,
-                              expected=f"{cfg.material!r} (the {prefix}material or "
-                              "[material] name), or leave the key out")
-        full["material"] = {**mat, "name": cfg.material}
-    return full
-
-
-#: the FE engine's key of each ``fe`` shorthand setting (errors name the shorthand's key)
-_SHORTHAND_KEYS = {"cut.length_mm": "length_mm", "mesh.element_size_um": "element_size_um",
-                   "solver.mass_scaling": "mass_scaling", "contact.friction": "friction",
-                   "contact.shear_limit_MPa": "shear_limit_MPa",
-                   "tool.clearance_deg": "clearance_deg",
-                   "solver.steady_window_fraction": "steady_window_fraction",
-                   "mesh.separation": "separation",
-                   "mesh.separation_height_um": "separation_height_um"}
-_GRID_KEYS = {"cut.uncut_chip_thickness_um": "uncut_chip_thickness_um",
-              "cut.cutting_speed_m_per_min": "cutting_speed_m_per_min",
-              "tool.rake_deg": "rake_deg", "tool.edge_radius_um": "edge_radius_um"}
-
-
-def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
-    """Every virtual test's config passes the engine's checks (before any run). An error
-    names the key as the user wrote it: the shorthand's (``calibration.fe.<key>``), the
-    inline table's (``calibration.fe_config.<key>``), the FE config file's own key (with that
-    file), or the grid's key for h and vc."""
-    from robobore.cutting.fe.config import parse_config
-
-    for h in cfg.uncut_chip_thickness_um:
-        for v in cfg.cutting_speed_m_per_min:
-            try:
-                parse_config(fe_config_dict(cfg, h, v), cfg.fe_config_source)
-            except ConfigError as exc:
-                key = exc.field
-                if cfg.fe_config is None and key in _SHORTHAND_KEYS:
-                    key = f"{field}.{_SHORTHAND_KEYS[key]}"
-                elif key in _GRID_KEYS:  # the grid's or the insert's own key
-                    key = f"{field.rsplit('.', 1)[0]}.{_GRID_KEYS[key]}" if "." in field \
-                        else _GRID_KEYS[key]
-                elif cfg.fe_config_source == "inline" and key:  # the key in this file
-                    key = f"{field}.{key}"
-                expected = exc.expected
-                if expected is None and exc.field in ("cut.uncut_chip_thickness_um",
-                                                      "cut.cutting_speed_m_per_min"):
-                    expected = _engine_range(exc.field)
-                msg = exc.message.removesuffix(f" (got {exc.value!r})")  # said once below
-                raise ConfigError(f"{field} at the grid point h {h:g} um, vc {v:g} m/min: "
-                                  f"{msg}",
-                                  file=source if exc.file in (None, "inline", "<config>")
-                                  else exc.file,
-                                  field=key,
-                                  value=exc.value, expected=expected) from None
-
-
-def _engine_range(key: str) -> str:
-    """The FE engine's accepted range of a ``cut`` key, in words."""
-    from robobore.cutting.fe.config import CutSection
-
-    name = key.split(".")[-1]
-    b = {k: getattr(m, k) for m in CutSection.model_fields[name].metadata
-         for k in ("gt", "ge", "lt", "le") if getattr(m, k, None) is not None}
-    sym = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
-    unit = "um" if name.endswith("_um") else "m/min"
-    return (" and ".join(f"{sym[k]} {v:g}" for k, v in b.items()) + f" {unit} (the FE "
-            f"engine's range of {key})")
-
-
-def load_calibration_config(path: str | Path) -> CalibrationConfig:
-    from robobore.io.config import load_toml
-
-    return calibration_from_mapping(load_toml(path), source=str(path))
-
-
-def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> dict[str, Any]:
-    """The FE engine's config (``robobore fe orthogonal`` contract) of one grid point."""
-    if cfg.fe_config is not None:
-        from robobore.cutting.fe.validate import point_config
-
-        return point_config(cfg.fe_config, h_um, vc_m_per_min)
-    fe = cfg.fe
-    return {
-        "parameters": "a_priori",
-        "material": {"name": cfg.material},
-        "tool": {"rake_deg": cfg.rake_deg, "clearance_deg": fe.clearance_deg,
-                 "edge_radius_um": cfg.edge_radius_um},
-        "cut": {"uncut_chip_thickness_um": float(h_um),
-                "cutting_speed_m_per_min": float(vc_m_per_min),
-                "length_mm": fe.length_mm, "width_mm": 1.0},
-        "contact": {"friction": fe.friction, "shear_limit_MPa": fe.shear_limit_MPa},
-        "mesh": {"frame": "workpiece", "element_size_um": fe.element_size_um,
-                 "separation": fe.separation,
-                 **({} if fe.separation_height_um is None
-                    else {"separation_height_um": fe.separation_height_um})},
-        "solver": {"mass_scaling": fe.mass_scaling, "heat_conduction": False,
-                   "steady_window_fraction": fe.steady_window_fraction},
-    }
-
-
-_SUMMARY_KEYS = ("cutting_force_N_per_mm", "feed_force_N_per_mm", "cutting_force_std_N_per_mm",
-                 "feed_force_std_N_per_mm", "chip_ratio", "shear_angle_deg", "energy_error",
-                 "peak_temperature_K", "wall_time_s", "steps")
-
-
-def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
-    """Run one virtual orthogonal test (in a worker process); returns the FE summary subset."""
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.solver import simulate_orthogonal
-
-    res = simulate_orthogonal(parse_config(fe_cfg))
-    s = res.summary
-    out: dict[str, Any] = {}
-    for k in _SUMMARY_KEYS:
-        v = s.get(k)
-        if isinstance(v, float) and not math.isfinite(v):
-            v = None
-        out[k] = v
-    for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm"):
-        if out[k] is None:
-            raise NumericalError(f"FE gave no finite {k}", field=k,
-                                 expected="a finite mean force")
-    return out
-
-
-#: revision of the FE engine's physics in the cache key: bump it whenever a change of the
-#: engine changes its results for the same config, so that cached FE forces of another
-#: revision are not reused. Revision 2: the contact's stick/slip return mapping on the trial
-#: velocity
-FE_ENGINE_REVISION = 2
-
-
-def fe_cache_inputs(fe_cfg: dict[str, Any]) -> dict[str, Any]:
-    """Cache key inputs: the full FE config after defaults (a changed default changes the
-    key) and :data:`FE_ENGINE_REVISION`."""
-    from robobore.cutting.fe.config import parse_config
-
-    return {"fe_config": parse_config(fe_cfg).model_dump(mode="json"),
-            "engine_revision": FE_ENGINE_REVISION}
-
-
-def _limit_numba_threads(n: int) -> None:
-    """Process-pool initializer: at most ``n`` numba threads in this worker."""
-    import numba
-
-    numba.set_num_threads(max(1, min(n, numba.config.NUMBA_NUM_THREADS)))
-
-
-def run_grid(cfg: CalibrationConfig, *, cache: Any | None = None, workers: int = 1,
-             progress: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
-    """FE forces at every grid point (cached). Returns one record per point (h-major order):
-    ``h_um, vc_m_per_min, Fc_N_per_m, Ff_N_per_m, cached, fe`` (the FE summary)."""
-    import json
-
-    from robobore.study.cache import ResultCache
-
-    cache = cache if cache is not None else ResultCache()
-    points = [(h, v) for h in cfg.uncut_chip_thickness_um for v in cfg.cutting_speed_m_per_min]
-    cfgs = [fe_config_dict(cfg, h, v) for h, v in points]
-    inputs = [fe_cache_inputs(c) for c in cfgs]
-    summaries: list[dict[str, Any] | None] = []
-    hits: list[bool] = []
-    for inp in inputs:
-        folder = cache.get(FE_NAMESPACE, inp)
-        if folder is not None:
-            summaries.append(json.loads((folder / "summary.json").read_text()))
-            hits.append(True)
-            if progress:
-                progress(1)
-        else:
-            summaries.append(None)
-            hits.append(False)
-    # the thickest chips are the most expensive: start them first (better load balance)
-    todo = sorted((i for i, s in enumerate(summaries) if s is None),
-                  key=lambda i: -points[i][0] / points[i][1])
-
-    def store(i: int, summ: dict[str, Any]) -> None:
-        cache.put(FE_NAMESPACE, inputs[i], {"summary.json": json.dumps(summ, indent=1)})
-        summaries[i] = summ
-        if progress:
-            progress(1)
-
-    if todo and workers > 1 and len(todo) > 1:
-        nproc = min(workers, len(todo))
-        # each worker gets its share of the cores for numba's parallel loops: oversubscribed
-        # numba threads slow the FE kernels 5-20x (docs/fe.md)
-        threads = max(1, (os.cpu_count() or 1) // nproc)
-        with ProcessPoolExecutor(max_workers=nproc, initializer=_limit_numba_threads,
-                                 initargs=(threads,)) as ex:
-            futs = {ex.submit(run_fe_point, cfgs[i]): i for i in todo}
-            for f in as_completed(futs):
-                store(futs[f], f.result())
-    else:
-        for i in todo:
-            store(i, run_fe_point(cfgs[i]))
-    out = []
-    for (h, v), s, hit in zip(points, summaries, hits, strict=True):
-        assert s is not None
-        out.append({"h_um": h, "vc_m_per_min": v,
-                    "Fc_N_per_m": s["cutting_force_N_per_mm"] * 1e3,
-                    "Ff_N_per_m": s["feed_force_N_per_mm"] * 1e3, "cached": hit, "fe": s})
-    return out
 
 
 def fit_edge_model(h_m: np.ndarray, force_N_per_m: np.ndarray) -> dict[str, float]:
@@ -453,6 +91,7 @@ def fit_edge_model(h_m: np.ndarray, force_N_per_m: np.ndarray) -> dict[str, floa
 def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str, Any]:
     """Fit the coefficients to FE records (:func:`run_grid`) and build the file's content."""
     from robobore import __version__
+    from robobore.cutting import fe
     from robobore.cutting.forces import (
         CuttingCoefficients,
         orthogonal_parameters_from_data,
@@ -566,72 +205,9 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
         "grid": {"uncut_chip_thickness_um": cfg.uncut_chip_thickness_um,
                  "cutting_speed_m_per_min": cfg.cutting_speed_m_per_min},
         "robobore_version": __version__,
-        "fe_engine_revision": FE_ENGINE_REVISION,
+        "fe_engine_revision": fe.FE_ENGINE_REVISION,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
-
-
-#: where the validated model was checked against measured forces (docs/fe.md, "Model choice":
-#: ../shared/data/ti64_orthogonal_cutting_forces.json, TC4)
-VALIDATION_DOMAIN = {"uncut_chip_thickness_um": (40.0, 80.0),
-                     "cutting_speed_m_per_min": (5.0, 30.0), "rake_deg": 15.0,
-                     "edge_radius_um": 20.0, "element_size_um": 10.0, "length_mm": 0.3,
-                     "material": "TC4"}
-
-
-def _departures(cfg: CalibrationConfig, c: Any) -> list[str]:
-    """How the virtual tests leave the validated model's checked domain (in words)."""
-    d = VALIDATION_DOMAIN
-    out = []
-    for key, vals in (("uncut_chip_thickness_um", cfg.uncut_chip_thickness_um),
-                      ("cutting_speed_m_per_min", cfg.cutting_speed_m_per_min)):
-        lo, hi = d[key]
-        off = [v for v in vals if not lo <= v <= hi]
-        if off:
-            out.append(f"{key} {', '.join(f'{v:g}' for v in off)} outside the validated "
-                       f"{lo:g}-{hi:g}")
-    for key, val in (("rake_deg", cfg.rake_deg), ("edge_radius_um", cfg.edge_radius_um)):
-        if val != d[key]:
-            out.append(f"{key} {val:g} (validated at {d[key]:g})")
-    if c.mesh.element_size_um > d["element_size_um"]:
-        out.append(f"element_size_um {c.mesh.element_size_um:g} coarser than the validated "
-                   f"{d['element_size_um']:g}")
-    if c.cut.length_mm < d["length_mm"]:
-        out.append(f"length_mm {c.cut.length_mm:g} shorter than the validated "
-                   f"{d['length_mm']:g}")
-    if cfg.material != d["material"]:
-        out.append(f"material {cfg.material} (validated on {d['material']})")
-    return out
-
-
-def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
-    """The FE model of the virtual tests in words, with its validation status: whether its
-    physics (frame, friction, material, conduction) are the engine's validated defaults."""
-    from robobore.cutting.fe.config import parse_config
-
-    h0, v0 = cfg.uncut_chip_thickness_um[0], cfg.cutting_speed_m_per_min[0]
-    c = parse_config(fe_config_dict(cfg, h0, v0))
-    ref = parse_config({k: c.model_dump()[k] for k in ("tool", "cut")} |
-                       {"mesh": {"element_size_um": c.mesh.element_size_um}})
-    same = (c.mesh.frame == ref.mesh.frame
-            and c.contact.model_dump() == ref.contact.model_dump()
-            and c.material.model_dump() == ref.material.model_dump()
-            and c.parameters == ref.parameters
-            and c.solver.heat_conduction == ref.solver.heat_conduction
-            and c.tool_support is None)
-    law = c.friction_law()
-    summary = (f"{c.mesh.frame}-frame model, {c.mesh.element_size_um:g} um elements, "
-               f"{c.cut.length_mm:g} mm of {'tool travel' if c.mesh.frame == 'tool' else 'cut'}, "
-               f"friction {law}, parameters {c.parameters}")
-    validation = ("the engine's validated model (docs/fe.md, 'Model choice': Fc within 10 % "
-                  "and Ff within 25 % of the nine measured Ti6Al4V points, h 40-80 um, "
-                  "vc 5-30 m/min, 10 um elements; CALIBRATED friction law and hardening "
-                  "hold chosen on those points)" if same else
-                  "not the engine's validated model (docs/fe.md, 'Model choice')")
-    return {"source": cfg.fe_config_source or "fe shorthand (workpiece frame, a-priori)",
-            "summary": summary, "validation": validation, "validated_physics": same,
-            "outside_validation": _departures(cfg, c),
-            "config": None if cfg.fe_config is None else cfg.fe_config}
 
 
 #: A fit is flagged when it misses an FE point by more than this (issue 6 acceptance: 5 %).
@@ -835,10 +411,6 @@ def mechanistic_check(cfg: CalibrationConfig, records: list[dict[str, Any]],
             "summary": summary, "passes": ok(summary), "cross_validation": cv,
             "tolerances": {"fe_point": FE_POINT_TOLERANCE, "measured": MEASURED_TOLERANCE}}
 
-
-__all__ = ["FESettings", "CalibrationConfig", "calibration_from_mapping",
-           "load_calibration_config", "fe_config_dict", "run_fe_point", "run_grid",
-           "fit_edge_model", "fit_warnings", "FIT_TOLERANCE", "calibrate",
-           "calibrate_forces", "predicted_forces", "FE_NAMESPACE", "fe_model_description",
-           "mechanistic_orthogonal_forces", "mechanistic_check", "validation_calibration",
-           "FE_POINT_TOLERANCE", "MEASURED_TOLERANCE"]
+__all__ = ["fit_edge_model", "fit_warnings", "FIT_TOLERANCE", "calibrate", "calibrate_forces",
+           "predicted_forces", "mechanistic_orthogonal_forces", "mechanistic_check",
+           "validation_calibration", "FE_POINT_TOLERANCE", "MEASURED_TOLERANCE"]

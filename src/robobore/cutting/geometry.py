@@ -226,7 +226,7 @@ def chip_area(insert: BoringInsert, depth_m: float, feed_m: float, n_grid: int =
     """
     _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
     _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
-    z_hi = _lead_end(insert, depth_m)
+    z_hi = lead_end(insert, depth_m)
     r = insert.nose_radius_m
     s_maj, s_min = r * math.sin(insert.kappa), r * math.sin(insert.kappa_end)
     # piecewise over the profile's corners (the integrand jumps at s_maj - f when kappa = 90)
@@ -251,7 +251,7 @@ def scallop_area(insert: BoringInsert, feed_m: float, n_grid: int = 20001) -> fl
     return float(np.trapezoid(g, z))
 
 
-def _lead_end(insert: BoringInsert, depth: float) -> float:
+def lead_end(insert: BoringInsert, depth: float) -> float:
     """zeta [m] where the leading edge reaches the pre-bore surface (drop = ap)."""
     r, k = insert.nose_radius_m, insert.kappa
     d_arc = r * (1 - math.cos(k))
@@ -405,5 +405,5 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
                         feed_m=float(feed_m), n_trailing=int(n_tr), trailing_end_zeta_m=z_i)
 
 
-__all__ = ["BoringInsert", "EdgeElements", "chip_area", "scallop_area", "edge_elements",
+__all__ = ["BoringInsert", "EdgeElements", "chip_area", "scallop_area", "edge_elements", "lead_end",
            "trailing_intersection"]

@@ -134,14 +134,14 @@ def fe3d_elements(cfg: Any) -> float:
     builder fills, ``(cut_length + ahead)`` along the cut, from half a feed behind the
     insert to the end of its engaged edge plus two side margins along the feed, and ``ap +
     max(depth_factor ap, 4 le)`` deep, over ``le^3``."""
-    from robobore.cutting.fe.boring3d import _lead_end
+    from robobore.cutting.geometry import lead_end
 
     le = float(cfg.mesh.element_size_um) * 1e-6
     ap = float(cfg.cut.depth_of_cut_mm) * 1e-3
     f = float(cfg.cut.feed_mm_per_rev) * 1e-3
     L = (float(cfg.cut.cut_length_mm) + float(cfg.mesh.ahead_mm)) * 1e-3
     side = float(cfg.mesh.side_margin_um) * 1e-6 or 3.0 * le
-    width = 0.5 * f + float(_lead_end(cfg.insert.to_insert(), ap)) + 2.0 * side
+    width = 0.5 * f + float(lead_end(cfg.insert.to_insert(), ap)) + 2.0 * side
     depth = ap + max(float(cfg.mesh.depth_factor) * ap, 4.0 * le)
     return L * width * depth / le**3
 

@@ -222,13 +222,13 @@ def _validate_spec(spec: CampaignSpec, robot: Any) -> np.ndarray:
     if refl.ndim != 2 or refl.shape[1] != 3 or refl.shape[0] < 3:
         raise ConfigError("at least 3 reflectors are needed", field="reflectors_flange_m",
                           expected="(m >= 3, 3) positions in m in the flange frame")
-    if _collinear(refl):
+    if collinear(refl):
         raise ConfigError("reflectors are collinear", field="reflectors_flange_m",
                           value=refl.tolist(), expected="3 or more non-collinear points, m")
     return q
 
 
-def _collinear(points: np.ndarray, rel_tol: float = 1e-3) -> bool:
+def collinear(points: np.ndarray, rel_tol: float = 1e-3) -> bool:
     """True if points (m, 3) are (nearly) on one line: s2/s1 of the centred cloud < rel_tol."""
     P = np.asarray(points, float)
     if P.shape[0] < 3:
@@ -392,6 +392,7 @@ __all__ = [
     "DEFAULT_POSTURES_DEG",
     "PAPER_PRESSURES_MPA",
     "TrackerNoise",
+    "collinear",
     "Campaign",
     "CampaignSpec",
     "pressure_foot_spec",

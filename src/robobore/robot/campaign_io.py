@@ -31,7 +31,7 @@ import numpy as np
 
 from robobore.errors import DataError
 from robobore.io.ranges import check_value
-from robobore.robot.campaign import Campaign, _collinear
+from robobore.robot.campaign import Campaign, collinear
 
 Q_COLS = tuple(f"q{i}_deg" for i in range(1, 7))
 F_COLS = ("force_x_N", "force_y_N", "force_z_N")
@@ -213,7 +213,7 @@ def validate_campaign(c: Campaign, robot=None) -> None:
             raise DataError(f"posture {lab!r}: only {len(ref_refl)} reflector(s) at load step 0",
                             file=src, row=c.row_number(i0), field="reflector",
                             expected="3 or more non-collinear reflectors")
-        if _collinear(c.xyz_m[ref]):
+        if collinear(c.xyz_m[ref]):
             raise DataError(f"posture {lab!r}: reflectors {ref_refl} are collinear",
                             file=src, row=c.row_number(i0), field="x_m",
                             expected="3 or more non-collinear reflectors (m)")

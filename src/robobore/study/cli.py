@@ -13,7 +13,16 @@ from typing import Any
 import typer
 from rich.markup import escape
 
-from robobore.clitools import JSON_OPTION, emit, fmt, handle_errors, kv_table, stderr, stdout
+from robobore.clitools import (
+    JSON_OPTION,
+    emit,
+    fmt,
+    handle_errors,
+    kv_table,
+    stage_progress,
+    stderr,
+    stdout,
+)
 
 ALLOW_FAILURES_OPTION = typer.Option(
     False, "--allow-failures", help="Exit 0 even when some conditions failed (they are still "
@@ -91,10 +100,10 @@ def sweep_cmd(
         return
     check_output_dir(store, "--out", "the results store")
     check_output_file(report, "--report", "the HTML report")
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), stage_progress(sys.stderr.isatty()) as progress:
         warnings.simplefilter("ignore", StoreWarning)  # printed below, one line each
         outcome = run_sweep(plan, store, scheduler=scheduler, workers=workers,
-                            processes=not threads, progress=sys.stderr.isatty())
+                            processes=not threads, progress=progress)
     for w in outcome.warnings:
         stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     res = {"name": plan.name, "runner": plan.runner, **outcome.to_dict()}
@@ -291,10 +300,10 @@ def paper_cmd(
     from robobore.study.store import StoreWarning
 
     check_output_dir(out, "--out", "the study's results")
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), \
+            stage_progress(sys.stderr.isatty() and not as_json) as progress:
         warnings.simplefilter("ignore", StoreWarning)  # printed below, one line each
-        res = run_paper(config, out, fast=fast, workers=workers,
-                        progress=sys.stderr.isatty() and not as_json)
+        res = run_paper(config, out, fast=fast, workers=workers, progress=progress)
     for w in res.get("sweep", {}).get("warnings", []):
         stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     emit(res, as_json, _render_paper)
@@ -353,13 +362,15 @@ def calibrate_forces_cmd(
 ) -> None:
     """FE-calibrated mechanistic coefficients: 2D FE over h x vc, least-squares fit."""
     from robobore.clitools import progress_bar
-    from robobore.cutting.calibrate import calibrate_forces, load_calibration_config
+    from robobore.cutting.calibrate import calibrate_forces
+    from robobore.cutting.calibration_config import load_calibration_config
     from robobore.io.outputs import check_output_file
-    from robobore.study.paper import example_config_path
+    from robobore.study.paper_config import PaperConfig, example_config_path
 
     check_output_file(out, "--out", "the coefficients JSON")
     path = config if config is not None else example_config_path()
-    cfg = load_calibration_config(path)
+    # a paper config holds a calibration: its other sections are accepted
+    cfg = load_calibration_config(path, other_sections=PaperConfig.model_fields)
     n = len(cfg.uncut_chip_thickness_um) * len(cfg.cutting_speed_m_per_min)
     with progress_bar("FE virtual cutting tests", total=n,
                       enabled=sys.stderr.isatty() and not as_json) as advance:

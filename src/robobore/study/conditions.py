@@ -43,7 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
-from robobore.study.hashing import stable_hash
+from robobore.io.hashing import stable_hash
 
 #: Quantities that identify a condition, in CSV/config order.
 CONDITION_FIELDS = ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm", "pressure_MPa")

@@ -17,7 +17,10 @@ Pipeline (:func:`run_paper`), on the bundled SYNTHETIC example data by default
 7. comparison with the (SYNTHETIC) measured CSV and the paper's qualitative checks;
 8. the report (``paper_report``), ``results.nc`` and ``paper_summary.json`` in OUT.
 
-The config file (TOML) is documented in ``docs/paper.md`` and in the bundled example.
+The config file (TOML) is documented in ``docs/paper.md`` and in the bundled example; its
+model and reader are :mod:`robobore.study.paper_config`, the checks of step 7
+:mod:`robobore.study.paper_checks`, the SYNTHETIC measured CSV of the example
+:mod:`robobore.study.paper_synthetic`.
 """
 
 from __future__ import annotations
@@ -25,182 +28,20 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
 
-from robobore.dynamics.config import BoreCfg, InsertCfg, PressureFootCfg
+from robobore.dynamics.config import PressureFootCfg
 from robobore.errors import ConfigError
+from robobore.study.paper_checks import qualitative_checks
+from robobore.study.paper_config import PaperConfig, load_paper_config
 
 RUNNER = "boring"
 PAPER_DAMPING_N_S_PER_M = 23.7  # the paper's equivalent damping coefficient
-
-
-def example_dir() -> Path:
-    """Folder of the bundled example (config, coefficients, SYNTHETIC measured CSV)."""
-    return Path(str(resources.files("robobore") / "data" / "paper_example"))
-
-
-def example_config_path() -> Path:
-    return example_dir() / "paper.toml"
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class XYZ(_Strict):
-    x: float = Field(gt=0)
-    y: float = Field(gt=0)
-    z: float = Field(gt=0)
-
-
-class StudySection(_Strict):
-    name: str = "paper"
-    title: str = "Robotic boring of TC4: the paper's study"
-    revolutions: int = Field(60, ge=10, le=5000)
-    ra_tolerance_um: float = Field(1.6, gt=0)
-    samples_per_rev_stored: int = Field(120, ge=8, le=100000)
-    speed_rpm: list[float] = Field(default_factory=lambda: [200.0, 300.0, 400.0, 500.0, 600.0,
-                                                             800.0, 1000.0])
-    feed_mm_per_rev: list[float] = Field(default_factory=lambda: [0.1, 0.125, 0.15, 0.2, 0.3,
-                                                                   0.4, 0.5])
-    depth_of_cut_mm: list[float] = Field(default_factory=lambda: [0.05, 0.1, 0.15, 0.2, 0.25,
-                                                                   0.3])
-    pressure_MPa: list[float] = Field(default_factory=lambda: [0.0, 0.3])
-    base: dict[str, float] = Field(default_factory=lambda: {
-        "speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.05})
-    design: Literal["ofat", "grid"] = "ofat"
-    machine_tool: bool = True
-
-
-class RobotSection(_Strict):
-    name: str = "irb6600-175-2.55"
-    campaign: str | None = None  # None: bundled SYNTHETIC campaign
-    posture_deg: list[float] = Field(
-        default_factory=lambda: [-48.38, 54.82, 6.86, -54.16, 107.43, -21.95])
-    tcp_m: list[float] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-class ModalSection(_Strict):
-    file: str | None = None  # None: bundled SYNTHETIC hammer test
-    band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0], min_length=2,
-                                 max_length=2, description="analysis band [lo, hi], Hz")
-    n_modes: int = Field(5, ge=3, le=50)
-    max_order: int = Field(40, ge=4, le=200)
-
-
-class MachineToolSection(_Strict):
-    note: str = ""
-    stiffness_N_per_m: XYZ
-    frequency_Hz: XYZ
-    damping_ratio: XYZ
-
-
-class LobesSection(_Strict):
-    speed_min_rpm: float = Field(150.0, gt=0)
-    speed_max_rpm: float = Field(1100.0, gt=0)
-    count: int = Field(200, ge=10, le=5000)
-    method: Literal["frequency", "semidiscretization"] = "semidiscretization"
-
-
-class MaterialSection(_Strict):
-    name: str = "TC4"
-
-
-class CoefficientsSection(_Strict):
-    file: str  # stored FE-calibrated coefficients (used by --fast)
-    #: per-speed fits at two or more speeds evaluated at each condition's cutting speed
-    #: (robobore.cutting.forces.coefficients_at_speed); false: the pooled set
-    speed_dependent: bool = True
-
-
-class MeasuredSection(_Strict):
-    file: str | None = None
-    truth_note: str = ""
-
-
-class PaperConfig(_Strict):
-    study: StudySection = StudySection()
-    robot: RobotSection = RobotSection()
-    modal: ModalSection = ModalSection()
-    insert: InsertCfg = InsertCfg()
-    bore: BoreCfg
-    material: MaterialSection = MaterialSection()
-    pressure_foot: PressureFootCfg = PressureFootCfg()
-    machine_tool: MachineToolSection
-    calibration: dict[str, Any]
-    coefficients: CoefficientsSection
-    measured: MeasuredSection = MeasuredSection()
-    lobes: LobesSection = LobesSection()
-
-
-def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict[str, Any], Path]:
-    """Read and validate a paper config; returns the model, the raw dict and its path."""
-    from robobore.io.config import load_toml, validate_model
-
-    p = Path(path) if path is not None else example_config_path()
-    raw = load_toml(p)
-    cfg = validate_model(PaperConfig, raw, source=p)
-    for name in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm"):
-        lv = getattr(cfg.study, name)
-        if not lv or any(not (math.isfinite(v) and v > 0) for v in lv):
-            raise ConfigError("levels must be positive numbers", file=str(p),
-                              field=f"study.{name}", value=lv,
-                              expected="a non-empty list of positive values")
-        if name not in cfg.study.base:
-            raise ConfigError("missing base value", file=str(p), field=f"study.base.{name}",
-                              expected="the base condition of the one-factor-at-a-time design")
-    if any(v < 0 for v in cfg.study.pressure_MPa) or not cfg.study.pressure_MPa:
-        raise ConfigError("bad foot pressures", file=str(p), field="study.pressure_MPa",
-                          value=cfg.study.pressure_MPa, expected="a list of values >= 0 MPa")
-    if not 0.0 <= cfg.modal.band_Hz[0] < cfg.modal.band_Hz[1]:
-        raise ConfigError("empty analysis band", file=str(p), field="modal.band_Hz",
-                          value=cfg.modal.band_Hz, expected="[lo, hi] with 0 <= lo < hi (Hz)")
-    if cfg.lobes.speed_max_rpm <= cfg.lobes.speed_min_rpm:
-        raise ConfigError("lobe speed range empty", file=str(p), field="lobes.speed_max_rpm",
-                          value=cfg.lobes.speed_max_rpm,
-                          expected=f"> speed_min_rpm = {cfg.lobes.speed_min_rpm} r/min")
-    raw = _resolve_files(cfg, raw, p)
-    # the [calibration] section is validated even when --fast does not run it
-    from robobore.cutting.calibrate import calibration_from_mapping
-
-    try:
-        calibration_from_mapping({"calibration": raw.get("calibration", {}),
-                                  "insert": raw.get("insert", {}),
-                                  "material": raw.get("material", {})}, source=str(p))
-    except ConfigError as exc:  # keys of the calibration model: name them in the file's terms
-        f = exc.field or ""
-        if f and not f.startswith(("calibration", "insert", "material")):
-            raise ConfigError(exc.message, file=exc.file, field=f"calibration.{f}",
-                              value=exc.value, expected=exc.expected) from None
-        raise
-    return cfg, raw, p
-
-
-def _resolve_files(cfg: PaperConfig, raw: dict[str, Any], p: Path) -> dict[str, Any]:
-    """Files named in the config, resolved against its folder (robobore.io.paths); the
-    absolute paths replace the names in ``cfg`` and in the raw config kept as provenance."""
-    from robobore.io.paths import names_a_path, resolve_config_path
-
-    for sec, key, must, what in (("robot", "campaign", True, "campaign CSV"),
-                                 ("modal", "file", True, "hammer-test file"),
-                                 ("coefficients", "file", False, "coefficients file"),
-                                 ("measured", "file", True, "measured CSV")):
-        v = getattr(getattr(cfg, sec), key)
-        if v is None:
-            continue
-        a = str(resolve_config_path(v, p, f"{sec}.{key}", must_exist=must, what=what))
-        setattr(getattr(cfg, sec), key, a)
-        raw = {**raw, sec: {**raw.get(sec, {}), key: a}}
-    if names_a_path(cfg.robot.name):
-        a = str(resolve_config_path(cfg.robot.name, p, "robot.name", what="robot file"))
-        cfg.robot.name = a
-        raw = {**raw, "robot": {**raw.get("robot", {}), "name": a}}
-    return raw
 
 
 def _resolve(base: Path, name: str | None) -> Path | None:
@@ -288,9 +129,11 @@ def build_equivalent(stiffness: dict[str, Any], modes: dict[str, Any],
 
 
 def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fast: bool,
-                      workers: int, progress: Any = None) -> dict[str, Any]:
+                      workers: int, progress: Callable[[int], None] | None = None
+                      ) -> dict[str, Any]:
     """The coefficients file content: stored (``fast``) or freshly FE-calibrated (cached FE)."""
-    from robobore.cutting.calibrate import calibrate_forces, calibration_from_mapping
+    from robobore.cutting.calibrate import calibrate_forces
+    from robobore.cutting.calibration_config import calibration_from_mapping
 
     if fast:
         p = _resolve(cfg_path, cfg.coefficients.file)
@@ -423,164 +266,6 @@ def compute_lobes(cfg: PaperConfig, robot_model: dict[str, Any]) -> dict[str, An
     return out
 
 
-# ----------------------------------------------------------------------------- checks
-def _rank_corr(x: list[float], y: list[float]) -> float | None:
-    if len(x) < 3:
-        return None
-    rx = np.argsort(np.argsort(x)).astype(float)
-    ry = np.argsort(np.argsort(y)).astype(float)
-    if rx.std() == 0 or ry.std() == 0:
-        return None
-    return float(np.corrcoef(rx, ry)[0, 1])
-
-
-def series(rows: list[dict[str, Any]], cfg: PaperConfig, vary: str, system: str,
-           pressure: float) -> list[dict[str, Any]]:
-    """Rows of the one-factor series ``vary`` (others at the base), sorted by ``vary``."""
-    base = cfg.study.base
-    others = [n for n in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm") if n != vary]
-    sel = [r for r in rows if r["system"] == system and r["pressure_MPa"] == pressure
-           and all(math.isclose(r[o], base[o]) for o in others) and r.get("summary")]
-    return sorted(sel, key=lambda r: r[vary])
-
-
-def qualitative_checks(rows: list[dict[str, Any]], cfg: PaperConfig) -> list[dict[str, Any]]:
-    """The paper's qualitative findings, checked on our results (computed, never assumed).
-
-    Each check: ``finding`` (the paper's), ``verdict`` (what decides "vibrating": the chatter
-    verdict, the paper's roughness criterion, or the amplitudes), ``ours`` (what our results
-    show), ``agrees``. Findings about vibrating / not vibrating are checked twice, against the
-    chatter verdict and, separately, against the paper's criterion.
-    """
-    out: list[dict[str, Any]] = []
-    p_foot = cfg.pressure_foot.pressure_MPa
-    paper_onset = {"speed_rpm": 500.0, "feed_mm_per_rev": 0.2, "depth_of_cut_mm": 0.1}
-    names = {"speed_rpm": ("spindle speed", "r/min"), "feed_mm_per_rev": ("feed", "mm/r"),
-             "depth_of_cut_mm": ("depth of cut", "mm")}
-    for vary in ("depth_of_cut_mm", "feed_mm_per_rev"):
-        s = series(rows, cfg, vary, "robot", 0.0)
-        x = [r[vary] for r in s]
-        fa = [r["summary"].get("feed_amplitude_um", math.nan) for r in s]
-        fx = [r["summary"].get("force_amplitude_x_N", math.nan) for r in s]
-        rho_a, rho_f = _rank_corr(x, fa), _rank_corr(x, fx)
-        ok = rho_a is not None and rho_f is not None and rho_a > 0.5 and rho_f > 0.5
-        out.append({
-            "finding": f"vibration grows with {names[vary][0]} (paper, robot without foot)",
-            "verdict": "amplitudes",
-            "ours": (f"rank correlation with {names[vary][0]}: feed amplitude "
-                     f"{_f(rho_a)}, X force amplitude {_f(rho_f)} ({len(s)} levels)"),
-            "agrees": bool(ok) if rho_a is not None else None})
-    for verdict in VERDICTS:
-        vname = VERDICT_NAMES[verdict].format(tol=cfg.study.ra_tolerance_um)
-        word = "chattering" if verdict == "chatter" else "vibratory"
-        for vary in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm"):
-            s = series(rows, cfg, vary, "robot", 0.0)
-            vib = [r[vary] for r in s if vibrates(r["summary"], verdict) is True]
-            onset = min(vib) if vib else None
-            name, unit = names[vary]
-            po = paper_onset[vary]
-            levels = [r[vary] for r in s]
-            if onset is None:
-                ours = f"no {word} level of {name} in {_lv(levels)} {unit}"
-                agrees = False
-            else:
-                above = [r for r in s if r[vary] >= onset]
-                mono = all(vibrates(r["summary"], verdict) is True for r in above)
-                ours = (f"first {word} {name}: {onset:g} {unit}"
-                        + ("" if mono else f" (not {word} at every higher level)"))
-                # agreement: our onset falls between the level below the paper's and the
-                # paper's
-                below = [v for v in levels if v < po]
-                lo = max(below) if below else -math.inf
-                agrees = lo < onset <= po * 1.0000001 and mono
-            out.append({"finding": f"vibratory from {name} >= {po:g} {unit} (paper, onset)",
-                        "verdict": vname, "ours": ours, "agrees": agrees})
-    pairs = []
-    by = {(r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]): r for r in rows
-          if r["system"] == "robot" and r["pressure_MPa"] == 0.0 and r.get("summary")}
-    for r in rows:
-        if r["system"] == "robot" and r["pressure_MPa"] == p_foot and r.get("summary"):
-            b = by.get((r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]))
-            if b is not None:
-                pairs.append((b["summary"], r["summary"]))
-    if pairs:
-        lower = sum(1 for a, b in pairs
-                    if b.get("feed_amplitude_um", 0) < a.get("feed_amplitude_um", 0))
-        lower_f = sum(1 for a, b in pairs
-                      if b.get("force_amplitude_x_N", 0) < a.get("force_amplitude_x_N", 0))
-        ratio = [b["feed_amplitude_um"] / a["feed_amplitude_um"] for a, b in pairs
-                 if a.get("feed_amplitude_um", 0) > 0]
-        med = float(np.median(ratio)) if ratio else None
-        out.append({"finding": f"the pressure foot ({p_foot:g} MPa) reduces the feed "
-                               "(vibration) amplitude",
-                    "verdict": "amplitudes",
-                    "ours": (f"feed amplitude lower with the foot in {lower}/{len(pairs)} "
-                             f"conditions (median ratio with/without {_f(med)})"),
-                    "agrees": lower >= 0.8 * len(pairs)})
-        out.append({"finding": f"the pressure foot ({p_foot:g} MPa) reduces the cutting-force "
-                               "amplitude",
-                    "verdict": "amplitudes",
-                    "ours": f"X force amplitude lower with the foot in {lower_f}/{len(pairs)} "
-                            "conditions",
-                    "agrees": lower_f >= 0.8 * len(pairs)})
-        for verdict in VERDICTS:
-            word = "chattering" if verdict == "chatter" else "vibratory"
-            vib0 = sum(1 for a, _ in pairs if vibrates(a, verdict) is True)
-            vib1 = sum(1 for _, b in pairs if vibrates(b, verdict) is True)
-            out.append({"finding": "the pressure foot suppresses vibration (fewer vibratory "
-                                   "cuts)",
-                        "verdict": VERDICT_NAMES[verdict].format(tol=cfg.study.ra_tolerance_um),
-                        "ours": f"{word}: {vib0} without the foot, {vib1} with it "
-                                f"(of {len(pairs)})",
-                        "agrees": vib1 <= vib0})
-    mt = {(r["speed_rpm"], r["feed_mm_per_rev"], r["depth_of_cut_mm"]): r for r in rows
-          if r["system"] == "machine_tool" and r.get("summary")}
-    if mt:
-        n = lower = 0
-        for k, r in mt.items():
-            b = by.get(k)
-            if b is None:
-                continue
-            n += 1
-            lower += r["summary"]["feed_amplitude_um"] <= b["summary"]["feed_amplitude_um"]
-        vibs = {v: sum(1 for r in mt.values() if vibrates(r["summary"], v) is True)
-                for v in VERDICTS}
-        out.append({"finding": "a (stiff) machine tool vibrates less than the robot",
-                    "verdict": "feed amplitude",
-                    "ours": f"machine tool feed amplitude <= robot's in {lower}/{n} conditions; "
-                            f"machine tool chattering in {vibs['chatter']}/{len(mt)}, "
-                            f"vibratory by the paper's criterion in {vibs['paper']}/{len(mt)}",
-                    "agrees": lower >= 0.8 * n if n else None})
-    return out
-
-
-#: The verdicts the paper's findings are checked against (:func:`vibrates`).
-VERDICTS = ("chatter", "paper")
-VERDICT_NAMES = {"chatter": "chatter (vibration grows)",
-                 "paper": "paper's criterion (Ra > {tol:g} um)"}
-
-
-def vibrates(summary: dict[str, Any] | None, verdict: str) -> bool | None:
-    """Whether a condition's summary counts as vibrating under ``verdict``: ``"chatter"``
-    (the vibration grows, :mod:`robobore.dynamics.chatter`) or ``"paper"`` (the paper's
-    criterion, the summary's ``stable`` flag: Ra above the tolerance). None when unknown."""
-    if not summary:
-        return None
-    if verdict == "chatter":
-        v = summary.get("chatter")
-        return None if v is None else bool(v)
-    st = summary.get("stable")
-    return None if st is None else not st
-
-
-def _f(v: float | None) -> str:
-    return "n/a" if v is None or not math.isfinite(v) else f"{v:.3g}"
-
-
-def _lv(levels: list[float]) -> str:
-    return ", ".join(f"{v:g}" for v in levels)
-
-
 # ----------------------------------------------------------------------------- outputs
 def results_dataset(rows: list[dict[str, Any]]) -> Any:
     """All conditions and their summaries as one Dataset (dimension ``condition``)."""
@@ -627,12 +312,31 @@ def results_dataset(rows: list[dict[str, Any]]) -> Any:
     return ds
 
 
+def _stage(progress: Callable[[str, int, int], None] | None, task: str,
+           total: int) -> Callable[[int], None]:
+    """``advance(n)`` of one stage, reported as ``progress(task, done, total)`` (done 0 now)."""
+    done = [0]
+
+    def advance(n: int) -> None:
+        done[0] += n
+        if progress is not None:
+            progress(task, done[0], total)
+
+    advance(0)
+    return advance
+
+
 def run_paper(config: str | Path | None = None, out: str | Path = "paper-results", *,
-              fast: bool = False, workers: int | None = None, progress: bool = False,
+              fast: bool = False, workers: int | None = None,
+              progress: Callable[[str, int, int], None] | None = None,
               browser_check: bool = False) -> dict[str, Any]:
-    """Run the whole study (see module doc); returns the JSON summary (also written)."""
+    """Run the whole study (see module doc); returns the JSON summary (also written).
+
+    ``progress(task, done, total)``, if given, is called as each stage advances; the stages
+    in order: "identify robot and modes", "FE force calibration" (not with ``fast``),
+    "sweep <name>" (:func:`robobore.study.sweep.run_sweep`), "lobes, comparison, report".
+    """
     from robobore import __version__
-    from robobore.clitools import progress_bar
     from robobore.io.results import write_json, write_netcdf
     from robobore.study.compare import compare, read_measured_csv
     from robobore.study.paper_report import build_report
@@ -651,25 +355,23 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     def lap(name: str, t: float) -> None:
         timings[name] = time.perf_counter() - t
 
-    # successive bars (rich allows one live display at a time; the sweep has its own)
-    with progress_bar("identify robot and modes", total=2, enabled=progress) as advance:
-        t = time.perf_counter()
-        stiff = identify_stiffness(cfg, cfg_path)
-        lap("stiffness", t)
-        advance(1)
-        t = time.perf_counter()
-        modes = identify_modes(cfg, cfg_path)
-        lap("modes", t)
-        advance(1)
+    advance = _stage(progress, "identify robot and modes", 2)
+    t = time.perf_counter()
+    stiff = identify_stiffness(cfg, cfg_path)
+    lap("stiffness", t)
+    advance(1)
+    t = time.perf_counter()
+    modes = identify_modes(cfg, cfg_path)
+    lap("modes", t)
+    advance(1)
     t = time.perf_counter()
     eq = build_equivalent(stiff, modes, cfg.pressure_foot)
     lap("equivalent", t)
     t = time.perf_counter()
     n_fe = (len(cfg.calibration.get("uncut_chip_thickness_um", []))
             * len(cfg.calibration.get("cutting_speed_m_per_min", [])))
-    with progress_bar("FE force calibration", total=n_fe, enabled=progress and not fast
-                      ) as advance:
-        coeffs = load_or_calibrate(cfg, raw, cfg_path, fast, max(nw, 1), progress=advance)
+    advance = None if fast else _stage(progress, "FE force calibration", n_fe)
+    coeffs = load_or_calibrate(cfg, raw, cfg_path, fast, max(nw, 1), progress=advance)
     lap("force_calibration", t)
     write_json(outdir / "coefficients.json", {k: v for k, v in coeffs.items()
                                               if k not in ("file",)})
@@ -694,150 +396,80 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
             f = store.failure(m["key"]) or {}
             r["error"] = f.get("error", "not computed")
         rows.append(r)
-    with progress_bar("lobes, comparison, report", total=3, enabled=progress) as advance:
-        t = time.perf_counter()
-        lob = compute_lobes(cfg, robot_model)
-        lap("lobes", t)
-        advance(1)
-        t = time.perf_counter()
-        cmp = None
-        mpath = _resolve(cfg_path, cfg.measured.file)
-        if mpath is not None:
-            table = read_measured_csv(mpath)
-            sims = [({k: r[k] for k in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm",
-                                        "pressure_MPa", "posture")}, r["summary"])
-                    for r in rows if r["system"] == "robot" and r["summary"]]
-            cmp = compare(table, sims)
-        checks = qualitative_checks(rows, cfg)
-        lap("comparison", t)
-        advance(1)
-        t = time.perf_counter()
-        ds = results_dataset(rows)
-        write_netcdf(ds, outdir / "results.nc", config=raw)
-        eq_json = {k: (v.to_dict() if hasattr(v, "to_dict") else v) for k, v in eq.items()}
-        write_json(outdir / "equivalent_model.json", eq_json)
-        from robobore.plan.paper import paper_posture_plan
+    advance = _stage(progress, "lobes, comparison, report", 3)
+    t = time.perf_counter()
+    lob = compute_lobes(cfg, robot_model)
+    lap("lobes", t)
+    advance(1)
+    t = time.perf_counter()
+    cmp = None
+    mpath = _resolve(cfg_path, cfg.measured.file)
+    if mpath is not None:
+        table = read_measured_csv(mpath)
+        sims = [({k: r[k] for k in ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm",
+                                    "pressure_MPa", "posture")}, r["summary"])
+                for r in rows if r["system"] == "robot" and r["summary"]]
+        cmp = compare(table, sims)
+    checks = qualitative_checks(rows, cfg)
+    lap("comparison", t)
+    advance(1)
+    t = time.perf_counter()
+    ds = results_dataset(rows)
+    write_netcdf(ds, outdir / "results.nc", config=raw)
+    eq_json = {k: (v.to_dict() if hasattr(v, "to_dict") else v) for k, v in eq.items()}
+    write_json(outdir / "equivalent_model.json", eq_json)
+    from robobore.plan.paper import paper_posture_plan
 
-        summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs)
-        done = [r for r in rows if r["summary"]]
-        n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
-        n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
-        summary: dict[str, Any] = {
-            "report": str(outdir / "report.html"),
-            "conditions": len(rows), "computed": len(done),
-            "failed": [{"key": r["key"], "system": r["system"],
-                        "condition": {k: r[k] for k in ("speed_rpm", "feed_mm_per_rev",
-                                                        "depth_of_cut_mm", "pressure_MPa")},
-                        "error": r.get("error")} for r in rows if not r["summary"]],
-            "stable": n_stable, "vibratory": n_vib,
-            "stable_vibratory_by": "the paper's criterion (Ra > tolerance)",
-            "chatter": sum(1 for r in done if r["summary"].get("chatter") is True),
-            "rough": sum(1 for r in done if r["summary"].get("surface_finish_ok") is False),
-            "tool_leaves_cut": sum(1 for r in done
-                                   if r["summary"].get("tool_leaves_cut") is True),
-            "fast": fast, "workers": nw, "synthetic_inputs": True,
-            "config": str(cfg_path), "out": str(outdir),
-            "sweep": outcome.to_dict(),
-            "directional_stiffness_N_per_m": stiff["directional_stiffness_N_per_m"],
-            "modes_Hz": [m["frequency_Hz"] for m in modes["modes"]],
-            "equivalent_model": {"without_foot": eq["without_foot"].table(),
-                                 "with_foot": eq["with_foot"].table()},
-            "coefficients": coeffs["coefficients"],
-            "coefficients_mode": coeffs.get("mode"),
-            "comparison": None if cmp is None else {"groups": cmp.groups,
-                                                    "agreement": cmp.agreement},
-            "qualitative_checks": checks,
-            "robobore_version": __version__,
-            "posture_plan": summary_posture,
-        }
-        rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
-                           rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,
-                           summary=summary)
-        rep.write(outdir / "report.html")
-        lap("report", t)
-        if browser_check:
-            from robobore.study.browser import check_html_in_browser
+    summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs)
+    done = [r for r in rows if r["summary"]]
+    n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
+    n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
+    summary: dict[str, Any] = {
+        "report": str(outdir / "report.html"),
+        "conditions": len(rows), "computed": len(done),
+        "failed": [{"key": r["key"], "system": r["system"],
+                    "condition": {k: r[k] for k in ("speed_rpm", "feed_mm_per_rev",
+                                                    "depth_of_cut_mm", "pressure_MPa")},
+                    "error": r.get("error")} for r in rows if not r["summary"]],
+        "stable": n_stable, "vibratory": n_vib,
+        "stable_vibratory_by": "the paper's criterion (Ra > tolerance)",
+        "chatter": sum(1 for r in done if r["summary"].get("chatter") is True),
+        "rough": sum(1 for r in done if r["summary"].get("surface_finish_ok") is False),
+        "tool_leaves_cut": sum(1 for r in done
+                               if r["summary"].get("tool_leaves_cut") is True),
+        "fast": fast, "workers": nw, "synthetic_inputs": True,
+        "config": str(cfg_path), "out": str(outdir),
+        "sweep": outcome.to_dict(),
+        "directional_stiffness_N_per_m": stiff["directional_stiffness_N_per_m"],
+        "modes_Hz": [m["frequency_Hz"] for m in modes["modes"]],
+        "equivalent_model": {"without_foot": eq["without_foot"].table(),
+                             "with_foot": eq["with_foot"].table()},
+        "coefficients": coeffs["coefficients"],
+        "coefficients_mode": coeffs.get("mode"),
+        "comparison": None if cmp is None else {"groups": cmp.groups,
+                                                "agreement": cmp.agreement},
+        "qualitative_checks": checks,
+        "robobore_version": __version__,
+        "posture_plan": summary_posture,
+    }
+    rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
+                       rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,
+                       summary=summary)
+    rep.write(outdir / "report.html")
+    lap("report", t)
+    if browser_check:
+        from robobore.study.browser import check_html_in_browser
 
-            chk = check_html_in_browser(outdir / "report.html")
-            summary["browser_check"] = {"ok": chk.ok}
-        timings["total"] = time.perf_counter() - t0
-        summary["timings_s"] = timings
-        summary["wall_time_s"] = timings["total"]
-        write_json(outdir / "paper_summary.json", summary)
-        advance(1)
+        chk = check_html_in_browser(outdir / "report.html")
+        summary["browser_check"] = {"ok": chk.ok}
+    timings["total"] = time.perf_counter() - t0
+    summary["timings_s"] = timings
+    summary["wall_time_s"] = timings["total"]
+    write_json(outdir / "paper_summary.json", summary)
+    advance(1)
     return summary
 
 
-# ----------------------------------------------------------------------------- example data
-#: Ground truth of the SYNTHETIC measured CSV (see data/paper_example/README.md): the
-#: boring model with the TRUE robot (the campaign's assumed joint stiffness, the hammer
-#: test's true modes) and the MEASURED TC4 coefficients (Ducobu et al. 2022 fit, not the FE
-#: calibration), plus 8 % truncated Gaussian noise on every amplitude (seed 2026).
-MEASURED_NOISE = 0.08
-MEASURED_SEED = 2026
-
-
-def truth_robot_model(cfg: PaperConfig) -> dict[str, Any]:
-    """The 'real' robot of the SYNTHETIC measurements (documented ground truth)."""
-    from robobore.modal.virtual import robot_boring_truth
-    from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
-    from robobore.robot.kinematics import get_robot
-    from robobore.robot.stiffness import directional_stiffness_xyz
-
-    robot = get_robot(cfg.robot.name)
-    k = directional_stiffness_xyz(robot, np.radians(cfg.robot.posture_deg),
-                                  np.asarray(IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD),
-                                  frame="boring", tcp_m=cfg.robot.tcp_m)
-    tr = robot_boring_truth()
-    f = [float(v) for v in tr.frequencies_Hz]
-    z = [float(v) for v in tr.damping_ratios]
-    return {"system": "robot", "dynamics": {
-        "equivalent": {"stiffness_N_per_m": dict(k),
-                       "frequency_Hz": {"x": f[0], "y": f[1], "z": f[2]},
-                       "damping_ratio": {"x": z[0], "y": z[1], "z": z[2]},
-                       "pressure_foot": cfg.pressure_foot.model_dump(),
-                       "note": "SYNTHETIC ground truth"},
-        "insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
-        "coefficients": {"material": "TC4"},
-        "simulation": {"revolutions": cfg.study.revolutions,
-                       "ra_tolerance_um": cfg.study.ra_tolerance_um}}}
-
-
-def make_synthetic_measured(config: str | Path | None, path: str | Path) -> Path:
-    """Write the SYNTHETIC measured CSV of the robot conditions of ``config``.
-
-    Conditions whose ground-truth simulation fails (a :class:`RoboboreError`, e.g. a
-    non-finite integration) cannot be 'measured': they are left out and listed in a
-    ``#`` comment line of the file.
-    """
-    from robobore.errors import RoboboreError
-    from robobore.io.results import atomic_write_text
-    from robobore.study.runners import boring_runner
-    from robobore.study.summary import summarise
-    from robobore.study.synthetic import synthetic_measured_csv
-
-    cfg, _, _ = load_paper_config(config)
-    model = truth_robot_model(cfg)
-    recs, missing = [], []
-    for c in study_conditions(cfg):
-        try:
-            ds = boring_runner(c, {"model": model,
-                                   "runner_options": {"samples_per_rev_stored": 8}})
-        except RoboboreError as exc:
-            missing.append(f"n={c['speed_rpm']:g} f={c['feed_mm_per_rev']:g} "
-                           f"ap={c['depth_of_cut_mm']:g} P={c['pressure_MPa']:g} ({exc})")
-            continue
-        recs.append((c, summarise(ds)))
-    p = synthetic_measured_csv(recs, path, rel_noise=MEASURED_NOISE, seed=MEASURED_SEED)
-    if missing:
-        text = Path(p).read_text()
-        head, _, rest = text.partition("\n")
-        note = ("# not measured (the ground-truth simulation failed): " + "; ".join(missing))
-        atomic_write_text(p, head + "\n" + note + "\n" + rest)
-    return Path(p)
-
-
-__all__ = ["PaperConfig", "load_paper_config", "run_paper", "example_config_path",
-           "example_dir", "identify_stiffness", "identify_modes", "build_equivalent",
-           "dynamics_model", "study_conditions", "build_plan", "qualitative_checks",
-           "make_synthetic_measured", "truth_robot_model", "results_dataset"]
+__all__ = ["run_paper", "identify_stiffness", "identify_modes", "build_equivalent",
+           "load_or_calibrate", "dynamics_model", "study_conditions", "build_plan",
+           "compute_lobes", "results_dataset", "RUNNER", "PAPER_DAMPING_N_S_PER_M"]

@@ -139,7 +139,7 @@ def force_model_validation(rep: Report, coeffs: dict[str, Any],
     """The validation table of the FE model the coefficients come from: the bundled record
     of the default model (``robobore/data/fe_validation``) when the calibration ran the
     validated physics on its material; otherwise a note that no validation applies."""
-    from robobore.cutting.calibrate import VALIDATION_DOMAIN
+    from robobore.cutting.calibration_config import VALIDATION_DOMAIN
     from robobore.cutting.fe.validate import bundled_validation_path, load_validation_record
 
     m = coeffs.get("fe_model") if isinstance(coeffs.get("fe_model"), dict) else {}

@@ -223,7 +223,7 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     processes: bool = True,
-    progress: bool = False,
+    progress: Callable[[str, int, int], None] | None = None,
     index_every_s: float = 2.0,
     connect_timeout_s: float = 15.0,
 ) -> SweepOutcome:
@@ -233,7 +233,9 @@ def run_sweep(
     local cluster with ``workers`` workers (default: CPU count), processes or threads
     (``processes``); ``workers=0`` (and no scheduler) runs serially in this process.
     ``runner`` overrides the plan's runner spec (a picklable function). The store is
-    locked for the duration (:meth:`ResultsStore.lock`).
+    locked for the duration (:meth:`ResultsStore.lock`). ``progress(task, done, total)``, if
+    given, is called with ``task = "sweep <name>"`` once before the first condition (done 0)
+    and after each condition that finishes, ``total`` being the conditions to compute.
     """
     if not isinstance(store, ResultsStore):
         store = ResultsStore(store)
@@ -245,11 +247,10 @@ def run_sweep(
 
 
 def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: str | None,
-                workers: int | None, processes: bool, progress: bool, index_every_s: float,
+                workers: int | None, processes: bool,
+                progress: Callable[[str, int, int], None] | None, index_every_s: float,
                 connect_timeout_s: float) -> SweepOutcome:
     import warnings
-
-    from robobore.clitools import progress_bar
 
     store.cleanup_partial()  # safe: the lock says no other sweep is writing here
     bad = store.set_aside_invalid(i.key for i in plan.items)
@@ -270,18 +271,25 @@ def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: 
         nw = workers or _default_workers()
         mode = f"dask local cluster, {nw} {'process' if processes else 'thread'} worker(s)"
 
-    with progress_bar(f"sweep {plan.name}", total=len(todo), enabled=progress) as advance:
-        rec = _Recorder(store, plan, advance, index_every_s)
-        rec.write_index()
-        if todo:
-            if scheduler is None and workers == 0:
-                for item in todo:
-                    rec.record(item, execute(fn, item.condition, item.context))
-            else:
-                _run_dask(fn, todo, rec, scheduler=scheduler,
-                          workers=workers or _default_workers(), processes=processes,
-                          connect_timeout_s=connect_timeout_s)
-        index = rec.write_index()
+    task, done = f"sweep {plan.name}", [0]
+
+    def advance(n: int) -> None:
+        done[0] += n
+        if progress is not None:
+            progress(task, done[0], len(todo))
+
+    advance(0)
+    rec = _Recorder(store, plan, advance, index_every_s)
+    rec.write_index()
+    if todo:
+        if scheduler is None and workers == 0:
+            for item in todo:
+                rec.record(item, execute(fn, item.condition, item.context))
+        else:
+            _run_dask(fn, todo, rec, scheduler=scheduler,
+                      workers=workers or _default_workers(), processes=processes,
+                      connect_timeout_s=connect_timeout_s)
+    index = rec.write_index()
     store.write_summary_csv([i.key for i in plan.items])
     return SweepOutcome(
         store=store.root, total=len(plan.items), skipped=skipped, computed=rec.computed,

@@ -229,7 +229,7 @@ def run_validation(base: dict[str, Any], measured: list[MeasuredPoint], *,
     (the ``--json`` contract, docs/fe.md) plus ``config``, ``out_dir`` and per-point extras.
     """
     from robobore import __version__
-    from robobore.cutting.calibrate import FE_ENGINE_REVISION
+    from robobore.cutting.fe import FE_ENGINE_REVISION
     from robobore.cutting.fe.config import parse_config
     from robobore.cutting.fe.solver import check_device, setup_orthogonal, simulate_orthogonal
 

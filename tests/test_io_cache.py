@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from robobore.errors import InputError
-from robobore.study.cache import ResultCache, default_cache_dir
+from robobore.io.cache import ResultCache, default_cache_dir
 
 FE = {"material": "TC4", "h_um": 50.0, "v_m_per_min": 60, "mesh": {"n": 4000, "rake_deg": 5}}
 

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from robobore.errors import InputError
-from robobore.study.hashing import canonical_json, stable_hash
+from robobore.io.hashing import canonical_json, stable_hash
 
 
 def test_representation_does_not_change_the_hash():

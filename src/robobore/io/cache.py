@@ -1,7 +1,7 @@
 """Content-addressed cache of computed result files (used for FE virtual cutting tests).
 
 An entry is a folder named by the SHA-256 of the canonical JSON
-(:func:`robobore.study.hashing.canonical_json`) of ``{"namespace", "inputs", "version"}``:
+(:func:`robobore.io.hashing.canonical_json`) of ``{"namespace", "inputs", "version"}``:
 the same inputs with the same package version give the same entry on every machine; any
 change of input (or a new version of robobore) gives a new one. Layout::
 
@@ -29,8 +29,8 @@ from pathlib import Path
 from typing import Any
 
 from robobore.errors import InputError
+from robobore.io.hashing import canonicalise, stable_hash
 from robobore.io.results import fsync_dir
-from robobore.study.hashing import canonicalise, stable_hash
 
 
 def default_cache_dir() -> Path:

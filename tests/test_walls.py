@@ -1,0 +1,340 @@
+"""Walls between robobore's modules, checked on the source with ``ast``.
+
+- Only the command-line modules import the command-line layer: a module other than
+  ``cli.py``, ``*/cli.py``, ``*/cli_*.py``, ``clitools.py`` and ``__main__.py`` that imports
+  ``robobore.cli``, ``robobore.clitools`` or a ``cli`` module fails. Library code reports
+  progress through a ``progress`` callback that the CLI builds.
+- No module uses another module's private name (``from robobore.x import _y``, or ``m._y``
+  where ``m`` is a robobore module bound by an import).
+- No import cycle between robobore's modules, following the imports at module level and
+  those inside functions (``python tests/test_walls.py`` prints both counts).
+
+Every failure names ``file:line`` of the offending import or attribute. ``EXEMPT`` lists the
+packages not yet held to the private-name and cycle rules, by name, so that each can be
+removed when it is brought in line.
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from collections import defaultdict
+from dataclasses import dataclass
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+ROOT_PACKAGE = "robobore"
+
+#: packages (dotted prefixes) not yet held to the private-name and import-cycle rules
+EXEMPT: tuple[str, ...] = ("robobore.cutting.fe",)
+
+CLI_LAYER = ("robobore.cli", "robobore.clitools")
+
+
+@dataclass(frozen=True)
+class Import:
+    module: str  # the importing module
+    path: Path
+    line: int
+    target: str  # the imported module (resolved: a submodule when the name is one)
+    names: tuple[str, ...]  # names taken from the target by ``from ... import``
+    top_level: bool  # executed when the module is imported (not inside a function)
+    type_checking: bool  # under ``if TYPE_CHECKING:``
+
+    @property
+    def where(self) -> str:
+        return f"{_rel(self.path)}:{self.line}"
+
+
+def _rel(path: Path) -> Path:
+    """``src/robobore/...``: the path from the folder holding the package."""
+    parts = path.parts
+    return Path(*parts[parts.index(ROOT_PACKAGE) - 1:])
+
+
+def module_files(src: Path = SRC) -> dict[str, Path]:
+    """Dotted module name -> file, for every module of the package."""
+    out = {}
+    for p in sorted((src / ROOT_PACKAGE).rglob("*.py")):
+        parts = list(p.relative_to(src).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = p
+    return out
+
+
+def _is_package(mod: str, files: dict[str, Path]) -> bool:
+    return files[mod].name == "__init__.py"
+
+
+def _resolve_from(mod: str, node: ast.ImportFrom, files: dict[str, Path]) -> str:
+    if not node.level:
+        return node.module or ""
+    base = mod.split(".")
+    if not _is_package(mod, files):
+        base = base[:-1]
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _walk(tree: ast.AST):
+    """(node, inside_function, under_type_checking) for every node."""
+    stack = [(tree, False, False)]
+    while stack:
+        node, in_func, tc = stack.pop()
+        yield node, in_func, tc
+        for child in ast.iter_child_nodes(node):
+            c_func = in_func or isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef
+                                           | ast.Lambda)
+            c_tc = tc or (isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+                          and child in node.body)
+            stack.append((child, c_func, c_tc))
+
+
+def imports(files: dict[str, Path] | None = None) -> list[Import]:
+    """Every import of a robobore module by a robobore module."""
+    files = files if files is not None else module_files()
+    out = []
+    for mod, path in files.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        for node, in_func, tc in _walk(tree):
+            if isinstance(node, ast.Import):
+                for a in node.names:
+                    if a.name.split(".")[0] == ROOT_PACKAGE:
+                        out.append(Import(mod, path, node.lineno, a.name, (), not in_func, tc))
+            elif isinstance(node, ast.ImportFrom):
+                base = _resolve_from(mod, node, files)
+                if base.split(".")[0] != ROOT_PACKAGE:
+                    continue
+                plain = []
+                for a in node.names:
+                    sub = f"{base}.{a.name}"
+                    if sub in files:  # ``from package import module``
+                        out.append(Import(mod, path, node.lineno, sub, (), not in_func, tc))
+                    else:
+                        plain.append(a.name)
+                if plain or not node.names:
+                    out.append(Import(mod, path, node.lineno, base, tuple(plain), not in_func,
+                                      tc))
+    return sorted(out, key=lambda i: (str(i.path), i.line))
+
+
+def _private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__")
+
+
+def _exempt(mod: str) -> bool:
+    return any(mod == e or mod.startswith(e + ".") for e in EXEMPT)
+
+
+def is_cli_module(mod: str) -> bool:
+    last = mod.rsplit(".", 1)[-1]
+    return (mod in CLI_LAYER or mod == f"{ROOT_PACKAGE}.__main__" or last == "cli"
+            or last.startswith("cli_"))
+
+
+def cli_layer_violations(files: dict[str, Path] | None = None) -> list[str]:
+    """Non-CLI modules importing the CLI layer (anywhere in the module, also in functions)."""
+    files = files if files is not None else module_files()
+    bad = []
+    for imp in imports(files):
+        if is_cli_module(imp.module):
+            continue
+        if is_cli_module(imp.target):
+            bad.append(f"{imp.where}: {imp.module} imports {imp.target} (the CLI layer)")
+    return bad
+
+
+def private_name_violations(files: dict[str, Path] | None = None,
+                            exempt: bool = True) -> list[str]:
+    """Uses of another module's private name: ``from robobore.x import _y``, ``x._y``, an
+    import of a private module."""
+    files = files if files is not None else module_files()
+    bad = []
+    for mod, path in files.items():
+        if exempt and _exempt(mod):
+            continue
+        rel = _rel(path)
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        bound: dict[str, str] = {}  # local name -> robobore module it is bound to
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                for a in node.names:
+                    if a.name.split(".")[0] != ROOT_PACKAGE:
+                        continue
+                    if a.asname:
+                        bound[a.asname] = a.name
+                    else:
+                        bound[ROOT_PACKAGE] = ROOT_PACKAGE
+                    if any(_private(p) for p in a.name.split(".")):
+                        bad.append(f"{rel}:{node.lineno}: {mod} imports private module {a.name}")
+            elif isinstance(node, ast.ImportFrom):
+                base = _resolve_from(mod, node, files)
+                if base.split(".")[0] != ROOT_PACKAGE or base == mod:
+                    continue
+                for a in node.names:
+                    if f"{base}.{a.name}" in files:
+                        bound[a.asname or a.name] = f"{base}.{a.name}"
+                    if _private(a.name):
+                        bad.append(f"{rel}:{node.lineno}: {mod} imports {base}.{a.name}")
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and _private(node.attr):
+                target = _dotted(node.value, bound)
+                if target is not None and target in files and target != mod:
+                    bad.append(f"{rel}:{node.lineno}: {mod} uses {target}.{node.attr}")
+    return sorted(set(bad))
+
+
+def _dotted(node: ast.AST, bound: dict[str, str]) -> str | None:
+    if isinstance(node, ast.Name):
+        return bound.get(node.id)
+    if isinstance(node, ast.Attribute):
+        head = _dotted(node.value, bound)
+        return f"{head}.{node.attr}" if head is not None else None
+    return None
+
+
+def import_graph(files: dict[str, Path] | None = None, function_level: bool = False
+                 ) -> dict[str, dict[str, Import]]:
+    """module -> {imported module: first import} over runtime imports (module level; with
+    ``function_level`` also those inside functions). ``TYPE_CHECKING`` imports are left out."""
+    files = files if files is not None else module_files()
+    graph: dict[str, dict[str, Import]] = defaultdict(dict)
+    for imp in imports(files):
+        if imp.type_checking or (not imp.top_level and not function_level):
+            continue
+        if imp.target in files and imp.target != imp.module:
+            graph[imp.module].setdefault(imp.target, imp)
+    return graph
+
+
+def cycles(graph: dict[str, dict[str, Import]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan), sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+    counter = [0]
+    sys.setrecursionlimit(max(10000, sys.getrecursionlimit()))
+
+    def strong(v: str) -> None:
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, {}):
+            if w not in index:
+                strong(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(set(graph) | {w for e in graph.values() for w in e}):
+        if v not in index:
+            strong(v)
+    return sorted(out)
+
+
+def cycle_report(graph: dict[str, dict[str, Import]], comp: list[str]) -> str:
+    members = set(comp)
+    edges = [f"    {imp.where}: {a} -> {b}" for a in comp
+             for b, imp in sorted(graph.get(a, {}).items()) if b in members]
+    return f"cycle among {', '.join(comp)}:\n" + "\n".join(edges)
+
+
+def cycle_violations(files: dict[str, Path] | None = None, function_level: bool = False,
+                     exempt: bool = True) -> list[str]:
+    graph = import_graph(files, function_level)
+    return [cycle_report(graph, c) for c in cycles(graph)
+            if not (exempt and all(_exempt(m) for m in c))]
+
+
+def module_sizes(files: dict[str, Path] | None = None) -> dict[str, int]:
+    files = files if files is not None else module_files()
+    return {m: len(p.read_text(encoding="utf-8").splitlines()) for m, p in files.items()}
+
+
+# -- the tests ------------------------------------------------------------------------------
+
+def test_only_cli_modules_import_the_cli_layer():
+    bad = cli_layer_violations()
+    assert not bad, "library code must take a progress callback, not import the CLI:\n" + \
+        "\n".join(bad)
+
+
+def test_no_private_name_used_across_modules():
+    bad = private_name_violations()
+    assert not bad, "another module's private name used (make it public or move it):\n" + \
+        "\n".join(bad)
+
+
+def test_no_import_cycle():
+    """Neither through module-level imports nor through imports inside functions (a cycle
+    hidden in a function is still two modules that need each other)."""
+    bad = cycle_violations(function_level=True)
+    assert not bad, "import cycles:\n" + "\n".join(bad)
+
+
+def test_the_scanners_see_a_planted_violation(tmp_path):
+    """Each scanner finds the violation planted in a small fake package."""
+    pkg = tmp_path / ROOT_PACKAGE
+    (pkg / "a").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "cli.py").write_text("import robobore.a.x\n")
+    (pkg / "clitools.py").write_text("def progress_bar(): pass\n")
+    (pkg / "a" / "__init__.py").write_text("")
+    (pkg / "a" / "x.py").write_text(
+        "from robobore.a.y import _hidden\nfrom robobore.a import y\n\n\n"
+        "def f():\n    from robobore.clitools import progress_bar\n    return y._other\n")
+    (pkg / "a" / "y.py").write_text("import robobore.a.x\n_hidden = _other = 1\n")
+    files = module_files(tmp_path)
+    cli_bad = cli_layer_violations(files)
+    assert len(cli_bad) == 1 and "a/x.py:6" in cli_bad[0] and "robobore.clitools" in cli_bad[0]
+    priv = private_name_violations(files)
+    assert len(priv) == 2 and "a/x.py:1" in priv[0] and "a/x.py:7" in priv[1]
+    cyc = cycle_violations(files)
+    assert len(cyc) == 1 and "a/x.py:1" in cyc[0] and "a/y.py:1" in cyc[0]
+
+
+def main() -> None:
+    files = module_files()
+    n_cli = cli_layer_violations(files)
+    priv_all = private_name_violations(files, exempt=False)
+    priv = private_name_violations(files)
+    print(f"modules: {len(files)}")
+    print(f"CLI-layer imports by library modules: {len(n_cli)}")
+    for b in n_cli:
+        print("  " + b)
+    print(f"private names used across modules: {len(priv_all)} in all, {len(priv)} outside "
+          f"{', '.join(EXEMPT)}")
+    for b in priv_all:
+        print("  " + b)
+    for fl in (False, True):
+        g = import_graph(files, function_level=fl)
+        cyc = cycles(g)
+        out = [c for c in cyc if not all(_exempt(m) for m in c)]
+        print(f"import cycles ({'module + function level' if fl else 'module level'}): "
+              f"{len(cyc)} strongly connected groups ({sum(map(len, cyc))} modules), "
+              f"{len(out)} outside {', '.join(EXEMPT)}")
+        for c in cyc:
+            print("  " + cycle_report(g, c).replace("\n", "\n  "))
+    sizes = module_sizes(files)
+    big = sorted(((n, m) for m, n in sizes.items() if n > 600), reverse=True)
+    print(f"modules over 600 lines: {len(big)}")
+    for n, m in big:
+        print(f"  {n:5d} {m}")
+
+
+if __name__ == "__main__":
+    main()
