@@ -61,10 +61,9 @@ def joint_stiffness_arg(k: Any, name: str = "joint_stiffness") -> Any:
         raise InputError("not joint stiffnesses", field=name, value=k,
                          expected="a StiffnessIdentification, a JointStiffness, its dict "
                                   "form or n numbers in N m/rad")
-    from robobore.robot.identify import StiffnessIdentification
-
-    if isinstance(k, StiffnessIdentification):
-        return k.joint
+    joint = getattr(k, "joint", None)  # a StiffnessIdentification (identify imports this module)
+    if isinstance(joint, JointStiffness):
+        return joint
     if isinstance(k, list | tuple | np.ndarray) or np.isscalar(k):
         return k
     raise InputError("not joint stiffnesses", field=name, value=type(k).__name__,
