@@ -8,10 +8,10 @@ Usage::
         [--separation erosion_layer|node_split] [--no-support] [--out results.json]
 
 ``speed`` prints element-updates per second of the full time step (nodes, contact, elements,
-tool, heat conduction every 10 steps) on a wall block of about ``--elements`` hexahedra,
-serial and parallel, each with the adiabatic model as the reference run in the same process
-(the ratio is the cost of conduction), with the load average (the machine is shared: figures
-are noisy). ``paper`` runs
+tool, heat conduction every 10 steps) on a wall block of about ``--elements`` hexahedra, on
+one numba thread and on all of them, each with the adiabatic model as the reference run in
+the same process (the ratio is the cost of conduction), with the load average (the machine is
+shared: figures are noisy). ``paper`` runs
 ``examples/fe_boring_paper.toml`` (ap = 0.05 mm, f = 0.15 mm/r, n = 300 r/min, TC4; insert
 and bore diameter are documented assumptions) at each element size, compares the rotating-
 frame forces with the mechanistic model (default TC4 coefficients, or ``--coefficients``,
@@ -32,6 +32,7 @@ import os
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,9 +52,10 @@ def speed(n_elements: int, steps: int) -> dict:
     le = 12.5 * (8120 / n_elements) ** (1 / 3)
     d["mesh"]["element_size_um"] = min(le, 16.6)
     out = {}
+    n_max = numba.get_num_threads()
     for par in (False, True):
+        numba.set_num_threads(n_max if par else 1)
         for cond in (True, False):
-            d["solver"]["parallel"] = par
             d["solver"]["heat_conduction"] = cond
             s = setup_boring(parse_boring_config(d))
             st = s.state
@@ -65,7 +67,7 @@ def speed(n_elements: int, steps: int) -> dict:
             cpu = time.process_time() - c0
             rate = st.n_elements * taken / wall
             per_cpu = st.n_elements * taken / cpu
-            key = ("parallel" if par else "serial") + ("" if cond else "_adiabatic")
+            key = (f"{n_max}_threads" if par else "1_thread") + ("" if cond else "_adiabatic")
             out[key] = {"elements": st.n_elements, "steps": int(taken), "wall_s": wall,
                         "cpu_s": cpu, "element_updates_per_s": rate,
                         "element_updates_per_cpu_s": per_cpu, "load": _load()}
@@ -75,7 +77,7 @@ def speed(n_elements: int, steps: int) -> dict:
             print(f"{key:19s}: {st.n_elements} elements x {taken} steps in {wall:.2f} s wall, "
                   f"{cpu:.2f} s CPU -> {rate / 1e6:.2f} M element-updates/s wall, "
                   f"{per_cpu / 1e6:.2f} M per CPU-second ({_load()})", flush=True)
-        base = "parallel" if par else "serial"
+        base = f"{n_max}_threads" if par else "1_thread"
         ratio = (out[base]["element_updates_per_cpu_s"]
                  / out[base + "_adiabatic"]["element_updates_per_cpu_s"])
         out[base]["ratio_to_adiabatic"] = ratio

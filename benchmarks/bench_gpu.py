@@ -23,7 +23,7 @@ bits, and an explicit cut amplifies them over many steps).
 
 ``speed3d`` / ``speed2d``: the boring example (3D) / the contract config (2D) meshed at each
 element size; the same initial state is advanced ``--gpu-steps`` on the GPU and
-``--cpu-steps`` on the CPU with ``--cpu-threads`` numba threads (the loops forced parallel):
+``--cpu-steps`` on the CPU with ``--cpu-threads`` numba threads:
 element-updates per second of each, their ratio, and the state difference after the CPU's
 steps (the GPU runs the same steps first). ``--profile`` adds a per-kernel breakdown (a
 synchronised rerun).
@@ -118,7 +118,7 @@ def small3d(n_samples: int = 4000):
     p[K3.P_EROSION] = K3.ERODE_ALL
     p[K3.P_SAMPLE_DT] = 2e-9
     return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=n_samples,
-                       tool_tip=(-12e-6, -1.2 * le, 0.0), parallel=False)
+                       tool_tip=(-12e-6, -1.2 * le, 0.0))
 
 
 def _diff3(a, b) -> dict:
@@ -152,7 +152,7 @@ def check3d(steps: list[int]) -> dict:
     return res
 
 
-def _boring_dict(le: float, ms: float, cut_mm: float, parallel):
+def _boring_dict(le: float, ms: float, cut_mm: float):
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
@@ -160,8 +160,6 @@ def _boring_dict(le: float, ms: float, cut_mm: float, parallel):
     d["cut"]["cut_length_mm"] = cut_mm
     d["solver"]["mass_scaling"] = ms
     d.setdefault("contact", {})["friction"] = "table"
-    if parallel is not None:
-        d["solver"]["parallel"] = parallel
     return d
 
 
@@ -221,7 +219,7 @@ def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
     numba.set_num_threads(min(cpu_threads, numba.config.NUMBA_NUM_THREADS))
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
-        st0 = setup_boring(parse_boring_config(_boring_dict(le, 400.0, 0.15, True))).state
+        st0 = setup_boring(parse_boring_config(_boring_dict(le, 400.0, 0.15))).state
         row = {"element_size_um": le, **_speed_row(st0, st0.n_elements, advance3,
                                                     advance3_gpu, _diff3, gpu_steps,
                                                     cpu_steps, use_gpu, profile)}
@@ -242,8 +240,7 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
     for le in sizes:
         by = {}
         for dev in devices:
-            cfg = parse_boring_config(_boring_dict(le, ms, cut_mm, True if dev == "cpu"
-                                                   else None))
+            cfg = parse_boring_config(_boring_dict(le, ms, cut_mm))
             r = simulate_boring(cfg, device=dev)
             s = r.summary
             by[dev] = {k: s[k] for k in ("force_rotating_N", "force_mean_N",

@@ -21,9 +21,8 @@ from robobore.cutting.fe.solver3d import (
 )
 from robobore.cutting.fe.thermal3d import (
     conduct3,
-    conduct3_serial,
     face_neighbours,
-    tool_heat3_serial,
+    tool_heat3,
 )
 from robobore.errors import ConfigError
 from robobore.material import load_material
@@ -42,10 +41,9 @@ def _bar(nx: int, le: float, twin_row: int | None = None):
     return make_state3(nodes, conn, fixed, TC4, twin=twin)
 
 
-def _conduct(st, dt_th, parallel=False):
-    f = conduct3 if parallel else conduct3_serial
-    f(st.conn, st.x, st.y, st.z, st.alive, st.enbr, st.pairs, st.vol0, st.temp, st.tbuf, KCOND,
-      RCP, dt_th)
+def _conduct(st, dt_th):
+    conduct3(st.conn, st.x, st.y, st.z, st.alive, st.enbr, st.pairs, st.vol0, st.temp, st.tbuf,
+             KCOND, RCP, dt_th)
 
 
 def _heat(st) -> float:
@@ -108,7 +106,7 @@ def test_huge_step_stays_bounded():
     lo, hi = st.temp.min(), st.temp.max()
     q0 = _heat(st)
     for _ in range(20):
-        _conduct(st, 1.0, parallel=True)  # 1 s: ~1e5 explicit limits
+        _conduct(st, 1.0)  # 1 s: ~1e5 explicit limits
         assert st.temp.min() >= lo - 1e-9 and st.temp.max() <= hi + 1e-9
     assert abs(_heat(st) / q0 - 1.0) < 1e-13
     assert st.temp.max() - st.temp.min() < 0.3 * (hi - lo)  # and it does mix
@@ -138,24 +136,21 @@ def test_frictional_heat_and_contact_with_the_cold_insert():
     # frictional heat only
     st.fric[mid] = 1e-6  # J
     q0 = _heat(st)
-    tool_heat3_serial(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive,
-                      st.enbr, st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP,
-                      0.0, 0.5, 293.0, 1e-7)
+    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
+               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, 0.0, 0.5, 293.0, 1e-7)
     assert _heat(st) - q0 == pytest.approx(0.5e-6, rel=1e-12)
     # the second pass books only new dissipation
     q1 = _heat(st)
-    tool_heat3_serial(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive,
-                      st.enbr, st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP,
-                      0.0, 0.5, 293.0, 1e-7)
+    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
+               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, 0.0, 0.5, 293.0, 1e-7)
     assert _heat(st) == pytest.approx(q1, rel=1e-15)
     # contact: the whole top face touches a 293 K insert, the block at 800 K
     st.temp[:] = 800.0
     st.cf[top, 1] = -1.0
     hc, dt = 1e5, 1e-9
     q2 = _heat(st)
-    tool_heat3_serial(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive,
-                      st.enbr, st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP,
-                      hc, 0.0, 293.0, dt)
+    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
+               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, hc, 0.0, 293.0, dt)
     area = (2 * le) ** 2  # every top-face node in contact: the whole face exchanges (the
     # side faces touch along an edge only: no area)
     assert q2 - _heat(st) == pytest.approx(hc * area * (800.0 - 293.0) * dt, rel=1e-12)
@@ -165,9 +160,8 @@ def test_frictional_heat_and_contact_with_the_cold_insert():
     st.cf[corner, 1] = 0.0
     st.temp[:] = 800.0
     q3 = _heat(st)
-    tool_heat3_serial(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive,
-                      st.enbr, st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP,
-                      hc, 0.0, 293.0, dt)
+    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
+               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, hc, 0.0, 293.0, dt)
     area = 3.5 * le * le
     assert q3 - _heat(st) == pytest.approx(hc * area * (800.0 - 293.0) * dt, rel=1e-12)
     assert n_all == st.x.size

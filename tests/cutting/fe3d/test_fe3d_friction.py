@@ -93,7 +93,7 @@ def _node_on_rake(speed: float, slip_tau_steps: float):
     p[K3.P_RN], p[K3.P_KAPPA], p[K3.P_KEND] = RN, KAP, KEND
     p[K3.P_RAKE], p[K3.P_CLR], p[K3.P_RE] = RAKE, CLR, RE
     s = make_state3(nodes, conn, np.zeros(len(nodes), np.int64), load_material("TC4"), prm=p,
-                    tool_tip=(0.0, 0.0, 0.0), parallel=False)
+                    tool_tip=(0.0, 0.0, 0.0))
     dt = float(s.clock[1])
     s.prm[K3.P_SLIP_TAU] = slip_tau_steps * dt
     y = 30e-6

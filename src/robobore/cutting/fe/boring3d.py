@@ -166,8 +166,6 @@ class SolverSection(_Strict):
     #: erode an element whose stable step falls below this fraction of the initial one
     erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
     n_samples: int = Field(default=200, ge=10, le=100000)
-    #: parallel element/node loops: "auto" (meshes of 20000 elements or more), true, false
-    parallel: bool | Literal["auto"] = "auto"
     chunk_steps: int = Field(default=500, ge=10, le=10**7)
     #: fraction of the cut (from its end) averaged for the steady-state values
     steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
@@ -473,8 +471,7 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
         p[K3.P_MX], p[K3.P_MY], p[K3.P_MZ] = ts.mass_kg
         p[K3.P_THETA0] = math.radians(ts.theta0_deg)
     st = make_state3(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, n_samples=s.n_samples,
-                     tool_tip=(x0, 0.0, 0.0), layer=mesh.layer, twin=mesh.twin,
-                     parallel=None if s.parallel == "auto" else bool(s.parallel))
+                     tool_tip=(x0, 0.0, 0.0), layer=mesh.layer, twin=mesh.twin)
     if ts is not None:
         dt = float(st.clock[1])
         for i, (k, m) in enumerate(zip(ts.total_stiffness(), ts.mass_kg, strict=True)):

@@ -66,16 +66,13 @@ P_RN, P_KAPPA, P_KEND, P_RAKE, P_CLR, P_RE, P_TANI, P_TOOL = 12, 13, 14, 15, 16,
 P_VC, P_VF, P_RADIUS, P_SUPPORT = 20, 21, 22, 23
 P_KX, P_KY, P_KZ, P_CX, P_CY, P_CZ, P_MX, P_MY, P_MZ = 24, 25, 26, 27, 28, 29, 30, 31, 32
 P_THETA0, P_SAMPLE_DT, P_TEND, P_EROSION = 33, 34, 35, 36
-# 1: parallel element/node loops (prange), 0: serial (better for small meshes or a loaded
-# machine, where every parallel region's barrier waits for a descheduled thread)
-P_PARALLEL = 37
 # node splitting: a tied pair parts within this distance of the insert [m]
-P_GATE = 38
+P_GATE = 37
 # friction vs sliding speed (the 2D engine's slots, kernels.P_MUTAB_N ...): number of table
 # points (0: the constant P_MU), MU_TABLE_MAX velocities [m/s], MU_TABLE_MAX coefficients,
 # and the time constant [s] of the filter on each node's sliding speed
 MU_TABLE_MAX = 8
-P_MUTAB_N = 39
+P_MUTAB_N = 38
 P_MUTAB_V = P_MUTAB_N + 1
 P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
 P_SLIP_TAU = P_MUTAB_MU + MU_TABLE_MAX

@@ -72,7 +72,6 @@ from robobore.cutting.fe.hex8 import (
     P_MX,
     P_MY,
     P_MZ,
-    P_PARALLEL,
     P_PEN,
     P_RADIUS,
     P_RAKE,
@@ -116,7 +115,7 @@ from robobore.cutting.fe.kernels import (
     STATUS_OK,
 )
 from robobore.cutting.fe.physics import tool_gap, tool_support_step
-from robobore.cutting.fe.thermal3d import conduct3, conduct3_serial, tool_heat3, tool_heat3_serial
+from robobore.cutting.fe.thermal3d import conduct3, tool_heat3
 from robobore.material import johnson_cook as jc
 from robobore.material.johnson_cook import rebind
 
@@ -126,7 +125,7 @@ __all__ = [
     "P_TAU", "P_PEN", "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR",
     "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF", "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY",
     "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY", "P_MZ", "P_THETA0", "P_SAMPLE_DT",
-    "P_TEND", "P_EROSION", "P_PARALLEL", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN",
+    "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER", "ERODE_ALL", "N_EN",
     "N_IST", "STATUS_OK", "P_COND_EVERY", "P_COND_T", "P_HC", "P_FHEAT", "P_TTOOL",
     "is_conduction_step_py", "conduction_pass3", "insert_gap3_py", "insert_gap3",
     "contact_force3_py", "contact_force3", "hex_node_py",
@@ -421,25 +420,6 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
 
 
 @njit(cache=True)
-def element_update3_serial(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg,
-                           qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
-    """:func:`hex8.hex_element_py` over all elements (one thread)."""
-    for e in range(conn.shape[0]):
-        hex_element(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
-                    vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
-
-
-@njit(cache=True)
-def node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
-                        cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
-                        pairs):
-    """:func:`hex_node_py` over all nodes (one thread)."""
-    for n in range(x.shape[0]):
-        hex_node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
-                 fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs)
-
-
-@njit(cache=True)
 def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
     """Totals of the energy accumulators into ``en`` (2D engine's indices) [J]."""
     ke = 0.0
@@ -583,24 +563,15 @@ is_conduction_step = njit(cache=True, inline="always")(is_conduction_step_py)
 
 @njit(cache=True)
 def conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
-                     tbuf, theat, mat, prm, t_end_step, par):
+                     tbuf, theat, mat, prm, t_end_step):
     """Conduction and the thermal contact with the insert over the time since the last pass,
     ``t_end_step - prm[P_COND_T]`` [s], which then moves to ``t_end_step``."""
     dt_th = t_end_step - prm[P_COND_T]
     rcp = mat[jc.RHO] * mat[jc.CP]
-    if par:
-        conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp, dt_th)
-    else:
-        conduct3_serial(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp,
-                        dt_th)
+    conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp, dt_th)
     if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-        if par:
-            tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
-                       temp, theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
-        else:
-            tool_heat3_serial(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
-                              fric, temp, theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
-                              dt_th)
+        tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
+                   theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
     prm[P_COND_T] = t_end_step
 
 
@@ -618,33 +589,21 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
     thermal3d`, :func:`conduction_pass3`).
     """
     erosion = int(prm[P_EROSION])
-    par = prm[P_PARALLEL] > 0.5
     ne = conn.shape[0]
     taken = 0
     for _s in range(n_steps):
         dt = clock[1]
         t = clock[0]
         cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
-        if par:
-            node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
-                         cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
-                         pairs)
-        else:
-            node_update3_serial(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
-                                fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx,
-                                tvy, tvz, dt, pairs)
+        node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
+                     fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs)
         fwx, fwy, fwz, ncont = contact_total3(cf)
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, fwz, dt)
-        if par:
-            element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg,
-                            qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
-        else:
-            element_update3_serial(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p,
-                                   temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, mat, prm,
-                                   dt, erosion)
+        element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
+                        vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
         if is_conduction_step(ist[I_STEP], prm):
             conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
-                             fric, temp, tbuf, theat, mat, prm, t + dt, par)
+                             fric, temp, tbuf, theat, mat, prm, t + dt)
         dtmin = 1e30
         for e in range(ne):
             if dte[e] < dtmin:

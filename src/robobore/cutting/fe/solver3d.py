@@ -154,13 +154,9 @@ def hex_volumes(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
     return vol
 
 
-#: meshes with at least this many elements run the parallel (prange) loops by default
-PARALLEL_MIN_ELEMENTS = 20000
-
-
 def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
                 prm: np.ndarray | None = None, n_samples: int = 1,
-                layer: np.ndarray | None = None, parallel: bool | None = None,
+                layer: np.ndarray | None = None,
                 tool_tip: tuple[float, float, float] = (1e3, 1e3, 1e3),
                 twin: np.ndarray | None = None) -> FEState3:
     """State for a hexahedral mesh ``nodes`` (n, 3) [m], ``conn`` (e, 8) in VTK order.
@@ -168,12 +164,8 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
     ``fixed`` (n,) bit mask (1 x, 2 y, 4 z: velocity component held at its value, i.e.
     zero unless set). Lumped nodal masses from the (mass-scaled) density; stresses zero;
     temperature T_room. The insert's tip reference starts at ``tool_tip`` [m]. ``layer`` (e,)
-    marks the elements that may erode by damage under ERODE_LAYER. ``parallel``: run the
-    element/node loops with ``prange`` (None: when the mesh has at least
-    :data:`PARALLEL_MIN_ELEMENTS` elements; on a small mesh, or a machine with more busy
-    threads than cores, the per-step barriers cost more than the parallel work saves).
-    ``twin`` (n,) pairs the doubled nodes of a parting surface (node splitting, -1 = none);
-    the pairs start tied.
+    marks the elements that may erode by damage under ERODE_LAYER. ``twin`` (n,) pairs the
+    doubled nodes of a parting surface (node splitting, -1 = none); the pairs start tied.
     """
     nodes = np.ascontiguousarray(nodes, dtype=np.float64)
     conn = np.ascontiguousarray(conn, dtype=np.int64)
@@ -183,9 +175,6 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
     n = nodes.shape[0]
     ne = conn.shape[0]
     prm = default_prm3() if prm is None else np.asarray(prm, np.float64).copy()
-    if parallel is None:
-        parallel = ne >= PARALLEL_MIN_ELEMENTS
-    prm[K3.P_PARALLEL] = 1.0 if parallel else 0.0
     vol = hex_volumes(nodes, conn)
     if np.any(vol <= 0):
         bad = int(np.argmin(vol))

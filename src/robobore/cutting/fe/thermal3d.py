@@ -42,8 +42,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["HEX_FACES", "face_neighbours", "hex_face_corner_py", "conduct3", "conduct3_serial",
-           "tool_heat3", "tool_heat3_serial"]
+__all__ = ["HEX_FACES", "face_neighbours", "hex_face_corner_py", "conduct3", "tool_heat3"]
 
 #: the corners of each face of a hexahedron in VTK order, in cyclic order round the face:
 #: xi = -1, xi = +1, eta = -1, eta = +1, zeta = -1, zeta = +1
@@ -264,18 +263,6 @@ def conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt
         temp[e] = tbuf[e, 3]
 
 
-@njit(cache=True)
-def conduct3_serial(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th):
-    """:func:`conduct3` on one thread."""
-    ne = conn.shape[0]
-    for e in range(ne):
-        hex_centroid3(e, conn, x, y, z, tbuf)
-    for e in range(ne):
-        hex_conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th)
-    for e in range(ne):
-        temp[e] = tbuf[e, 3]
-
-
 @njit(parallel=True, cache=True)
 def tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
                theat, rcp, hc, eta, t_tool, dt_th):
@@ -285,17 +272,6 @@ def tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, f
         tool_heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
                         fric, temp, theat, rcp, hc, eta, t_tool, dt_th)
     for e in prange(conn.shape[0]):
-        tool_heat_elem3(e, conn, alive, temp, theat, rcp)
-
-
-@njit(cache=True)
-def tool_heat3_serial(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
-                      temp, theat, rcp, hc, eta, t_tool, dt_th):
-    """:func:`tool_heat3` on one thread."""
-    for n in range(x.shape[0]):
-        tool_heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
-                        fric, temp, theat, rcp, hc, eta, t_tool, dt_th)
-    for e in range(conn.shape[0]):
         tool_heat_elem3(e, conn, alive, temp, theat, rcp)
 
 
