@@ -57,7 +57,7 @@ from robobore.cutting.fe.solver3d import (
     make_state3,
     split_node_layer,
 )
-from robobore.cutting.geometry import BoringInsert, chip_area
+from robobore.cutting.geometry import BoringInsert, chip_area, lead_end
 from robobore.errors import ConfigError, NumericalError
 from robobore.io.config import load_toml, validate_model
 from robobore.material import Material, load_material
@@ -294,18 +294,6 @@ class BoringMesh:
     twin: np.ndarray | None = None
 
 
-def _lead_end(insert: BoringInsert, ap: float) -> float:
-    """Axial position where the current edge profile reaches the pre-bore radius [m]."""
-    lo, hi = 0.0, insert.nose_radius_m + ap * 50
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        if insert.drop(np.array([mid]))[0] < ap:
-            lo = mid
-        else:
-            hi = mid
-    return hi
-
-
 def parting_surface(insert: BoringInsert, zs: np.ndarray, height: float,
                     y_low: float) -> np.ndarray:
     """Height y(z) [m] of the surface ``height`` [m] above the insert's edge profile.
@@ -350,7 +338,7 @@ def build_boring_mesh(insert: BoringInsert, ap: float, f: float, le: float, leng
     path crosses chip rows, and the chip elements it crosses form an erosion layer (damage
     erosion, as without splitting).
     """
-    z_end = _lead_end(insert, ap)
+    z_end = lead_end(insert, ap)
     margin = side_margin if side_margin > 0 else 3 * le
     z0 = -0.5 * f - margin
     z1 = z_end + margin

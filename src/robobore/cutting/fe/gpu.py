@@ -34,11 +34,14 @@ import numpy as np
 
 from robobore.errors import ConfigError
 
-__all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled"]
+__all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled",
+           # shared with the 2D GPU engine (robobore.cutting.fe.gpu2d)
+           "MAX_BLOCK", "bind_cuda", "chunk_list_py", "jc_device_functions", "persistent_run",
+           "profile_ticker"]
 
 _THREADS = 128
-#: largest block size of the persistent kernel (its shared compaction counters)
-_MAX_BLOCK = 1024
+#: largest block size of the persistent kernels, 2D and 3D (their shared compaction counters)
+MAX_BLOCK = 1024
 # reduction slots on the device
 R_DTMIN, R_BAD, R_FX, R_FY, R_FZ, R_NC = 0, 1, 2, 3, 4, 5
 N_RED = 6
@@ -171,7 +174,7 @@ def _kernels():
     LANES = K3.N_SUM_LANES
     float64 = _float64
     int64 = _int64
-    NCNT = _MAX_BLOCK + 1
+    NCNT = MAX_BLOCK + 1
 
     I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K3.I_STATUS, K3.I_STEP, K3.I_SAMPLE, K3.I_BADELEM
     ST_OK, ST_DONE, ST_INV = K3.STATUS_OK, K3.STATUS_DONE, K3.STATUS_INVERTED
@@ -490,7 +493,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     host-side launch cost).
     """
     from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
+    from robobore.cutting.fe.status import STATUS_TEXT, instability_error
 
     require_gpu()
     k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_thermal, k_run = _kernels()
@@ -509,9 +512,9 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     erosion = int(st.prm[K3.P_EROSION])
     t_start = st.time
     step0 = int(st.ist[K3.I_STEP])
-    tick = _ticker(profile)
-    run = _persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
-                          profile, persistent)
+    tick = profile_ticker(profile)
+    run = persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
+                         profile, persistent)
     heat = st.prm[K3.P_HC] > 0.0 or st.prm[K3.P_FHEAT] > 0.0
     while True:
         if run is not None:
@@ -558,9 +561,9 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
         for name in ("ist", "clock"):
             getattr(st, name)[...] = g[name].copy_to_host()
         status = int(st.ist[K3.I_STATUS])
-        if status in _STATUS_TEXT or status == K3.STATUS_DONE or check is not None:
+        if status in STATUS_TEXT or status == K3.STATUS_DONE or check is not None:
             _copy_back(st, g)
-        if status in _STATUS_TEXT:
+        if status in STATUS_TEXT:
             raise instability_error(st, "3D simulation (GPU)", "a smaller solver.cfl, a larger "
                                     "mesh.element_size_um or less mass scaling")
         if progress is not None:
@@ -581,11 +584,12 @@ _RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "nc
              "theat")
 
 
-def _persistent_run(kernel, args: list, n_nodes: int, profile, persistent: bool | None):
-    """``run(n_steps)`` of a persistent kernel whose arguments are ``n_steps``, ``args``, the
-    chunk flags and the chunk list (allocated here for ``n_nodes`` nodes); ``None`` where the
-    caller launches one kernel per phase (``persistent`` False, or None with a ``profile``,
-    or a cooperative launch that cannot be set up -- then with a warning)."""
+def persistent_run(kernel, args: list, n_nodes: int, profile, persistent: bool | None):
+    """``run(n_steps)`` of a persistent kernel (2D or 3D engine) whose arguments are
+    ``n_steps``, ``args``, the chunk flags and the chunk list (allocated here for ``n_nodes``
+    nodes); ``None`` where the caller launches one kernel per phase (``persistent`` False, or
+    None with a ``profile``, or a cooperative launch that cannot be set up -- then with a
+    warning)."""
     from robobore.cutting.fe.kernels import N_SUM_LANES
 
     auto = persistent is None
@@ -633,10 +637,11 @@ def _cooperative(kernel, args: list, threads: int, fallback: bool = False):
     return lambda *a: launcher(*a)
 
 
-def _ticker(profile: dict[str, float] | None) -> Callable[[str | None], None]:
-    """``tick(name)``: with a ``profile`` dict, wait for the device and add the wall time
-    since the previous tick under ``name`` (``None`` only restarts the clock); without one,
-    a no-op (the launches stay asynchronous)."""
+def profile_ticker(profile: dict[str, float] | None) -> Callable[[str | None], None]:
+    """``tick(name)`` for the launch-per-kernel loops of both GPU engines: with a ``profile``
+    dict, wait for the device and add the wall time since the previous tick under ``name``
+    (``None`` only restarts the clock); without one, a no-op (the launches stay
+    asynchronous)."""
     if profile is None:
         return lambda name: None
     import time

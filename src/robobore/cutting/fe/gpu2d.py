@@ -59,13 +59,16 @@ import numpy as np
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe import rezone as RZ
 from robobore.cutting.fe.gpu import (
-    _MAX_BLOCK,
+    MAX_BLOCK,
     bind_cuda,
     chunk_list_py,
     jc_device_functions,
+    persistent_run,
+    profile_ticker,
     require_gpu,
 )
 from robobore.cutting.fe.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
+from robobore.cutting.fe.status import STATUS_TEXT, instability_error
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported"]
@@ -160,7 +163,7 @@ def _kernels():
     LANES = K.N_SUM_LANES
     float64 = _float64
     int64 = _int64
-    NCNT = _MAX_BLOCK + 1
+    NCNT = MAX_BLOCK + 1
 
     I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K.I_STATUS, K.I_STEP, K.I_SAMPLE, K.I_BADELEM
     ST_OK, ST_DONE, ST_INV = K.STATUS_OK, K.STATUS_DONE, K.STATUS_INVERTED
@@ -672,9 +675,6 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     as in :func:`robobore.cutting.fe.gpu.advance3_gpu` (per-kernel wall times for
     benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
-    from robobore.cutting.fe.gpu import _persistent_run, _ticker
-    from robobore.cutting.fe.solver import _STATUS_TEXT, instability_error
-
     every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
     mode = int(st.prm[K.P_RZ_MODE])
     # the tool-frame ALE runs here; Laplacian rezoning and the ploughed-layer ALE do not
@@ -708,10 +708,10 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
     t_start = st.time
     step0 = int(st.ist[K.I_STEP])
-    tick = _ticker(profile)
-    run = _persistent_run(k_run, [g[name] for name in _ARRAYS]
-                          + [erosion, cond_every, int(theat), rz_every, dred], nn, profile,
-                          persistent)
+    tick = profile_ticker(profile)
+    run = persistent_run(k_run, [g[name] for name in _ARRAYS]
+                         + [erosion, cond_every, int(theat), rz_every, dred], nn, profile,
+                         persistent)
     while True:
         if run is not None:
             run(chunk_steps)
@@ -770,9 +770,9 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         for name in ("ist", "clock"):
             getattr(st, name)[...] = g[name].copy_to_host()
         status = int(st.ist[K.I_STATUS])
-        if status in _STATUS_TEXT or status == K.STATUS_DONE or check is not None:
+        if status in STATUS_TEXT or status == K.STATUS_DONE or check is not None:
             _copy_back(st, g)
-        if status in _STATUS_TEXT:
+        if status in STATUS_TEXT:
             raise instability_error(st, "simulation (GPU)", "a smaller solver.cfl, a larger "
                                     "mesh.element_size_um or less mass scaling")
         if progress is not None:

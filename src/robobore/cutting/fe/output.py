@@ -33,9 +33,10 @@ def shear_angle_deg(chip_ratio: float, rake_rad: float) -> float:
     return math.degrees(math.atan2(math.cos(rake_rad), chip_ratio - math.sin(rake_rad)))
 
 
-def _point_polyline_distance(px: np.ndarray, py: np.ndarray, lx: np.ndarray,
-                             ly: np.ndarray) -> np.ndarray:
-    """Distance of each point to the polyline through (lx, ly) (ordered)."""
+def point_polyline_distance(px: np.ndarray, py: np.ndarray, lx: np.ndarray,
+                            ly: np.ndarray) -> np.ndarray:
+    """Distance of each point to the polyline through (lx, ly) (ordered): the chip thickness
+    of both mesh frames (:func:`measure_chip` and ``toolframe.measure_chip_toolframe``)."""
     ax, ay = lx[:-1], ly[:-1]
     bx, by = lx[1:], ly[1:]
     dx, dy = bx - ax, by - ay
@@ -107,7 +108,7 @@ def measure_chip(st, mesh, h: float, rake: float, vc: float) -> ChipGeometry:
     if len(ix) < 2:
         return nan
     lx, ly, ly0 = np.array(ix), np.array(iy), np.array(iy0)
-    d = _point_polyline_distance(x[outer], y[outer], lx, ly)
+    d = point_polyline_distance(x[outer], y[outer], lx, ly)
     # original thickness of the surviving material near each outer node's column
     near = np.argmin(np.abs(st.x0[outer][:, None] - np.array(kept)[None, :]), axis=1)
     t0 = -ly0[near]

@@ -30,6 +30,7 @@ from robobore.cutting.fe.rezone import (
     row_stencil,
     smoothing_stencil,
 )
+from robobore.cutting.fe.status import STATUS_TEXT, instability_error
 from robobore.cutting.fe.threads import ThreadGovernor
 from robobore.errors import ConfigError, NumericalError
 from robobore.material import Material, load_material
@@ -269,26 +270,6 @@ def init_forces(st: FEState) -> float:
     return dt
 
 
-_STATUS_TEXT = {
-    K.STATUS_NONFINITE: "non-finite forces, velocities or time step",
-    K.STATUS_DT_COLLAPSE: "stable time step collapsed below 1/1000 of the initial one "
-                          "(an element inverted or was crushed)",
-    K.STATUS_INVERTED: "an element turned inside out (negative area)",
-    K.STATUS_NO_ELEMENTS: "no element left (all eroded or inverted)",
-}
-
-
-def instability_error(st: Any, label: str, hint: str) -> NumericalError:
-    """The error for a run stopped by an instability status (2D or 3D, CPU or GPU): step,
-    time, cause (and the inverted element), what to change."""
-    status = int(st.ist[K.I_STATUS])
-    return NumericalError(
-        f"{label} unstable at step {int(st.ist[K.I_STEP])}, time {st.time:.6g} s: "
-        f"{_STATUS_TEXT[status]}"
-        + (f" (element {int(st.ist[K.I_BADELEM])})" if status == K.STATUS_INVERTED else "")
-        + f"; try {hint}")
-
-
 def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: int, *,
                  chunk_steps: int, label: str, hint: str,
                  progress: Callable[[float], None] | None = None,
@@ -326,7 +307,7 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
                 gov.record(threads, int(taken), time.perf_counter() - t0)
             total += int(taken)
             status = int(st.ist[K.I_STATUS])
-            if status in _STATUS_TEXT:
+            if status in STATUS_TEXT:
                 raise instability_error(st, label, hint)
             if progress is not None:
                 progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))

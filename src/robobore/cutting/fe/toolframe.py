@@ -57,7 +57,7 @@ import numpy as np
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.mesh import QuadMeshSizes
-from robobore.cutting.fe.output import ChipGeometry, _point_polyline_distance, shear_angle_deg
+from robobore.cutting.fe.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 from robobore.cutting.fe.rezone import (
     BF_OPEN,
     BF_VIRGIN,
@@ -362,7 +362,7 @@ def measure_chip_toolframe(st, mesh: ToolFrameMesh, h: float, rake: float,
     s_end = (x[ob] - cx) * trx + (y[ob] - cy) * try_
     sel = top[(s_top > 0.4 * s_end) & (s_top < 0.9 * s_end)]
     if sel.size >= 2:
-        d = _point_polyline_distance(x[sel], y[sel], x[under], y[under])
+        d = point_polyline_distance(x[sel], y[sel], x[under], y[under])
         tc = float(np.median(d))
         geo = ChipGeometry(tc, h, tc / h, shear_angle_deg(tc / h, rake), int(sel.size))
     else:
