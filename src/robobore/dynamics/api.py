@@ -9,7 +9,7 @@ equivalent-model stage's object (``equivalent=``, an
 :class:`~robobore.equivalent.EquivalentModel` or its dict form) when the config holds only
 the process; a dict config's ``coefficients`` may be the cutting stage's
 :class:`~robobore.cutting.forces.CuttingCoefficients` or a coefficients-file content
-(:func:`robobore.dynamics.config.with_coefficients`).
+(:func:`robobore.dynamics.handoff.with_coefficients`).
 
 The summary's verdicts (:mod:`robobore.dynamics.chatter`): ``chatter`` (the vibration
 grows), ``surface_finish`` ("ok" / "rough": Ra after form removal against
@@ -32,9 +32,8 @@ from robobore.dynamics.config import (
     build_structure,
     load_dynamics_config,
     resolve_model_files,
-    with_coefficients,
-    with_equivalent,
 )
+from robobore.dynamics.handoff import with_coefficients, with_equivalent
 from robobore.errors import ConfigError, InputError
 from robobore.io.config import validate_model
 
@@ -74,7 +73,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     ``source`` names where a dict or model config came from (a file, a section), for error
     messages. ``equivalent``: the robot as the equivalent-model stage's
     :class:`~robobore.equivalent.EquivalentModel` (or its dict form), when the config holds
-    only the process (:func:`robobore.dynamics.config.with_equivalent`).
+    only the process (:func:`robobore.dynamics.handoff.with_equivalent`).
 
     ``pressure_MPa`` (boring configs with an ``[equivalent]`` section) replaces the pressure
     foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
