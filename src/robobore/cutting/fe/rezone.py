@@ -35,6 +35,11 @@ Two ways of choosing the new node positions share the remap:
   per pass; the machined surface (the top row) keeps its shape, the rows under it are
   spread evenly in depth between it and the layer's bottom row (which stays Lagrangian),
   and the material flows through the elements (:func:`row_stencil`, :func:`_row_move`).
+
+The remap's scalar passes are in :mod:`robobore.cutting.fe.remap`, the host-side stencils
+(:func:`smoothing_stencil`, :func:`row_stencil`, :func:`edge_neighbours`) in
+:mod:`robobore.cutting.fe.rezone_stencils`; this module chooses the new node positions and
+runs the pass (:func:`rezone`).
 """
 
 from __future__ import annotations
@@ -45,8 +50,27 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.physics import tool_gap
+from robobore.cutting.fe.remap import (
+    BF_CLOSED,
+    BF_OPEN,
+    BF_VIRGIN,
+    N_RZ_FIELDS,
+    rz_flux,
+    rz_flux_py,
+    rz_node_mass,
+    rz_node_mass_py,
+    rz_velocity,
+    rz_velocity_py,
+    rz_write,
+    rz_write_py,
+    swept_py,
+)
+from robobore.cutting.fe.rezone_stencils import (
+    edge_neighbours,
+    row_stencil,
+    smoothing_stencil,
+)
 
-N_RZ_FIELDS = 11
 #: node relocation of a rezoning pass: Laplacian smoothing, sliding along node rows, or the
 #: tool-frame ALE (every node back to its place in the tool's frame, see
 #: :mod:`robobore.cutting.fe.toolframe`)
@@ -54,127 +78,8 @@ MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME = 0, 1, 2
 #: tool-frame node classes (``acls[:, 0]``): interior, rigid (inflow face, bottom), on a
 #: surface chain (free or against the tool), chain end on an outflow line, on an outflow face
 TF_INTERIOR, TF_RIGID, TF_CHAIN, TF_LINE, TF_FACE = 0, 1, 2, 3, 4
-#: flux through an element edge on the outline (``bflag``): none, virgin material flowing
-#: in (inflow face), open (outflow; a backflow brings the element's own state)
-BF_CLOSED, BF_VIRGIN, BF_OPEN = 0, 1, 2
 #: Jacobi sweeps of the mesh-displacement interpolation per tool-frame pass
 TF_SWEEPS = 4
-
-
-def smoothing_stencil(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Interior chip-layer nodes of a structured cutting mesh and their 4 neighbours.
-
-    Returns ``nodes`` (k,) and ``nbr`` (k, 6) node indices (the 4 neighbours, then -1, -1:
-    the layout of :func:`row_stencil`).
-    """
-    conn = mesh.conn
-    # structured grid sizes from the node coordinates of row 0
-    xs0 = mesh.nodes[:, 0]
-    ys0 = mesh.nodes[:, 1]
-    ny_nodes = len(np.unique(ys0))
-    nx_nodes = mesh.n_nodes // ny_nodes
-    assert nx_nodes * ny_nodes == mesh.n_nodes
-    del conn, xs0
-    yrows = ys0.reshape(ny_nodes, nx_nodes)[:, 0]
-    # chip underside row: top of the separation layer; surface row: top
-    under = int(np.argmin(np.abs(yrows - mesh.layer_top)))
-    top = ny_nodes - 1
-    nodes = []
-    nbr = []
-    for j in range(under + 1, top):
-        for i in range(1, nx_nodes - 1):
-            n = j * nx_nodes + i
-            nodes.append(n)
-            nbr.append((n - 1, n + 1, n - nx_nodes, n + nx_nodes, -1, -1))
-    return np.array(nodes, dtype=np.int64), np.array(nbr, dtype=np.int64).reshape(-1, 6)
-
-
-def row_stencil(mesh, depth: float) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes of the ploughed layer of a node-splitting mesh for ``MODE_ROWS``.
-
-    The node rows (equal initial y) from the parting line (its workpiece-side copies) down
-    to, but not including, ``depth`` [m] below it; in each row, the nodes whose left and
-    right neighbours (by initial x) are joined to them by element edges. Fixed nodes are
-    left out. Returns ``nodes`` (k,) and ``nbr`` (k, 6) = (left, right, parting-line node
-    of the same column, node of the same column at ``depth`` (-1: none, or the node is on
-    the parting line), node above, node below in the column (-1: none)); a node moves only
-    once its parting-line node is released.
-    """
-    if mesh.twin is None:
-        raise ValueError("row_stencil needs a node-splitting mesh (twin)")
-    xy = mesh.nodes
-    y_p = mesh.layer_top
-    tol = 1e-6 * mesh.element_size
-    idx = np.arange(mesh.n_nodes)
-    upper = (mesh.twin >= 0) & (mesh.twin < idx)
-    below = (xy[:, 1] <= y_p + tol) & (xy[:, 1] > y_p - depth - tol)
-    cand = np.where(~upper & below)[0]
-    edges: set[tuple[int, int]] = set()
-    for el in mesh.conn:
-        for k in range(4):
-            a, b = int(el[k]), int(el[(k + 1) % 4])
-            edges.add((a, b) if a < b else (b, a))
-
-    def joined(a: int, b: int) -> bool:
-        return (min(a, b), max(a, b)) in edges
-
-    rkey = np.round((y_p - xy[cand, 1]) / tol).astype(np.int64)
-    xkey = np.round(xy[cand, 0] / tol).astype(np.int64)
-    at = {(int(r), int(c)): int(n) for r, c, n in zip(rkey, xkey, cand, strict=True)}
-    rows = np.unique(rkey)
-    bottom_key = int(np.round(depth / tol))
-    nodes: list[int] = []
-    nbr: list[tuple[int, int, int, int, int, int]] = []
-    for j, key in enumerate(rows):
-        if key >= bottom_key:
-            break
-        row = cand[rkey == key]
-        row = row[np.argsort(xy[row, 0])]
-        for i in range(1, row.size - 1):
-            n, lft, rgt = int(row[i]), int(row[i - 1]), int(row[i + 1])
-            if mesh.fixed[n] or not (joined(lft, n) and joined(n, rgt)):
-                continue
-            c = int(np.round(xy[n, 0] / tol))
-            pc = at.get((int(rows[0]), c), -1)
-            if pc < 0:
-                continue
-            up = at.get((int(rows[j - 1]), c), -1) if j > 0 else -1
-            dn = at.get((int(rows[j + 1]), c), -1) if j + 1 < rows.size else -1
-            bt = at.get((bottom_key, c), -1) if j > 0 else -1
-            if up >= 0 and not joined(up, n):
-                up = -1
-            if dn >= 0 and not joined(n, dn):
-                dn = -1
-            if bt >= 0 and (up < 0 or dn < 0):
-                bt = -1
-            nodes.append(n)
-            nbr.append((lft, rgt, pc, bt, up, dn))
-    return np.array(nodes, dtype=np.int64), np.array(nbr, dtype=np.int64).reshape(-1, 6)
-
-
-def edge_neighbours(conn: np.ndarray) -> np.ndarray:
-    """(n_elem, 4): element across edge k (nodes k -> k+1), -1 on the boundary."""
-    ne = conn.shape[0]
-    out = -np.ones((ne, 4), dtype=np.int64)
-    seen: dict[tuple[int, int], tuple[int, int]] = {}
-    for e in range(ne):
-        for k in range(4):
-            a, b = int(conn[e, k]), int(conn[e, (k + 1) % 4])
-            key = (a, b) if a < b else (b, a)
-            if key in seen:
-                e2, k2 = seen.pop(key)
-                out[e, k] = e2
-                out[e2, k2] = e
-            else:
-                seen[key] = (e, k)
-    return out
-
-
-def swept_py(ax0, ay0, bx0, by0, ax1, ay1, bx1, by1):
-    """Area swept outward by edge a->b of a counter-clockwise element moving 0 -> 1."""
-    s = (ax0 * by0 - bx0 * ay0) + (bx0 * by1 - bx1 * by0) + (bx1 * ay1 - ax1 * by1) \
-        + (ax1 * ay0 - ax0 * ay1)
-    return -0.5 * s
 
 
 def limit_py(px, py, tx, ty, lim):
@@ -199,7 +104,6 @@ def off_tool_py(px, py, qx, qy, tg):
     return qx, qy
 
 
-_swept = njit(cache=True)(swept_py)
 _limit = njit(cache=True, inline="always")(limit_py)
 _off_tool = njit(cache=True, inline="always")(off_tool_py)
 
@@ -406,158 +310,11 @@ def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
         yn[n] = ty
 
 
-def rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-               eps_p, temp, dmg, qhx, qhy, area0, t_room):
-    """Donor-cell remap of element ``e`` (old geometry ``x``, ``y`` -> new ``xn``, ``yn``):
-    its new intensive fields and reference area into ``buf[e]`` (see :func:`rezone`).
-    Reads the old state only, so all elements can run at once."""
-    for f in range(N_RZ_FIELDS):
-        buf[e, f] = 0.0
-    if alive[e] != 1:
-        return
-    i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-    a_old = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-    # the area after the pass that the fluxes account for: the old area plus the areas
-    # swept by the edges shared with live elements (an edge on the outline or next to
-    # an eroded element carries no flux, so a boundary node that slides along a
-    # curved surface neither creates nor destroys mass)
-    a_new = a_old
-    c0 = sdx[e] * a_old
-    c1 = sdy[e] * a_old
-    c2 = sdz[e] * a_old
-    c3 = sdxy[e] * a_old
-    c4 = pres[e] * a_old
-    c5 = eps_p[e] * a_old
-    c6 = temp[e] * a_old
-    c7 = dmg[e] * a_old
-    c8 = qhx[e] * a_old
-    c9 = qhy[e] * a_old
-    c10 = area0[e]
-    for kk in range(4):
-        a = conn[e, kk]
-        b = conn[e, (kk + 1) % 4]
-        sw = _swept(x[a], y[a], x[b], y[b], xn[a], yn[a], xn[b], yn[b])
-        if sw == 0.0:
-            continue
-        nb = np.int64(enbr[e, kk])
-        u = nb
-        if nb < 0:
-            # an outline edge carries a flux only where bflag opens it
-            if bflag.shape[0] == 0 or bflag[e, kk] == BF_CLOSED:
-                continue
-            a_new += sw
-            if sw > 0.0 and bflag[e, kk] == BF_VIRGIN:
-                c6 += sw * t_room  # virgin: no stress, strain, damage; A0 = A
-                c10 += sw
-                continue
-            u = np.int64(e)  # outflow (or backflow through an open face): own state
-        elif alive[nb] != 1:
-            continue
-        else:
-            a_new += sw
-            if sw <= 0.0:
-                u = np.int64(e)
-        iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
-        au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
-                    + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
-        c0 += sw * sdx[u]
-        c1 += sw * sdy[u]
-        c2 += sw * sdz[u]
-        c3 += sw * sdxy[u]
-        c4 += sw * pres[u]
-        c5 += sw * eps_p[u]
-        c6 += sw * temp[u]
-        c7 += sw * dmg[u]
-        c8 += sw * qhx[u]
-        c9 += sw * qhy[u]
-        c10 += sw * area0[u] / au
-    inv = 1.0 / a_new
-    buf[e, 0] = c0 * inv
-    buf[e, 1] = c1 * inv
-    buf[e, 2] = c2 * inv
-    buf[e, 3] = c3 * inv
-    buf[e, 4] = c4 * inv
-    buf[e, 5] = c5 * inv
-    buf[e, 6] = c6 * inv
-    buf[e, 7] = c7 * inv
-    buf[e, 8] = c8 * inv
-    buf[e, 9] = c9 * inv
-    buf[e, 10] = c10
-
-
-def rz_velocity_py(n, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf):
-    """Velocity increment of moved node ``n`` into ``vbuf[n]``: first-order Taylor with the
-    mean old velocity gradient of its elements (read from the old state only). Returns 1
-    when the node moves, else 0."""
-    vbuf[n, 0] = 0.0
-    vbuf[n, 1] = 0.0
-    dx = xn[n] - x[n]
-    dy = yn[n] - y[n]
-    if dx == 0.0 and dy == 0.0:
-        return 0
-    gxx = 0.0
-    gxy = 0.0
-    gyx = 0.0
-    gyy = 0.0
-    cnt = 0
-    for q in range(ptr[n], ptr[n + 1]):
-        e = nel[q]
-        i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-        A = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-        inv2a = 0.5 / A
-        bx1 = (y[i2] - y[i4]) * inv2a
-        bx2 = (y[i3] - y[i1]) * inv2a
-        bx3 = (y[i4] - y[i2]) * inv2a
-        bx4 = (y[i1] - y[i3]) * inv2a
-        by1 = (x[i4] - x[i2]) * inv2a
-        by2 = (x[i1] - x[i3]) * inv2a
-        by3 = (x[i2] - x[i4]) * inv2a
-        by4 = (x[i3] - x[i1]) * inv2a
-        gxx += vx[i1] * bx1 + vx[i2] * bx2 + vx[i3] * bx3 + vx[i4] * bx4
-        gxy += vx[i1] * by1 + vx[i2] * by2 + vx[i3] * by3 + vx[i4] * by4
-        gyx += vy[i1] * bx1 + vy[i2] * bx2 + vy[i3] * bx3 + vy[i4] * bx4
-        gyy += vy[i1] * by1 + vy[i2] * by2 + vy[i3] * by3 + vy[i4] * by4
-        cnt += 1
-    if cnt > 0:
-        vbuf[n, 0] = (gxx * dx + gxy * dy) / cnt
-        vbuf[n, 1] = (gyx * dx + gyy * dy) / cnt
-    return 1
-
-
-def rz_write_py(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0):
-    """Live element ``e`` takes its remapped fields from ``buf[e]``."""
-    if alive[e] != 1:
-        return
-    sdx[e] = buf[e, 0]
-    sdy[e] = buf[e, 1]
-    sdz[e] = buf[e, 2]
-    sdxy[e] = buf[e, 3]
-    pres[e] = buf[e, 4]
-    eps_p[e] = buf[e, 5]
-    temp[e] = buf[e, 6]
-    dmg[e] = buf[e, 7]
-    qhx[e] = buf[e, 8]
-    qhy[e] = buf[e, 9]
-    area0[e] = buf[e, 10]
-
-
-def rz_node_mass_py(n, ptr, nel, area0, rho_s, mass):
-    """Lumped mass of node ``n`` from its elements' (remapped) reference areas."""
-    m = 0.0
-    for q in range(ptr[n], ptr[n + 1]):
-        m += 0.25 * rho_s * area0[nel[q]]
-    mass[n] = m
-
-
 tf_place = njit(cache=True, inline="always")(tf_place_py)
 tf_face = njit(cache=True, inline="always")(tf_face_py)
 tf_sweep = njit(cache=True, inline="always")(tf_sweep_py)
 tf_sweep_copy = njit(cache=True, inline="always")(tf_sweep_copy_py)
 tf_interior = njit(cache=True, inline="always")(tf_interior_py)
-rz_flux = njit(cache=True, inline="always")(rz_flux_py)
-rz_velocity = njit(cache=True, inline="always")(rz_velocity_py)
-rz_write = njit(cache=True, inline="always")(rz_write_py)
-rz_node_mass = njit(cache=True, inline="always")(rz_node_mass_py)
 
 
 @njit(parallel=True, cache=True)
@@ -643,3 +400,46 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
     for n in prange(nn):
         rz_node_mass(n, ptr, nel, area0, rho_s, mass)
     return moved
+
+
+__all__ = [
+    "MODE_LAPLACE",
+    "MODE_ROWS",
+    "MODE_TOOLFRAME",
+    "TF_INTERIOR",
+    "TF_RIGID",
+    "TF_CHAIN",
+    "TF_LINE",
+    "TF_FACE",
+    "TF_SWEEPS",
+    "limit_py",
+    "off_tool_py",
+    "tf_place_py",
+    "tf_face_py",
+    "tf_sweep_py",
+    "tf_sweep_copy_py",
+    "tf_interior_py",
+    "tf_place",
+    "tf_face",
+    "tf_sweep",
+    "tf_sweep_copy",
+    "tf_interior",
+    "toolframe_targets",
+    "rezone",
+    "smoothing_stencil",
+    "row_stencil",
+    "edge_neighbours",
+    "N_RZ_FIELDS",
+    "BF_CLOSED",
+    "BF_VIRGIN",
+    "BF_OPEN",
+    "swept_py",
+    "rz_flux_py",
+    "rz_velocity_py",
+    "rz_write_py",
+    "rz_node_mass_py",
+    "rz_flux",
+    "rz_velocity",
+    "rz_write",
+    "rz_node_mass",
+]
