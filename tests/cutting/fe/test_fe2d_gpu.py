@@ -252,10 +252,10 @@ def test_toolframe_ale_on_the_gpu_matches_cpu_engine_in_simulator(tmp_path):
     middle of a coarse cut (tool on springs, conduction every 4 steps with the thermal
     contact, friction read at the sliding speed) with the ALE pass at every 10th step --
     node placement, Jacobi sweeps, donor-cell remap with inflow of virgin material, velocity
-    remap and nodal masses, all run by the GPU kernels from rezone.py's scalar functions --
-    give the same bits as the CPU engine in numba's simulator, with the persistent kernel and
-    with one launch per kernel; the force split by tool face too. (Own numba cache: see the
-    test above.)"""
+    remap and nodal masses, all run by the GPU kernels from the scalar functions of rezone.py
+    and remap.py -- give the same bits as the CPU engine in numba's simulator, with the
+    persistent kernel and with one launch per kernel; the force split by tool face too. (Own
+    numba cache: see the test above.)"""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", NUMBA_NUM_THREADS="1",
                NUMBA_CACHE_DIR=str(tmp_path / "numba_cache"))
     tf = Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml"
