@@ -25,8 +25,8 @@ from robobore.cutting.fe.rezone import (
     TF_INTERIOR,
     TF_LINE,
     TF_RIGID,
-    _swept,
     rezone,
+    swept_py,
 )
 from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.toolframe import build_toolframe_mesh
@@ -118,8 +118,8 @@ def test_remap_open_boundaries_balance_mass():
             if st.enbr[e, k] >= 0 or st.bflag[e, k] == 0:
                 continue
             a, b = st.conn[e, k], st.conn[e, (k + 1) % 4]
-            sw = _swept(x_old[a], y_old[a], x_old[b], y_old[b], st.x[a], st.y[a], st.x[b],
-                        st.y[b])
+            sw = swept_py(x_old[a], y_old[a], x_old[b], y_old[b], st.x[a], st.y[a], st.x[b],
+                          st.y[b])
             if st.bflag[e, k] == BF_VIRGIN and sw > 0:
                 swept_in += sw
             else:
