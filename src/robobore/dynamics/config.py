@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from robobore.dynamics.handoff import equivalent_section, with_equivalent
+from robobore.dynamics.handoff import equivalent_extras, equivalent_section, with_equivalent
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
 from robobore.io.paths import resolve_config_path
@@ -388,15 +388,8 @@ def resolve_model_files(raw: dict[str, Any], path: str | Path,
                           file=src, field=missing.replace("_", "-"),
                           expected="both --stiffness-file (identify stiffness --json) and "
                                    "--modes-file (identify modes --json), or [model] keys")
-    eq_raw = raw.get("equivalent")
-    extra: dict[str, Any] = {}
-    if eq_raw is not None:
-        if not isinstance(eq_raw, dict) or set(eq_raw) - {"pressure_foot", "note"}:
-            raise ConfigError("the robot model is given twice (identification files and "
-                              "[equivalent] values)", file=src, field="equivalent",
-                              expected="[equivalent] with only pressure_foot/note, or no "
-                                       "model files")
-        extra = dict(eq_raw)
+    extra = equivalent_extras(raw, "identification files and [equivalent] values",
+                              "no model files", src)
     try:
         if ef is not None:
             em = EquivalentModel.from_dict(_read_json_file(ef, "model equivalent --json", src))

@@ -50,6 +50,21 @@ def equivalent_section(em: Any, note: str) -> dict[str, Any]:
             "note": note}
 
 
+def equivalent_extras(raw: dict[str, Any], given_twice: str, otherwise: str,
+                      source: str | None) -> dict[str, Any]:
+    """The ``[equivalent]`` keys of ``raw`` that may stand beside a robot model given
+    elsewhere (``pressure_foot``, ``note``); any other value there gives the model twice
+    (ConfigError naming ``given_twice``; ``otherwise`` completes what is expected)."""
+    eq_raw = raw.get("equivalent")
+    if eq_raw is None:
+        return {}
+    if not isinstance(eq_raw, dict) or set(eq_raw) - {"pressure_foot", "note"}:
+        raise ConfigError(f"the robot model is given twice ({given_twice})", file=source,
+                          field="equivalent",
+                          expected=f"[equivalent] with only pressure_foot/note, or {otherwise}")
+    return dict(eq_raw)
+
+
 def with_equivalent(raw: dict[str, Any], equivalent: Any, source: str | None = None
                     ) -> dict[str, Any]:
     """``raw`` with its ``[equivalent]`` section made from ``equivalent`` (an
@@ -64,14 +79,8 @@ def with_equivalent(raw: dict[str, Any], equivalent: Any, source: str | None = N
                           "argument)", file=source, field="model",
                           expected="a config without [model] files when an equivalent model "
                                    "is given")
-    eq_raw = raw.get("equivalent")
-    extra: dict[str, Any] = {}
-    if eq_raw is not None:
-        if not isinstance(eq_raw, dict) or set(eq_raw) - {"pressure_foot", "note"}:
-            raise ConfigError("the robot model is given twice ([equivalent] values and the "
-                              "equivalent argument)", file=source, field="equivalent",
-                              expected="[equivalent] with only pressure_foot/note, or none")
-        extra = dict(eq_raw)
+    extra = equivalent_extras(raw, "[equivalent] values and the equivalent argument",
+                              "none", source)
     out = dict(raw)
     out["equivalent"] = {**equivalent_section(em, "; ".join(em.notes)), **extra}
     return out
@@ -96,5 +105,5 @@ def with_coefficients(raw: dict[str, Any]) -> dict[str, Any]:
     return raw
 
 
-__all__ = ["EQUIVALENT_KEYS", "equivalent_arg", "equivalent_section", "with_equivalent",
-           "with_coefficients"]
+__all__ = ["EQUIVALENT_KEYS", "equivalent_arg", "equivalent_extras", "equivalent_section",
+           "with_equivalent", "with_coefficients"]

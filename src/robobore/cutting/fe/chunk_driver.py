@@ -46,16 +46,17 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
     st.ist[K.I_STATUS] = K.STATUS_OK
     total = 0
     t_start = st.time
-    gov = ThreadGovernor() if governor is None else governor
+    gov = (governor or ThreadGovernor()) if adaptive_threads else None
     threads_before = numba.get_num_threads()
     try:
         while True:
-            threads, steps = gov.next_chunk(chunk_steps) if adaptive_threads \
-                else (threads_before, chunk_steps)
-            numba.set_num_threads(threads)
-            t0 = time.perf_counter()
-            taken = run_chunk(steps, *st.kernel_args())
-            if adaptive_threads:
+            if gov is None:
+                taken = run_chunk(chunk_steps, *st.kernel_args())
+            else:
+                threads, steps = gov.next_chunk(chunk_steps)
+                numba.set_num_threads(threads)
+                t0 = time.perf_counter()
+                taken = run_chunk(steps, *st.kernel_args())
                 gov.record(threads, int(taken), time.perf_counter() - t0)
             total += int(taken)
             status = int(st.ist[K.I_STATUS])
