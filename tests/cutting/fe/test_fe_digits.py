@@ -1,0 +1,123 @@
+"""The FE engines' results to 1e-9, stored: the default validation configuration, the contract
+config, the tool-support example and the 3D paper condition, each on a short cut.
+
+The engines are deterministic (the same digits on any thread count and chunk size,
+tests/cutting/fe/test_fe_threads.py), so any change to the code that is meant to keep the
+physics (a restructure, a faster loop) must reproduce these digits. A change that is meant to
+change the physics updates them in the same commit, with the reason in the commit message.
+The runs go through the CLI (`robobore fe orthogonal|boring CONFIG --json`), so the test does
+not depend on how the engine's modules are laid out.
+
+Regenerate: ``python tests/cutting/fe/test_fe_digits.py`` prints the current digits.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from robobore.io.config import load_toml
+
+_EX = Path(__file__).parents[3] / "examples"
+
+#: case -> (example file, section and key of the cut length, short cut length [mm], CLI
+#: subcommand, outputs compared)
+CASES = {
+    "validation_config": ("fe_orthogonal_toolframe_calibrated.toml", ("cut", "length_mm"), 0.01,
+                          "orthogonal", ("cutting_force_N_per_mm", "feed_force_N_per_mm",
+                                         "steps")),
+    "contract": ("fe_orthogonal.toml", ("cut", "length_mm"), 0.01, "orthogonal",
+                 ("cutting_force_N_per_mm", "feed_force_N_per_mm", "steps")),
+    "tool_support": ("fe_orthogonal_tool_support.toml", ("cut", "length_mm"), 0.03,
+                     "orthogonal", ("cutting_force_N_per_mm", "feed_force_N_per_mm", "steps",
+                                    "tool_dx_mean_um", "tool_dy_mean_um")),
+    "boring_paper": ("fe_boring_paper.toml", ("cut", "cut_length_mm"), 0.02, "boring",
+                     ("force_rotating_N", "steps")),
+}
+
+#: digits of the engines at the stored commit (see the module docstring)
+EXPECTED: dict[str, dict] = {
+    "validation_config": {
+        "cutting_force_N_per_mm": 128.45242508266676,
+        "feed_force_N_per_mm": 46.017717160532754,
+        "steps": 18192
+    },
+    "contract": {
+        "cutting_force_N_per_mm": 128.45242508266676,
+        "feed_force_N_per_mm": 46.017717160532754,
+        "steps": 18192
+    },
+    "tool_support": {
+        "cutting_force_N_per_mm": 93.25557868854906,
+        "feed_force_N_per_mm": 31.6974573140153,
+        "steps": 18966,
+        "tool_dx_mean_um": 4.034106611982266,
+        "tool_dy_mean_um": 0.8414518106925286
+    },
+    "boring_paper": {
+        "force_rotating_N": {
+            "tangential": 17.095214502129565,
+            "radial": -7.02022382076883,
+            "feed": -1.2345788895525702
+        },
+        "steps": 15597
+    }
+}
+
+
+def _toml(d: dict) -> str:
+    """A TOML text of a two-level dict of scalars and lists (enough for the examples)."""
+    lines = [f"{k} = {json.dumps(v)}" for k, v in d.items() if not isinstance(v, dict)]
+    for k, v in d.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            lines += [f"{kk} = {json.dumps(vv)}" for kk, vv in v.items()]
+    return "\n".join(lines) + "\n"
+
+
+def run_case(name: str, tmp: Path) -> dict:
+    example, (sec, key), length, sub, keys = CASES[name]
+    d = load_toml(_EX / example)
+    d[sec][key] = length
+    cfg = tmp / f"{name}.toml"
+    cfg.write_text(_toml(d))
+    out = subprocess.run([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 0, out.stderr[-2000:]
+    res = json.loads(out.stdout)
+    return {k: _pick(res, k) for k in keys}
+
+
+def _pick(res: dict, key: str):
+    if key in res:
+        return res[key]
+    for v in res.values():  # one level down (e.g. the 3D summary)
+        if isinstance(v, dict) and key in v:
+            return v[key]
+    raise KeyError(key)
+
+
+def _close(a, b, rel: float = 1e-9) -> bool:
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_close(a[k], b[k], rel) for k in a)
+    if isinstance(a, int) and not isinstance(a, bool):
+        return a == b
+    return abs(a - b) <= rel * max(abs(a), abs(b), 1e-300)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(CASES))
+def test_engine_reproduces_stored_digits(name, tmp_path):
+    got = run_case(name, tmp_path)
+    assert _close(got, EXPECTED[name]), (name, got, EXPECTED[name])
+
+
+if __name__ == "__main__":
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as t:
+        print(json.dumps({n: run_case(n, Path(t)) for n in CASES}, indent=1))
