@@ -1,0 +1,121 @@
+"""FE throughput of this checkout against another git revision, measured in the same run.
+
+    python benchmarks/bench_fe_before_after.py --ref REV [--repeats 3] [--json OUT]
+
+Builds REV in a temporary git worktree and runs the same cases on both trees, interleaved
+(ref, this, ref, this, ...) so that a change of machine load hits both alike: the 2D contract
+config (`examples/fe_orthogonal.toml`, 0.3 mm) and the 3D paper condition
+(`examples/fe_boring_paper.toml`, 12.5 um elements, 0.05 mm of cut, no tool support). Each run
+is a fresh `python -m robobore fe orthogonal|boring CONFIG --json` process with PYTHONPATH on
+that tree's `src`; one short warm-up run per tree and case fills the numba caches first. Prints
+the element updates per second (median of the repeats) of both trees, their ratio, and whether
+the forces agree to 1e-9 (a restructure must not change them). The machine load (1-minute
+average) is printed with each run: take figures with nothing else running.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+sys.path.insert(0, str(ROOT / "src"))
+from robobore.io.config import load_toml  # noqa: E402
+
+#: case -> (example, overrides, CLI subcommand, force keys)
+CASES = {
+    "2D contract": ("fe_orthogonal.toml", {("cut", "length_mm"): 0.3}, "orthogonal"),
+    "3D paper 12.5 um": ("fe_boring_paper.toml", {("cut", "cut_length_mm"): 0.05,
+                                                  ("mesh", "element_size_um"): 12.5},
+                         "boring"),
+}
+
+
+def _toml(d: dict) -> str:
+    lines = [f"{k} = {json.dumps(v)}" for k, v in d.items() if not isinstance(v, dict)]
+    for k, v in d.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            lines += [f"{kk} = {json.dumps(vv)}" for kk, vv in v.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _config(case: str, tmp: Path, warmup: bool) -> Path:
+    example, over, _ = CASES[case]
+    d = load_toml(ROOT / "examples" / example)
+    d.pop("tool_support", None)
+    for (sec, key), v in over.items():
+        d.setdefault(sec, {})[key] = v
+    if warmup:
+        sec, key = next(iter(over))
+        d[sec][key] = 0.005
+    p = tmp / (case.replace(" ", "_") + ("_warm" if warmup else "") + ".toml")
+    p.write_text(_toml(d))
+    return p
+
+
+def _run(tree: Path, case: str, cfg: Path) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(tree / "src"))
+    sub = CASES[case][2]
+    out = subprocess.run([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
+                         capture_output=True, text=True, env=env, check=False)
+    if out.returncode != 0:
+        raise SystemExit(f"{tree}: {case} failed:\n{out.stderr[-3000:]}")
+    r = json.loads(out.stdout)
+    forces = (r.get("force_rotating_N") or r.get("summary", {}).get("force_rotating_N")
+              or {"cutting": r.get("cutting_force_N_per_mm"),
+                  "feed": r.get("feed_force_N_per_mm")})
+    rate = r.get("element_updates_per_s") or r.get("summary", {}).get("element_updates_per_s")
+    return {"rate": float(rate), "forces": forces, "load": os.getloadavg()[0]}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--ref", required=True, help="git revision to compare with (e.g. a tag)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--json", default=None, help="write the figures to this file")
+    a = ap.parse_args(argv)
+    with tempfile.TemporaryDirectory() as t:
+        tmp = Path(t)
+        ref_tree = tmp / "ref"
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q",
+                        str(ref_tree), a.ref], check=True)
+        try:
+            trees = {"ref": ref_tree, "this": ROOT}
+            res: dict = {"ref": a.ref, "cases": {}}
+            for case in CASES:
+                for tree in trees.values():
+                    _run(tree, case, _config(case, tmp, warmup=True))
+                runs: dict[str, list] = {"ref": [], "this": []}
+                for i in range(a.repeats):
+                    for name, tree in trees.items():
+                        r = _run(tree, case, _config(case, tmp, warmup=False))
+                        runs[name].append(r)
+                        print(f"{case:18s} {name:4s} #{i + 1}: {r['rate'] / 1e6:6.2f} M/s "
+                              f"(load {r['load']:.1f})", flush=True)
+                med = {k: statistics.median(r["rate"] for r in v) for k, v in runs.items()}
+                fa, fb = runs["ref"][0]["forces"], runs["this"][0]["forces"]
+                same = all(abs(fa[k] - fb[k]) <= 1e-9 * max(abs(fa[k]), 1e-300) for k in fa)
+                res["cases"][case] = {"ref_M_per_s": med["ref"] / 1e6,
+                                      "this_M_per_s": med["this"] / 1e6,
+                                      "ratio": med["this"] / med["ref"],
+                                      "forces_equal_1e-9": same, "runs": runs}
+                print(f"{case:18s} ref {med['ref'] / 1e6:.2f} M/s, this "
+                      f"{med['this'] / 1e6:.2f} M/s, ratio {med['this'] / med['ref']:.3f}, "
+                      f"forces equal to 1e-9: {same}", flush=True)
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force",
+                            str(ref_tree)], check=False)
+    if a.json:
+        Path(a.json).write_text(json.dumps(res, indent=1))
+
+
+if __name__ == "__main__":
+    main()
