@@ -283,7 +283,8 @@ def _diff2(a, b) -> dict:
 
 def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
-    from robobore.cutting.fe.solver import advance, setup_orthogonal
+    from robobore.cutting.fe.chunk_driver import advance
+    from robobore.cutting.fe.orthogonal import setup_orthogonal
 
     advance_gpu = None
     if use_gpu:
@@ -302,7 +303,7 @@ def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
 
 def ortho2d(devices: list[str], length_mm: float | None, le: float | None,
             config: str | None = None) -> dict:
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.orthogonal import simulate_orthogonal
 
     cfg = _ortho_cfg(le, length_mm, config)
     by = {}

@@ -68,7 +68,7 @@ def main() -> int:
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.fe.config import load_fe_config
-    from robobore.cutting.fe.solver import setup_orthogonal
+    from robobore.cutting.fe.orthogonal import setup_orthogonal
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

@@ -37,8 +37,8 @@ def main() -> None:
     a = ap.parse_args()
 
     from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.orthogonal import simulate_orthogonal
     from robobore.cutting.fe.slab3d import simulate_slab3
-    from robobore.cutting.fe.solver import simulate_orthogonal
     from robobore.io.results import atomic_write_text
 
     d = {"parameters": "a_priori", "material": {"name": "TC4"},

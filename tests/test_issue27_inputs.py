@@ -33,7 +33,7 @@ def _no_run(*a, **k):
 @pytest.fixture(autouse=True)
 def _never_run(monkeypatch):
     monkeypatch.setattr(calruns, "run_fe_point", _no_run)
-    monkeypatch.setattr("robobore.cutting.fe.solver.simulate_orthogonal", _no_run)
+    monkeypatch.setattr("robobore.cutting.fe.orthogonal.simulate_orthogonal", _no_run)
 
 
 def _garbled_material(tmp_path: Path) -> Path:

@@ -105,7 +105,7 @@ def test_unwritable_output_refused_before_any_work(tmp_path, monkeypatch, args, 
     # modules that bind a patched name at import: imported first, so they keep the real one
     importlib.import_module("robobore.modal.example")
 
-    for mod, name in (("robobore.cutting.fe.solver", "simulate_orthogonal"),
+    for mod, name in (("robobore.cutting.fe.orthogonal", "simulate_orthogonal"),
                       ("robobore.cutting.fe.boring3d", "simulate_boring"),
                       ("robobore.cutting.calibrate", "calibrate_forces"),
                       ("robobore.study.paper", "run_paper"),

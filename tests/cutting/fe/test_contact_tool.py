@@ -18,7 +18,8 @@ from hypothesis import strategies as st
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe import physics as P
-from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.cutting.fe.chunk_driver import advance
+from robobore.cutting.fe.state2d import default_prm, make_state
 
 RAKE = math.radians(15.0)
 CLR = math.radians(2.0)

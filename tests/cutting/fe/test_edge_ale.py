@@ -19,8 +19,8 @@ from conftest import edge_band_dict
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.rezone import MODE_ROWS, rezone, row_stencil
-from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 
 ALE = {"edge_ale_interval": 10, "edge_ale_depth_um": 10.0}

@@ -20,7 +20,7 @@ from conftest import edge_band_dict
 
 from robobore.cutting.fe.config import parse_config
 from robobore.cutting.fe.mesh import build_edge_refined_mesh
-from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 
 H, LE, SH = 30e-6, 10e-6, 5e-6

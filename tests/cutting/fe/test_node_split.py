@@ -16,9 +16,11 @@ import pytest
 from conftest import elastic_tc4, strip_mesh
 
 from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.chunk_driver import advance
 from robobore.cutting.fe.config import parse_config
 from robobore.cutting.fe.mesh import build_mesh
-from robobore.cutting.fe.solver import advance, default_prm, make_state, setup_orthogonal
+from robobore.cutting.fe.orthogonal import setup_orthogonal
+from robobore.cutting.fe.state2d import default_prm, make_state
 
 
 def _split(nodes, conn, nx, ny, row):

@@ -16,6 +16,7 @@ import pytest
 
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.physics import tool_gap_py
 from robobore.cutting.fe.rezone import (
     BF_OPEN,
@@ -28,7 +29,6 @@ from robobore.cutting.fe.rezone import (
     rezone,
     swept_py,
 )
-from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.toolframe import build_toolframe_mesh
 from robobore.errors import ConfigError
 
@@ -185,7 +185,7 @@ def test_tool_frame_on_gpu_needs_a_gpu():
     """The tool-frame model runs on the GPU (the simulator test in
     test_fe2d_gpu.py); without a usable GPU --device gpu stops with the clear error."""
     from robobore.cutting.fe.gpu import cuda_available
-    from robobore.cutting.fe.solver import check_device
+    from robobore.cutting.fe.orthogonal import check_device
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,

@@ -126,7 +126,7 @@ def test_bad_points_option(text):
 def test_config_errors_before_any_run(tmp_path, monkeypatch):
     import tomllib
 
-    monkeypatch.setattr("robobore.cutting.fe.solver.simulate_orthogonal", _no_run)
+    monkeypatch.setattr("robobore.cutting.fe.orthogonal.simulate_orthogonal", _no_run)
     base = tomllib.loads(TINY)
     # a point whose chip is too thin for the element: found at planning, naming the point
     meas = V.read_measured(_files(tmp_path, {"measured": {"Fc": {"60": {"30": 1.0},
@@ -196,7 +196,7 @@ def test_cli_json_contract_and_resume(tmp_path):
 def test_interrupted_validation_resumes(tmp_path):
     import tomllib
 
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.orthogonal import simulate_orthogonal
 
     base = tomllib.loads(TINY)
     meas = V.read_measured(_files(tmp_path)[1])
@@ -232,7 +232,7 @@ def test_interrupted_validation_resumes(tmp_path):
 def test_points_option_runs_a_prediction(tmp_path):
     import tomllib
 
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.orthogonal import simulate_orthogonal
 
     base = tomllib.loads(TINY)
     meas = V.read_measured(_files(tmp_path)[1])

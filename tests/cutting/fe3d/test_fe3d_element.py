@@ -244,7 +244,7 @@ def test_hourglass_resistance_matches_2d_quad_in_plane_strain(hgs, hgv):
     Before the scaling was aligned the cube resisted 3x (stiffness) and 2x (viscous) more, and
     a plane-strain slab cut by the 3D engine gave 1.5x the 2D cutting force."""
     from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.solver import default_prm, make_state
+    from robobore.cutting.fe.state2d import default_prm, make_state
 
     a = 10e-6
     v0 = 0.1

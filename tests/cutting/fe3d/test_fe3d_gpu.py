@@ -41,7 +41,10 @@ SCRIPT = textwrap.dedent("""
         # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s, and
         # heat conduction with the thermal contact every 3 steps (20 passes)
         from robobore.cutting.fe.config import ContactSection, SolverSection
-        from robobore.cutting.fe.solver import apply_friction_settings, apply_thermal_settings
+        from robobore.cutting.fe.engine_settings import (
+            apply_friction_settings,
+            apply_thermal_settings,
+        )
         from robobore.material import load_material
         s = bench.small3d(n_samples=40)
         apply_friction_settings(s.prm, ContactSection(), s.prm[K3.P_VC] * 60.0, K3)

@@ -17,8 +17,8 @@ from __future__ import annotations
 import pytest
 
 from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.orthogonal import simulate_orthogonal
 from robobore.cutting.fe.slab3d import simulate_slab3
-from robobore.cutting.fe.solver import simulate_orthogonal
 from robobore.errors import ConfigError
 
 CFG = {"parameters": "a_priori", "material": {"name": "TC4"},

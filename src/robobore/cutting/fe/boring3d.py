@@ -49,7 +49,7 @@ from robobore.cutting.fe.boring3d_config import (
     parse_boring_config,
 )
 from robobore.cutting.fe.boring3d_mesh import BoringMesh, build_boring_mesh, parting_surface
-from robobore.cutting.fe.solver import (
+from robobore.cutting.fe.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,

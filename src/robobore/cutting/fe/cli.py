@@ -51,8 +51,8 @@ def orthogonal_cmd(
 @handle_errors
 def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
     from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.orthogonal import check_device, simulate_orthogonal
     from robobore.cutting.fe.output import plot_chip, to_dataset, write_vtk
-    from robobore.cutting.fe.solver import check_device, simulate_orthogonal
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_netcdf
 

@@ -110,9 +110,9 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                 check: Callable[[Any], None] | None = None,
                 profile: dict[str, float] | None = None,
                 persistent: bool | None = None) -> int:
-    """GPU counterpart of :func:`robobore.cutting.fe.solver.advance` (same contract).
+    """GPU counterpart of :func:`robobore.cutting.fe.chunk_driver.advance` (same contract).
 
-    Copies the :class:`~robobore.cutting.fe.solver.FEState` to the device, runs chunks of
+    Copies the :class:`~robobore.cutting.fe.state2d.FEState` to the device, runs chunks of
     ``chunk_steps`` steps there, copies the step counter and clock back after each chunk
     (the whole state when ``check`` is given, before calling it) and the whole state at the
     end. Returns the number of steps taken. Raises NumericalError on instability (same

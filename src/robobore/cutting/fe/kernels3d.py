@@ -20,7 +20,7 @@ chunk loop :func:`run_chunk3`. The scalar functions:
 * :func:`hex_node_py` -- gather, contact and central-difference update of one node.
 
 Energy indices, status codes and the energy-balance definition are the 2D engine's
-(:mod:`robobore.cutting.fe.kernels`), so :func:`robobore.cutting.fe.solver.energy_error`
+(:mod:`robobore.cutting.fe.kernels`), so :func:`robobore.cutting.fe.chunk_driver.energy_error`
 applies to both.
 
 Frames: the kernels work in the *local* frame of the insert at the start of the run

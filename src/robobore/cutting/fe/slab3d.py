@@ -21,12 +21,12 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
+from robobore.cutting.fe.chunk_driver import energy_error
 from robobore.cutting.fe.config import FEConfig
-from robobore.cutting.fe.solver import (
+from robobore.cutting.fe.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,
-    energy_error,
 )
 from robobore.cutting.fe.solver3d import (
     FEState3,

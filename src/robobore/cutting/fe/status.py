@@ -1,7 +1,7 @@
 """Run status of the explicit engines: what each instability code in ``ist[I_STATUS]`` means
 and the error raised for it.
 
-Shared by every chunk driver (2D and 3D, CPU and GPU: :func:`robobore.cutting.fe.solver.
+Shared by every chunk driver (2D and 3D, CPU and GPU: :func:`robobore.cutting.fe.chunk_driver.
 drive_chunks`, :func:`robobore.cutting.fe.gpu2d.advance_gpu`,
 :func:`robobore.cutting.fe.gpu.advance3_gpu`). The codes themselves are
 :mod:`robobore.cutting.fe.kernels`' ``STATUS_*`` (the 3D kernels use the same ones).
