@@ -54,7 +54,7 @@ class Competitor:
 
 def run_2d(length_mm: float, adaptive: bool) -> tuple[float, dict]:
     from robobore.cutting.fe.chunk_driver import advance
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.orthogonal import setup_orthogonal
 
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")

@@ -261,7 +261,7 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
 
 # ----------------------------------------------------------------------------------- 2D
 def _ortho_cfg(le: float | None, length_mm: float | None, config: str | None = None):
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     cfg = load_fe_config(config or ROOT / "examples" / "fe_orthogonal.toml")
     if le is not None:

@@ -67,7 +67,7 @@ def main() -> int:
     from robobore.cutting.fe import kernels as K
     from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.orthogonal import setup_orthogonal
     from robobore.io.config import load_toml
 

@@ -59,7 +59,7 @@ PKG = ROOT / "src" / "robobore"
 
 #: parse-only drivers (commands that would run FE simulations or the whole paper study)
 PARSE = {
-    "fe": "from robobore.cutting.fe.config import load_fe_config as f",
+    "fe": "from robobore.cutting.fe.config.orthogonal import load_fe_config as f",
     "fe_boring": "from robobore.cutting.fe.boring3d import load_boring_config as f",
     "calibration": "from robobore.cutting.calibration_config import load_calibration_config as f",
     "paper": "from robobore.study.paper_config import load_paper_config as f",

@@ -36,7 +36,7 @@ def main() -> None:
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
 
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.orthogonal import simulate_orthogonal
     from robobore.cutting.fe.slab3d import simulate_slab3
     from robobore.io.results import atomic_write_text

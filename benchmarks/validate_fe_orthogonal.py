@@ -22,7 +22,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.validate import parse_points, read_measured, run_validation
 from robobore.io.config import load_toml
 

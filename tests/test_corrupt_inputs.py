@@ -33,7 +33,7 @@ def _dynamics(p: Path):
 
 
 def _fe(p: Path):
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     load_fe_config(p)
 

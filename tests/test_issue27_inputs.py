@@ -18,7 +18,7 @@ from robobore.cli import app
 from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.fe.boring3d import parse_boring_config
-from robobore.cutting.fe.config import load_fe_config, parse_config
+from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
 from robobore.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]

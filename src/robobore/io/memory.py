@@ -93,7 +93,7 @@ def check_memory(estimate_bytes: float, what: str, key: str, *, file: str | None
 
 
 def fe2d_elements(cfg: Any) -> float:
-    """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.FEConfig`).
+    """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`).
 
     Workpiece frame: ``(length_mm + ahead_mm) / le`` columns times the rows of the fine zone
     (``(1 + fine_depth_factor) h / le``) plus the graded rows below it. Tool frame: the

@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting.fe.config import load_fe_config, parse_config
+from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
 from robobore.errors import ConfigError
 
 EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.orthogonal import simulate_orthogonal
 
 FC_MEAS, FF_MEAS, R_MEAS = 118.23, 50.3, 1.23

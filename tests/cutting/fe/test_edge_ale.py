@@ -18,7 +18,7 @@ import pytest
 from conftest import edge_band_dict
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.rezone import MODE_ROWS, rezone, row_stencil
 from robobore.errors import ConfigError

@@ -46,7 +46,7 @@ SCRIPT = PRELUDE + textwrap.dedent("""
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
     from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.gpu2d import advance_gpu
     from robobore.cutting.fe.chunk_driver import advance
     from robobore.cutting.fe.orthogonal import setup_orthogonal
@@ -114,7 +114,7 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
     import copy, json, sys, tomllib
     import numpy as np
     from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.gpu2d import advance_gpu
     from robobore.cutting.fe.chunk_driver import advance
     from robobore.cutting.fe.orthogonal import setup_orthogonal
@@ -164,7 +164,7 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
 def test_gpu2d_module_imports_and_reports_cleanly():
     assert callable(gpu2d.advance_gpu)
     if not gpu.cuda_available():
-        from robobore.cutting.fe.config import load_fe_config
+        from robobore.cutting.fe.config.orthogonal import load_fe_config
         from robobore.cutting.fe.orthogonal import simulate_orthogonal
 
         with pytest.raises(ConfigError, match="no usable NVIDIA GPU"):
@@ -293,7 +293,7 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
     from numba import typeof
     from numba.core.datamodel import default_manager
 
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.orthogonal import setup_orthogonal
 
     def nbytes(t) -> int:

@@ -85,7 +85,7 @@ needs_threads = pytest.mark.skipif(numba.get_num_threads() < 2,
 @needs_threads
 def test_2d_default_model_gives_the_same_digits_on_any_thread_count():
     from robobore.cutting.fe.chunk_driver import advance
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.orthogonal import setup_orthogonal
 
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")

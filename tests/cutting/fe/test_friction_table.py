@@ -2,8 +2,8 @@
 
 Reference: a tribometer gives the Coulomb coefficient against the *sliding* velocity (Rech et
 al. 2013, CIRP Annals 62, 79-82, the source of the Ti6Al4V table bundled in
-robobore.cutting.fe.config); a slip-rate-dependent table is read piecewise linearly and is
-constant beyond its ends (as Abaqus' friction tables). The engine looks the coefficient up
+robobore.cutting.fe.config.orthogonal); a slip-rate-dependent table is read piecewise linearly and
+is constant beyond its ends (as Abaqus' friction tables). The engine looks the coefficient up
 per contact node and step at the node's sliding speed relative to the tool.
 """
 
@@ -16,7 +16,7 @@ from conftest import elastic_tc4, strip_mesh
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe import physics as P
 from robobore.cutting.fe.chunk_driver import advance
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.state2d import default_prm, make_state
 from robobore.errors import ConfigError
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.physics import tool_gap_py
 from robobore.cutting.fe.rezone import (
@@ -202,7 +202,7 @@ def test_example_config_builds():
     """examples/fe_orthogonal_toolframe.toml: the tool-frame defaults land in the engine."""
     from pathlib import Path
 
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     cfg = load_fe_config(Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml")
     su = setup_orthogonal(cfg)
@@ -224,7 +224,7 @@ def test_domain_keys_move_the_tool_frame_boundaries():
     edge centre at x = 0 before the tool moves)."""
     from pathlib import Path
 
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     path = Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml"
     base = setup_orthogonal(load_fe_config(path))

@@ -15,8 +15,8 @@ import pytest
 from robobore.cutting.fe import kernels as K2
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.boring3d import parse_boring_config
-from robobore.cutting.fe.config import ContactSection
-from robobore.cutting.fe.engine_settings import apply_friction_settings
+from robobore.cutting.fe.config.engine_settings import apply_friction_settings
+from robobore.cutting.fe.config.orthogonal import ContactSection
 from robobore.cutting.fe.solver3d import box_mesh, default_prm3, make_state3
 from robobore.cutting.fe.state2d import default_prm
 from robobore.errors import ConfigError

@@ -40,8 +40,8 @@ SCRIPT = textwrap.dedent("""
         # the default friction law (rech2013_calibrated: the table read at each contact
         # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s, and
         # heat conduction with the thermal contact every 3 steps (20 passes)
-        from robobore.cutting.fe.config import ContactSection, SolverSection
-        from robobore.cutting.fe.engine_settings import (
+        from robobore.cutting.fe.config.orthogonal import ContactSection, SolverSection
+        from robobore.cutting.fe.config.engine_settings import (
             apply_friction_settings,
             apply_thermal_settings,
         )

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import pytest
 
-from robobore.cutting.fe.config import parse_config
+from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.orthogonal import simulate_orthogonal
 from robobore.cutting.fe.slab3d import simulate_slab3
 from robobore.errors import ConfigError

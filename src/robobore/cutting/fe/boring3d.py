@@ -1,7 +1,7 @@
 """The paper's equivalent 3D FE boring model: an insert with nose radius cutting the bore wall.
 
 Model (all choices documented in ``docs/fe3d.md``; the configuration schema is
-:mod:`robobore.cutting.fe.boring3d_config`, the mesh builder
+:mod:`robobore.cutting.fe.config.boring3d`, the mesh builder
 :mod:`robobore.cutting.fe.boring3d_mesh`; this module sets the model up, runs it and
 compares it with the mechanistic model):
 
@@ -43,13 +43,13 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.boring3d_config import (
+from robobore.cutting.fe.boring3d_mesh import BoringMesh, build_boring_mesh, parting_surface
+from robobore.cutting.fe.config.boring3d import (
     BoringFEConfig,
     load_boring_config,
     parse_boring_config,
 )
-from robobore.cutting.fe.boring3d_mesh import BoringMesh, build_boring_mesh, parting_surface
-from robobore.cutting.fe.engine_settings import (
+from robobore.cutting.fe.config.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,

@@ -50,7 +50,7 @@ def orthogonal_cmd(
 
 @handle_errors
 def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.orthogonal import check_device, simulate_orthogonal
     from robobore.cutting.fe.output import plot_chip, to_dataset, write_vtk
     from robobore.io.outputs import check_output_dir, check_output_file
@@ -140,7 +140,7 @@ def validate_cmd(
 
 @handle_errors
 def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu") -> None:
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.validate import parse_points, read_measured, run_validation
     from robobore.io.config import load_toml
 

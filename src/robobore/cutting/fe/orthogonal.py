@@ -1,6 +1,6 @@
 """The orthogonal-cutting model: :func:`setup_orthogonal` builds mesh, tool and state from an
-:class:`~robobore.cutting.fe.config.FEConfig`, :func:`run_orthogonal` runs it on the CPU or
-the GPU, :func:`simulate_orthogonal` sets up, runs and measures it (forces, chip, energies)
+:class:`~robobore.cutting.fe.config.orthogonal.FEConfig`, :func:`run_orthogonal` runs it on the CPU
+or the GPU, :func:`simulate_orthogonal` sets up, runs and measures it (forces, chip, energies)
 into an :class:`~robobore.cutting.fe.output.FEResult`.
 """
 
@@ -19,12 +19,12 @@ from robobore.cutting.fe.chunk_driver import (
     advance,
     energy_error,
 )
-from robobore.cutting.fe.config import FEConfig
-from robobore.cutting.fe.engine_settings import (
+from robobore.cutting.fe.config.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,
 )
+from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.mesh import CuttingMesh, build_edge_refined_mesh, build_mesh
 from robobore.cutting.fe.rezone import MODE_ROWS, MODE_TOOLFRAME, TF_RIGID
 from robobore.cutting.fe.rezone_stencils import row_stencil, smoothing_stencil

@@ -1,6 +1,6 @@
 """Cross-check of the 3D engine against the 2D engine: an orthogonal cut on a 3D slab.
 
-The 2D orthogonal-cutting config (:class:`robobore.cutting.fe.config.FEConfig`, node
+The 2D orthogonal-cutting config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`, node
 splitting) is rebuilt as a thin 3D slab in plane strain -- ``n_z`` hexahedra across the width,
 z velocities held on both faces -- and cut by the 3D engine's insert with a straight edge
 (nose radius 1 m, so every normal section of the edge is the 2D wedge: same rake, clearance
@@ -22,12 +22,12 @@ import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.chunk_driver import energy_error
-from robobore.cutting.fe.config import FEConfig
-from robobore.cutting.fe.engine_settings import (
+from robobore.cutting.fe.config.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,
 )
+from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.solver3d import (
     FEState3,
     advance3,

@@ -54,11 +54,11 @@ def apply_friction_settings(p: np.ndarray, contact: Any, vc_m_per_min: float,
     """Write the friction of a ``[contact]`` section into ``p`` (returned); shared by the 2D
     and 3D engines.
 
-    ``contact`` is a :class:`robobore.cutting.fe.config.ContactSection` (or the 3D engine's,
-    built on it), ``vc_m_per_min`` the cutting speed, ``kernels`` the engine's kernel module (its
-    ``P_MU``, ``P_TAU``, ``P_MUTAB_*`` and ``P_SLIP_TAU`` slots). ``P_MU``: the constant, or
-    the table at the cutting speed; with ``friction_velocity = "sliding"`` the table goes into
-    the ``P_MUTAB_*`` slots (velocities in m/s) and every contact node reads it at its own
+    ``contact`` is a :class:`robobore.cutting.fe.config.orthogonal.ContactSection` (or the 3D
+    engine's, built on it), ``vc_m_per_min`` the cutting speed, ``kernels`` the engine's kernel
+    module (its ``P_MU``, ``P_TAU``, ``P_MUTAB_*`` and ``P_SLIP_TAU`` slots). ``P_MU``: the
+    constant, or the table at the cutting speed; with ``friction_velocity = "sliding"`` the table
+    goes into the ``P_MUTAB_*`` slots (velocities in m/s) and every contact node reads it at its own
     sliding speed, filtered over the time the tool takes to travel ``sliding_filter_um``.
     """
     k = kernels

@@ -11,8 +11,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from robobore.cutting.fe.config import ContactSection as ContactSection2D
-from robobore.cutting.fe.config import MaterialSection, apply_parameter_set
+from robobore.cutting.fe.config.orthogonal import ContactSection as ContactSection2D
+from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
@@ -63,14 +63,15 @@ _CONTACT_2D_ONLY = ("normal_damping",)
 
 
 class ContactSection(ContactSection2D):
-    """The 2D engine's ``[contact]`` (:class:`robobore.cutting.fe.config.ContactSection`):
-    the same friction keys, values and defaults -- ``friction`` a bundled friction law
-    (default ``rech2013_calibrated``: the Rech et al. 2013 table x 1.5 read at each contact
-    node's filtered sliding speed, no shear cap), "table" or a constant Coulomb coefficient;
-    ``friction_velocity``, ``friction_table_*``, ``sliding_filter_um``, ``shear_limit_MPa``,
-    ``penalty_factor`` and the thermal contact (``thermal_conductance_W_per_m2K``,
-    ``friction_heat_fraction``, ``tool_temperature_K``, used with ``solver.heat_conduction``)
-    -- without ``normal_damping`` (the 3D contact has no normal damping)."""
+    """The 2D engine's ``[contact]``
+    (:class:`robobore.cutting.fe.config.orthogonal.ContactSection`): the same friction keys, values
+    and defaults -- ``friction`` a bundled friction law (default ``rech2013_calibrated``: the Rech
+    et al. 2013 table x 1.5 read at each contact node's filtered sliding speed, no shear cap),
+    "table" or a constant Coulomb coefficient; ``friction_velocity``, ``friction_table_*``,
+    ``sliding_filter_um``, ``shear_limit_MPa``, ``penalty_factor`` and the thermal contact
+    (``thermal_conductance_W_per_m2K``, ``friction_heat_fraction``, ``tool_temperature_K``, used
+    with ``solver.heat_conduction``) -- without ``normal_damping`` (the 3D contact has no normal
+    damping)."""
 
     @model_validator(mode="after")
     def _no_2d_only(self) -> ContactSection:
@@ -174,9 +175,9 @@ class ToolSupportSection(_Strict):
 
 
 class BoringFEConfig(_Strict):
-    #: the 2D engine's switch (:class:`robobore.cutting.fe.config.FEConfig`): "calibrated"
-    #: (default) -- friction law "rech2013_calibrated" and the material file's hardening
-    #: hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;
+    #: the 2D engine's switch (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`):
+    #: "calibrated" (default) -- friction law "rech2013_calibrated" and the material file's
+    #: hardening hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;
     #: "a_priori" -- friction law "rech2013" and the plain Johnson-Cook law. Explicit
     #: contact.friction and material.hardening_strain_limit keys win over either
     parameters: Literal["calibrated", "a_priori"] = "calibrated"
