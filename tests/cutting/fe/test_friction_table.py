@@ -14,9 +14,9 @@ import pytest
 from conftest import elastic_tc4, strip_mesh
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe import physics as P
 from robobore.cutting.fe.chunk_driver import advance
 from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.physics.tool_contact import tool_contact as P
 from robobore.cutting.fe.state2d import default_prm, make_state
 from robobore.errors import ConfigError
 

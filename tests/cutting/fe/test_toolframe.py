@@ -17,7 +17,7 @@ import pytest
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
-from robobore.cutting.fe.physics import tool_gap_py
+from robobore.cutting.fe.physics.tool_contact import tool_gap_py
 from robobore.cutting.fe.rezone import (
     BF_OPEN,
     BF_VIRGIN,

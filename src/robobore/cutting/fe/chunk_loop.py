@@ -79,6 +79,11 @@ from robobore.cutting.fe.node_contact import (
     node_update,
     tool_geometry,
 )
+from robobore.cutting.fe.physics.thermal2d import (
+    conduct,
+    parting_conduct,
+    tool_heat,
+)
 from robobore.cutting.fe.quad_bbar import (
     element_update_bbar,
 )
@@ -86,11 +91,6 @@ from robobore.cutting.fe.quad_element import (
     element_update,
 )
 from robobore.cutting.fe.rezone import rezone
-from robobore.cutting.fe.thermal2d import (
-    conduct,
-    parting_conduct,
-    tool_heat,
-)
 from robobore.cutting.fe.tool_motion import (
     tool_kinematics,
     tool_step,

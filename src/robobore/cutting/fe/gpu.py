@@ -3,13 +3,13 @@
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
 (:func:`hex8.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
 and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
-:mod:`robobore.cutting.fe.physics`), re-bound to device versions with
+:mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
 :func:`robobore.material.johnson_cook.rebind` and compiled with
 ``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
 force total (one block, in the CPU's fixed lane order, so a run is reproducible bit for
 bit), the tool (one thread), elements (stable step by atomic min), and the step end (one
 thread: time, status, time-averaged histories); every ``solver.conduction_interval`` steps
-the heat conduction of :mod:`robobore.cutting.fe.thermal3d` adds five more (centroids, new
+the heat conduction of :mod:`robobore.cutting.fe.physics.thermal3d` adds five more (centroids, new
 temperatures, their copy, the insert's heat per node, then per element). The loop stays on
 the device; the host only checks the status between chunks.
 

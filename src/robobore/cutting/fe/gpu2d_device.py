@@ -3,7 +3,7 @@
 
 The element, node, tool, conduction, energy and tool-frame ALE updates are the plain-Python
 scalar functions the CPU engine compiles with ``njit`` (:mod:`robobore.cutting.fe.kernels`,
-:mod:`robobore.cutting.fe.rezone`, :mod:`robobore.cutting.fe.physics`,
+:mod:`robobore.cutting.fe.rezone`, :mod:`robobore.cutting.fe.physics.tool_contact`,
 :mod:`robobore.material.johnson_cook`); :func:`device_functions2` re-binds each one's callees
 to their device versions (:func:`robobore.material.johnson_cook.rebind`) and compiles it with
 ``numba.cuda.jit(device=True)``.
@@ -23,7 +23,7 @@ __all__ = ["device_functions2"]
 def device_functions2(dev) -> SimpleNamespace:
     """The device functions of the 2D GPU kernels, by the names the kernels call them
     (``dev`` = ``numba.cuda.jit(device=True)``)."""
-    from robobore.cutting.fe.physics import (
+    from robobore.cutting.fe.physics.tool_contact import (
         contact_force_py,
         tool_face_py,
         tool_gap_py,

@@ -4,7 +4,7 @@ engine.
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
 (:func:`hex8.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
 and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
-:mod:`robobore.cutting.fe.physics`), re-bound to device versions with
+:mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
 :func:`robobore.material.johnson_cook.rebind` and compiled with
 ``numba.cuda.jit(device=True)``. :func:`kernels3` returns the launch-per-kernel phases
 (nodes, contact-force total, tool, elements, step end, the heat-conduction kernels) and the
@@ -46,9 +46,13 @@ def kernels3():
     from numba import int64 as _int64
 
     from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe import thermal3d as T3
     from robobore.cutting.fe.hex8 import hex_element_py
-    from robobore.cutting.fe.physics import tool_face_py, tool_gap_py, tool_support_step_py
+    from robobore.cutting.fe.physics.tool_contact import thermal3d as T3
+    from robobore.cutting.fe.physics.tool_contact import (
+        tool_face_py,
+        tool_gap_py,
+        tool_support_step_py,
+    )
     from robobore.material import johnson_cook as jc
 
     dev = cuda.jit(device=True)

@@ -10,7 +10,7 @@ names of its modules in one place.
 * :mod:`~robobore.cutting.fe.node_contact`: the node update with tool contact, friction and
   node-splitting separation (:func:`node_update`); the contact-force total and its split by
   tool face.
-* :mod:`~robobore.cutting.fe.thermal2d`: heat conduction, across the parting line and with
+* :mod:`~robobore.cutting.fe.physics.thermal2d`: heat conduction, across the parting line and with
   the tool.
 * :mod:`~robobore.cutting.fe.tool_motion`: the tool's kinematics and its support springs.
 * :mod:`~robobore.cutting.fe.chunk_loop`: the compiled time-step loop (:func:`run_chunk`).
@@ -160,6 +160,21 @@ from robobore.cutting.fe.node_contact import (
     tool_geometry,
     tool_geometry_py,
 )
+from robobore.cutting.fe.physics.thermal2d import (
+    conduct,
+    parting_conduct,
+    parting_edge,
+    parting_edge_py,
+    quad_centroid,
+    quad_centroid_py,
+    quad_conduct,
+    quad_conduct_py,
+    tool_heat,
+    tool_heat_elem,
+    tool_heat_elem_py,
+    tool_heat_node,
+    tool_heat_node_py,
+)
 from robobore.cutting.fe.quad_bbar import (
     element_update_bbar,
     quad_bbar,
@@ -181,21 +196,6 @@ from robobore.cutting.fe.quad_element import (
     quad_retire_py,
     quad_step,
     quad_step_py,
-)
-from robobore.cutting.fe.thermal2d import (
-    conduct,
-    parting_conduct,
-    parting_edge,
-    parting_edge_py,
-    quad_centroid,
-    quad_centroid_py,
-    quad_conduct,
-    quad_conduct_py,
-    tool_heat,
-    tool_heat_elem,
-    tool_heat_elem_py,
-    tool_heat_node,
-    tool_heat_node_py,
 )
 from robobore.cutting.fe.tool_motion import (
     tool_kinematics,

@@ -2,16 +2,17 @@
 
 Reuses the 2D engine's scalar physics unchanged: the Johnson-Cook return mapping and damage
 (:mod:`robobore.material.johnson_cook`), the 2D wedge signed distance
-(:func:`robobore.cutting.fe.physics.tool_gap`, applied in the local normal section of the
-insert edge) and the spring-damper step (:func:`robobore.cutting.fe.physics.tool_support_step`).
-The 3D state layout and scalar functions (``_py`` original + ``njit``, device-ready) are
+(:func:`robobore.cutting.fe.physics.tool_contact.tool_gap`, applied in the local normal section of
+the insert edge) and the spring-damper step
+(:func:`robobore.cutting.fe.physics.tool_contact.tool_support_step`). The 3D state layout and scalar
+functions (``_py`` original + ``njit``, device-ready) are
 :mod:`robobore.cutting.fe.scalar3d`, re-exported here; this module holds the parallel loops
 (elements, nodes), the energy sums, the contact-force total, the conduction pass and the
 chunk loop :func:`run_chunk3`. The scalar functions:
 
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
-* :func:`contact_force3_py` -- the 2D contact law (:func:`physics.contact_force_py`: mass-
+* :func:`contact_force3_py` -- the 2D contact law (:func:`tool_contact.contact_force_py`: mass-
   proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
@@ -114,6 +115,7 @@ from robobore.cutting.fe.kernels import (
     STATUS_NONFINITE,
     STATUS_OK,
 )
+from robobore.cutting.fe.physics.thermal3d import conduct3, tool_heat3
 from robobore.cutting.fe.scalar3d import (
     FIX_X,
     FIX_Y,
@@ -169,7 +171,6 @@ from robobore.cutting.fe.scalar3d import (
     tool_step,
     tool_step_py,
 )
-from robobore.cutting.fe.thermal3d import conduct3, tool_heat3
 from robobore.material import johnson_cook as jc
 
 __all__ = [

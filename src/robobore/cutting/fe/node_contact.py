@@ -32,7 +32,7 @@ from robobore.cutting.fe.layout import (
     P_TCX,
     P_TCY,
 )
-from robobore.cutting.fe.physics import (
+from robobore.cutting.fe.physics.tool_contact import (
     contact_force,
     tool_face,
     tool_gap,
@@ -240,8 +240,8 @@ def contact_total(cfx, cfy):
 def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o):
     """Node ``i``'s contact force on the tool added to its face's pair in ``out[o:o + 6]``
     = [Fx, Fy] of the rake face, the edge arc and the flank [N/m]. A node belongs to the
-    face that gives its gap (:func:`robobore.cutting.fe.physics.tool_face_py`). Called in
-    increasing node order by one thread on both devices (:func:`contact_split`, the GPU's
+    face that gives its gap (:func:`robobore.cutting.fe.physics.tool_contact.tool_face_py`). Called
+    in increasing node order by one thread on both devices (:func:`contact_split`, the GPU's
     block 0), so the sums have the same bits."""
     fx = cfx[i]
     fy = cfy[i]

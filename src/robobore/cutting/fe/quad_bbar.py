@@ -23,7 +23,7 @@ from robobore.cutting.fe.layout import (
     P_DT_ERODE,
     P_MS,
 )
-from robobore.cutting.fe.physics import (
+from robobore.cutting.fe.physics.tool_contact import (
     jc_damage_increment,
     radial_return,
 )

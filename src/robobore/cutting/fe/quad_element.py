@@ -42,7 +42,7 @@ from robobore.cutting.fe.layout import (
     P_TCX,
     P_TCY,
 )
-from robobore.cutting.fe.physics import (
+from robobore.cutting.fe.physics.tool_contact import (
     jc_damage_increment,
     radial_return,
     tool_gap,

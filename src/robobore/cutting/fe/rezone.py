@@ -49,7 +49,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from robobore.cutting.fe.physics import tool_gap
+from robobore.cutting.fe.physics.tool_contact import tool_gap
 from robobore.cutting.fe.remap import (
     BF_CLOSED,
     BF_OPEN,

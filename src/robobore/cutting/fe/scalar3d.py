@@ -7,7 +7,7 @@ kernels of :mod:`robobore.cutting.fe.gpu3d_kernels` the device versions of the s
 
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
-* :func:`contact_force3_py` -- the 2D contact law (:func:`physics.contact_force_py`: mass-
+* :func:`contact_force3_py` -- the 2D contact law (:func:`tool_contact.contact_force_py`: mass-
   proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
@@ -61,7 +61,7 @@ from robobore.cutting.fe.hex8 import (
     P_VC,
     P_VF,
 )
-from robobore.cutting.fe.physics import tool_gap, tool_support_step
+from robobore.cutting.fe.physics.tool_contact import tool_gap, tool_support_step
 from robobore.material.johnson_cook import rebind
 
 __all__ = [
@@ -136,7 +136,7 @@ def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
     (centre at y = rn, z = 0) spanning local approach angles -kend..kappa, continued by the
     major edge (approach angle ``kappa`` to the feed axis) and the minor (end) edge (angle
     ``kend``). In every normal section of the edge the insert is the 2D wedge of the 2D
-    engine (:func:`physics.tool_gap_py`: normal rake ``rake``, clearance ``clr``, edge radius
+    engine (:func:`tool_contact.tool_gap_py`: normal rake ``rake``, clearance ``clr``, edge radius
     ``re`` [rad, m]); the wedge apex runs along the profile offset by ``re`` into the tool.
     The inclination enters as ``x -> x - tani * s`` with ``s`` the arc length along the edge
     from the tip (small-angle model). Exact for points in a normal section; near the surface
@@ -158,7 +158,7 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
     """Contact force on a node touching the rigid insert [N] (3D form of the 2D law).
 
     Normal: penalty ``Fn = pen_factor * mass / dt^2 * (-gap)`` (as
-    :func:`physics.contact_force_py`). Tangential: the same return mapping on the trial
+    :func:`tool_contact.contact_force_py`). Tangential: the same return mapping on the trial
     sliding velocity (the tangential part of ``v_r + dt fo / mass``, ``fo`` = ``(fox, foy,
     foz)`` the node's element forces this step [N]): the force that stops it in one step,
     limited by Coulomb ``mu Fn`` and by the shear cap ``tau_max * trib_area`` (the node's
@@ -368,7 +368,7 @@ def tool_step_py(tool, prm, fwx, fwy, fwz, dt):
     """Advance the tool one step given the contact force ON THE WORKPIECE (local) [N].
 
     Stores the force on the tool (local), steps the three boring-frame spring-damper units
-    (:func:`physics.tool_support_step_py`; force rotated with the bar angle), moves the guide
+    (:func:`tool_contact.tool_support_step_py`; force rotated with the bar angle), moves the guide
     (cutting speed along x, feed speed along z) and the bar angle. Returns the work done on
     the workpiece during the step [J] (tool velocity averaged over the step).
     """

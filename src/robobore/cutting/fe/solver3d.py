@@ -16,7 +16,7 @@ import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.chunk_driver import drive_chunks, energy_error
-from robobore.cutting.fe.thermal3d import face_neighbours
+from robobore.cutting.fe.physics.thermal3d import face_neighbours
 from robobore.cutting.fe.threads import ThreadGovernor
 from robobore.errors import ConfigError
 from robobore.material import Material
@@ -77,7 +77,7 @@ class FEState3:
     #: node splitting, (n, 2) int64: partner node (-1: none) and whether the pair is still
     #: tied (one array: see :func:`kernels3d.hex_node_py`)
     pairs: np.ndarray
-    #: heat conduction (:mod:`robobore.cutting.fe.thermal3d`): the element across each face
+    #: heat conduction (:mod:`robobore.cutting.fe.physics.thermal3d`): the element across each face
     #: (e, 6) int64 (-1 none, -(nb + 2) across a parting face); scratch (e, 4): centroid,
     #: new temperature; per node (n, 3): frictional dissipation already turned into heat
     #: [J], heat exchanged with the insert in the current pass [J], volume of the node's live

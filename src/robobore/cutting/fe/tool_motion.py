@@ -28,7 +28,7 @@ from robobore.cutting.fe.layout import (
     T_VUX,
     T_VUY,
 )
-from robobore.cutting.fe.physics import (
+from robobore.cutting.fe.physics.tool_contact import (
     tool_support_step,
 )
 

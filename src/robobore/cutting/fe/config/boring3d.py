@@ -130,7 +130,7 @@ class SolverSection(_Strict):
     #: node splitting: a tied pair parts within this distance of the insert [um]
     separation_gate_um: float = Field(default=0.0, ge=0.0)
     #: heat conduction between the workpiece's elements and the thermal contact with the
-    #: insert (the 2D engine's model, :mod:`robobore.cutting.fe.thermal3d`), every
+    #: insert (the 2D engine's model, :mod:`robobore.cutting.fe.physics.thermal3d`), every
     #: ``conduction_interval`` steps; false: adiabatic
     heat_conduction: bool = True
     conduction_interval: int = Field(default=10, ge=1, le=10000)
