@@ -73,28 +73,28 @@ from robobore.cutting.fe.layout import (
     T_UX,
     T_UY,
 )
-from robobore.cutting.fe.node_contact import (
-    contact_split,
-    contact_total,
-    node_update,
-    tool_geometry,
-)
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
     parting_conduct,
     tool_heat,
 )
-from robobore.cutting.fe.quad_bbar import (
+from robobore.cutting.fe.quad.bbar import (
     element_update_bbar,
 )
-from robobore.cutting.fe.quad_element import (
+from robobore.cutting.fe.quad.element import (
     element_update,
 )
-from robobore.cutting.fe.rezone import rezone
-from robobore.cutting.fe.tool_motion import (
+from robobore.cutting.fe.quad.node_contact import (
+    contact_split,
+    contact_total,
+    node_update,
+    tool_geometry,
+)
+from robobore.cutting.fe.quad.tool_motion import (
     tool_kinematics,
     tool_step,
 )
+from robobore.cutting.fe.rezone import rezone
 from robobore.material import johnson_cook as jc
 
 

@@ -3,16 +3,16 @@ names of its modules in one place.
 
 * :mod:`~robobore.cutting.fe.layout`: index layout of the small state arrays (``P_*``,
   ``T_*``, ``E_*``, ``I_*``, ``STATUS_*``, ``H_*``).
-* :mod:`~robobore.cutting.fe.quad_element`: the one-point quadrilateral with hourglass
+* :mod:`~robobore.cutting.fe.quad.element`: the one-point quadrilateral with hourglass
   control, material update and erosion (:func:`element_update`).
-* :mod:`~robobore.cutting.fe.quad_bbar`: the fully integrated B-bar quadrilateral
+* :mod:`~robobore.cutting.fe.quad.bbar`: the fully integrated B-bar quadrilateral
   (:func:`element_update_bbar`).
-* :mod:`~robobore.cutting.fe.node_contact`: the node update with tool contact, friction and
+* :mod:`~robobore.cutting.fe.quad.node_contact`: the node update with tool contact, friction and
   node-splitting separation (:func:`node_update`); the contact-force total and its split by
   tool face.
 * :mod:`~robobore.cutting.fe.physics.thermal2d`: heat conduction, across the parting line and with
   the tool.
-* :mod:`~robobore.cutting.fe.tool_motion`: the tool's kinematics and its support springs.
+* :mod:`~robobore.cutting.fe.quad.tool_motion`: the tool's kinematics and its support springs.
 * :mod:`~robobore.cutting.fe.chunk_loop`: the compiled time-step loop (:func:`run_chunk`).
 
 The per-element, per-node, conduction and tool updates are plain-Python scalar functions
@@ -144,22 +144,6 @@ from robobore.cutting.fe.layout import (
     T_VUX,
     T_VUY,
 )
-from robobore.cutting.fe.node_contact import (
-    N_SUM_LANES,
-    contact_split,
-    contact_split_node,
-    contact_split_node_py,
-    contact_total,
-    friction_at,
-    friction_at_py,
-    lane_sum,
-    lane_sum_py,
-    node_update,
-    quad_node,
-    quad_node_py,
-    tool_geometry,
-    tool_geometry_py,
-)
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
     parting_conduct,
@@ -175,12 +159,12 @@ from robobore.cutting.fe.physics.thermal2d import (
     tool_heat_node,
     tool_heat_node_py,
 )
-from robobore.cutting.fe.quad_bbar import (
+from robobore.cutting.fe.quad.bbar import (
     element_update_bbar,
     quad_bbar,
     quad_bbar_py,
 )
-from robobore.cutting.fe.quad_element import (
+from robobore.cutting.fe.quad.element import (
     damage_erosion,
     damage_erosion_py,
     element_update,
@@ -197,7 +181,23 @@ from robobore.cutting.fe.quad_element import (
     quad_step,
     quad_step_py,
 )
-from robobore.cutting.fe.tool_motion import (
+from robobore.cutting.fe.quad.node_contact import (
+    N_SUM_LANES,
+    contact_split,
+    contact_split_node,
+    contact_split_node_py,
+    contact_total,
+    friction_at,
+    friction_at_py,
+    lane_sum,
+    lane_sum_py,
+    node_update,
+    quad_node,
+    quad_node_py,
+    tool_geometry,
+    tool_geometry_py,
+)
+from robobore.cutting.fe.quad.tool_motion import (
     tool_kinematics,
     tool_kinematics_py,
     tool_step,

@@ -1,7 +1,7 @@
 """The fully integrated quadrilateral with mean-dilatation B-bar (2x2 Gauss points, no
 hourglass modes) and its parallel element update (``solver.element = "q4_bbar"``).
 
-Same material model and erosion as :mod:`robobore.cutting.fe.quad_element`; the
+Same material model and erosion as :mod:`robobore.cutting.fe.quad.element`; the
 per-Gauss-point state lives in ``gps`` (``layout.G_*``).
 """
 
@@ -27,7 +27,7 @@ from robobore.cutting.fe.physics.tool_contact import (
     jc_damage_increment,
     radial_return,
 )
-from robobore.cutting.fe.quad_element import (
+from robobore.cutting.fe.quad.element import (
     damage_erosion,
     quad_area_corners,
     quad_bvectors,
