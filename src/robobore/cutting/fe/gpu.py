@@ -1,7 +1,7 @@
 """GPU backend of the 3D explicit engine (numba-cuda), built from the SAME scalar physics.
 
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
-(:func:`hex8.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
+(:func:`hex.element.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
 and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
 :mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
 :func:`robobore.material.johnson_cook.rebind` and compiled with

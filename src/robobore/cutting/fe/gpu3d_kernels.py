@@ -2,7 +2,7 @@
 engine.
 
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
-(:func:`hex8.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
+(:func:`hex.element.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
 and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
 :mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
 :func:`robobore.material.johnson_cook.rebind` and compiled with
@@ -46,7 +46,7 @@ def kernels3():
     from numba import int64 as _int64
 
     from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.hex8 import hex_element_py
+    from robobore.cutting.fe.hex.element import hex_element_py
     from robobore.cutting.fe.physics.tool_contact import thermal3d as T3
     from robobore.cutting.fe.physics.tool_contact import (
         tool_face_py,

@@ -6,7 +6,7 @@ Reuses the 2D engine's scalar physics unchanged: the Johnson-Cook return mapping
 the insert edge) and the spring-damper step
 (:func:`robobore.cutting.fe.physics.tool_contact.tool_support_step`). The 3D state layout and scalar
 functions (``_py`` original + ``njit``, device-ready) are
-:mod:`robobore.cutting.fe.scalar3d`, re-exported here; this module holds the parallel loops
+:mod:`robobore.cutting.fe.hex.scalar3d`, re-exported here; this module holds the parallel loops
 (elements, nodes), the energy sums, the contact-force total, the conduction pass and the
 chunk loop :func:`run_chunk3`. The scalar functions:
 
@@ -37,7 +37,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from robobore.cutting.fe.hex8 import (
+from robobore.cutting.fe.hex.element import (
     ERODE_ALL,
     ERODE_LAYER,
     ERODE_NONE,
@@ -91,32 +91,7 @@ from robobore.cutting.fe.hex8 import (
     P_VF,
     hex_element,
 )
-from robobore.cutting.fe.kernels import (
-    E_ERODED,
-    E_EROKE,
-    E_EXT,
-    E_FRIC,
-    E_HG,
-    E_INT,
-    E_KIN,
-    E_NODEWORK,
-    E_PLAST,
-    I_BADELEM,
-    I_SAMPLE,
-    I_STATUS,
-    I_STEP,
-    N_EN,
-    N_IST,
-    N_SUM_LANES,
-    STATUS_DONE,
-    STATUS_DT_COLLAPSE,
-    STATUS_INVERTED,
-    STATUS_NO_ELEMENTS,
-    STATUS_NONFINITE,
-    STATUS_OK,
-)
-from robobore.cutting.fe.physics.thermal3d import conduct3, tool_heat3
-from robobore.cutting.fe.scalar3d import (
+from robobore.cutting.fe.hex.scalar3d import (
     FIX_X,
     FIX_Y,
     FIX_Z,
@@ -171,6 +146,31 @@ from robobore.cutting.fe.scalar3d import (
     tool_step,
     tool_step_py,
 )
+from robobore.cutting.fe.kernels import (
+    E_ERODED,
+    E_EROKE,
+    E_EXT,
+    E_FRIC,
+    E_HG,
+    E_INT,
+    E_KIN,
+    E_NODEWORK,
+    E_PLAST,
+    I_BADELEM,
+    I_SAMPLE,
+    I_STATUS,
+    I_STEP,
+    N_EN,
+    N_IST,
+    N_SUM_LANES,
+    STATUS_DONE,
+    STATUS_DT_COLLAPSE,
+    STATUS_INVERTED,
+    STATUS_NO_ELEMENTS,
+    STATUS_NONFINITE,
+    STATUS_OK,
+)
+from robobore.cutting.fe.physics.thermal3d import conduct3, tool_heat3
 from robobore.material import johnson_cook as jc
 
 __all__ = [
@@ -198,7 +198,7 @@ __all__ = [
 @njit(parallel=True, cache=True)
 def element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
                     ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
-    """:func:`hex8.hex_element_py` over all elements (parallel)."""
+    """:func:`hex.element.hex_element_py` over all elements (parallel)."""
     for e in prange(conn.shape[0]):
         hex_element(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
                     vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
