@@ -15,10 +15,7 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
-from robobore.cutting.fe.physics.tool_contact import tool_gap_py
-from robobore.cutting.fe.rezone import (
+from robobore.cutting.fe.ale.rezone import (
     BF_OPEN,
     BF_VIRGIN,
     MODE_TOOLFRAME,
@@ -29,7 +26,10 @@ from robobore.cutting.fe.rezone import (
     rezone,
     swept_py,
 )
-from robobore.cutting.fe.toolframe import build_toolframe_mesh
+from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.physics.tool_contact import tool_gap_py
 from robobore.errors import ConfigError
 
 RAKE, CLR, R = math.radians(15.0), math.radians(2.0), 20e-6

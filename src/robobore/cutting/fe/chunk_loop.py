@@ -10,6 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
+from robobore.cutting.fe.ale.rezone import rezone
 from robobore.cutting.fe.layout import (
     E_ERODED,
     E_EROKE,
@@ -94,7 +95,6 @@ from robobore.cutting.fe.quad.tool_motion import (
     tool_kinematics,
     tool_step,
 )
-from robobore.cutting.fe.rezone import rezone
 from robobore.material import johnson_cook as jc
 
 

@@ -32,7 +32,7 @@ checked in the simulator and compiled for sm_90, not timed on a GPU.
 
 The tool-frame ALE model (``mesh.frame = "tool"``) runs here too: every
 ``solver.ale_interval`` steps, after the tool step, the persistent kernel runs the ALE pass of
-:func:`robobore.cutting.fe.rezone.rezone` (``MODE_TOOLFRAME``) from the same scalar functions
+:func:`robobore.cutting.fe.ale.rezone.rezone` (``MODE_TOOLFRAME``) from the same scalar functions
 (``tf_place_py``, ``tf_face_py``, the Jacobi sweeps ``tf_sweep_py`` / ``tf_sweep_copy_py``,
 ``tf_interior_py``, the donor-cell remap ``rz_flux_py``, ``rz_velocity_py``, ``rz_write_py``,
 ``rz_node_mass_py``), a grid barrier wherever one pass reads what another wrote (14 per
@@ -59,10 +59,10 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe import rezone as RZ
+from robobore.cutting.fe.ale import rezone as RZ
+from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.cutting.fe.gpu2d_kernels import N_RED, R_BAD, R_DTMIN, kernels2
 from robobore.cutting.fe.gpu_shared import bind_cuda, persistent_run, profile_ticker, require_gpu
-from robobore.cutting.fe.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.cutting.fe.status import STATUS_TEXT, instability_error
 from robobore.errors import ConfigError
 

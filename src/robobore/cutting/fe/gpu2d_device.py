@@ -3,7 +3,7 @@
 
 The element, node, tool, conduction, energy and tool-frame ALE updates are the plain-Python
 scalar functions the CPU engine compiles with ``njit`` (:mod:`robobore.cutting.fe.kernels`,
-:mod:`robobore.cutting.fe.rezone`, :mod:`robobore.cutting.fe.physics.tool_contact`,
+:mod:`robobore.cutting.fe.ale.rezone`, :mod:`robobore.cutting.fe.physics.tool_contact`,
 :mod:`robobore.material.johnson_cook`); :func:`device_functions2` re-binds each one's callees
 to their device versions (:func:`robobore.material.johnson_cook.rebind`) and compiles it with
 ``numba.cuda.jit(device=True)``.
@@ -14,7 +14,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe import rezone as RZ
+from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.gpu_shared import chunk_list_py, jc_device_functions
 
 __all__ = ["device_functions2"]

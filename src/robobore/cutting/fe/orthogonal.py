@@ -15,6 +15,8 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.ale.rezone import MODE_ROWS, MODE_TOOLFRAME, TF_RIGID
+from robobore.cutting.fe.ale.stencils import row_stencil, smoothing_stencil
 from robobore.cutting.fe.chunk_driver import (
     advance,
     energy_error,
@@ -26,8 +28,6 @@ from robobore.cutting.fe.config.engine_settings import (
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.mesh import CuttingMesh, build_edge_refined_mesh, build_mesh
-from robobore.cutting.fe.rezone import MODE_ROWS, MODE_TOOLFRAME, TF_RIGID
-from robobore.cutting.fe.rezone_stencils import row_stencil, smoothing_stencil
 from robobore.cutting.fe.state2d import (
     FEState,
     default_prm,
@@ -91,7 +91,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     cm = cfg.mesh
     tool_frame = cm.frame == "tool"
     if tool_frame:
-        from robobore.cutting.fe.toolframe import build_toolframe_mesh
+        from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 
         ee = (cm.element_size_um / 4.0 if cm.edge_element_um is None else cm.edge_element_um)
         try:
@@ -298,7 +298,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     ff = hh[:, K.H_FY] * 1e-3
     cut_pos_mm = (setup.x_cut_start - hh[:, K.H_TIP_X]) * 1e3
     if cfg.mesh.frame == "tool":
-        from robobore.cutting.fe.toolframe import measure_chip_toolframe
+        from robobore.cutting.fe.ale.toolframe import measure_chip_toolframe
 
         chip, r_vel, n_vel = measure_chip_toolframe(st, setup.mesh, setup.h, setup.rake,
                                                     setup.vc)

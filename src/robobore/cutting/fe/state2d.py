@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.remap import N_RZ_FIELDS
-from robobore.cutting.fe.rezone_stencils import edge_neighbours
+from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
+from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.errors import ConfigError
 from robobore.material import Material
 
@@ -91,7 +91,7 @@ class FEState:
     ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: rezoning: velocity increments of the moved nodes (n_nodes, 2), scratch
     vbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
-    #: tool-frame ALE (``mesh.frame = "tool"``, robobore.cutting.fe.toolframe): node classes
+    #: tool-frame ALE (``mesh.frame = "tool"``, robobore.cutting.fe.ale.toolframe): node classes
     #: and neighbours (n, 7), node data (n, 6), flux type of each element edge (e, 4); empty
     #: for the Lagrangian models
     acls: np.ndarray = field(default=None)  # type: ignore[assignment]

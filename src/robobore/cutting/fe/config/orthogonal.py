@@ -254,7 +254,7 @@ class MeshSection(_Strict):
     #: the mesh's frame: "workpiece" (Lagrangian: the mesh moves with the material, chip and
     #: workpiece part by ``separation``) or "tool" (ALE: the mesh travels with the tool,
     #: material flows in ahead of it and out behind the flank and through the chip's top,
-    #: no separation criterion and no erosion; see robobore.cutting.fe.toolframe). With
+    #: no separation criterion and no erosion; see robobore.cutting.fe.ale.toolframe). With
     #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
     #: round the edge (default element_size_um / 4), and the separation keys are not used
     frame: Literal["workpiece", "tool"] = "tool"
@@ -317,7 +317,7 @@ class SolverSection(_Strict):
     #: safety against inverted elements; counted and reported separately); 0 disables
     distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
     #: steps between chip rezoning passes (Laplacian smoothing + donor-cell remap of the
-    #: chip layer, see robobore.cutting.fe.rezone); 0 = pure Lagrangian
+    #: chip layer, see robobore.cutting.fe.ale.rezone); 0 = pure Lagrangian
     rezone_interval: int = Field(default=0, ge=0, le=10**6)
     #: relaxation of each smoothing pass (fraction of the move towards the neighbour mean)
     rezone_relaxation: float = Field(default=0.3, gt=0.0, le=1.0)
@@ -325,7 +325,7 @@ class SolverSection(_Strict):
     #: within ``edge_ale_depth_um`` under the parting line, once their column's pair has
     #: been released at the edge, slide along their rows back towards their initial x
     #: (Eulerian in the cutting direction, Lagrangian in depth) and the element state is
-    #: remapped (donor cell, see robobore.cutting.fe.rezone); 0 = off (pure Lagrangian)
+    #: remapped (donor cell, see robobore.cutting.fe.ale.rezone); 0 = off (pure Lagrangian)
     edge_ale_interval: int = Field(default=0, ge=0, le=10**6)
     #: depth [um] of the ploughed layer under the parting line that edge_ale_interval
     #: treats (rows strictly above this depth move; default: the edge band's lower part)

@@ -254,7 +254,7 @@ def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o)
 
 def tool_geometry_py(prm):
     """The tool's edge centre x, y, rake and flank normals and edge radius from ``prm``: the
-    tool geometry tuple of the ALE passes (:mod:`robobore.cutting.fe.rezone`)."""
+    tool geometry tuple of the ALE passes (:mod:`robobore.cutting.fe.ale.rezone`)."""
     return (prm[P_TCX], prm[P_TCY], prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
             prm[P_R])
 

@@ -36,9 +36,9 @@ Two ways of choosing the new node positions share the remap:
   spread evenly in depth between it and the layer's bottom row (which stays Lagrangian),
   and the material flows through the elements (:func:`row_stencil`, :func:`_row_move`).
 
-The remap's scalar passes are in :mod:`robobore.cutting.fe.remap`, the host-side stencils
+The remap's scalar passes are in :mod:`robobore.cutting.fe.ale.remap`, the host-side stencils
 (:func:`smoothing_stencil`, :func:`row_stencil`, :func:`edge_neighbours`) in
-:mod:`robobore.cutting.fe.rezone_stencils`; this module chooses the new node positions and
+:mod:`robobore.cutting.fe.ale.stencils`; this module chooses the new node positions and
 runs the pass (:func:`rezone`).
 """
 
@@ -49,8 +49,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from robobore.cutting.fe.physics.tool_contact import tool_gap
-from robobore.cutting.fe.remap import (
+from robobore.cutting.fe.ale.remap import (
     BF_CLOSED,
     BF_OPEN,
     BF_VIRGIN,
@@ -65,15 +64,16 @@ from robobore.cutting.fe.remap import (
     rz_write_py,
     swept_py,
 )
-from robobore.cutting.fe.rezone_stencils import (
+from robobore.cutting.fe.ale.stencils import (
     edge_neighbours,
     row_stencil,
     smoothing_stencil,
 )
+from robobore.cutting.fe.physics.tool_contact import tool_gap
 
 #: node relocation of a rezoning pass: Laplacian smoothing, sliding along node rows, or the
 #: tool-frame ALE (every node back to its place in the tool's frame, see
-#: :mod:`robobore.cutting.fe.toolframe`)
+#: :mod:`robobore.cutting.fe.ale.toolframe`)
 MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME = 0, 1, 2
 #: tool-frame node classes (``acls[:, 0]``): interior, rigid (inflow face, bottom), on a
 #: surface chain (free or against the tool), chain end on an outflow line, on an outflow face
@@ -320,7 +320,7 @@ tf_interior = njit(cache=True, inline="always")(tf_interior_py)
 @njit(parallel=True, cache=True)
 def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scratch):
     """MODE_TOOLFRAME: new node positions ``xn``, ``yn`` (see
-    :mod:`robobore.cutting.fe.toolframe`). ``x0``, ``y0`` are the nodes' places in the tool
+    :mod:`robobore.cutting.fe.ale.toolframe`). ``x0``, ``y0`` are the nodes' places in the tool
     frame at the start (the tool's edge centre then at x = its current x - ``off``);
     ``acls``/``aflt`` the classes, neighbours, face fractions, line directions, local sizes
     and the mesh displacement carried from pass to pass (``aflt[:, 4:6]``, updated);

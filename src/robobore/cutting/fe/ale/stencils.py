@@ -1,4 +1,4 @@
-"""Host-side stencils of the rezoning passes (:mod:`robobore.cutting.fe.rezone`): the chip
+"""Host-side stencils of the rezoning passes (:mod:`robobore.cutting.fe.ale.rezone`): the chip
 nodes smoothed by ``MODE_LAPLACE`` and their neighbours (:func:`smoothing_stencil`), the
 ploughed-layer nodes of ``MODE_ROWS`` (:func:`row_stencil`), and the element neighbours
 across each edge that the remap needs (:func:`edge_neighbours`).

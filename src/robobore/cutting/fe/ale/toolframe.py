@@ -18,7 +18,7 @@ inflow/outflow boundaries, Lagrangian free surfaces, a pre-shaped chip).
 
 The time step is the engine's Lagrangian step (workpiece frame: the tool moves at -vc, the
 workpiece far below is fixed). Every ``solver.ale_interval`` steps
-:func:`robobore.cutting.fe.rezone.rezone` (``MODE_TOOLFRAME``) moves every node back to its
+:func:`robobore.cutting.fe.ale.rezone.rezone` (``MODE_TOOLFRAME``) moves every node back to its
 place in the tool's frame and remaps the element state (donor cell) and the nodal velocities:
 
 * inflow face and bottom (``TF_RIGID``): fixed in the workpiece (v = 0), carried with the
@@ -56,9 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.mesh import QuadMeshSizes
-from robobore.cutting.fe.output import ChipGeometry, point_polyline_distance, shear_angle_deg
-from robobore.cutting.fe.rezone import (
+from robobore.cutting.fe.ale.rezone import (
     BF_OPEN,
     BF_VIRGIN,
     TF_CHAIN,
@@ -67,6 +65,8 @@ from robobore.cutting.fe.rezone import (
     TF_LINE,
     TF_RIGID,
 )
+from robobore.cutting.fe.mesh import QuadMeshSizes
+from robobore.cutting.fe.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 
 
 @dataclass
