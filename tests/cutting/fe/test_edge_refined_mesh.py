@@ -19,7 +19,7 @@ import pytest
 from conftest import edge_band_dict
 
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.mesh import build_edge_refined_mesh
+from robobore.cutting.fe.mesh.orthogonal import build_edge_refined_mesh
 from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 

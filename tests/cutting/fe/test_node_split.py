@@ -18,7 +18,7 @@ from conftest import elastic_tc4, strip_mesh
 from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.chunk_driver import advance
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.mesh import build_mesh
+from robobore.cutting.fe.mesh.orthogonal import build_mesh
 from robobore.cutting.fe.orthogonal import setup_orthogonal
 from robobore.cutting.fe.state2d import default_prm, make_state
 

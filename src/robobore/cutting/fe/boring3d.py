@@ -2,7 +2,7 @@
 
 Model (all choices documented in ``docs/fe3d.md``; the configuration schema is
 :mod:`robobore.cutting.fe.config.boring3d`, the mesh builder
-:mod:`robobore.cutting.fe.boring3d_mesh`; this module sets the model up, runs it and
+:mod:`robobore.cutting.fe.mesh.boring3d`; this module sets the model up, runs it and
 compares it with the mechanistic model):
 
 * **Workpiece** -- a block of the bore wall, *locally flat* (the wall unrolled): for a bore
@@ -43,7 +43,6 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.boring3d_mesh import BoringMesh, build_boring_mesh, parting_surface
 from robobore.cutting.fe.config.boring3d import (
     BoringFEConfig,
     load_boring_config,
@@ -54,6 +53,7 @@ from robobore.cutting.fe.config.engine_settings import (
     apply_solver_settings,
     apply_thermal_settings,
 )
+from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
 from robobore.cutting.fe.solver3d import (
     FEState3,
     advance3,

@@ -27,7 +27,7 @@ from robobore.cutting.fe.config.engine_settings import (
     apply_thermal_settings,
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
-from robobore.cutting.fe.mesh import CuttingMesh, build_edge_refined_mesh, build_mesh
+from robobore.cutting.fe.mesh.orthogonal import CuttingMesh, build_edge_refined_mesh, build_mesh
 from robobore.cutting.fe.state2d import (
     FEState,
     default_prm,

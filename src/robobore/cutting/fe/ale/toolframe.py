@@ -65,7 +65,7 @@ from robobore.cutting.fe.ale.rezone import (
     TF_LINE,
     TF_RIGID,
 )
-from robobore.cutting.fe.mesh import QuadMeshSizes
+from robobore.cutting.fe.mesh.orthogonal import QuadMeshSizes
 from robobore.cutting.fe.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 
 
