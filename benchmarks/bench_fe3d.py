@@ -43,8 +43,8 @@ def _load() -> str:
 
 
 def speed(n_elements: int, steps: int) -> dict:
-    from robobore.cutting.fe import kernels3d as K3
     from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

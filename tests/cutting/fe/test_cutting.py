@@ -122,7 +122,7 @@ def test_force_by_face_sums_to_the_total(rigid):
 def test_contact_split_classifies_by_face():
     """Nodes placed on the rake face, the edge arc and the flank of a tool with rake 15 deg,
     clearance 2 deg, r = 20 um at the origin: each force lands in its face's slot."""
-    from robobore.cutting.fe.kernels import contact_split
+    from robobore.cutting.fe.engine.kernels import contact_split
 
     r = 20e-6
     rake, clr = math.radians(15.0), math.radians(2.0)

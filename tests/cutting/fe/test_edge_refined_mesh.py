@@ -147,7 +147,7 @@ def test_chip_ratio_uses_the_parting_line_as_the_underside():
     it, not from the lowest surviving node of each column (which lies inside the chip)."""
     from types import SimpleNamespace
 
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
     from robobore.cutting.fe.output import measure_chip
 
     h, sep, s = 60e-6, 5e-6, 2.5
@@ -189,7 +189,7 @@ def test_chip_ratio_from_the_chip_speed():
     varies across the chip is averaged with the nodal masses."""
     from types import SimpleNamespace
 
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
     from robobore.cutting.fe.output import chip_ratio_from_velocity
 
     h, vc, r_true = 60e-6, 0.5, 1.37

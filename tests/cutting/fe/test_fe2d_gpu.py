@@ -19,7 +19,8 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting.fe import gpu, gpu2d
+from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
+from robobore.cutting.fe.engine.gpu import backend3d as gpu
 from robobore.errors import ConfigError
 
 EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
@@ -27,7 +28,7 @@ EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
 #: shared by the simulator scripts: histories every 5 steps over the compared steps
 PRELUDE = textwrap.dedent("""
     import numpy as np
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
 
     def sample_every_5_steps(st, rows):
         dt = float(st.clock[1])
@@ -45,10 +46,10 @@ SCRIPT = PRELUDE + textwrap.dedent("""
     import numpy as np
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
     from robobore.cutting.fe.config.orthogonal import parse_config
-    from robobore.cutting.fe.gpu2d import advance_gpu
-    from robobore.cutting.fe.chunk_driver import advance
+    from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
+    from robobore.cutting.fe.engine.chunk_driver import advance
     from robobore.cutting.fe.orthogonal import setup_orthogonal
 
     cfg = parse_config({
@@ -113,10 +114,10 @@ SCRIPT = PRELUDE + textwrap.dedent("""
 SCRIPT_TF = PRELUDE + textwrap.dedent("""
     import copy, json, sys, tomllib
     import numpy as np
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
     from robobore.cutting.fe.config.orthogonal import parse_config
-    from robobore.cutting.fe.gpu2d import advance_gpu
-    from robobore.cutting.fe.chunk_driver import advance
+    from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
+    from robobore.cutting.fe.engine.chunk_driver import advance
     from robobore.cutting.fe.orthogonal import setup_orthogonal
 
     d = tomllib.load(open(sys.argv[1], "rb"))

@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 from conftest import elastic_tc4, strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.chunk_driver import advance
 from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.physics.tool_contact import tool_contact as P
-from robobore.cutting.fe.state2d import default_prm, make_state
 from robobore.errors import ConfigError
 
 
@@ -129,7 +129,7 @@ def test_the_engine_slides_against_the_table_at_the_sliding_speed():
 
 
 def test_the_3d_slab_reads_the_table_at_the_sliding_speed():
-    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.slab3d import setup_slab3
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},

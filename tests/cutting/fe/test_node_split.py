@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 from conftest import elastic_tc4, strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.chunk_driver import advance
 from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.mesh.orthogonal import build_mesh
 from robobore.cutting.fe.orthogonal import setup_orthogonal
-from robobore.cutting.fe.state2d import default_prm, make_state
 
 
 def _split(nodes, conn, nx, ny, row):

@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 from conftest import strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.chunk_driver import advance
 from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state, parting_edges
 from robobore.cutting.fe.mesh.orthogonal import _split_nodes
 from robobore.cutting.fe.orthogonal import setup_orthogonal
-from robobore.cutting.fe.state2d import default_prm, make_state, parting_edges
 from robobore.errors import ConfigError
 from robobore.material import load_material
 

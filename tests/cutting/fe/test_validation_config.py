@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.config.orthogonal import FRICTION_TABLE_MU, load_fe_config, parse_config
+from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.orthogonal import setup_orthogonal
 from robobore.cutting.fe.validate import point_config
 from robobore.material import johnson_cook as jc

@@ -146,7 +146,7 @@ def test_tiny_run_physics(tiny_run):
 
 
 def test_gpu_request_without_gpu_is_a_clear_error(tiny_run):
-    from robobore.cutting.fe.gpu import cuda_available
+    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
 
     if cuda_available():
         pytest.skip("a CUDA device is present: the no-GPU error path does not apply")

@@ -10,19 +10,19 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-from robobore.cutting.fe.physics.thermal3d import (
-    conduct3,
-    face_neighbours,
-    tool_heat3,
-)
-from robobore.cutting.fe.solver3d import (
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
     energy_error,
     make_state3,
     split_node_layer,
+)
+from robobore.cutting.fe.physics.thermal3d import (
+    conduct3,
+    face_neighbours,
+    tool_heat3,
 )
 from robobore.errors import ConfigError
 from robobore.material import load_material

@@ -15,9 +15,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robobore.cutting.fe import kernels3d as K3
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import advance3, box_mesh, default_prm3, make_state3
 from robobore.cutting.fe.physics.tool_contact import contact_force_py, tool_gap_py
-from robobore.cutting.fe.solver3d import advance3, box_mesh, default_prm3, make_state3
 from robobore.material import Material, load_material
 
 RN, KAP, KEND, RAKE, CLR, RE = 0.4e-3, math.radians(90), math.radians(5), math.radians(7), \

@@ -42,7 +42,6 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe import kernels3d as K3
 from robobore.cutting.fe.config.boring3d import (
     BoringFEConfig,
     load_boring_config,
@@ -53,14 +52,15 @@ from robobore.cutting.fe.config.engine_settings import (
     apply_solver_settings,
     apply_thermal_settings,
 )
-from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
-from robobore.cutting.fe.solver3d import (
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import (
     FEState3,
     advance3,
     default_prm3,
     energy_error,
     make_state3,
 )
+from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
 from robobore.cutting.geometry import BoringInsert, chip_area
 from robobore.errors import ConfigError, NumericalError
 from robobore.material import Material, load_material
@@ -171,7 +171,8 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
                     device: str = "cpu") -> BoringFEResult:
     """Set up and run the boring model; returns a :class:`BoringFEResult`.
 
-    ``device``: "cpu" (numba, parallel) or "gpu" (numba-cuda, :mod:`robobore.cutting.fe.gpu`).
+    ``device``: "cpu" (numba, parallel) or "gpu" (numba-cuda,
+    :mod:`robobore.cutting.fe.engine.gpu.backend3d`).
     """
     from robobore.cutting.forces import rotating_to_boring
 
@@ -190,7 +191,7 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
 
     t0 = time.perf_counter()
     if device == "gpu":
-        from robobore.cutting.fe.gpu import advance3_gpu
+        from robobore.cutting.fe.engine.gpu.backend3d import advance3_gpu
 
         steps = advance3_gpu(st, setup.t_end, chunk_steps=cfg.solver.chunk_steps,
                              progress=progress, check=check)

@@ -69,7 +69,7 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
     if device == "gpu":
-        from robobore.cutting.fe.gpu import require_gpu
+        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
         require_gpu()
     from robobore.io.outputs import check_output_dir

@@ -14,25 +14,25 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.ale.rezone import MODE_ROWS, MODE_TOOLFRAME, TF_RIGID
 from robobore.cutting.fe.ale.stencils import row_stencil, smoothing_stencil
-from robobore.cutting.fe.chunk_driver import (
-    advance,
-    energy_error,
-)
 from robobore.cutting.fe.config.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
-from robobore.cutting.fe.mesh.orthogonal import CuttingMesh, build_edge_refined_mesh, build_mesh
-from robobore.cutting.fe.state2d import (
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import (
+    advance,
+    energy_error,
+)
+from robobore.cutting.fe.engine.state2d import (
     FEState,
     default_prm,
     make_state,
 )
+from robobore.cutting.fe.mesh.orthogonal import CuttingMesh, build_edge_refined_mesh, build_mesh
 from robobore.errors import ConfigError, NumericalError
 from robobore.material import Material, load_material
 
@@ -205,8 +205,8 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
     if device == "gpu":
-        from robobore.cutting.fe.gpu import require_gpu
-        from robobore.cutting.fe.gpu2d import check_gpu_supported
+        from robobore.cutting.fe.engine.gpu.backend2d import check_gpu_supported
+        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
         check_gpu_supported(cfg.solver.rezone_interval, source, cfg.solver.element,
                             cfg.solver.edge_ale_interval)
@@ -218,7 +218,7 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
     """Run the cutting model to the end; returns (wall time [s], steps taken).
 
     ``device``: "cpu" (numba, parallel; the default) or "gpu" (numba-cuda,
-    :func:`robobore.cutting.fe.gpu2d.advance_gpu`).
+    :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`).
     """
     check_device(device, setup.cfg)
     st = setup.state
@@ -234,7 +234,7 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
 
     t0 = time.perf_counter()
     if device == "gpu":
-        from robobore.cutting.fe.gpu2d import advance_gpu
+        from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
 
         steps = advance_gpu(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
                             progress=progress, check=check)

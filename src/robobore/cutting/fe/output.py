@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.engine import kernels as K
 
 
 @dataclass(frozen=True)

@@ -20,15 +20,15 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.chunk_driver import energy_error
 from robobore.cutting.fe.config.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
     apply_thermal_settings,
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
-from robobore.cutting.fe.solver3d import (
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.chunk_driver import energy_error
+from robobore.cutting.fe.engine.state3d import (
     FEState3,
     advance3,
     default_prm3,

@@ -11,7 +11,7 @@ outflow).
 
 The passes are plain-Python scalar functions (``rz_flux_py``, ``rz_velocity_py``,
 ``rz_write_py``, ``rz_node_mass_py``) that the CPU pass calls as ``njit`` functions and
-:mod:`robobore.cutting.fe.gpu2d` compiles for an NVIDIA GPU.
+:mod:`robobore.cutting.fe.engine.gpu.backend2d` compiles for an NVIDIA GPU.
 """
 
 from __future__ import annotations

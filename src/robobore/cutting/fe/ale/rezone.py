@@ -191,7 +191,8 @@ def _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode
 
 
 # -- the tool-frame and remap passes as scalar functions (one node or element each), called
-# -- by the CPU's prange loops below and by the GPU kernels (robobore.cutting.fe.gpu2d)
+# -- by the CPU's prange loops below and by the GPU kernels
+# (robobore.cutting.fe.engine.gpu.backend2d)
 
 def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
     """MODE_TOOLFRAME, first pass, node ``n``: the new place of a rigid node, a surface-chain
@@ -367,7 +368,7 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
 
     The passes are the scalar functions :func:`rz_flux_py`, :func:`rz_velocity_py`,
     :func:`rz_write_py` and :func:`rz_node_mass_py` (and the tool-frame ones), which the
-    GPU engine runs in the same order (:mod:`robobore.cutting.fe.gpu2d`)."""
+    GPU engine runs in the same order (:mod:`robobore.cutting.fe.engine.gpu.backend2d`)."""
     nn = x.shape[0]
     ne = conn.shape[0]
     for n in prange(nn):

@@ -55,7 +55,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.ale.rezone import (
     BF_OPEN,
     BF_VIRGIN,
@@ -65,6 +64,7 @@ from robobore.cutting.fe.ale.rezone import (
     TF_LINE,
     TF_RIGID,
 )
+from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.mesh.orthogonal import QuadMeshSizes
 from robobore.cutting.fe.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 

@@ -5,9 +5,9 @@ trial stress, Johnson-Cook return via the shared :func:`robobore.material.johnso
 adiabatic heating, Johnson-Cook damage, bulk viscosity, stable step, internal energy,
 Flanagan-Belytschko hourglass control, internal nodal forces). It reads and writes array
 elements only and allocates nothing, so the same source is compiled for the CPU
-(:data:`hex_element`, called from a ``prange`` loop in :mod:`robobore.cutting.fe.kernels3d`)
+(:data:`hex_element`, called from a ``prange`` loop in :mod:`robobore.cutting.fe.engine.kernels3d`)
 and for an NVIDIA GPU (``numba.cuda.jit(device=True)`` after
-:func:`robobore.material.johnson_cook.rebind`, in :mod:`robobore.cutting.fe.gpu`).
+:func:`robobore.material.johnson_cook.rebind`, in :mod:`robobore.cutting.fe.engine.gpu.backend3d`).
 
 Element: 8-node trilinear hexahedron (VTK node order: 0-3 the face zeta = -1 counter-clockwise
 seen from +zeta, 4-7 above them), one-point (uniform strain) integration with the mean
@@ -97,7 +97,7 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     (internal force on corner I along i [N]) and ``dte[e]`` (stable step [s]). Sets
     ``alive[e]`` to 0 (eroded by damage: everywhere, or only where ``layer[e]`` with
     ``erosion`` = ERODE_LAYER), -1 (distortion / time-step erosion) or -2 (inverted).
-    Allocates nothing; compiled for the CPU (``hex_element``) and the GPU (``gpu.py``).
+    Allocates nothing; compiled for the CPU (``hex_element``) and the GPU (``engine/gpu/kernels3d.py``).
     """
     if alive[e] != 1:
         for k in range(24):

@@ -2,8 +2,8 @@
 
 The index layout of the tool state and of the history columns, and the per-node and tool
 updates, written in the device-ready style of the 2D engine (``_py`` original + ``njit``):
-the CPU loops of :mod:`robobore.cutting.fe.kernels3d` call the ``njit`` versions and the GPU
-kernels of :mod:`robobore.cutting.fe.gpu3d_kernels` the device versions of the same code.
+the CPU loops of :mod:`robobore.cutting.fe.engine.kernels3d` call the ``njit`` versions and the GPU
+kernels of :mod:`robobore.cutting.fe.engine.gpu.kernels3d` the device versions of the same code.
 
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
@@ -11,14 +11,14 @@ kernels of :mod:`robobore.cutting.fe.gpu3d_kernels` the device versions of the s
   proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
-  (:func:`robobore.cutting.fe.kernels.friction_at_py`, the same code re-bound to the 3D
+  (:func:`robobore.cutting.fe.engine.kernels.friction_at_py`, the same code re-bound to the 3D
   parameter slots);
 * :func:`hex_node_py` -- gather, contact and central-difference update of one node;
 * :func:`tool_kinematics_py`, :func:`tool_step_py` -- the tool's position and its support's
   step in the boring frame; :func:`lane_sum3_py` -- one lane of the contact-force total;
   :func:`is_conduction_step_py` -- the steps that end with a conduction pass.
 
-Frames: see :mod:`robobore.cutting.fe.kernels3d`.
+Frames: see :mod:`robobore.cutting.fe.engine.kernels3d`.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import math
 
 from numba import njit
 
-from robobore.cutting.fe import kernels as _K2
+from robobore.cutting.fe.engine import kernels as _K2
 from robobore.cutting.fe.hex.element import (
     MU_TABLE_MAX,
     P_CLR,
@@ -198,7 +198,7 @@ contact_force3 = njit(cache=True)(contact_force3_py)
 if MU_TABLE_MAX != _K2.MU_TABLE_MAX:  # pragma: no cover - a guard on the shared slot layout
     raise ImportError("hex8.MU_TABLE_MAX differs from kernels.MU_TABLE_MAX")
 #: Coulomb coefficient at a sliding speed [m/s]: the 2D engine's
-#: :func:`robobore.cutting.fe.kernels.friction_at_py` (the constant ``prm[P_MU]`` when
+#: :func:`robobore.cutting.fe.engine.kernels.friction_at_py` (the constant ``prm[P_MU]`` when
 #: ``prm[P_MUTAB_N]`` = 0, else the table, linear between its points, constant beyond its
 #: ends) reading the 3D engine's parameter slots
 friction_at3_py = rebind(_K2.friction_at_py, P_MU=P_MU, P_MUTAB_N=P_MUTAB_N,

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.solver3d import hex_conn, split_node_layer
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import hex_conn, split_node_layer
 from robobore.cutting.geometry import BoringInsert, lead_end
 
 __all__ = ["BoringMesh", "parting_surface", "build_boring_mesh"]

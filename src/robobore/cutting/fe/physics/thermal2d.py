@@ -5,7 +5,7 @@ contact with the tool (:func:`tool_heat`: frictional heat and interface conducta
 The per-element, per-edge and per-node updates are plain-Python scalar functions
 (``quad_centroid_py``, ``quad_conduct_py``, ``parting_edge_py``, ``tool_heat_node_py``,
 ``tool_heat_elem_py``) that the CPU loops call as ``njit`` functions and
-:mod:`robobore.cutting.fe.gpu2d` compiles for an NVIDIA GPU.
+:mod:`robobore.cutting.fe.engine.gpu.backend2d` compiles for an NVIDIA GPU.
 """
 
 from __future__ import annotations
@@ -82,7 +82,7 @@ def parting_edge_py(i, ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
     """Conduction across parting-line edge ``i`` while both its node pairs are still tied.
 
     ``ppair`` (m, 4): an element, the element across the parting line, and the first one's
-    two nodes on the edge (:func:`robobore.cutting.fe.state2d.parting_edges`). The two
+    two nodes on the edge (:func:`robobore.cutting.fe.engine.state2d.parting_edges`). The two
     elements share no nodes (the line's nodes are doubled), so :func:`conduct` sees the
     line as a free surface; while the pairs are tied the material is continuous there and
     heat flows across with the two-point conductance (and cap) of :func:`quad_conduct_py`.

@@ -11,7 +11,7 @@ import math
 
 from numba import njit, prange
 
-from robobore.cutting.fe.layout import (
+from robobore.cutting.fe.engine.layout import (
     G_EPS,
     G_SX,
     G_SXY,

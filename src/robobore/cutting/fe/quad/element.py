@@ -14,7 +14,7 @@ with orthogonal hourglass control", IJNME 17, 679-706; Belytschko, Liu, Moran (2
 
 ``quad_element_py`` and its helpers are plain-Python scalar functions that allocate nothing;
 :func:`element_update` calls their ``njit`` versions (``inline="always"``) over all elements
-and :mod:`robobore.cutting.fe.gpu2d` compiles the same source for an NVIDIA GPU.
+and :mod:`robobore.cutting.fe.engine.gpu.backend2d` compiles the same source for an NVIDIA GPU.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import math
 
 from numba import njit, prange
 
-from robobore.cutting.fe.layout import (
+from robobore.cutting.fe.engine.layout import (
     ERODE_ALL,
     ERODE_LAYER,
     P_BV1,
@@ -144,7 +144,7 @@ def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pr
     time step). Reads and writes array elements only and allocates nothing, so the same
     source is compiled for the CPU (:data:`quad_element`) and for a GPU
     (``numba.cuda.jit(device=True)`` after :func:`robobore.material.johnson_cook.rebind`,
-    in :mod:`robobore.cutting.fe.gpu2d`).
+    in :mod:`robobore.cutting.fe.engine.gpu.backend2d`).
 
     Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
     was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).

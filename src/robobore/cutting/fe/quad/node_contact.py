@@ -4,7 +4,7 @@ separation; the fixed-order contact-force total and its split by tool face.
 
 ``quad_node_py`` is a plain-Python scalar function that allocates nothing;
 :func:`node_update` calls its ``njit`` version over all nodes and
-:mod:`robobore.cutting.fe.gpu2d` compiles the same source for an NVIDIA GPU.
+:mod:`robobore.cutting.fe.engine.gpu.backend2d` compiles the same source for an NVIDIA GPU.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from robobore.cutting.fe.layout import (
+from robobore.cutting.fe.engine.layout import (
     P_CDAMP,
     P_GATE,
     P_MU,
@@ -69,7 +69,7 @@ def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, 
     """Gather element forces on node ``n``, add tool contact, advance its velocity and position.
 
     One node of :func:`node_update` (scalar code, allocates nothing: compiled for the CPU as
-    :data:`quad_node` and for a GPU in :mod:`robobore.cutting.fe.gpu2d`). Returns
+    :data:`quad_node` and for a GPU in :mod:`robobore.cutting.fe.engine.gpu.backend2d`). Returns
     ``(fx, fy, touched)``: this node's contact force on the workpiece [N/m] (``cfx[n]``,
     ``cfy[n]``) and whether it touched the tool. Contact uses positions at step n and
     velocities at n-1/2; ``cfx``/``cfy`` receive the contact force on the node [N/m]; ``fric``

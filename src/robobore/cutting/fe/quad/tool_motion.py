@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from robobore.cutting.fe.layout import (
+from robobore.cutting.fe.engine.layout import (
     P_CX,
     P_CY,
     P_KX,

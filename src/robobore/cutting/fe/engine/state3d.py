@@ -4,7 +4,8 @@
 :func:`make_state3` builds one from any hexahedral mesh (used by the boring model and the
 element tests); :func:`advance3` runs :func:`kernels3d.run_chunk3` in chunks and turns an
 instability into :class:`robobore.errors.NumericalError` with the 2D engine's messages.
-The energy balance is :func:`robobore.cutting.fe.chunk_driver.energy_error` (same accumulators).
+The energy balance is :func:`robobore.cutting.fe.engine.chunk_driver.energy_error` (same
+accumulators).
 """
 
 from __future__ import annotations
@@ -14,10 +15,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.chunk_driver import drive_chunks, energy_error
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.chunk_driver import drive_chunks, energy_error
+from robobore.cutting.fe.engine.threads import ThreadGovernor
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
-from robobore.cutting.fe.threads import ThreadGovernor
 from robobore.errors import ConfigError
 from robobore.material import Material
 
@@ -248,7 +249,8 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
 
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
-    ``adaptive_threads``, ``governor``: see :func:`~robobore.cutting.fe.chunk_driver.drive_chunks`.
+    ``adaptive_threads``, ``governor``: see
+    :func:`~robobore.cutting.fe.engine.chunk_driver.drive_chunks`.
     """
     return drive_chunks(st, t_end, K3.run_chunk3, K3.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",

@@ -1,7 +1,7 @@
 """The state of the plane-strain engine: :class:`FEState` holds every array of a model
 (structure of arrays); :func:`make_state` builds one from any quad mesh (used by the cutting
 model and by the element/bar tests), :func:`default_prm` the neutral parameter vector
-(:mod:`robobore.cutting.fe.layout`), :func:`parting_edges` the parting-line edges of a
+(:mod:`robobore.cutting.fe.engine.layout`), :func:`parting_edges` the parting-line edges of a
 node-splitting mesh, :func:`init_forces` the forces and stable step of the first
 configuration.
 """
@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
 from robobore.cutting.fe.ale.stencils import edge_neighbours
+from robobore.cutting.fe.engine import kernels as K
 from robobore.errors import ConfigError
 from robobore.material import Material
 

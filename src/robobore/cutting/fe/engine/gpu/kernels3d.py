@@ -9,7 +9,7 @@ and the shared material/contact/support functions (:mod:`robobore.material.johns
 ``numba.cuda.jit(device=True)``. :func:`kernels3` returns the launch-per-kernel phases
 (nodes, contact-force total, tool, elements, step end, the heat-conduction kernels) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch; the
-host driver is :func:`robobore.cutting.fe.gpu.advance3_gpu`.
+host driver is :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from __future__ import annotations
 import functools
 import math  # noqa: F401  (math.isfinite inside the kernels)
 
-from robobore.cutting.fe.gpu_shared import (
+from robobore.cutting.fe.engine.gpu.shared import (
     MAX_BLOCK,
     bind_cuda,
     chunk_list_py,
@@ -45,7 +45,7 @@ def kernels3():
     from numba import float64 as _float64
     from numba import int64 as _int64
 
-    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.hex.element import hex_element_py
     from robobore.cutting.fe.physics.tool_contact import thermal3d as T3
     from robobore.cutting.fe.physics.tool_contact import (

@@ -1,8 +1,8 @@
 """Device versions of the 2D engine's scalar functions, for the GPU engine's kernels
-(:mod:`robobore.cutting.fe.gpu2d_kernels`).
+(:mod:`robobore.cutting.fe.engine.gpu.kernels2d`).
 
 The element, node, tool, conduction, energy and tool-frame ALE updates are the plain-Python
-scalar functions the CPU engine compiles with ``njit`` (:mod:`robobore.cutting.fe.kernels`,
+scalar functions the CPU engine compiles with ``njit`` (:mod:`robobore.cutting.fe.engine.kernels`,
 :mod:`robobore.cutting.fe.ale.rezone`, :mod:`robobore.cutting.fe.physics.tool_contact`,
 :mod:`robobore.material.johnson_cook`); :func:`device_functions2` re-binds each one's callees
 to their device versions (:func:`robobore.material.johnson_cook.rebind`) and compiles it with
@@ -13,9 +13,9 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.ale import rezone as RZ
-from robobore.cutting.fe.gpu_shared import chunk_list_py, jc_device_functions
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.gpu.shared import chunk_list_py, jc_device_functions
 
 __all__ = ["device_functions2"]
 

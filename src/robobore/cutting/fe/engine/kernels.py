@@ -1,7 +1,7 @@
 """Numba kernels of the explicit plane-strain cutting engine (SI units, per unit width): the
 names of its modules in one place.
 
-* :mod:`~robobore.cutting.fe.layout`: index layout of the small state arrays (``P_*``,
+* :mod:`~robobore.cutting.fe.engine.layout`: index layout of the small state arrays (``P_*``,
   ``T_*``, ``E_*``, ``I_*``, ``STATUS_*``, ``H_*``).
 * :mod:`~robobore.cutting.fe.quad.element`: the one-point quadrilateral with hourglass
   control, material update and erosion (:func:`element_update`).
@@ -13,21 +13,21 @@ names of its modules in one place.
 * :mod:`~robobore.cutting.fe.physics.thermal2d`: heat conduction, across the parting line and with
   the tool.
 * :mod:`~robobore.cutting.fe.quad.tool_motion`: the tool's kinematics and its support springs.
-* :mod:`~robobore.cutting.fe.chunk_loop`: the compiled time-step loop (:func:`run_chunk`).
+* :mod:`~robobore.cutting.fe.engine.chunk_loop`: the compiled time-step loop (:func:`run_chunk`).
 
 The per-element, per-node, conduction and tool updates are plain-Python scalar functions
 (``*_py``) that allocate nothing; the CPU loops call their ``njit`` versions
-(``inline="always"``) and :mod:`robobore.cutting.fe.gpu2d` compiles the same source for an
-NVIDIA GPU.
+(``inline="always"``) and :mod:`robobore.cutting.fe.engine.gpu.backend2d` compiles the same source
+for an NVIDIA GPU.
 """
 
 from __future__ import annotations
 
-from robobore.cutting.fe.chunk_loop import (
+from robobore.cutting.fe.engine.chunk_loop import (
     run_chunk,
     sum_energies_py,
 )
-from robobore.cutting.fe.layout import (
+from robobore.cutting.fe.engine.layout import (
     E_ERODED,
     E_EROKE,
     E_EXT,

@@ -19,12 +19,12 @@ clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is
 the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine.
 
 Layout: the CUDA plumbing shared with the 2D engine (availability, binding, the cooperative
-launch) is :mod:`robobore.cutting.fe.gpu_shared`; the kernels are built in
-:mod:`robobore.cutting.fe.gpu3d_kernels`; this module is the host driver.
+launch) is :mod:`robobore.cutting.fe.engine.gpu.shared`; the kernels are built in
+:mod:`robobore.cutting.fe.engine.gpu.kernels3d`; this module is the host driver.
 
 Limits: per-sample energy histories are not recorded on the GPU (the final energy totals
 are computed on the host from the copied-back state). The 2D engine's GPU port, built the
-same way from its scalar functions, is :mod:`robobore.cutting.fe.gpu2d`.
+same way from its scalar functions, is :mod:`robobore.cutting.fe.engine.gpu.backend2d`.
 """
 
 from __future__ import annotations
@@ -33,8 +33,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from robobore.cutting.fe.gpu3d_kernels import N_RED, R_BAD, R_DTMIN, kernels3
-from robobore.cutting.fe.gpu_shared import (
+from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, R_BAD, R_DTMIN, kernels3
+from robobore.cutting.fe.engine.gpu.shared import (
     MAX_BLOCK,
     THREADS,
     bind_cuda,
@@ -49,7 +49,7 @@ from robobore.cutting.fe.gpu_shared import (
 )
 
 __all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled", "N_RED",
-           # shared with the 2D GPU engine (robobore.cutting.fe.gpu2d)
+           # shared with the 2D GPU engine (robobore.cutting.fe.engine.gpu.backend2d)
            "MAX_BLOCK", "bind_cuda", "chunk_list_py", "jc_device_functions", "persistent_run",
            "profile_ticker"]
 
@@ -71,7 +71,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                  check: Callable[[object], None] | None = None,
                  profile: dict[str, float] | None = None,
                  persistent: bool | None = None) -> int:
-    """GPU counterpart of :func:`robobore.cutting.fe.solver3d.advance3` (same contract).
+    """GPU counterpart of :func:`robobore.cutting.fe.engine.state3d.advance3` (same contract).
 
     Copies the state to the device, runs chunks of ``chunk_steps`` steps, copies the state
     back after each chunk (for ``check``/``progress``) and at the end, and computes the
@@ -83,8 +83,8 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     ``profile`` is asked for; the same bits as the five launches a step, without their
     host-side launch cost).
     """
-    from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.status import STATUS_TEXT, instability_error
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 
     require_gpu()
     cuda = bind_cuda()
@@ -178,7 +178,7 @@ _RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "nc
 
 
 def _copy_back(st, g) -> None:
-    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.engine import kernels3d as K3
 
     for name in _MUTABLE:
         getattr(st, name)[...] = g[name].copy_to_host()

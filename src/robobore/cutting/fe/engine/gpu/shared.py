@@ -5,7 +5,8 @@ of a persistent kernel, or the per-launch profile clock of the launch-per-kernel
 
 Importing this module needs neither a GPU nor numba's CUDA target; :func:`require_gpu` raises
 a clear :class:`robobore.errors.ConfigError` when no GPU is usable. The engines themselves are
-:mod:`robobore.cutting.fe.gpu` (3D) and :mod:`robobore.cutting.fe.gpu2d` (2D).
+:mod:`robobore.cutting.fe.engine.gpu.backend3d` (3D) and
+:mod:`robobore.cutting.fe.engine.gpu.backend2d` (2D).
 """
 
 from __future__ import annotations
@@ -121,7 +122,7 @@ def persistent_run(kernel, args: list, n_nodes: int, profile, persistent: bool |
     nodes); ``None`` where the caller launches one kernel per phase (``persistent`` False, or
     None with a ``profile``, or a cooperative launch that cannot be set up -- then with a
     warning)."""
-    from robobore.cutting.fe.kernels import N_SUM_LANES
+    from robobore.cutting.fe.engine.kernels import N_SUM_LANES
 
     auto = persistent is None
     if not (profile is None if auto else persistent):

@@ -24,8 +24,8 @@ bar and the energy check).
 
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``).
-Importing this module needs neither; :func:`robobore.cutting.fe.gpu.require_gpu` raises a
-clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
+Importing this module needs neither; :func:`robobore.cutting.fe.engine.gpu.backend3d.require_gpu`
+raises a clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
 the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine. The
 workpiece-frame model is timed on an H100 (docs/fe.md, "GPU path"); the tool-frame model is
 checked in the simulator and compiled for sm_90, not timed on a GPU.
@@ -40,9 +40,9 @@ pass); the launch-per-kernel path launches one kernel per pass. The contact forc
 face (``kernels.contact_split``) is added by one thread in increasing node order over the
 chunks holding a contact node: the CPU's serial order, the same bits.
 
-Layout: the device functions are bound in :mod:`robobore.cutting.fe.gpu2d_device`, the
-kernels built in :mod:`robobore.cutting.fe.gpu2d_kernels`, the CUDA plumbing shared with the
-3D engine is :mod:`robobore.cutting.fe.gpu_shared`; this module is the host driver.
+Layout: the device functions are bound in :mod:`robobore.cutting.fe.engine.gpu.device2d`, the
+kernels built in :mod:`robobore.cutting.fe.engine.gpu.kernels2d`, the CUDA plumbing shared with the
+3D engine is :mod:`robobore.cutting.fe.engine.gpu.shared`; this module is the host driver.
 
 Kernel parameters: the persistent kernel takes the whole state, 3944 bytes of CUDA's classic
 4096-byte limit (checked by a test with numba's data model).
@@ -58,12 +58,17 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe import kernels as K
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
-from robobore.cutting.fe.gpu2d_kernels import N_RED, R_BAD, R_DTMIN, kernels2
-from robobore.cutting.fe.gpu_shared import bind_cuda, persistent_run, profile_ticker, require_gpu
-from robobore.cutting.fe.status import STATUS_TEXT, instability_error
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, R_BAD, R_DTMIN, kernels2
+from robobore.cutting.fe.engine.gpu.shared import (
+    bind_cuda,
+    persistent_run,
+    profile_ticker,
+    require_gpu,
+)
+from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported", "N_RED"]
@@ -110,15 +115,15 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                 check: Callable[[Any], None] | None = None,
                 profile: dict[str, float] | None = None,
                 persistent: bool | None = None) -> int:
-    """GPU counterpart of :func:`robobore.cutting.fe.chunk_driver.advance` (same contract).
+    """GPU counterpart of :func:`robobore.cutting.fe.engine.chunk_driver.advance` (same contract).
 
-    Copies the :class:`~robobore.cutting.fe.state2d.FEState` to the device, runs chunks of
+    Copies the :class:`~robobore.cutting.fe.engine.state2d.FEState` to the device, runs chunks of
     ``chunk_steps`` steps there, copies the step counter and clock back after each chunk
     (the whole state when ``check`` is given, before calling it) and the whole state at the
     end. Returns the number of steps taken. Raises NumericalError on instability (same
     messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
     rezoning, the ploughed-layer ALE or the B-bar element. ``profile`` and ``persistent``:
-    as in :func:`robobore.cutting.fe.gpu.advance3_gpu` (per-kernel wall times for
+    as in :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu` (per-kernel wall times for
     benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
     every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0

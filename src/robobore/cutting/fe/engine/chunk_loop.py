@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
-from robobore.cutting.fe.layout import (
+from robobore.cutting.fe.engine.layout import (
     E_ERODED,
     E_EROKE,
     E_EXT,

@@ -16,13 +16,13 @@ chunk loop :func:`run_chunk3`. The scalar functions:
   proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
-  (:func:`robobore.cutting.fe.kernels.friction_at_py`, the same code re-bound to the 3D
+  (:func:`robobore.cutting.fe.engine.kernels.friction_at_py`, the same code re-bound to the 3D
   parameter slots);
 * :func:`hex_node_py` -- gather, contact and central-difference update of one node.
 
 Energy indices, status codes and the energy-balance definition are the 2D engine's
-(:mod:`robobore.cutting.fe.kernels`), so :func:`robobore.cutting.fe.chunk_driver.energy_error`
-applies to both.
+(:mod:`robobore.cutting.fe.engine.kernels`), so
+:func:`robobore.cutting.fe.engine.chunk_driver.energy_error` applies to both.
 
 Frames: the kernels work in the *local* frame of the insert at the start of the run
 (x along the cutting velocity, y normal to the bore wall pointing out of the material,
@@ -37,6 +37,30 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe.engine.kernels import (
+    E_ERODED,
+    E_EROKE,
+    E_EXT,
+    E_FRIC,
+    E_HG,
+    E_INT,
+    E_KIN,
+    E_NODEWORK,
+    E_PLAST,
+    I_BADELEM,
+    I_SAMPLE,
+    I_STATUS,
+    I_STEP,
+    N_EN,
+    N_IST,
+    N_SUM_LANES,
+    STATUS_DONE,
+    STATUS_DT_COLLAPSE,
+    STATUS_INVERTED,
+    STATUS_NO_ELEMENTS,
+    STATUS_NONFINITE,
+    STATUS_OK,
+)
 from robobore.cutting.fe.hex.element import (
     ERODE_ALL,
     ERODE_LAYER,
@@ -146,30 +170,6 @@ from robobore.cutting.fe.hex.scalar3d import (
     tool_step,
     tool_step_py,
 )
-from robobore.cutting.fe.kernels import (
-    E_ERODED,
-    E_EROKE,
-    E_EXT,
-    E_FRIC,
-    E_HG,
-    E_INT,
-    E_KIN,
-    E_NODEWORK,
-    E_PLAST,
-    I_BADELEM,
-    I_SAMPLE,
-    I_STATUS,
-    I_STEP,
-    N_EN,
-    N_IST,
-    N_SUM_LANES,
-    STATUS_DONE,
-    STATUS_DT_COLLAPSE,
-    STATUS_INVERTED,
-    STATUS_NO_ELEMENTS,
-    STATUS_NONFINITE,
-    STATUS_OK,
-)
 from robobore.cutting.fe.physics.thermal3d import conduct3, tool_heat3
 from robobore.material import johnson_cook as jc
 
@@ -252,7 +252,7 @@ def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nw
 @njit(cache=True)
 def contact_total3(cf):
     """Total contact force on the workpiece [N] and number of contact nodes, summed in the
-    fixed lane order of :func:`robobore.cutting.fe.kernels.contact_total` (the GPU engine
+    fixed lane order of :func:`robobore.cutting.fe.engine.kernels.contact_total` (the GPU engine
     sums the same way, so a GPU run is reproducible bit for bit)."""
     fx = 0.0
     fy = 0.0

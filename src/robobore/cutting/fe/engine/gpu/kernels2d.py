@@ -1,11 +1,11 @@
 """The 2D GPU engine's kernels (numba-cuda), built from the SAME scalar physics as the CPU
-engine (their device versions: :func:`robobore.cutting.fe.gpu2d_device.device_functions2`).
+engine (their device versions: :func:`robobore.cutting.fe.engine.gpu.device2d.device_functions2`).
 
 :func:`kernels2` returns the launch-per-kernel phases (nodes, contact-force total, tool,
 elements, the heat-conduction kernels, step end, the tool-frame ALE passes) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch; the
-host driver is :func:`robobore.cutting.fe.gpu2d.advance_gpu`, whose docstring describes the
-step's phases.
+host driver is :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring
+describes the step's phases.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ from __future__ import annotations
 import functools
 import math  # noqa: F401  (math.isfinite inside the kernels)
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.gpu2d_device import device_functions2
-from robobore.cutting.fe.gpu_shared import MAX_BLOCK, bind_cuda
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.gpu.device2d import device_functions2
+from robobore.cutting.fe.engine.gpu.shared import MAX_BLOCK, bind_cuda
 
 __all__ = ["kernels2", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC", "R_SPLIT", "N_RED"]
 

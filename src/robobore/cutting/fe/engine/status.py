@@ -1,17 +1,18 @@
 """Run status of the explicit engines: what each instability code in ``ist[I_STATUS]`` means
 and the error raised for it.
 
-Shared by every chunk driver (2D and 3D, CPU and GPU: :func:`robobore.cutting.fe.chunk_driver.
-drive_chunks`, :func:`robobore.cutting.fe.gpu2d.advance_gpu`,
-:func:`robobore.cutting.fe.gpu.advance3_gpu`). The codes themselves are
-:mod:`robobore.cutting.fe.kernels`' ``STATUS_*`` (the 3D kernels use the same ones).
+Shared by every chunk driver (2D and 3D, CPU and GPU:
+:func:`robobore.cutting.fe.engine.chunk_driver. drive_chunks`,
+:func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`,
+:func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`). The codes themselves are
+:mod:`robobore.cutting.fe.engine.kernels`' ``STATUS_*`` (the 3D kernels use the same ones).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from robobore.cutting.fe import kernels as K
+from robobore.cutting.fe.engine import kernels as K
 from robobore.errors import NumericalError
 
 __all__ = ["STATUS_TEXT", "instability_error"]

@@ -1,7 +1,7 @@
 """The host driver of the compiled loops: :func:`drive_chunks` runs a chunk loop (2D or 3D)
 to an end time with progress and checks between chunks and turns a non-finite state or a
 collapsing time step into :class:`robobore.errors.NumericalError`; :func:`advance` drives
-the 2D loop (:func:`robobore.cutting.fe.chunk_loop.run_chunk`); :func:`energy_error` is
+the 2D loop (:func:`robobore.cutting.fe.engine.chunk_loop.run_chunk`); :func:`energy_error` is
 the energy-balance error checked during a run.
 """
 
@@ -14,12 +14,12 @@ from typing import Any
 import numba
 import numpy as np
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.state2d import (
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.state2d import (
     FEState,
 )
-from robobore.cutting.fe.status import STATUS_TEXT, instability_error
-from robobore.cutting.fe.threads import ThreadGovernor
+from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
+from robobore.cutting.fe.engine.threads import ThreadGovernor
 
 
 def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: int, *,
@@ -30,14 +30,14 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
                  governor: ThreadGovernor | None = None) -> int:
     """Run a compiled chunk loop (2D ``run_chunk`` or 3D ``run_chunk3``) until ``t_end`` [s].
 
-    Shared by :func:`advance` and :func:`~robobore.cutting.fe.solver3d.advance3`: ``st`` has
+    Shared by :func:`advance` and :func:`~robobore.cutting.fe.engine.state3d.advance3`: ``st`` has
     ``prm``, ``ist``, ``time`` and ``kernel_args()``; ``p_tend`` is the index of the end time in
     that engine's ``prm``. ``progress(fraction_done)`` and ``check(state)`` (may raise) are
     called between chunks. Raises NumericalError (``label``, step, time, cause, ``hint``) on
     instability; returns the number of steps taken.
 
     ``adaptive_threads`` (default): each chunk runs on the thread count a
-    :class:`~robobore.cutting.fe.threads.ThreadGovernor` (``governor``, or a fresh one) finds
+    :class:`~robobore.cutting.fe.engine.threads.ThreadGovernor` (``governor``, or a fresh one) finds
     faster, all of numba's threads or one, so that a run sharing the cores with other work
     keeps its share; the results do not depend on it. False: numba's thread count throughout.
     numba's thread count is restored on return.
