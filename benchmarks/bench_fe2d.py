@@ -29,7 +29,7 @@ from pathlib import Path
 import numba
 
 from robobore.cutting.fe.config.orthogonal import load_fe_config
-from robobore.cutting.fe.orthogonal import simulate_orthogonal
+from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "fe_orthogonal.toml"
 

@@ -55,7 +55,7 @@ class Competitor:
 def run_2d(length_mm: float, adaptive: bool) -> tuple[float, dict]:
     from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.engine.chunk_driver import advance
-    from robobore.cutting.fe.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
     cfg.cut.length_mm = length_mm
@@ -71,8 +71,8 @@ def run_2d(length_mm: float, adaptive: bool) -> tuple[float, dict]:
 
 
 def run_3d(n_steps: int, element_um: float, adaptive: bool) -> tuple[float, dict]:
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

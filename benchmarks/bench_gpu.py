@@ -210,8 +210,8 @@ def _speed_row(st0, n_elements: int, advance, advance_gpu, diff, gpu_steps: int,
 
 def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
 
     advance3_gpu = None
     if use_gpu:
@@ -230,7 +230,7 @@ def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
 
 def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
             coefficients: str | None) -> dict:
-    from robobore.cutting.fe.boring3d import (
+    from robobore.cutting.fe.models.boring3d import (
         compare_with_mechanistic,
         parse_boring_config,
         simulate_boring,
@@ -284,7 +284,7 @@ def _diff2(a, b) -> dict:
 def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
     from robobore.cutting.fe.engine.chunk_driver import advance
-    from robobore.cutting.fe.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     advance_gpu = None
     if use_gpu:
@@ -303,7 +303,7 @@ def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
 
 def ortho2d(devices: list[str], length_mm: float | None, le: float | None,
             config: str | None = None) -> dict:
-    from robobore.cutting.fe.orthogonal import simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     cfg = _ortho_cfg(le, length_mm, config)
     by = {}

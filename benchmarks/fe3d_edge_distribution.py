@@ -27,9 +27,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.forces import boring_forces, load_coefficients, ti64_coefficients
     from robobore.io.config import load_toml
     from robobore.io.results import atomic_write_bytes

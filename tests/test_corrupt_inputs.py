@@ -39,7 +39,7 @@ def _fe(p: Path):
 
 
 def _fe_boring(p: Path):
-    from robobore.cutting.fe.boring3d import load_boring_config
+    from robobore.cutting.fe.models.boring3d import load_boring_config
 
     load_boring_config(p)
 

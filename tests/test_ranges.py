@@ -358,7 +358,7 @@ def test_fe_orthogonal_material_file_is_config_relative(tmp_path, monkeypatch):
 
 
 def test_fe_boring_material_file_is_config_relative(tmp_path, monkeypatch):
-    from robobore.cutting.fe.boring3d import load_boring_config
+    from robobore.cutting.fe.models.boring3d import load_boring_config
 
     cfgdir = _fe_material_case(tmp_path, monkeypatch)
     text = (EX / "fe_boring_paper.toml").read_text()

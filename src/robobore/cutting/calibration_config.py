@@ -256,7 +256,7 @@ def load_calibration_config(path: str | Path, other_sections: Collection[str] = 
 def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> dict[str, Any]:
     """The FE engine's config (``robobore fe orthogonal`` contract) of one grid point."""
     if cfg.fe_config is not None:
-        from robobore.cutting.fe.validate import point_config
+        from robobore.cutting.fe.models.validate import point_config
 
         return point_config(cfg.fe_config, h_um, vc_m_per_min)
     fe = cfg.fe

@@ -29,7 +29,7 @@ _SUMMARY_KEYS = ("cutting_force_N_per_mm", "feed_force_N_per_mm", "cutting_force
 def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     """Run one virtual orthogonal test (in a worker process); returns the FE summary subset."""
     from robobore.cutting.fe.config.orthogonal import parse_config
-    from robobore.cutting.fe.orthogonal import simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     res = simulate_orthogonal(parse_config(fe_cfg))
     s = res.summary

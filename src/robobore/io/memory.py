@@ -33,7 +33,7 @@ from robobore.errors import ConfigError
 #: element on the bundled fe_orthogonal*.toml examples; the rest is the history and the
 #: copies taken for the output.
 FE2D_BYTES_PER_ELEMENT = 1500
-#: 3D explicit FE (robobore.cutting.fe.boring3d): bytes per hexahedral element at the peak
+#: 3D explicit FE (robobore.cutting.fe.models.boring3d): bytes per hexahedral element at the peak
 #: (a set-up run of examples/fe_boring_paper.toml measures 910 bytes per element).
 FE3D_BYTES_PER_ELEMENT = 1500
 #: time-domain boring (robobore.dynamics.timedomain): float64 values held per time step:

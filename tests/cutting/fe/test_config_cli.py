@@ -95,7 +95,7 @@ def test_bad_tool_support(tmp_path):
 
 
 def test_tool_support_too_stiff_for_the_step():
-    from robobore.cutting.fe.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     d = _with("tool_support", "stiffness_N_per_m", [1e13, 1e7])
     d["tool_support"].update(damping_N_s_per_m=10.0, mass_kg=0.001)

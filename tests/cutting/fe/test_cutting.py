@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.orthogonal import simulate_orthogonal
+from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
 FC_MEAS, FF_MEAS, R_MEAS = 118.23, 50.3, 1.23
 BASE = {

@@ -20,7 +20,7 @@ from conftest import edge_band_dict
 from robobore.cutting.fe.ale.rezone import MODE_ROWS, rezone, row_stencil
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 
 ALE = {"edge_ale_interval": 10, "edge_ale_depth_um": 10.0}

@@ -50,7 +50,7 @@ SCRIPT = PRELUDE + textwrap.dedent("""
     from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
     from robobore.cutting.fe.engine.chunk_driver import advance
-    from robobore.cutting.fe.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     cfg = parse_config({
         "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
@@ -118,7 +118,7 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
     from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
     from robobore.cutting.fe.engine.chunk_driver import advance
-    from robobore.cutting.fe.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     d = tomllib.load(open(sys.argv[1], "rb"))
     d["cut"]["length_mm"] = 0.02  # one element: the shortest cut the config accepts
@@ -166,7 +166,7 @@ def test_gpu2d_module_imports_and_reports_cleanly():
     assert callable(gpu2d.advance_gpu)
     if not gpu.cuda_available():
         from robobore.cutting.fe.config.orthogonal import load_fe_config
-        from robobore.cutting.fe.orthogonal import simulate_orthogonal
+        from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
         with pytest.raises(ConfigError, match="no usable NVIDIA GPU"):
             simulate_orthogonal(load_fe_config(EXAMPLE), device="gpu")
@@ -295,7 +295,7 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
     from numba.core.datamodel import default_manager
 
     from robobore.cutting.fe.config.orthogonal import parse_config
-    from robobore.cutting.fe.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     def nbytes(t) -> int:
         if isinstance(t, tuple):

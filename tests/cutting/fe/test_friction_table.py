@@ -130,7 +130,7 @@ def test_the_engine_slides_against_the_table_at_the_sliding_speed():
 
 def test_the_3d_slab_reads_the_table_at_the_sliding_speed():
     from robobore.cutting.fe.engine import kernels3d as K3
-    from robobore.cutting.fe.slab3d import setup_slab3
+    from robobore.cutting.fe.models.slab3d import setup_slab3
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,

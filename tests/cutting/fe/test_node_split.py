@@ -20,7 +20,7 @@ from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.mesh.orthogonal import build_mesh
-from robobore.cutting.fe.orthogonal import setup_orthogonal
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
 
 def _split(nodes, conn, nx, ny, row):

@@ -28,7 +28,7 @@ from robobore.cutting.fe.ale.rezone import (
 from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.orthogonal import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.physics.tool_contact import tool_gap_py
 from robobore.errors import ConfigError
 
@@ -185,7 +185,7 @@ def test_tool_frame_on_gpu_needs_a_gpu():
     """The tool-frame model runs on the GPU (the simulator test in
     test_fe2d_gpu.py); without a usable GPU --device gpu stops with the clear error."""
     from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
-    from robobore.cutting.fe.orthogonal import check_device
+    from robobore.cutting.fe.models.orthogonal import check_device
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,

@@ -10,7 +10,6 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import (
     advance3,
@@ -19,6 +18,7 @@ from robobore.cutting.fe.engine.state3d import (
     make_state3,
     split_node_layer,
 )
+from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
 from robobore.cutting.fe.physics.thermal3d import (
     conduct3,
     face_neighbours,

@@ -1,6 +1,6 @@
 """CLI commands of the FE stage (registered by ``robobore.cli``): ``robobore fe orthogonal``
-(``--device cpu|gpu``), ``robobore fe validate`` (:mod:`robobore.cutting.fe.validate`) and, from
-:mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
+(``--device cpu|gpu``), ``robobore fe validate`` (:mod:`robobore.cutting.fe.models.validate`) and,
+from :mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
 
 from __future__ import annotations
 
@@ -51,8 +51,8 @@ def orthogonal_cmd(
 @handle_errors
 def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
     from robobore.cutting.fe.config.orthogonal import load_fe_config
-    from robobore.cutting.fe.orthogonal import check_device, simulate_orthogonal
-    from robobore.cutting.fe.output import plot_chip, to_dataset, write_vtk
+    from robobore.cutting.fe.models.orthogonal import check_device, simulate_orthogonal
+    from robobore.cutting.fe.models.output import plot_chip, to_dataset, write_vtk
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_netcdf
 
@@ -141,7 +141,7 @@ def validate_cmd(
 @handle_errors
 def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu") -> None:
     from robobore.cutting.fe.config.orthogonal import parse_config
-    from robobore.cutting.fe.validate import parse_points, read_measured, run_validation
+    from robobore.cutting.fe.models.validate import parse_points, read_measured, run_validation
     from robobore.io.config import load_toml
 
     base = load_toml(config)

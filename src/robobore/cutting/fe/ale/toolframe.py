@@ -66,7 +66,7 @@ from robobore.cutting.fe.ale.rezone import (
 )
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.mesh.orthogonal import QuadMeshSizes
-from robobore.cutting.fe.output import ChipGeometry, point_polyline_distance, shear_angle_deg
+from robobore.cutting.fe.models.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 
 
 @dataclass

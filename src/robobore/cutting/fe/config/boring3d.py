@@ -1,4 +1,4 @@
-"""The configuration schema of the 3D FE boring model (:mod:`robobore.cutting.fe.boring3d`):
+"""The configuration schema of the 3D FE boring model (:mod:`robobore.cutting.fe.models.boring3d`):
 its TOML sections (insert, cut, contact, mesh, solver, tool support, material), their units,
 defaults and ranges, and the parser that checks them (errors name the key, the value and the
 expected range). The options are documented in ``docs/fe3d.md``.

@@ -28,7 +28,7 @@ Frames: the kernels work in the *local* frame of the insert at the start of the 
 (x along the cutting velocity, y normal to the bore wall pointing out of the material,
 towards the bore axis, z along the feed). The tool support integrates in the *boring*
 frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
-``theta(t) = theta0 + vc t / R``; see :mod:`robobore.cutting.fe.boring3d`.
+``theta(t) = theta0 + vc t / R``; see :mod:`robobore.cutting.fe.models.boring3d`.
 """
 from __future__ import annotations
 

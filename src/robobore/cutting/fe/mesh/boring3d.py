@@ -1,4 +1,4 @@
-"""The hexahedral mesh of the 3D FE boring model (:mod:`robobore.cutting.fe.boring3d`): a
+"""The hexahedral mesh of the 3D FE boring model (:mod:`robobore.cutting.fe.models.boring3d`): a
 locally flat block of the bore wall whose top surface carries the feed marks of the previous
 revolution, with the separation layer along the insert's edge path and, for node splitting,
 the parting surface and its twin nodes.

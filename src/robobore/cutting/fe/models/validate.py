@@ -231,7 +231,11 @@ def run_validation(base: dict[str, Any], measured: list[MeasuredPoint], *,
     from robobore import __version__
     from robobore.cutting.fe import FE_ENGINE_REVISION
     from robobore.cutting.fe.config.orthogonal import parse_config
-    from robobore.cutting.fe.orthogonal import check_device, setup_orthogonal, simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import (
+        check_device,
+        setup_orthogonal,
+        simulate_orthogonal,
+    )
 
     simulate = simulate or simulate_orthogonal
     by_hv = {(m.h_um, m.vc_m_per_min): m for m in measured}

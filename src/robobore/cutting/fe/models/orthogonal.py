@@ -1,7 +1,7 @@
 """The orthogonal-cutting model: :func:`setup_orthogonal` builds mesh, tool and state from an
 :class:`~robobore.cutting.fe.config.orthogonal.FEConfig`, :func:`run_orthogonal` runs it on the CPU
 or the GPU, :func:`simulate_orthogonal` sets up, runs and measures it (forces, chip, energies)
-into an :class:`~robobore.cutting.fe.output.FEResult`.
+into an :class:`~robobore.cutting.fe.models.output.FEResult`.
 """
 
 from __future__ import annotations
@@ -245,7 +245,7 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
 
 
 def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
-    from robobore.cutting.fe.output import tool_outline
+    from robobore.cutting.fe.models.output import tool_outline
 
     st = setup.state
     cfg = setup.cfg
@@ -274,7 +274,7 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     ``device``: "cpu" (default) or "gpu" (see :func:`run_orthogonal`); checked before the
     mesh is built.
     """
-    from robobore.cutting.fe.output import (
+    from robobore.cutting.fe.models.output import (
         FEResult,
         chip_ratio_from_velocity,
         measure_chip,
