@@ -293,7 +293,7 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
     STATUS_DONE at ``prm[P_TEND]``, or an instability status. Returns the steps taken.
     Every ``prm[P_COND_EVERY]`` steps (0: adiabatic) heat conduction and the thermal contact
     with the insert run over the time since the last pass (:mod:`~robobore.cutting.fe.
-    thermal3d`, :func:`conduction_pass3`).
+    physics.thermal3d`, :func:`conduction_pass3`).
     """
     erosion = int(prm[P_EROSION])
     ne = conn.shape[0]
