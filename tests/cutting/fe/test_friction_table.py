@@ -17,7 +17,7 @@ from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
-from robobore.cutting.fe.physics.tool_contact import tool_contact as P
+from robobore.cutting.fe.physics import tool_contact as P
 from robobore.errors import ConfigError
 
 

@@ -47,7 +47,7 @@ def kernels3():
 
     from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.hex.element import hex_element_py
-    from robobore.cutting.fe.physics.tool_contact import thermal3d as T3
+    from robobore.cutting.fe.physics import thermal3d as T3
     from robobore.cutting.fe.physics.tool_contact import (
         tool_face_py,
         tool_gap_py,
