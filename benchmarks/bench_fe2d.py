@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numba
 
-from robobore.cutting.fe.config import load_fe_config
-from robobore.cutting.fe.solver import simulate_orthogonal
+from robobore.cutting.fe.config.orthogonal import load_fe_config
+from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "fe_orthogonal.toml"
 
@@ -82,7 +82,7 @@ def main() -> None:
             d["contact"] = {k: v for k, v in d["contact"].items()
                             if not k.startswith("friction_table_")}
             d["contact"]["friction"] = cfg.contact._law
-        from robobore.cutting.fe.config import parse_config
+        from robobore.cutting.fe.config.orthogonal import parse_config
 
         ref = parse_config(d, "workpiece-frame reference")
         r = _run(ref, "reference")

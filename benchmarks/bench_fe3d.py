@@ -43,8 +43,8 @@ def _load() -> str:
 
 
 def speed(n_elements: int, steps: int) -> dict:
-    from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
@@ -89,7 +89,7 @@ def speed(n_elements: int, steps: int) -> dict:
 def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None,
           friction: str | None = None, separation: str | None = None,
           support: bool = True) -> dict:
-    from robobore.cutting.fe.boring3d import (
+    from robobore.cutting.fe.models.boring3d import (
         compare_with_mechanistic,
         parse_boring_config,
         simulate_boring,

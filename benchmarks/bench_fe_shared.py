@@ -5,7 +5,7 @@ cut) and the 3D boring model at the paper condition (``examples/fe_boring_paper.
 fixed number of steps), it runs the same stretch of simulation four ways in one process:
 
 - ``quiet, fixed``: all of numba's threads on every chunk, nothing else running;
-- ``quiet, adaptive``: the default (:class:`robobore.cutting.fe.threads.ThreadGovernor`
+- ``quiet, adaptive``: the default (:class:`robobore.cutting.fe.engine.threads.ThreadGovernor`
   chooses all threads or one per chunk from the measured rate);
 - ``shared, fixed`` and ``shared, adaptive``: the same with one CPU-bound competitor process
   (a Python busy loop) started before and killed after the run.
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numba
 
-from robobore.cutting.fe.threads import ThreadGovernor
+from robobore.cutting.fe.engine.threads import ThreadGovernor
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -53,8 +53,9 @@ class Competitor:
 
 
 def run_2d(length_mm: float, adaptive: bool) -> tuple[float, dict]:
-    from robobore.cutting.fe.config import load_fe_config
-    from robobore.cutting.fe.solver import advance, setup_orthogonal
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
+    from robobore.cutting.fe.engine.chunk_driver import advance
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
     cfg.cut.length_mm = length_mm
@@ -70,8 +71,8 @@ def run_2d(length_mm: float, adaptive: bool) -> tuple[float, dict]:
 
 
 def run_3d(n_steps: int, element_um: float, adaptive: bool) -> tuple[float, dict]:
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-    from robobore.cutting.fe.solver3d import advance3
+    from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

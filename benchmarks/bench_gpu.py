@@ -71,7 +71,7 @@ def env() -> dict:
         out["numba_cuda"] = getattr(numba_cuda, "__version__", "?")
     except Exception as e:  # pragma: no cover - depends on the machine
         out["numba_cuda"] = f"not importable: {e}"
-    from robobore.cutting.fe.gpu import cuda_available
+    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
 
     out["cuda_available"] = cuda_available()
     if out["cuda_available"]:
@@ -95,8 +95,8 @@ def small3d(n_samples: int = 4000):
     histories every 2 ns."""
     import math
 
-    from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.solver3d import box_mesh, default_prm3, make_state3
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.state3d import box_mesh, default_prm3, make_state3
     from robobore.material import load_material
 
     le = 20e-6
@@ -122,7 +122,7 @@ def small3d(n_samples: int = 4000):
 
 
 def _diff3(a, b) -> dict:
-    from robobore.cutting.fe import kernels3d as K3
+    from robobore.cutting.fe.engine import kernels3d as K3
 
     out = {k: _rel(getattr(a, k), getattr(b, k))
            for k in ("x", "vx", "vy", "vz", "sd", "pres", "eps_p", "temp", "tool")}
@@ -132,8 +132,8 @@ def _diff3(a, b) -> dict:
 
 
 def check3d(steps: list[int]) -> dict:
-    from robobore.cutting.fe.gpu import advance3_gpu
-    from robobore.cutting.fe.solver3d import advance3
+    from robobore.cutting.fe.engine.gpu.backend3d import advance3_gpu
+    from robobore.cutting.fe.engine.state3d import advance3
 
     res = {}
     for n in steps:
@@ -210,12 +210,12 @@ def _speed_row(st0, n_elements: int, advance, advance_gpu, diff, gpu_steps: int,
 
 def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-    from robobore.cutting.fe.solver3d import advance3
+    from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
 
     advance3_gpu = None
     if use_gpu:
-        from robobore.cutting.fe.gpu import advance3_gpu
+        from robobore.cutting.fe.engine.gpu.backend3d import advance3_gpu
     numba.set_num_threads(min(cpu_threads, numba.config.NUMBA_NUM_THREADS))
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
@@ -230,7 +230,7 @@ def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
 
 def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
             coefficients: str | None) -> dict:
-    from robobore.cutting.fe.boring3d import (
+    from robobore.cutting.fe.models.boring3d import (
         compare_with_mechanistic,
         parse_boring_config,
         simulate_boring,
@@ -261,7 +261,7 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
 
 # ----------------------------------------------------------------------------------- 2D
 def _ortho_cfg(le: float | None, length_mm: float | None, config: str | None = None):
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     cfg = load_fe_config(config or ROOT / "examples" / "fe_orthogonal.toml")
     if le is not None:
@@ -272,7 +272,7 @@ def _ortho_cfg(le: float | None, length_mm: float | None, config: str | None = N
 
 
 def _diff2(a, b) -> dict:
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
 
     out = {k: _rel(getattr(a, k), getattr(b, k))
            for k in ("x", "y", "vx", "vy", "sdx", "pres", "eps_p", "temp", "tool")}
@@ -283,11 +283,12 @@ def _diff2(a, b) -> dict:
 
 def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
-    from robobore.cutting.fe.solver import advance, setup_orthogonal
+    from robobore.cutting.fe.engine.chunk_driver import advance
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     advance_gpu = None
     if use_gpu:
-        from robobore.cutting.fe.gpu2d import advance_gpu
+        from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
     numba.set_num_threads(min(cpu_threads, numba.config.NUMBA_NUM_THREADS))
     res = {"cpu_threads": cpu_threads, "runs": []}
     for le in sizes:
@@ -302,7 +303,7 @@ def speed2d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
 
 def ortho2d(devices: list[str], length_mm: float | None, le: float | None,
             config: str | None = None) -> dict:
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     cfg = _ortho_cfg(le, length_mm, config)
     by = {}

@@ -63,12 +63,13 @@ def main() -> int:
         return 2
     disp.get_current_device = lambda: types.SimpleNamespace(compute_capability=cc)
 
-    from robobore.cutting.fe import gpu, gpu2d
-    from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-    from robobore.cutting.fe.config import load_fe_config
-    from robobore.cutting.fe.solver import setup_orthogonal
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
+    from robobore.cutting.fe.engine.gpu import backend3d as gpu
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

@@ -59,8 +59,8 @@ PKG = ROOT / "src" / "robobore"
 
 #: parse-only drivers (commands that would run FE simulations or the whole paper study)
 PARSE = {
-    "fe": "from robobore.cutting.fe.config import load_fe_config as f",
-    "fe_boring": "from robobore.cutting.fe.boring3d import load_boring_config as f",
+    "fe": "from robobore.cutting.fe.config.orthogonal import load_fe_config as f",
+    "fe_boring": "from robobore.cutting.fe.models.boring3d import load_boring_config as f",
     "calibration": "from robobore.cutting.calibration_config import load_calibration_config as f",
     "paper": "from robobore.study.paper_config import load_paper_config as f",
     "material": "from robobore.material import load_material as f",
@@ -75,8 +75,8 @@ PARSE = {
 NO_FE = ("import sys\n"
          "import robobore.cutting.calibrate as c\n"
          "import robobore.cutting.calibration_runs as r\n"
-         "import robobore.cutting.fe.boring3d as b\n"
-         "import robobore.cutting.fe.solver as s\n"
+         "import robobore.cutting.fe.models.boring3d as b\n"
+         "import robobore.cutting.fe.models.orthogonal as s\n"
          "from robobore.material import load_material\n"
          "def _stub(cfg=None, *a, source=None, **k):\n"
          "    m = getattr(cfg, 'material', None)\n"

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from robobore.cutting import calibrate as cal
-from robobore.cutting.fe.validate import (
+from robobore.cutting.fe.models.validate import (
     bundled_validation_path,
     load_validation_record,
     read_measured,

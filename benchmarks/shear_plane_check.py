@@ -65,7 +65,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robobore.cutting.fe.output import shear_angle_deg
+from robobore.cutting.fe.models.output import shear_angle_deg
 from robobore.material.library import load_material
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -8,7 +8,7 @@ Usage::
 
 Runs the 2D engine (``robobore fe orthogonal`` physics, node splitting 5 um above the edge's
 lowest point, Rech friction table) and the 3D engine on a plane-strain slab of the same cut
-(:mod:`robobore.cutting.fe.slab3d`), and prints cutting and feed force per unit width from
+(:mod:`robobore.cutting.fe.models.slab3d`), and prints cutting and feed force per unit width from
 both with the relative differences, energy errors, hourglass fractions and wall times. The
 default is the condition of the paper example's FE calibration (h = 100 um, 80 m/min, rake 7,
 clearance 7, edge 20 um, 10 um elements). Results go to ``--out`` (atomic JSON) when given.
@@ -36,9 +36,9 @@ def main() -> None:
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
 
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.slab3d import simulate_slab3
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
+    from robobore.cutting.fe.models.slab3d import simulate_slab3
     from robobore.io.results import atomic_write_text
 
     d = {"parameters": "a_priori", "material": {"name": "TC4"},

@@ -1,5 +1,5 @@
 """FE orthogonal validation against the nine measured Ti6Al4V points, with run times and
-throughput: a thin caller of :mod:`robobore.cutting.fe.validate` (the same protocol as
+throughput: a thin caller of :mod:`robobore.cutting.fe.models.validate` (the same protocol as
 ``robobore fe validate``).
 
 Reference: ../shared/data/ti64_orthogonal_cutting_forces.json (Ducobu, Pantale et al., CIRP
@@ -22,8 +22,8 @@ import os
 import tempfile
 from pathlib import Path
 
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.validate import parse_points, read_measured, run_validation
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.models.validate import parse_points, read_measured, run_validation
 from robobore.io.config import load_toml
 
 ROOT = Path(__file__).resolve().parents[1]

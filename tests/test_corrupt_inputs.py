@@ -33,13 +33,13 @@ def _dynamics(p: Path):
 
 
 def _fe(p: Path):
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     load_fe_config(p)
 
 
 def _fe_boring(p: Path):
-    from robobore.cutting.fe.boring3d import load_boring_config
+    from robobore.cutting.fe.models.boring3d import load_boring_config
 
     load_boring_config(p)
 

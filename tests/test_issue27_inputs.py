@@ -17,8 +17,8 @@ from typer.testing import CliRunner
 from robobore.cli import app
 from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
-from robobore.cutting.fe.boring3d import parse_boring_config
-from robobore.cutting.fe.config import load_fe_config, parse_config
+from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
+from robobore.cutting.fe.models.boring3d import parse_boring_config
 from robobore.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +33,7 @@ def _no_run(*a, **k):
 @pytest.fixture(autouse=True)
 def _never_run(monkeypatch):
     monkeypatch.setattr(calruns, "run_fe_point", _no_run)
-    monkeypatch.setattr("robobore.cutting.fe.solver.simulate_orthogonal", _no_run)
+    monkeypatch.setattr("robobore.cutting.fe.models.orthogonal.simulate_orthogonal", _no_run)
 
 
 def _garbled_material(tmp_path: Path) -> Path:

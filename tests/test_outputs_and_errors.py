@@ -105,8 +105,8 @@ def test_unwritable_output_refused_before_any_work(tmp_path, monkeypatch, args, 
     # modules that bind a patched name at import: imported first, so they keep the real one
     importlib.import_module("robobore.modal.example")
 
-    for mod, name in (("robobore.cutting.fe.solver", "simulate_orthogonal"),
-                      ("robobore.cutting.fe.boring3d", "simulate_boring"),
+    for mod, name in (("robobore.cutting.fe.models.orthogonal", "simulate_orthogonal"),
+                      ("robobore.cutting.fe.models.boring3d", "simulate_boring"),
                       ("robobore.cutting.calibrate", "calibrate_forces"),
                       ("robobore.study.paper", "run_paper"),
                       ("robobore.study.sweep", "run_sweep"),
@@ -246,8 +246,8 @@ def test_fe_meshes_refused_at_parse_time(tmp_path):
     import re
     import tomllib
 
-    from robobore.cutting.fe.boring3d import load_boring_config, parse_boring_config
-    from robobore.cutting.fe.config import load_fe_config, parse_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
+    from robobore.cutting.fe.models.boring3d import load_boring_config, parse_boring_config
     from robobore.io.memory import fe2d_elements, fe3d_elements
 
     for f in sorted(EX.glob("fe_orthogonal*.toml")):

@@ -343,7 +343,7 @@ def _fe_material_case(tmp_path, monkeypatch):
 
 
 def test_fe_orthogonal_material_file_is_config_relative(tmp_path, monkeypatch):
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.material import load_material
 
     cfgdir = _fe_material_case(tmp_path, monkeypatch)
@@ -358,7 +358,7 @@ def test_fe_orthogonal_material_file_is_config_relative(tmp_path, monkeypatch):
 
 
 def test_fe_boring_material_file_is_config_relative(tmp_path, monkeypatch):
-    from robobore.cutting.fe.boring3d import load_boring_config
+    from robobore.cutting.fe.models.boring3d import load_boring_config
 
     cfgdir = _fe_material_case(tmp_path, monkeypatch)
     text = (EX / "fe_boring_paper.toml").read_text()
@@ -369,7 +369,7 @@ def test_fe_boring_material_file_is_config_relative(tmp_path, monkeypatch):
 
 
 def test_material_missing_file_names_config_and_key(tmp_path, monkeypatch):
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     monkeypatch.chdir(tmp_path)
     text = (EX / "fe_orthogonal.toml").read_text()

@@ -208,7 +208,7 @@ def test_boring_chip_calibration_example_is_valid():
     parses, and its FE points respect the engine's element size <= h / 3 check."""
     from pathlib import Path
 
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
 
     path = Path(__file__).parents[2] / "examples" / "calibration_boring_chip.toml"
     c = calcfg.load_calibration_config(path)
@@ -262,7 +262,7 @@ def _full(fe_config, tmp_path=None, **kw):
 
 
 def test_full_fe_config_inline_overrides_only_h_vc_and_the_insert():
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
 
     c = _full(_FULL)
     assert c.fe_config_source == "inline"

@@ -20,7 +20,7 @@ import pytest
 from robobore.cutting import calibrate as cal
 from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
-from robobore.cutting.fe.validate import (
+from robobore.cutting.fe.models.validate import (
     bundled_validation_path,
     load_validation_record,
     read_measured,

@@ -184,7 +184,7 @@ def test_radial_return_with_a_hardening_strain_limit_recovers_a_constructed_root
 
 def test_hardening_strain_limit_from_files_and_configs(tmp_path):
     """The key in a material file, its override in an FE config, and a bad value."""
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.errors import ConfigError
     from robobore.material import load_material
 

@@ -11,7 +11,7 @@ import re
 
 import pytest
 
-from robobore.cutting.fe.validate import bundled_validation_path, load_validation_record
+from robobore.cutting.fe.models.validate import bundled_validation_path, load_validation_record
 from robobore.errors import DataError
 from robobore.study import paper_config as pc
 from robobore.study.paper_report import force_model_fe_text, force_model_validation

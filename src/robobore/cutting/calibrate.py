@@ -326,7 +326,7 @@ def validation_calibration(record: dict[str, Any], fe_config: dict[str, Any],
     """The FE points of a validation record as a calibration: (config, records).
 
     ``record``: the ``--json`` output of ``robobore fe validate``
-    (:func:`robobore.cutting.fe.validate.load_validation_record`); ``fe_config``: the FE
+    (:func:`robobore.cutting.fe.models.validate.load_validation_record`); ``fe_config``: the FE
     config mapping it ran (its ``[tool]`` is the insert, its ``[material]`` the material).
     The grid is the record's chip thicknesses x speeds (every combination must be in the
     record); the records carry the simulated forces (N/m) as :func:`run_grid` gives them, so
@@ -364,7 +364,7 @@ def mechanistic_check(cfg: CalibrationConfig, records: list[dict[str, Any]],
 
     ``records``: FE points as :func:`run_grid` gives them (``h_um``, ``vc_m_per_min``,
     ``Fc_N_per_m``, ``Ff_N_per_m``, ``fe``); ``measured``: measured points
-    (:func:`robobore.cutting.fe.validate.read_measured`, N/mm) or None. Returns
+    (:func:`robobore.cutting.fe.models.validate.read_measured`, N/mm) or None. Returns
 
     - ``coefficients``: the calibration (:func:`calibrate`),
     - ``points``: per FE point the mechanistic forces at its (h, vc) through

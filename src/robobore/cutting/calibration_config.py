@@ -202,7 +202,7 @@ def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
     names the key as the user wrote it: the shorthand's (``calibration.fe.<key>``), the
     inline table's (``calibration.fe_config.<key>``), the FE config file's own key (with that
     file), or the grid's key for h and vc."""
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
 
     for h in cfg.uncut_chip_thickness_um:
         for v in cfg.cutting_speed_m_per_min:
@@ -232,7 +232,7 @@ def _check_grid(cfg: CalibrationConfig, source: str | None, field: str) -> None:
 
 def _engine_range(key: str) -> str:
     """The FE engine's accepted range of a ``cut`` key, in words."""
-    from robobore.cutting.fe.config import CutSection
+    from robobore.cutting.fe.config.orthogonal import CutSection
 
     name = key.split(".")[-1]
     b = {k: getattr(m, k) for m in CutSection.model_fields[name].metadata
@@ -256,7 +256,7 @@ def load_calibration_config(path: str | Path, other_sections: Collection[str] = 
 def fe_config_dict(cfg: CalibrationConfig, h_um: float, vc_m_per_min: float) -> dict[str, Any]:
     """The FE engine's config (``robobore fe orthogonal`` contract) of one grid point."""
     if cfg.fe_config is not None:
-        from robobore.cutting.fe.validate import point_config
+        from robobore.cutting.fe.models.validate import point_config
 
         return point_config(cfg.fe_config, h_um, vc_m_per_min)
     fe = cfg.fe
@@ -314,7 +314,7 @@ def _departures(cfg: CalibrationConfig, c: Any) -> list[str]:
 def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
     """The FE model of the virtual tests in words, with its validation status: whether its
     physics (frame, friction, material, conduction) are the engine's validated defaults."""
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
 
     h0, v0 = cfg.uncut_chip_thickness_um[0], cfg.cutting_speed_m_per_min[0]
     c = parse_config(fe_config_dict(cfg, h0, v0))

@@ -28,8 +28,8 @@ _SUMMARY_KEYS = ("cutting_force_N_per_mm", "feed_force_N_per_mm", "cutting_force
 
 def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     """Run one virtual orthogonal test (in a worker process); returns the FE summary subset."""
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     res = simulate_orthogonal(parse_config(fe_cfg))
     s = res.summary
@@ -50,7 +50,7 @@ def fe_cache_inputs(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     """Cache key inputs: the full FE config after defaults (a changed default changes the
     key) and the engine's :data:`robobore.cutting.fe.FE_ENGINE_REVISION`."""
     from robobore.cutting import fe
-    from robobore.cutting.fe.config import parse_config
+    from robobore.cutting.fe.config.orthogonal import parse_config
 
     return {"fe_config": parse_config(fe_cfg).model_dump(mode="json"),
             "engine_revision": fe.FE_ENGINE_REVISION}

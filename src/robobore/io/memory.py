@@ -33,7 +33,7 @@ from robobore.errors import ConfigError
 #: element on the bundled fe_orthogonal*.toml examples; the rest is the history and the
 #: copies taken for the output.
 FE2D_BYTES_PER_ELEMENT = 1500
-#: 3D explicit FE (robobore.cutting.fe.boring3d): bytes per hexahedral element at the peak
+#: 3D explicit FE (robobore.cutting.fe.models.boring3d): bytes per hexahedral element at the peak
 #: (a set-up run of examples/fe_boring_paper.toml measures 910 bytes per element).
 FE3D_BYTES_PER_ELEMENT = 1500
 #: time-domain boring (robobore.dynamics.timedomain): float64 values held per time step:
@@ -93,7 +93,7 @@ def check_memory(estimate_bytes: float, what: str, key: str, *, file: str | None
 
 
 def fe2d_elements(cfg: Any) -> float:
-    """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.FEConfig`).
+    """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`).
 
     Workpiece frame: ``(length_mm + ahead_mm) / le`` columns times the rows of the fine zone
     (``(1 + fine_depth_factor) h / le``) plus the graded rows below it. Tool frame: the

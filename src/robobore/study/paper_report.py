@@ -140,7 +140,7 @@ def force_model_validation(rep: Report, coeffs: dict[str, Any],
     of the default model (``robobore/data/fe_validation``) when the calibration ran the
     validated physics on its material; otherwise a note that no validation applies."""
     from robobore.cutting.calibration_config import VALIDATION_DOMAIN
-    from robobore.cutting.fe.validate import bundled_validation_path, load_validation_record
+    from robobore.cutting.fe.models.validate import bundled_validation_path, load_validation_record
 
     m = coeffs.get("fe_model") if isinstance(coeffs.get("fe_model"), dict) else {}
     mat = coeffs.get("material")

@@ -20,9 +20,10 @@ import numpy as np
 import pytest
 from conftest import elastic_tc4, strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 

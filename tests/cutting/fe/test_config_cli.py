@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting.fe.config import load_fe_config, parse_config
+from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
 from robobore.errors import ConfigError
 
 EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
@@ -95,7 +95,7 @@ def test_bad_tool_support(tmp_path):
 
 
 def test_tool_support_too_stiff_for_the_step():
-    from robobore.cutting.fe.solver import setup_orthogonal
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     d = _with("tool_support", "stiffness_N_per_m", [1e13, 1e7])
     d["tool_support"].update(damping_N_s_per_m=10.0, mass_kg=0.001)

@@ -16,9 +16,10 @@ from conftest import elastic_tc4, strip_mesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe import physics as P
-from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state
+from robobore.cutting.fe.physics import tool_contact as P
 
 RAKE = math.radians(15.0)
 CLR = math.radians(2.0)

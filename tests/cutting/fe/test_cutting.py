@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.solver import simulate_orthogonal
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
 FC_MEAS, FF_MEAS, R_MEAS = 118.23, 50.3, 1.23
 BASE = {
@@ -122,7 +122,7 @@ def test_force_by_face_sums_to_the_total(rigid):
 def test_contact_split_classifies_by_face():
     """Nodes placed on the rake face, the edge arc and the flank of a tool with rake 15 deg,
     clearance 2 deg, r = 20 um at the origin: each force lands in its face's slot."""
-    from robobore.cutting.fe.kernels import contact_split
+    from robobore.cutting.fe.engine.kernels import contact_split
 
     r = 20e-6
     rake, clr = math.radians(15.0), math.radians(2.0)

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import FRICTION_TABLE_MU, load_fe_config, parse_config
-from robobore.cutting.fe.solver import setup_orthogonal
+from robobore.cutting.fe.config.orthogonal import FRICTION_TABLE_MU, load_fe_config, parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml
 from robobore.material import johnson_cook as jc

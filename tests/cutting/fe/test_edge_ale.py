@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 from conftest import edge_band_dict
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.rezone import MODE_ROWS, rezone, row_stencil
-from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.ale.rezone import MODE_ROWS, rezone, row_stencil
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 
 ALE = {"edge_ale_interval": 10, "edge_ale_depth_um": 10.0}
@@ -213,7 +213,7 @@ def test_bad_ale_configs_name_the_field(sections):
 
 
 def test_gpu_refuses_the_ale():
-    from robobore.cutting.fe.gpu2d import check_gpu_supported
+    from robobore.cutting.fe.engine.gpu.backend2d import check_gpu_supported
 
     with pytest.raises(ConfigError) as ei:
         check_gpu_supported(0, "t.toml", "q4r", 10)

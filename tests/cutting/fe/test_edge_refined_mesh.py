@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 from conftest import edge_band_dict
 
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.mesh import build_edge_refined_mesh
-from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.mesh.orthogonal import build_edge_refined_mesh
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.errors import ConfigError
 
 H, LE, SH = 30e-6, 10e-6, 5e-6
@@ -147,8 +147,8 @@ def test_chip_ratio_uses_the_parting_line_as_the_underside():
     it, not from the lowest surviving node of each column (which lies inside the chip)."""
     from types import SimpleNamespace
 
-    from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.output import measure_chip
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.models.output import measure_chip
 
     h, sep, s = 60e-6, 5e-6, 2.5
     m = build_edge_refined_mesh(h, LE, 0.3e-3, split_height=sep, levels=2,
@@ -189,8 +189,8 @@ def test_chip_ratio_from_the_chip_speed():
     varies across the chip is averaged with the nodal masses."""
     from types import SimpleNamespace
 
-    from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.output import chip_ratio_from_velocity
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.models.output import chip_ratio_from_velocity
 
     h, vc, r_true = 60e-6, 0.5, 1.37
     m = build_edge_refined_mesh(h, LE, 0.3e-3, split_height=SH, levels=2,

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 from conftest import elastic_tc4, strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.errors import NumericalError
 from robobore.material import load_material
 

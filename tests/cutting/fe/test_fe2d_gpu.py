@@ -19,7 +19,8 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting.fe import gpu, gpu2d
+from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
+from robobore.cutting.fe.engine.gpu import backend3d as gpu
 from robobore.errors import ConfigError
 
 EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
@@ -27,7 +28,7 @@ EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
 #: shared by the simulator scripts: histories every 5 steps over the compared steps
 PRELUDE = textwrap.dedent("""
     import numpy as np
-    from robobore.cutting.fe import kernels as K
+    from robobore.cutting.fe.engine import kernels as K
 
     def sample_every_5_steps(st, rows):
         dt = float(st.clock[1])
@@ -45,10 +46,11 @@ SCRIPT = PRELUDE + textwrap.dedent("""
     import numpy as np
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
-    from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.gpu2d import advance_gpu
-    from robobore.cutting.fe.solver import advance, setup_orthogonal
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
+    from robobore.cutting.fe.engine.chunk_driver import advance
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     cfg = parse_config({
         "tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
@@ -112,10 +114,11 @@ SCRIPT = PRELUDE + textwrap.dedent("""
 SCRIPT_TF = PRELUDE + textwrap.dedent("""
     import copy, json, sys, tomllib
     import numpy as np
-    from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.gpu2d import advance_gpu
-    from robobore.cutting.fe.solver import advance, setup_orthogonal
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
+    from robobore.cutting.fe.engine.chunk_driver import advance
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     d = tomllib.load(open(sys.argv[1], "rb"))
     d["cut"]["length_mm"] = 0.02  # one element: the shortest cut the config accepts
@@ -162,8 +165,8 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
 def test_gpu2d_module_imports_and_reports_cleanly():
     assert callable(gpu2d.advance_gpu)
     if not gpu.cuda_available():
-        from robobore.cutting.fe.config import load_fe_config
-        from robobore.cutting.fe.solver import simulate_orthogonal
+        from robobore.cutting.fe.config.orthogonal import load_fe_config
+        from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
         with pytest.raises(ConfigError, match="no usable NVIDIA GPU"):
             simulate_orthogonal(load_fe_config(EXAMPLE), device="gpu")
@@ -291,8 +294,8 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
     from numba import typeof
     from numba.core.datamodel import default_manager
 
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.solver import setup_orthogonal
+    from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     def nbytes(t) -> int:
         if isinstance(t, tuple):

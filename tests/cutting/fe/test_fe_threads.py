@@ -9,8 +9,8 @@ import numba
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import threads as T
-from robobore.cutting.fe.threads import ThreadGovernor
+from robobore.cutting.fe.engine import threads as T
+from robobore.cutting.fe.engine.threads import ThreadGovernor
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -84,8 +84,9 @@ needs_threads = pytest.mark.skipif(numba.get_num_threads() < 2,
 
 @needs_threads
 def test_2d_default_model_gives_the_same_digits_on_any_thread_count():
-    from robobore.cutting.fe.config import load_fe_config
-    from robobore.cutting.fe.solver import advance, setup_orthogonal
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
+    from robobore.cutting.fe.engine.chunk_driver import advance
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal.toml")
     cfg.cut.length_mm = 0.005
@@ -102,8 +103,8 @@ def test_2d_default_model_gives_the_same_digits_on_any_thread_count():
 
 @needs_threads
 def test_3d_boring_model_gives_the_same_digits_on_any_thread_count():
-    from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-    from robobore.cutting.fe.solver3d import advance3
+    from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
 
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                  "cut_length_mm": 0.02},

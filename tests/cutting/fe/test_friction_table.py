@@ -2,8 +2,8 @@
 
 Reference: a tribometer gives the Coulomb coefficient against the *sliding* velocity (Rech et
 al. 2013, CIRP Annals 62, 79-82, the source of the Ti6Al4V table bundled in
-robobore.cutting.fe.config); a slip-rate-dependent table is read piecewise linearly and is
-constant beyond its ends (as Abaqus' friction tables). The engine looks the coefficient up
+robobore.cutting.fe.config.orthogonal); a slip-rate-dependent table is read piecewise linearly and
+is constant beyond its ends (as Abaqus' friction tables). The engine looks the coefficient up
 per contact node and step at the node's sliding speed relative to the tool.
 """
 
@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 from conftest import elastic_tc4, strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe import physics as P
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.solver import advance, default_prm, make_state
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state
+from robobore.cutting.fe.physics import tool_contact as P
 from robobore.errors import ConfigError
 
 
@@ -128,8 +129,8 @@ def test_the_engine_slides_against_the_table_at_the_sliding_speed():
 
 
 def test_the_3d_slab_reads_the_table_at_the_sliding_speed():
-    from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.slab3d import setup_slab3
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.models.slab3d import setup_slab3
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,

@@ -14,16 +14,12 @@ import numpy as np
 import pytest
 from conftest import strip_mesh
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.mesh import _split_nodes
-from robobore.cutting.fe.solver import (
-    advance,
-    default_prm,
-    make_state,
-    parting_edges,
-    setup_orthogonal,
-)
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.state2d import default_prm, make_state, parting_edges
+from robobore.cutting.fe.mesh.orthogonal import _split_nodes
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 from robobore.errors import ConfigError
 from robobore.material import load_material
 
@@ -187,7 +183,7 @@ def test_the_tool_sink_cools_the_cut():
     """A short cut with conduction: the tool as a strong heat sink (1e7 W/m2K, all
     frictional heat into the tool) leaves the workpiece with less heat than an adiabatic
     tool that takes none of the frictional heat (all of it into the workpiece)."""
-    from robobore.cutting.fe.solver import run_orthogonal
+    from robobore.cutting.fe.models.orthogonal import run_orthogonal
 
     def heat(**contact):
         su = setup_orthogonal(_short_cut_cfg(**contact))

@@ -14,10 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.physics import tool_gap_py
-from robobore.cutting.fe.rezone import (
+from robobore.cutting.fe.ale.rezone import (
     BF_OPEN,
     BF_VIRGIN,
     MODE_TOOLFRAME,
@@ -28,8 +25,11 @@ from robobore.cutting.fe.rezone import (
     rezone,
     swept_py,
 )
-from robobore.cutting.fe.solver import setup_orthogonal, simulate_orthogonal
-from robobore.cutting.fe.toolframe import build_toolframe_mesh
+from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
+from robobore.cutting.fe.physics.tool_contact import tool_gap_py
 from robobore.errors import ConfigError
 
 RAKE, CLR, R = math.radians(15.0), math.radians(2.0), 20e-6
@@ -184,8 +184,8 @@ def test_tool_frame_config_errors(patch, field):
 def test_tool_frame_on_gpu_needs_a_gpu():
     """The tool-frame model runs on the GPU (the simulator test in
     test_fe2d_gpu.py); without a usable GPU --device gpu stops with the clear error."""
-    from robobore.cutting.fe.gpu import cuda_available
-    from robobore.cutting.fe.solver import check_device
+    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
+    from robobore.cutting.fe.models.orthogonal import check_device
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
                         "cut": {"uncut_chip_thickness_um": 60, "cutting_speed_m_per_min": 30,
@@ -202,7 +202,7 @@ def test_example_config_builds():
     """examples/fe_orthogonal_toolframe.toml: the tool-frame defaults land in the engine."""
     from pathlib import Path
 
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     cfg = load_fe_config(Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml")
     su = setup_orthogonal(cfg)
@@ -224,7 +224,7 @@ def test_domain_keys_move_the_tool_frame_boundaries():
     edge centre at x = 0 before the tool moves)."""
     from pathlib import Path
 
-    from robobore.cutting.fe.config import load_fe_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
 
     path = Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml"
     base = setup_orthogonal(load_fe_config(path))

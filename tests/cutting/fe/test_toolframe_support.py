@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import pytest
 
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.solver import simulate_orthogonal
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
 BASE = {"tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
         "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,

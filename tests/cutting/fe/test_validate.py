@@ -1,5 +1,5 @@
-"""``robobore fe validate`` (robobore.cutting.fe.validate): the measured-forces reader and its
-errors, the per-point config (only h and vc replaced), the --json contract, the resume of an
+"""``robobore fe validate`` (robobore.cutting.fe.models.validate): the measured-forces reader and
+its errors, the per-point config (only h and vc replaced), the --json contract, the resume of an
 interrupted validation, and every input error found before the first FE run.
 
 The runs use a tiny tool-frame config (20 um elements, 5 um round the edge, 20 um of tool
@@ -17,7 +17,7 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting.fe import validate as V
+from robobore.cutting.fe.models import validate as V
 from robobore.errors import ConfigError, DataError
 
 TINY = """\
@@ -126,7 +126,7 @@ def test_bad_points_option(text):
 def test_config_errors_before_any_run(tmp_path, monkeypatch):
     import tomllib
 
-    monkeypatch.setattr("robobore.cutting.fe.solver.simulate_orthogonal", _no_run)
+    monkeypatch.setattr("robobore.cutting.fe.models.orthogonal.simulate_orthogonal", _no_run)
     base = tomllib.loads(TINY)
     # a point whose chip is too thin for the element: found at planning, naming the point
     meas = V.read_measured(_files(tmp_path, {"measured": {"Fc": {"60": {"30": 1.0},
@@ -141,7 +141,7 @@ def test_config_errors_before_any_run(tmp_path, monkeypatch):
 
 
 def test_cli_bad_inputs_exit_2_without_running(tmp_path, monkeypatch):
-    monkeypatch.setattr("robobore.cutting.fe.validate.run_validation", _no_run)
+    monkeypatch.setattr("robobore.cutting.fe.models.validate.run_validation", _no_run)
     c, m = _files(tmp_path, {"measured": {"Fc": {"60": {"30": "abc"}}}})
     r = CliRunner().invoke(app, ["fe", "validate", str(c), "--measured", str(m), "--json"])
     assert r.exit_code == 2 and "measured.Fc.60.30" in r.output and "abc" in r.output
@@ -196,7 +196,7 @@ def test_cli_json_contract_and_resume(tmp_path):
 def test_interrupted_validation_resumes(tmp_path):
     import tomllib
 
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     base = tomllib.loads(TINY)
     meas = V.read_measured(_files(tmp_path)[1])
@@ -232,7 +232,7 @@ def test_interrupted_validation_resumes(tmp_path):
 def test_points_option_runs_a_prediction(tmp_path):
     import tomllib
 
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     base = tomllib.loads(TINY)
     meas = V.read_measured(_files(tmp_path)[1])

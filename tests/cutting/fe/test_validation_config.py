@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels as K
-from robobore.cutting.fe.config import FRICTION_TABLE_MU, load_fe_config, parse_config
-from robobore.cutting.fe.solver import setup_orthogonal
-from robobore.cutting.fe.validate import point_config
+from robobore.cutting.fe.config.orthogonal import FRICTION_TABLE_MU, load_fe_config, parse_config
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.models.orthogonal import setup_orthogonal
+from robobore.cutting.fe.models.validate import point_config
 from robobore.material import johnson_cook as jc
 
 _ROOT = Path(__file__).parents[3]
@@ -86,7 +86,7 @@ def test_calibrated_set_meets_the_bands_at_the_contract_point():
     tolerances: Fc 10 %, Ff 25 % (issue 27), chip ratio within the measured range 1.18-1.97
     +-30 %, energy error 5 %. Measured: Fc -4.5 %, Ff -9.2 %, chip ratio 1.70, energy error
     1.3 % (~160 s on 2 cores)."""
-    from robobore.cutting.fe.solver import simulate_orthogonal
+    from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     s = simulate_orthogonal(load_fe_config(_EXAMPLE)).summary
     fc_meas, ff_meas = 118.23, 50.3

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from robobore.cutting.fe.cli import validation_warnings
-from robobore.cutting.fe.config import load_fe_config, parse_config
+from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
 from robobore.io.config import load_toml
 
 _EX = Path(__file__).parents[3] / "examples"

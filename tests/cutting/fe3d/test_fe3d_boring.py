@@ -14,8 +14,8 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
-from robobore.cutting.fe.boring3d import build_boring_mesh, parse_boring_config
 from robobore.cutting.fe.cli_boring import register_boring
+from robobore.cutting.fe.models.boring3d import build_boring_mesh, parse_boring_config
 from robobore.cutting.geometry import BoringInsert, chip_area
 from robobore.errors import ConfigError
 
@@ -66,7 +66,7 @@ def test_bad_configs_name_the_field(path, value, match):
 
 
 def test_unknown_material_is_a_clear_error():
-    from robobore.cutting.fe.boring3d import setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
 
     d = _base()
     d["material"] = {"name": "unobtainium"}
@@ -148,7 +148,7 @@ def test_tiny_run_physics(tiny_run):
 
 
 def test_gpu_request_without_gpu_is_a_clear_error(tiny_run):
-    from robobore.cutting.fe.gpu import cuda_available
+    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
 
     if cuda_available():
         pytest.skip("a CUDA device is present: the no-GPU error path does not apply")

@@ -1,5 +1,5 @@
-"""Heat conduction of the 3D engine (cutting/fe/thermal3d.py): the face table, a 1D diffusion
-against the analytic solution, exact heat conservation, the bound of the explicit update,
+"""Heat conduction of the 3D engine (cutting/fe/physics/thermal3d.py): the face table, a 1D
+diffusion against the analytic solution, exact heat conservation, the bound of the explicit update,
 conduction across tied (not parted) faces of node splitting, the thermal contact with the
 insert, and the boring model with and without conduction."""
 
@@ -10,16 +10,16 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.boring3d import parse_boring_config, setup_boring
-from robobore.cutting.fe.solver3d import (
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
     energy_error,
     make_state3,
     split_node_layer,
 )
-from robobore.cutting.fe.thermal3d import (
+from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+from robobore.cutting.fe.physics.thermal3d import (
     conduct3,
     face_neighbours,
     tool_heat3,

@@ -1,8 +1,8 @@
 """3D contact law and insert geometry; rigid-insert contact patch without excess penetration.
 
 The contact law is the 2D engine's (mass-proportional penalty, Coulomb, shear cap;
-:func:`robobore.cutting.fe.physics.contact_force_py`) with a tangential vector; the
-insert's signed distance is the 2D wedge (:func:`physics.tool_gap_py`) in the normal
+:func:`robobore.cutting.fe.physics.tool_contact.contact_force_py`) with a tangential vector; the
+insert's signed distance is the 2D wedge (:func:`tool_contact.tool_gap_py`) in the normal
 section of the nose-radius edge.
 """
 
@@ -15,9 +15,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.physics import contact_force_py, tool_gap_py
-from robobore.cutting.fe.solver3d import advance3, box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import advance3, box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.physics.tool_contact import contact_force_py, tool_gap_py
 from robobore.material import Material, load_material
 
 RN, KAP, KEND, RAKE, CLR, RE = 0.4e-3, math.radians(90), math.radians(5), math.radians(7), \

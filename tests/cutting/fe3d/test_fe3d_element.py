@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.solver3d import (
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
     default_prm3,
@@ -243,8 +243,8 @@ def test_hourglass_resistance_matches_2d_quad_in_plane_strain(hgs, hgv):
     means the same in both engines. Tolerance 1e-9 relative (same formulas, rounding only).
     Before the scaling was aligned the cube resisted 3x (stiffness) and 2x (viscous) more, and
     a plane-strain slab cut by the 3D engine gave 1.5x the 2D cutting force."""
-    from robobore.cutting.fe import kernels as K
-    from robobore.cutting.fe.solver import default_prm, make_state
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine.state2d import default_prm, make_state
 
     a = 10e-6
     v0 = 0.1

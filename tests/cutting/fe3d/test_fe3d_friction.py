@@ -12,12 +12,13 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels as K2
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.boring3d import parse_boring_config
-from robobore.cutting.fe.config import ContactSection
-from robobore.cutting.fe.solver import apply_friction_settings, default_prm
-from robobore.cutting.fe.solver3d import box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.config.engine_settings import apply_friction_settings
+from robobore.cutting.fe.config.orthogonal import ContactSection
+from robobore.cutting.fe.engine import kernels as K2
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state2d import default_prm
+from robobore.cutting.fe.engine.state3d import box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.models.boring3d import parse_boring_config
 from robobore.errors import ConfigError
 from robobore.material import load_material
 from robobore.material.friction import friction_law

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from robobore.cutting.fe import gpu
+from robobore.cutting.fe.engine.gpu import backend3d as gpu
 from robobore.errors import ConfigError
 
 #: the GPU benchmark script; its ``small3d`` builds the simulator test's state
@@ -27,9 +27,9 @@ SCRIPT = textwrap.dedent("""
     import numpy as np
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
-    from robobore.cutting.fe import kernels3d as K3
-    from robobore.cutting.fe.gpu import advance3_gpu
-    from robobore.cutting.fe.solver3d import advance3
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.gpu.backend3d import advance3_gpu
+    from robobore.cutting.fe.engine.state3d import advance3
 
     # the state builder of benchmarks/bench_gpu.py (its check3d runs the same cut on a GPU)
     spec = importlib.util.spec_from_file_location("bench_gpu", sys.argv[2])
@@ -40,8 +40,11 @@ SCRIPT = textwrap.dedent("""
         # the default friction law (rech2013_calibrated: the table read at each contact
         # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s, and
         # heat conduction with the thermal contact every 3 steps (20 passes)
-        from robobore.cutting.fe.config import ContactSection, SolverSection
-        from robobore.cutting.fe.solver import apply_friction_settings, apply_thermal_settings
+        from robobore.cutting.fe.config.orthogonal import ContactSection, SolverSection
+        from robobore.cutting.fe.config.engine_settings import (
+            apply_friction_settings,
+            apply_thermal_settings,
+        )
         from robobore.material import load_material
         s = bench.small3d(n_samples=40)
         apply_friction_settings(s.prm, ContactSection(), s.prm[K3.P_VC] * 60.0, K3)

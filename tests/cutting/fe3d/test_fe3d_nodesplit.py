@@ -13,14 +13,14 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe import kernels3d as K3
-from robobore.cutting.fe.boring3d import (
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.state3d import advance3, box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.models.boring3d import (
     build_boring_mesh,
     parse_boring_config,
     parting_surface,
     setup_boring,
 )
-from robobore.cutting.fe.solver3d import advance3, box_mesh, default_prm3, make_state3
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
 from robobore.material import load_material

@@ -2,7 +2,7 @@
 
 Reference: the 2D engine (``robobore fe orthogonal``, node splitting), whose element,
 contact and material functions are validated in tests/cutting/fe; a 3D slab held in plane
-strain (:mod:`robobore.cutting.fe.slab3d`) must give the same forces per unit width when the
+strain (:mod:`robobore.cutting.fe.models.slab3d`) must give the same forces per unit width when the
 two engines mean the same thing by every setting. Short cut (h 40 um, 0.1 mm, 10 um
 elements, 80 m/min, rake 7, clearance 7, edge 20 um) to stay cheap in CI. Measured
 2026-11-21: Fc 81.7 (2D) vs 86.8 N/mm (3D), +6.2 %; Ff 26.3 vs 31.5 N/mm, +19 %. Tolerance:
@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import pytest
 
-from robobore.cutting.fe.config import parse_config
-from robobore.cutting.fe.slab3d import simulate_slab3
-from robobore.cutting.fe.solver import simulate_orthogonal
+from robobore.cutting.fe.config.orthogonal import parse_config
+from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
+from robobore.cutting.fe.models.slab3d import simulate_slab3
 from robobore.errors import ConfigError
 
 CFG = {"parameters": "a_priori", "material": {"name": "TC4"},

@@ -1,6 +1,6 @@
 """CLI commands of the FE stage (registered by ``robobore.cli``): ``robobore fe orthogonal``
-(``--device cpu|gpu``), ``robobore fe validate`` (:mod:`robobore.cutting.fe.validate`) and, from
-:mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
+(``--device cpu|gpu``), ``robobore fe validate`` (:mod:`robobore.cutting.fe.models.validate`) and,
+from :mod:`robobore.cutting.fe.cli_boring`, ``robobore fe boring``."""
 
 from __future__ import annotations
 
@@ -93,9 +93,9 @@ def orthogonal_cmd(
 
 @handle_errors
 def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
-    from robobore.cutting.fe.config import load_fe_config
-    from robobore.cutting.fe.output import plot_chip, to_dataset, write_vtk
-    from robobore.cutting.fe.solver import check_device, simulate_orthogonal
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
+    from robobore.cutting.fe.models.orthogonal import check_device, simulate_orthogonal
+    from robobore.cutting.fe.models.output import plot_chip, to_dataset, write_vtk
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_netcdf
 
@@ -143,7 +143,7 @@ def _plot_forces(res, path: Path) -> Path:
     fig, ax = plt.subplots(figsize=(7, 4), dpi=120)
     ax.plot(h["cut_length_mm"], h["cutting_force_N_per_mm"], label="Fc")
     ax.plot(h["cut_length_mm"], h["feed_force_N_per_mm"], label="Ff")
-    from robobore.cutting.fe.kernels import FACES
+    from robobore.cutting.fe.engine.kernels import FACES
 
     for face, style in zip(FACES, (":", "--", "-."), strict=True):
         if f"{face}_cutting_force_N_per_mm" in h:  # CPU runs: the split by tool face
@@ -186,8 +186,8 @@ def validate_cmd(
 
 @handle_errors
 def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu") -> None:
-    from robobore.cutting.fe.config import parse_config
-    from robobore.cutting.fe.validate import parse_points, read_measured, run_validation
+    from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.models.validate import parse_points, read_measured, run_validation
     from robobore.io.config import load_toml
 
     base = load_toml(config)

@@ -65,7 +65,7 @@ def boring_cmd(
 
 @handle_errors
 def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
-    from robobore.cutting.fe.boring3d import (
+    from robobore.cutting.fe.models.boring3d import (
         compare_with_mechanistic,
         load_boring_config,
         simulate_boring,
@@ -77,7 +77,7 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
     if device == "gpu":
-        from robobore.cutting.fe.gpu import require_gpu
+        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
         require_gpu()
     from robobore.io.outputs import check_output_dir

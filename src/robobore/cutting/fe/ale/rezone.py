@@ -1,0 +1,446 @@
+"""ALE-type rezoning of the chip: Laplacian node smoothing + first-order donor-cell remap.
+
+A Lagrangian chip mesh shears without limit in the primary and secondary shear zones
+(elements 10-20 times thinner than wide, stable step collapsing). Every ``interval`` steps
+the interior nodes of the chip layer (not on the free surface, not on the chip underside
+that slides on the rake, not next to an eroded element) are moved a fraction ``omega``
+towards the average of their four structured-grid neighbours (Laplacian smoothing in index
+space, Winslow-like). The element state is then transported through the moving element
+edges by a conservative first-order donor-cell (upwind) remap: for each edge the area swept
+by its motion carries the state of the element it sweeps into (Benson 1992, "Computational
+methods in Lagrangian and Eulerian hydrocodes", CMAME 99, sec. 4.2). Nodal velocities are
+remapped by a first-order Taylor expansion with the mean velocity gradient of the adjacent
+elements. Node moves are limited to ``max_move`` of the local element size so the remap
+Courant number stays below 1.
+
+Remapped element fields: deviatoric stress, pressure, plastic strain, temperature, damage,
+stored hourglass force; element mass (held as the reference area ``area0`` = mass /
+scaled density) is remapped conservatively and the lumped nodal masses recomputed. Only
+edges shared by two live elements carry a flux: what an edge on the outline (or next to an
+eroded element) sweeps as its nodes slide along a curved surface is not mass that enters
+or leaves the model, so mass is conserved exactly and the intensive fields are divided by
+the area their fluxes account for (a uniform field stays uniform).
+
+Two ways of choosing the new node positions share the remap:
+
+* ``MODE_LAPLACE`` (``solver.rezone_interval``, structured uniform mesh): the chip interior
+  is smoothed as above (:func:`smoothing_stencil`).
+* ``MODE_ROWS`` (``solver.edge_ale_interval``, node splitting): the **ploughed layer** --
+  the node rows within ``depth`` under the parting line, which pass under the cutting edge
+  and which a Lagrangian mesh shears until the distortion erosion deletes them -- is made
+  Eulerian in the cutting direction and Lagrangian in depth. Once a column's parting-line
+  pair has been released (the material there has met the edge), its surface node slides
+  along the surface (the polyline through it and its row neighbours) back towards its
+  initial x, by at most ``max_move`` of the shorter row segment
+  per pass; the machined surface (the top row) keeps its shape, the rows under it are
+  spread evenly in depth between it and the layer's bottom row (which stays Lagrangian),
+  and the material flows through the elements (:func:`row_stencil`, :func:`_row_move`).
+
+The remap's scalar passes are in :mod:`robobore.cutting.fe.ale.remap`, the host-side stencils
+(:func:`smoothing_stencil`, :func:`row_stencil`, :func:`edge_neighbours`) in
+:mod:`robobore.cutting.fe.ale.stencils`; this module chooses the new node positions and
+runs the pass (:func:`rezone`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from robobore.cutting.fe.ale.remap import (
+    BF_CLOSED,
+    BF_OPEN,
+    BF_VIRGIN,
+    N_RZ_FIELDS,
+    rz_flux,
+    rz_flux_py,
+    rz_node_mass,
+    rz_node_mass_py,
+    rz_velocity,
+    rz_velocity_py,
+    rz_write,
+    rz_write_py,
+    swept_py,
+)
+from robobore.cutting.fe.ale.stencils import (
+    edge_neighbours,
+    row_stencil,
+    smoothing_stencil,
+)
+from robobore.cutting.fe.physics.tool_contact import tool_gap
+
+#: node relocation of a rezoning pass: Laplacian smoothing, sliding along node rows, or the
+#: tool-frame ALE (every node back to its place in the tool's frame, see
+#: :mod:`robobore.cutting.fe.ale.toolframe`)
+MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME = 0, 1, 2
+#: tool-frame node classes (``acls[:, 0]``): interior, rigid (inflow face, bottom), on a
+#: surface chain (free or against the tool), chain end on an outflow line, on an outflow face
+TF_INTERIOR, TF_RIGID, TF_CHAIN, TF_LINE, TF_FACE = 0, 1, 2, 3, 4
+#: Jacobi sweeps of the mesh-displacement interpolation per tool-frame pass
+TF_SWEEPS = 4
+
+
+def limit_py(px, py, tx, ty, lim):
+    """``(tx, ty)`` moved back towards ``(px, py)`` so that the move is at most ``lim``."""
+    dx = tx - px
+    dy = ty - py
+    d = math.sqrt(dx * dx + dy * dy)
+    if d > lim:
+        return px + dx * lim / d, py + dy * lim / d
+    return tx, ty
+
+
+def off_tool_py(px, py, qx, qy, tg):
+    """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
+    ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
+    slides along a chord wrapped round the edge adds no penalty energy."""
+    g0, _a, _b = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+    g1, n1x, n1y = tool_gap(qx, qy, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+    gt = min(g0, 0.0)
+    if g1 < gt:
+        return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
+    return qx, qy
+
+
+_limit = njit(cache=True, inline="always")(limit_py)
+_off_tool = njit(cache=True, inline="always")(off_tool_py)
+
+
+@njit(cache=True, inline="always")
+def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
+    """MODE_ROWS: move node ``n`` of the ploughed layer back towards its column.
+
+    A node of the machined surface (the parting-line row) slides along the surface (its row
+    line) towards its initial x. A node under it that has a column node at the layer's
+    depth moves towards its initial x and towards its initial share of the column between
+    the surface node and that bottom node (the layer's compression under the edge is spread
+    over all its rows instead of crushing the top one); without one it slides along its
+    row. Each move is at most ``max_move`` of the shortest distance to the node's row and
+    column neighbours.
+
+    A surface node that the slide would put into the tool, or deeper into it than it was --
+    the chord between two surface nodes wrapped round the edge lies inside the tool -- is
+    put back along the tool normal to the tool surface (or to its old penetration), so the
+    pass adds no penalty energy. ``tg`` = tool edge centre x, y, rake and flank normals,
+    edge radius.
+    """
+    lft, rgt, pc, bt = snbr[k, 0], snbr[k, 1], snbr[k, 2], snbr[k, 3]
+    if tied[pc] != 0:
+        return
+    hl = np.sqrt((x[lft] - x[n]) ** 2 + (y[lft] - y[n]) ** 2)
+    hr = np.sqrt((x[rgt] - x[n]) ** 2 + (y[rgt] - y[n]) ** 2)
+    if bt >= 0:
+        up, dn = snbr[k, 4], snbr[k, 5]
+        hv = min(abs(y[up] - y[n]), abs(y[dn] - y[n]))
+        f = (y0[pc] - y0[n]) / (y0[pc] - y0[bt])
+        xn[n], yn[n] = _limit(x[n], y[n], x0[n], y[pc] + f * (y[bt] - y[pc]),
+                              max_move * min(min(hl, hr), hv))
+        return
+    lim = max_move * min(hl, hr)
+    dx = x0[n] - x[n]
+    if dx > lim:
+        dx = lim
+    elif dx < -lim:
+        dx = -lim
+    if dx > 0.0:
+        run = x[rgt] - x[n]
+        if run <= 0.1 * hr:  # row folded back or too steep: leave the node
+            return
+        dy = dx * (y[rgt] - y[n]) / run
+    elif dx < 0.0:
+        run = x[lft] - x[n]
+        if run >= -0.1 * hl:
+            return
+        dy = dx * (y[lft] - y[n]) / run
+    else:
+        return
+    px = x[n] + dx
+    py = y[n] + dy
+    if pc == n:
+        px, py = _off_tool(x[n], y[n], px, py, tg)
+    xn[n] = px
+    yn[n] = py
+
+
+@njit(parallel=True, cache=True)
+def _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode, tied, x0,
+              y0, tg):
+    """MODE_LAPLACE / MODE_ROWS: new positions of the nodes ``snodes`` whose elements are all
+    alive (Laplacian smoothing with relaxation ``omega``, or :func:`_row_move`)."""
+    for k in prange(snodes.shape[0]):
+        n = snodes[k]
+        ok = True
+        for q in range(ptr[n], ptr[n + 1]):
+            if alive[nel[q]] != 1:
+                ok = False
+        if not ok:
+            continue
+        if mode == MODE_ROWS:
+            _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg)
+            continue
+        ax = 0.25 * (x[snbr[k, 0]] + x[snbr[k, 1]] + x[snbr[k, 2]] + x[snbr[k, 3]])
+        ay = 0.25 * (y[snbr[k, 0]] + y[snbr[k, 1]] + y[snbr[k, 2]] + y[snbr[k, 3]])
+        # limit by the local size (mean distance to the neighbours)
+        h = 0.0
+        for j in range(4):
+            h += np.sqrt((x[snbr[k, j]] - x[n]) ** 2 + (y[snbr[k, j]] - y[n]) ** 2)
+        xn[n], yn[n] = _limit(x[n], y[n], x[n] + omega * (ax - x[n]),
+                              y[n] + omega * (ay - y[n]), max_move * 0.25 * h)
+
+
+# -- the tool-frame and remap passes as scalar functions (one node or element each), called
+# -- by the CPU's prange loops below and by the GPU kernels
+# (robobore.cutting.fe.engine.gpu.backend2d)
+
+def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
+    """MODE_TOOLFRAME, first pass, node ``n``: the new place of a rigid node, a surface-chain
+    node or a chain end on an outflow line into ``xn[n]``, ``yn[n]`` (other classes: left
+    as they are). Reads the old positions only."""
+    c = acls[n, 0]
+    px = x[n]
+    py = y[n]
+    qx = x0[n] + off
+    qy = y0[n]
+    if c == TF_RIGID:
+        xn[n] = qx
+        yn[n] = qy
+    elif c == TF_CHAIN:
+        a = acls[n, 1]
+        b = acls[n, 2]
+        tx = px
+        ty = py
+        best = (qx - px) ** 2 + (qy - py) ** 2
+        la = math.sqrt((x[a] - px) ** 2 + (y[a] - py) ** 2)
+        lb = math.sqrt((x[b] - px) ** 2 + (y[b] - py) ** 2)
+        for k in range(2):
+            m = a if k == 0 else b
+            ex = x[m] - px
+            ey = y[m] - py
+            l2 = ex * ex + ey * ey
+            if l2 <= 0.0:
+                continue
+            t = ((qx - px) * ex + (qy - py) * ey) / l2
+            if t <= 0.0:
+                continue
+            t = min(t, 1.0)
+            sx = px + t * ex
+            sy = py + t * ey
+            d = (qx - sx) ** 2 + (qy - sy) ** 2
+            if d < best:
+                best = d
+                tx = sx
+                ty = sy
+        tx, ty = _limit(px, py, tx, ty, max_move * min(la, lb))
+        tx, ty = _off_tool(px, py, tx, ty, tg)
+        xn[n] = tx
+        yn[n] = ty
+    elif c == TF_LINE:
+        # where the surface (its last segment, extended) crosses the line through the
+        # node's tool-frame place along aflt[n, 1:3], at most aflt[n, 0] from that place
+        a = acls[n, 1]
+        ex = px - x[a]
+        ey = py - y[a]
+        dx = aflt[n, 1]
+        dy = aflt[n, 2]
+        cr = ex * dy - ey * dx
+        le = math.sqrt(ex * ex + ey * ey)
+        if abs(cr) > 0.05 * le:
+            t = ((qx - x[a]) * dy - (qy - y[a]) * dx) / cr
+            tx = x[a] + t * ex
+            ty = y[a] + t * ey
+            s = (tx - qx) * dx + (ty - qy) * dy
+        else:  # surface nearly along the line: project onto it
+            s = (px - qx) * dx + (py - qy) * dy
+        # at most aflt[n, 0] along the line from the node's place
+        s = max(-aflt[n, 0], min(aflt[n, 0], s))
+        tx = qx + s * dx
+        ty = qy + s * dy
+        tx, ty = _limit(px, py, tx, ty, max_move * le)
+        tx, ty = _off_tool(px, py, tx, ty, tg)
+        xn[n] = tx
+        yn[n] = ty
+
+
+def tf_face_py(n, xn, yn, x0, y0, acls, aflt, off):
+    """MODE_TOOLFRAME, second pass, node ``n`` (after :func:`tf_place_py` of every node):
+    an outflow-face node spread between its two (placed) ends; then, for every node but an
+    interior one, its mesh displacement (the boundary values of the interpolation)."""
+    c = acls[n, 0]
+    if c == TF_FACE:
+        a = acls[n, 1]
+        b = acls[n, 2]
+        f = aflt[n, 0]
+        xn[n] = xn[a] + f * (xn[b] - xn[a])
+        yn[n] = yn[a] + f * (yn[b] - yn[a])
+    if c != TF_INTERIOR:
+        aflt[n, 4] = xn[n] - x0[n] - off
+        aflt[n, 5] = yn[n] - y0[n]
+
+
+def tf_sweep_py(n, acls, aflt, scratch):
+    """One Jacobi sweep of the mesh-displacement interpolation, interior node ``n``: the mean
+    of its four edge neighbours into ``scratch[n]`` (all nodes, then :func:`tf_sweep_copy_py`)."""
+    if acls[n, 0] != TF_INTERIOR:
+        return
+    sx = 0.0
+    sy = 0.0
+    for k in range(4):
+        m = acls[n, 3 + k]
+        sx += aflt[m, 4]
+        sy += aflt[m, 5]
+    scratch[n, 0] = 0.25 * sx
+    scratch[n, 1] = 0.25 * sy
+
+
+def tf_sweep_copy_py(n, acls, aflt, scratch):
+    """Second half of a Jacobi sweep: interior node ``n`` takes its new displacement."""
+    if acls[n, 0] == TF_INTERIOR:
+        aflt[n, 4] = scratch[n, 0]
+        aflt[n, 5] = scratch[n, 1]
+
+
+def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
+    """MODE_TOOLFRAME, last pass, interior node ``n``: its place in the tool frame plus the
+    interpolated mesh displacement, the move limited to ``max_move`` of its local size."""
+    if acls[n, 0] == TF_INTERIOR:
+        tx, ty = _limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
+                        max_move * aflt[n, 3])
+        xn[n] = tx
+        yn[n] = ty
+
+
+tf_place = njit(cache=True, inline="always")(tf_place_py)
+tf_face = njit(cache=True, inline="always")(tf_face_py)
+tf_sweep = njit(cache=True, inline="always")(tf_sweep_py)
+tf_sweep_copy = njit(cache=True, inline="always")(tf_sweep_copy_py)
+tf_interior = njit(cache=True, inline="always")(tf_interior_py)
+
+
+@njit(parallel=True, cache=True)
+def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scratch):
+    """MODE_TOOLFRAME: new node positions ``xn``, ``yn`` (see
+    :mod:`robobore.cutting.fe.ale.toolframe`). ``x0``, ``y0`` are the nodes' places in the tool
+    frame at the start (the tool's edge centre then at x = its current x - ``off``);
+    ``acls``/``aflt`` the classes, neighbours, face fractions, line directions, local sizes
+    and the mesh displacement carried from pass to pass (``aflt[:, 4:6]``, updated);
+    ``scratch`` (n, 2) work array. The passes (:func:`tf_place_py`, :func:`tf_face_py`,
+    ``TF_SWEEPS`` x :func:`tf_sweep_py` + :func:`tf_sweep_copy_py`,
+    :func:`tf_interior_py`) each read only what the previous ones wrote.
+    """
+    nn = x.shape[0]
+    # 1. rigid nodes, surface chains and the chain ends on the outflow lines
+    for n in prange(nn):
+        tf_place(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg)
+    # 2. outflow faces between their (now placed) ends; the boundary values of the mesh
+    # displacement
+    for n in prange(nn):
+        tf_face(n, xn, yn, x0, y0, acls, aflt, off)
+    # 3. Jacobi sweeps of the interior
+    for _sweep in range(TF_SWEEPS):
+        for n in prange(nn):
+            tf_sweep(n, acls, aflt, scratch)
+        for n in prange(nn):
+            tf_sweep_copy(n, acls, aflt, scratch)
+    for n in prange(nn):
+        tf_interior(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move)
+
+
+@njit(parallel=True, cache=True)
+def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
+           sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s, omega,
+           max_move, mode, tied, x0, y0, vbuf, tg, acls, aflt, bflag, t_room, off):
+    """One relocation + remap pass (see module docstring). ``mode``: MODE_LAPLACE (``omega``
+    the relaxation) or MODE_ROWS (``tied``, ``x0``, ``y0``: pair state and initial
+    positions of the nodes).
+    ``xn``, ``yn`` (n_nodes,) and ``buf`` (n_elem, N_RZ_FIELDS) are work arrays. Returns
+    the number of nodes moved. ``vbuf`` (n_nodes, 2) is scratch for the velocity
+    increments (all computed from the old velocities before any is applied); ``tg`` the
+    tool geometry for MODE_ROWS and MODE_TOOLFRAME (see :func:`_row_move`).
+
+    MODE_TOOLFRAME (:func:`toolframe_targets`): ``acls``, ``aflt`` the node classes and data,
+    ``off`` the tool's x travel since the start [m]; ``snodes`` are the nodes whose velocity
+    is remapped (all but the rigid ones). ``bflag`` (n_elem, 4), any mode with
+    ``bflag.shape[0] > 0``: flux type of each outline edge (BF_*): virgin material at
+    ``t_room`` [K] flows in through BF_VIRGIN edges, material leaves through BF_VIRGIN and
+    BF_OPEN edges (and comes back through BF_OPEN ones with the element's own state).
+
+    The passes are the scalar functions :func:`rz_flux_py`, :func:`rz_velocity_py`,
+    :func:`rz_write_py` and :func:`rz_node_mass_py` (and the tool-frame ones), which the
+    GPU engine runs in the same order (:mod:`robobore.cutting.fe.engine.gpu.backend2d`)."""
+    nn = x.shape[0]
+    ne = conn.shape[0]
+    for n in prange(nn):
+        xn[n] = x[n]
+        yn[n] = y[n]
+    # 1. new positions of movable nodes
+    if mode == MODE_TOOLFRAME:
+        toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, vbuf)
+    else:
+        _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode, tied,
+                  x0, y0, tg)
+    # 2. element fluxes into buf (old geometry x, y -> new geometry xn, yn)
+    for e in prange(ne):
+        rz_flux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+                eps_p, temp, dmg, qhx, qhy, area0, t_room)
+    # 3. nodal velocity: first-order Taylor with the mean old gradient of adjacent elements
+    moved = 0
+    for k in prange(snodes.shape[0]):
+        moved += rz_velocity(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+    for k in prange(snodes.shape[0]):
+        n = snodes[k]
+        vx[n] += vbuf[n, 0]
+        vy[n] += vbuf[n, 1]
+    # 4. write back element fields and positions, recompute nodal masses
+    for e in prange(ne):
+        rz_write(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0)
+    for n in prange(nn):
+        x[n] = xn[n]
+        y[n] = yn[n]
+    for n in prange(nn):
+        rz_node_mass(n, ptr, nel, area0, rho_s, mass)
+    return moved
+
+
+__all__ = [
+    "MODE_LAPLACE",
+    "MODE_ROWS",
+    "MODE_TOOLFRAME",
+    "TF_INTERIOR",
+    "TF_RIGID",
+    "TF_CHAIN",
+    "TF_LINE",
+    "TF_FACE",
+    "TF_SWEEPS",
+    "limit_py",
+    "off_tool_py",
+    "tf_place_py",
+    "tf_face_py",
+    "tf_sweep_py",
+    "tf_sweep_copy_py",
+    "tf_interior_py",
+    "tf_place",
+    "tf_face",
+    "tf_sweep",
+    "tf_sweep_copy",
+    "tf_interior",
+    "toolframe_targets",
+    "rezone",
+    "smoothing_stencil",
+    "row_stencil",
+    "edge_neighbours",
+    "N_RZ_FIELDS",
+    "BF_CLOSED",
+    "BF_VIRGIN",
+    "BF_OPEN",
+    "swept_py",
+    "rz_flux_py",
+    "rz_velocity_py",
+    "rz_write_py",
+    "rz_node_mass_py",
+    "rz_flux",
+    "rz_velocity",
+    "rz_write",
+    "rz_node_mass",
+]

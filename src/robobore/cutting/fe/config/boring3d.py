@@ -1,0 +1,232 @@
+"""The configuration schema of the 3D FE boring model (:mod:`robobore.cutting.fe.models.boring3d`):
+its TOML sections (insert, cut, contact, mesh, solver, tool support, material), their units,
+defaults and ranges, and the parser that checks them (errors name the key, the value and the
+expected range). The options are documented in ``docs/fe3d.md``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from robobore.cutting.fe.config.orthogonal import ContactSection as ContactSection2D
+from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
+from robobore.cutting.geometry import BoringInsert
+from robobore.errors import ConfigError
+from robobore.io.config import load_toml, validate_model
+from robobore.material import load_material
+from robobore.material.library import resolve_material_name
+
+__all__ = ["InsertSection", "CutSection", "ContactSection", "MeshSection", "SolverSection",
+           "ToolSupportSection", "BoringFEConfig", "parse_boring_config", "load_boring_config"]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class InsertSection(_Strict):
+    """Insert geometry (defaults: a CCMT 060204-type insert in a 90-deg boring bar)."""
+
+    nose_radius_mm: float = Field(default=0.4, gt=0.0, le=5.0)
+    approach_angle_deg: float = Field(default=90.0, gt=0.0, le=90.0)
+    end_edge_angle_deg: float = Field(default=5.0, gt=0.0, le=60.0)
+    rake_deg: float = Field(default=7.0, ge=-30.0, le=30.0)
+    clearance_deg: float = Field(default=7.0, gt=0.0, le=30.0)
+    edge_radius_um: float = Field(default=20.0, ge=0.0, le=200.0)
+    inclination_deg: float = Field(default=0.0, ge=-15.0, le=15.0)
+
+    def to_insert(self) -> BoringInsert:
+        return BoringInsert(nose_radius_m=self.nose_radius_mm * 1e-3,
+                            approach_angle_deg=self.approach_angle_deg,
+                            end_edge_angle_deg=self.end_edge_angle_deg, rake_deg=self.rake_deg,
+                            inclination_deg=self.inclination_deg,
+                            clearance_deg=self.clearance_deg,
+                            edge_radius_m=self.edge_radius_um * 1e-6)
+
+
+class CutSection(_Strict):
+    depth_of_cut_mm: float = Field(gt=0.0, le=2.0, description="radial depth ap, mm")
+    feed_mm_per_rev: float = Field(gt=0.0, le=2.0)
+    speed_rpm: float = Field(gt=0.0, le=20000.0)
+    #: bore diameter after the pass [mm] (an assumption where the paper gives none)
+    bore_diameter_mm: float = Field(default=40.0, gt=1.0, le=2000.0)
+    #: length of cut along the wall simulated [mm]
+    cut_length_mm: float = Field(default=0.3, gt=0.0, le=20.0)
+
+
+#: keys of the 2D engine's [contact] that the 3D model does not use: its contact law has no
+#: normal damping
+_CONTACT_2D_ONLY = ("normal_damping",)
+
+
+class ContactSection(ContactSection2D):
+    """The 2D engine's ``[contact]``
+    (:class:`robobore.cutting.fe.config.orthogonal.ContactSection`): the same friction keys, values
+    and defaults -- ``friction`` a bundled friction law (default ``rech2013_calibrated``: the Rech
+    et al. 2013 table x 1.5 read at each contact node's filtered sliding speed, no shear cap),
+    "table" or a constant Coulomb coefficient; ``friction_velocity``, ``friction_table_*``,
+    ``sliding_filter_um``, ``shear_limit_MPa``, ``penalty_factor`` and the thermal contact
+    (``thermal_conductance_W_per_m2K``, ``friction_heat_fraction``, ``tool_temperature_K``, used
+    with ``solver.heat_conduction``) -- without ``normal_damping`` (the 3D contact has no normal
+    damping)."""
+
+    @model_validator(mode="after")
+    def _no_2d_only(self) -> ContactSection:
+        bad = sorted(set(_CONTACT_2D_ONLY) & self.model_fields_set)
+        if bad:
+            raise ValueError(f"{', '.join(bad)}: not used by the 3D boring model (its contact "
+                             "has no normal damping); remove the key")
+        return self
+
+
+class MeshSection(_Strict):
+    #: element size [um]; at most ap / 3 (3 elements through the chip's depth)
+    element_size_um: float = Field(gt=0.0)
+    #: material below the new bore surface, in depths of cut (>= 4 elements is enforced)
+    depth_factor: float = Field(default=1.5, ge=0.5, le=20.0)
+    #: material beyond the chip on each side along the feed axis [um] (0 = 3 elements)
+    side_margin_um: float = Field(default=0.0, ge=0.0)
+    #: uncut material left ahead of the insert at the end of the cut [mm]
+    ahead_mm: float = Field(default=0.06, gt=0.0, le=5.0)
+    #: how the chip separates from the workpiece: "erosion_layer" (elements crossed by the
+    #: edge path erode by Johnson-Cook damage) or "node_split" (the nodes of a parting
+    #: surface are doubled and tied, and part where they reach the insert: the 2D engine's
+    #: method, used by the FE calibration of the mechanistic coefficients; with the 2-4
+    #: elements through the boring chip that 3D affords on a CPU it gave larger forces than
+    #: the layer, docs/fe3d.md)
+    separation: Literal["node_split", "erosion_layer"] = "erosion_layer"
+    #: node splitting: height of the parting surface above the edge's lowest points,
+    #: along the profile normal [um] (the 2D calibration's 5 um = 0.25 edge radii)
+    separation_height_um: float = Field(default=5.0, ge=0.0)
+    #: node splitting: element rows of the chip above the parting surface (0 = about one
+    #: per element size of the thickest chip section, at least 3)
+    chip_rows: int = Field(default=0, ge=0, le=50)
+
+
+class SolverSection(_Strict):
+    mass_scaling: float = Field(default=100.0, ge=1.0, le=1e6)
+    cfl: float = Field(default=0.8, gt=0.0, le=1.0)
+    hourglass_viscous: float = Field(default=0.05, ge=0.0, le=0.5)
+    hourglass_stiffness: float = Field(default=0.05, ge=0.0, le=0.5)
+    bulk_viscosity_linear: float = Field(default=0.06, ge=0.0, le=1.0)
+    bulk_viscosity_quadratic: float = Field(default=1.2, ge=0.0, le=4.0)
+    #: erosion of elements whose Johnson-Cook damage reaches 1: "layer" (only in the
+    #: separation layer, the elements crossed by the path of the cutting edge), "everywhere"
+    #: or "none"
+    erosion: Literal["layer", "everywhere", "none"] = "layer"
+    #: erode an element whose volume ratio V/V0 falls below this (0 disables)
+    distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
+    #: erode an element whose stable step falls below this fraction of the initial one
+    erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
+    n_samples: int = Field(default=200, ge=10, le=100000)
+    chunk_steps: int = Field(default=500, ge=10, le=10**7)
+    #: fraction of the cut (from its end) averaged for the steady-state values
+    steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
+    #: stop with NumericalError when the energy error exceeds this after 10 % of the cut
+    energy_error_limit: float = Field(default=0.5, gt=0.0)
+    #: node splitting: a tied pair parts within this distance of the insert [um]
+    separation_gate_um: float = Field(default=0.0, ge=0.0)
+    #: heat conduction between the workpiece's elements and the thermal contact with the
+    #: insert (the 2D engine's model, :mod:`robobore.cutting.fe.physics.thermal3d`), every
+    #: ``conduction_interval`` steps; false: adiabatic
+    heat_conduction: bool = True
+    conduction_interval: int = Field(default=10, ge=1, le=10000)
+
+
+def _triple(v: Any) -> list[float]:
+    vals = [v, v, v] if isinstance(v, float | int) else list(v)
+    if len(vals) != 3:
+        raise ValueError("give one value or [X, Y, Z]")
+    return [float(x) for x in vals]
+
+
+class ToolSupportSection(_Strict):
+    """Equivalent 3-direction model: per boring-frame axis X, Y, Z (one value or [X, Y, Z])."""
+
+    stiffness_N_per_m: list[float]
+    damping_N_s_per_m: list[float]
+    mass_kg: list[float]
+    #: extra stiffness of the pressure foot per axis [N/m] (0 = no foot)
+    pressure_foot_N_per_m: list[float] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    #: bar angle at the start of the run [deg] (from X towards Y)
+    theta0_deg: float = 0.0
+
+    @field_validator("stiffness_N_per_m", "damping_N_s_per_m", "mass_kg",
+                     "pressure_foot_N_per_m", mode="before")
+    @classmethod
+    def _t(cls, v: Any) -> Any:
+        return _triple(v)
+
+    @model_validator(mode="after")
+    def _pos(self) -> ToolSupportSection:
+        for name in ("stiffness_N_per_m", "damping_N_s_per_m", "pressure_foot_N_per_m"):
+            if any(x < 0 for x in getattr(self, name)):
+                raise ValueError(f"{name} must be >= 0")
+        if any(m <= 0 for m in self.mass_kg):
+            raise ValueError("mass_kg must be > 0")
+        return self
+
+    def total_stiffness(self) -> list[float]:
+        return [a + b for a, b in zip(self.stiffness_N_per_m, self.pressure_foot_N_per_m,
+                                      strict=True)]
+
+
+class BoringFEConfig(_Strict):
+    #: the 2D engine's switch (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`):
+    #: "calibrated" (default) -- friction law "rech2013_calibrated" and the material file's
+    #: hardening hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;
+    #: "a_priori" -- friction law "rech2013" and the plain Johnson-Cook law. Explicit
+    #: contact.friction and material.hardening_strain_limit keys win over either
+    parameters: Literal["calibrated", "a_priori"] = "calibrated"
+    material: MaterialSection = MaterialSection()
+    insert: InsertSection = InsertSection()
+    cut: CutSection
+    contact: ContactSection = ContactSection()
+    mesh: MeshSection
+    solver: SolverSection = SolverSection()
+    tool_support: ToolSupportSection | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _parameter_set(cls, data: Any) -> Any:
+        # the 2D config's rule: the friction law and hardening of ``parameters`` where the
+        # keys are not given
+        return apply_parameter_set(data) if isinstance(data, dict) else data
+
+    def friction_law(self) -> str:
+        """The friction law in words (:meth:`ContactSection.law_description`)."""
+        return self.contact.law_description()
+
+
+def parse_boring_config(data: dict[str, Any], source: str | None = None) -> BoringFEConfig:
+    """Validate a config dict (from TOML) and the cross-field rules."""
+    cfg = validate_model(BoringFEConfig, data, source=source)
+    cfg.material.name = resolve_material_name(cfg.material.name, source)  # config-relative
+    load_material(cfg.material.name, source=source)  # read and checked at load, not at run
+    ap_um = cfg.cut.depth_of_cut_mm * 1e3
+    le = cfg.mesh.element_size_um
+    if le > ap_um / 3.0 + 1e-9:
+        raise ConfigError("element too large for the depth of cut", file=source,
+                          field="mesh.element_size_um", value=le,
+                          expected=f"at most cut.depth_of_cut_mm/3 = {ap_um / 3.0:.4g} um")
+    if cfg.insert.edge_radius_um >= cfg.insert.nose_radius_mm * 1e3:
+        raise ConfigError("edge radius not smaller than the nose radius", file=source,
+                          field="insert.edge_radius_um", value=cfg.insert.edge_radius_um,
+                          expected=f"< {cfg.insert.nose_radius_mm * 1e3:g} um")
+    if cfg.cut.bore_diameter_mm < 20 * cfg.cut.cut_length_mm:
+        raise ConfigError("bore too small for the locally flat wall model", file=source,
+                          field="cut.bore_diameter_mm", value=cfg.cut.bore_diameter_mm,
+                          expected=f">= 20 x cut.cut_length_mm = "
+                          f"{20 * cfg.cut.cut_length_mm:g} mm")
+    from robobore.io.memory import check_fe3d
+
+    check_fe3d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
+    return cfg
+
+
+def load_boring_config(path: str | Path) -> BoringFEConfig:
+    """Read and validate a boring FE config file (TOML)."""
+    return parse_boring_config(load_toml(path), source=str(path))

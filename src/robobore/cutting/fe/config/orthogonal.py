@@ -1,0 +1,578 @@
+"""The FE orthogonal-cutting config (TOML) as a pydantic model, with documented defaults.
+
+Human units in the key names (um, mm, m/min, deg, MPa). Only the contract keys are required
+(tool, cut, mesh.element_size_um; see ``examples/fe_orthogonal.toml``); every other key has
+the default documented on its field. The defaults are the validated model (docs/fe.md,
+"Model choice"): the tool-frame ALE mesh, heat conduction, mass scaling 100 (30 / vc)^2, the
+CALIBRATED friction law ``rech2013_calibrated`` and the bundled material's CALIBRATED
+hardening hold (TC4: plastic strain 0.6). ``parameters = "a_priori"`` is the one switch back
+to the source's values (friction law ``rech2013``, plain Johnson-Cook hardening).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    field_validator,
+    model_validator,
+)
+
+from robobore.errors import ConfigError
+from robobore.io.config import load_toml, validate_model
+from robobore.material.friction import (
+    A_PRIORI_LAW,
+    CALIBRATED_LAW,
+    friction_law,
+    friction_laws,
+)
+
+#: Coulomb friction coefficient vs cutting speed [m/min] for Ti6Al4V on uncoated WC
+#: (Rech et al. 2013, as used by Ducobu, Pantale et al. 2022; see
+#: ../shared/data/ti64_orthogonal_cutting_forces.json). Used when ``contact.friction`` is
+#: "table": linear interpolation, constant beyond the ends.
+FRICTION_TABLE_VC_M_MIN = np.array([5.0, 7.5, 10.0, 20.0, 30.0, 40.0])
+FRICTION_TABLE_MU = np.array([0.24, 0.22, 0.21, 0.19, 0.18, 0.17])
+#: most points of a friction table (the engine's parameter slots: kernels.MU_TABLE_MAX)
+MU_TABLE_MAX = 8
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class MaterialSection(_Strict):
+    #: bundled material name (e.g. "TC4") or a path to a material TOML file
+    name: str = "TC4"
+    #: plastic strain beyond which the Johnson-Cook hardening term B eps^n is held at its
+    #: value (replaces the material file's ``hardening_strain_limit``); "none": the plain
+    #: law. None: the file's (the bundled TC4: 0.6, CALIBRATED), or "none" with
+    #: ``parameters = "a_priori"``
+    hardening_strain_limit: float | Literal["none"] | None = None
+
+    @field_validator("hardening_strain_limit")
+    @classmethod
+    def _hold(cls, v: Any) -> Any:
+        if isinstance(v, float) and not v > 0.0:
+            raise ValueError('must be > 0 (a plastic strain), or "none" for the plain law')
+        return v
+
+    def strain_limit(self) -> float | None:
+        """The value for :func:`robobore.material.load_material`: None (the file's), a
+        plastic strain, or inf (the plain law)."""
+        v = self.hardening_strain_limit
+        return float("inf") if v == "none" else v
+
+
+class ToolSection(_Strict):
+    rake_deg: float = Field(ge=-30.0, le=40.0, description="rake angle, -30..40 deg")
+    clearance_deg: float = Field(gt=0.0, le=30.0, description="clearance angle, 0..30 deg")
+    edge_radius_um: float = Field(ge=0.0, le=200.0, description="cutting-edge radius, um")
+
+
+class CutSection(_Strict):
+    uncut_chip_thickness_um: float = Field(gt=0.0, le=2000.0)
+    cutting_speed_m_per_min: float = Field(gt=0.0, le=2000.0)
+    #: length of cut simulated [mm] (the tool's travel in the tool frame); at least one
+    #: element (mesh.element_size_um)
+    length_mm: float = Field(gt=0.0, le=50.0, description="length of cut simulated, mm")
+    #: width of cut [mm]; 2D results are per unit width, totals (tool support) use it; at
+    #: least the uncut chip thickness (plane strain)
+    width_mm: float = Field(default=1.0, gt=0.0)
+
+
+class ContactSection(_Strict):
+    #: the friction: a bundled friction law by name (robobore/material/friction_laws.toml:
+    #: "rech2013_calibrated", CALIBRATED, or "rech2013", A-PRIORI; the law gives the table,
+    #: the velocity it is read at and the shear cap, the last two overridable by their
+    #: keys), "table" (the friction_table_* keys, or without them the Rech et al. 2013
+    #: table at the cutting speed), or a constant Coulomb coefficient. None: the law of
+    #: ``parameters`` (the FE config's top-level key)
+    friction: float | str | None = None
+    #: cap on the contact shear stress [MPa]. None: the friction law's (rech2013: 576 MPa,
+    #: the Ducobu/Pantale model input; rech2013_calibrated: 5000, no cap), else 576
+    shear_limit_MPa: float | None = Field(default=None, gt=0.0)
+    #: penalty factor: normal stiffness = factor * nodal mass / dt^2 (0 < factor <= 0.5)
+    penalty_factor: float = Field(default=0.1, gt=0.0, le=0.5)
+    #: thermal contact with the tool, used with ``solver.heat_conduction`` (adiabatic runs
+    #: exchange no heat): interface conductance [W/(m^2 K)] between the workpiece surface
+    #: in contact and the tool, a heat sink at ``tool_temperature_K`` (0: adiabatic tool)
+    thermal_conductance_W_per_m2K: float = Field(default=1.0e5, ge=0.0, le=1.0e9)
+    #: fraction of the frictional dissipation that heats the workpiece (chip underside and
+    #: machined surface); the rest goes into the tool
+    friction_heat_fraction: float = Field(default=0.5, ge=0.0, le=1.0)
+    #: viscous damping of the contact's normal penalty spring, as a fraction of its critical
+    #: damping (LS-DYNA's VDC); it damps the contact chatter, through which an explicit
+    #: penalty contact otherwise creates energy (k dg^2 / 2 a step), and its dissipation is
+    #: booked with the friction's. None: 0 for mesh.frame = "workpiece", 1 (critical) for "tool"
+    #: (whose edge-arc nodes are in contact for the whole run)
+    normal_damping: float | None = Field(default=None, ge=0.0, le=1.0)
+    #: temperature of the tool [K]; None: the material's room temperature
+    tool_temperature_K: float | None = Field(default=None, gt=0.0, le=3000.0)
+
+    #: what the friction table's velocity is (friction = "table"): "cutting_speed" -- one
+    #: coefficient for the whole run, the table at cut.cutting_speed_m_per_min -- or
+    #: "sliding" -- every node in contact, every step, uses the table at its own sliding
+    #: speed relative to the tool (the chip's speed ~vc / r up the rake, ~0 in the stagnation
+    #: zone at the edge): how a tribometer's mu(sliding velocity) is read, as Abaqus'
+    #: slip-rate-dependent friction; constant beyond the table's ends (2D and 3D engines).
+    #: None: the friction law's, else "cutting_speed"
+    friction_velocity: Literal["cutting_speed", "sliding"] | None = None
+    #: the friction table's velocities [m/min], increasing, 2..8 points; None: the Rech et
+    #: al. 2013 table (FRICTION_TABLE_VC_M_MIN). Give friction_table_mu with it
+    friction_table_velocity_m_per_min: list[float] | None = None
+    #: the friction table's Coulomb coefficients (0..2), one per velocity
+    friction_table_mu: list[float] | None = None
+    #: friction_velocity = "sliding": time constant of the low-pass filter on each node's
+    #: sliding speed, as the tool's travel in it [um] (a contact node's velocity chatters
+    #: from step to step; the filtered speed is the material's mean sliding speed there)
+    sliding_filter_um: float = Field(default=1.0, gt=0.0, le=1000.0)
+
+    #: the bundled friction law the table came from (None: "table" or a constant)
+    _law: str | None = PrivateAttr(default=None)
+
+    @field_validator("friction")
+    @classmethod
+    def _mu(cls, v: Any) -> Any:
+        if isinstance(v, float) and not (0.0 <= v <= 2.0):
+            raise ValueError("friction coefficient must be within 0..2")
+        if isinstance(v, str) and v != "table" and v not in friction_laws():
+            raise ValueError(f"unknown friction {v!r}: expected a Coulomb coefficient "
+                             f'0..2, "table" or a friction law, one of {sorted(friction_laws())}')
+        return v
+
+    @model_validator(mode="after")
+    def _table(self) -> ContactSection:
+        fs = set(self.model_fields_set)
+        v, mu = self.friction_table_velocity_m_per_min, self.friction_table_mu
+        if (v is None) != (mu is None):
+            raise ValueError("friction_table_velocity_m_per_min and friction_table_mu go "
+                             "together: give both or neither")
+        if self.friction is None:
+            self.friction = CALIBRATED_LAW
+        if isinstance(self.friction, str) and self.friction != "table":
+            if v is not None:
+                raise ValueError(f"friction = {self.friction!r} is a friction law with its "
+                                 'own table: give friction = "table" with a user table')
+            law = friction_law(self.friction)
+            self._law = law.name
+            self.friction = "table"
+            v = self.friction_table_velocity_m_per_min = list(law.velocity_m_per_min)
+            mu = self.friction_table_mu = list(law.mu)
+            if self.friction_velocity is None:
+                self.friction_velocity = law.read_at
+            if self.shear_limit_MPa is None:
+                self.shear_limit_MPa = law.shear_limit_MPa
+        if self.shear_limit_MPa is None:
+            self.shear_limit_MPa = 576.0
+        table_keys = v is not None or "friction_velocity" in fs
+        if self.friction_velocity is None:
+            self.friction_velocity = "cutting_speed"
+        if self.friction != "table" and table_keys:
+            raise ValueError(f"friction = {self.friction!r} is a constant coefficient: the "
+                             "friction table keys (friction_table_*, friction_velocity) need "
+                             'friction = "table"')
+        if "sliding_filter_um" in self.model_fields_set and self.friction_velocity != "sliding":
+            raise ValueError("sliding_filter_um filters the sliding speed of "
+                             'friction_velocity = "sliding"; it is not used otherwise')
+        if v is not None and mu is not None:
+            if not 2 <= len(v) <= MU_TABLE_MAX or len(mu) != len(v):
+                raise ValueError(f"friction table: {len(v)} velocities and {len(mu)} "
+                                 f"coefficients; expected the same number, 2..{MU_TABLE_MAX}")
+            if v[0] < 0.0 or any(b <= a for a, b in zip(v, v[1:], strict=False)):
+                raise ValueError(f"friction_table_velocity_m_per_min = {v}: expected "
+                                 "increasing velocities >= 0 m/min")
+            if any(not 0.0 <= m <= 2.0 for m in mu):
+                raise ValueError(f"friction_table_mu = {mu}: expected coefficients in 0..2")
+        return self
+
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """The friction table: velocities [m/min] and Coulomb coefficients."""
+        if self.friction_table_velocity_m_per_min is None:
+            return FRICTION_TABLE_VC_M_MIN, FRICTION_TABLE_MU
+        return (np.asarray(self.friction_table_velocity_m_per_min, float),
+                np.asarray(self.friction_table_mu, float))
+
+    def coefficient_at(self, vc_m_per_min: float) -> float:
+        """Coulomb coefficient at a cutting speed [m/min]: the constant given, or the table
+        there (with ``friction_velocity = "sliding"`` the nominal value: each contact node
+        then reads the table at its own sliding speed)."""
+        if self.friction == "table":
+            v, mu = self.table()
+            return float(np.interp(vc_m_per_min, v, mu))
+        return float(self.friction)
+
+    def law_description(self) -> str:
+        """The friction law in words (for summaries)."""
+        if self.friction != "table":
+            return f"Coulomb {float(self.friction):g}"
+        law = self._law
+        src = (f"law {law} ({friction_law(law).status})" if law is not None else
+               "Rech et al. 2013" if self.friction_table_velocity_m_per_min is None else "user")
+        arg = "each node's sliding speed" if self.friction_velocity == "sliding" else \
+            "the cutting speed"
+        return f"Coulomb, {src} table at {arg}"
+
+
+class MeshSection(_Strict):
+    #: element size in the cutting zone and chip layer [um]; at most h/3
+    element_size_um: float = Field(gt=0.0)
+    #: depth of the fine zone below the cut line, in uncut chip thicknesses
+    fine_depth_factor: float = Field(default=1.0, ge=0.2, le=10.0)
+    #: total workpiece height below the free surface, in uncut chip thicknesses
+    height_factor: float = Field(default=5.0, ge=2.0, le=50.0)
+    #: growth ratio of element size outside the fine zone (1 = uniform)
+    grading: float = Field(default=1.25, ge=1.0, le=2.0)
+    #: position of the one-element separation layer: "above_cut_line" (its bottom on the
+    #: tool's lowest point: everything below is ploughed under the edge and rubs the flank)
+    #: "centred" (centred on the cut line: half of it lies below the tool) or
+    #: "below_cut_line" (its top on the cut line: the chip layer is the full h and the
+    #: layer is the material crushed under the edge)
+    separation_layer: Literal["above_cut_line", "centred", "below_cut_line"] = "centred"
+    #: how chip and workpiece part: "node_split" (doubled nodes along a parting line, tied
+    #: until the tool edge reaches them) or "erosion_layer" (a one-element layer eroded by
+    #: Johnson-Cook damage, placed by ``separation_layer``)
+    separation: Literal["node_split", "erosion_layer"] = "erosion_layer"
+    #: height of the parting line (node_split) -- or of the erosion layer's bottom, when
+    #: given -- above the tool's lowest point [um]: the material below it (the stagnation
+    #: zone) is ploughed under the edge radius instead of leaving with the chip
+    separation_height_um: float | None = Field(default=None, ge=0.0)
+    #: uncut material left ahead of the tool at the end of the cut [mm]
+    ahead_mm: float = Field(default=0.3, gt=0.0, le=20.0)
+    #: element size [um] in a band round the parting line, where the material passes the
+    #: cutting edge (node splitting only); element_size_um / edge_element_um must be 2, 4
+    #: or 8 (conforming 2:1 transition rows). None: uniform element_size_um
+    edge_element_um: float | None = Field(default=None, gt=0.0)
+    #: extent of the refined band above and below the parting line [um]
+    edge_band_um: tuple[float, float] = (10.0, 10.0)
+    #: the mesh's frame: "workpiece" (Lagrangian: the mesh moves with the material, chip and
+    #: workpiece part by ``separation``) or "tool" (ALE: the mesh travels with the tool,
+    #: material flows in ahead of it and out behind the flank and through the chip's top,
+    #: no separation criterion and no erosion; see robobore.cutting.fe.ale.toolframe). With
+    #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
+    #: round the edge (default element_size_um / 4), and the separation keys are not used
+    frame: Literal["workpiece", "tool"] = "tool"
+    #: tool frame: chip thickness / h of the pre-shaped chip the run starts from (the
+    #: chip's shape then follows from the flow)
+    initial_chip_ratio: float = Field(default=1.6, ge=1.0, le=5.0)
+    #: tool frame: height [um] above the tool's lowest point where the mesh's chip and
+    #: workpiece blocks meet on the edge arc (a mesh choice, not where the material divides);
+    #: None: min(edge radius, h) / 2
+    join_height_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: length [um] of the pre-shaped chip up the rake face, from where the rake
+    #: face starts to the chip's top face (an outflow boundary); None: max(1.5 chip
+    #: thicknesses, 80 um). It must exceed the tool-chip contact length: a chip that still
+    #: touches the rake at its top face is held there by the boundary (docs/fe.md, "Mesh")
+    chip_length_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: depth [um] of the mesh's bottom below the cut line; the bottom is held
+    #: fixed in the workpiece (a rigid base). None: max(2.5 h, 120 um)
+    depth_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: distance [um] of the inflow face ahead of the chip's root. None:
+    #: max(1.5 h, 60 um)
+    inflow_length_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: distance [um] of the back face (the outflow of the machined surface)
+    #: behind the edge centre. None: max(2 h, 120 um)
+    back_length_um: float | None = Field(default=None, gt=0.0)
+
+    @field_validator("edge_band_um")
+    @classmethod
+    def _band(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if any(not (x > 0.0) for x in v):
+            raise ValueError("both extents (above, below) must be > 0 um")
+        return v
+
+
+class SolverSection(_Strict):
+    #: density factor applied to the inertial (not the thermal) mass: time step grows by
+    #: sqrt(mass_scaling); 1 = none. None: the validation protocol's 100 (30 / vc)^2 with vc
+    #: in m/min (at least 1), which keeps vc / (scaled wave speed) and hence the steps per
+    #: mm of cut the same at every speed
+    mass_scaling: float | None = Field(default=None, ge=1.0, le=1e6)
+    #: fraction of the stable time step (element length / dilatational wave speed)
+    cfl: float = Field(default=0.8, gt=0.0, le=1.0)
+    #: element formulation: "q4r" (one-point quad with Flanagan-Belytschko hourglass
+    #: control) or "q4_bbar" (2x2 Gauss points with mean-dilatation B-bar: no hourglass
+    #: modes, about 2x the element cost; the hourglass coefficients are not used)
+    element: Literal["q4r", "q4_bbar"] = "q4r"
+    #: Flanagan-Belytschko hourglass control coefficients (viscous, stiffness)
+    hourglass_viscous: float = Field(default=0.05, ge=0.0, le=0.5)
+    hourglass_stiffness: float = Field(default=0.05, ge=0.0, le=0.5)
+    #: bulk viscosity (linear, quadratic), active in compression
+    bulk_viscosity_linear: float = Field(default=0.06, ge=0.0, le=1.0)
+    bulk_viscosity_quadratic: float = Field(default=1.2, ge=0.0, le=4.0)
+    #: where elements erode when JC damage reaches 1: "layer" (separation layer along the
+    #: cut line), "everywhere", or "none"
+    erosion: Literal["layer", "everywhere", "none"] = "layer"
+    #: when given, a separation-layer element whose damage reached 1 erodes only once one of
+    #: its nodes is within this distance [um] of the tool surface (the material separates
+    #: at the cutting edge, not ahead of it); None: erode wherever the damage reaches 1
+    separation_gate_um: float | None = Field(default=None, ge=0.0)
+    #: erode an element whose area ratio A/A0 or corner Jacobian falls below this (numerical
+    #: safety against inverted elements; counted and reported separately); 0 disables
+    distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
+    #: steps between chip rezoning passes (Laplacian smoothing + donor-cell remap of the
+    #: chip layer, see robobore.cutting.fe.ale.rezone); 0 = pure Lagrangian
+    rezone_interval: int = Field(default=0, ge=0, le=10**6)
+    #: relaxation of each smoothing pass (fraction of the move towards the neighbour mean)
+    rezone_relaxation: float = Field(default=0.3, gt=0.0, le=1.0)
+    #: steps between ALE passes of the ploughed layer (node splitting only): the node rows
+    #: within ``edge_ale_depth_um`` under the parting line, once their column's pair has
+    #: been released at the edge, slide along their rows back towards their initial x
+    #: (Eulerian in the cutting direction, Lagrangian in depth) and the element state is
+    #: remapped (donor cell, see robobore.cutting.fe.ale.rezone); 0 = off (pure Lagrangian)
+    edge_ale_interval: int = Field(default=0, ge=0, le=10**6)
+    #: depth [um] of the ploughed layer under the parting line that edge_ale_interval
+    #: treats (rows strictly above this depth move; default: the edge band's lower part)
+    edge_ale_depth_um: float = Field(default=10.0, gt=0.0)
+    #: tool frame (mesh.frame = "tool"): steps between the passes that move the mesh back
+    #: to its place in the tool's frame and remap the element state and node velocities
+    ale_interval: int = Field(default=10, ge=1, le=10**4)
+    #: erode an element whose stable time step falls below this fraction of the initial
+    #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
+    erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
+    #: heat conduction between workpiece elements (finite volumes on the deformed mesh,
+    #: explicit, every ``conduction_interval`` steps), with the thermal contact to the tool
+    #: (``contact.thermal_conductance_W_per_m2K``, ``friction_heat_fraction``); the other
+    #: free surfaces are adiabatic. False: adiabatic heating only
+    heat_conduction: bool = True
+    conduction_interval: int = Field(default=10, ge=1, le=10000)
+    #: number of force/tool samples over the whole run
+    n_samples: int = Field(default=400, ge=10, le=100000)
+    #: steps per compiled chunk between progress updates
+    chunk_steps: int = Field(default=2000, ge=10, le=10**7)
+    #: fraction of the cut (from its end) averaged for the steady-state values
+    steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
+    #: stop with NumericalError when |energy error| exceeds this after 10 % of the cut
+    energy_error_limit: float = Field(default=0.5, gt=0.0)
+
+
+class ToolSupport(_Strict):
+    """Spring/damper/mass holding the tool to its guide point; (x, y) pairs or one value."""
+
+    stiffness_N_per_m: float | list[float]
+    damping_N_s_per_m: float | list[float]
+    mass_kg: float | list[float]
+
+    @field_validator("stiffness_N_per_m", "damping_N_s_per_m", "mass_kg")
+    @classmethod
+    def _pair(cls, v: Any) -> Any:
+        vals = [v, v] if isinstance(v, float | int) else list(v)
+        if len(vals) != 2:
+            raise ValueError("give one value or [x, y]")
+        if any(x < 0 for x in vals):
+            raise ValueError("must be >= 0")
+        return [float(x) for x in vals]
+
+    @model_validator(mode="after")
+    def _pos(self) -> ToolSupport:
+        if any(m <= 0 for m in self.mass_kg):  # type: ignore[union-attr]
+            raise ValueError("mass_kg must be > 0")
+        return self
+
+
+#: the friction law each ``parameters`` value selects when ``contact.friction`` is not given
+PARAMETER_SETS = {"calibrated": CALIBRATED_LAW, "a_priori": A_PRIORI_LAW}
+
+
+def auto_mass_scaling(cutting_speed_m_per_min: float) -> float:
+    """The default mass scaling: 100 (30 / vc)^2, at least 1 (vc in m/min)."""
+    return max(1.0, 100.0 * (30.0 / cutting_speed_m_per_min) ** 2)
+
+
+def apply_parameter_set(data: dict[str, Any]) -> dict[str, Any]:
+    """A raw config dict with the friction law and the hardening of its ``parameters`` set
+    ("calibrated", the default, or "a_priori") filled in where ``contact.friction`` and
+    ``material.hardening_strain_limit`` are not given (the 2D and the 3D boring configs)."""
+    params = data.get("parameters", "calibrated")
+    contact = data.get("contact", {})
+    if params in PARAMETER_SETS and isinstance(contact, dict) and "friction" not in contact:
+        data = {**data, "contact": {**contact, "friction": PARAMETER_SETS[params]}}
+    mat = data.get("material", {})
+    if params == "a_priori" and isinstance(mat, dict) and "hardening_strain_limit" not in mat:
+        data = {**data, "material": {**mat, "hardening_strain_limit": "none"}}
+    return data
+
+
+class FEConfig(_Strict):
+    #: "calibrated" (default): the validated model's CALIBRATED choices -- friction law
+    #: "rech2013_calibrated" and the material file's hardening hold; "a_priori": the
+    #: source's values, nothing chosen against measured forces -- friction law "rech2013"
+    #: and the plain Johnson-Cook law. Explicit contact.friction and
+    #: material.hardening_strain_limit keys win over either
+    parameters: Literal["calibrated", "a_priori"] = "calibrated"
+    material: MaterialSection = MaterialSection()
+    tool: ToolSection
+    cut: CutSection
+    contact: ContactSection = ContactSection()
+    mesh: MeshSection
+    solver: SolverSection = SolverSection()
+    tool_support: ToolSupport | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _parameter_set(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        if not isinstance(data.get("solver", {}), BaseModel):
+            data = {**data, "solver": dict(data.get("solver", {}))}
+        return apply_parameter_set(data)
+
+    @model_validator(mode="after")
+    def _mass_scaling(self) -> FEConfig:
+        if self.solver.mass_scaling is None:
+            self.solver.mass_scaling = auto_mass_scaling(self.cut.cutting_speed_m_per_min)
+        return self
+
+    def friction_coefficient(self) -> float:
+        """Coulomb coefficient at the cutting speed (:meth:`ContactSection.coefficient_at`)."""
+        return self.contact.coefficient_at(self.cut.cutting_speed_m_per_min)
+
+    def friction_law(self) -> str:
+        """The friction law in words (:meth:`ContactSection.law_description`)."""
+        return self.contact.law_description()
+
+
+def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
+    """Cross-field checks (element size vs chip thickness, cut length vs element size,
+    width vs chip thickness)."""
+    h = cfg.cut.uncut_chip_thickness_um
+    le = cfg.mesh.element_size_um
+    if le > h / 3.0 + 1e-12:
+        raise ConfigError("element too large for the chip thickness", file=source,
+                          field="mesh.element_size_um", value=le,
+                          expected=f"an element size in um at most uncut_chip_thickness_um/3 "
+                          f"= {h / 3.0:.4g} um")
+    length_um = cfg.cut.length_mm * 1e3
+    if length_um < le - 1e-9:
+        raise ConfigError("cut too short for the mesh", file=source, field="cut.length_mm",
+                          value=cfg.cut.length_mm,
+                          expected=f"at least one element of cut, mesh.element_size_um = "
+                          f"{le:g} um = {le * 1e-3:.4g} mm (a shorter cut moves no material "
+                          "through an element of the cutting zone; a steady state takes many "
+                          "more: the validated runs cut 0.3 mm, 30 elements of 10 um)")
+    if cfg.cut.width_mm * 1e3 < h - 1e-9:
+        raise ConfigError("width of cut below the uncut chip thickness", file=source,
+                          field="cut.width_mm", value=cfg.cut.width_mm,
+                          expected=f"at least uncut_chip_thickness_um = {h:g} um = "
+                          f"{h * 1e-3:.4g} mm (the 2D model is plane strain: the width must "
+                          "exceed the chip thickness)")
+    sh = cfg.mesh.separation_height_um
+    if sh is not None and sh > h - le + 1e-12:
+        raise ConfigError("separation line too high for the chip thickness", file=source,
+                          field="mesh.separation_height_um", value=sh,
+                          expected=f"a height in um at most uncut_chip_thickness_um - "
+                          f"element_size_um = {h - le:.4g} um (one element row of chip)")
+    ee = cfg.mesh.edge_element_um
+    if cfg.mesh.frame == "tool":
+        return _check_tool_frame(cfg, source)
+    if ee is not None:
+        if cfg.mesh.separation != "node_split":
+            raise ConfigError("edge refinement needs node splitting", file=source,
+                              field="mesh.edge_element_um", value=ee,
+                              expected='no value, or mesh.separation = "node_split"')
+        ratio = le / ee
+        if min(abs(ratio - r) for r in (2, 4, 8)) > 1e-6 * ratio:
+            raise ConfigError("edge element size must divide the element size by 2, 4 or 8",
+                              file=source, field="mesh.edge_element_um", value=ee,
+                              expected=f"one of {le / 2:.4g}, {le / 4:.4g}, {le / 8:.4g} um "
+                              f"(element_size_um / 2, 4, 8)")
+        if cfg.solver.rezone_interval > 0:
+            raise ConfigError("rezoning needs the uniform structured mesh", file=source,
+                              field="solver.rezone_interval",
+                              value=cfg.solver.rezone_interval,
+                              expected="0 with mesh.edge_element_um")
+    ale = cfg.solver.edge_ale_interval
+    if ale > 0:
+        if cfg.mesh.separation != "node_split":
+            raise ConfigError("the ploughed-layer ALE needs node splitting", file=source,
+                              field="solver.edge_ale_interval", value=ale,
+                              expected='0, or mesh.separation = "node_split"')
+        if cfg.solver.rezone_interval > 0:
+            raise ConfigError("chip rezoning and the ploughed-layer ALE exclude each other",
+                              file=source, field="solver.edge_ale_interval", value=ale,
+                              expected="0 when solver.rezone_interval > 0")
+        if cfg.solver.element == "q4_bbar":
+            raise ConfigError("the ploughed-layer ALE does not remap the Gauss-point state "
+                              "of the B-bar element", file=source,
+                              field="solver.edge_ale_interval", value=ale,
+                              expected='0 with solver.element = "q4_bbar", or element "q4r"')
+    if cfg.solver.element == "q4_bbar" and cfg.solver.rezone_interval > 0:
+        raise ConfigError("rezoning does not remap the Gauss-point state of the B-bar "
+                          "element", file=source, field="solver.rezone_interval",
+                          value=cfg.solver.rezone_interval,
+                          expected='0 with solver.element = "q4_bbar", or element "q4r"')
+    return cfg
+
+
+def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
+    """Cross-field checks of the tool-frame ALE model (mesh.frame = "tool")."""
+    le = cfg.mesh.element_size_um
+    ee = cfg.mesh.edge_element_um
+    if ee is not None and ee > le:
+        raise ConfigError("edge element larger than the element size", file=source,
+                          field="mesh.edge_element_um", value=ee,
+                          expected=f"at most mesh.element_size_um = {le:.4g} um")
+    if cfg.tool.edge_radius_um <= 0.0:
+        raise ConfigError("the tool-frame mesh wraps the cutting edge: it needs an edge "
+                          "radius", file=source, field="tool.edge_radius_um",
+                          value=cfg.tool.edge_radius_um, expected='> 0 um with mesh.frame '
+                          '= "tool"')
+    jh = cfg.mesh.join_height_um
+    r = cfg.tool.edge_radius_um
+    h = cfg.cut.uncut_chip_thickness_um
+    if jh is not None and (jh > r or jh > 0.75 * h):
+        raise ConfigError("join height off the lower front of the edge arc", file=source,
+                          field="mesh.join_height_um", value=jh,
+                          expected=f"at most the edge radius ({r:.4g} um) and 3/4 of the "
+                          f"uncut chip thickness ({0.75 * h:.4g} um)")
+    cl = cfg.mesh.chip_length_um
+    if cl is not None and cl < 2.0 * h:
+        raise ConfigError("chip too short for the tool-frame mesh", file=source,
+                          field="mesh.chip_length_um", value=cl,
+                          expected=f"at least 2 uncut chip thicknesses ({2 * h:.4g} um)")
+    for name, val, low, what in (
+            ("depth_um", cfg.mesh.depth_um, h, "the uncut chip thickness"),
+            ("inflow_length_um", cfg.mesh.inflow_length_um, h, "the uncut chip thickness"),
+            ("back_length_um", cfg.mesh.back_length_um, max(2.0 * r, h),
+             "the larger of 2 edge radii and the uncut chip thickness")):
+        if val is not None and val < low:
+            raise ConfigError("tool-frame domain too small", file=source,
+                              field=f"mesh.{name}", value=val,
+                              expected=f"at least {what} ({low:.4g} um)")
+    s = cfg.solver
+    for name, bad, want in (("rezone_interval", s.rezone_interval > 0, "0"),
+                            ("edge_ale_interval", s.edge_ale_interval > 0, "0"),
+                            ("element", s.element != "q4r", '"q4r"'),
+                            ("erosion", s.erosion == "everywhere", '"layer" or "none"')):
+        if bad:
+            raise ConfigError("not available with the tool-frame mesh", file=source,
+                              field=f"solver.{name}", value=getattr(s, name),
+                              expected=f'{want} with mesh.frame = "tool"')
+    return cfg
+
+
+def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
+    """Validate a config dict (as read from TOML); a material file named in it is resolved
+    against the config file's folder (robobore.io.paths)."""
+    from robobore.io.memory import check_fe2d
+    from robobore.material.library import load_material, resolve_material_name
+
+    cfg = validate_model(FEConfig, data, source=source or "<config>")
+    cfg.material.name = resolve_material_name(cfg.material.name, source)
+    # the material is read and checked now, not first when the run starts
+    load_material(cfg.material.name, source=source,
+                  hardening_strain_limit=cfg.material.strain_limit())
+    cfg = check_config(cfg, source)
+    check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
+    return cfg
+
+
+def load_fe_config(path: str | Path) -> FEConfig:
+    """Read and validate an FE config TOML file."""
+    return parse_config(load_toml(path), str(path))

@@ -1,0 +1,257 @@
+"""The compiled time-step loop of the plane-strain engine (:func:`run_chunk`): element,
+node and tool updates, heat passes, rezoning, energy totals, history sampling and the
+stop conditions, a chunk of steps at a time.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from robobore.cutting.fe.ale.rezone import rezone
+from robobore.cutting.fe.engine.layout import (
+    E_ERODED,
+    E_EROKE,
+    E_EXT,
+    E_FRIC,
+    E_HG,
+    E_INT,
+    E_KIN,
+    E_NODEWORK,
+    E_PLAST,
+    ELEM_Q4BBAR,
+    H_EERO,
+    H_EEXT,
+    H_EFRIC,
+    H_EHG,
+    H_EINT,
+    H_EKIN,
+    H_EPL,
+    H_FX,
+    H_FX_RAKE,
+    H_FY,
+    H_NCONT,
+    H_T,
+    H_TIP_X,
+    H_UX,
+    H_UY,
+    I_BADELEM,
+    I_SAMPLE,
+    I_STATUS,
+    I_STEP,
+    P_ALE_X0,
+    P_CFL,
+    P_COND_ACC,
+    P_COND_EVERY,
+    P_DTMIN,
+    P_ELEM,
+    P_EROSION,
+    P_FHEAT,
+    P_HC,
+    P_MS,
+    P_NFX,
+    P_NFY,
+    P_NRX,
+    P_NRY,
+    P_RZ_EVERY,
+    P_RZ_MAXMOVE,
+    P_RZ_MODE,
+    P_RZ_OMEGA,
+    P_SAMPLE_DT,
+    P_TCX,
+    P_TEND,
+    P_TTOOL,
+    STATUS_DONE,
+    STATUS_DT_COLLAPSE,
+    STATUS_INVERTED,
+    STATUS_NO_ELEMENTS,
+    STATUS_NONFINITE,
+    T_FX,
+    T_FY,
+    T_GX,
+    T_UX,
+    T_UY,
+)
+from robobore.cutting.fe.physics.thermal2d import (
+    conduct,
+    parting_conduct,
+    tool_heat,
+)
+from robobore.cutting.fe.quad.bbar import (
+    element_update_bbar,
+)
+from robobore.cutting.fe.quad.element import (
+    element_update,
+)
+from robobore.cutting.fe.quad.node_contact import (
+    contact_split,
+    contact_total,
+    node_update,
+    tool_geometry,
+)
+from robobore.cutting.fe.quad.tool_motion import (
+    tool_kinematics,
+    tool_step,
+)
+from robobore.material import johnson_cook as jc
+
+
+def sum_energies_py(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
+    """Totals of the energy accumulators into ``en`` [J/m] (serial, a fixed order)."""
+    ke = 0.0
+    for n in range(mass.shape[0]):
+        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
+    si = 0.0
+    sp = 0.0
+    sh = 0.0
+    se = 0.0
+    for e in range(ie.shape[0]):
+        si += ie[e]
+        sp += plast[e]
+        sh += hge[e]
+        if alive[e] != 1:
+            se += ie[e]
+    sf = 0.0
+    spn = 0.0
+    sek = 0.0
+    sw = 0.0
+    for n in range(mass.shape[0]):
+        sf += fric[n]
+        spn += pen[n]
+        sek += ero_ke[n]
+        sw += nwork[n]
+    en[E_KIN] = ke
+    en[E_INT] = si
+    en[E_PLAST] = sp
+    en[E_HG] = sh
+    en[E_FRIC] = sf + spn
+    en[E_NODEWORK] = sw
+    en[E_ERODED] = se + sek
+    en[E_EROKE] = sek
+
+
+_sum_energies = njit(cache=True)(sum_energies_py)
+
+
+@njit(cache=True)
+def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
+              sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
+              dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
+              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
+              gps, fheat, tcq, ppair, x0, y0, vbuf, acls, aflt, bflag, vslip):
+    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
+
+    ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
+    sample interval). Stops early with ``ist[I_STATUS]`` = STATUS_DONE at ``prm[P_TEND]``,
+    STATUS_NONFINITE or STATUS_DT_COLLAPSE. Returns the number of steps taken.
+    """
+    erosion = int(prm[P_EROSION])
+    bbar = int(prm[P_ELEM]) == ELEM_Q4BBAR
+    cfl = prm[P_CFL]
+    rz_every = int(prm[P_RZ_EVERY])
+    rho_s = mat[jc.RHO] * prm[P_MS]
+    fsplit = np.zeros(6)
+    taken = 0
+    for _s in range(n_steps):
+        dt = clock[1]
+        t = clock[0]
+        cx, cy, tvx, tvy = tool_kinematics(tool, prm)
+        ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
+                            fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy,
+                            prm, dt, twin, tied, vslip)
+        fwx, fwy = contact_total(cfx, cfy)
+        contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+                      fsplit)
+        en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
+        if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
+            rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
+                   sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
+                   prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE], int(prm[P_RZ_MODE]), tied, x0, y0,
+                   vbuf, tool_geometry(prm), acls, aflt, bflag, mat[jc.TROOM],
+                   prm[P_TCX] - prm[P_ALE_X0])
+        if bbar:
+            dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
+                                             sdxy, pres, eps_p, temp, dmg, gps, area0, ie, fex,
+                                             fey, dte, plast, rate, mat, prm, dt, erosion)
+        else:
+            dtmin, bad = element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy,
+                                        pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex,
+                                        fey, dte, plast, rate, mat, prm, dt, erosion)
+        cond_every = int(prm[P_COND_EVERY])
+        if cond_every > 0:
+            prm[P_COND_ACC] += dt
+            if ist[I_STEP] % cond_every == 0:
+                rcp = mat[jc.RHO] * mat[jc.CP]
+                conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp,
+                        prm[P_COND_ACC])
+                if ppair.shape[0] > 0:
+                    parting_conduct(ppair, x, y, alive, tied, temp, tbuf, mat[jc.KCOND], rcp,
+                                    prm[P_COND_ACC])
+                if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+                    tool_heat(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric,
+                              fheat, temp, tbuf, tcq, rcp, prm[P_HC], prm[P_FHEAT],
+                              prm[P_TTOOL], prm[P_COND_ACC])
+                prm[P_COND_ACC] = 0.0
+        if bad >= 0:
+            ist[I_BADELEM] = bad
+            ist[I_STATUS] = STATUS_INVERTED
+            return taken + 1
+        if dtmin >= 1e30:
+            ist[I_STATUS] = STATUS_NO_ELEMENTS
+            return taken + 1
+        new_dt = cfl * dtmin
+        t += dt
+        clock[0] = t
+        taken += 1
+        ist[I_STEP] += 1
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(new_dt)):
+            ist[I_STATUS] = STATUS_NONFINITE
+            return taken
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = STATUS_DT_COLLAPSE
+            clock[1] = new_dt
+            return taken
+        clock[1] = new_dt
+        # time-averaged histories
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_NCONT] += dt * ncont
+        for j in range(6):
+            hacc[H_FX_RAKE + j] += dt * fsplit[j]
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            if not math.isfinite(en[E_KIN]):
+                ist[I_STATUS] = STATUS_NONFINITE
+                return taken
+            hist[k, H_T] = t
+            hist[k, H_FX] = hacc[H_FX] / ta
+            hist[k, H_FY] = hacc[H_FY] / ta
+            hist[k, H_UX] = hacc[H_UX] / ta
+            hist[k, H_UY] = hacc[H_UY] / ta
+            hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            for j in range(6):
+                hist[k, H_FX_RAKE + j] = hacc[H_FX_RAKE + j] / ta
+            hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
+            hist[k, H_EKIN] = en[E_KIN]
+            hist[k, H_EINT] = en[E_INT]
+            hist[k, H_EPL] = en[E_PLAST]
+            hist[k, H_EHG] = en[E_HG]
+            hist[k, H_EFRIC] = en[E_FRIC]
+            hist[k, H_EEXT] = en[E_EXT]
+            hist[k, H_EERO] = en[E_ERODED]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = STATUS_DONE
+            _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            return taken
+    return taken

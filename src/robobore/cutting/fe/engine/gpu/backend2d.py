@@ -1,0 +1,270 @@
+"""GPU backend of the 2D explicit engine (numba-cuda), built from the SAME scalar physics.
+
+The per-element, per-node, tool and conduction updates are the plain-Python scalar functions
+of the CPU engine (:func:`kernels.quad_element_py`, :func:`kernels.quad_node_py`,
+:func:`kernels.tool_kinematics_py`, :func:`kernels.tool_step_py`,
+:func:`kernels.quad_centroid_py`, :func:`kernels.quad_conduct_py`,
+:func:`kernels.sum_energies_py`) and the shared material/contact/support functions
+(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), re-bound
+to device versions with :func:`robobore.material.johnson_cook.rebind` and compiled with
+``numba.cuda.jit(device=True)``; the CPU engine calls the ``njit`` versions of the same
+functions from its ``prange`` loops.
+
+One time step is five kernel launches: nodes (contact count by atomic add), the contact-
+force total (one block, summed in the CPU engine's fixed lane order,
+``kernels.contact_total``: the same bits on both devices), the tool (one thread: support
+springs, external work), elements (stable step by atomic min, inverted element by atomic
+max) and the step end (one thread: time, status, time-averaged histories and, at each
+sample, the energy totals summed serially in the CPU engine's order). With
+``solver.heat_conduction`` more launches run every ``solver.conduction_interval`` steps:
+centroids, fluxes, copy, the tied parting-line edges (node splitting), the thermal
+contact with the tool (nodes, then elements) and the reset of the accumulated time. The
+loop stays on the device; the host copies the state back between chunks (for the progress
+bar and the energy check).
+
+
+Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``).
+Importing this module needs neither; :func:`robobore.cutting.fe.engine.gpu.backend3d.require_gpu`
+raises a clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
+the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine. The
+workpiece-frame model is timed on an H100 (docs/fe.md, "GPU path"); the tool-frame model is
+checked in the simulator and compiled for sm_90, not timed on a GPU.
+
+The tool-frame ALE model (``mesh.frame = "tool"``) runs here too: every
+``solver.ale_interval`` steps, after the tool step, the persistent kernel runs the ALE pass of
+:func:`robobore.cutting.fe.ale.rezone.rezone` (``MODE_TOOLFRAME``) from the same scalar functions
+(``tf_place_py``, ``tf_face_py``, the Jacobi sweeps ``tf_sweep_py`` / ``tf_sweep_copy_py``,
+``tf_interior_py``, the donor-cell remap ``rz_flux_py``, ``rz_velocity_py``, ``rz_write_py``,
+``rz_node_mass_py``), a grid barrier wherever one pass reads what another wrote (14 per
+pass); the launch-per-kernel path launches one kernel per pass. The contact force by tool
+face (``kernels.contact_split``) is added by one thread in increasing node order over the
+chunks holding a contact node: the CPU's serial order, the same bits.
+
+Layout: the device functions are bound in :mod:`robobore.cutting.fe.engine.gpu.device2d`, the
+kernels built in :mod:`robobore.cutting.fe.engine.gpu.kernels2d`, the CUDA plumbing shared with the
+3D engine is :mod:`robobore.cutting.fe.engine.gpu.shared`; this module is the host driver.
+
+Kernel parameters: the persistent kernel takes the whole state, 3944 bytes of CUDA's classic
+4096-byte limit (checked by a test with numba's data model).
+
+Not ported: Laplacian rezoning (``solver.rezone_interval`` > 0), the ploughed-layer ALE and
+the B-bar element are refused with a ConfigError.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.fe.ale import rezone as RZ
+from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, R_BAD, R_DTMIN, kernels2
+from robobore.cutting.fe.engine.gpu.shared import (
+    bind_cuda,
+    persistent_run,
+    profile_ticker,
+    require_gpu,
+)
+from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
+from robobore.errors import ConfigError
+
+__all__ = ["advance_gpu", "check_gpu_supported", "N_RED"]
+
+_THREADS = 128
+#: the kernels (benchmarks/gpu_compile_check.py compiles them)
+_kernels = kernels2
+
+def check_gpu_supported(rezone_interval: int, source: str | None = None,
+                        element: str = "q4r", edge_ale_interval: int = 0) -> None:
+    """Raise a ConfigError for a setting the GPU engine does not run (rezoning, the
+    ploughed-layer ALE, B-bar)."""
+    if element != "q4r":
+        raise ConfigError("the B-bar element is not ported to the GPU", file=source,
+                          field="solver.element", value=element,
+                          expected='"q4r" with --device gpu, or --device cpu')
+    if rezone_interval > 0:
+        raise ConfigError("rezoning is not available on the GPU", file=source,
+                          field="solver.rezone_interval", value=rezone_interval,
+                          expected="0 (off, the default) with --device gpu, or --device cpu")
+    if edge_ale_interval > 0:
+        raise ConfigError("the ploughed-layer ALE is not available on the GPU", file=source,
+                          field="solver.edge_ale_interval", value=edge_ale_interval,
+                          expected="0 (off, the default) with --device gpu, or --device cpu")
+
+
+#: FEState arrays used by the kernels (copied to the device)
+_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
+           "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
+           "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
+           "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
+           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair", "vslip",
+           "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
+#: the arrays the kernels change (copied back to the host)
+_MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "sdx", "sdy", "sdz", "sdxy", "pres",
+            "eps_p", "temp", "dmg", "qhx", "qhy", "area0", "ie", "hge", "fex", "fey", "dte",
+            "plast", "rate", "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm",
+            "tool", "en", "ist", "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq",
+            "vslip", "xn", "yn", "buf", "vbuf", "aflt")
+
+
+def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
+                progress: Callable[[float], None] | None = None,
+                check: Callable[[Any], None] | None = None,
+                profile: dict[str, float] | None = None,
+                persistent: bool | None = None) -> int:
+    """GPU counterpart of :func:`robobore.cutting.fe.engine.chunk_driver.advance` (same contract).
+
+    Copies the :class:`~robobore.cutting.fe.engine.state2d.FEState` to the device, runs chunks of
+    ``chunk_steps`` steps there, copies the step counter and clock back after each chunk
+    (the whole state when ``check`` is given, before calling it) and the whole state at the
+    end. Returns the number of steps taken. Raises NumericalError on instability (same
+    messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
+    rezoning, the ploughed-layer ALE or the B-bar element. ``profile`` and ``persistent``:
+    as in :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu` (per-kernel wall times for
+    benchmarks; one cooperative launch per chunk, the default without ``profile``).
+    """
+    every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
+    mode = int(st.prm[K.P_RZ_MODE])
+    # the tool-frame ALE runs here; Laplacian rezoning and the ploughed-layer ALE do not
+    check_gpu_supported(every if mode == MODE_LAPLACE else 0, None,
+                        "q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar",
+                        every if mode == MODE_ROWS else 0)
+    rz_every = every if mode == MODE_TOOLFRAME else 0
+    require_gpu()
+    cuda = bind_cuda()
+    (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
+     k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,
+     ale) = _kernels()
+    (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
+     k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass) = ale
+    st.prm[K.P_TEND] = t_end
+    st.ist[K.I_STATUS] = K.STATUS_OK
+    g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _ARRAYS}
+    red = np.zeros(N_RED)
+    red[R_DTMIN] = 1e30
+    red[R_BAD] = -1.0
+    dred = cuda.to_device(red)
+    nn = st.x.shape[0]
+    ne = st.conn.shape[0]
+    gn = (nn + _THREADS - 1) // _THREADS
+    ge = (ne + _THREADS - 1) // _THREADS
+    erosion = int(st.prm[K.P_EROSION])
+    cond_every = int(st.prm[K.P_COND_EVERY])
+    npair = int(st.ppair.shape[0])
+    gp = max(1, (npair + _THREADS - 1) // _THREADS)
+    nsn = int(st.snodes.shape[0])
+    gs = max(1, (nsn + _THREADS - 1) // _THREADS)
+    theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
+    t_start = st.time
+    step0 = int(st.ist[K.I_STEP])
+    tick = profile_ticker(profile)
+    run = persistent_run(k_run, [g[name] for name in _ARRAYS]
+                         + [erosion, cond_every, int(theat), rz_every, dred], nn, profile,
+                         persistent)
+    while True:
+        if run is not None:
+            run(chunk_steps)
+        # while the status is OK every launch sequence is exactly one step, so the host
+        # knows the step index (conduction runs where ist[I_STEP] % cond_every == 0, as on
+        # the CPU); once the status changes the remaining launches return at once
+        step = int(st.ist[K.I_STEP])
+        for i in range(0 if run is not None else chunk_steps):
+            tick(None)
+            k_nodes[gn, _THREADS](g["x"], g["y"], g["vx"], g["vy"], g["mass"], g["fixed"],
+                                  g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
+                                  g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
+                                  g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
+                                  g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"],
+                                  dred)
+            tick("nodes")
+            k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
+                                            g["prm"], dred)
+            tick("contact_sum")
+            k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+            tick("tool")
+            if rz_every > 0 and (step + i) % rz_every == 0:
+                _ale_launches(g, ale, gn, ge, gs)
+                tick("ale")
+            k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
+                                  g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
+                                  g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
+                                  g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
+                                  g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
+                                  g["clock"], erosion, g["ist"], dred)
+            tick("elements")
+            if cond_every > 0 and (step + i) % cond_every == 0:
+                k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
+                k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
+                                        g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
+                k_conduct_end[ge, _THREADS](g["temp"], g["tbuf"], g["prm"], g["ist"])
+                if npair > 0:
+                    k_parting[gp, _THREADS](g["ppair"], g["x"], g["y"], g["alive"], g["tied"],
+                                            g["temp"], g["tbuf"], g["mat"], g["prm"],
+                                            g["ist"])
+                if theat:
+                    k_theat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["ptr"],
+                                                g["nel"], g["ncorner"], g["alive"], g["enbr"],
+                                                g["cfx"], g["cfy"], g["fric"], g["fheat"],
+                                                g["temp"], g["tbuf"], g["tcq"], g["mat"],
+                                                g["prm"], g["ist"])
+                    k_theat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["tcq"],
+                                                g["mat"], g["ist"])
+                k_conduct_reset[1, 1](g["prm"], g["ist"])
+                tick("conduction")
+            k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
+                           g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
+                           g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"],
+                           g["nwork"])
+            tick("finish")
+        for name in ("ist", "clock"):
+            getattr(st, name)[...] = g[name].copy_to_host()
+        status = int(st.ist[K.I_STATUS])
+        if status in STATUS_TEXT or status == K.STATUS_DONE or check is not None:
+            _copy_back(st, g)
+        if status in STATUS_TEXT:
+            raise instability_error(st, "simulation (GPU)", "a smaller solver.cfl, a larger "
+                                    "mesh.element_size_um or less mass scaling")
+        if progress is not None:
+            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
+        if check is not None:
+            check(st)
+        if status == K.STATUS_DONE or st.time >= t_end:
+            _copy_back(st, g)
+            return int(st.ist[K.I_STEP]) - step0
+
+
+def _ale_launches(g: dict, ale: tuple, gn: int, ge: int, gs: int) -> None:
+    """One tool-frame ALE pass as one launch per phase (the persistent kernel's phases)."""
+    (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
+     k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass) = ale
+    T = _THREADS
+    k_ale_place[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["x0"], g["y0"], g["acls"],
+                       g["aflt"], g["prm"], g["ist"])
+    k_ale_face[gn, T](g["xn"], g["yn"], g["x0"], g["y0"], g["acls"], g["aflt"], g["prm"],
+                      g["ist"])
+    for _ in range(RZ.TF_SWEEPS):
+        k_ale_sweep[gn, T](g["acls"], g["aflt"], g["vbuf"], g["ist"])
+        k_ale_sweep_copy[gn, T](g["acls"], g["aflt"], g["vbuf"], g["ist"])
+    k_ale_interior[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["x0"], g["y0"], g["acls"],
+                          g["aflt"], g["prm"], g["ist"])
+    k_ale_flux[ge, T](g["conn"], g["x"], g["y"], g["xn"], g["yn"], g["alive"], g["enbr"],
+                      g["bflag"], g["buf"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"], g["pres"],
+                      g["eps_p"], g["temp"], g["dmg"], g["qhx"], g["qhy"], g["area0"],
+                      g["mat"], g["ist"])
+    k_ale_velocity[gs, T](g["snodes"], g["x"], g["y"], g["xn"], g["yn"], g["vx"], g["vy"],
+                          g["ptr"], g["nel"], g["conn"], g["vbuf"], g["ist"])
+    k_ale_apply[gs, T](g["snodes"], g["vx"], g["vy"], g["vbuf"], g["ist"])
+    k_ale_write[ge, T](g["alive"], g["buf"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
+                       g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"], g["qhy"],
+                       g["area0"], g["ist"])
+    k_ale_nodes[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["ist"])
+    k_ale_mass[gn, T](g["ptr"], g["nel"], g["area0"], g["mass"], g["mat"], g["prm"],
+                      g["ist"])
+
+
+def _copy_back(st: Any, g: dict) -> None:
+    for name in _MUTABLE:
+        getattr(st, name)[...] = g[name].copy_to_host()

@@ -1,0 +1,188 @@
+"""GPU backend of the 3D explicit engine (numba-cuda), built from the SAME scalar physics.
+
+The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
+(:func:`hex.element.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
+and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
+:mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
+:func:`robobore.material.johnson_cook.rebind` and compiled with
+``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
+force total (one block, in the CPU's fixed lane order, so a run is reproducible bit for
+bit), the tool (one thread), elements (stable step by atomic min), and the step end (one
+thread: time, status, time-averaged histories); every ``solver.conduction_interval`` steps
+the heat conduction of :mod:`robobore.cutting.fe.physics.thermal3d` adds five more (centroids, new
+temperatures, their copy, the insert's heat per node, then per element). The loop stays on
+the device; the host only checks the status between chunks.
+
+Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``, i.e.
+``numba-cuda``). Importing this module never needs either; :func:`require_gpu` raises a
+clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
+the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine.
+
+Layout: the CUDA plumbing shared with the 2D engine (availability, binding, the cooperative
+launch) is :mod:`robobore.cutting.fe.engine.gpu.shared`; the kernels are built in
+:mod:`robobore.cutting.fe.engine.gpu.kernels3d`; this module is the host driver.
+
+Limits: per-sample energy histories are not recorded on the GPU (the final energy totals
+are computed on the host from the copied-back state). The 2D engine's GPU port, built the
+same way from its scalar functions, is :mod:`robobore.cutting.fe.engine.gpu.backend2d`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, R_BAD, R_DTMIN, kernels3
+from robobore.cutting.fe.engine.gpu.shared import (
+    MAX_BLOCK,
+    THREADS,
+    bind_cuda,
+    chunk_list_py,
+    cooperative,
+    cuda_available,
+    jc_device_functions,
+    persistent_run,
+    profile_ticker,
+    require_gpu,
+    simulator_enabled,
+)
+
+__all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled", "N_RED",
+           # shared with the 2D GPU engine (robobore.cutting.fe.engine.gpu.backend2d)
+           "MAX_BLOCK", "bind_cuda", "chunk_list_py", "jc_device_functions", "persistent_run",
+           "profile_ticker"]
+
+_THREADS = THREADS
+#: the kernels (benchmarks/gpu_compile_check.py compiles the persistent one, the last)
+_kernels = kernels3
+#: the cooperative launch (tests/cutting/fe3d/test_fe3d_gpu.py checks its fallback)
+_cooperative = cooperative
+
+#: arrays of FEState3 that the kernels change (copied back to the host)
+_MUTABLE = ("x", "y", "z", "vx", "vy", "vz", "alive", "sd", "pres", "eps_p", "temp", "dmg",
+            "qh", "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
+            "ero_ke", "nwork", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "prm",
+            "tbuf", "theat")
+
+
+def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
+                 progress: Callable[[float], None] | None = None,
+                 check: Callable[[object], None] | None = None,
+                 profile: dict[str, float] | None = None,
+                 persistent: bool | None = None) -> int:
+    """GPU counterpart of :func:`robobore.cutting.fe.engine.state3d.advance3` (same contract).
+
+    Copies the state to the device, runs chunks of ``chunk_steps`` steps, copies the state
+    back after each chunk (for ``check``/``progress``) and at the end, and computes the
+    energy totals on the host. Raises NumericalError on instability, ConfigError when no
+    GPU is usable. ``profile`` (a dict, for benchmarks): synchronize after every launch and
+    add each kernel's wall time [s] under its name (slows the run down; five launches a
+    step). ``persistent``: run each chunk as one cooperative launch of the persistent
+    kernel (``None``, the default: when the device supports cooperative launches and no
+    ``profile`` is asked for; the same bits as the five launches a step, without their
+    host-side launch cost).
+    """
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
+
+    require_gpu()
+    cuda = bind_cuda()
+    k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_thermal, k_run = _kernels()
+    k_centroids, k_conduct, k_copy_temp, k_heat_nodes, k_heat_elems, k_cond_done = k_thermal
+    st.prm[K3.P_TEND] = t_end
+    st.ist[K3.I_STATUS] = K3.STATUS_OK
+    g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _RUN_ARGS}
+    red = np.zeros(N_RED)
+    red[R_DTMIN] = 1e30
+    red[R_BAD] = -1.0
+    dred = cuda.to_device(red)
+    nn = st.x.shape[0]
+    ne = st.conn.shape[0]
+    gn = (nn + _THREADS - 1) // _THREADS
+    ge = (ne + _THREADS - 1) // _THREADS
+    erosion = int(st.prm[K3.P_EROSION])
+    t_start = st.time
+    step0 = int(st.ist[K3.I_STEP])
+    tick = profile_ticker(profile)
+    run = persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
+                         profile, persistent)
+    heat = st.prm[K3.P_HC] > 0.0 or st.prm[K3.P_FHEAT] > 0.0
+    while True:
+        if run is not None:
+            run(chunk_steps)
+        step = int(st.ist[K3.I_STEP])  # the launch path: the host counts the steps
+        for _ in range(0 if run is not None else chunk_steps):
+            tick(None)
+            k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
+                                  g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
+                                  g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
+                                  g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
+                                  g["ist"], dred, g["pairs"])
+            tick("nodes")
+            k_contact_sum[1, K3.N_SUM_LANES](g["cf"], dred)
+            tick("contact_sum")
+            k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+            tick("tool")
+            k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
+                                  g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],
+                                  g["temp"], g["dmg"], g["qh"], g["vol0"], g["ie"], g["hge"],
+                                  g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
+                                  g["clock"], erosion, g["ist"], dred)
+            tick("elements")
+            if K3.is_conduction_step_py(step, st.prm):
+                k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
+                k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
+                                        g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],
+                                        g["prm"], g["clock"], g["ist"])
+                k_copy_temp[ge, _THREADS](g["temp"], g["tbuf"], g["ist"])
+                if heat:
+                    k_heat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["ptr"],
+                                               g["nel"], g["ncorner"], g["alive"], g["enbr"],
+                                               g["pairs"], g["vol0"], g["cf"], g["fric"],
+                                               g["temp"], g["theat"], g["mat"], g["prm"],
+                                               g["clock"], g["ist"])
+                    k_heat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["theat"],
+                                               g["mat"], g["ist"])
+                k_cond_done[1, 1](g["prm"], g["clock"], g["ist"])
+                tick("conduction")
+            step += 1
+            k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
+                           g["en"], dred)
+            tick("finish")
+        for name in ("ist", "clock"):
+            getattr(st, name)[...] = g[name].copy_to_host()
+        status = int(st.ist[K3.I_STATUS])
+        if status in STATUS_TEXT or status == K3.STATUS_DONE or check is not None:
+            _copy_back(st, g)
+        if status in STATUS_TEXT:
+            raise instability_error(st, "3D simulation (GPU)", "a smaller solver.cfl, a larger "
+                                    "mesh.element_size_um or less mass scaling")
+        if progress is not None:
+            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
+        if check is not None:
+            check(st)
+        if status == K3.STATUS_DONE or st.time >= t_end:
+            _copy_back(st, g)
+            return int(st.ist[K3.I_STEP]) - step0
+
+
+#: the state arrays on the device, in the persistent kernel's argument order (then erosion,
+#: red, the chunk flags and the chunk list)
+_RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
+             "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
+             "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
+             "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "enbr", "tbuf",
+             "theat")
+
+
+
+def _copy_back(st, g) -> None:
+    from robobore.cutting.fe.engine import kernels3d as K3
+
+    for name in _MUTABLE:
+        getattr(st, name)[...] = g[name].copy_to_host()
+    ext = float(st.en[K3.E_EXT])
+    K3.sum_energies3(st.mass, st.vx, st.vy, st.vz, st.ie, st.plast, st.hge, st.alive, st.fric,
+                     st.pen, st.ero_ke, st.nwork, st.en)
+    st.en[K3.E_EXT] = ext

@@ -1,0 +1,533 @@
+"""The 2D GPU engine's kernels (numba-cuda), built from the SAME scalar physics as the CPU
+engine (their device versions: :func:`robobore.cutting.fe.engine.gpu.device2d.device_functions2`).
+
+:func:`kernels2` returns the launch-per-kernel phases (nodes, contact-force total, tool,
+elements, the heat-conduction kernels, step end, the tool-frame ALE passes) and the
+persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch; the
+host driver is :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring
+describes the step's phases.
+"""
+
+from __future__ import annotations
+
+import functools
+import math  # noqa: F401  (math.isfinite inside the kernels)
+
+from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.gpu.device2d import device_functions2
+from robobore.cutting.fe.engine.gpu.shared import MAX_BLOCK, bind_cuda
+
+__all__ = ["kernels2", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC", "R_SPLIT", "N_RED"]
+
+# reduction slots on the device
+R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
+#: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
+R_SPLIT = 5
+N_RED = 11
+
+#: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
+#: substitute its own inside the kernels)
+cuda = None
+
+
+@functools.lru_cache(maxsize=1)
+def kernels2():
+    """Compile (lazily, once) the device functions and kernels: ``(k_nodes, k_contact_sum,
+    k_tool, k_elems, k_centroids, k_conduct, k_conduct_end, k_parting, k_theat_nodes,
+    k_theat_elems, k_conduct_reset, k_finish, k_run, ale)`` with ``ale`` the tool-frame ALE
+    pass's kernels (the launch-per-kernel path)."""
+    global cuda
+    cuda = bind_cuda()  # also gpu_shared's, for chunk_list_py
+    from numba import float64 as _float64
+    from numba import int64 as _int64
+
+    from robobore.material import johnson_cook as jc
+
+    f = device_functions2(cuda.jit(device=True))
+    (csplit, tool_geometry, tplace, tfacep, tsweep, tscopy, tinter, rflux, rvel, rwrite, rmass,
+     SWEEPS, elem, node, kin, tstep, cent, cond, pedge, thnode, thelem, sumen, lsum, chunks) = (
+        f.csplit, f.tool_geometry, f.tplace, f.tfacep, f.tsweep, f.tscopy, f.tinter, f.rflux,
+        f.rvel, f.rwrite, f.rmass, f.SWEEPS, f.elem, f.node, f.kin, f.tstep, f.cent, f.cond,
+        f.pedge, f.thnode, f.thelem, f.sumen, f.lsum, f.chunks)
+    LANES = K.N_SUM_LANES
+    float64 = _float64
+    int64 = _int64
+    NCNT = MAX_BLOCK + 1
+
+    I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K.I_STATUS, K.I_STEP, K.I_SAMPLE, K.I_BADELEM
+    ST_OK, ST_DONE, ST_INV = K.STATUS_OK, K.STATUS_DONE, K.STATUS_INVERTED
+    ST_NOEL, ST_NONF, ST_DTC = K.STATUS_NO_ELEMENTS, K.STATUS_NONFINITE, K.STATUS_DT_COLLAPSE
+    P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K.P_CFL, K.P_DTMIN, K.P_TEND, K.P_SAMPLE_DT
+    P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
+    P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
+    P_TCX, P_NRX, P_NRY, P_NFX, P_NFY = K.P_TCX, K.P_NRX, K.P_NRY, K.P_NFX, K.P_NFY
+    P_ALE_X0, P_RZ_MAXMOVE, P_MS = K.P_ALE_X0, K.P_RZ_MAXMOVE, K.P_MS
+    H_FX_RAKE = K.H_FX_RAKE
+    T_FX, T_FY, T_UX, T_UY, T_GX = K.T_FX, K.T_FY, K.T_UX, K.T_UY, K.T_GX
+    E_EXT, E_KIN, E_INT, E_PLAST, E_HG, E_FRIC, E_ERODED = (K.E_EXT, K.E_KIN, K.E_INT,
+                                                            K.E_PLAST, K.E_HG, K.E_FRIC,
+                                                            K.E_ERODED)
+    H_T, H_FX, H_FY, H_UX, H_UY, H_TIP_X, H_NCONT = (K.H_T, K.H_FX, K.H_FY, K.H_UX, K.H_UY,
+                                                     K.H_TIP_X, K.H_NCONT)
+    H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO = (K.H_EKIN, K.H_EINT, K.H_EPL,
+                                                             K.H_EHG, K.H_EFRIC, K.H_EEXT,
+                                                             K.H_EERO)
+    KCOND, RHO, CP, TROOM = jc.KCOND, jc.RHO, jc.CP, jc.TROOM
+
+    @cuda.jit(device=True)
+    def lanes_total(px, py, red):
+        # the lanes' partial sums added in lane order by one thread: the order of the CPU's
+        # kernels.contact_total, so the total has the same bits on both devices
+        sx = 0.0
+        sy = 0.0
+        for j in range(LANES):
+            sx += px[j]
+            sy += py[j]
+        red[R_FX] = sx
+        red[R_FY] = sy
+        return sx, sy
+
+    @cuda.jit(device=True)
+    def split_add(n, x, y, cfx, cfy, cx, cy, prm, red):
+        # node n's share of the contact force by tool face into red[R_SPLIT:], called in
+        # increasing node order by one thread: the CPU's serial order (kernels.contact_split)
+        csplit(n, cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+               red, R_SPLIT)
+
+    @cuda.jit(device=True)
+    def split_reset(red):
+        for j in range(6):
+            red[R_SPLIT + j] = 0.0
+
+    @cuda.jit
+    def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
+                fric, pen, ndead, ero_ke, nwork, prm, tool, clock, ist, twin, tied, vslip, red):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cx, cy, tvx, tvy = kin(tool, prm)
+        fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0,
+                                 fex, fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy,
+                                 tvx, tvy, prm, clock[1], twin, tied, vslip)
+        if touched:
+            cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
+
+    @cuda.jit
+    def k_contact_sum(cfx, cfy, x, y, tool, prm, red):
+        # the CPU's fixed-order total (kernels.contact_total): one thread per lane, then
+        # the lanes in order by thread 0 -- the same bits on both devices; then the split by
+        # tool face over every node in order (the persistent kernel visits only the chunks
+        # holding a contact node)
+        t = cuda.threadIdx.x
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        px[t] = lsum(cfx, t, LANES)
+        py[t] = lsum(cfy, t, LANES)
+        cuda.syncthreads()
+        if t == 0:
+            lanes_total(px, py, red)
+            cx, cy, tvx, tvy = kin(tool, prm)
+            split_reset(red)
+            for n in range(x.shape[0]):
+                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
+
+    @cuda.jit
+    def k_ale_place(x, y, xn, yn, x0, y0, acls, aflt, prm, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        xn[n] = x[n]
+        yn[n] = y[n]
+        tplace(n, x, y, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0],
+               prm[P_RZ_MAXMOVE], tool_geometry(prm))
+
+    @cuda.jit
+    def k_ale_face(xn, yn, x0, y0, acls, aflt, prm, ist):
+        n = cuda.grid(1)
+        if n >= xn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tfacep(n, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0])
+
+    @cuda.jit
+    def k_ale_sweep(acls, aflt, vbuf, ist):
+        n = cuda.grid(1)
+        if n >= acls.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tsweep(n, acls, aflt, vbuf)
+
+    @cuda.jit
+    def k_ale_sweep_copy(acls, aflt, vbuf, ist):
+        n = cuda.grid(1)
+        if n >= acls.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tscopy(n, acls, aflt, vbuf)
+
+    @cuda.jit
+    def k_ale_interior(x, y, xn, yn, x0, y0, acls, aflt, prm, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        tinter(n, x, y, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0],
+               prm[P_RZ_MAXMOVE])
+
+    @cuda.jit
+    def k_ale_flux(conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+                   eps_p, temp, dm, qhx, qhy, area0, mat, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+              eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
+
+    @cuda.jit
+    def k_ale_velocity(snodes, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf, ist):
+        k = cuda.grid(1)
+        if k >= snodes.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+
+    @cuda.jit
+    def k_ale_apply(snodes, vx, vy, vbuf, ist):
+        k = cuda.grid(1)
+        if k >= snodes.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        n = snodes[k]
+        vx[n] += vbuf[n, 0]
+        vy[n] += vbuf[n, 1]
+
+    @cuda.jit
+    def k_ale_write(alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0,
+                    ist):
+        e = cuda.grid(1)
+        if e >= alive.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rwrite(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0)
+
+    @cuda.jit
+    def k_ale_nodes(x, y, xn, yn, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        x[n] = xn[n]
+        y[n] = yn[n]
+
+    @cuda.jit
+    def k_ale_mass(ptr, nel, area0, mass, mat, prm, ist):
+        n = cuda.grid(1)
+        if n >= mass.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        rmass(n, ptr, nel, area0, mat[RHO] * prm[P_MS], mass)
+
+    @cuda.jit
+    def k_tool(tool, prm, en, clock, ist, red):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        dt = clock[1]
+        en[E_EXT] += tstep(tool, prm, red[R_FX], red[R_FY], dt)
+        if prm[P_COND_EVERY] > 0.0:
+            prm[P_COND_ACC] += dt
+        red[R_DTMIN] = 1e30
+        red[R_BAD] = -1.0
+
+    @cuda.jit
+    def k_elems(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm,
+                qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, clock, erosion,
+                ist, red):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                      temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm,
+                      clock[1], erosion)
+        cuda.atomic.min(red, R_DTMIN, d)
+        if inv:
+            cuda.atomic.max(red, R_BAD, float(e))
+
+    @cuda.jit
+    def k_centroids(conn, x, y, tbuf, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cent(e, conn, x, y, tbuf)
+
+    @cuda.jit
+    def k_conduct(conn, x, y, alive, enbr, temp, tbuf, mat, prm, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
+             prm[P_COND_ACC])
+
+    @cuda.jit
+    def k_conduct_end(temp, tbuf, prm, ist):
+        e = cuda.grid(1)
+        if e >= temp.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        temp[e] = tbuf[e, 3]
+
+    @cuda.jit
+    def k_parting(ppair, x, y, alive, tied, temp, tbuf, mat, prm, ist):
+        i = cuda.grid(1)
+        if i >= ppair.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        pedge(i, ppair, x, y, alive, tied, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
+              prm[P_COND_ACC])
+
+    @cuda.jit
+    def k_theat_nodes(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp,
+                      tbuf, tcq, mat, prm, ist):
+        n = cuda.grid(1)
+        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        thnode(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp,
+               tbuf, tcq, mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
+               prm[P_COND_ACC])
+
+    @cuda.jit
+    def k_theat_elems(conn, alive, temp, tcq, mat, ist):
+        e = cuda.grid(1)
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
+            return
+        thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
+
+    @cuda.jit
+    def k_conduct_reset(prm, ist):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        prm[P_COND_ACC] = 0.0
+
+    @cuda.jit(device=True)
+    def finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge, alive,
+               fric, pen, ero_ke, nwork):
+        # the step end (one thread): time, stable step, status, histories
+        dt = clock[1]
+        fwx = red[R_FX]
+        fwy = red[R_FY]
+        nc = red[R_NC]
+        red[R_NC] = 0.0  # the force total is rewritten by k_contact_sum every step
+        if red[R_BAD] >= 0.0:
+            ist[I_BADELEM] = int(red[R_BAD])
+            ist[I_STATUS] = ST_INV
+            return
+        dtmin = red[R_DTMIN]
+        if dtmin >= 1e30:
+            ist[I_STATUS] = ST_NOEL
+            return
+        new_dt = prm[P_CFL] * dtmin
+        t = clock[0] + dt
+        clock[0] = t
+        ist[I_STEP] += 1
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(new_dt)):
+            ist[I_STATUS] = ST_NONF
+            return
+        clock[1] = new_dt
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = ST_DTC
+            return
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_NCONT] += dt * nc
+        for j in range(6):
+            hacc[H_FX_RAKE + j] += dt * red[R_SPLIT + j]
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            if not math.isfinite(en[E_KIN]):
+                ist[I_STATUS] = ST_NONF
+                return
+            hist[k, H_T] = t
+            hist[k, H_FX] = hacc[H_FX] / ta
+            hist[k, H_FY] = hacc[H_FY] / ta
+            hist[k, H_UX] = hacc[H_UX] / ta
+            hist[k, H_UY] = hacc[H_UY] / ta
+            hist[k, H_NCONT] = hacc[H_NCONT] / ta
+            for j in range(6):
+                hist[k, H_FX_RAKE + j] = hacc[H_FX_RAKE + j] / ta
+            hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
+            hist[k, H_EKIN] = en[E_KIN]
+            hist[k, H_EINT] = en[E_INT]
+            hist[k, H_EPL] = en[E_PLAST]
+            hist[k, H_EHG] = en[E_HG]
+            hist[k, H_EFRIC] = en[E_FRIC]
+            hist[k, H_EEXT] = en[E_EXT]
+            hist[k, H_EERO] = en[E_ERODED]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = ST_DONE
+            sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+
+    @cuda.jit
+    def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
+                 alive, fric, pen, ero_ke, nwork):
+        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
+            return
+        finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge, alive,
+               fric, pen, ero_ke, nwork)
+
+    @cuda.jit
+    def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
+              sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte,
+              plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool, en, ist,
+              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, vslip, snodes, x0,
+              y0, xn, yn, buf, vbuf, acls, aflt, bflag, erosion, cond_every, theat, rz_every,
+              red, cflag, clist):
+        # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
+        # of the kernels above separated by grid-wide barriers (one launch per chunk instead
+        # of five to twelve per step); same functions, same order, same bits
+        grid = cuda.cg.this_grid()
+        tid = cuda.grid(1)
+        nthr = cuda.gridsize(1)
+        t = cuda.threadIdx.x
+        nb = cuda.blockDim.x
+        nn = x.shape[0]
+        ne = conn.shape[0]
+        npair = ppair.shape[0]
+        nsn = snodes.shape[0]
+        rho_s = mat[RHO] * prm[P_MS]
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        cnt = cuda.shared.array(NCNT, int64)
+        for _ in range(n_steps):
+            if ist[I_STATUS] != ST_OK:
+                return
+            step = ist[I_STEP]
+            dt = clock[1]
+            cx, cy, tvx, tvy = kin(tool, prm)
+            for n in range(tid, nn, nthr):
+                fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
+                                         area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
+                                         nwork, cx, cy, tvx, tvy, prm, dt, twin, tied,
+                                         vslip)
+                if touched:
+                    cuda.atomic.add(red, R_NC, 1.0)
+                if cfx[n] != 0.0 or cfy[n] != 0.0:
+                    cflag[n // LANES] = 1  # the chunk of LANES nodes holding n has contact
+            grid.sync()
+            if cuda.blockIdx.x == 0:
+                # block 0: the contact-force total in the CPU's lane order over the chunks
+                # holding a contact node (the others hold zeros), then the tool
+                m = chunks(cflag, clist, cnt, t, nb)
+                for lane in range(t, LANES, nb):
+                    sx = 0.0
+                    sy = 0.0
+                    for i in range(m):
+                        n = clist[i] * LANES + lane
+                        if n < nn:
+                            sx += cfx[n]
+                            sy += cfy[n]
+                    px[lane] = sx
+                    py[lane] = sy
+                cuda.syncthreads()
+                if t == 0:
+                    sx, sy = lanes_total(px, py, red)
+                    # the split by tool face, in increasing node order over the listed
+                    # chunks (the CPU's serial order; the other nodes carry no force)
+                    split_reset(red)
+                    for i in range(m):
+                        for lane in range(LANES):
+                            n = clist[i] * LANES + lane
+                            if n < nn:
+                                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
+                    en[E_EXT] += tstep(tool, prm, sx, sy, dt)
+                    if prm[P_COND_EVERY] > 0.0:
+                        prm[P_COND_ACC] += dt
+            # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
+            # elements' gated erosion and the ALE pass read (as after k_tool): a barrier
+            grid.sync()
+            if rz_every > 0 and step % rz_every == 0:
+                # the tool-frame ALE pass (rezone.rezone, MODE_TOOLFRAME): the same passes in
+                # the same order, a barrier wherever one reads what another wrote
+                off = prm[P_TCX] - prm[P_ALE_X0]
+                mm = prm[P_RZ_MAXMOVE]
+                tgeo = tool_geometry(prm)
+                for n in range(tid, nn, nthr):
+                    xn[n] = x[n]
+                    yn[n] = y[n]
+                    tplace(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm, tgeo)
+                grid.sync()
+                for n in range(tid, nn, nthr):
+                    tfacep(n, xn, yn, x0, y0, acls, aflt, off)
+                grid.sync()
+                for _sw in range(SWEEPS):
+                    for n in range(tid, nn, nthr):
+                        tsweep(n, acls, aflt, vbuf)
+                    grid.sync()
+                    for n in range(tid, nn, nthr):
+                        tscopy(n, acls, aflt, vbuf)
+                    grid.sync()
+                for n in range(tid, nn, nthr):
+                    tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz,
+                          sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
+                for k in range(tid, nsn, nthr):
+                    rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+                grid.sync()
+                for k in range(tid, nsn, nthr):
+                    n = snodes[k]
+                    vx[n] += vbuf[n, 0]
+                    vy[n] += vbuf[n, 1]
+                for e in range(tid, ne, nthr):
+                    rwrite(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx,
+                           qhy, area0)
+                for n in range(tid, nn, nthr):
+                    x[n] = xn[n]
+                    y[n] = yn[n]
+                grid.sync()
+                for n in range(tid, nn, nthr):
+                    rmass(n, ptr, nel, area0, rho_s, mass)
+                grid.sync()
+            for e in range(tid, ne, nthr):
+                d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
+                              eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
+                              rate, mat, prm, dt, erosion)
+                cuda.atomic.min(red, R_DTMIN, d)
+                if inv:
+                    cuda.atomic.max(red, R_BAD, float(e))
+            grid.sync()
+            if cond_every > 0 and step % cond_every == 0:
+                for e in range(tid, ne, nthr):
+                    cent(e, conn, x, y, tbuf)
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND],
+                         mat[RHO] * mat[CP], prm[P_COND_ACC])
+                grid.sync()
+                for e in range(tid, ne, nthr):
+                    temp[e] = tbuf[e, 3]
+                grid.sync()
+                if npair > 0:
+                    for i in range(tid, npair, nthr):
+                        pedge(i, ppair, x, y, alive, tied, temp, tbuf, mat[KCOND],
+                              mat[RHO] * mat[CP], prm[P_COND_ACC])
+                    grid.sync()
+                if theat != 0:
+                    for n in range(tid, nn, nthr):
+                        thnode(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric,
+                               fheat, temp, tbuf, tcq, mat[RHO] * mat[CP], prm[P_HC],
+                               prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
+                    grid.sync()
+                    for e in range(tid, ne, nthr):
+                        thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
+                    grid.sync()
+                if tid == 0:
+                    prm[P_COND_ACC] = 0.0
+            if tid == 0:
+                finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
+                       alive, fric, pen, ero_ke, nwork)
+                red[R_DTMIN] = 1e30
+                red[R_BAD] = -1.0
+            grid.sync()
+
+    ale = (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
+           k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass)
+    return (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
+            k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run, ale)

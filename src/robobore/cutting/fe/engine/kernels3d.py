@@ -1,0 +1,377 @@
+"""Numba kernels of the 3D explicit engine (hexahedra, SI units, forces in N).
+
+Reuses the 2D engine's scalar physics unchanged: the Johnson-Cook return mapping and damage
+(:mod:`robobore.material.johnson_cook`), the 2D wedge signed distance
+(:func:`robobore.cutting.fe.physics.tool_contact.tool_gap`, applied in the local normal section of
+the insert edge) and the spring-damper step
+(:func:`robobore.cutting.fe.physics.tool_contact.tool_support_step`). The 3D state layout and scalar
+functions (``_py`` original + ``njit``, device-ready) are
+:mod:`robobore.cutting.fe.hex.scalar3d`, re-exported here; this module holds the parallel loops
+(elements, nodes), the energy sums, the contact-force total, the conduction pass and the
+chunk loop :func:`run_chunk3`. The scalar functions:
+
+* :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
+  approach and end-edge angles, rake, clearance, edge radius and inclination;
+* :func:`contact_force3_py` -- the 2D contact law (:func:`tool_contact.contact_force_py`: mass-
+  proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
+  tangential *vector*;
+* :func:`friction_at3_py` -- the 2D engine's friction table lookup
+  (:func:`robobore.cutting.fe.engine.kernels.friction_at_py`, the same code re-bound to the 3D
+  parameter slots);
+* :func:`hex_node_py` -- gather, contact and central-difference update of one node.
+
+Energy indices, status codes and the energy-balance definition are the 2D engine's
+(:mod:`robobore.cutting.fe.engine.kernels`), so
+:func:`robobore.cutting.fe.engine.chunk_driver.energy_error` applies to both.
+
+Frames: the kernels work in the *local* frame of the insert at the start of the run
+(x along the cutting velocity, y normal to the bore wall pointing out of the material,
+towards the bore axis, z along the feed). The tool support integrates in the *boring*
+frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
+``theta(t) = theta0 + vc t / R``; see :mod:`robobore.cutting.fe.models.boring3d`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from robobore.cutting.fe.engine.kernels import (
+    E_ERODED,
+    E_EROKE,
+    E_EXT,
+    E_FRIC,
+    E_HG,
+    E_INT,
+    E_KIN,
+    E_NODEWORK,
+    E_PLAST,
+    I_BADELEM,
+    I_SAMPLE,
+    I_STATUS,
+    I_STEP,
+    N_EN,
+    N_IST,
+    N_SUM_LANES,
+    STATUS_DONE,
+    STATUS_DT_COLLAPSE,
+    STATUS_INVERTED,
+    STATUS_NO_ELEMENTS,
+    STATUS_NONFINITE,
+    STATUS_OK,
+)
+from robobore.cutting.fe.hex.element import (
+    ERODE_ALL,
+    ERODE_LAYER,
+    ERODE_NONE,
+    N_PRM,
+    P_BV1,
+    P_BV2,
+    P_CFL,
+    P_CLR,
+    P_COND_EVERY,
+    P_COND_T,
+    P_CX,
+    P_CY,
+    P_CZ,
+    P_DIST,
+    P_DT_ERODE,
+    P_DTMIN,
+    P_EROSION,
+    P_FHEAT,
+    P_GATE,
+    P_HC,
+    P_HGS,
+    P_HGV,
+    P_KAPPA,
+    P_KEND,
+    P_KX,
+    P_KY,
+    P_KZ,
+    P_MS,
+    P_MU,
+    P_MUTAB_MU,
+    P_MUTAB_N,
+    P_MUTAB_V,
+    P_MX,
+    P_MY,
+    P_MZ,
+    P_PEN,
+    P_RADIUS,
+    P_RAKE,
+    P_RE,
+    P_RN,
+    P_SAMPLE_DT,
+    P_SLIP_TAU,
+    P_SUPPORT,
+    P_TANI,
+    P_TAU,
+    P_TEND,
+    P_THETA0,
+    P_TOOL,
+    P_TTOOL,
+    P_VC,
+    P_VF,
+    hex_element,
+)
+from robobore.cutting.fe.hex.scalar3d import (
+    FIX_X,
+    FIX_Y,
+    FIX_Z,
+    H_EERO,
+    H_EEXT,
+    H_EFRIC,
+    H_EHG,
+    H_EINT,
+    H_EKIN,
+    H_EPL,
+    H_FX,
+    H_FY,
+    H_FZ,
+    H_NCONT,
+    H_T,
+    H_THETA,
+    H_TIPX,
+    H_UX,
+    H_UY,
+    H_UZ,
+    N_HIST,
+    N_TOOL,
+    T_FX,
+    T_FY,
+    T_FZ,
+    T_GX,
+    T_GY,
+    T_GZ,
+    T_THETA,
+    T_UX,
+    T_UY,
+    T_UZ,
+    T_VX,
+    T_VY,
+    T_VZ,
+    contact_force3,
+    contact_force3_py,
+    edge_section,
+    edge_section_py,
+    friction_at3,
+    friction_at3_py,
+    hex_node,
+    hex_node_py,
+    insert_gap3,
+    insert_gap3_py,
+    is_conduction_step,
+    is_conduction_step_py,
+    lane_sum3,
+    lane_sum3_py,
+    tool_kinematics,
+    tool_kinematics_py,
+    tool_step,
+    tool_step_py,
+)
+from robobore.cutting.fe.physics.thermal3d import conduct3, tool_heat3
+from robobore.material import johnson_cook as jc
+
+__all__ = [
+    "N_PRM", "P_CFL", "P_MS", "P_HGV", "P_HGS", "P_BV1", "P_BV2", "P_DIST", "P_DT_ERODE",
+    "P_DTMIN", "P_MU", "P_MUTAB_N", "P_MUTAB_V", "P_MUTAB_MU", "P_SLIP_TAU", "P_TAU", "P_PEN",
+    "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR", "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF",
+    "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY", "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY",
+    "P_MZ", "P_THETA0", "P_SAMPLE_DT", "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER",
+    "ERODE_ALL", "N_EN", "N_IST", "STATUS_OK", "P_COND_EVERY", "P_COND_T", "P_HC", "P_FHEAT",
+    "P_TTOOL", "is_conduction_step_py", "conduction_pass3", "insert_gap3_py", "insert_gap3",
+    "contact_force3_py", "contact_force3", "hex_node_py", "hex_node", "element_update3",
+    "node_update3", "run_chunk3", "FIX_X", "FIX_Y", "FIX_Z", "T_GX", "T_GY", "T_GZ", "T_UX",
+    "T_UY", "T_UZ", "T_VX", "T_VY", "T_VZ", "T_FX", "T_FY", "T_FZ", "T_THETA", "N_TOOL", "H_T",
+    "H_FX", "H_FY", "H_FZ", "H_UX", "H_UY", "H_UZ", "H_TIPX", "H_THETA", "H_EKIN", "H_EINT",
+    "H_EPL", "H_EHG", "H_EFRIC", "H_EEXT", "H_EERO", "H_NCONT", "N_HIST", "edge_section_py",
+    "edge_section", "friction_at3_py", "friction_at3", "tool_kinematics_py", "tool_kinematics",
+    "tool_step_py", "tool_step", "lane_sum3_py", "lane_sum3", "is_conduction_step", "E_ERODED",
+    "E_EXT", "E_FRIC", "E_HG", "E_INT", "E_KIN", "E_PLAST", "I_BADELEM", "I_SAMPLE",
+    "I_STATUS", "I_STEP", "N_SUM_LANES", "P_GATE", "STATUS_DONE", "STATUS_DT_COLLAPSE",
+    "STATUS_INVERTED", "STATUS_NONFINITE", "STATUS_NO_ELEMENTS", "sum_energies3",
+    "contact_total3",
+]
+
+
+@njit(parallel=True, cache=True)
+def element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
+                    ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
+    """:func:`hex.element.hex_element_py` over all elements (parallel)."""
+    for e in prange(conn.shape[0]):
+        hex_element(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
+                    vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+
+
+@njit(parallel=True, cache=True)
+def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
+                 pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs):
+    """:func:`hex_node_py` over all nodes (parallel)."""
+    for n in prange(x.shape[0]):
+        hex_node(np.int64(n), x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
+                 fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
+                 pairs)
+
+
+@njit(cache=True)
+def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
+    """Totals of the energy accumulators into ``en`` (2D engine's indices) [J]."""
+    ke = 0.0
+    sf = 0.0
+    spn = 0.0
+    sek = 0.0
+    sw = 0.0
+    for n in range(mass.shape[0]):
+        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n] + vz[n] * vz[n])
+        sf += fric[n]
+        spn += pen[n]
+        sek += ero_ke[n]
+        sw += nwork[n]
+    si = 0.0
+    sp = 0.0
+    sh = 0.0
+    se = 0.0
+    for e in range(ie.shape[0]):
+        si += ie[e]
+        sp += plast[e]
+        sh += hge[e]
+        if alive[e] != 1:
+            se += ie[e]
+    en[E_KIN] = ke
+    en[E_INT] = si
+    en[E_PLAST] = sp
+    en[E_HG] = sh
+    en[E_FRIC] = sf + spn
+    en[E_NODEWORK] = sw
+    en[E_ERODED] = se + sek
+    en[E_EROKE] = sek
+
+
+
+@njit(cache=True)
+def contact_total3(cf):
+    """Total contact force on the workpiece [N] and number of contact nodes, summed in the
+    fixed lane order of :func:`robobore.cutting.fe.engine.kernels.contact_total` (the GPU engine
+    sums the same way, so a GPU run is reproducible bit for bit)."""
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    nc = 0
+    for lane in range(N_SUM_LANES):
+        a, b, c, k = lane_sum3(cf, lane, N_SUM_LANES)
+        fx += a
+        fy += b
+        fz += c
+        nc += k
+    return fx, fy, fz, nc
+
+
+
+@njit(cache=True)
+def conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
+                     tbuf, theat, mat, prm, t_end_step):
+    """Conduction and the thermal contact with the insert over the time since the last pass,
+    ``t_end_step - prm[P_COND_T]`` [s], which then moves to ``t_end_step``."""
+    dt_th = t_end_step - prm[P_COND_T]
+    rcp = mat[jc.RHO] * mat[jc.CP]
+    conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp, dt_th)
+    if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+        tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
+                   theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
+    prm[P_COND_T] = t_end_step
+
+
+@njit(cache=True)
+def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
+               sd, pres, eps_p, temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
+               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, enbr,
+               tbuf, theat):
+    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
+
+    ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
+    STATUS_DONE at ``prm[P_TEND]``, or an instability status. Returns the steps taken.
+    Every ``prm[P_COND_EVERY]`` steps (0: adiabatic) heat conduction and the thermal contact
+    with the insert run over the time since the last pass (:mod:`~robobore.cutting.fe.
+    physics.thermal3d`, :func:`conduction_pass3`).
+    """
+    erosion = int(prm[P_EROSION])
+    ne = conn.shape[0]
+    taken = 0
+    for _s in range(n_steps):
+        dt = clock[1]
+        t = clock[0]
+        cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
+        node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
+                     fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs)
+        fwx, fwy, fwz, ncont = contact_total3(cf)
+        en[E_EXT] += tool_step(tool, prm, fwx, fwy, fwz, dt)
+        element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
+                        vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
+        if is_conduction_step(ist[I_STEP], prm):
+            conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
+                             fric, temp, tbuf, theat, mat, prm, t + dt)
+        dtmin = 1e30
+        for e in range(ne):
+            if dte[e] < dtmin:
+                dtmin = dte[e]
+            if alive[e] == -2:
+                ist[I_BADELEM] = e
+                ist[I_STATUS] = STATUS_INVERTED
+        taken += 1
+        ist[I_STEP] += 1
+        t += dt
+        clock[0] = t
+        if ist[I_STATUS] == STATUS_INVERTED:
+            return taken
+        if dtmin >= 1e30:
+            ist[I_STATUS] = STATUS_NO_ELEMENTS
+            return taken
+        new_dt = prm[P_CFL] * dtmin
+        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(fwz)
+                and math.isfinite(new_dt)):
+            ist[I_STATUS] = STATUS_NONFINITE
+            return taken
+        if new_dt < prm[P_DTMIN]:
+            ist[I_STATUS] = STATUS_DT_COLLAPSE
+            clock[1] = new_dt
+            return taken
+        clock[1] = new_dt
+        hacc[H_FX] += dt * tool[T_FX]
+        hacc[H_FY] += dt * tool[T_FY]
+        hacc[H_FZ] += dt * tool[T_FZ]
+        hacc[H_UX] += dt * tool[T_UX]
+        hacc[H_UY] += dt * tool[T_UY]
+        hacc[H_UZ] += dt * tool[T_UZ]
+        hacc[H_NCONT] += dt * ncont
+        clock[2] += dt
+        k = ist[I_SAMPLE]
+        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
+            ta = clock[2]
+            sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            if not math.isfinite(en[E_KIN]):
+                ist[I_STATUS] = STATUS_NONFINITE
+                return taken
+            hist[k, H_T] = t
+            for j in (H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ, H_NCONT):
+                hist[k, j] = hacc[j] / ta
+            hist[k, H_TIPX] = tool[T_GX]
+            hist[k, H_THETA] = tool[T_THETA]
+            hist[k, H_EKIN] = en[E_KIN]
+            hist[k, H_EINT] = en[E_INT]
+            hist[k, H_EPL] = en[E_PLAST]
+            hist[k, H_EHG] = en[E_HG]
+            hist[k, H_EFRIC] = en[E_FRIC]
+            hist[k, H_EEXT] = en[E_EXT]
+            hist[k, H_EERO] = en[E_ERODED]
+            for j in range(hacc.shape[0]):
+                hacc[j] = 0.0
+            clock[2] = 0.0
+            ist[I_SAMPLE] = k + 1
+        if t >= prm[P_TEND]:
+            ist[I_STATUS] = STATUS_DONE
+            sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+            return taken
+    sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+    return taken
+

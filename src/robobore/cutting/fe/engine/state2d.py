@@ -1,0 +1,253 @@
+"""The state of the plane-strain engine: :class:`FEState` holds every array of a model
+(structure of arrays); :func:`make_state` builds one from any quad mesh (used by the cutting
+model and by the element/bar tests), :func:`default_prm` the neutral parameter vector
+(:mod:`robobore.cutting.fe.engine.layout`), :func:`parting_edges` the parting-line edges of a
+node-splitting mesh, :func:`init_forces` the forces and stable step of the first
+configuration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
+from robobore.cutting.fe.ale.stencils import edge_neighbours
+from robobore.cutting.fe.engine import kernels as K
+from robobore.errors import ConfigError
+from robobore.material import Material
+
+
+@dataclass
+class FEState:
+    """All arrays of an explicit model (SI, per unit width). Shapes: nodes (n,), elements (e,)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    mass: np.ndarray
+    fixed: np.ndarray
+    ptr: np.ndarray
+    nel: np.ndarray
+    ncorner: np.ndarray
+    conn: np.ndarray
+    layer: np.ndarray
+    alive: np.ndarray
+    sdx: np.ndarray
+    sdy: np.ndarray
+    sdz: np.ndarray
+    sdxy: np.ndarray
+    pres: np.ndarray
+    eps_p: np.ndarray
+    temp: np.ndarray
+    dmg: np.ndarray
+    qhx: np.ndarray
+    qhy: np.ndarray
+    area0: np.ndarray
+    ie: np.ndarray
+    hge: np.ndarray
+    fex: np.ndarray
+    fey: np.ndarray
+    dte: np.ndarray
+    plast: np.ndarray
+    rate: np.ndarray
+    cfx: np.ndarray
+    cfy: np.ndarray
+    fric: np.ndarray
+    pen: np.ndarray
+    ndead: np.ndarray
+    ero_ke: np.ndarray
+    nwork: np.ndarray
+    mat: np.ndarray
+    prm: np.ndarray
+    tool: np.ndarray
+    en: np.ndarray
+    ist: np.ndarray
+    clock: np.ndarray
+    hacc: np.ndarray
+    hist: np.ndarray
+    enbr: np.ndarray = field(default=None)  # type: ignore[assignment]
+    snodes: np.ndarray = field(default=None)  # type: ignore[assignment]
+    snbr: np.ndarray = field(default=None)  # type: ignore[assignment]
+    xn: np.ndarray = field(default=None)  # type: ignore[assignment]
+    yn: np.ndarray = field(default=None)  # type: ignore[assignment]
+    buf: np.ndarray = field(default=None)  # type: ignore[assignment]
+    x0: np.ndarray = field(default=None)  # type: ignore[assignment]
+    y0: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: node splitting: partner node (-1: none) and whether the pair is still tied
+    twin: np.ndarray = field(default=None)  # type: ignore[assignment]
+    tied: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: scratch for the heat-conduction update (n_elem, 4)
+    tbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: Gauss-point state of the B-bar element (n_elem, 4, N_GPS); (0, 4, N_GPS) for Q4R
+    gps: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: thermal contact: frictional dissipation already turned into heat (n_nodes,), scratch
+    #: (n_nodes, 2), and the parting-line edges (m, 4) = an element, the element across the
+    #: line, and the first one's two nodes on the edge (conduction across tied pairs)
+    fheat: np.ndarray = field(default=None)  # type: ignore[assignment]
+    tcq: np.ndarray = field(default=None)  # type: ignore[assignment]
+    ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: rezoning: velocity increments of the moved nodes (n_nodes, 2), scratch
+    vbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: tool-frame ALE (``mesh.frame = "tool"``, robobore.cutting.fe.ale.toolframe): node classes
+    #: and neighbours (n, 7), node data (n, 6), flux type of each element edge (e, 4); empty
+    #: for the Lagrangian models
+    acls: np.ndarray = field(default=None)  # type: ignore[assignment]
+    aflt: np.ndarray = field(default=None)  # type: ignore[assignment]
+    bflag: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: friction by sliding speed: each node's filtered sliding speed [m/s] (n_nodes,)
+    vslip: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def kernel_args(self) -> tuple:
+        return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
+                self.ncorner, self.conn, self.layer, self.alive, self.sdx, self.sdy, self.sdz,
+                self.sdxy, self.pres, self.eps_p, self.temp, self.dmg, self.qhx, self.qhy,
+                self.area0, self.ie, self.hge, self.fex, self.fey, self.dte, self.plast,
+                self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
+                self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
+                self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
+                self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
+                self.ppair, self.x0, self.y0, self.vbuf, self.acls, self.aflt, self.bflag,
+                self.vslip)
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.conn.shape[0])
+
+    @property
+    def time(self) -> float:
+        return float(self.clock[0])
+
+
+def default_prm() -> np.ndarray:
+    """Parameter vector with neutral values (no tool contact, no support, no erosion)."""
+    p = np.zeros(K.N_PRM)
+    p[K.P_CFL] = 0.8
+    p[K.P_MS] = 1.0
+    p[K.P_HGV] = 0.05
+    p[K.P_HGS] = 0.05
+    p[K.P_BV1] = 0.06
+    p[K.P_BV2] = 1.2
+    p[K.P_DIST] = 0.0
+    p[K.P_PEN] = 0.1
+    p[K.P_TAU] = 1e30
+    p[K.P_R] = 0.0
+    # tool far away: rake normal (-1, 0), flank normal (0, -1)
+    p[K.P_NRX], p[K.P_NRY], p[K.P_NFX], p[K.P_NFY] = -1.0, 0.0, 0.0, -1.0
+    p[K.P_WIDTH] = 1.0
+    p[K.P_SAMPLE_DT] = 1e30
+    p[K.P_TEND] = 1e30
+    p[K.P_EROSION] = K.ERODE_NONE
+    p[K.P_GATE] = -1.0
+    return p
+
+
+def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
+               prm: np.ndarray | None = None, layer: np.ndarray | None = None,
+               n_samples: int = 1, tool_center: tuple[float, float] = (1e3, 1e3),
+               twin: np.ndarray | None = None) -> FEState:
+    """State for a quad mesh ``nodes`` (n, 2) [m], ``conn`` (e, 4) counter-clockwise.
+
+    Lumped nodal masses from the (mass-scaled) density; stresses zero; temperature at
+    T_room. The tool starts with its edge centre at ``tool_center`` [m].
+    """
+    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+    conn = np.ascontiguousarray(conn, dtype=np.int64)
+    n = nodes.shape[0]
+    ne = conn.shape[0]
+    prm = default_prm() if prm is None else prm.astype(np.float64)
+    mat = material.to_array()
+    xs = nodes[:, 0].copy()
+    ys = nodes[:, 1].copy()
+    xe = xs[conn]
+    ye = ys[conn]
+    area = 0.5 * ((xe[:, 2] - xe[:, 0]) * (ye[:, 3] - ye[:, 1])
+                  + (xe[:, 1] - xe[:, 3]) * (ye[:, 2] - ye[:, 0]))
+    if np.any(area <= 0):
+        bad = int(np.argmin(area))
+        raise ConfigError("mesh has an element with non-positive area (nodes must be "
+                          "counter-clockwise)", field="conn", value=bad)
+    mass = np.zeros(n)
+    np.add.at(mass, conn.ravel(), np.repeat(area * material.rho * prm[K.P_MS] / 4.0, 4))
+    counts = np.bincount(conn.ravel(), minlength=n)
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum(counts)
+    nel = np.empty(ptr[-1], dtype=np.int64)
+    nco = np.empty(ptr[-1], dtype=np.int64)
+    fill = ptr[:-1].copy()
+    flat = conn.ravel()
+    order = np.argsort(flat, kind="stable")
+    nel[:] = order // 4
+    nco[:] = order % 4
+    del fill
+    tool = np.zeros(K.N_TOOL)
+    tool[K.T_GX], tool[K.T_GY] = tool_center
+    z = np.zeros
+    st = FEState(
+        x=xs, y=ys, vx=z(n), vy=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.bool_),
+        ptr=ptr, nel=nel, ncorner=nco, conn=conn,
+        layer=np.zeros(ne, np.bool_) if layer is None else np.asarray(layer, np.bool_),
+        alive=np.ones(ne, np.int64), sdx=z(ne), sdy=z(ne), sdz=z(ne), sdxy=z(ne), pres=z(ne),
+        eps_p=z(ne), temp=np.full(ne, material.T_room), dmg=z(ne), qhx=z(ne), qhy=z(ne),
+        area0=area.copy(), ie=z(ne), hge=z(ne), fex=z((ne, 4)), fey=z((ne, 4)),
+        dte=z(ne), plast=z(ne), rate=z(ne), cfx=z(n), cfy=z(n), fric=z(n), pen=z(n),
+        ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
+        en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
+        hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
+        enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64),
+        snbr=np.zeros((0, 6), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)),
+        twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
+        tied=(np.zeros(n, np.int64) if twin is None
+              else (np.asarray(twin) >= 0).astype(np.int64)),
+        tbuf=z((ne, 4)),
+        gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)),
+        fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)),
+        acls=np.zeros((0, 7), np.int64), aflt=z((0, 6)), bflag=np.zeros((0, 4), np.int64),
+        vslip=z(n))
+    init_forces(st)
+    return st
+
+
+def parting_edges(conn: np.ndarray, twin: np.ndarray | None) -> np.ndarray:
+    """(m, 4) int64: the edges of a node-splitting parting line, as element, element across,
+    and the element's two nodes on the edge (the twins of the element across's nodes)."""
+    if twin is None:
+        return np.zeros((0, 4), np.int64)
+    tw = np.asarray(twin, np.int64)
+    owner: dict[tuple[int, int], tuple[int, int, int]] = {}
+    rows: list[tuple[int, int, int, int]] = []
+    for e in range(conn.shape[0]):
+        for k in range(4):
+            a, b = int(conn[e, k]), int(conn[e, (k + 1) % 4])
+            if tw[a] < 0 or tw[b] < 0:
+                continue
+            other = (min(int(tw[a]), int(tw[b])), max(int(tw[a]), int(tw[b])))
+            if other in owner:
+                e2, _, _ = owner.pop(other)
+                rows.append((e2, e, int(tw[a]), int(tw[b])))
+            else:
+                owner[(min(a, b), max(a, b))] = (e, a, b)
+    out = np.array(rows, dtype=np.int64).reshape(-1, 4)
+    # each element on one edge at most: the edges can then be updated in parallel
+    if np.unique(out[:, :2]).size != 2 * out.shape[0]:
+        raise ValueError("an element has two edges on the parting line")
+    return out
+
+
+def init_forces(st: FEState) -> float:
+    """Element forces and stable step of the current configuration (no stress update)."""
+    K.element_update(st.conn, st.x, st.y, st.vx * 0.0, st.vy * 0.0, st.alive, st.layer,
+                     st.sdx.copy(), st.sdy.copy(), st.sdz.copy(), st.sdxy.copy(),
+                     st.pres.copy(), st.eps_p.copy(), st.temp.copy(), st.dmg.copy(),
+                     st.qhx.copy(), st.qhy.copy(), st.area0, st.ie.copy(), st.hge.copy(),
+                     st.fex, st.fey, st.dte, st.plast.copy(), st.rate.copy(), st.mat, st.prm,
+                     1e-30, K.ERODE_NONE)
+    dt = st.prm[K.P_CFL] * float(np.min(st.dte))
+    st.clock[1] = dt
+    if st.prm[K.P_DTMIN] <= 0:
+        st.prm[K.P_DTMIN] = 1e-3 * dt
+    if st.prm[K.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
+        st.prm[K.P_DT_ERODE] = -st.prm[K.P_DT_ERODE] * float(np.min(st.dte))
+    return dt

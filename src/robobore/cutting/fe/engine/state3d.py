@@ -1,0 +1,312 @@
+"""3D explicit solver: state arrays of a hexahedral model and the chunked time loop.
+
+:class:`FEState3` holds every array (structure of arrays, SI, forces in N);
+:func:`make_state3` builds one from any hexahedral mesh (used by the boring model and the
+element tests); :func:`advance3` runs :func:`kernels3d.run_chunk3` in chunks and turns an
+instability into :class:`robobore.errors.NumericalError` with the 2D engine's messages.
+The energy balance is :func:`robobore.cutting.fe.engine.chunk_driver.energy_error` (same
+accumulators).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.chunk_driver import drive_chunks, energy_error
+from robobore.cutting.fe.engine.threads import ThreadGovernor
+from robobore.cutting.fe.physics.thermal3d import face_neighbours
+from robobore.errors import ConfigError
+from robobore.material import Material
+
+__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "advance3", "energy_error",
+           "hex_volumes", "split_node_layer"]
+
+#: node sign pattern of the reference hexahedron (VTK order), shape (8, 3)
+HEX_SIGNS = np.array([(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),
+                      (-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)], float)
+
+
+@dataclass
+class FEState3:
+    """All arrays of a 3D explicit model. Shapes: nodes (n,), (n, 3); elements (e,), (e, k)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    vz: np.ndarray
+    mass: np.ndarray
+    fixed: np.ndarray
+    ptr: np.ndarray
+    nel: np.ndarray
+    ncorner: np.ndarray
+    conn: np.ndarray
+    alive: np.ndarray
+    layer: np.ndarray
+    sd: np.ndarray
+    pres: np.ndarray
+    eps_p: np.ndarray
+    temp: np.ndarray
+    dmg: np.ndarray
+    qh: np.ndarray
+    vol0: np.ndarray
+    ie: np.ndarray
+    hge: np.ndarray
+    fe: np.ndarray
+    dte: np.ndarray
+    plast: np.ndarray
+    rate: np.ndarray
+    cf: np.ndarray  # (n, 4): contact force on the node [N], filtered sliding speed [m/s]
+    fric: np.ndarray
+    pen: np.ndarray
+    ndead: np.ndarray
+    ero_ke: np.ndarray
+    nwork: np.ndarray
+    mat: np.ndarray
+    prm: np.ndarray
+    tool: np.ndarray
+    en: np.ndarray
+    ist: np.ndarray
+    clock: np.ndarray
+    hacc: np.ndarray
+    hist: np.ndarray
+    #: node splitting, (n, 2) int64: partner node (-1: none) and whether the pair is still
+    #: tied (one array: see :func:`kernels3d.hex_node_py`)
+    pairs: np.ndarray
+    #: heat conduction (:mod:`robobore.cutting.fe.physics.thermal3d`): the element across each face
+    #: (e, 6) int64 (-1 none, -(nb + 2) across a parting face); scratch (e, 4): centroid,
+    #: new temperature; per node (n, 3): frictional dissipation already turned into heat
+    #: [J], heat exchanged with the insert in the current pass [J], volume of the node's live
+    #: elements [m^3]
+    enbr: np.ndarray
+    tbuf: np.ndarray
+    theat: np.ndarray
+
+    def kernel_args(self) -> tuple:
+        """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+    @property
+    def twin(self) -> np.ndarray:
+        """Partner of each node on a parting surface (-1: none), a view."""
+        return self.pairs[:, 0]
+
+    @property
+    def tied(self) -> np.ndarray:
+        """1 while a node's pair is tied, a view."""
+        return self.pairs[:, 1]
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.conn.shape[0])
+
+    @property
+    def time(self) -> float:
+        return float(self.clock[0])
+
+    def nodes(self) -> np.ndarray:
+        """Current nodal positions, shape (n, 3) [m]."""
+        return np.stack([self.x, self.y, self.z], axis=1)
+
+
+def default_prm3() -> np.ndarray:
+    """Parameter vector with neutral values (no insert, no support, no erosion)."""
+    p = np.zeros(K3.N_PRM)
+    p[K3.P_CFL] = 0.8
+    p[K3.P_MS] = 1.0
+    p[K3.P_HGV] = 0.05
+    p[K3.P_HGS] = 0.05
+    p[K3.P_BV1] = 0.06
+    p[K3.P_BV2] = 1.2
+    p[K3.P_PEN] = 0.1
+    p[K3.P_TAU] = 1e30
+    p[K3.P_SAMPLE_DT] = 1e30
+    p[K3.P_TEND] = 1e30
+    p[K3.P_EROSION] = K3.ERODE_NONE
+    p[K3.P_GATE] = -1.0
+    p[K3.P_KAPPA] = np.pi / 2
+    p[K3.P_KEND] = np.radians(5.0)
+    p[K3.P_RN] = 1e-3
+    p[K3.P_COND_EVERY] = 0  # adiabatic
+    return p
+
+
+def hex_volumes(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Exact volumes of trilinear hexahedra (2x2x2 Gauss), shape (e,) [m^3]."""
+    xe = nodes[conn]  # (e, 8, 3)
+    g = 1.0 / np.sqrt(3.0)
+    vol = np.zeros(conn.shape[0])
+    for a in (-g, g):
+        for b in (-g, g):
+            for c in (-g, g):
+                xi = np.array([a, b, c])
+                fac = [1.0 + HEX_SIGNS[:, k] * xi[k] for k in range(3)]
+                dN = np.empty((8, 3))
+                dN[:, 0] = HEX_SIGNS[:, 0] * fac[1] * fac[2] / 8
+                dN[:, 1] = HEX_SIGNS[:, 1] * fac[0] * fac[2] / 8
+                dN[:, 2] = HEX_SIGNS[:, 2] * fac[0] * fac[1] / 8
+                J = np.einsum("eia,ib->eab", xe, dN)
+                vol += np.linalg.det(J)
+    return vol
+
+
+def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
+                prm: np.ndarray | None = None, n_samples: int = 1,
+                layer: np.ndarray | None = None,
+                tool_tip: tuple[float, float, float] = (1e3, 1e3, 1e3),
+                twin: np.ndarray | None = None) -> FEState3:
+    """State for a hexahedral mesh ``nodes`` (n, 3) [m], ``conn`` (e, 8) in VTK order.
+
+    ``fixed`` (n,) bit mask (1 x, 2 y, 4 z: velocity component held at its value, i.e.
+    zero unless set). Lumped nodal masses from the (mass-scaled) density; stresses zero;
+    temperature T_room. The insert's tip reference starts at ``tool_tip`` [m]. ``layer`` (e,)
+    marks the elements that may erode by damage under ERODE_LAYER. ``twin`` (n,) pairs the
+    doubled nodes of a parting surface (node splitting, -1 = none); the pairs start tied.
+    """
+    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+    conn = np.ascontiguousarray(conn, dtype=np.int64)
+    if nodes.ndim != 2 or nodes.shape[1] != 3 or conn.ndim != 2 or conn.shape[1] != 8:
+        raise ConfigError("mesh must be nodes (n, 3) and conn (e, 8)", field="mesh",
+                          value=f"{nodes.shape}, {conn.shape}", expected="(n, 3), (e, 8)")
+    n = nodes.shape[0]
+    ne = conn.shape[0]
+    prm = default_prm3() if prm is None else np.asarray(prm, np.float64).copy()
+    vol = hex_volumes(nodes, conn)
+    if np.any(vol <= 0):
+        bad = int(np.argmin(vol))
+        raise ConfigError("mesh has a hexahedron with non-positive volume (node order must "
+                          "be the VTK order)", field="conn", value=bad)
+    mass = np.zeros(n)
+    np.add.at(mass, conn.ravel(), np.repeat(vol * material.rho * prm[K3.P_MS] / 8.0, 8))
+    counts = np.bincount(conn.ravel(), minlength=n)
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum(counts)
+    order = np.argsort(conn.ravel(), kind="stable")
+    z = np.zeros
+    tw = -np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)
+    if tw.shape != (n,) or np.any(tw >= n) or np.any(
+            tw[tw[tw >= 0]] != np.flatnonzero(tw >= 0)):
+        raise ConfigError("twin must pair nodes symmetrically", field="twin",
+                          value=str(tw.shape), expected=f"(n,) = ({n},), twin[twin[i]] = i")
+    try:
+        enbr = face_neighbours(conn, tw)
+    except ValueError as exc:
+        raise ConfigError(f"mesh is not a valid hexahedral mesh: {exc}", field="conn",
+                          value=f"{ne} elements", expected="each face shared by at most two "
+                          "hexahedra") from None
+    tool = z(K3.N_TOOL)
+    tool[K3.T_GX], tool[K3.T_GY], tool[K3.T_GZ] = tool_tip
+    tool[K3.T_THETA] = prm[K3.P_THETA0]
+    if prm[K3.P_TTOOL] <= 0.0:
+        prm[K3.P_TTOOL] = material.T_room
+    st = FEState3(
+        x=nodes[:, 0].copy(), y=nodes[:, 1].copy(), z=nodes[:, 2].copy(), vx=z(n), vy=z(n),
+        vz=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.int64).copy(), ptr=ptr,
+        nel=(order // 8).astype(np.int64), ncorner=(order % 8).astype(np.int64), conn=conn,
+        alive=np.ones(ne, np.int64),
+        layer=np.zeros(ne, np.bool_) if layer is None else np.asarray(layer, np.bool_).copy(),
+        sd=z((ne, 6)), pres=z(ne), eps_p=z(ne),
+        temp=np.full(ne, material.T_room), dmg=z(ne), qh=z((ne, 12)), vol0=vol, ie=z(ne),
+        hge=z(ne), fe=z((ne, 24)), dte=z(ne), plast=z(ne), rate=z(ne), cf=z((n, 4)),
+        fric=z(n), pen=z(n), ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n),
+        mat=material.to_array(), prm=prm, tool=tool, en=z(K3.N_EN),
+        ist=np.zeros(K3.N_IST, np.int64), clock=z(3), hacc=z(K3.N_HIST),
+        hist=np.full((max(1, n_samples), K3.N_HIST), np.nan),
+        pairs=np.ascontiguousarray(np.stack([tw, (tw >= 0).astype(np.int64)], axis=1)),
+        enbr=enbr, tbuf=z((ne, 4)),
+        theat=z((n, 3)))
+    init_forces3(st)
+    return st
+
+
+def init_forces3(st: FEState3) -> float:
+    """Stable step of the current configuration (no stress update); sets ``clock[1]``."""
+    dte = np.zeros_like(st.dte)
+    K3.element_update3(st.conn, st.x, st.y, st.z, st.vx * 0.0, st.vy * 0.0, st.vz * 0.0,
+                       st.alive.copy(), st.layer, st.sd.copy(), st.pres.copy(), st.eps_p.copy(),
+                       st.temp.copy(), st.dmg.copy(), st.qh.copy(), st.vol0, st.ie.copy(),
+                       st.hge.copy(), np.zeros_like(st.fe), dte, st.plast.copy(),
+                       st.rate.copy(), st.mat, st.prm, 1e-30, K3.ERODE_NONE)
+    dt = st.prm[K3.P_CFL] * float(np.min(dte))
+    st.clock[1] = dt
+    if st.prm[K3.P_DTMIN] <= 0:
+        st.prm[K3.P_DTMIN] = 1e-3 * dt
+    if st.prm[K3.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
+        st.prm[K3.P_DT_ERODE] = -st.prm[K3.P_DT_ERODE] * float(np.min(dte))
+    return dt
+
+
+def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
+             progress: Callable[[float], None] | None = None,
+             check: Callable[[FEState3], None] | None = None,
+             adaptive_threads: bool = True, governor: ThreadGovernor | None = None) -> int:
+    """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
+
+    ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
+    Raises NumericalError (step, time, cause, what to change) on instability.
+    ``adaptive_threads``, ``governor``: see
+    :func:`~robobore.cutting.fe.engine.chunk_driver.drive_chunks`.
+    """
+    return drive_chunks(st, t_end, K3.run_chunk3, K3.P_TEND, chunk_steps=chunk_steps,
+                        label="3D simulation",
+                        hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "
+                        "scaling or a softer contact.penalty_factor",
+                        progress=progress, check=check, adaptive_threads=adaptive_threads,
+                        governor=governor)
+
+
+def box_mesh(nx: int, ny: int, nz: int, lx: float, ly: float, lz: float,
+             origin: tuple[float, float, float] = (0.0, 0.0, 0.0)):
+    """Structured hexahedral box: nodes (n, 3) [m], conn (e, 8) (VTK order), node index grid.
+
+    Node (i, j, k) is ``(i * (ny + 1) + j) * (nz + 1) + k`` along x, y, z.
+    """
+    xs = origin[0] + np.linspace(0.0, lx, nx + 1)
+    ys = origin[1] + np.linspace(0.0, ly, ny + 1)
+    zs = origin[2] + np.linspace(0.0, lz, nz + 1)
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    idx = np.arange(nodes.shape[0]).reshape(nx + 1, ny + 1, nz + 1)
+    return nodes, hex_conn(idx), idx
+
+
+def hex_conn(idx: np.ndarray) -> np.ndarray:
+    """Connectivity (e, 8), VTK order, of a structured node-index grid idx (i, j, k)."""
+    a = idx[:-1, :-1, :-1]
+    b = idx[1:, :-1, :-1]
+    c = idx[1:, 1:, :-1]
+    d = idx[:-1, 1:, :-1]
+    e = idx[:-1, :-1, 1:]
+    f = idx[1:, :-1, 1:]
+    g = idx[1:, 1:, 1:]
+    h = idx[:-1, 1:, 1:]
+    return np.stack([a, b, c, d, e, f, g, h], axis=-1).reshape(-1, 8).astype(np.int64)
+
+
+def split_node_layer(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, idx: np.ndarray,
+                     j: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Node splitting on node layer ``j`` of a structured mesh (``idx`` from :func:`box_mesh`
+    or the like, elements in :func:`hex_conn` order): its nodes that are not fully fixed are
+    doubled, the elements of rows ``>= j`` take the copies (which inherit the fixed bits).
+    Returns ``(nodes, conn, fixed, twin)`` with ``twin`` pairing each copy with its original.
+    """
+    nx, ny, nz = (k - 1 for k in idx.shape)
+    line = idx[:, j, :].ravel()
+    line = line[fixed[line] != 7]
+    new = nodes.shape[0] + np.arange(line.size)
+    nodes = np.vstack([nodes, nodes[line]])
+    fixed = np.concatenate([fixed, fixed[line]])
+    remap = np.arange(nodes.shape[0])
+    remap[line] = new
+    above = np.broadcast_to(np.arange(ny)[None, :, None], (nx, ny, nz)).ravel() >= j
+    conn = conn.copy()
+    conn[above] = remap[conn[above]]
+    twin = -np.ones(nodes.shape[0], np.int64)
+    twin[line] = new
+    twin[new] = line
+    return nodes, conn, fixed, twin

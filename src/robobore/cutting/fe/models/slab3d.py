@@ -1,0 +1,134 @@
+"""Cross-check of the 3D engine against the 2D engine: an orthogonal cut on a 3D slab.
+
+The 2D orthogonal-cutting config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`, node
+splitting) is rebuilt as a thin 3D slab in plane strain -- ``n_z`` hexahedra across the width,
+z velocities held on both faces -- and cut by the 3D engine's insert with a straight edge
+(nose radius 1 m, so every normal section of the edge is the 2D wedge: same rake, clearance
+and edge radius). Material, friction, parting-line height, mass scaling, hourglass, bulk
+viscosity and erosion limits are the 2D config's. Both engines share the constitutive and
+contact functions, so in the resolved regime the two must give the same forces per unit
+width; ``benchmarks/validate_fe3d_planestrain.py`` prints the comparison and
+``tests/cutting/fe3d/test_fe3d_planestrain.py`` holds it (docs/fe3d.md, "Plane-strain
+cross-check").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.fe.config.engine_settings import (
+    apply_friction_settings,
+    apply_solver_settings,
+    apply_thermal_settings,
+)
+from robobore.cutting.fe.config.orthogonal import FEConfig
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.chunk_driver import energy_error
+from robobore.cutting.fe.engine.state3d import (
+    FEState3,
+    advance3,
+    default_prm3,
+    hex_conn,
+    make_state3,
+    split_node_layer,
+)
+from robobore.errors import ConfigError
+from robobore.material import load_material
+
+__all__ = ["SlabSetup", "setup_slab3", "simulate_slab3"]
+
+
+@dataclass
+class SlabSetup:
+    state: FEState3
+    t_end: float
+    width: float
+    vc: float
+    cut_length: float
+
+
+def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
+                ahead: float = 0.1e-3) -> SlabSetup:
+    """3D plane-strain slab of the 2D config ``cfg`` (workpiece frame, node splitting only)."""
+    if cfg.mesh.frame != "workpiece":
+        raise ConfigError("the 3D slab cross-check is a workpiece-frame model",
+                          field="mesh.frame", value=cfg.mesh.frame, expected='"workpiece"')
+    if cfg.mesh.separation != "node_split":
+        raise ConfigError("the 3D slab cross-check needs node splitting",
+                          field="mesh.separation", value=cfg.mesh.separation,
+                          expected="node_split")
+    mat = load_material(cfg.material.name,
+                        hardening_strain_limit=cfg.material.strain_limit())
+    h = cfg.cut.uncut_chip_thickness_um * 1e-6
+    le = cfg.mesh.element_size_um * 1e-6
+    L = cfg.cut.length_mm * 1e-3
+    re = cfg.tool.edge_radius_um * 1e-6
+    sep = (cfg.mesh.separation_height_um or 0.0) * 1e-6
+    vc = cfg.cut.cutting_speed_m_per_min / 60.0
+    depth = max(depth_factor * h, 4 * le)
+    nx = max(2, int(round((L + ahead) / le)))
+    n_up = max(1, int(round((h - sep) / le)))
+    n_dn = max(3, int(round((depth + sep) / le)))
+    xs = np.linspace(0.0, L + ahead, nx + 1)
+    ys = np.concatenate([np.linspace(-depth, sep, n_dn + 1), np.linspace(sep, h, n_up + 1)[1:]])
+    width = n_z * le
+    zs = np.linspace(0.0, width, n_z + 1)
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    nodes = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    ny = ys.size - 1
+    idx = np.arange(nodes.shape[0]).reshape(nx + 1, ny + 1, n_z + 1)
+    conn = hex_conn(idx)
+    fixed = np.zeros(nodes.shape[0], np.int64)
+    fixed[idx[:, :, 0].ravel()] |= K3.FIX_Z
+    fixed[idx[:, :, -1].ravel()] |= K3.FIX_Z
+    fixed[idx[:, 0, :].ravel()] = 7
+    fixed[idx[-1, :, :].ravel()] = 7
+    # parting line: double its nodes (not the fully fixed ones); the chip rows take the copies
+    nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, n_dn)
+    p = apply_solver_settings(default_prm3(), cfg.solver, K3)
+    apply_friction_settings(p, cfg.contact, cfg.cut.cutting_speed_m_per_min, K3)
+    apply_thermal_settings(p, cfg.solver, cfg.contact, mat, K3)
+    p[K3.P_PEN] = cfg.contact.penalty_factor
+    p[K3.P_TOOL] = 1.0
+    p[K3.P_RN] = 1.0
+    p[K3.P_KAPPA] = 0.5 * math.pi
+    p[K3.P_KEND] = 0.49 * math.pi
+    p[K3.P_RAKE] = math.radians(cfg.tool.rake_deg)
+    p[K3.P_CLR] = math.radians(cfg.tool.clearance_deg)
+    p[K3.P_RE] = re
+    p[K3.P_VC] = vc
+    gate = cfg.solver.separation_gate_um
+    p[K3.P_GATE] = 0.0 if gate is None else gate * 1e-6
+    gap0 = 0.5 * le
+    t_end = (L + re + gap0) / vc
+    n_samples = cfg.solver.n_samples
+    p[K3.P_SAMPLE_DT] = t_end / n_samples
+    st = make_state3(nodes, conn, fixed, mat, prm=p, n_samples=n_samples,
+                     tool_tip=(-(re + gap0), 0.0, 0.5 * width), twin=twin)
+    return SlabSetup(state=st, t_end=t_end, width=width, vc=vc, cut_length=L)
+
+
+def simulate_slab3(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
+                   **kw: Any) -> dict[str, Any]:
+    """Run the slab; forces on the tool per unit width [N/mm] averaged over the last
+    ``steady_fraction`` of the cut, energy error, hourglass fraction, eroded elements."""
+    s = setup_slab3(cfg, n_z=n_z, **kw)
+    st = s.state
+    steps = advance3(st, s.t_end)
+    hh = st.hist[np.isfinite(st.hist[:, K3.H_T])]
+    win = hh[:, K3.H_T] >= s.t_end - steady_fraction * s.cut_length / s.vc
+    w_mm = s.width * 1e3
+    return {
+        "cutting_force_N_per_mm": float(-np.mean(hh[win, K3.H_FX]) / w_mm),
+        "feed_force_N_per_mm": float(np.mean(hh[win, K3.H_FY]) / w_mm),
+        "out_of_plane_force_N_per_mm": float(np.mean(hh[win, K3.H_FZ]) / w_mm),
+        "energy_error": energy_error(st.en),
+        "hourglass_fraction": float(st.en[K3.E_HG] / max(st.en[K3.E_INT], 1e-300)),
+        "eroded": int(np.sum(st.alive != 1)),
+        "n_elements": st.n_elements,
+        "steps": int(steps),
+    }
