@@ -14,15 +14,22 @@ Usage::
 numba-cuda asks the current device for its compute capability when it compiles device
 functions; with no device there, this script answers with ``--cc`` (a development aid, not
 something the engines do).
+
+The CPU functions this script compiles on the way go to a temporary numba cache: with
+numba-cuda loaded, numba's CPU code differs in the last bits, and those cache files would
+otherwise be picked up by later CPU runs of the engines in this checkout (the stored digits of
+tests/cutting/fe/test_fe_digits.py would then not be reproduced).
 """
 
 from __future__ import annotations
 
 import argparse
+import atexit
 import glob
 import inspect
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -30,7 +37,10 @@ import time
 import types
 from pathlib import Path
 
-import numpy as np
+os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="robobore_gpu_compile_check_numba_")
+atexit.register(shutil.rmtree, os.environ["NUMBA_CACHE_DIR"], ignore_errors=True)
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
