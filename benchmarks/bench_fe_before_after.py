@@ -55,7 +55,7 @@ def _config(case: str, tmp: Path, warmup: bool) -> Path:
         d.setdefault(sec, {})[key] = v
     if warmup:
         sec, key = next(iter(over))
-        d[sec][key] = 0.005
+        d[sec][key] = 0.02
     p = tmp / (case.replace(" ", "_") + ("_warm" if warmup else "") + ".toml")
     p.write_text(_toml(d))
     return p
