@@ -1,3 +1,3 @@
-"""Configuration of the FE models: the orthogonal-cutting schema (:mod:`.orthogonal`), the 3D
-boring schema (:mod:`.boring3d`) and the settings both write into an engine's parameter vector
-(:mod:`.engine_settings`)."""
+"""Configuration of the FE models: the solver keys both share (:mod:`.solver`), the
+orthogonal-cutting schema (:mod:`.orthogonal`), the 3D boring schema (:mod:`.boring3d`) and
+the settings both write into an engine's parameter vector (:mod:`.engine_settings`)."""

@@ -9,10 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from robobore.cutting.fe.config.orthogonal import ContactSection as ContactSection2D
 from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
+from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
@@ -23,11 +24,7 @@ __all__ = ["InsertSection", "CutSection", "ContactSection", "MeshSection", "Solv
            "ToolSupportSection", "BoringFEConfig", "parse_boring_config", "load_boring_config"]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class InsertSection(_Strict):
+class InsertSection(Strict):
     """Insert geometry (defaults: a CCMT 060204-type insert in a 90-deg boring bar)."""
 
     nose_radius_mm: float = Field(default=0.4, gt=0.0, le=5.0)
@@ -47,7 +44,7 @@ class InsertSection(_Strict):
                             edge_radius_m=self.edge_radius_um * 1e-6)
 
 
-class CutSection(_Strict):
+class CutSection(Strict):
     depth_of_cut_mm: float = Field(gt=0.0, le=2.0, description="radial depth ap, mm")
     feed_mm_per_rev: float = Field(gt=0.0, le=2.0)
     speed_rpm: float = Field(gt=0.0, le=20000.0)
@@ -82,7 +79,7 @@ class ContactSection(ContactSection2D):
         return self
 
 
-class MeshSection(_Strict):
+class MeshSection(Strict):
     #: element size [um]; at most ap / 3 (3 elements through the chip's depth)
     element_size_um: float = Field(gt=0.0)
     #: material below the new bore surface, in depths of cut (>= 4 elements is enforced)
@@ -106,34 +103,16 @@ class MeshSection(_Strict):
     chip_rows: int = Field(default=0, ge=0, le=50)
 
 
-class SolverSection(_Strict):
+class SolverSection(SolverSettings):
+    """The shared solver keys (:class:`~robobore.cutting.fe.config.solver.SolverSettings`) and
+    those of the 3D engine (defaults for its cost per step: a fixed mass scaling, fewer
+    samples and shorter chunks)."""
+
     mass_scaling: float = Field(default=100.0, ge=1.0, le=1e6)
-    cfl: float = Field(default=0.8, gt=0.0, le=1.0)
-    hourglass_viscous: float = Field(default=0.05, ge=0.0, le=0.5)
-    hourglass_stiffness: float = Field(default=0.05, ge=0.0, le=0.5)
-    bulk_viscosity_linear: float = Field(default=0.06, ge=0.0, le=1.0)
-    bulk_viscosity_quadratic: float = Field(default=1.2, ge=0.0, le=4.0)
-    #: erosion of elements whose Johnson-Cook damage reaches 1: "layer" (only in the
-    #: separation layer, the elements crossed by the path of the cutting edge), "everywhere"
-    #: or "none"
-    erosion: Literal["layer", "everywhere", "none"] = "layer"
-    #: erode an element whose volume ratio V/V0 falls below this (0 disables)
-    distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
-    #: erode an element whose stable step falls below this fraction of the initial one
-    erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
     n_samples: int = Field(default=200, ge=10, le=100000)
     chunk_steps: int = Field(default=500, ge=10, le=10**7)
-    #: fraction of the cut (from its end) averaged for the steady-state values
-    steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
-    #: stop with NumericalError when the energy error exceeds this after 10 % of the cut
-    energy_error_limit: float = Field(default=0.5, gt=0.0)
     #: node splitting: a tied pair parts within this distance of the insert [um]
     separation_gate_um: float = Field(default=0.0, ge=0.0)
-    #: heat conduction between the workpiece's elements and the thermal contact with the
-    #: insert (the 2D engine's model, :mod:`robobore.cutting.fe.physics.thermal3d`), every
-    #: ``conduction_interval`` steps; false: adiabatic
-    heat_conduction: bool = True
-    conduction_interval: int = Field(default=10, ge=1, le=10000)
 
 
 def _triple(v: Any) -> list[float]:
@@ -143,7 +122,7 @@ def _triple(v: Any) -> list[float]:
     return [float(x) for x in vals]
 
 
-class ToolSupportSection(_Strict):
+class ToolSupportSection(Strict):
     """Equivalent 3-direction model: per boring-frame axis X, Y, Z (one value or [X, Y, Z])."""
 
     stiffness_N_per_m: list[float]
@@ -174,7 +153,7 @@ class ToolSupportSection(_Strict):
                                       strict=True)]
 
 
-class BoringFEConfig(_Strict):
+class BoringFEConfig(Strict):
     #: the 2D engine's switch (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`):
     #: "calibrated" (default) -- friction law "rech2013_calibrated" and the material file's
     #: hardening hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;

@@ -17,13 +17,13 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import (
     BaseModel,
-    ConfigDict,
     Field,
     PrivateAttr,
     field_validator,
     model_validator,
 )
 
+from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
 from robobore.material.friction import (
@@ -43,11 +43,7 @@ FRICTION_TABLE_MU = np.array([0.24, 0.22, 0.21, 0.19, 0.18, 0.17])
 MU_TABLE_MAX = 8
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class MaterialSection(_Strict):
+class MaterialSection(Strict):
     #: bundled material name (e.g. "TC4") or a path to a material TOML file
     name: str = "TC4"
     #: plastic strain beyond which the Johnson-Cook hardening term B eps^n is held at its
@@ -70,13 +66,13 @@ class MaterialSection(_Strict):
         return float("inf") if v == "none" else v
 
 
-class ToolSection(_Strict):
+class ToolSection(Strict):
     rake_deg: float = Field(ge=-30.0, le=40.0, description="rake angle, -30..40 deg")
     clearance_deg: float = Field(gt=0.0, le=30.0, description="clearance angle, 0..30 deg")
     edge_radius_um: float = Field(ge=0.0, le=200.0, description="cutting-edge radius, um")
 
 
-class CutSection(_Strict):
+class CutSection(Strict):
     uncut_chip_thickness_um: float = Field(gt=0.0, le=2000.0)
     cutting_speed_m_per_min: float = Field(gt=0.0, le=2000.0)
     #: length of cut simulated [mm] (the tool's travel in the tool frame); at least one
@@ -87,7 +83,7 @@ class CutSection(_Strict):
     width_mm: float = Field(default=1.0, gt=0.0)
 
 
-class ContactSection(_Strict):
+class ContactSection(Strict):
     #: the friction: a bundled friction law by name (robobore/material/friction_laws.toml:
     #: "rech2013_calibrated", CALIBRATED, or "rech2013", A-PRIORI; the law gives the table,
     #: the velocity it is read at and the shear cap, the last two overridable by their
@@ -220,7 +216,7 @@ class ContactSection(_Strict):
         return f"Coulomb, {src} table at {arg}"
 
 
-class MeshSection(_Strict):
+class MeshSection(Strict):
     #: element size in the cutting zone and chip layer [um]; at most h/3
     element_size_um: float = Field(gt=0.0)
     #: depth of the fine zone below the cut line, in uncut chip thicknesses
@@ -288,34 +284,23 @@ class MeshSection(_Strict):
         return v
 
 
-class SolverSection(_Strict):
+class SolverSection(SolverSettings):
+    """The shared solver keys (:class:`~robobore.cutting.fe.config.solver.SolverSettings`) and
+    those of the plane-strain engine."""
+
     #: density factor applied to the inertial (not the thermal) mass: time step grows by
     #: sqrt(mass_scaling); 1 = none. None: the validation protocol's 100 (30 / vc)^2 with vc
     #: in m/min (at least 1), which keeps vc / (scaled wave speed) and hence the steps per
     #: mm of cut the same at every speed
     mass_scaling: float | None = Field(default=None, ge=1.0, le=1e6)
-    #: fraction of the stable time step (element length / dilatational wave speed)
-    cfl: float = Field(default=0.8, gt=0.0, le=1.0)
     #: element formulation: "q4r" (one-point quad with Flanagan-Belytschko hourglass
     #: control) or "q4_bbar" (2x2 Gauss points with mean-dilatation B-bar: no hourglass
     #: modes, about 2x the element cost; the hourglass coefficients are not used)
     element: Literal["q4r", "q4_bbar"] = "q4r"
-    #: Flanagan-Belytschko hourglass control coefficients (viscous, stiffness)
-    hourglass_viscous: float = Field(default=0.05, ge=0.0, le=0.5)
-    hourglass_stiffness: float = Field(default=0.05, ge=0.0, le=0.5)
-    #: bulk viscosity (linear, quadratic), active in compression
-    bulk_viscosity_linear: float = Field(default=0.06, ge=0.0, le=1.0)
-    bulk_viscosity_quadratic: float = Field(default=1.2, ge=0.0, le=4.0)
-    #: where elements erode when JC damage reaches 1: "layer" (separation layer along the
-    #: cut line), "everywhere", or "none"
-    erosion: Literal["layer", "everywhere", "none"] = "layer"
     #: when given, a separation-layer element whose damage reached 1 erodes only once one of
     #: its nodes is within this distance [um] of the tool surface (the material separates
     #: at the cutting edge, not ahead of it); None: erode wherever the damage reaches 1
     separation_gate_um: float | None = Field(default=None, ge=0.0)
-    #: erode an element whose area ratio A/A0 or corner Jacobian falls below this (numerical
-    #: safety against inverted elements; counted and reported separately); 0 disables
-    distortion_limit: float = Field(default=0.05, ge=0.0, lt=1.0)
     #: steps between chip rezoning passes (Laplacian smoothing + donor-cell remap of the
     #: chip layer, see robobore.cutting.fe.ale.rezone); 0 = pure Lagrangian
     rezone_interval: int = Field(default=0, ge=0, le=10**6)
@@ -333,26 +318,13 @@ class SolverSection(_Strict):
     #: tool frame (mesh.frame = "tool"): steps between the passes that move the mesh back
     #: to its place in the tool's frame and remap the element state and node velocities
     ale_interval: int = Field(default=10, ge=1, le=10**4)
-    #: erode an element whose stable time step falls below this fraction of the initial
-    #: smallest one (time-step erosion, as LS-DYNA's ERODE option); 0 disables
-    erode_time_step_fraction: float = Field(default=0.3, ge=0.0, lt=1.0)
-    #: heat conduction between workpiece elements (finite volumes on the deformed mesh,
-    #: explicit, every ``conduction_interval`` steps), with the thermal contact to the tool
-    #: (``contact.thermal_conductance_W_per_m2K``, ``friction_heat_fraction``); the other
-    #: free surfaces are adiabatic. False: adiabatic heating only
-    heat_conduction: bool = True
-    conduction_interval: int = Field(default=10, ge=1, le=10000)
     #: number of force/tool samples over the whole run
     n_samples: int = Field(default=400, ge=10, le=100000)
     #: steps per compiled chunk between progress updates
     chunk_steps: int = Field(default=2000, ge=10, le=10**7)
-    #: fraction of the cut (from its end) averaged for the steady-state values
-    steady_window_fraction: float = Field(default=0.5, gt=0.0, le=1.0)
-    #: stop with NumericalError when |energy error| exceeds this after 10 % of the cut
-    energy_error_limit: float = Field(default=0.5, gt=0.0)
 
 
-class ToolSupport(_Strict):
+class ToolSupport(Strict):
     """Spring/damper/mass holding the tool to its guide point; (x, y) pairs or one value."""
 
     stiffness_N_per_m: float | list[float]
@@ -399,7 +371,7 @@ def apply_parameter_set(data: dict[str, Any]) -> dict[str, Any]:
     return data
 
 
-class FEConfig(_Strict):
+class FEConfig(Strict):
     #: "calibrated" (default): the validated model's CALIBRATED choices -- friction law
     #: "rech2013_calibrated" and the material file's hardening hold; "a_priori": the
     #: source's values, nothing chosen against measured forces -- friction law "rech2013"
