@@ -20,6 +20,7 @@ from robobore.cutting.fe.engine.state2d import (
 )
 from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 from robobore.cutting.fe.engine.threads import ThreadGovernor
+from robobore.errors import NumericalError
 
 
 def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: int, *,
@@ -98,3 +99,21 @@ def energy_error(en: np.ndarray) -> float:
     parts = en[K.E_KIN] + en[K.E_INT] + en[K.E_HG] + en[K.E_FRIC] + en[K.E_EROKE]
     scale = max(abs(en[K.E_EXT]), abs(parts), 1e-300)
     return float(abs(en[K.E_EXT] - parts) / scale)
+
+
+def energy_check(t_contact: float, t_end: float, limit: float) -> Callable[[Any], None]:
+    """The ``check(state)`` both engines run between chunks: once a tenth of the cut after
+    first contact is done, a state whose :func:`energy_error` exceeds ``limit``
+    (``solver.energy_error_limit``) stops the run with a NumericalError naming the step,
+    the time and the limit."""
+    t_on = t_contact + 0.1 * (t_end - t_contact)
+
+    def check(s: Any) -> None:
+        if s.time > t_on:
+            err = energy_error(s.en)
+            if err > limit:
+                raise NumericalError(
+                    f"energy balance lost at step {int(s.ist[K.I_STEP])}, time {s.time:.6g} s:"
+                    f" error {err:.3g} > solver.energy_error_limit {limit}")
+
+    return check

@@ -53,6 +53,7 @@ from robobore.cutting.fe.config.engine_settings import (
     apply_thermal_settings,
 )
 from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine.chunk_driver import energy_check
 from robobore.cutting.fe.engine.state3d import (
     FEState3,
     advance3,
@@ -62,7 +63,7 @@ from robobore.cutting.fe.engine.state3d import (
 )
 from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
 from robobore.cutting.geometry import BoringInsert, chip_area
-from robobore.errors import ConfigError, NumericalError
+from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
 __all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "BoringMesh",
@@ -181,13 +182,7 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     dt0 = float(st.clock[1])
     limit = cfg.solver.energy_error_limit
 
-    def check(s: FEState3) -> None:
-        if s.time > setup.t_contact + 0.1 * (setup.t_end - setup.t_contact):
-            err = energy_error(s.en)
-            if err > limit:
-                raise NumericalError(
-                    f"energy balance lost at step {int(s.ist[K3.I_STEP])}, time {s.time:.6g} s:"
-                    f" error {err:.3g} > solver.energy_error_limit {limit}")
+    check = energy_check(setup.t_contact, setup.t_end, limit)
 
     t0 = time.perf_counter()
     if device == "gpu":

@@ -25,6 +25,7 @@ from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import (
     advance,
+    energy_check,
     energy_error,
 )
 from robobore.cutting.fe.engine.state2d import (
@@ -33,7 +34,7 @@ from robobore.cutting.fe.engine.state2d import (
     make_state,
 )
 from robobore.cutting.fe.mesh.orthogonal import CuttingMesh, build_edge_refined_mesh, build_mesh
-from robobore.errors import ConfigError, NumericalError
+from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
 
@@ -224,13 +225,7 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
     st = setup.state
     limit = setup.cfg.solver.energy_error_limit
 
-    def check(s: FEState) -> None:
-        if s.time > setup.t_contact + 0.1 * (setup.t_end - setup.t_contact):
-            err = energy_error(s.en)
-            if err > limit:
-                raise NumericalError(
-                    f"energy balance lost at step {int(s.ist[K.I_STEP])}, time {s.time:.6g} s:"
-                    f" error {err:.3g} > solver.energy_error_limit {limit}")
+    check = energy_check(setup.t_contact, setup.t_end, limit)
 
     t0 = time.perf_counter()
     if device == "gpu":
