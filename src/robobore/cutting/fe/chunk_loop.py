@@ -1,6 +1,8 @@
 """The compiled time-step loop of the plane-strain engine (:func:`run_chunk`): element,
-node and tool updates, heat passes, rezoning, energy totals, history sampling and the
-stop conditions, a chunk of steps at a time.
+node and tool updates, heat passes and rezoning, a chunk of steps at a time; each step ends
+with the engines' shared end of step (:mod:`robobore.cutting.fe.history`: stop conditions,
+time-averaged histories, history samples with the energy totals), bound here to the 2D
+layout (:data:`ENGINE2`, :func:`tool_columns_py`, :data:`sum_energies_py`).
 """
 
 from __future__ import annotations
@@ -8,17 +10,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from robobore.cutting.fe.history import bind_end_step
+from robobore.cutting.fe.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.layout import (
-    E_ERODED,
-    E_EROKE,
     E_EXT,
-    E_FRIC,
-    E_HG,
-    E_INT,
-    E_KIN,
-    E_NODEWORK,
-    E_PLAST,
     ELEM_Q4BBAR,
     I_STEP,
     P_ALE_X0,
@@ -71,51 +65,10 @@ from robobore.cutting.fe.tool_motion import (
 )
 from robobore.material import johnson_cook as jc
 
-
-def sum_energies_py(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
-    """Totals of the energy accumulators into ``en`` [J/m] (serial, a fixed order)."""
-    ke = 0.0
-    for n in range(mass.shape[0]):
-        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
-    si = 0.0
-    sp = 0.0
-    sh = 0.0
-    se = 0.0
-    for e in range(ie.shape[0]):
-        si += ie[e]
-        sp += plast[e]
-        sh += hge[e]
-        if alive[e] != 1:
-            se += ie[e]
-    sf = 0.0
-    spn = 0.0
-    sek = 0.0
-    sw = 0.0
-    for n in range(mass.shape[0]):
-        sf += fric[n]
-        spn += pen[n]
-        sek += ero_ke[n]
-        sw += nwork[n]
-    en[E_KIN] = ke
-    en[E_INT] = si
-    en[E_PLAST] = sp
-    en[E_HG] = sh
-    en[E_FRIC] = sf + spn
-    en[E_NODEWORK] = sw
-    en[E_ERODED] = se + sek
-    en[E_EROKE] = sek
-
-
-_sum_energies = njit(cache=True)(sum_energies_py)
-
-
-def energy_totals_py(es, en):
-    """:func:`sum_energies_py` of the state arrays ``es`` = (mass, vx, vy, ie, plast, hge,
-    alive, fric, pen, ero_ke, nwork) into ``en``; True (the 2D engine records the energies
-    in every history sample)."""
-    mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork = es
-    _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
-    return True
+#: the energy totals (:func:`robobore.cutting.fe.history.energy_totals_py` in 2D) of the state
+#: arrays ``es`` = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
+#: ``en`` [J/m] (serial, a fixed order)
+sum_energies_py = jc.rebind(energy_totals_py, NDIM=2)
 
 
 def tool_columns_py(tool):
@@ -130,7 +83,7 @@ ENGINE2 = {"NDIM": 2, "N_SPLIT": 6, "N_TOOL_COLUMNS": 1, "T_FORCE": T_FX, "T_DIS
            "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
            "COUNT_STOPPED_STEP": 0}
 #: the end of a step on the CPU (:func:`robobore.cutting.fe.history.end_step_py`)
-_end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), njit(energy_totals_py))
+_end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), njit(sum_energies_py))
 
 
 @njit(cache=True)
@@ -152,7 +105,7 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
     fsplit = np.zeros(6)
-    es = (mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
+    es = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
     taken = 0
     for _s in range(n_steps):
         dt = clock[1]

@@ -75,8 +75,7 @@ def device_functions2(dev) -> SimpleNamespace:
     from robobore.cutting.fe import chunk_loop as CL
     from robobore.cutting.fe.history import bind_end_step
 
-    totals = dev(jc.rebind(CL.energy_totals_py, _sum_energies=dev(K.sum_energies_py)))
-    end_step = bind_end_step(dev, CL.ENGINE2, dev(CL.tool_columns_py), totals)
+    end_step = bind_end_step(dev, CL.ENGINE2, dev(CL.tool_columns_py), dev(CL.sum_energies_py))
     return SimpleNamespace(
         csplit=csplit, tool_geometry=tool_geometry, tplace=tplace, tfacep=tfacep,
         tsweep=tsweep, tscopy=tscopy, tinter=tinter, rflux=rflux, rvel=rvel, rwrite=rwrite,

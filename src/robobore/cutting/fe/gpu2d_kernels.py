@@ -298,7 +298,7 @@ def kernels2():
         if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
             return
         finish(tool, prm, clock, ist, hacc, hist, en, red,
-               (mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
+               (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
 
     @cuda.jit
     def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
@@ -451,7 +451,7 @@ def kernels2():
                     prm[P_COND_ACC] = 0.0
             if tid == 0:
                 finish(tool, prm, clock, ist, hacc, hist, en, red,
-                       (mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
+                       (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
                 red[R_DTMIN] = 1e30
                 red[R_BAD] = -1.0
             grid.sync()

@@ -33,9 +33,10 @@ An engine is described by the names :func:`bind_end_step` rebinds: ``NDIM``, ``N
 ``P_SAMPLE_DT``, ``P_TEND`` (parameter slots), ``COUNT_STOPPED_STEP`` (1: a step stopped by
 an inverted element or an empty mesh still moves the clock and the step counter on, the 3D
 engine; 0: it does not, the 2D engine), ``tool_columns(tool)`` (the two instantaneous tool
-values, the second ignored with one column) and ``energy_totals(es, en)`` (sums the energy
-accumulators of the state arrays ``es`` into ``en`` and returns True, or returns False where
-the engine records no per-sample energies: then only the external work is written).
+values, the second ignored with one column) and ``energy_totals(es, en)`` (the totals of the
+energy accumulators, :func:`energy_totals_py`, bound to the engine's ``NDIM``; or a function
+that returns False where the engine records no per-sample energies: then only the external
+work is written).
 """
 
 from __future__ import annotations
@@ -44,11 +45,13 @@ import math
 
 from robobore.cutting.fe.layout import (
     E_ERODED,
+    E_EROKE,
     E_EXT,
     E_FRIC,
     E_HG,
     E_INT,
     E_KIN,
+    E_NODEWORK,
     E_PLAST,
     I_BADELEM,
     I_SAMPLE,
@@ -63,8 +66,8 @@ from robobore.cutting.fe.layout import (
 from robobore.material.johnson_cook import rebind
 
 __all__ = ["H_T", "H_AVG", "HE_KIN", "HE_INT", "HE_PL", "HE_HG", "HE_FRIC", "HE_EXT", "HE_ERO",
-           "HIST_ENERGIES", "columns", "sample_history_py", "end_step_py", "bind_end_step",
-           "ENGINE_NAMES"]
+           "HIST_ENERGIES", "columns", "energy_totals_py", "sample_history_py", "end_step_py",
+           "bind_end_step", "ENGINE_NAMES"]
 
 #: history column of the time at the end of each sample interval [s]
 H_T = 0
@@ -95,6 +98,47 @@ def columns(ndim: int, n_split: int, n_tool_columns: int) -> dict[str, int]:
     return {"force": H_AVG, "disp": H_AVG + ndim, "ncont": H_AVG + 2 * ndim,
             "split": H_AVG + 2 * ndim + 1, "n_avg": n_avg, "tool": tool, "energy": energy,
             "n_hist": energy + len(HIST_ENERGIES)}
+
+
+def energy_totals_py(es, en):
+    """Totals of the energy accumulators into ``en`` (serial, a fixed order; [J/m] in 2D, [J]
+    in 3D); True. ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke,
+    nwork); ``vz`` is read only where ``NDIM`` = 3 (bound with
+    :func:`robobore.material.johnson_cook.rebind`)."""
+    mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork = es
+    ke = 0.0
+    sf = 0.0
+    spn = 0.0
+    sek = 0.0
+    sw = 0.0
+    for n in range(mass.shape[0]):
+        v2 = vx[n] * vx[n] + vy[n] * vy[n]
+        if NDIM == 3:
+            v2 += vz[n] * vz[n]
+        ke += 0.5 * mass[n] * v2
+        sf += fric[n]
+        spn += pen[n]
+        sek += ero_ke[n]
+        sw += nwork[n]
+    si = 0.0
+    sp = 0.0
+    sh = 0.0
+    se = 0.0
+    for e in range(ie.shape[0]):
+        si += ie[e]
+        sp += plast[e]
+        sh += hge[e]
+        if alive[e] != 1:
+            se += ie[e]
+    en[E_KIN] = ke
+    en[E_INT] = si
+    en[E_PLAST] = sp
+    en[E_HG] = sh
+    en[E_FRIC] = sf + spn
+    en[E_NODEWORK] = sw
+    en[E_ERODED] = se + sek
+    en[E_EROKE] = sek
+    return True
 
 
 def sample_history_py(k, t, ist, clock, tool, en, hacc, hist, es):

@@ -88,16 +88,14 @@ from robobore.cutting.fe.hex8 import (
     P_VF,
     hex_element,
 )
-from robobore.cutting.fe.history import bind_end_step
+from robobore.cutting.fe.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.kernels import (
     E_ERODED,
-    E_EROKE,
     E_EXT,
     E_FRIC,
     E_HG,
     E_INT,
     E_KIN,
-    E_NODEWORK,
     E_PLAST,
     I_BADELEM,
     I_SAMPLE,
@@ -212,47 +210,17 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
                  pairs)
 
 
+#: the energy totals (:func:`robobore.cutting.fe.history.energy_totals_py` in 3D) of the state
+#: arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
+#: ``en`` (2D engine's indices) [J]
+sum_energies3_py = jc.rebind(energy_totals_py, NDIM=3)
+_energy_totals3 = njit(sum_energies3_py)
+
+
 @njit(cache=True)
 def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
-    """Totals of the energy accumulators into ``en`` (2D engine's indices) [J]."""
-    ke = 0.0
-    sf = 0.0
-    spn = 0.0
-    sek = 0.0
-    sw = 0.0
-    for n in range(mass.shape[0]):
-        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n] + vz[n] * vz[n])
-        sf += fric[n]
-        spn += pen[n]
-        sek += ero_ke[n]
-        sw += nwork[n]
-    si = 0.0
-    sp = 0.0
-    sh = 0.0
-    se = 0.0
-    for e in range(ie.shape[0]):
-        si += ie[e]
-        sp += plast[e]
-        sh += hge[e]
-        if alive[e] != 1:
-            se += ie[e]
-    en[E_KIN] = ke
-    en[E_INT] = si
-    en[E_PLAST] = sp
-    en[E_HG] = sh
-    en[E_FRIC] = sf + spn
-    en[E_NODEWORK] = sw
-    en[E_ERODED] = se + sek
-    en[E_EROKE] = sek
-
-
-def energy_totals3_py(es, en):
-    """:func:`sum_energies3` of the state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge,
-    alive, fric, pen, ero_ke, nwork) into ``en``; True (the CPU engine records the energies in
-    every history sample)."""
-    mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork = es
-    sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
-    return True
+    """:data:`sum_energies3_py` of these arrays."""
+    _energy_totals3((mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork), en)
 
 
 def tool_columns3_py(tool):
@@ -269,7 +237,7 @@ ENGINE3 = {"NDIM": 3, "N_SPLIT": 0, "N_TOOL_COLUMNS": 2, "T_FORCE": T_FX, "T_DIS
            "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
            "COUNT_STOPPED_STEP": 1}
 #: the end of a step on the CPU (:func:`robobore.cutting.fe.history.end_step_py`)
-_end_step3 = bind_end_step(njit, ENGINE3, njit(tool_columns3_py), njit(energy_totals3_py))
+_end_step3 = bind_end_step(njit, ENGINE3, njit(tool_columns3_py), _energy_totals3)
 
 
 @njit(cache=True)
@@ -347,6 +315,6 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
         if not _end_step3(dt, bad, dtmin, fwx, fwy, fwz, ncont, hacc, ist, clock, prm, tool,
                           en, hacc, hist, es):
             return taken
-    sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+    _energy_totals3(es, en)
     return taken
 
