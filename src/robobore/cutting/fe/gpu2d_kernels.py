@@ -18,7 +18,7 @@ from robobore.cutting.fe.gpu_shared import MAX_BLOCK, bind_cuda
 
 __all__ = ["kernels2", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC", "R_SPLIT", "N_RED"]
 
-# reduction slots on the device
+# reduction slots on the device (gpu_shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
 R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
 #: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
 R_SPLIT = 5
