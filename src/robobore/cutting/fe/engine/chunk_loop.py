@@ -1,45 +1,20 @@
 """The compiled time-step loop of the plane-strain engine (:func:`run_chunk`): element,
-node and tool updates, heat passes, rezoning, energy totals, history sampling and the
-stop conditions, a chunk of steps at a time.
+node and tool updates, heat passes and rezoning, a chunk of steps at a time; each step ends
+with the engines' shared end of step (:mod:`robobore.cutting.fe.engine.history`: stop conditions,
+time-averaged histories, history samples with the energy totals), bound here to the 2D
+layout (:data:`ENGINE2`, :func:`tool_columns_py`, :data:`sum_energies_py`).
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
+from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.engine.layout import (
-    E_ERODED,
-    E_EROKE,
     E_EXT,
-    E_FRIC,
-    E_HG,
-    E_INT,
-    E_KIN,
-    E_NODEWORK,
-    E_PLAST,
     ELEM_Q4BBAR,
-    H_EERO,
-    H_EEXT,
-    H_EFRIC,
-    H_EHG,
-    H_EINT,
-    H_EKIN,
-    H_EPL,
-    H_FX,
-    H_FX_RAKE,
-    H_FY,
-    H_NCONT,
-    H_T,
-    H_TIP_X,
-    H_UX,
-    H_UY,
-    I_BADELEM,
-    I_SAMPLE,
-    I_STATUS,
     I_STEP,
     P_ALE_X0,
     P_CFL,
@@ -63,16 +38,9 @@ from robobore.cutting.fe.engine.layout import (
     P_TCX,
     P_TEND,
     P_TTOOL,
-    STATUS_DONE,
-    STATUS_DT_COLLAPSE,
-    STATUS_INVERTED,
-    STATUS_NO_ELEMENTS,
-    STATUS_NONFINITE,
     T_FX,
-    T_FY,
     T_GX,
     T_UX,
-    T_UY,
 )
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
@@ -97,42 +65,26 @@ from robobore.cutting.fe.quad.tool_motion import (
 )
 from robobore.material import johnson_cook as jc
 
-
-def sum_energies_py(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
-    """Totals of the energy accumulators into ``en`` [J/m] (serial, a fixed order)."""
-    ke = 0.0
-    for n in range(mass.shape[0]):
-        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
-    si = 0.0
-    sp = 0.0
-    sh = 0.0
-    se = 0.0
-    for e in range(ie.shape[0]):
-        si += ie[e]
-        sp += plast[e]
-        sh += hge[e]
-        if alive[e] != 1:
-            se += ie[e]
-    sf = 0.0
-    spn = 0.0
-    sek = 0.0
-    sw = 0.0
-    for n in range(mass.shape[0]):
-        sf += fric[n]
-        spn += pen[n]
-        sek += ero_ke[n]
-        sw += nwork[n]
-    en[E_KIN] = ke
-    en[E_INT] = si
-    en[E_PLAST] = sp
-    en[E_HG] = sh
-    en[E_FRIC] = sf + spn
-    en[E_NODEWORK] = sw
-    en[E_ERODED] = se + sek
-    en[E_EROKE] = sek
+#: the energy totals (:func:`robobore.cutting.fe.engine.history.energy_totals_py` in 2D) of the
+#: state arrays ``es`` = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
+#: ``en`` [J/m] (serial, a fixed order)
+sum_energies_py = jc.rebind(energy_totals_py, NDIM=2)
 
 
-_sum_energies = njit(cache=True)(sum_energies_py)
+def tool_columns_py(tool):
+    """The 2D engine's instantaneous tool history column: the tool tip's x [m] (guide plus
+    support displacement; the second value unused)."""
+    return tool[T_GX] + tool[T_UX], 0.0
+
+
+#: the 2D engine's history layout and parameter slots for
+#: :mod:`robobore.cutting.fe.engine.history` (forces and displacements x, y; the force by
+#: tool face, six columns; the tip's x)
+ENGINE2 = {"NDIM": 2, "N_SPLIT": 6, "N_TOOL_COLUMNS": 1, "T_FORCE": T_FX, "T_DISP": T_UX,
+           "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
+           "COUNT_STOPPED_STEP": 0}
+#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`)
+_end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), njit(sum_energies_py))
 
 
 @njit(cache=True)
@@ -144,19 +96,20 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
-    sample interval). Stops early with ``ist[I_STATUS]`` = STATUS_DONE at ``prm[P_TEND]``,
-    STATUS_NONFINITE or STATUS_DT_COLLAPSE. Returns the number of steps taken.
+    sample interval). Each step ends with :func:`robobore.cutting.fe.engine.history.end_step_py`
+    (stop checks, time-averaged histories, samples): stops early with ``ist[I_STATUS]`` =
+    STATUS_DONE at ``prm[P_TEND]`` or an instability status. Returns the number of steps
+    taken.
     """
     erosion = int(prm[P_EROSION])
     bbar = int(prm[P_ELEM]) == ELEM_Q4BBAR
-    cfl = prm[P_CFL]
     rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
     fsplit = np.zeros(6)
+    es = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
     taken = 0
     for _s in range(n_steps):
         dt = clock[1]
-        t = clock[0]
         cx, cy, tvx, tvy = tool_kinematics(tool, prm)
         ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
                             fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy,
@@ -194,64 +147,8 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
                               fheat, temp, tbuf, tcq, rcp, prm[P_HC], prm[P_FHEAT],
                               prm[P_TTOOL], prm[P_COND_ACC])
                 prm[P_COND_ACC] = 0.0
-        if bad >= 0:
-            ist[I_BADELEM] = bad
-            ist[I_STATUS] = STATUS_INVERTED
-            return taken + 1
-        if dtmin >= 1e30:
-            ist[I_STATUS] = STATUS_NO_ELEMENTS
-            return taken + 1
-        new_dt = cfl * dtmin
-        t += dt
-        clock[0] = t
         taken += 1
-        ist[I_STEP] += 1
-        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(new_dt)):
-            ist[I_STATUS] = STATUS_NONFINITE
-            return taken
-        if new_dt < prm[P_DTMIN]:
-            ist[I_STATUS] = STATUS_DT_COLLAPSE
-            clock[1] = new_dt
-            return taken
-        clock[1] = new_dt
-        # time-averaged histories
-        hacc[H_FX] += dt * tool[T_FX]
-        hacc[H_FY] += dt * tool[T_FY]
-        hacc[H_UX] += dt * tool[T_UX]
-        hacc[H_UY] += dt * tool[T_UY]
-        hacc[H_NCONT] += dt * ncont
-        for j in range(6):
-            hacc[H_FX_RAKE + j] += dt * fsplit[j]
-        clock[2] += dt
-        k = ist[I_SAMPLE]
-        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
-            ta = clock[2]
-            _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
-            if not math.isfinite(en[E_KIN]):
-                ist[I_STATUS] = STATUS_NONFINITE
-                return taken
-            hist[k, H_T] = t
-            hist[k, H_FX] = hacc[H_FX] / ta
-            hist[k, H_FY] = hacc[H_FY] / ta
-            hist[k, H_UX] = hacc[H_UX] / ta
-            hist[k, H_UY] = hacc[H_UY] / ta
-            hist[k, H_NCONT] = hacc[H_NCONT] / ta
-            for j in range(6):
-                hist[k, H_FX_RAKE + j] = hacc[H_FX_RAKE + j] / ta
-            hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
-            hist[k, H_EKIN] = en[E_KIN]
-            hist[k, H_EINT] = en[E_INT]
-            hist[k, H_EPL] = en[E_PLAST]
-            hist[k, H_EHG] = en[E_HG]
-            hist[k, H_EFRIC] = en[E_FRIC]
-            hist[k, H_EEXT] = en[E_EXT]
-            hist[k, H_EERO] = en[E_ERODED]
-            for j in range(hacc.shape[0]):
-                hacc[j] = 0.0
-            clock[2] = 0.0
-            ist[I_SAMPLE] = k + 1
-        if t >= prm[P_TEND]:
-            ist[I_STATUS] = STATUS_DONE
-            _sum_energies(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+        if not _end_step(dt, bad, dtmin, fwx, fwy, 0.0, ncont, fsplit, ist, clock, prm, tool,
+                         en, hacc, hist, es):
             return taken
     return taken

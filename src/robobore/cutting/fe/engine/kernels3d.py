@@ -32,20 +32,17 @@ frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.engine.kernels import (
     E_ERODED,
-    E_EROKE,
     E_EXT,
     E_FRIC,
     E_HG,
     E_INT,
     E_KIN,
-    E_NODEWORK,
     E_PLAST,
     I_BADELEM,
     I_SAMPLE,
@@ -214,39 +211,34 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
                  pairs)
 
 
+#: the energy totals (:func:`robobore.cutting.fe.engine.history.energy_totals_py` in 3D) of the
+#: state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
+#: ``en`` (2D engine's indices) [J]
+sum_energies3_py = jc.rebind(energy_totals_py, NDIM=3)
+_energy_totals3 = njit(sum_energies3_py)
+
+
 @njit(cache=True)
 def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
-    """Totals of the energy accumulators into ``en`` (2D engine's indices) [J]."""
-    ke = 0.0
-    sf = 0.0
-    spn = 0.0
-    sek = 0.0
-    sw = 0.0
-    for n in range(mass.shape[0]):
-        ke += 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n] + vz[n] * vz[n])
-        sf += fric[n]
-        spn += pen[n]
-        sek += ero_ke[n]
-        sw += nwork[n]
-    si = 0.0
-    sp = 0.0
-    sh = 0.0
-    se = 0.0
-    for e in range(ie.shape[0]):
-        si += ie[e]
-        sp += plast[e]
-        sh += hge[e]
-        if alive[e] != 1:
-            se += ie[e]
-    en[E_KIN] = ke
-    en[E_INT] = si
-    en[E_PLAST] = sp
-    en[E_HG] = sh
-    en[E_FRIC] = sf + spn
-    en[E_NODEWORK] = sw
-    en[E_ERODED] = se + sek
-    en[E_EROKE] = sek
+    """:data:`sum_energies3_py` of these arrays."""
+    _energy_totals3((mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork), en)
 
+
+def tool_columns3_py(tool):
+    """The 3D engine's instantaneous tool history columns: the guide's x [m] (local frame)
+    and the bar angle [rad]."""
+    return tool[T_GX], tool[T_THETA]
+
+
+#: the 3D engine's history layout and parameter slots for :mod:`robobore.cutting.fe.engine.history`
+#: (forces, local frame, and support displacements, boring frame, x, y, z; no force by tool
+#: face; the guide's x and the bar angle; a step stopped by an inverted element or an empty
+#: mesh still counted)
+ENGINE3 = {"NDIM": 3, "N_SPLIT": 0, "N_TOOL_COLUMNS": 2, "T_FORCE": T_FX, "T_DISP": T_UX,
+           "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
+           "COUNT_STOPPED_STEP": 1}
+#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`)
+_end_step3 = bind_end_step(njit, ENGINE3, njit(tool_columns3_py), _energy_totals3)
 
 
 @njit(cache=True)
@@ -290,13 +282,15 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
-    STATUS_DONE at ``prm[P_TEND]``, or an instability status. Returns the steps taken.
+    STATUS_DONE at ``prm[P_TEND]``, or an instability status (each step ends with
+    :func:`robobore.cutting.fe.engine.history.end_step_py`). Returns the steps taken.
     Every ``prm[P_COND_EVERY]`` steps (0: adiabatic) heat conduction and the thermal contact
     with the insert run over the time since the last pass (:mod:`~robobore.cutting.fe.
     physics.thermal3d`, :func:`conduction_pass3`).
     """
     erosion = int(prm[P_EROSION])
     ne = conn.shape[0]
+    es = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
     taken = 0
     for _s in range(n_steps):
         dt = clock[1]
@@ -312,66 +306,16 @@ def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, con
             conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
                              fric, temp, tbuf, theat, mat, prm, t + dt)
         dtmin = 1e30
+        bad = -1
         for e in range(ne):
             if dte[e] < dtmin:
                 dtmin = dte[e]
             if alive[e] == -2:
-                ist[I_BADELEM] = e
-                ist[I_STATUS] = STATUS_INVERTED
+                bad = e
         taken += 1
-        ist[I_STEP] += 1
-        t += dt
-        clock[0] = t
-        if ist[I_STATUS] == STATUS_INVERTED:
+        if not _end_step3(dt, bad, dtmin, fwx, fwy, fwz, ncont, hacc, ist, clock, prm, tool,
+                          en, hacc, hist, es):
             return taken
-        if dtmin >= 1e30:
-            ist[I_STATUS] = STATUS_NO_ELEMENTS
-            return taken
-        new_dt = prm[P_CFL] * dtmin
-        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(fwz)
-                and math.isfinite(new_dt)):
-            ist[I_STATUS] = STATUS_NONFINITE
-            return taken
-        if new_dt < prm[P_DTMIN]:
-            ist[I_STATUS] = STATUS_DT_COLLAPSE
-            clock[1] = new_dt
-            return taken
-        clock[1] = new_dt
-        hacc[H_FX] += dt * tool[T_FX]
-        hacc[H_FY] += dt * tool[T_FY]
-        hacc[H_FZ] += dt * tool[T_FZ]
-        hacc[H_UX] += dt * tool[T_UX]
-        hacc[H_UY] += dt * tool[T_UY]
-        hacc[H_UZ] += dt * tool[T_UZ]
-        hacc[H_NCONT] += dt * ncont
-        clock[2] += dt
-        k = ist[I_SAMPLE]
-        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
-            ta = clock[2]
-            sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
-            if not math.isfinite(en[E_KIN]):
-                ist[I_STATUS] = STATUS_NONFINITE
-                return taken
-            hist[k, H_T] = t
-            for j in (H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ, H_NCONT):
-                hist[k, j] = hacc[j] / ta
-            hist[k, H_TIPX] = tool[T_GX]
-            hist[k, H_THETA] = tool[T_THETA]
-            hist[k, H_EKIN] = en[E_KIN]
-            hist[k, H_EINT] = en[E_INT]
-            hist[k, H_EPL] = en[E_PLAST]
-            hist[k, H_EHG] = en[E_HG]
-            hist[k, H_EFRIC] = en[E_FRIC]
-            hist[k, H_EEXT] = en[E_EXT]
-            hist[k, H_EERO] = en[E_ERODED]
-            for j in range(hacc.shape[0]):
-                hacc[j] = 0.0
-            clock[2] = 0.0
-            ist[I_SAMPLE] = k + 1
-        if t >= prm[P_TEND]:
-            ist[I_STATUS] = STATUS_DONE
-            sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
-            return taken
-    sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+    _energy_totals3(es, en)
     return taken
 

@@ -2,7 +2,8 @@
 
 ``prm`` float64 parameters (``P_*``), ``tool`` float64 tool state (``T_*``), ``en`` float64
 energy accumulators (``E_*``), ``ist`` int64 counters/status (``I_*``, ``STATUS_*``), ``hist``
-(n_samples, N_HIST) time-averaged histories (``H_*``); element formulations (``ELEM_*``),
+(n_samples, N_HIST) histories (``H_*``, the column order of
+:mod:`robobore.cutting.fe.engine.history`); element formulations (``ELEM_*``),
 per-Gauss-point state of the B-bar element (``G_*``), erosion modes (``ERODE_*``).
 """
 
@@ -61,12 +62,14 @@ I_STEP, I_SAMPLE, I_STATUS, I_ERODED_DAMAGE, I_ERODED_DIST, I_BADELEM = 0, 1, 2,
 N_IST = 6
 STATUS_OK, STATUS_NONFINITE, STATUS_DT_COLLAPSE, STATUS_DONE, STATUS_INVERTED = 0, 1, 2, 3, 4
 STATUS_NO_ELEMENTS = 5
-# --- history columns (time averages over each sample interval)
-H_T, H_FX, H_FY, H_UX, H_UY, H_TIP_X, H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT = range(12)
-H_EERO, H_NCONT = 12, 13
-# force on the tool by face (rake, edge arc, flank), x and y [N/m]; CPU engine only (the GPU
-# engine leaves these columns NaN)
-H_FX_RAKE, H_FY_RAKE, H_FX_EDGE, H_FY_EDGE, H_FX_FLANK, H_FY_FLANK = range(14, 20)
+# --- history columns, in the order of robobore.cutting.fe.engine.history: the time [s]; the time
+# averages over each sample interval (force on the tool [N/m], tool support displacement [m],
+# contact nodes, then the force on the tool by face -- rake, edge arc, flank, x and y [N/m]);
+# the tool tip's x [m]; the energies at the interval's end [J/m]
+H_T, H_FX, H_FY, H_UX, H_UY, H_NCONT = range(6)
+H_FX_RAKE, H_FY_RAKE, H_FX_EDGE, H_FY_EDGE, H_FX_FLANK, H_FY_FLANK = range(6, 12)
+H_TIP_X = 12
+H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO = range(13, 20)
 N_HIST = 20
 #: names of the tool faces of that split, in column order (summary ``force_by_face_N_per_mm``)
 FACES = ("rake", "edge", "flank")

@@ -82,9 +82,13 @@ FIX_X, FIX_Y, FIX_Z = 1, 2, 4
 T_GX, T_GY, T_GZ, T_UX, T_UY, T_UZ, T_VX, T_VY, T_VZ = 0, 1, 2, 3, 4, 5, 6, 7, 8
 T_FX, T_FY, T_FZ, T_THETA = 9, 10, 11, 12
 N_TOOL = 13
-# --- history columns (time averages over each sample interval; energies at its end)
-H_T, H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ, H_TIPX, H_THETA = 0, 1, 2, 3, 4, 5, 6, 7, 8
-H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO, H_NCONT = 9, 10, 11, 12, 13, 14, 15, 16
+# --- history columns, in the order of robobore.cutting.fe.engine.history: the time [s]; the time
+# averages over each sample interval (force on the tool, local frame [N]; tool support
+# displacement, boring frame [m]; contact nodes); the guide's x [m] and the bar angle [rad];
+# the energies at the interval's end [J]
+H_T, H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ, H_NCONT = range(8)
+H_TIPX, H_THETA = 8, 9
+H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO = range(10, 17)
 N_HIST = 17
 
 

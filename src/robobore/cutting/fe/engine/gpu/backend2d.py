@@ -41,8 +41,10 @@ face (``kernels.contact_split``) is added by one thread in increasing node order
 chunks holding a contact node: the CPU's serial order, the same bits.
 
 Layout: the device functions are bound in :mod:`robobore.cutting.fe.engine.gpu.device2d`, the
-kernels built in :mod:`robobore.cutting.fe.engine.gpu.kernels2d`, the CUDA plumbing shared with the
-3D engine is :mod:`robobore.cutting.fe.engine.gpu.shared`; this module is the host driver.
+kernels built in :mod:`robobore.cutting.fe.engine.gpu.kernels2d`, the CUDA plumbing shared with
+the 3D engine is :mod:`robobore.cutting.fe.engine.gpu.shared`, whose
+:func:`~robobore.cutting.fe.engine.gpu.shared.drive_gpu` is the host driver of both engines;
+this module hands it the 2D state, the kernels and the launch-per-kernel step.
 
 Kernel parameters: the persistent kernel takes the whole state, 3944 bytes of CUDA's classic
 4096-byte limit (checked by a test with numba's data model).
@@ -56,19 +58,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
-
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, R_BAD, R_DTMIN, kernels2
-from robobore.cutting.fe.engine.gpu.shared import (
-    bind_cuda,
-    persistent_run,
-    profile_ticker,
-    require_gpu,
-)
-from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
+from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, kernels2
+from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported", "N_RED"]
@@ -134,106 +128,69 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                         every if mode == MODE_ROWS else 0)
     rz_every = every if mode == MODE_TOOLFRAME else 0
     require_gpu()
-    cuda = bind_cuda()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,
      ale) = _kernels()
-    (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
-     k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass) = ale
-    st.prm[K.P_TEND] = t_end
-    st.ist[K.I_STATUS] = K.STATUS_OK
-    g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _ARRAYS}
-    red = np.zeros(N_RED)
-    red[R_DTMIN] = 1e30
-    red[R_BAD] = -1.0
-    dred = cuda.to_device(red)
-    nn = st.x.shape[0]
-    ne = st.conn.shape[0]
-    gn = (nn + _THREADS - 1) // _THREADS
-    ge = (ne + _THREADS - 1) // _THREADS
+    gn, ge = blocks(st.x.shape[0]), blocks(st.conn.shape[0])
     erosion = int(st.prm[K.P_EROSION])
     cond_every = int(st.prm[K.P_COND_EVERY])
     npair = int(st.ppair.shape[0])
-    gp = max(1, (npair + _THREADS - 1) // _THREADS)
-    nsn = int(st.snodes.shape[0])
-    gs = max(1, (nsn + _THREADS - 1) // _THREADS)
+    gp, gs = blocks(npair), blocks(int(st.snodes.shape[0]))
     theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
-    t_start = st.time
-    step0 = int(st.ist[K.I_STEP])
-    tick = profile_ticker(profile)
-    run = persistent_run(k_run, [g[name] for name in _ARRAYS]
-                         + [erosion, cond_every, int(theat), rz_every, dred], nn, profile,
-                         persistent)
-    while True:
-        if run is not None:
-            run(chunk_steps)
-        # while the status is OK every launch sequence is exactly one step, so the host
-        # knows the step index (conduction runs where ist[I_STEP] % cond_every == 0, as on
-        # the CPU); once the status changes the remaining launches return at once
-        step = int(st.ist[K.I_STEP])
-        for i in range(0 if run is not None else chunk_steps):
-            tick(None)
-            k_nodes[gn, _THREADS](g["x"], g["y"], g["vx"], g["vy"], g["mass"], g["fixed"],
-                                  g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
-                                  g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
-                                  g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
-                                  g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"],
-                                  dred)
-            tick("nodes")
-            k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
-                                            g["prm"], dred)
-            tick("contact_sum")
-            k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
-            tick("tool")
-            if rz_every > 0 and (step + i) % rz_every == 0:
-                _ale_launches(g, ale, gn, ge, gs)
-                tick("ale")
-            k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
-                                  g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
-                                  g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
-                                  g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
-                                  g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
-                                  g["clock"], erosion, g["ist"], dred)
-            tick("elements")
-            if cond_every > 0 and (step + i) % cond_every == 0:
-                k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
-                k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
+
+    def launch_step(g, dred, step, tick):
+        # one step as one launch per phase (the persistent kernel's phases); conduction
+        # where ist[I_STEP] % cond_every == 0, as on the CPU
+        tick(None)
+        k_nodes[gn, _THREADS](g["x"], g["y"], g["vx"], g["vy"], g["mass"], g["fixed"],
+                              g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
+                              g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
+                              g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
+                              g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"], dred)
+        tick("nodes")
+        k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
+                                        g["prm"], dred)
+        tick("contact_sum")
+        k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+        tick("tool")
+        if rz_every > 0 and step % rz_every == 0:
+            _ale_launches(g, ale, gn, ge, gs)
+            tick("ale")
+        k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
+                              g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
+                              g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
+                              g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
+                              g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
+                              g["clock"], erosion, g["ist"], dred)
+        tick("elements")
+        if cond_every > 0 and step % cond_every == 0:
+            k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
+            k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
+                                    g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
+            k_conduct_end[ge, _THREADS](g["temp"], g["tbuf"], g["prm"], g["ist"])
+            if npair > 0:
+                k_parting[gp, _THREADS](g["ppair"], g["x"], g["y"], g["alive"], g["tied"],
                                         g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
-                k_conduct_end[ge, _THREADS](g["temp"], g["tbuf"], g["prm"], g["ist"])
-                if npair > 0:
-                    k_parting[gp, _THREADS](g["ppair"], g["x"], g["y"], g["alive"], g["tied"],
-                                            g["temp"], g["tbuf"], g["mat"], g["prm"],
+            if theat:
+                k_theat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["ptr"], g["nel"],
+                                            g["ncorner"], g["alive"], g["enbr"], g["cfx"],
+                                            g["cfy"], g["fric"], g["fheat"], g["temp"],
+                                            g["tbuf"], g["tcq"], g["mat"], g["prm"],
                                             g["ist"])
-                if theat:
-                    k_theat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["ptr"],
-                                                g["nel"], g["ncorner"], g["alive"], g["enbr"],
-                                                g["cfx"], g["cfy"], g["fric"], g["fheat"],
-                                                g["temp"], g["tbuf"], g["tcq"], g["mat"],
-                                                g["prm"], g["ist"])
-                    k_theat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["tcq"],
-                                                g["mat"], g["ist"])
-                k_conduct_reset[1, 1](g["prm"], g["ist"])
-                tick("conduction")
-            k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
-                           g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
-                           g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"],
-                           g["nwork"])
-            tick("finish")
-        for name in ("ist", "clock"):
-            getattr(st, name)[...] = g[name].copy_to_host()
-        status = int(st.ist[K.I_STATUS])
-        if status in STATUS_TEXT or status == K.STATUS_DONE or check is not None:
-            _copy_back(st, g)
-        if status in STATUS_TEXT:
-            raise instability_error(st, "simulation (GPU)", "a smaller solver.cfl, a larger "
-                                    "mesh.element_size_um or less mass scaling")
-        if progress is not None:
-            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
-        if check is not None:
-            check(st)
-        if status == K.STATUS_DONE or st.time >= t_end:
-            _copy_back(st, g)
-            return int(st.ist[K.I_STEP]) - step0
+                k_theat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["tcq"],
+                                            g["mat"], g["ist"])
+            k_conduct_reset[1, 1](g["prm"], g["ist"])
+            tick("conduction")
+        k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
+                       g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
+                       g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"], g["nwork"])
+        tick("finish")
+
+    return drive_gpu(st, t_end, names=_ARRAYS, p_tend=K.P_TEND, n_red=N_RED, k_run=k_run,
+                     run_extra=[erosion, cond_every, int(theat), rz_every],
+                     launch_step=launch_step, copy_back=_copy_back, label="simulation (GPU)",
+                     chunk_steps=chunk_steps, progress=progress, check=check, profile=profile,
+                     persistent=persistent)
 
 
 def _ale_launches(g: dict, ale: tuple, gn: int, ge: int, gs: int) -> None:

@@ -20,7 +20,9 @@ the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU
 
 Layout: the CUDA plumbing shared with the 2D engine (availability, binding, the cooperative
 launch) is :mod:`robobore.cutting.fe.engine.gpu.shared`; the kernels are built in
-:mod:`robobore.cutting.fe.engine.gpu.kernels3d`; this module is the host driver.
+:mod:`robobore.cutting.fe.engine.gpu.kernels3d`; this module hands them, with the 3D state and
+its launch-per-kernel step, to the host driver both engines share
+(:func:`robobore.cutting.fe.engine.gpu.shared.drive_gpu`).
 
 Limits: per-sample energy histories are not recorded on the GPU (the final energy totals
 are computed on the host from the copied-back state). The 2D engine's GPU port, built the
@@ -31,16 +33,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import numpy as np
-
-from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, R_BAD, R_DTMIN, kernels3
+from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, kernels3
 from robobore.cutting.fe.engine.gpu.shared import (
     MAX_BLOCK,
     THREADS,
     bind_cuda,
+    blocks,
     chunk_list_py,
     cooperative,
     cuda_available,
+    drive_gpu,
     jc_device_functions,
     persistent_run,
     profile_ticker,
@@ -84,87 +86,57 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     host-side launch cost).
     """
     from robobore.cutting.fe.engine import kernels3d as K3
-    from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 
     require_gpu()
-    cuda = bind_cuda()
     k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_thermal, k_run = _kernels()
     k_centroids, k_conduct, k_copy_temp, k_heat_nodes, k_heat_elems, k_cond_done = k_thermal
-    st.prm[K3.P_TEND] = t_end
-    st.ist[K3.I_STATUS] = K3.STATUS_OK
-    g = {name: cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in _RUN_ARGS}
-    red = np.zeros(N_RED)
-    red[R_DTMIN] = 1e30
-    red[R_BAD] = -1.0
-    dred = cuda.to_device(red)
-    nn = st.x.shape[0]
-    ne = st.conn.shape[0]
-    gn = (nn + _THREADS - 1) // _THREADS
-    ge = (ne + _THREADS - 1) // _THREADS
+    gn, ge = blocks(st.x.shape[0]), blocks(st.conn.shape[0])
     erosion = int(st.prm[K3.P_EROSION])
-    t_start = st.time
-    step0 = int(st.ist[K3.I_STEP])
-    tick = profile_ticker(profile)
-    run = persistent_run(k_run, [g[name] for name in _RUN_ARGS] + [erosion, dred], nn,
-                         profile, persistent)
     heat = st.prm[K3.P_HC] > 0.0 or st.prm[K3.P_FHEAT] > 0.0
-    while True:
-        if run is not None:
-            run(chunk_steps)
-        step = int(st.ist[K3.I_STEP])  # the launch path: the host counts the steps
-        for _ in range(0 if run is not None else chunk_steps):
-            tick(None)
-            k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
-                                  g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
-                                  g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
-                                  g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
-                                  g["ist"], dred, g["pairs"])
-            tick("nodes")
-            k_contact_sum[1, K3.N_SUM_LANES](g["cf"], dred)
-            tick("contact_sum")
-            k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
-            tick("tool")
-            k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
-                                  g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],
-                                  g["temp"], g["dmg"], g["qh"], g["vol0"], g["ie"], g["hge"],
-                                  g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
-                                  g["clock"], erosion, g["ist"], dred)
-            tick("elements")
-            if K3.is_conduction_step_py(step, st.prm):
-                k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
-                k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
-                                        g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],
-                                        g["prm"], g["clock"], g["ist"])
-                k_copy_temp[ge, _THREADS](g["temp"], g["tbuf"], g["ist"])
-                if heat:
-                    k_heat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["ptr"],
-                                               g["nel"], g["ncorner"], g["alive"], g["enbr"],
-                                               g["pairs"], g["vol0"], g["cf"], g["fric"],
-                                               g["temp"], g["theat"], g["mat"], g["prm"],
-                                               g["clock"], g["ist"])
-                    k_heat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["theat"],
-                                               g["mat"], g["ist"])
-                k_cond_done[1, 1](g["prm"], g["clock"], g["ist"])
-                tick("conduction")
-            step += 1
-            k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
-                           g["en"], dred)
-            tick("finish")
-        for name in ("ist", "clock"):
-            getattr(st, name)[...] = g[name].copy_to_host()
-        status = int(st.ist[K3.I_STATUS])
-        if status in STATUS_TEXT or status == K3.STATUS_DONE or check is not None:
-            _copy_back(st, g)
-        if status in STATUS_TEXT:
-            raise instability_error(st, "3D simulation (GPU)", "a smaller solver.cfl, a larger "
-                                    "mesh.element_size_um or less mass scaling")
-        if progress is not None:
-            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
-        if check is not None:
-            check(st)
-        if status == K3.STATUS_DONE or st.time >= t_end:
-            _copy_back(st, g)
-            return int(st.ist[K3.I_STEP]) - step0
+
+    def launch_step(g, dred, step, tick):
+        # one step as one launch per phase (the persistent kernel's phases)
+        tick(None)
+        k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
+                              g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
+                              g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
+                              g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
+                              g["ist"], dred, g["pairs"])
+        tick("nodes")
+        k_contact_sum[1, K3.N_SUM_LANES](g["cf"], dred)
+        tick("contact_sum")
+        k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+        tick("tool")
+        k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
+                              g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],
+                              g["temp"], g["dmg"], g["qh"], g["vol0"], g["ie"], g["hge"],
+                              g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
+                              g["clock"], erosion, g["ist"], dred)
+        tick("elements")
+        if K3.is_conduction_step_py(step, st.prm):
+            k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
+            k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
+                                    g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],
+                                    g["prm"], g["clock"], g["ist"])
+            k_copy_temp[ge, _THREADS](g["temp"], g["tbuf"], g["ist"])
+            if heat:
+                k_heat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["ptr"],
+                                           g["nel"], g["ncorner"], g["alive"], g["enbr"],
+                                           g["pairs"], g["vol0"], g["cf"], g["fric"],
+                                           g["temp"], g["theat"], g["mat"], g["prm"],
+                                           g["clock"], g["ist"])
+                k_heat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["theat"],
+                                           g["mat"], g["ist"])
+            k_cond_done[1, 1](g["prm"], g["clock"], g["ist"])
+            tick("conduction")
+        k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
+                       g["en"], dred)
+        tick("finish")
+
+    return drive_gpu(st, t_end, names=_RUN_ARGS, p_tend=K3.P_TEND, n_red=N_RED, k_run=k_run,
+                     run_extra=[erosion], launch_step=launch_step, copy_back=_copy_back,
+                     label="3D simulation (GPU)", chunk_steps=chunk_steps, progress=progress,
+                     check=check, profile=profile, persistent=persistent)
 
 
 #: the state arrays on the device, in the persistent kernel's argument order (then erosion,

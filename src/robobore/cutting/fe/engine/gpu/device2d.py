@@ -1,8 +1,9 @@
 """Device versions of the 2D engine's scalar functions, for the GPU engine's kernels
 (:mod:`robobore.cutting.fe.engine.gpu.kernels2d`).
 
-The element, node, tool, conduction, energy and tool-frame ALE updates are the plain-Python
-scalar functions the CPU engine compiles with ``njit`` (:mod:`robobore.cutting.fe.engine.kernels`,
+The element, node, tool, conduction, energy, tool-frame ALE and end-of-step updates are the
+plain-Python scalar functions the CPU engine compiles with ``njit``
+(:mod:`robobore.cutting.fe.engine.kernels`, :mod:`robobore.cutting.fe.engine.history`,
 :mod:`robobore.cutting.fe.ale.rezone`, :mod:`robobore.cutting.fe.physics.tool_contact`,
 :mod:`robobore.material.johnson_cook`); :func:`device_functions2` re-binds each one's callees
 to their device versions (:func:`robobore.material.johnson_cook.rebind`) and compiles it with
@@ -68,12 +69,16 @@ def device_functions2(dev) -> SimpleNamespace:
     pedge = dev(K.parting_edge_py)
     thnode = dev(K.tool_heat_node_py)
     thelem = dev(K.tool_heat_elem_py)
-    sumen = dev(K.sum_energies_py)
     lsum = dev(K.lane_sum_py)
     chunks = dev(chunk_list_py)
+    # the end of a step (robobore.cutting.fe.engine.history) bound to the 2D engine
+    from robobore.cutting.fe.engine import chunk_loop as CL
+    from robobore.cutting.fe.engine.history import bind_end_step
+
+    end_step = bind_end_step(dev, CL.ENGINE2, dev(CL.tool_columns_py), dev(CL.sum_energies_py))
     return SimpleNamespace(
         csplit=csplit, tool_geometry=tool_geometry, tplace=tplace, tfacep=tfacep,
         tsweep=tsweep, tscopy=tscopy, tinter=tinter, rflux=rflux, rvel=rvel, rwrite=rwrite,
         rmass=rmass, SWEEPS=SWEEPS, elem=elem, node=node, kin=kin, tstep=tstep, cent=cent,
-        cond=cond, pedge=pedge, thnode=thnode, thelem=thelem, sumen=sumen, lsum=lsum,
+        cond=cond, pedge=pedge, thnode=thnode, thelem=thelem, end_step=end_step, lsum=lsum,
         chunks=chunks)

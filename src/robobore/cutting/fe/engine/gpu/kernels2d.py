@@ -11,7 +11,6 @@ describes the step's phases.
 from __future__ import annotations
 
 import functools
-import math  # noqa: F401  (math.isfinite inside the kernels)
 
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
@@ -19,7 +18,7 @@ from robobore.cutting.fe.engine.gpu.shared import MAX_BLOCK, bind_cuda
 
 __all__ = ["kernels2", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC", "R_SPLIT", "N_RED"]
 
-# reduction slots on the device
+# reduction slots on the device (gpu_shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
 R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
 #: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
 R_SPLIT = 5
@@ -45,33 +44,22 @@ def kernels2():
 
     f = device_functions2(cuda.jit(device=True))
     (csplit, tool_geometry, tplace, tfacep, tsweep, tscopy, tinter, rflux, rvel, rwrite, rmass,
-     SWEEPS, elem, node, kin, tstep, cent, cond, pedge, thnode, thelem, sumen, lsum, chunks) = (
+     SWEEPS, elem, node, kin, tstep, cent, cond, pedge, thnode, thelem, end_step, lsum,
+     chunks) = (
         f.csplit, f.tool_geometry, f.tplace, f.tfacep, f.tsweep, f.tscopy, f.tinter, f.rflux,
         f.rvel, f.rwrite, f.rmass, f.SWEEPS, f.elem, f.node, f.kin, f.tstep, f.cent, f.cond,
-        f.pedge, f.thnode, f.thelem, f.sumen, f.lsum, f.chunks)
+        f.pedge, f.thnode, f.thelem, f.end_step, f.lsum, f.chunks)
     LANES = K.N_SUM_LANES
     float64 = _float64
     int64 = _int64
     NCNT = MAX_BLOCK + 1
 
-    I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K.I_STATUS, K.I_STEP, K.I_SAMPLE, K.I_BADELEM
-    ST_OK, ST_DONE, ST_INV = K.STATUS_OK, K.STATUS_DONE, K.STATUS_INVERTED
-    ST_NOEL, ST_NONF, ST_DTC = K.STATUS_NO_ELEMENTS, K.STATUS_NONFINITE, K.STATUS_DT_COLLAPSE
-    P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K.P_CFL, K.P_DTMIN, K.P_TEND, K.P_SAMPLE_DT
+    I_STATUS, I_STEP, ST_OK = K.I_STATUS, K.I_STEP, K.STATUS_OK
     P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
     P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
     P_TCX, P_NRX, P_NRY, P_NFX, P_NFY = K.P_TCX, K.P_NRX, K.P_NRY, K.P_NFX, K.P_NFY
     P_ALE_X0, P_RZ_MAXMOVE, P_MS = K.P_ALE_X0, K.P_RZ_MAXMOVE, K.P_MS
-    H_FX_RAKE = K.H_FX_RAKE
-    T_FX, T_FY, T_UX, T_UY, T_GX = K.T_FX, K.T_FY, K.T_UX, K.T_UY, K.T_GX
-    E_EXT, E_KIN, E_INT, E_PLAST, E_HG, E_FRIC, E_ERODED = (K.E_EXT, K.E_KIN, K.E_INT,
-                                                            K.E_PLAST, K.E_HG, K.E_FRIC,
-                                                            K.E_ERODED)
-    H_T, H_FX, H_FY, H_UX, H_UY, H_TIP_X, H_NCONT = (K.H_T, K.H_FX, K.H_FY, K.H_UX, K.H_UY,
-                                                     K.H_TIP_X, K.H_NCONT)
-    H_EKIN, H_EINT, H_EPL, H_EHG, H_EFRIC, H_EEXT, H_EERO = (K.H_EKIN, K.H_EINT, K.H_EPL,
-                                                             K.H_EHG, K.H_EFRIC, K.H_EEXT,
-                                                             K.H_EERO)
+    E_EXT = K.E_EXT
     KCOND, RHO, CP, TROOM = jc.KCOND, jc.RHO, jc.CP, jc.TROOM
 
     @cuda.jit(device=True)
@@ -297,79 +285,20 @@ def kernels2():
         prm[P_COND_ACC] = 0.0
 
     @cuda.jit(device=True)
-    def finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge, alive,
-               fric, pen, ero_ke, nwork):
-        # the step end (one thread): time, stable step, status, histories
-        dt = clock[1]
-        fwx = red[R_FX]
-        fwy = red[R_FY]
+    def finish(tool, prm, clock, ist, hacc, hist, en, red, es):
+        # the step end (one thread): history.end_step_py on the step's reductions
         nc = red[R_NC]
         red[R_NC] = 0.0  # the force total is rewritten by k_contact_sum every step
-        if red[R_BAD] >= 0.0:
-            ist[I_BADELEM] = int(red[R_BAD])
-            ist[I_STATUS] = ST_INV
-            return
-        dtmin = red[R_DTMIN]
-        if dtmin >= 1e30:
-            ist[I_STATUS] = ST_NOEL
-            return
-        new_dt = prm[P_CFL] * dtmin
-        t = clock[0] + dt
-        clock[0] = t
-        ist[I_STEP] += 1
-        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(new_dt)):
-            ist[I_STATUS] = ST_NONF
-            return
-        clock[1] = new_dt
-        if new_dt < prm[P_DTMIN]:
-            ist[I_STATUS] = ST_DTC
-            return
-        hacc[H_FX] += dt * tool[T_FX]
-        hacc[H_FY] += dt * tool[T_FY]
-        hacc[H_UX] += dt * tool[T_UX]
-        hacc[H_UY] += dt * tool[T_UY]
-        hacc[H_NCONT] += dt * nc
-        for j in range(6):
-            hacc[H_FX_RAKE + j] += dt * red[R_SPLIT + j]
-        clock[2] += dt
-        k = ist[I_SAMPLE]
-        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
-            ta = clock[2]
-            sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
-            if not math.isfinite(en[E_KIN]):
-                ist[I_STATUS] = ST_NONF
-                return
-            hist[k, H_T] = t
-            hist[k, H_FX] = hacc[H_FX] / ta
-            hist[k, H_FY] = hacc[H_FY] / ta
-            hist[k, H_UX] = hacc[H_UX] / ta
-            hist[k, H_UY] = hacc[H_UY] / ta
-            hist[k, H_NCONT] = hacc[H_NCONT] / ta
-            for j in range(6):
-                hist[k, H_FX_RAKE + j] = hacc[H_FX_RAKE + j] / ta
-            hist[k, H_TIP_X] = tool[T_GX] + tool[T_UX]
-            hist[k, H_EKIN] = en[E_KIN]
-            hist[k, H_EINT] = en[E_INT]
-            hist[k, H_EPL] = en[E_PLAST]
-            hist[k, H_EHG] = en[E_HG]
-            hist[k, H_EFRIC] = en[E_FRIC]
-            hist[k, H_EEXT] = en[E_EXT]
-            hist[k, H_EERO] = en[E_ERODED]
-            for j in range(hacc.shape[0]):
-                hacc[j] = 0.0
-            clock[2] = 0.0
-            ist[I_SAMPLE] = k + 1
-        if t >= prm[P_TEND]:
-            ist[I_STATUS] = ST_DONE
-            sumen(mass, vx, vy, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en)
+        end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], 0.0, nc,
+                 red[R_SPLIT:], ist, clock, prm, tool, en, hacc, hist, es)
 
     @cuda.jit
     def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
                  alive, fric, pen, ero_ke, nwork):
         if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
             return
-        finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge, alive,
-               fric, pen, ero_ke, nwork)
+        finish(tool, prm, clock, ist, hacc, hist, en, red,
+               (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
 
     @cuda.jit
     def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
@@ -521,8 +450,8 @@ def kernels2():
                 if tid == 0:
                     prm[P_COND_ACC] = 0.0
             if tid == 0:
-                finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
-                       alive, fric, pen, ero_ke, nwork)
+                finish(tool, prm, clock, ist, hacc, hist, en, red,
+                       (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
                 red[R_DTMIN] = 1e30
                 red[R_BAD] = -1.0
             grid.sync()

@@ -15,7 +15,6 @@ host driver is :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`.
 from __future__ import annotations
 
 import functools
-import math  # noqa: F401  (math.isfinite inside the kernels)
 
 from robobore.cutting.fe.engine.gpu.shared import (
     MAX_BLOCK,
@@ -26,13 +25,19 @@ from robobore.cutting.fe.engine.gpu.shared import (
 
 __all__ = ["kernels3", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ", "R_NC", "N_RED"]
 
-# reduction slots on the device
+# reduction slots on the device (gpu_shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
 R_DTMIN, R_BAD, R_FX, R_FY, R_FZ, R_NC = 0, 1, 2, 3, 4, 5
 N_RED = 6
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)
 cuda = None
+
+
+def no_energy_totals_py(es, en):
+    """The energy totals of the 3D GPU engine's history samples: none (False; the samples
+    record the external work only, the host sums the totals from the copied-back state)."""
+    return False
 
 
 @functools.lru_cache(maxsize=1)
@@ -75,6 +80,7 @@ def kernels3():
     centroid3, conduct3 = th["hex_centroid3"], th["hex_conduct3"]
     heat_node3, heat_elem3 = th["tool_heat_node3"], th["tool_heat_elem3"]
     is_cond = dev(K3.is_conduction_step_py)
+    from robobore.cutting.fe.engine.history import bind_end_step
     RHO, CP, KCOND = jc.RHO, jc.CP, jc.KCOND
     P_COND_T, P_HC, P_FHEAT, P_TTOOL = K3.P_COND_T, K3.P_HC, K3.P_FHEAT, K3.P_TTOOL
     chunks = dev(chunk_list_py)
@@ -83,15 +89,10 @@ def kernels3():
     int64 = _int64
     NCNT = MAX_BLOCK + 1
 
-    I_STATUS, I_STEP, I_SAMPLE, I_BADELEM = K3.I_STATUS, K3.I_STEP, K3.I_SAMPLE, K3.I_BADELEM
-    ST_OK, ST_DONE, ST_INV = K3.STATUS_OK, K3.STATUS_DONE, K3.STATUS_INVERTED
-    ST_NOEL, ST_NONF, ST_DTC = K3.STATUS_NO_ELEMENTS, K3.STATUS_NONFINITE, K3.STATUS_DT_COLLAPSE
-    P_CFL, P_DTMIN, P_TEND, P_SAMPLE_DT = K3.P_CFL, K3.P_DTMIN, K3.P_TEND, K3.P_SAMPLE_DT
-    T_FX, T_FY, T_FZ, T_UX, T_UY, T_UZ = K3.T_FX, K3.T_FY, K3.T_FZ, K3.T_UX, K3.T_UY, K3.T_UZ
-    T_GX, T_THETA, E_EXT = K3.T_GX, K3.T_THETA, K3.E_EXT
-    H_T, H_FX, H_FY, H_FZ, H_UX, H_UY, H_UZ = (K3.H_T, K3.H_FX, K3.H_FY, K3.H_FZ, K3.H_UX,
-                                               K3.H_UY, K3.H_UZ)
-    H_NCONT, H_TIPX, H_THETA, H_EEXT = K3.H_NCONT, K3.H_TIPX, K3.H_THETA, K3.H_EEXT
+    I_STATUS, I_STEP, ST_OK, E_EXT = K3.I_STATUS, K3.I_STEP, K3.STATUS_OK, K3.E_EXT
+    # the end of a step (robobore.cutting.fe.engine.history) bound to the 3D engine, without the
+    # per-sample energy totals
+    end_step = bind_end_step(dev, K3.ENGINE3, dev(K3.tool_columns3_py), dev(no_energy_totals_py))
 
     @cuda.jit(device=True)
     def lanes_total(px, py, pz, pn, red):
@@ -209,59 +210,10 @@ def kernels3():
 
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red):
-        # the step end (one thread): time, stable step, status, time-averaged histories
-        dt = clock[1]
-        t = clock[0] + dt
-        clock[0] = t
-        ist[I_STEP] += 1
-        fwx = red[R_FX]
-        fwy = red[R_FY]
-        fwz = red[R_FZ]
-        nc = red[R_NC]
-        if red[R_BAD] >= 0.0:
-            ist[I_BADELEM] = int(red[R_BAD])
-            ist[I_STATUS] = ST_INV
-            return
-        if red[R_DTMIN] >= 1e30:
-            ist[I_STATUS] = ST_NOEL
-            return
-        new_dt = prm[P_CFL] * red[R_DTMIN]
-        if not (math.isfinite(fwx) and math.isfinite(fwy) and math.isfinite(fwz)
-                and math.isfinite(new_dt)):
-            ist[I_STATUS] = ST_NONF
-            return
-        clock[1] = new_dt
-        if new_dt < prm[P_DTMIN]:
-            ist[I_STATUS] = ST_DTC
-            return
-        hacc[H_FX] += dt * tool[T_FX]
-        hacc[H_FY] += dt * tool[T_FY]
-        hacc[H_FZ] += dt * tool[T_FZ]
-        hacc[H_UX] += dt * tool[T_UX]
-        hacc[H_UY] += dt * tool[T_UY]
-        hacc[H_UZ] += dt * tool[T_UZ]
-        hacc[H_NCONT] += dt * nc
-        clock[2] += dt
-        k = ist[I_SAMPLE]
-        if t >= (k + 1) * prm[P_SAMPLE_DT] and k < hist.shape[0]:
-            ta = clock[2]
-            hist[k, H_T] = t
-            hist[k, H_FX] = hacc[H_FX] / ta
-            hist[k, H_FY] = hacc[H_FY] / ta
-            hist[k, H_FZ] = hacc[H_FZ] / ta
-            hist[k, H_UX] = hacc[H_UX] / ta
-            hist[k, H_UY] = hacc[H_UY] / ta
-            hist[k, H_UZ] = hacc[H_UZ] / ta
-            hist[k, H_NCONT] = hacc[H_NCONT] / ta
-            hist[k, H_TIPX] = tool[T_GX]
-            hist[k, H_THETA] = tool[T_THETA]
-            hist[k, H_EEXT] = en[E_EXT]
-            for j in range(hacc.shape[0]):
-                hacc[j] = 0.0
-            clock[2] = 0.0
-            ist[I_SAMPLE] = k + 1
-        if t >= prm[P_TEND]:
-            ist[I_STATUS] = ST_DONE
+        # the step end (one thread): history.end_step_py on the step's reductions (no
+        # per-sample energy totals: the host sums them from the copied-back state)
+        end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], red[R_FZ],
+                 red[R_NC], red, ist, clock, prm, tool, en, hacc, hist, ())
 
     @cuda.jit
     def k_finish(tool, prm, clock, ist, hacc, hist, en, red):

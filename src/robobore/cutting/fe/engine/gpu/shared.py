@@ -1,7 +1,8 @@
 """CUDA plumbing shared by the 2D and 3D GPU engines (numba-cuda): availability checks, the
 binding of the ``numba.cuda`` module, the Johnson-Cook device functions, the block-level
-chunk listing of the persistent kernels, and the host side of a chunk (the cooperative launch
-of a persistent kernel, or the per-launch profile clock of the launch-per-kernel loop).
+chunk listing of the persistent kernels, the host side of a chunk (the cooperative launch
+of a persistent kernel, or the per-launch profile clock of the launch-per-kernel loop) and the
+host driver of both engines (:func:`drive_gpu`).
 
 Importing this module needs neither a GPU nor numba's CUDA target; :func:`require_gpu` raises
 a clear :class:`robobore.errors.ConfigError` when no GPU is usable. The engines themselves are
@@ -20,7 +21,7 @@ from robobore.errors import ConfigError
 
 __all__ = ["THREADS", "MAX_BLOCK", "simulator_enabled", "cuda_available", "require_gpu",
            "jc_device_functions", "bind_cuda", "chunk_list_py", "persistent_run", "cooperative",
-           "profile_ticker"]
+           "profile_ticker", "blocks", "drive_gpu"]
 
 #: threads per block of the GPU engines' launches
 THREADS = 128
@@ -190,3 +191,71 @@ def profile_ticker(profile: dict[str, float] | None) -> Callable[[str | None], N
         last[0] = now
 
     return tick
+
+
+def blocks(n: int) -> int:
+    """Blocks of :data:`THREADS` threads that cover ``n`` items (at least one)."""
+    return max(1, (n + THREADS - 1) // THREADS)
+
+
+def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: int, k_run,
+              run_extra: list, launch_step: Callable, copy_back: Callable, label: str,
+              chunk_steps: int, progress: Callable[[float], None] | None,
+              check: Callable | None, profile: dict[str, float] | None,
+              persistent: bool | None) -> int:
+    """The host driver of both GPU engines
+    (:func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`,
+    :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`): the state's arrays
+    ``names`` to the device, then chunks of ``chunk_steps`` steps until ``t_end`` [s] or a stop
+    status; returns the number of steps taken.
+
+    A chunk is one cooperative launch of the persistent kernel ``k_run`` (arguments: the
+    arrays, ``run_extra``, the ``n_red`` reduction slots of the kernels, the smallest stable
+    step in slot 0 and the inverted element in slot 1; see
+    :func:`persistent_run`), or ``launch_step(g, dred, step, tick)`` once per step (``g`` the
+    device arrays by name, ``step`` the step's number, ``tick`` the :func:`profile_ticker`).
+    After each chunk the step counter and clock come back (the whole state, by
+    ``copy_back(st, g)``, when ``check`` is given, at the end and on a stop); an instability
+    status raises :func:`robobore.cutting.fe.status.instability_error` labelled ``label``.
+    """
+    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
+
+    require_gpu()
+    _cuda = bind_cuda()
+    st.prm[p_tend] = t_end
+    st.ist[K.I_STATUS] = K.STATUS_OK
+    g = {name: _cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in names}
+    red = np.zeros(n_red)
+    red[0] = 1e30  # no stable step yet (R_DTMIN)
+    red[1] = -1.0  # no inverted element (R_BAD)
+    dred = _cuda.to_device(red)
+    t_start = st.time
+    step0 = int(st.ist[K.I_STEP])
+    tick = profile_ticker(profile)
+    run = persistent_run(k_run, [g[name] for name in names] + list(run_extra) + [dred],
+                         st.x.shape[0], profile, persistent)
+    while True:
+        if run is not None:
+            run(chunk_steps)
+        else:
+            # while the status is OK every launch sequence is exactly one step, so the host
+            # knows the step number; once the status changes the launches return at once
+            step = int(st.ist[K.I_STEP])
+            for i in range(chunk_steps):
+                launch_step(g, dred, step + i, tick)
+        for name in ("ist", "clock"):
+            getattr(st, name)[...] = g[name].copy_to_host()
+        status = int(st.ist[K.I_STATUS])
+        if status in STATUS_TEXT or status == K.STATUS_DONE or check is not None:
+            copy_back(st, g)
+        if status in STATUS_TEXT:
+            raise instability_error(st, label, "a smaller solver.cfl, a larger "
+                                    "mesh.element_size_um or less mass scaling")
+        if progress is not None:
+            progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
+        if check is not None:
+            check(st)
+        if status == K.STATUS_DONE or st.time >= t_end:
+            copy_back(st, g)
+            return int(st.ist[K.I_STEP]) - step0
