@@ -18,7 +18,7 @@ from robobore.cutting.fe.engine.gpu.shared import MAX_BLOCK, bind_cuda
 
 __all__ = ["kernels2", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC", "R_SPLIT", "N_RED"]
 
-# reduction slots on the device (gpu_shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
+# reduction slots on the device (engine.gpu.shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
 R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
 #: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
 R_SPLIT = 5
@@ -36,7 +36,7 @@ def kernels2():
     k_theat_elems, k_conduct_reset, k_finish, k_run, ale)`` with ``ale`` the tool-frame ALE
     pass's kernels (the launch-per-kernel path)."""
     global cuda
-    cuda = bind_cuda()  # also gpu_shared's, for chunk_list_py
+    cuda = bind_cuda()  # also engine.gpu.shared's, for chunk_list_py
     from numba import float64 as _float64
     from numba import int64 as _int64
 

@@ -25,7 +25,7 @@ from robobore.cutting.fe.engine.gpu.shared import (
 
 __all__ = ["kernels3", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ", "R_NC", "N_RED"]
 
-# reduction slots on the device (gpu_shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
+# reduction slots on the device (engine.gpu.shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
 R_DTMIN, R_BAD, R_FX, R_FY, R_FZ, R_NC = 0, 1, 2, 3, 4, 5
 N_RED = 6
 
