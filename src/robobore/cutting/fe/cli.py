@@ -125,7 +125,7 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
         for face, f in r.get("force_by_face_N_per_mm", {}).items():
             rows.append((f"{face} Fc / Ff [N/mm]", f"{f['cutting']:.2f} / {f['feed']:.2f}"))
         stdout.print(kv_table("FE orthogonal cutting", rows))
-        for w in r["warnings"]:
+        for w in r.get("warnings", []):
             stdout.print(f"[yellow]warning:[/] {w}")
         for k, v in r.get("files", {}).items():
             stdout.print(f"{k}: {v}")
@@ -238,7 +238,7 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
         rows.append(("measured file", r["measured_file"]))
         rows.append(("results folder", r["out_dir"]))
         stdout.print(kv_table("Summary", rows))
-        for w in r["warnings"]:
+        for w in r.get("warnings", []):
             stdout.print(f"[yellow]warning:[/] {w}")
         for k, v in r.get("files", {}).items():
             stdout.print(f"{k}: {v}")

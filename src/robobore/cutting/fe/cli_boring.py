@@ -106,7 +106,7 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
              f"{mc[c]['fe_N']:.3g} / {mc[c]['model_N']:.3g}, "
              f"{100 * mc[c]['relative_difference']:+.1f} %")
             for c in ("tangential", "radial", "feed")]))
-        for w in r["warnings"]:
+        for w in r.get("warnings", []):
             stdout.print(f"[yellow]warning:[/] {w}")
 
     emit(result, as_json, render)
