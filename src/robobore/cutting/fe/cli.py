@@ -238,8 +238,6 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
         rows.append(("measured file", r["measured_file"]))
         rows.append(("results folder", r["out_dir"]))
         stdout.print(kv_table("Summary", rows))
-        for w in r.get("warnings", []):
-            stdout.print(f"[yellow]warning:[/] {w}")
         for k, v in r.get("files", {}).items():
             stdout.print(f"{k}: {v}")
 
