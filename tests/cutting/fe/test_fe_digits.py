@@ -89,16 +89,7 @@ def run_case(name: str, tmp: Path) -> dict:
                          capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stderr[-2000:]
     res = json.loads(out.stdout)
-    return {k: _pick(res, k) for k in keys}
-
-
-def _pick(res: dict, key: str):
-    if key in res:
-        return res[key]
-    for v in res.values():  # one level down (e.g. the 3D summary)
-        if isinstance(v, dict) and key in v:
-            return v[key]
-    raise KeyError(key)
+    return {k: res[k] for k in keys}
 
 
 def _close(a, b, rel: float = 1e-9) -> bool:
