@@ -14,7 +14,7 @@ by the engine's config model when the calibration config is read, before any run
 from __future__ import annotations
 
 import math
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
@@ -286,28 +286,31 @@ VALIDATION_DOMAIN = {"uncut_chip_thickness_um": (40.0, 80.0),
                      "material": "TC4"}
 
 
-def _departures(cfg: CalibrationConfig, c: Any) -> list[str]:
-    """How the virtual tests leave the validated model's checked domain (in words)."""
+def domain_departures(h_um: Sequence[float], vc_m_per_min: Sequence[float], *,
+                      rake_deg: float, edge_radius_um: float, element_size_um: float,
+                      length_mm: float, material: str) -> list[str]:
+    """How FE runs at the chip thicknesses ``h_um`` and cutting speeds ``vc_m_per_min`` with
+    this tool, mesh, cut length and material leave :data:`VALIDATION_DOMAIN`, one line per
+    departure in words (empty: inside it). Used by ``robobore fe orthogonal`` (its
+    ``warnings``) and by the calibration's FE model description."""
     d = VALIDATION_DOMAIN
     out = []
-    for key, vals in (("uncut_chip_thickness_um", cfg.uncut_chip_thickness_um),
-                      ("cutting_speed_m_per_min", cfg.cutting_speed_m_per_min)):
+    for key, vals in (("uncut_chip_thickness_um", h_um), ("cutting_speed_m_per_min", vc_m_per_min)):
         lo, hi = d[key]
         off = [v for v in vals if not lo <= v <= hi]
         if off:
             out.append(f"{key} {', '.join(f'{v:g}' for v in off)} outside the validated "
                        f"{lo:g}-{hi:g}")
-    for key, val in (("rake_deg", cfg.rake_deg), ("edge_radius_um", cfg.edge_radius_um)):
+    for key, val in (("rake_deg", rake_deg), ("edge_radius_um", edge_radius_um)):
         if val != d[key]:
             out.append(f"{key} {val:g} (validated at {d[key]:g})")
-    if c.mesh.element_size_um > d["element_size_um"]:
-        out.append(f"element_size_um {c.mesh.element_size_um:g} coarser than the validated "
+    if element_size_um > d["element_size_um"]:
+        out.append(f"element_size_um {element_size_um:g} coarser than the validated "
                    f"{d['element_size_um']:g}")
-    if c.cut.length_mm < d["length_mm"]:
-        out.append(f"length_mm {c.cut.length_mm:g} shorter than the validated "
-                   f"{d['length_mm']:g}")
-    if cfg.material != d["material"]:
-        out.append(f"material {cfg.material} (validated on {d['material']})")
+    if length_mm < d["length_mm"]:
+        out.append(f"length_mm {length_mm:g} shorter than the validated {d['length_mm']:g}")
+    if material != d["material"]:
+        out.append(f"material {material} (validated on {d['material']})")
     return out
 
 
@@ -337,9 +340,13 @@ def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
                   "not the engine's validated model (docs/fe.md, 'Model choice')")
     return {"source": cfg.fe_config_source or "fe shorthand (workpiece frame, a-priori)",
             "summary": summary, "validation": validation, "validated_physics": same,
-            "outside_validation": _departures(cfg, c),
+            "outside_validation": domain_departures(
+                cfg.uncut_chip_thickness_um, cfg.cutting_speed_m_per_min,
+                rake_deg=cfg.rake_deg, edge_radius_um=cfg.edge_radius_um,
+                element_size_um=c.mesh.element_size_um, length_mm=c.cut.length_mm,
+                material=cfg.material),
             "config": None if cfg.fe_config is None else cfg.fe_config}
 
 __all__ = ["FESettings", "CalibrationConfig", "calibration_from_mapping",
-           "load_calibration_config", "fe_config_dict", "fe_model_description",
+           "load_calibration_config", "fe_config_dict", "fe_model_description", "domain_departures",
            "VALIDATION_DOMAIN"]

@@ -24,8 +24,9 @@ def test_each_departure_is_named():
     d["tool"]["rake_deg"] = 7.0
     d["contact"] = {"friction": 0.3}
     w = " | ".join(validation_warnings(parse_config(d)))
-    for text in ("Coulomb 0.3", "uncut_chip_thickness_um 100 (validated 40-80)",
-                 "cutting_speed_m_per_min 60 (validated 5-30)", "rake_deg 7 (validated at 15)"):
+    for text in ("Coulomb 0.3", "uncut_chip_thickness_um 100 outside the validated 40-80",
+                 "cutting_speed_m_per_min 60 outside the validated 5-30",
+                 "rake_deg 7 (validated at 15)"):
         assert text in w, (text, w)
     # a unit slip inside the ranges the engine accepts is still flagged (h 60 -> 6 um needs
     # 2 um elements, which pass the engine's own checks)
@@ -33,6 +34,11 @@ def test_each_departure_is_named():
     d["cut"]["uncut_chip_thickness_um"] = 6.0
     d["mesh"]["element_size_um"] = 2.0
     assert any("uncut_chip_thickness_um 6 " in x for x in validation_warnings(parse_config(d)))
+    # a cut shorter than the validated 0.3 mm is named too
+    d = load_toml(_EX / "fe_orthogonal.toml")
+    d["cut"]["length_mm"] = 0.1
+    assert any("length_mm 0.1 shorter than the validated 0.3" in x
+               for x in validation_warnings(parse_config(d)))
 
 
 def test_variants_are_flagged():

@@ -39,7 +39,7 @@ def validation_warnings(cfg) -> list[str]:
     """What in an FE orthogonal config leaves the validated model or its checked domain
     (docs/fe.md, "Validation against the measured forces"), in words: printed with every run
     so that a result is never read as validated where it is not."""
-    from robobore.cutting.calibration_config import VALIDATION_DOMAIN as D
+    from robobore.cutting.calibration_config import domain_departures
     from robobore.material.friction import friction_law
 
     out = []
@@ -59,20 +59,11 @@ def validation_warnings(cfg) -> list[str]:
     if cfg.parameters != "a_priori" and not same_friction:
         out.append(f"friction: {cfg.friction_law()}; the validated model reads the law "
                    "rech2013_calibrated at each node's sliding speed")
-    off = []
-    for key, val in (("uncut_chip_thickness_um", cfg.cut.uncut_chip_thickness_um),
-                     ("cutting_speed_m_per_min", cfg.cut.cutting_speed_m_per_min)):
-        lo, hi = D[key]
-        if not lo <= val <= hi:
-            off.append(f"{key} {val:g} (validated {lo:g}-{hi:g})")
-    for key, val in (("rake_deg", cfg.tool.rake_deg), ("edge_radius_um", cfg.tool.edge_radius_um)):
-        if val != D[key]:
-            off.append(f"{key} {val:g} (validated at {D[key]:g})")
-    if cfg.mesh.element_size_um > D["element_size_um"]:
-        off.append(f"element_size_um {cfg.mesh.element_size_um:g} (validated at "
-                   f"{D['element_size_um']:g} and finer)")
-    if cfg.material.name != D["material"]:
-        off.append(f"material {cfg.material.name} (validated on {D['material']})")
+    off = domain_departures(
+        [cfg.cut.uncut_chip_thickness_um], [cfg.cut.cutting_speed_m_per_min],
+        rake_deg=cfg.tool.rake_deg, edge_radius_um=cfg.tool.edge_radius_um,
+        element_size_um=cfg.mesh.element_size_um, length_mm=cfg.cut.length_mm,
+        material=cfg.material.name)
     if off:
         out.append("outside the domain checked against measured forces: " + "; ".join(off))
     return out
