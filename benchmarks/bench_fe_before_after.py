@@ -27,7 +27,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 sys.path.insert(0, str(ROOT / "src"))
-from robobore.io.config import load_toml  # noqa: E402
+from robobore.io.config import dump_toml, load_toml  # noqa: E402
 
 #: case -> (example, overrides, CLI subcommand, force keys)
 CASES = {
@@ -36,15 +36,6 @@ CASES = {
                                                   ("mesh", "element_size_um"): 12.5},
                          "boring"),
 }
-
-
-def _toml(d: dict) -> str:
-    lines = [f"{k} = {json.dumps(v)}" for k, v in d.items() if not isinstance(v, dict)]
-    for k, v in d.items():
-        if isinstance(v, dict):
-            lines.append(f"[{k}]")
-            lines += [f"{kk} = {json.dumps(vv)}" for kk, vv in v.items()]
-    return "\n".join(lines) + "\n"
 
 
 def _config(case: str, tmp: Path, warmup: bool) -> Path:
@@ -57,7 +48,7 @@ def _config(case: str, tmp: Path, warmup: bool) -> Path:
         sec, key = next(iter(over))
         d[sec][key] = 0.02
     p = tmp / (case.replace(" ", "_") + ("_warm" if warmup else "") + ".toml")
-    p.write_text(_toml(d))
+    p.write_text(dump_toml(d))
     return p
 
 

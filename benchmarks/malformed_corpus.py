@@ -56,6 +56,8 @@ ROOT = Path(__file__).resolve().parents[1]
 EX = ROOT / "examples"
 DATA = ROOT / "src" / "robobore" / "data"
 PKG = ROOT / "src" / "robobore"
+sys.path.insert(0, str(ROOT / "src"))
+from robobore.io.config import dump_toml  # noqa: E402
 
 #: parse-only drivers (commands that would run FE simulations or the whole paper study)
 PARSE = {
@@ -172,49 +174,6 @@ def _set(d, key, value):
         cur[last] = value
 
 
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float):
-        if v != v:
-            return "nan"
-        if v in (float("inf"), float("-inf")):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
-    raise TypeError(v)
-
-
-def _dump_toml(d: dict) -> str:
-    """Small TOML writer (tables, arrays of tables, inline values)."""
-    out: list[str] = []
-
-    def table(t: dict, name: str) -> None:
-        scal = {k: v for k, v in t.items() if not isinstance(v, dict) and not (
-            isinstance(v, list) and v and all(isinstance(x, dict) for x in v))}
-        if name:
-            out.append(f"[{name}]")
-        for k, v in scal.items():
-            out.append(f"{k} = {_toml_value(v)}")
-        for k, v in t.items():
-            if isinstance(v, dict):
-                table(v, f"{name}.{k}" if name else k)
-            elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
-                for x in v:
-                    out.append(f"[[{name + '.' if name else ''}{k}]]")
-                    for kk, vv in x.items():
-                        out.append(f"{kk} = {_toml_value(vv)}")
-    table(d, "")
-    return "\n".join(out) + "\n"
-
-
 # ----------------------------------------------------------------------------- generators
 def toml_cases(kind: str, src: Path, argv_of, extra: dict[str, bytes] | None = None,
                max_slips: int = 12) -> list[Case]:
@@ -234,7 +193,7 @@ def toml_cases(kind: str, src: Path, argv_of, extra: dict[str, bytes] | None = N
     for k, v, (f, w) in slips[:max_slips]:
         d = tomllib.loads(text.decode())
         _set(d, k, v * f if w != "coherence > 1" else 1.7)
-        mk(f"unit slip {k} ({w}): {v!r} -> {v * f!r}", _dump_toml(d).encode())
+        mk(f"unit slip {k} ({w}): {v!r} -> {v * f!r}", dump_toml(d).encode())
     numeric = [k for k, _ in leaves]
     for i, bad in enumerate(["nan", "true", '"abc"', "inf"]):
         if not numeric:
@@ -243,7 +202,7 @@ def toml_cases(kind: str, src: Path, argv_of, extra: dict[str, bytes] | None = N
         d = tomllib.loads(text.decode())
         _set(d, k, {"nan": float("nan"), "true": True, '"abc"': "abc",
                     "inf": float("inf")}[bad])
-        mk(f"{bad} in {k}", _dump_toml(d).encode())
+        mk(f"{bad} in {k}", dump_toml(d).encode())
     sections = [k for k, v in data.items() if isinstance(v, dict)]
     if sections:
         s = sections[0]

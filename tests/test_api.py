@@ -24,6 +24,7 @@ import pytest
 from robobore import api
 from robobore.equivalent import EquivalentModel
 from robobore.errors import ConfigError, InputError
+from robobore.io.config import dump_toml
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -272,11 +273,11 @@ def test_lobes_take_the_model_or_its_dict_form_like_the_equivalent_section(chain
         assert got["mode_coupling_limit_mm"] == ref["mode_coupling_limit_mm"]
     # a TOML process config, and the CLI's --equivalent-file route, give the same lobes
     toml = tmp_path / "process.toml"
-    toml.write_text(_toml(proc))
+    toml.write_text(dump_toml(proc))
     got = api.stability_lobes(toml, em, method="frequency")
     np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
     (tmp_path / "eq.json").write_text(json.dumps(em.to_dict()))
-    (tmp_path / "files.toml").write_text('[model]\nequivalent_file = "eq.json"\n' + _toml(proc))
+    (tmp_path / "files.toml").write_text('[model]\nequivalent_file = "eq.json"\n' + dump_toml(proc))
     got = api.stability_lobes(tmp_path / "files.toml", method="frequency")
     np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
     # a validated DynamicsConfig with the model given separately
@@ -292,15 +293,6 @@ def test_lobes_take_the_model_or_its_dict_form_like_the_equivalent_section(chain
 def _section(em: EquivalentModel) -> dict:
     return {"stiffness_N_per_m": dict(em.stiffness_N_per_m),
             "frequency_Hz": dict(em.frequency_Hz), "damping_ratio": dict(em.damping_ratio)}
-
-
-def _toml(d: dict) -> str:
-    """A flat two-level dict as TOML (JSON scalars are TOML scalars here)."""
-    lines = []
-    for sec, body in d.items():
-        lines.append(f"[{sec}]")
-        lines += [f"{k} = {json.dumps(v)}" for k, v in body.items()]
-    return "\n".join(lines) + "\n"
 
 
 def test_boring_run_takes_the_model_or_its_dict_form(chain):

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import math
+import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +15,7 @@ from typer.testing import CliRunner
 
 from robobore.cli import app
 from robobore.errors import ConfigError, InputError
-from robobore.io.config import load_toml, validate_model
+from robobore.io.config import dump_toml, load_toml, validate_model
 from robobore.io.results import atomic_write_text, to_jsonable, write_json, write_netcdf
 
 
@@ -49,6 +52,20 @@ def test_load_toml_errors(tmp_path):
     bad.write_text("[a\nb = ")
     with pytest.raises(ConfigError, match="not valid TOML"):
         load_toml(bad)
+
+
+def test_dump_toml_reads_back_every_example_and_edge_values():
+    for f in sorted((Path(__file__).parents[1] / "examples").glob("*.toml")):
+        d = load_toml(f)
+        assert tomllib.loads(dump_toml(d)) == d, f.name
+    d = {"top": 1, "a b": "x\"y", "t": {"nested": {"flag": False, "v": [1.5, -2]}, "e": {}},
+         "rows": [{"k": 1, "sub": {"q": "w"}}, {"k": 2}], "inline": [[1, 2], []],
+         "odd": {"nan": float("nan"), "inf": float("-inf")}}
+    r = tomllib.loads(dump_toml(d))
+    assert math.isnan(r["odd"].pop("nan")) and math.isnan(d["odd"].pop("nan"))
+    assert r == d
+    with pytest.raises(TypeError):
+        dump_toml({"x": object()})
 
 
 def test_atomic_write_leaves_no_temp(tmp_path):

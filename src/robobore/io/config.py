@@ -8,6 +8,7 @@ was expected.
 
 from __future__ import annotations
 
+import json
 import tomllib
 from pathlib import Path
 from types import UnionType
@@ -53,6 +54,58 @@ def load_toml(path: str | Path) -> dict[str, Any]:
         rc = data.get(ranges.OVERRIDE_KEY)
         data[ranges.OVERRIDE_KEY] = {**(rc if isinstance(rc, dict) else {}), **off}
     return data
+
+
+def _toml_key(k: Any) -> str:
+    k = str(k)
+    return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else json.dumps(k)
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        if v != v:
+            return "nan"
+        if v in (float("inf"), float("-inf")):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a JSON string is a TOML basic string
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(x)}"
+                                for k, x in v.items()) + " }"
+    raise TypeError(f"no TOML form for {type(v).__name__} {v!r}")
+
+
+def dump_toml(data: dict[str, Any]) -> str:
+    """The TOML text of a dict as :func:`load_toml` reads it back (tables, arrays of tables,
+    scalars, arrays, nan/inf): for writing a modified config (tests, benchmarks, sweeps)."""
+    out: list[str] = []
+
+    def is_aot(v: Any) -> bool:
+        return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+    def table(t: dict[str, Any], name: str) -> None:
+        for k, v in t.items():
+            if not isinstance(v, dict) and not is_aot(v):
+                out.append(f"{_toml_key(k)} = {_toml_value(v)}")
+        for k, v in t.items():
+            sub = f"{name}.{_toml_key(k)}" if name else _toml_key(k)
+            if isinstance(v, dict):
+                out.append(f"[{sub}]")
+                table(v, sub)
+            elif is_aot(v):
+                for x in v:
+                    out.append(f"[[{sub}]]")
+                    table(x, sub)
+
+    table(data, "")
+    return "\n".join(out) + "\n"
 
 
 def _allows_bool(ann: Any) -> bool:

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from robobore.io.config import load_toml
+from robobore.io.config import dump_toml, load_toml
 
 _EX = Path(__file__).parents[3] / "examples"
 
@@ -69,22 +69,12 @@ EXPECTED: dict[str, dict] = {
 }
 
 
-def _toml(d: dict) -> str:
-    """A TOML text of a two-level dict of scalars and lists (enough for the examples)."""
-    lines = [f"{k} = {json.dumps(v)}" for k, v in d.items() if not isinstance(v, dict)]
-    for k, v in d.items():
-        if isinstance(v, dict):
-            lines.append(f"[{k}]")
-            lines += [f"{kk} = {json.dumps(vv)}" for kk, vv in v.items()]
-    return "\n".join(lines) + "\n"
-
-
 def run_case(name: str, tmp: Path) -> dict:
     example, (sec, key), length, sub, keys = CASES[name]
     d = load_toml(_EX / example)
     d[sec][key] = length
     cfg = tmp / f"{name}.toml"
-    cfg.write_text(_toml(d))
+    cfg.write_text(dump_toml(d))
     out = subprocess.run([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
                          capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stderr[-2000:]
