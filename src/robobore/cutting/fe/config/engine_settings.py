@@ -27,8 +27,7 @@ def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
     p[k.P_BV2] = s.bulk_viscosity_quadratic
     p[k.P_DIST] = s.distortion_limit
     p[k.P_DT_ERODE] = -s.erode_time_step_fraction
-    p[k.P_EROSION] = {"none": k.ERODE_NONE, "layer": k.ERODE_LAYER,
-                      "everywhere": k.ERODE_ALL}[s.erosion]
+    p[k.P_EROSION] = {"none": k.ERODE_NONE, "layer": k.ERODE_LAYER}[s.erosion]
     if hasattr(k, "P_ELEM"):
         p[k.P_ELEM] = {"q4r": k.ELEM_Q4R, "q4_bbar": k.ELEM_Q4BBAR}[s.element]
     return p

@@ -301,20 +301,6 @@ class SolverSection(SolverSettings):
     #: its nodes is within this distance [um] of the tool surface (the material separates
     #: at the cutting edge, not ahead of it); None: erode wherever the damage reaches 1
     separation_gate_um: float | None = Field(default=None, ge=0.0)
-    #: steps between chip rezoning passes (Laplacian smoothing + donor-cell remap of the
-    #: chip layer, see robobore.cutting.fe.ale.rezone); 0 = pure Lagrangian
-    rezone_interval: int = Field(default=0, ge=0, le=10**6)
-    #: relaxation of each smoothing pass (fraction of the move towards the neighbour mean)
-    rezone_relaxation: float = Field(default=0.3, gt=0.0, le=1.0)
-    #: steps between ALE passes of the ploughed layer (node splitting only): the node rows
-    #: within ``edge_ale_depth_um`` under the parting line, once their column's pair has
-    #: been released at the edge, slide along their rows back towards their initial x
-    #: (Eulerian in the cutting direction, Lagrangian in depth) and the element state is
-    #: remapped (donor cell, see robobore.cutting.fe.ale.rezone); 0 = off (pure Lagrangian)
-    edge_ale_interval: int = Field(default=0, ge=0, le=10**6)
-    #: depth [um] of the ploughed layer under the parting line that edge_ale_interval
-    #: treats (rows strictly above this depth move; default: the edge band's lower part)
-    edge_ale_depth_um: float = Field(default=10.0, gt=0.0)
     #: tool frame (mesh.frame = "tool"): steps between the passes that move the mesh back
     #: to its place in the tool's frame and remap the element state and node velocities
     ale_interval: int = Field(default=10, ge=1, le=10**4)
@@ -454,31 +440,6 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                               file=source, field="mesh.edge_element_um", value=ee,
                               expected=f"one of {le / 2:.4g}, {le / 4:.4g}, {le / 8:.4g} um "
                               f"(element_size_um / 2, 4, 8)")
-        if cfg.solver.rezone_interval > 0:
-            raise ConfigError("rezoning needs the uniform structured mesh", file=source,
-                              field="solver.rezone_interval",
-                              value=cfg.solver.rezone_interval,
-                              expected="0 with mesh.edge_element_um")
-    ale = cfg.solver.edge_ale_interval
-    if ale > 0:
-        if cfg.mesh.separation != "node_split":
-            raise ConfigError("the ploughed-layer ALE needs node splitting", file=source,
-                              field="solver.edge_ale_interval", value=ale,
-                              expected='0, or mesh.separation = "node_split"')
-        if cfg.solver.rezone_interval > 0:
-            raise ConfigError("chip rezoning and the ploughed-layer ALE exclude each other",
-                              file=source, field="solver.edge_ale_interval", value=ale,
-                              expected="0 when solver.rezone_interval > 0")
-        if cfg.solver.element == "q4_bbar":
-            raise ConfigError("the ploughed-layer ALE does not remap the Gauss-point state "
-                              "of the B-bar element", file=source,
-                              field="solver.edge_ale_interval", value=ale,
-                              expected='0 with solver.element = "q4_bbar", or element "q4r"')
-    if cfg.solver.element == "q4_bbar" and cfg.solver.rezone_interval > 0:
-        raise ConfigError("rezoning does not remap the Gauss-point state of the B-bar "
-                          "element", file=source, field="solver.rezone_interval",
-                          value=cfg.solver.rezone_interval,
-                          expected='0 with solver.element = "q4_bbar", or element "q4r"')
     return cfg
 
 
@@ -517,15 +478,10 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
             raise ConfigError("tool-frame domain too small", file=source,
                               field=f"mesh.{name}", value=val,
                               expected=f"at least {what} ({low:.4g} um)")
-    s = cfg.solver
-    for name, bad, want in (("rezone_interval", s.rezone_interval > 0, "0"),
-                            ("edge_ale_interval", s.edge_ale_interval > 0, "0"),
-                            ("element", s.element != "q4r", '"q4r"'),
-                            ("erosion", s.erosion == "everywhere", '"layer" or "none"')):
-        if bad:
-            raise ConfigError("not available with the tool-frame mesh", file=source,
-                              field=f"solver.{name}", value=getattr(s, name),
-                              expected=f'{want} with mesh.frame = "tool"')
+    if cfg.solver.element != "q4r":
+        raise ConfigError("not available with the tool-frame mesh", file=source,
+                          field="solver.element", value=cfg.solver.element,
+                          expected='"q4r" with mesh.frame = "tool"')
     return cfg
 
 

@@ -70,7 +70,6 @@ class FEState:
     hist: np.ndarray
     enbr: np.ndarray = field(default=None)  # type: ignore[assignment]
     snodes: np.ndarray = field(default=None)  # type: ignore[assignment]
-    snbr: np.ndarray = field(default=None)  # type: ignore[assignment]
     xn: np.ndarray = field(default=None)  # type: ignore[assignment]
     yn: np.ndarray = field(default=None)  # type: ignore[assignment]
     buf: np.ndarray = field(default=None)  # type: ignore[assignment]
@@ -89,7 +88,7 @@ class FEState:
     fheat: np.ndarray = field(default=None)  # type: ignore[assignment]
     tcq: np.ndarray = field(default=None)  # type: ignore[assignment]
     ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
-    #: rezoning: velocity increments of the moved nodes (n_nodes, 2), scratch
+    #: tool-frame ALE: velocity increments of the moved nodes (n_nodes, 2), scratch
     vbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: tool-frame ALE (``mesh.frame = "tool"``, robobore.cutting.fe.ale.toolframe): node classes
     #: and neighbours (n, 7), node data (n, 6), flux type of each element edge (e, 4); empty
@@ -107,7 +106,7 @@ class FEState:
                 self.area0, self.ie, self.hge, self.fex, self.fey, self.dte, self.plast,
                 self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
-                self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
+                self.hacc, self.hist, self.enbr, self.snodes, self.xn, self.yn,
                 self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
                 self.ppair, self.x0, self.y0, self.vbuf, self.acls, self.aflt, self.bflag,
                 self.vslip)
@@ -196,8 +195,8 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
         en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
         hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
-        enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64),
-        snbr=np.zeros((0, 6), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)),
+        enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64), xn=z(n), yn=z(n),
+        buf=z((ne, N_RZ_FIELDS)),
         twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),

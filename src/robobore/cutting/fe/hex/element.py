@@ -84,7 +84,7 @@ P_COND_EVERY = P_SLIP_TAU + 1
 P_COND_T, P_HC, P_FHEAT, P_TTOOL = P_COND_EVERY + 1, P_COND_EVERY + 2, P_COND_EVERY + 3, \
     P_COND_EVERY + 4
 N_PRM = P_TTOOL + 1
-ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
+ERODE_NONE, ERODE_LAYER = 0, 1
 
 
 def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
@@ -95,8 +95,7 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     ``sd[e]`` (xx, yy, zz, xy, yz, zx) [Pa], pressure, plastic strain, temperature, damage,
     hourglass stresses ``qh[e]`` (4 modes x 3), energies) and writes ``fe[e, 3 I + i]``
     (internal force on corner I along i [N]) and ``dte[e]`` (stable step [s]). Sets
-    ``alive[e]`` to 0 (eroded by damage: everywhere, or only where ``layer[e]`` with
-    ``erosion`` = ERODE_LAYER), -1 (distortion / time-step erosion) or -2 (inverted).
+    ``alive[e]`` to 0 (eroded by damage where ``layer[e]`` with ``erosion`` = ERODE_LAYER), -1 (distortion / time-step erosion) or -2 (inverted).
     Allocates nothing; compiled for the CPU (``hex_element``) and the GPU (``engine/gpu/kernels3d.py``).
     """
     if alive[e] != 1:
@@ -460,7 +459,7 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     fe[e, 21] = V * (fxx * bx7 + txy * by7 + tzx * bz7) + Qx0 * g0_7 + Qx1 * g1_7 + Qx2 * g2_7 + Qx3 * g3_7
     fe[e, 22] = V * (txy * bx7 + fyy * by7 + tyz * bz7) + Qy0 * g0_7 + Qy1 * g1_7 + Qy2 * g2_7 + Qy3 * g3_7
     fe[e, 23] = V * (tzx * bx7 + tyz * by7 + fzz * bz7) + Qz0 * g0_7 + Qz1 * g1_7 + Qz2 * g2_7 + Qz3 * g3_7
-    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+    if dmg[e] >= 1.0 and erosion == ERODE_LAYER and layer[e]:
         alive[e] = 0
 
 

@@ -14,8 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe.ale.rezone import MODE_ROWS, MODE_TOOLFRAME, TF_RIGID
-from robobore.cutting.fe.ale.stencils import row_stencil, smoothing_stencil
+from robobore.cutting.fe.ale.rezone import TF_RIGID
 from robobore.cutting.fe.config.engine_settings import (
     apply_friction_settings,
     apply_solver_settings,
@@ -156,12 +155,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_KX], p[K.P_KY] = ts.stiffness_N_per_m  # type: ignore[misc]
         p[K.P_CX], p[K.P_CY] = ts.damping_N_s_per_m  # type: ignore[misc]
         p[K.P_MX], p[K.P_MY] = ts.mass_kg  # type: ignore[misc]
-    p[K.P_RZ_EVERY] = s.rezone_interval
-    p[K.P_RZ_OMEGA] = s.rezone_relaxation
     p[K.P_RZ_MAXMOVE] = 0.2
-    if s.edge_ale_interval > 0:
-        p[K.P_RZ_EVERY] = s.edge_ale_interval
-        p[K.P_RZ_MODE] = MODE_ROWS
     apply_thermal_settings(p, s, cfg.contact, mat, K)
     if s.separation_gate_um is not None:
         p[K.P_GATE] = s.separation_gate_um * 1e-6
@@ -174,7 +168,6 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_DT_ERODE] = 0.0
         p[K.P_GATE] = -1.0
         p[K.P_RZ_EVERY] = s.ale_interval
-        p[K.P_RZ_MODE] = MODE_TOOLFRAME
         p[K.P_ALE_X0], p[K.P_TCX], p[K.P_TCY] = cx0, cx0, cy0
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p,
                     layer=getattr(mesh, "layer", None), n_samples=s.n_samples,
@@ -182,11 +175,6 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     if tool_frame:
         st.acls, st.aflt, st.bflag = mesh.acls.copy(), mesh.aflt.copy(), mesh.bflag.copy()
         st.snodes = np.where(mesh.acls[:, 0] != TF_RIGID)[0].astype(np.int64)
-        st.snbr = np.zeros((st.snodes.size, 6), np.int64)
-    if s.rezone_interval > 0:
-        st.snodes, st.snbr = smoothing_stencil(mesh)
-    if s.edge_ale_interval > 0:
-        st.snodes, st.snbr = row_stencil(mesh, s.edge_ale_depth_um * 1e-6)
     if ts is not None:
         dt = st.clock[1]
         for i, (k, m) in enumerate(zip(ts.stiffness_N_per_m, ts.mass_kg, strict=True)):  # type: ignore[arg-type]
@@ -209,8 +197,7 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
         from robobore.cutting.fe.engine.gpu.backend2d import check_gpu_supported
         from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
-        check_gpu_supported(cfg.solver.rezone_interval, source, cfg.solver.element,
-                            cfg.solver.edge_ale_interval)
+        check_gpu_supported(cfg.solver.element, source)
         require_gpu()
 
 
