@@ -24,6 +24,7 @@ from pydantic import (
 )
 
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
+from robobore.cutting.fe.engine.layout import MU_TABLE_MAX
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
 from robobore.material.friction import (
@@ -39,8 +40,6 @@ from robobore.material.friction import (
 #: "table": linear interpolation, constant beyond the ends.
 FRICTION_TABLE_VC_M_MIN = np.array([5.0, 7.5, 10.0, 20.0, 30.0, 40.0])
 FRICTION_TABLE_MU = np.array([0.24, 0.22, 0.21, 0.19, 0.18, 0.17])
-#: most points of a friction table (the engine's parameter slots: kernels.MU_TABLE_MAX)
-MU_TABLE_MAX = 8
 
 
 class MaterialSection(Strict):

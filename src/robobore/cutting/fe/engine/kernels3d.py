@@ -58,7 +58,8 @@ from robobore.cutting.fe.engine.kernels import (
     STATUS_NONFINITE,
     STATUS_OK,
 )
-from robobore.cutting.fe.hex.element import (
+from robobore.cutting.fe.hex.element import hex_element
+from robobore.cutting.fe.hex.layout3d import (
     ERODE_LAYER,
     ERODE_NONE,
     N_PRM,
@@ -109,7 +110,6 @@ from robobore.cutting.fe.hex.element import (
     P_TTOOL,
     P_VC,
     P_VF,
-    hex_element,
 )
 from robobore.cutting.fe.hex.scalar3d import (
     FIX_X,
