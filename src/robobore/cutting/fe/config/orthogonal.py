@@ -251,7 +251,8 @@ class MeshSection(Strict):
     #: material flows in ahead of it and out behind the flank and through the chip's top,
     #: no separation criterion and no erosion; see robobore.cutting.fe.ale.toolframe). With
     #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
-    #: round the edge (default element_size_um / 4), and the separation keys are not used
+    #: round the edge (default element_size_um / 4), and the separation keys are an error
+    #: (a key the chosen model has no place for is refused: robobore.cutting.fe.config.spec)
     frame: Literal["workpiece", "tool"] = "tool"
     #: tool frame: chip thickness / h of the pre-shaped chip the run starts from (the
     #: chip's shape then follows from the flow)
@@ -294,7 +295,7 @@ class SolverSection(SolverSettings):
     mass_scaling: float | None = Field(default=None, ge=1.0, le=1e6)
     #: element formulation: "q4r" (one-point quad with Flanagan-Belytschko hourglass
     #: control) or "q4_bbar" (2x2 Gauss points with mean-dilatation B-bar: no hourglass
-    #: modes, about 2x the element cost; the hourglass coefficients are not used)
+    #: modes, about 2x the element cost; the hourglass coefficients are an error with it)
     element: Literal["q4r", "q4_bbar"] = "q4r"
     #: when given, a separation-layer element whose damage reached 1 erodes only once one of
     #: its nodes is within this distance [um] of the tool surface (the material separates
@@ -487,15 +488,18 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
 def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
     """Validate a config dict (as read from TOML); a material file named in it is resolved
     against the config file's folder (robobore.io.paths)."""
+    from robobore.cutting.fe.config.spec import build_spec
     from robobore.io.memory import check_fe2d
     from robobore.material.library import load_material, resolve_material_name
 
     cfg = validate_model(FEConfig, data, source=source or "<config>")
     cfg.material.name = resolve_material_name(cfg.material.name, source)
     # the material is read and checked now, not first when the run starts
-    load_material(cfg.material.name, source=source,
-                  hardening_strain_limit=cfg.material.strain_limit())
+    material = load_material(cfg.material.name, source=source,
+                             hardening_strain_limit=cfg.material.strain_limit())
     cfg = check_config(cfg, source)
+    # the model choices: a key the chosen variants have no place for is an error now
+    build_spec(cfg, material, source)
     check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg
 
