@@ -137,3 +137,48 @@ def test_keys_of_the_chosen_variants_are_accepted():
     p = _spec(parse_config(_base(solver={"erosion": "none"}))).write_prm(
         np.zeros(K.N_PRM), K, 30.0)
     assert p[K.P_EROSION] == K.ERODE_NONE
+
+
+def _boring(**sections):
+    d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
+                 "cut_length_mm": 0.02},
+         "mesh": {"element_size_um": 16.6}, "solver": {}, "contact": {}}
+    for sec, kv in sections.items():
+        d[sec].update(kv)
+    return d
+
+
+def test_the_boring_spec_and_its_slots():
+    from robobore.cutting.fe.config.boring3d import load_boring_config, parse_boring_config
+    from robobore.cutting.fe.config.spec import EdgePathLayer, HexElement, build_boring_spec
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.state3d import default_prm3
+
+    cfg = load_boring_config(EX / "fe_boring_paper.toml")
+    mat = load_material(cfg.material.name, hardening_strain_limit=cfg.material.strain_limit())
+    s = build_boring_spec(cfg, mat, 37.7)
+    assert s.separation == EdgePathLayer() and s.damage_erosion
+    assert s.element == HexElement(0.05, 0.05) and isinstance(s.thermal, Conduction)
+    assert isinstance(s.friction, SlidingSpeedFriction) and s.hardening == HardeningHold(0.6)
+    p = s.write_prm(default_prm3(), K3, 37.7)
+    assert p[K3.P_GATE] == -1.0 and p[K3.P_EROSION] == K3.ERODE_LAYER
+    assert p[K3.P_MUTAB_N] == 6 and p[K3.P_COND_EVERY] == 10
+    ns = parse_boring_config(_boring(mesh={"separation": "node_split", "chip_rows": 4},
+                                     solver={"separation_gate_um": 1.0}))
+    s2 = build_boring_spec(ns, mat, 37.7)
+    assert s2.separation == NodeSplit(height_um=5.0, gate_um=1.0)
+    assert s2.write_prm(default_prm3(), K3, 37.7)[K3.P_GATE] == pytest.approx(1e-6)
+
+
+@pytest.mark.parametrize("sections, field, words", [
+    ({"solver": {"separation_gate_um": 1.0}}, "solver.separation_gate_um", "erosion_layer"),
+    ({"mesh": {"chip_rows": 4}}, "mesh.chip_rows", "no parting line"),
+    ({"solver": {"heat_conduction": False}, "contact": {"friction_heat_fraction": 0.3}},
+     "contact.friction_heat_fraction", "adiabatic"),
+])
+def test_a_boring_key_without_a_place_is_an_error(sections, field, words):
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
+
+    with pytest.raises(ConfigError) as ei:
+        parse_boring_config(_boring(**copy.deepcopy(sections)), "b.toml")
+    assert ei.value.field == field and words in str(ei.value) and "b.toml" in str(ei.value)

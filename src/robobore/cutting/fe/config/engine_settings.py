@@ -1,10 +1,11 @@
 """The config's solver, thermal and friction settings written into an engine's parameter
 vector (shared by the 2D and 3D engines: each passes its kernel module, whose ``P_*``
-indices the settings go to). The model-choice slots are written by the typed model spec
-(:mod:`robobore.cutting.fe.config.spec`): the 2D engine's all by
-:meth:`~robobore.cutting.fe.config.spec.ModelSpec.write_prm`, the friction and heat slots of
-both engines by :func:`~robobore.cutting.fe.config.spec.write_friction` and
-:func:`~robobore.cutting.fe.config.spec.write_thermal`.
+indices the settings go to). The model-choice slots are written by the typed model specs
+(:mod:`robobore.cutting.fe.config.spec`: ``ModelSpec.write_prm`` for the orthogonal model,
+``BoringSpec.write_prm`` for the boring model); :func:`apply_numerics` writes the numerics
+every model uses, and :func:`apply_solver_settings`, :func:`apply_friction_settings`,
+:func:`apply_thermal_settings` the 3D slab cross-check's slots from its 2D config (the last
+two through the spec's ``write_friction`` / ``write_thermal``).
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ def apply_numerics(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
 
 
 def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
-    """The 3D engine's ``[solver]`` settings into ``p`` (returned): :func:`apply_numerics`,
+    """A ``[solver]`` section into the 3D engine's ``p`` (returned): :func:`apply_numerics`,
     the hourglass coefficients, time-step erosion and damage erosion (``kernels``: the
     engine's kernel module, its ``P_*`` indices and ``ERODE_*`` codes)."""
     k = kernels

@@ -498,7 +498,7 @@ def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
     material = load_material(cfg.material.name, source=source,
                              hardening_strain_limit=cfg.material.strain_limit())
     cfg = check_config(cfg, source)
-    # the model choices: a key the chosen variants have no place for is an error now
+    # the model choices: a key the chosen variants have no place for is an error at load
     build_spec(cfg, material, source)
     check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg

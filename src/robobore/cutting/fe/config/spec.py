@@ -38,7 +38,8 @@ __all__ = [
     "ToolFrame", "NodeSplit", "ErosionLayer", "OnePointQuad", "BBarQuad", "WorkpieceFrame",
     "CoulombFriction", "SlidingSpeedFriction", "Adiabatic", "Conduction", "PlainHardening",
     "HardeningHold", "ModelSpec", "build_spec", "friction_spec", "thermal_spec", "write_friction",
-    "write_thermal", "MODEL_KEYS",
+    "write_thermal", "MODEL_KEYS", "HexElement", "EdgePathLayer", "BoringSpec",
+    "build_boring_spec", "BORING_MODEL_KEYS",
 ]
 
 
@@ -99,6 +100,20 @@ class WorkpieceFrame:
     separation: NodeSplit | ErosionLayer
     element: OnePointQuad | BBarQuad
     erode_time_step_fraction: float
+
+
+@dataclass(frozen=True)
+class HexElement:
+    """The 8-node hexahedron of the 3D engine with its hourglass control coefficients."""
+
+    hourglass_viscous: float
+    hourglass_stiffness: float
+
+
+@dataclass(frozen=True)
+class EdgePathLayer:
+    """3D separation by an erosion layer: the elements crossed by the path of the cutting
+    edge."""
 
 
 # --- friction, thermal, hardening
@@ -264,8 +279,9 @@ _VARIANT_TEXT = {
 class _Keys:
     """The keys a config gives (explicitly, in the TOML) and those the spec reads."""
 
-    def __init__(self, cfg: Any) -> None:
+    def __init__(self, cfg: Any, model_keys: tuple[str, ...] = MODEL_KEYS) -> None:
         self.cfg = cfg
+        self.model_keys = model_keys
         self.given = {f"{sec}.{k}" for sec in ("mesh", "solver", "contact")
                       for k in getattr(cfg, sec).model_fields_set}
         self.read: set[str] = set()
@@ -282,7 +298,7 @@ class _Keys:
             self.owner.setdefault(key, variant)
 
     def check(self, source: str | None) -> None:
-        for key in MODEL_KEYS:
+        for key in self.model_keys:
             if key in self.given and key not in self.read:
                 variant = self.owner.get(key)
                 why = _VARIANT_TEXT.get(variant or "", "the chosen model")
@@ -387,3 +403,79 @@ def build_spec(cfg: Any, material: Material, source: str | None = None) -> Model
         else PlainHardening())
     keys.check(source)
     return ModelSpec(frame=frame, friction=friction, thermal=thermal, hardening=hardening)
+
+
+@dataclass(frozen=True)
+class BoringSpec:
+    """The model choices of a 3D boring config: the workpiece frame (the only one of the 3D
+    engine) with its separation -- :class:`NodeSplit` (parting surface, gate) or
+    :class:`EdgePathLayer` --, damage erosion of the layer elements on the edge path (both
+    separations have them) on or off, the hexahedron, time-step erosion, friction, thermal
+    model and hardening."""
+
+    separation: NodeSplit | EdgePathLayer
+    damage_erosion: bool
+    element: HexElement
+    erode_time_step_fraction: float
+    friction: CoulombFriction | SlidingSpeedFriction
+    thermal: Adiabatic | Conduction
+    hardening: PlainHardening | HardeningHold
+
+    def write_prm(self, p: np.ndarray, kernels: Any, vc_m_per_min: float) -> np.ndarray:
+        """Write the model-choice slots of the 3D parameter vector ``p`` (returned);
+        ``kernels`` the 3D kernel module."""
+        k = kernels
+        p[k.P_HGV] = self.element.hourglass_viscous
+        p[k.P_HGS] = self.element.hourglass_stiffness
+        p[k.P_DT_ERODE] = -self.erode_time_step_fraction
+        p[k.P_EROSION] = k.ERODE_LAYER if self.damage_erosion else k.ERODE_NONE
+        sep = self.separation
+        p[k.P_GATE] = sep.gate_um * 1e-6 if isinstance(sep, NodeSplit) else -1.0
+        write_friction(p, self.friction, kernels, vc_m_per_min)
+        write_thermal(p, self.thermal, kernels)
+        return p
+
+
+#: the keys of a 3D boring config that belong to one model variant (see MODEL_KEYS)
+BORING_MODEL_KEYS = (
+    "mesh.separation_height_um", "mesh.chip_rows", "solver.separation_gate_um",
+    "solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
+    "contact.friction_heat_fraction", "contact.tool_temperature_K",
+)
+
+
+def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
+                      source: str | None = None) -> BoringSpec:
+    """The :class:`BoringSpec` of a validated 3D boring config (``material`` as loaded,
+    ``vc_m_per_min`` the cutting speed at the bore wall). Raises ConfigError naming a key the
+    config gives that the chosen variants have no place for (for example
+    ``solver.separation_gate_um`` with ``mesh.separation = "erosion_layer"``)."""
+    keys = _Keys(cfg, BORING_MODEL_KEYS)
+    sep: NodeSplit | EdgePathLayer
+    if cfg.mesh.separation == "node_split":
+        keys.get("mesh.chip_rows")
+        sep = NodeSplit(height_um=float(keys.get("mesh.separation_height_um")),
+                        gate_um=float(keys.get("solver.separation_gate_um")))
+    else:
+        keys.exclude("erosion_layer", "mesh.separation_height_um", "mesh.chip_rows",
+                     "solver.separation_gate_um")
+        sep = EdgePathLayer()
+    if cfg.solver.heat_conduction:
+        for key in ("solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
+                    "contact.friction_heat_fraction", "contact.tool_temperature_K"):
+            keys.get(key)
+    else:
+        keys.exclude("adiabatic", "solver.conduction_interval",
+                     "contact.thermal_conductance_W_per_m2K", "contact.friction_heat_fraction",
+                     "contact.tool_temperature_K")
+    s = cfg.solver
+    limit = material.hardening_strain_limit
+    keys.check(source)
+    return BoringSpec(
+        separation=sep, damage_erosion=s.erosion == "layer",
+        element=HexElement(float(s.hourglass_viscous), float(s.hourglass_stiffness)),
+        erode_time_step_fraction=float(s.erode_time_step_fraction),
+        friction=friction_spec(cfg.contact, vc_m_per_min),
+        thermal=thermal_spec(s, cfg.contact, material),
+        hardening=(HardeningHold(float(limit)) if limit is not None and math.isfinite(limit)
+                   else PlainHardening()))
