@@ -2,10 +2,10 @@
 vector (shared by the 2D and 3D engines: each passes its kernel module, whose ``P_*``
 indices the settings go to). The model-choice slots are written by the typed model specs
 (:mod:`robobore.cutting.fe.config.spec`: ``ModelSpec.write_prm`` for the orthogonal model,
-``BoringSpec.write_prm`` for the boring model); :func:`apply_numerics` writes the numerics
-every model uses, and :func:`apply_solver_settings`, :func:`apply_friction_settings`,
-:func:`apply_thermal_settings` the 3D slab cross-check's slots from its 2D config (the last
-two through the spec's ``write_friction`` / ``write_thermal``).
+``BoringSpec.write_prm`` for the boring model and the 3D slab cross-check);
+:func:`apply_numerics` writes the numerics every model uses; :func:`apply_friction_settings`
+and :func:`apply_thermal_settings` write one section's friction or heat through the spec's
+``write_friction`` / ``write_thermal``.
 """
 
 from __future__ import annotations
@@ -33,19 +33,6 @@ def apply_numerics(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
     p[k.P_BV1] = s.bulk_viscosity_linear
     p[k.P_BV2] = s.bulk_viscosity_quadratic
     p[k.P_DIST] = s.distortion_limit
-    return p
-
-
-def apply_solver_settings(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
-    """A ``[solver]`` section into the 3D engine's ``p`` (returned): :func:`apply_numerics`,
-    the hourglass coefficients, time-step erosion and damage erosion (``kernels``: the
-    engine's kernel module, its ``P_*`` indices and ``ERODE_*`` codes)."""
-    k = kernels
-    apply_numerics(p, s, k)
-    p[k.P_HGV] = s.hourglass_viscous
-    p[k.P_HGS] = s.hourglass_stiffness
-    p[k.P_DT_ERODE] = -s.erode_time_step_fraction
-    p[k.P_EROSION] = {"none": k.ERODE_NONE, "layer": k.ERODE_LAYER}[s.erosion]
     return p
 
 
