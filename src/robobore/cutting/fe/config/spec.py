@@ -61,8 +61,9 @@ class BBarQuad:
 @dataclass(frozen=True)
 class ToolFrame:
     """The tool-frame ALE mesh: moved back to its place in the tool's frame every
-    ``ale_interval`` steps; no separation criterion, no damage or time-step erosion; the
-    one-point quad."""
+    ``ale_interval`` steps; no separation criterion, no damage or time-step erosion (the mesh
+    does not move with the material, and a hole would have no flux rule); the one-point
+    quad."""
 
     ale_interval: int
     element: OnePointQuad
