@@ -75,7 +75,8 @@ def main() -> None:
           f"{os.cpu_count()} CPUs")
     s = _run(cfg, "default model" if args.config == EXAMPLE else "config")
     if args.reference == "workpiece":
-        d = cfg.model_dump(mode="json")
+        # the keys the config gives (a tool-frame key has no place in the workpiece frame)
+        d = cfg.model_dump(mode="json", exclude_unset=True)
         d["mesh"] = {k: v for k, v in d["mesh"].items() if k not in ("edge_element_um",)}
         d["mesh"]["frame"] = "workpiece"
         if cfg.contact._law is not None:  # the same friction law, by its name

@@ -115,10 +115,11 @@ def small3d(n_samples: int = 4000):
     p[K3.P_KX] = p[K3.P_KY] = p[K3.P_KZ] = 1e7
     p[K3.P_CX] = p[K3.P_CY] = p[K3.P_CZ] = 50.0
     p[K3.P_MX] = p[K3.P_MY] = p[K3.P_MZ] = 1e-3
-    p[K3.P_EROSION] = K3.ERODE_ALL
+    p[K3.P_EROSION] = K3.ERODE_LAYER
     p[K3.P_SAMPLE_DT] = 2e-9
+    # every element in the erosion layer: damage erodes anywhere in the box
     return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=n_samples,
-                       tool_tip=(-12e-6, -1.2 * le, 0.0))
+                       layer=np.ones(len(conn), np.bool_), tool_tip=(-12e-6, -1.2 * le, 0.0))
 
 
 def _diff3(a, b) -> dict:

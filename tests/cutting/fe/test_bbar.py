@@ -224,16 +224,13 @@ def test_elastic_bar_period_and_energy_bbar():
     assert t_zero == pytest.approx(T / 2, rel=0.02)
 
 
-def test_bbar_config_and_rezoning_refused():
+def test_bbar_config():
     base = {"tool": {"rake_deg": 15.0, "clearance_deg": 2.0, "edge_radius_um": 20.0},
             "cut": {"uncut_chip_thickness_um": 60.0, "cutting_speed_m_per_min": 30.0,
                     "length_mm": 1.0, "width_mm": 1.0},
             "mesh": {"element_size_um": 10.0, "frame": "workpiece"},
             "solver": {"element": "q4_bbar"}}
     assert parse_config(base).solver.element == "q4_bbar"
-    base["solver"]["rezone_interval"] = 10
-    with pytest.raises(ConfigError, match="rezone_interval"):
-        parse_config(base)
     base["solver"] = {"element": "q8"}
     with pytest.raises(ConfigError, match="solver.element"):
         parse_config(base)

@@ -172,10 +172,10 @@ def test_gpu2d_module_imports_and_reports_cleanly():
             simulate_orthogonal(load_fe_config(EXAMPLE), device="gpu")
 
 
-def test_rezoning_is_refused_on_the_gpu():
-    with pytest.raises(ConfigError, match="solver.rezone_interval"):
-        gpu2d.check_gpu_supported(10)
-    gpu2d.check_gpu_supported(0)
+def test_bbar_is_refused_on_the_gpu():
+    with pytest.raises(ConfigError, match="solver.element"):
+        gpu2d.check_gpu_supported("q4_bbar")
+    gpu2d.check_gpu_supported("q4r")
 
 
 def test_cli_device_gpu_fails_cleanly_without_gpu(tmp_path):
@@ -187,15 +187,15 @@ def test_cli_device_gpu_fails_cleanly_without_gpu(tmp_path):
     assert "Traceback" not in r.output
 
 
-def test_cli_rejects_unknown_device_and_rezoning_on_gpu(tmp_path):
+def test_cli_rejects_unknown_device_and_bbar_on_gpu(tmp_path):
     r = CliRunner().invoke(app, ["fe", "orthogonal", str(EXAMPLE), "--json", "--device", "tpu"])
     assert r.exit_code == 2
     assert "unknown device" in r.output and "tpu" in r.output
-    f = tmp_path / "rz.toml"
-    f.write_text(EXAMPLE.read_text() + "[solver]\nrezone_interval = 50\n")
+    f = tmp_path / "bbar.toml"
+    f.write_text(EXAMPLE.read_text() + '[solver]\nelement = "q4_bbar"\n')
     r = CliRunner().invoke(app, ["fe", "orthogonal", str(f), "--json", "--device", "gpu"])
     assert r.exit_code == 2
-    assert "solver.rezone_interval" in r.output
+    assert "solver.element" in r.output
 
 
 def _simulator_usable() -> bool:

@@ -17,7 +17,6 @@ import pytest
 from robobore.cutting.fe.ale.rezone import (
     BF_OPEN,
     BF_VIRGIN,
-    MODE_TOOLFRAME,
     TF_CHAIN,
     TF_INTERIOR,
     TF_LINE,
@@ -87,10 +86,9 @@ def _pass(st, off):
     tg = (st.prm[K.P_ALE_X0] + off, st.prm[K.P_TCY], st.prm[K.P_NRX], st.prm[K.P_NRY],
           st.prm[K.P_NFX], st.prm[K.P_NFY], st.prm[K.P_R])
     return rezone(st.x, st.y, st.vx, st.vy, st.mass, st.conn, st.alive, st.ptr, st.nel,
-                  st.enbr, st.snodes, st.snbr, st.xn, st.yn, st.buf, st.sdx, st.sdy, st.sdz,
-                  st.sdxy, st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy, st.area0,
-                  rho_s, 0.0, 0.2, MODE_TOOLFRAME, st.tied, st.x0, st.y0, st.vbuf, tg, st.acls,
-                  st.aflt, st.bflag, 293.0, off)
+                  st.enbr, st.snodes, st.xn, st.yn, st.buf, st.sdx, st.sdy, st.sdz, st.sdxy,
+                  st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy, st.area0, rho_s, 0.2,
+                  st.x0, st.y0, st.vbuf, tg, st.acls, st.aflt, st.bflag, 293.0, off)
 
 
 def test_remap_open_boundaries_balance_mass():
@@ -166,8 +164,6 @@ def test_short_tool_frame_cut():
     ({"mesh": {"inflow_length_um": 50.0}}, "mesh.inflow_length_um"),
     ({"mesh": {"back_length_um": 30.0}}, "mesh.back_length_um"),
     ({"solver": {"element": "q4_bbar"}}, "solver.element"),
-    ({"solver": {"rezone_interval": 10}}, "solver.rezone_interval"),
-    ({"solver": {"erosion": "everywhere"}}, "solver.erosion"),
 ])
 def test_tool_frame_config_errors(patch, field):
     d = {"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
@@ -207,7 +203,7 @@ def test_example_config_builds():
     cfg = load_fe_config(Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml")
     su = setup_orthogonal(cfg)
     p = su.state.prm
-    assert int(p[K.P_RZ_MODE]) == MODE_TOOLFRAME and int(p[K.P_RZ_EVERY]) == 10
+    assert int(p[K.P_RZ_EVERY]) == 10 and p[K.P_RZ_MAXMOVE] == 0.2
     assert p[K.P_CDAMP] == 1.0 and int(p[K.P_EROSION]) == K.ERODE_NONE
     assert su.t_contact == 0.0 and su.t_end == pytest.approx(0.3e-3 / 0.5)
     assert su.state.snodes.size == int((su.mesh.acls[:, 0] != TF_RIGID).sum())

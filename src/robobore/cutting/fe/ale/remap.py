@@ -1,4 +1,4 @@
-"""The donor-cell remap of a rezoning pass (:func:`robobore.cutting.fe.ale.rezone.rezone`).
+"""The donor-cell remap of the ALE pass (:func:`robobore.cutting.fe.ale.rezone.rezone`).
 
 First-order conservative (upwind) transport of the element state through the moving element
 edges: for each edge the area swept by its motion carries the state of the element it sweeps

@@ -1,52 +1,37 @@
-"""ALE-type rezoning of the chip: Laplacian node smoothing + first-order donor-cell remap.
+"""The tool-frame ALE pass of the plane-strain engine: node relocation + first-order donor-cell
+remap (:func:`rezone`).
 
-A Lagrangian chip mesh shears without limit in the primary and secondary shear zones
-(elements 10-20 times thinner than wide, stable step collapsing). Every ``interval`` steps
-the interior nodes of the chip layer (not on the free surface, not on the chip underside
-that slides on the rake, not next to an eroded element) are moved a fraction ``omega``
-towards the average of their four structured-grid neighbours (Laplacian smoothing in index
-space, Winslow-like). The element state is then transported through the moving element
-edges by a conservative first-order donor-cell (upwind) remap: for each edge the area swept
-by its motion carries the state of the element it sweeps into (Benson 1992, "Computational
-methods in Lagrangian and Eulerian hydrocodes", CMAME 99, sec. 4.2). Nodal velocities are
-remapped by a first-order Taylor expansion with the mean velocity gradient of the adjacent
-elements. Node moves are limited to ``max_move`` of the local element size so the remap
-Courant number stays below 1.
+Every ``solver.ale_interval`` steps the mesh of the tool-frame model (``mesh.frame = "tool"``,
+:mod:`robobore.cutting.fe.ale.toolframe`) is moved back to its place in the tool's frame
+(:func:`toolframe_targets`): rigid nodes (inflow face, bottom) to their place, surface-chain
+nodes sliding along their surface polyline towards it, chain ends along their outflow line,
+outflow-face nodes between their ends, interior nodes to their place plus a mesh displacement
+interpolated from the boundary's (Jacobi sweeps). Node moves are limited to ``max_move`` of
+the local element size so the remap Courant number stays below 1.
+
+The element state is then transported through the moving element edges by a conservative
+first-order donor-cell (upwind) remap: for each edge the area swept by its motion carries the
+state of the element it sweeps into (Benson 1992, "Computational methods in Lagrangian and
+Eulerian hydrocodes", CMAME 99, sec. 4.2). Nodal velocities are remapped by a first-order
+Taylor expansion with the mean velocity gradient of the adjacent elements.
 
 Remapped element fields: deviatoric stress, pressure, plastic strain, temperature, damage,
 stored hourglass force; element mass (held as the reference area ``area0`` = mass /
-scaled density) is remapped conservatively and the lumped nodal masses recomputed. Only
-edges shared by two live elements carry a flux: what an edge on the outline (or next to an
-eroded element) sweeps as its nodes slide along a curved surface is not mass that enters
-or leaves the model, so mass is conserved exactly and the intensive fields are divided by
-the area their fluxes account for (a uniform field stays uniform).
+scaled density) is remapped conservatively and the lumped nodal masses recomputed. Edges
+shared by two live elements carry a flux; outline edges carry one by their flux type
+(``bflag``: virgin material flows in through the inflow face, material leaves through the
+outflow faces); what any other outline edge sweeps as its nodes slide along a curved surface
+is not mass that enters or leaves the model, and the intensive fields are divided by the area
+their fluxes account for (a uniform field stays uniform).
 
-Two ways of choosing the new node positions share the remap:
-
-* ``MODE_LAPLACE`` (``solver.rezone_interval``, structured uniform mesh): the chip interior
-  is smoothed as above (:func:`smoothing_stencil`).
-* ``MODE_ROWS`` (``solver.edge_ale_interval``, node splitting): the **ploughed layer** --
-  the node rows within ``depth`` under the parting line, which pass under the cutting edge
-  and which a Lagrangian mesh shears until the distortion erosion deletes them -- is made
-  Eulerian in the cutting direction and Lagrangian in depth. Once a column's parting-line
-  pair has been released (the material there has met the edge), its surface node slides
-  along the surface (the polyline through it and its row neighbours) back towards its
-  initial x, by at most ``max_move`` of the shorter row segment
-  per pass; the machined surface (the top row) keeps its shape, the rows under it are
-  spread evenly in depth between it and the layer's bottom row (which stays Lagrangian),
-  and the material flows through the elements (:func:`row_stencil`, :func:`_row_move`).
-
-The remap's scalar passes are in :mod:`robobore.cutting.fe.ale.remap`, the host-side stencils
-(:func:`smoothing_stencil`, :func:`row_stencil`, :func:`edge_neighbours`) in
-:mod:`robobore.cutting.fe.ale.stencils`; this module chooses the new node positions and
-runs the pass (:func:`rezone`).
+The remap's scalar passes are in :mod:`robobore.cutting.fe.ale.remap`, the element neighbours
+across each edge (:func:`edge_neighbours`) in :mod:`robobore.cutting.fe.ale.stencils`.
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.ale.remap import (
@@ -64,17 +49,9 @@ from robobore.cutting.fe.ale.remap import (
     rz_write_py,
     swept_py,
 )
-from robobore.cutting.fe.ale.stencils import (
-    edge_neighbours,
-    row_stencil,
-    smoothing_stencil,
-)
+from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.physics.tool_contact import tool_gap
 
-#: node relocation of a rezoning pass: Laplacian smoothing, sliding along node rows, or the
-#: tool-frame ALE (every node back to its place in the tool's frame, see
-#: :mod:`robobore.cutting.fe.ale.toolframe`)
-MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME = 0, 1, 2
 #: tool-frame node classes (``acls[:, 0]``): interior, rigid (inflow face, bottom), on a
 #: surface chain (free or against the tool), chain end on an outflow line, on an outflow face
 TF_INTERIOR, TF_RIGID, TF_CHAIN, TF_LINE, TF_FACE = 0, 1, 2, 3, 4
@@ -108,94 +85,12 @@ _limit = njit(cache=True, inline="always")(limit_py)
 _off_tool = njit(cache=True, inline="always")(off_tool_py)
 
 
-@njit(cache=True, inline="always")
-def _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg):
-    """MODE_ROWS: move node ``n`` of the ploughed layer back towards its column.
-
-    A node of the machined surface (the parting-line row) slides along the surface (its row
-    line) towards its initial x. A node under it that has a column node at the layer's
-    depth moves towards its initial x and towards its initial share of the column between
-    the surface node and that bottom node (the layer's compression under the edge is spread
-    over all its rows instead of crushing the top one); without one it slides along its
-    row. Each move is at most ``max_move`` of the shortest distance to the node's row and
-    column neighbours.
-
-    A surface node that the slide would put into the tool, or deeper into it than it was --
-    the chord between two surface nodes wrapped round the edge lies inside the tool -- is
-    put back along the tool normal to the tool surface (or to its old penetration), so the
-    pass adds no penalty energy. ``tg`` = tool edge centre x, y, rake and flank normals,
-    edge radius.
-    """
-    lft, rgt, pc, bt = snbr[k, 0], snbr[k, 1], snbr[k, 2], snbr[k, 3]
-    if tied[pc] != 0:
-        return
-    hl = np.sqrt((x[lft] - x[n]) ** 2 + (y[lft] - y[n]) ** 2)
-    hr = np.sqrt((x[rgt] - x[n]) ** 2 + (y[rgt] - y[n]) ** 2)
-    if bt >= 0:
-        up, dn = snbr[k, 4], snbr[k, 5]
-        hv = min(abs(y[up] - y[n]), abs(y[dn] - y[n]))
-        f = (y0[pc] - y0[n]) / (y0[pc] - y0[bt])
-        xn[n], yn[n] = _limit(x[n], y[n], x0[n], y[pc] + f * (y[bt] - y[pc]),
-                              max_move * min(min(hl, hr), hv))
-        return
-    lim = max_move * min(hl, hr)
-    dx = x0[n] - x[n]
-    if dx > lim:
-        dx = lim
-    elif dx < -lim:
-        dx = -lim
-    if dx > 0.0:
-        run = x[rgt] - x[n]
-        if run <= 0.1 * hr:  # row folded back or too steep: leave the node
-            return
-        dy = dx * (y[rgt] - y[n]) / run
-    elif dx < 0.0:
-        run = x[lft] - x[n]
-        if run >= -0.1 * hl:
-            return
-        dy = dx * (y[lft] - y[n]) / run
-    else:
-        return
-    px = x[n] + dx
-    py = y[n] + dy
-    if pc == n:
-        px, py = _off_tool(x[n], y[n], px, py, tg)
-    xn[n] = px
-    yn[n] = py
-
-
-@njit(parallel=True, cache=True)
-def _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode, tied, x0,
-              y0, tg):
-    """MODE_LAPLACE / MODE_ROWS: new positions of the nodes ``snodes`` whose elements are all
-    alive (Laplacian smoothing with relaxation ``omega``, or :func:`_row_move`)."""
-    for k in prange(snodes.shape[0]):
-        n = snodes[k]
-        ok = True
-        for q in range(ptr[n], ptr[n + 1]):
-            if alive[nel[q]] != 1:
-                ok = False
-        if not ok:
-            continue
-        if mode == MODE_ROWS:
-            _row_move(k, n, x, y, xn, yn, snbr, tied, x0, y0, max_move, tg)
-            continue
-        ax = 0.25 * (x[snbr[k, 0]] + x[snbr[k, 1]] + x[snbr[k, 2]] + x[snbr[k, 3]])
-        ay = 0.25 * (y[snbr[k, 0]] + y[snbr[k, 1]] + y[snbr[k, 2]] + y[snbr[k, 3]])
-        # limit by the local size (mean distance to the neighbours)
-        h = 0.0
-        for j in range(4):
-            h += np.sqrt((x[snbr[k, j]] - x[n]) ** 2 + (y[snbr[k, j]] - y[n]) ** 2)
-        xn[n], yn[n] = _limit(x[n], y[n], x[n] + omega * (ax - x[n]),
-                              y[n] + omega * (ay - y[n]), max_move * 0.25 * h)
-
-
 # -- the tool-frame and remap passes as scalar functions (one node or element each), called
 # -- by the CPU's prange loops below and by the GPU kernels
 # (robobore.cutting.fe.engine.gpu.backend2d)
 
 def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
-    """MODE_TOOLFRAME, first pass, node ``n``: the new place of a rigid node, a surface-chain
+    """first pass, node ``n``: the new place of a rigid node, a surface-chain
     node or a chain end on an outflow line into ``xn[n]``, ``yn[n]`` (other classes: left
     as they are). Reads the old positions only."""
     c = acls[n, 0]
@@ -264,7 +159,7 @@ def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
 
 
 def tf_face_py(n, xn, yn, x0, y0, acls, aflt, off):
-    """MODE_TOOLFRAME, second pass, node ``n`` (after :func:`tf_place_py` of every node):
+    """second pass, node ``n`` (after :func:`tf_place_py` of every node):
     an outflow-face node spread between its two (placed) ends; then, for every node but an
     interior one, its mesh displacement (the boundary values of the interpolation)."""
     c = acls[n, 0]
@@ -302,7 +197,7 @@ def tf_sweep_copy_py(n, acls, aflt, scratch):
 
 
 def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
-    """MODE_TOOLFRAME, last pass, interior node ``n``: its place in the tool frame plus the
+    """last pass, interior node ``n``: its place in the tool frame plus the
     interpolated mesh displacement, the move limited to ``max_move`` of its local size."""
     if acls[n, 0] == TF_INTERIOR:
         tx, ty = _limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
@@ -320,7 +215,7 @@ tf_interior = njit(cache=True, inline="always")(tf_interior_py)
 
 @njit(parallel=True, cache=True)
 def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scratch):
-    """MODE_TOOLFRAME: new node positions ``xn``, ``yn`` (see
+    """New node positions ``xn``, ``yn`` (see
     :mod:`robobore.cutting.fe.ale.toolframe`). ``x0``, ``y0`` are the nodes' places in the tool
     frame at the start (the tool's edge centre then at x = its current x - ``off``);
     ``acls``/``aflt`` the classes, neighbours, face fractions, line directions, local sizes
@@ -348,23 +243,21 @@ def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scrat
 
 
 @njit(parallel=True, cache=True)
-def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
-           sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s, omega,
-           max_move, mode, tied, x0, y0, vbuf, tg, acls, aflt, bflag, t_room, off):
-    """One relocation + remap pass (see module docstring). ``mode``: MODE_LAPLACE (``omega``
-    the relaxation) or MODE_ROWS (``tied``, ``x0``, ``y0``: pair state and initial
-    positions of the nodes).
-    ``xn``, ``yn`` (n_nodes,) and ``buf`` (n_elem, N_RZ_FIELDS) are work arrays. Returns
-    the number of nodes moved. ``vbuf`` (n_nodes, 2) is scratch for the velocity
-    increments (all computed from the old velocities before any is applied); ``tg`` the
-    tool geometry for MODE_ROWS and MODE_TOOLFRAME (see :func:`_row_move`).
+def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx, sdy,
+           sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s, max_move, x0, y0, vbuf,
+           tg, acls, aflt, bflag, t_room, off):
+    """One tool-frame ALE pass: relocation + remap (see module docstring).
 
-    MODE_TOOLFRAME (:func:`toolframe_targets`): ``acls``, ``aflt`` the node classes and data,
-    ``off`` the tool's x travel since the start [m]; ``snodes`` are the nodes whose velocity
-    is remapped (all but the rigid ones). ``bflag`` (n_elem, 4), any mode with
-    ``bflag.shape[0] > 0``: flux type of each outline edge (BF_*): virgin material at
+    ``acls``, ``aflt`` the node classes and data (:func:`toolframe_targets`), ``x0``, ``y0``
+    the nodes' places in the tool frame at the start, ``off`` the tool's x travel since the
+    start [m], ``tg`` the tool geometry (tool edge centre x, y, rake and flank normals, edge
+    radius); ``snodes`` are the nodes whose velocity is remapped (all but the rigid ones).
+    ``bflag`` (n_elem, 4): flux type of each outline edge (BF_*): virgin material at
     ``t_room`` [K] flows in through BF_VIRGIN edges, material leaves through BF_VIRGIN and
     BF_OPEN edges (and comes back through BF_OPEN ones with the element's own state).
+    ``xn``, ``yn`` (n_nodes,) and ``buf`` (n_elem, N_RZ_FIELDS) are work arrays, ``vbuf``
+    (n_nodes, 2) scratch for the velocity increments (all computed from the old velocities
+    before any is applied). Returns the number of nodes moved.
 
     The passes are the scalar functions :func:`rz_flux_py`, :func:`rz_velocity_py`,
     :func:`rz_write_py` and :func:`rz_node_mass_py` (and the tool-frame ones), which the
@@ -375,11 +268,7 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
         xn[n] = x[n]
         yn[n] = y[n]
     # 1. new positions of movable nodes
-    if mode == MODE_TOOLFRAME:
-        toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, vbuf)
-    else:
-        _relocate(x, y, xn, yn, alive, ptr, nel, snodes, snbr, omega, max_move, mode, tied,
-                  x0, y0, tg)
+    toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, vbuf)
     # 2. element fluxes into buf (old geometry x, y -> new geometry xn, yn)
     for e in prange(ne):
         rz_flux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
@@ -404,9 +293,6 @@ def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn
 
 
 __all__ = [
-    "MODE_LAPLACE",
-    "MODE_ROWS",
-    "MODE_TOOLFRAME",
     "TF_INTERIOR",
     "TF_RIGID",
     "TF_CHAIN",
@@ -427,8 +313,6 @@ __all__ = [
     "tf_interior",
     "toolframe_targets",
     "rezone",
-    "smoothing_stencil",
-    "row_stencil",
     "edge_neighbours",
     "N_RZ_FIELDS",
     "BF_CLOSED",

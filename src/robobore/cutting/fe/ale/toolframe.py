@@ -18,7 +18,7 @@ inflow/outflow boundaries, Lagrangian free surfaces, a pre-shaped chip).
 
 The time step is the engine's Lagrangian step (workpiece frame: the tool moves at -vc, the
 workpiece far below is fixed). Every ``solver.ale_interval`` steps
-:func:`robobore.cutting.fe.ale.rezone.rezone` (``MODE_TOOLFRAME``) moves every node back to its
+:func:`robobore.cutting.fe.ale.rezone.rezone` moves every node back to its
 place in the tool's frame and remaps the element state (donor cell) and the nodal velocities:
 
 * inflow face and bottom (``TF_RIGID``): fixed in the workpiece (v = 0), carried with the

@@ -6,6 +6,7 @@ expected range). The options are documented in ``docs/fe3d.md``.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, Literal
 
@@ -184,7 +185,9 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
     """Validate a config dict (from TOML) and the cross-field rules."""
     cfg = validate_model(BoringFEConfig, data, source=source)
     cfg.material.name = resolve_material_name(cfg.material.name, source)  # config-relative
-    load_material(cfg.material.name, source=source)  # read and checked at load, not at run
+    # read and checked at load, not at run
+    mat = load_material(cfg.material.name, source=source,
+                        hardening_strain_limit=cfg.material.strain_limit())
     ap_um = cfg.cut.depth_of_cut_mm * 1e3
     le = cfg.mesh.element_size_um
     if le > ap_um / 3.0 + 1e-9:
@@ -200,8 +203,12 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
                           field="cut.bore_diameter_mm", value=cfg.cut.bore_diameter_mm,
                           expected=f">= 20 x cut.cut_length_mm = "
                           f"{20 * cfg.cut.cut_length_mm:g} mm")
+    from robobore.cutting.fe.config.spec import build_boring_spec
     from robobore.io.memory import check_fe3d
 
+    # the model choices: a key the chosen variants have no place for is an error at load
+    vc_m_per_min = math.pi * cfg.cut.bore_diameter_mm * 1e-3 * cfg.cut.speed_rpm
+    build_boring_spec(cfg, mat, vc_m_per_min, source)
     check_fe3d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg
 

@@ -24,6 +24,7 @@ from pydantic import (
 )
 
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
+from robobore.cutting.fe.engine.layout import MU_TABLE_MAX
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
 from robobore.material.friction import (
@@ -39,8 +40,6 @@ from robobore.material.friction import (
 #: "table": linear interpolation, constant beyond the ends.
 FRICTION_TABLE_VC_M_MIN = np.array([5.0, 7.5, 10.0, 20.0, 30.0, 40.0])
 FRICTION_TABLE_MU = np.array([0.24, 0.22, 0.21, 0.19, 0.18, 0.17])
-#: most points of a friction table (the engine's parameter slots: kernels.MU_TABLE_MAX)
-MU_TABLE_MAX = 8
 
 
 class MaterialSection(Strict):
@@ -252,7 +251,8 @@ class MeshSection(Strict):
     #: material flows in ahead of it and out behind the flank and through the chip's top,
     #: no separation criterion and no erosion; see robobore.cutting.fe.ale.toolframe). With
     #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
-    #: round the edge (default element_size_um / 4), and the separation keys are not used
+    #: round the edge (default element_size_um / 4), and the separation keys are an error
+    #: (a key the chosen model has no place for is refused: robobore.cutting.fe.config.spec)
     frame: Literal["workpiece", "tool"] = "tool"
     #: tool frame: chip thickness / h of the pre-shaped chip the run starts from (the
     #: chip's shape then follows from the flow)
@@ -295,26 +295,12 @@ class SolverSection(SolverSettings):
     mass_scaling: float | None = Field(default=None, ge=1.0, le=1e6)
     #: element formulation: "q4r" (one-point quad with Flanagan-Belytschko hourglass
     #: control) or "q4_bbar" (2x2 Gauss points with mean-dilatation B-bar: no hourglass
-    #: modes, about 2x the element cost; the hourglass coefficients are not used)
+    #: modes, about 2x the element cost; the hourglass coefficients are an error with it)
     element: Literal["q4r", "q4_bbar"] = "q4r"
     #: when given, a separation-layer element whose damage reached 1 erodes only once one of
     #: its nodes is within this distance [um] of the tool surface (the material separates
     #: at the cutting edge, not ahead of it); None: erode wherever the damage reaches 1
     separation_gate_um: float | None = Field(default=None, ge=0.0)
-    #: steps between chip rezoning passes (Laplacian smoothing + donor-cell remap of the
-    #: chip layer, see robobore.cutting.fe.ale.rezone); 0 = pure Lagrangian
-    rezone_interval: int = Field(default=0, ge=0, le=10**6)
-    #: relaxation of each smoothing pass (fraction of the move towards the neighbour mean)
-    rezone_relaxation: float = Field(default=0.3, gt=0.0, le=1.0)
-    #: steps between ALE passes of the ploughed layer (node splitting only): the node rows
-    #: within ``edge_ale_depth_um`` under the parting line, once their column's pair has
-    #: been released at the edge, slide along their rows back towards their initial x
-    #: (Eulerian in the cutting direction, Lagrangian in depth) and the element state is
-    #: remapped (donor cell, see robobore.cutting.fe.ale.rezone); 0 = off (pure Lagrangian)
-    edge_ale_interval: int = Field(default=0, ge=0, le=10**6)
-    #: depth [um] of the ploughed layer under the parting line that edge_ale_interval
-    #: treats (rows strictly above this depth move; default: the edge band's lower part)
-    edge_ale_depth_um: float = Field(default=10.0, gt=0.0)
     #: tool frame (mesh.frame = "tool"): steps between the passes that move the mesh back
     #: to its place in the tool's frame and remap the element state and node velocities
     ale_interval: int = Field(default=10, ge=1, le=10**4)
@@ -454,31 +440,6 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                               file=source, field="mesh.edge_element_um", value=ee,
                               expected=f"one of {le / 2:.4g}, {le / 4:.4g}, {le / 8:.4g} um "
                               f"(element_size_um / 2, 4, 8)")
-        if cfg.solver.rezone_interval > 0:
-            raise ConfigError("rezoning needs the uniform structured mesh", file=source,
-                              field="solver.rezone_interval",
-                              value=cfg.solver.rezone_interval,
-                              expected="0 with mesh.edge_element_um")
-    ale = cfg.solver.edge_ale_interval
-    if ale > 0:
-        if cfg.mesh.separation != "node_split":
-            raise ConfigError("the ploughed-layer ALE needs node splitting", file=source,
-                              field="solver.edge_ale_interval", value=ale,
-                              expected='0, or mesh.separation = "node_split"')
-        if cfg.solver.rezone_interval > 0:
-            raise ConfigError("chip rezoning and the ploughed-layer ALE exclude each other",
-                              file=source, field="solver.edge_ale_interval", value=ale,
-                              expected="0 when solver.rezone_interval > 0")
-        if cfg.solver.element == "q4_bbar":
-            raise ConfigError("the ploughed-layer ALE does not remap the Gauss-point state "
-                              "of the B-bar element", file=source,
-                              field="solver.edge_ale_interval", value=ale,
-                              expected='0 with solver.element = "q4_bbar", or element "q4r"')
-    if cfg.solver.element == "q4_bbar" and cfg.solver.rezone_interval > 0:
-        raise ConfigError("rezoning does not remap the Gauss-point state of the B-bar "
-                          "element", file=source, field="solver.rezone_interval",
-                          value=cfg.solver.rezone_interval,
-                          expected='0 with solver.element = "q4_bbar", or element "q4r"')
     return cfg
 
 
@@ -517,30 +478,26 @@ def _check_tool_frame(cfg: FEConfig, source: str | None) -> FEConfig:
             raise ConfigError("tool-frame domain too small", file=source,
                               field=f"mesh.{name}", value=val,
                               expected=f"at least {what} ({low:.4g} um)")
-    s = cfg.solver
-    for name, bad, want in (("rezone_interval", s.rezone_interval > 0, "0"),
-                            ("edge_ale_interval", s.edge_ale_interval > 0, "0"),
-                            ("element", s.element != "q4r", '"q4r"'),
-                            ("erosion", s.erosion == "everywhere", '"layer" or "none"')):
-        if bad:
-            raise ConfigError("not available with the tool-frame mesh", file=source,
-                              field=f"solver.{name}", value=getattr(s, name),
-                              expected=f'{want} with mesh.frame = "tool"')
+    # solver.element, the separation and erosion keys: no place in the tool frame's spec
+    # (config.spec.build_spec)
     return cfg
 
 
 def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
     """Validate a config dict (as read from TOML); a material file named in it is resolved
     against the config file's folder (robobore.io.paths)."""
+    from robobore.cutting.fe.config.spec import build_spec
     from robobore.io.memory import check_fe2d
     from robobore.material.library import load_material, resolve_material_name
 
     cfg = validate_model(FEConfig, data, source=source or "<config>")
     cfg.material.name = resolve_material_name(cfg.material.name, source)
     # the material is read and checked now, not first when the run starts
-    load_material(cfg.material.name, source=source,
-                  hardening_strain_limit=cfg.material.strain_limit())
+    material = load_material(cfg.material.name, source=source,
+                             hardening_strain_limit=cfg.material.strain_limit())
     cfg = check_config(cfg, source)
+    # the model choices: a key the chosen variants have no place for is an error at load
+    build_spec(cfg, material, source)
     check_fe2d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg
 

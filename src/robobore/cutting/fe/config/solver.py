@@ -33,8 +33,8 @@ class SolverSettings(Strict):
     bulk_viscosity_linear: float = Field(default=0.06, ge=0.0, le=1.0)
     bulk_viscosity_quadratic: float = Field(default=1.2, ge=0.0, le=4.0)
     #: where elements erode when their Johnson-Cook damage reaches 1: "layer" (the
-    #: separation layer along the path of the cutting edge), "everywhere", or "none"
-    erosion: Literal["layer", "everywhere", "none"] = "layer"
+    #: separation layer along the path of the cutting edge) or "none"
+    erosion: Literal["layer", "none"] = "layer"
     #: erode an element whose area (2D) or volume (3D) ratio to its initial one, or whose
     #: corner Jacobian, falls below this (numerical safety against inverted elements;
     #: counted and reported separately); 0 disables

@@ -1,5 +1,5 @@
 """The compiled time-step loop of the plane-strain engine (:func:`run_chunk`): element,
-node and tool updates, heat passes and rezoning, a chunk of steps at a time; each step ends
+node and tool updates, heat passes and the ALE pass, a chunk of steps at a time; each step ends
 with the engines' shared end of step (:mod:`robobore.cutting.fe.engine.history`: stop conditions,
 time-averaged histories, history samples with the energy totals), bound here to the 2D
 layout (:data:`ENGINE2`, :func:`tool_columns_py`, :data:`sum_energies_py`).
@@ -32,8 +32,6 @@ from robobore.cutting.fe.engine.layout import (
     P_NRY,
     P_RZ_EVERY,
     P_RZ_MAXMOVE,
-    P_RZ_MODE,
-    P_RZ_OMEGA,
     P_SAMPLE_DT,
     P_TCX,
     P_TEND,
@@ -91,7 +89,7 @@ _end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), njit(sum_energie
 def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
               sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
               dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
-              en, ist, clock, hacc, hist, enbr, snodes, snbr, xn, yn, buf, twin, tied, tbuf,
+              en, ist, clock, hacc, hist, enbr, snodes, xn, yn, buf, twin, tied, tbuf,
               gps, fheat, tcq, ppair, x0, y0, vbuf, acls, aflt, bflag, vslip):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
 
@@ -119,11 +117,10 @@ def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer
                       fsplit)
         en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
         if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
-            rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, snbr, xn, yn, buf,
-                   sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
-                   prm[P_RZ_OMEGA], prm[P_RZ_MAXMOVE], int(prm[P_RZ_MODE]), tied, x0, y0,
-                   vbuf, tool_geometry(prm), acls, aflt, bflag, mat[jc.TROOM],
-                   prm[P_TCX] - prm[P_ALE_X0])
+            rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx,
+                   sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
+                   prm[P_RZ_MAXMOVE], x0, y0, vbuf, tool_geometry(prm), acls, aflt, bflag,
+                   mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
         if bbar:
             dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
                                              sdxy, pres, eps_p, temp, dmg, gps, area0, ie, fex,

@@ -58,8 +58,8 @@ from robobore.cutting.fe.engine.kernels import (
     STATUS_NONFINITE,
     STATUS_OK,
 )
-from robobore.cutting.fe.hex.element import (
-    ERODE_ALL,
+from robobore.cutting.fe.hex.element import hex_element
+from robobore.cutting.fe.hex.layout3d import (
     ERODE_LAYER,
     ERODE_NONE,
     N_PRM,
@@ -110,7 +110,6 @@ from robobore.cutting.fe.hex.element import (
     P_TTOOL,
     P_VC,
     P_VF,
-    hex_element,
 )
 from robobore.cutting.fe.hex.scalar3d import (
     FIX_X,
@@ -176,7 +175,7 @@ __all__ = [
     "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR", "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF",
     "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY", "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY",
     "P_MZ", "P_THETA0", "P_SAMPLE_DT", "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER",
-    "ERODE_ALL", "N_EN", "N_IST", "STATUS_OK", "P_COND_EVERY", "P_COND_T", "P_HC", "P_FHEAT",
+    "N_EN", "N_IST", "STATUS_OK", "P_COND_EVERY", "P_COND_T", "P_HC", "P_FHEAT",
     "P_TTOOL", "is_conduction_step_py", "conduction_pass3", "insert_gap3_py", "insert_gap3",
     "contact_force3_py", "contact_force3", "hex_node_py", "hex_node", "element_update3",
     "node_update3", "run_chunk3", "FIX_X", "FIX_Y", "FIX_Z", "T_GX", "T_GY", "T_GZ", "T_UX",

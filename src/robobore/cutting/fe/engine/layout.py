@@ -1,56 +1,88 @@
 """Index layout of the 2D engine's small state arrays (module constants).
 
-``prm`` float64 parameters (``P_*``), ``tool`` float64 tool state (``T_*``), ``en`` float64
-energy accumulators (``E_*``), ``ist`` int64 counters/status (``I_*``, ``STATUS_*``), ``hist``
-(n_samples, N_HIST) histories (``H_*``, the column order of
+``prm`` float64 parameters (``P_*``: the first slot of each field of the one declaration
+:data:`PRM_FIELDS`, bound as module constants at import), ``tool`` float64 tool state
+(``T_*``), ``en`` float64 energy accumulators (``E_*``), ``ist`` int64 counters/status
+(``I_*``, ``STATUS_*``), ``hist`` (n_samples, N_HIST) histories (``H_*``, the column order of
 :mod:`robobore.cutting.fe.engine.history`); element formulations (``ELEM_*``),
-per-Gauss-point state of the B-bar element (``G_*``), erosion modes (``ERODE_*``).
+per-Gauss-point state of the B-bar element (``G_*``), damage erosion (``ERODE_*``).
 """
 
 from __future__ import annotations
 
-# --- prm indices (float parameters)
-P_CFL, P_MS, P_HGV, P_HGS, P_BV1, P_BV2, P_DIST = 0, 1, 2, 3, 4, 5, 6
-P_MU, P_TAU, P_PEN, P_R = 7, 8, 9, 10
-P_NRX, P_NRY, P_NFX, P_NFY = 11, 12, 13, 14
-P_VC, P_KX, P_KY, P_CX, P_CY, P_MX, P_MY, P_WIDTH = 15, 16, 17, 18, 19, 20, 21, 22
-P_SAMPLE_DT, P_DTMIN, P_TEND, P_EROSION, P_SUPPORT = 23, 24, 25, 26, 27
-P_RZ_EVERY, P_RZ_OMEGA, P_RZ_MAXMOVE, P_DT_ERODE = 28, 29, 30, 31
-#: separation gate [m] (a layer element erodes only with a node within this distance of the
-#: tool surface; < 0: no gate) and the current tool edge centre (set every step)
-P_GATE, P_TCX, P_TCY = 32, 33, 34
-#: heat conduction: steps between conduction updates (0: adiabatic), time accumulated since
-#: the last one [s]
-P_COND_EVERY, P_COND_ACC = 35, 36
-#: element formulation: ELEM_Q4R (one-point quad + hourglass control) or ELEM_Q4BBAR (2x2
-#: Gauss points with mean-dilatation B-bar, no hourglass modes)
-P_ELEM = 37
-#: thermal contact with the tool (heat conduction runs only): interface conductance
-#: [W/(m^2 K)] to a tool held at ``P_TTOOL`` [K], and the fraction of the frictional
-#: dissipation that heats the workpiece (the rest goes into the tool)
-P_HC, P_FHEAT, P_TTOOL = 38, 39, 40
-#: node relocation of the rezoning passes (rezone.MODE_LAPLACE or rezone.MODE_ROWS)
-P_RZ_MODE = 41
-#: tool-frame ALE: the tool edge centre's x at the start [m] (the mesh travels with the tool)
-P_ALE_X0 = 42
-#: viscous contact damping, fraction of the contact spring's critical damping
-P_CDAMP = 43
-#: friction vs sliding velocity (``contact.friction_velocity = "sliding"``): number of table
-#: points (0: the constant ``P_MU``), then MU_TABLE_MAX velocities [m/s] (increasing) and
-#: MU_TABLE_MAX coefficients; each contact node uses the table at its own sliding speed
-P_MUTAB_N = 44
+from robobore.cutting.fe.engine.prm_layout import prm_slots
+
+#: most points of a friction table read at the sliding speed (its ``P_MUTAB_*`` slots)
 MU_TABLE_MAX = 8
-P_MUTAB_V = 45
-P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
-#: time constant [s] of the filter on the sliding speed the friction table is read at
-P_SLIP_TAU = P_MUTAB_MU + MU_TABLE_MAX
-N_PRM = P_SLIP_TAU + 1
+
+#: the parameter vector ``prm`` of the 2D engine: (name, slots, meaning) in slot order; the
+#: module constant of each name is its first slot, ``N_PRM`` the length
+#: (:func:`robobore.cutting.fe.engine.prm_layout.prm_slots`, bound just below)
+PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
+    # time integration and element numerics
+    ("P_CFL", 1, "fraction of the stable time step"),
+    ("P_MS", 1, "mass scaling: density factor of the inertial mass"),
+    ("P_HGV", 1, "Flanagan-Belytschko hourglass coefficient, viscous"),
+    ("P_HGS", 1, "Flanagan-Belytschko hourglass coefficient, stiffness"),
+    ("P_BV1", 1, "bulk viscosity, linear"),
+    ("P_BV2", 1, "bulk viscosity, quadratic"),
+    ("P_DIST", 1, "distortion erosion limit (area ratio, corner Jacobian); 0: off"),
+    # contact and friction
+    ("P_MU", 1, "Coulomb coefficient (constant, or the table at the cutting speed)"),
+    ("P_TAU", 1, "cap on the contact shear stress [Pa]"),
+    ("P_PEN", 1, "penalty factor: normal stiffness = factor * nodal mass / dt^2"),
+    # tool geometry
+    ("P_R", 1, "edge radius [m]"),
+    ("P_NRX", 1, "rake face normal, x"),
+    ("P_NRY", 1, "rake face normal, y"),
+    ("P_NFX", 1, "flank face normal, x"),
+    ("P_NFY", 1, "flank face normal, y"),
+    # tool motion and support
+    ("P_VC", 1, "cutting speed [m/s] (the guide point moves at -vc along x)"),
+    ("P_KX", 1, "support stiffness x [N/m per m of width]"),
+    ("P_KY", 1, "support stiffness y [N/m per m of width]"),
+    ("P_CX", 1, "support damping x [N s/m per m of width]"),
+    ("P_CY", 1, "support damping y [N s/m per m of width]"),
+    ("P_MX", 1, "support mass x [kg per m of width]"),
+    ("P_MY", 1, "support mass y [kg per m of width]"),
+    ("P_WIDTH", 1, "width of cut [m]"),
+    # run control
+    ("P_SAMPLE_DT", 1, "history sample interval [s]"),
+    ("P_DTMIN", 1, "smallest time step before the run stops [s]"),
+    ("P_TEND", 1, "end time [s]"),
+    ("P_EROSION", 1, "damage erosion: ERODE_NONE or ERODE_LAYER"),
+    ("P_SUPPORT", 1, "tool on its support springs (1) or rigid (0)"),
+    # tool-frame ALE
+    ("P_RZ_EVERY", 1, "steps between tool-frame ALE passes (0: none, the workpiece frame)"),
+    ("P_RZ_MAXMOVE", 1, "largest node move of an ALE pass, fraction of the local size"),
+    ("P_DT_ERODE", 1, "time-step erosion: the smallest element step [s] (given as minus "
+                      "the fraction of the initial one until the first step); 0: off"),
+    ("P_GATE", 1, "separation gate [m]: a layer element erodes, a tied pair parts, only "
+                  "within this distance of the tool surface; < 0: no gate"),
+    ("P_TCX", 1, "tool edge centre x [m] (set every step)"),
+    ("P_TCY", 1, "tool edge centre y [m] (set every step)"),
+    # heat
+    ("P_COND_EVERY", 1, "steps between heat-conduction passes (0: adiabatic)"),
+    ("P_COND_ACC", 1, "time accumulated since the last conduction pass [s]"),
+    ("P_ELEM", 1, "element formulation: ELEM_Q4R or ELEM_Q4BBAR"),
+    ("P_HC", 1, "tool interface conductance [W/(m^2 K)] (conduction runs)"),
+    ("P_FHEAT", 1, "fraction of the frictional dissipation that heats the workpiece"),
+    ("P_TTOOL", 1, "tool heat-sink temperature [K]"),
+    ("P_ALE_X0", 1, "tool-frame ALE: the tool edge centre's x at the start [m]"),
+    ("P_CDAMP", 1, "viscous contact damping, fraction of the penalty spring's critical"),
+    # friction read at each node's sliding speed
+    ("P_MUTAB_N", 1, "friction table points (0: the constant P_MU)"),
+    ("P_MUTAB_V", MU_TABLE_MAX, "friction table velocities [m/s], increasing"),
+    ("P_MUTAB_MU", MU_TABLE_MAX, "friction table coefficients"),
+    ("P_SLIP_TAU", 1, "time constant of the filter on the sliding speed [s]"),
+)
+globals().update(prm_slots(PRM_FIELDS))
 ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
 N_GPS = 5
-# erosion modes
-ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
+#: damage erosion: none, or the elements of the separation layer
+ERODE_NONE, ERODE_LAYER = 0, 1
 # --- tool state: guide x, y; displacement u, v; velocity of displacement; force
 T_GX, T_GY, T_UX, T_UY, T_VUX, T_VUY, T_FX, T_FY = 0, 1, 2, 3, 4, 5, 6, 7
 N_TOOL = 8

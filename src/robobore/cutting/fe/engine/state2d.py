@@ -21,59 +21,112 @@ from robobore.material import Material
 
 @dataclass
 class FEState:
-    """All arrays of an explicit model (SI, per unit width). Shapes: nodes (n,), elements (e,)."""
+    """All arrays of an explicit model (SI, per unit width). Shapes: nodes (n,), elements (e,).
 
+    Grouped as declared: mesh, element state, element energies and outputs, contact and node
+    energies, parameters / tool / counters / histories, then the arrays of the ALE pass, node
+    splitting, conduction, the B-bar element and the friction table (empty where the model
+    does not use them). :meth:`kernel_args` lists them in the order of the compiled loop's
+    arguments.
+    """
+
+    # --- mesh: nodes (n,) and elements (e,)
+    #: node positions [m]
     x: np.ndarray
     y: np.ndarray
+    #: node velocities [m/s]
     vx: np.ndarray
     vy: np.ndarray
+    #: lumped nodal mass [kg/m] (mass-scaled density)
     mass: np.ndarray
+    #: node held in x and y (bool)
     fixed: np.ndarray
+    #: node-to-element lists (CSR): the elements of node n are nel[ptr[n]:ptr[n + 1]], the
+    #: node being their corner ncorner[...]
     ptr: np.ndarray
     nel: np.ndarray
     ncorner: np.ndarray
+    #: element corners (e, 4), counter-clockwise
     conn: np.ndarray
+    #: element of the separation (erosion) layer (bool)
     layer: np.ndarray
+    #: element state: 1 alive, 0 eroded by damage, -1 by distortion or time step, -2 inverted
     alive: np.ndarray
+    # --- element state (e,)
+    #: deviatoric stress xx, yy, zz, xy [Pa]
     sdx: np.ndarray
     sdy: np.ndarray
     sdz: np.ndarray
     sdxy: np.ndarray
+    #: pressure [Pa] (stress = deviatoric stress - pressure)
     pres: np.ndarray
+    #: equivalent plastic strain
     eps_p: np.ndarray
+    #: temperature [K]
     temp: np.ndarray
+    #: Johnson-Cook damage (erodes at 1 where allowed)
     dmg: np.ndarray
+    #: stored (co-rotated) hourglass stiffness force, x and y [N/m]
     qhx: np.ndarray
     qhy: np.ndarray
+    #: reference area [m^2] = element mass / (scaled density)
     area0: np.ndarray
+    # --- element energies and outputs (e,)
+    #: internal (stress) work [J/m]
     ie: np.ndarray
+    #: hourglass work [J/m]
     hge: np.ndarray
+    #: internal force on each corner, x and y (e, 4) [N/m]
     fex: np.ndarray
     fey: np.ndarray
+    #: stable time step of the element [s]
     dte: np.ndarray
+    #: plastic work [J/m]
     plast: np.ndarray
+    #: equivalent plastic strain rate of the last step [1/s]
     rate: np.ndarray
+    # --- contact and node energies (n,)
+    #: contact force on the node (from the tool), x and y [N/m]
     cfx: np.ndarray
     cfy: np.ndarray
+    #: frictional dissipation [J/m] (with the contact damping's)
     fric: np.ndarray
+    #: penalty energy stored in the contact spring [J/m]
     pen: np.ndarray
+    #: node without a live element (its kinetic energy then booked in ero_ke)
     ndead: np.ndarray
+    #: kinetic energy of the node when its last element eroded [J/m]
     ero_ke: np.ndarray
+    #: work of the contact force on the node [J/m]
     nwork: np.ndarray
+    # --- parameters, tool, counters and histories (engine.layout)
+    #: material vector (robobore.material.Material.to_array)
     mat: np.ndarray
+    #: parameter vector (engine.layout.PRM_FIELDS; model slots from config.spec)
     prm: np.ndarray
+    #: tool state (T_*)
     tool: np.ndarray
+    #: energy accumulators (E_*) [J/m]
     en: np.ndarray
+    #: counters and status (I_*)
     ist: np.ndarray
+    #: time [s], current step [s], time accumulated in the current sample interval [s]
     clock: np.ndarray
+    #: time-integrated history columns of the current sample interval (N_HIST,)
     hacc: np.ndarray
+    #: history rows (n_samples, N_HIST), engine.history's layout
     hist: np.ndarray
+    # --- ALE, separation, conduction and B-bar arrays
+    #: element across each edge (e, 4), -1 on the outline
     enbr: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: tool-frame ALE: the nodes whose velocity a pass remaps (all but the rigid ones; empty
+    #: for the Lagrangian models)
     snodes: np.ndarray = field(default=None)  # type: ignore[assignment]
-    snbr: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: ALE pass scratch: new node positions (n,), remapped element fields (e, N_RZ_FIELDS)
     xn: np.ndarray = field(default=None)  # type: ignore[assignment]
     yn: np.ndarray = field(default=None)  # type: ignore[assignment]
     buf: np.ndarray = field(default=None)  # type: ignore[assignment]
+    #: initial node positions [m] (the tool-frame places of the ALE, outputs)
     x0: np.ndarray = field(default=None)  # type: ignore[assignment]
     y0: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: node splitting: partner node (-1: none) and whether the pair is still tied
@@ -89,7 +142,7 @@ class FEState:
     fheat: np.ndarray = field(default=None)  # type: ignore[assignment]
     tcq: np.ndarray = field(default=None)  # type: ignore[assignment]
     ppair: np.ndarray = field(default=None)  # type: ignore[assignment]
-    #: rezoning: velocity increments of the moved nodes (n_nodes, 2), scratch
+    #: tool-frame ALE: velocity increments of the moved nodes (n_nodes, 2), scratch
     vbuf: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: tool-frame ALE (``mesh.frame = "tool"``, robobore.cutting.fe.ale.toolframe): node classes
     #: and neighbours (n, 7), node data (n, 6), flux type of each element edge (e, 4); empty
@@ -107,7 +160,7 @@ class FEState:
                 self.area0, self.ie, self.hge, self.fex, self.fey, self.dte, self.plast,
                 self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
-                self.hacc, self.hist, self.enbr, self.snodes, self.snbr, self.xn, self.yn,
+                self.hacc, self.hist, self.enbr, self.snodes, self.xn, self.yn,
                 self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
                 self.ppair, self.x0, self.y0, self.vbuf, self.acls, self.aflt, self.bflag,
                 self.vslip)
@@ -196,8 +249,8 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
         en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
         hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
-        enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64),
-        snbr=np.zeros((0, 6), np.int64), xn=z(n), yn=z(n), buf=z((ne, N_RZ_FIELDS)),
+        enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64), xn=z(n), yn=z(n),
+        buf=z((ne, N_RZ_FIELDS)),
         twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),

@@ -32,6 +32,16 @@ import math
 
 from numba import njit
 
+from robobore.cutting.fe.hex.layout3d import (
+    ERODE_LAYER,
+    P_BV1,
+    P_BV2,
+    P_DIST,
+    P_DT_ERODE,
+    P_HGS,
+    P_HGV,
+    P_MS,
+)
 from robobore.material.johnson_cook import (
     BETA_TQ,
     CP,
@@ -56,36 +66,6 @@ from robobore.material.johnson_cook import C as JC
 from robobore.material.johnson_cook import M as JM
 from robobore.material.johnson_cook import N as JN
 
-# --- prm indices shared with kernels3d (float parameters of a 3D model)
-P_CFL, P_MS, P_HGV, P_HGS, P_BV1, P_BV2, P_DIST, P_DT_ERODE, P_DTMIN = 0, 1, 2, 3, 4, 5, 6, 7, 8
-P_MU, P_TAU, P_PEN = 9, 10, 11
-# insert geometry: nose radius, approach angle, end-edge angle, rake, clearance, edge radius,
-# tan(inclination), insert present (1) or not (0)
-P_RN, P_KAPPA, P_KEND, P_RAKE, P_CLR, P_RE, P_TANI, P_TOOL = 12, 13, 14, 15, 16, 17, 18, 19
-# tool kinematics and support: cutting speed, feed speed, radius of the circle, support on
-P_VC, P_VF, P_RADIUS, P_SUPPORT = 20, 21, 22, 23
-P_KX, P_KY, P_KZ, P_CX, P_CY, P_CZ, P_MX, P_MY, P_MZ = 24, 25, 26, 27, 28, 29, 30, 31, 32
-P_THETA0, P_SAMPLE_DT, P_TEND, P_EROSION = 33, 34, 35, 36
-# node splitting: a tied pair parts within this distance of the insert [m]
-P_GATE = 37
-# friction vs sliding speed (the 2D engine's slots, kernels.P_MUTAB_N ...): number of table
-# points (0: the constant P_MU), MU_TABLE_MAX velocities [m/s], MU_TABLE_MAX coefficients,
-# and the time constant [s] of the filter on each node's sliding speed
-MU_TABLE_MAX = 8
-P_MUTAB_N = 38
-P_MUTAB_V = P_MUTAB_N + 1
-P_MUTAB_MU = P_MUTAB_V + MU_TABLE_MAX
-P_SLIP_TAU = P_MUTAB_MU + MU_TABLE_MAX
-# heat conduction (the 2D engine's model, kernels.P_COND_EVERY ...): steps between
-# conduction passes (0: adiabatic), the time [s] of the last pass, the interface conductance
-# to the insert [W/(m^2 K)], the fraction of the frictional dissipation that heats the
-# workpiece, the insert's temperature [K]
-P_COND_EVERY = P_SLIP_TAU + 1
-P_COND_T, P_HC, P_FHEAT, P_TTOOL = P_COND_EVERY + 1, P_COND_EVERY + 2, P_COND_EVERY + 3, \
-    P_COND_EVERY + 4
-N_PRM = P_TTOOL + 1
-ERODE_NONE, ERODE_LAYER, ERODE_ALL = 0, 1, 2
-
 
 def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
                    ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
@@ -95,8 +75,7 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     ``sd[e]`` (xx, yy, zz, xy, yz, zx) [Pa], pressure, plastic strain, temperature, damage,
     hourglass stresses ``qh[e]`` (4 modes x 3), energies) and writes ``fe[e, 3 I + i]``
     (internal force on corner I along i [N]) and ``dte[e]`` (stable step [s]). Sets
-    ``alive[e]`` to 0 (eroded by damage: everywhere, or only where ``layer[e]`` with
-    ``erosion`` = ERODE_LAYER), -1 (distortion / time-step erosion) or -2 (inverted).
+    ``alive[e]`` to 0 (eroded by damage where ``layer[e]`` with ``erosion`` = ERODE_LAYER), -1 (distortion / time-step erosion) or -2 (inverted).
     Allocates nothing; compiled for the CPU (``hex_element``) and the GPU (``engine/gpu/kernels3d.py``).
     """
     if alive[e] != 1:
@@ -460,7 +439,7 @@ def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, 
     fe[e, 21] = V * (fxx * bx7 + txy * by7 + tzx * bz7) + Qx0 * g0_7 + Qx1 * g1_7 + Qx2 * g2_7 + Qx3 * g3_7
     fe[e, 22] = V * (txy * bx7 + fyy * by7 + tyz * bz7) + Qy0 * g0_7 + Qy1 * g1_7 + Qy2 * g2_7 + Qy3 * g3_7
     fe[e, 23] = V * (tzx * bx7 + tyz * by7 + fzz * bz7) + Qz0 * g0_7 + Qz1 * g1_7 + Qz2 * g2_7 + Qz3 * g3_7
-    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+    if dmg[e] >= 1.0 and erosion == ERODE_LAYER and layer[e]:
         alive[e] = 0
 
 

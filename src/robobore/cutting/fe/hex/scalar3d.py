@@ -28,7 +28,7 @@ import math
 from numba import njit
 
 from robobore.cutting.fe.engine import kernels as _K2
-from robobore.cutting.fe.hex.element import (
+from robobore.cutting.fe.hex.layout3d import (
     MU_TABLE_MAX,
     P_CLR,
     P_COND_EVERY,

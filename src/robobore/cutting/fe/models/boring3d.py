@@ -47,11 +47,8 @@ from robobore.cutting.fe.config.boring3d import (
     load_boring_config,
     parse_boring_config,
 )
-from robobore.cutting.fe.config.engine_settings import (
-    apply_friction_settings,
-    apply_solver_settings,
-    apply_thermal_settings,
-)
+from robobore.cutting.fe.config.engine_settings import apply_numerics
+from robobore.cutting.fe.config.spec import BoringSpec, build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.chunk_driver import energy_check
 from robobore.cutting.fe.engine.state3d import (
@@ -83,6 +80,8 @@ class BoringSetup:
     vc: float
     t_end: float
     t_contact: float
+    #: the model choices the state was built from
+    spec: BoringSpec | None = None
 
 
 def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
@@ -103,9 +102,8 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
                              split_height=cfg.mesh.separation_height_um * 1e-6 if split
                              else None, chip_rows=cfg.mesh.chip_rows)
     s = cfg.solver
-    p = apply_solver_settings(default_prm3(), s, K3)
-    apply_friction_settings(p, cfg.contact, vc * 60.0, K3)
-    p[K3.P_GATE] = cfg.solver.separation_gate_um * 1e-6 if split else -1.0
+    spec = build_boring_spec(cfg, mat, vc * 60.0, source)
+    p = spec.write_prm(apply_numerics(default_prm3(), s, K3), K3, vc * 60.0)
     p[K3.P_PEN] = cfg.contact.penalty_factor
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = ins.nose_radius_m
@@ -118,7 +116,6 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     p[K3.P_VC] = vc
     p[K3.P_VF] = f * n_rps
     p[K3.P_RADIUS] = R
-    apply_thermal_settings(p, s, cfg.contact, mat, K3)
     gap0 = 0.5 * le
     x0 = -(ins.edge_radius_m + gap0)
     t_contact = gap0 / vc
@@ -142,7 +139,7 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
                                   expected=f"k < {0.25 * m / dt**2:.3g} N/m for mass {m} kg "
                                   f"and time step {dt:.3g} s")
     return BoringSetup(cfg=cfg, material=mat, insert=ins, mesh=mesh, state=st, ap=ap, f=f,
-                       vc=vc, t_end=t_end, t_contact=t_contact)
+                       vc=vc, t_end=t_end, t_contact=t_contact, spec=spec)
 
 
 @dataclass

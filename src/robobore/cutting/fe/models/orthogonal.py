@@ -14,14 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe.ale.rezone import MODE_ROWS, MODE_TOOLFRAME, TF_RIGID
-from robobore.cutting.fe.ale.stencils import row_stencil, smoothing_stencil
-from robobore.cutting.fe.config.engine_settings import (
-    apply_friction_settings,
-    apply_solver_settings,
-    apply_thermal_settings,
-)
+from robobore.cutting.fe.ale.rezone import TF_RIGID
+from robobore.cutting.fe.config.engine_settings import apply_numerics
 from robobore.cutting.fe.config.orthogonal import FEConfig
+from robobore.cutting.fe.config.spec import ModelSpec, build_spec
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import (
     advance,
@@ -55,6 +51,8 @@ class CuttingSetup:
     #: tool edge centre x [m] at which the cut length is 0 (the cut position of a sample is
     #: this minus the edge centre's x)
     x_cut_start: float = math.nan
+    #: the model choices the state was built from
+    spec: ModelSpec | None = None
 
 
 def _layer_offset(cfg: FEConfig, le: float) -> float:
@@ -127,8 +125,8 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                           layer_offset=_layer_offset(cfg, le),
                           split_height=_split_height(cfg))
     s = cfg.solver
-    p = apply_solver_settings(default_prm(), s, K)
-    apply_friction_settings(p, cfg.contact, cfg.cut.cutting_speed_m_per_min, K)
+    spec = build_spec(cfg, mat, source)
+    p = spec.write_prm(apply_numerics(default_prm(), s, K), K, cfg.cut.cutting_speed_m_per_min)
     p[K.P_PEN] = cfg.contact.penalty_factor
     nd = cfg.contact.normal_damping
     p[K.P_CDAMP] = (1.0 if cm.frame == "tool" else 0.0) if nd is None else nd
@@ -156,25 +154,8 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_KX], p[K.P_KY] = ts.stiffness_N_per_m  # type: ignore[misc]
         p[K.P_CX], p[K.P_CY] = ts.damping_N_s_per_m  # type: ignore[misc]
         p[K.P_MX], p[K.P_MY] = ts.mass_kg  # type: ignore[misc]
-    p[K.P_RZ_EVERY] = s.rezone_interval
-    p[K.P_RZ_OMEGA] = s.rezone_relaxation
-    p[K.P_RZ_MAXMOVE] = 0.2
-    if s.edge_ale_interval > 0:
-        p[K.P_RZ_EVERY] = s.edge_ale_interval
-        p[K.P_RZ_MODE] = MODE_ROWS
-    apply_thermal_settings(p, s, cfg.contact, mat, K)
-    if s.separation_gate_um is not None:
-        p[K.P_GATE] = s.separation_gate_um * 1e-6
-    elif cfg.mesh.separation == "node_split":
-        p[K.P_GATE] = 0.0  # pairs part when they touch the tool
     if tool_frame:
-        # no separation, no erosion (the mesh does not move with the material, and a hole
-        # would have no flux rule); the ALE pass every solver.ale_interval steps
-        p[K.P_EROSION] = K.ERODE_NONE
-        p[K.P_DT_ERODE] = 0.0
-        p[K.P_GATE] = -1.0
-        p[K.P_RZ_EVERY] = s.ale_interval
-        p[K.P_RZ_MODE] = MODE_TOOLFRAME
+        # the mesh travels with the tool from its start
         p[K.P_ALE_X0], p[K.P_TCX], p[K.P_TCY] = cx0, cx0, cy0
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p,
                     layer=getattr(mesh, "layer", None), n_samples=s.n_samples,
@@ -182,11 +163,6 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     if tool_frame:
         st.acls, st.aflt, st.bflag = mesh.acls.copy(), mesh.aflt.copy(), mesh.bflag.copy()
         st.snodes = np.where(mesh.acls[:, 0] != TF_RIGID)[0].astype(np.int64)
-        st.snbr = np.zeros((st.snodes.size, 6), np.int64)
-    if s.rezone_interval > 0:
-        st.snodes, st.snbr = smoothing_stencil(mesh)
-    if s.edge_ale_interval > 0:
-        st.snodes, st.snbr = row_stencil(mesh, s.edge_ale_depth_um * 1e-6)
     if ts is not None:
         dt = st.clock[1]
         for i, (k, m) in enumerate(zip(ts.stiffness_N_per_m, ts.mass_kg, strict=True)):  # type: ignore[arg-type]
@@ -197,7 +173,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                                   f"mass {m} kg and time step {dt:.3g} s")
     return CuttingSetup(cfg=cfg, material=mat, mesh=mesh, state=st, h=h, vc=vc, rake=rake,
                         t_end=t_end, t_contact=t_contact, mu=float(p[K.P_MU]),
-                        x_cut_start=x_cut_start)
+                        x_cut_start=x_cut_start, spec=spec)
 
 
 def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
@@ -209,8 +185,7 @@ def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
         from robobore.cutting.fe.engine.gpu.backend2d import check_gpu_supported
         from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
-        check_gpu_supported(cfg.solver.rezone_interval, source, cfg.solver.element,
-                            cfg.solver.edge_ale_interval)
+        check_gpu_supported(cfg.solver.element, source)
         require_gpu()
 
 

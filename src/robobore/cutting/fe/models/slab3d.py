@@ -21,11 +21,15 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe.config.engine_settings import (
-    apply_friction_settings,
-    apply_solver_settings,
-    apply_thermal_settings,
+    apply_numerics,
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
+from robobore.cutting.fe.config.spec import (
+    BoringSpec,
+    HexElement,
+    WorkpieceFrame,
+    build_spec,
+)
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.chunk_driver import energy_error
 from robobore.cutting.fe.engine.state3d import (
@@ -89,9 +93,19 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     fixed[idx[-1, :, :].ravel()] = 7
     # parting line: double its nodes (not the fully fixed ones); the chip rows take the copies
     nodes, conn, fixed, twin = split_node_layer(nodes, conn, fixed, idx, n_dn)
-    p = apply_solver_settings(default_prm3(), cfg.solver, K3)
-    apply_friction_settings(p, cfg.contact, cfg.cut.cutting_speed_m_per_min, K3)
-    apply_thermal_settings(p, cfg.solver, cfg.contact, mat, K3)
+    # the 2D config's model choices on the hexahedron (the parting line's gate, friction,
+    # heat, hardening as in 2D)
+    spec2 = build_spec(cfg, mat)
+    frame = spec2.frame
+    assert isinstance(frame, WorkpieceFrame)
+    spec = BoringSpec(separation=frame.separation, damage_erosion=cfg.solver.erosion == "layer",
+                      element=HexElement(cfg.solver.hourglass_viscous,
+                                         cfg.solver.hourglass_stiffness),
+                      erode_time_step_fraction=frame.erode_time_step_fraction,
+                      friction=spec2.friction, thermal=spec2.thermal,
+                      hardening=spec2.hardening)
+    p = spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
+                       cfg.cut.cutting_speed_m_per_min)
     p[K3.P_PEN] = cfg.contact.penalty_factor
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = 1.0
@@ -101,8 +115,6 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     p[K3.P_CLR] = math.radians(cfg.tool.clearance_deg)
     p[K3.P_RE] = re
     p[K3.P_VC] = vc
-    gate = cfg.solver.separation_gate_um
-    p[K3.P_GATE] = 0.0 if gate is None else gate * 1e-6
     gap0 = 0.5 * le
     t_end = (L + re + gap0) / vc
     n_samples = cfg.solver.n_samples

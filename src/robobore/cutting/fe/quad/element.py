@@ -24,7 +24,6 @@ import math
 from numba import njit, prange
 
 from robobore.cutting.fe.engine.layout import (
-    ERODE_ALL,
     ERODE_LAYER,
     P_BV1,
     P_BV2,
@@ -106,11 +105,12 @@ def quad_step_py(rho_s, a0, A, K, G, bsum, trd, bv1, bv2):
 
 
 def damage_erosion_py(e, conn, x, y, alive, layer, dmg, prm, erosion):
-    """Erode quad ``e`` once its Johnson-Cook damage reached 1 (everywhere, or in the
-    separation layer; there optionally only with a node within ``prm[P_GATE]`` of the tool)."""
-    if dmg[e] >= 1.0 and (erosion == ERODE_ALL or (erosion == ERODE_LAYER and layer[e])):
+    """Erode quad ``e`` of the separation layer once its Johnson-Cook damage reached 1
+    (``erosion`` = ERODE_LAYER; optionally only with a node within ``prm[P_GATE]`` of the
+    tool)."""
+    if dmg[e] >= 1.0 and erosion == ERODE_LAYER and layer[e]:
         gate = prm[P_GATE]
-        if gate < 0.0 or not layer[e]:
+        if gate < 0.0:
             alive[e] = 0
         else:
             gmin = 1e30

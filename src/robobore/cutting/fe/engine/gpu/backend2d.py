@@ -32,7 +32,7 @@ checked in the simulator and compiled for sm_90, not timed on a GPU.
 
 The tool-frame ALE model (``mesh.frame = "tool"``) runs here too: every
 ``solver.ale_interval`` steps, after the tool step, the persistent kernel runs the ALE pass of
-:func:`robobore.cutting.fe.ale.rezone.rezone` (``MODE_TOOLFRAME``) from the same scalar functions
+:func:`robobore.cutting.fe.ale.rezone.rezone` from the same scalar functions
 (``tf_place_py``, ``tf_face_py``, the Jacobi sweeps ``tf_sweep_py`` / ``tf_sweep_copy_py``,
 ``tf_interior_py``, the donor-cell remap ``rz_flux_py``, ``rz_velocity_py``, ``rz_write_py``,
 ``rz_node_mass_py``), a grid barrier wherever one pass reads what another wrote (14 per
@@ -49,8 +49,7 @@ this module hands it the 2D state, the kernels and the launch-per-kernel step.
 Kernel parameters: the persistent kernel takes the whole state, 3944 bytes of CUDA's classic
 4096-byte limit (checked by a test with numba's data model).
 
-Not ported: Laplacian rezoning (``solver.rezone_interval`` > 0), the ploughed-layer ALE and
-the B-bar element are refused with a ConfigError.
+Not ported: the B-bar element is refused with a ConfigError.
 """
 
 from __future__ import annotations
@@ -59,7 +58,6 @@ from collections.abc import Callable
 from typing import Any
 
 from robobore.cutting.fe.ale import rezone as RZ
-from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, kernels2
 from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
@@ -71,22 +69,12 @@ _THREADS = 128
 #: the kernels (benchmarks/gpu_compile_check.py compiles them)
 _kernels = kernels2
 
-def check_gpu_supported(rezone_interval: int, source: str | None = None,
-                        element: str = "q4r", edge_ale_interval: int = 0) -> None:
-    """Raise a ConfigError for a setting the GPU engine does not run (rezoning, the
-    ploughed-layer ALE, B-bar)."""
+def check_gpu_supported(element: str, source: str | None = None) -> None:
+    """Raise a ConfigError for a setting the GPU engine does not run (the B-bar element)."""
     if element != "q4r":
         raise ConfigError("the B-bar element is not ported to the GPU", file=source,
                           field="solver.element", value=element,
                           expected='"q4r" with --device gpu, or --device cpu')
-    if rezone_interval > 0:
-        raise ConfigError("rezoning is not available on the GPU", file=source,
-                          field="solver.rezone_interval", value=rezone_interval,
-                          expected="0 (off, the default) with --device gpu, or --device cpu")
-    if edge_ale_interval > 0:
-        raise ConfigError("the ploughed-layer ALE is not available on the GPU", file=source,
-                          field="solver.edge_ale_interval", value=edge_ale_interval,
-                          expected="0 (off, the default) with --device gpu, or --device cpu")
 
 
 #: FEState arrays used by the kernels (copied to the device)
@@ -116,17 +104,13 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     (the whole state when ``check`` is given, before calling it) and the whole state at the
     end. Returns the number of steps taken. Raises NumericalError on instability (same
     messages as the CPU engine) and ConfigError when no GPU is usable or the state asks for
-    rezoning, the ploughed-layer ALE or the B-bar element. ``profile`` and ``persistent``:
+    the B-bar element. ``profile`` and ``persistent``:
     as in :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu` (per-kernel wall times for
     benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
-    every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
-    mode = int(st.prm[K.P_RZ_MODE])
-    # the tool-frame ALE runs here; Laplacian rezoning and the ploughed-layer ALE do not
-    check_gpu_supported(every if mode == MODE_LAPLACE else 0, None,
-                        "q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar",
-                        every if mode == MODE_ROWS else 0)
-    rz_every = every if mode == MODE_TOOLFRAME else 0
+    check_gpu_supported("q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar")
+    # the tool-frame ALE pass every rz_every steps (0: the Lagrangian workpiece frame)
+    rz_every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,

@@ -371,7 +371,7 @@ def kernels2():
             # elements' gated erosion and the ALE pass read (as after k_tool): a barrier
             grid.sync()
             if rz_every > 0 and step % rz_every == 0:
-                # the tool-frame ALE pass (rezone.rezone, MODE_TOOLFRAME): the same passes in
+                # the tool-frame ALE pass (rezone.rezone): the same passes in
                 # the same order, a barrier wherever one reads what another wrote
                 off = prm[P_TCX] - prm[P_ALE_X0]
                 mm = prm[P_RZ_MAXMOVE]

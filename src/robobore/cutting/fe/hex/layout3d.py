@@ -1,0 +1,75 @@
+"""Index layout of the 3D engine's parameter vector ``prm`` (module constants ``P_*``, the
+first slot of each field of the one declaration :data:`PRM_FIELDS`, bound at import;
+``N_PRM`` its length) and the damage-erosion codes ``ERODE_*``; read by the hexahedron
+(:mod:`robobore.cutting.fe.hex.element`), the scalar node and tool functions
+(:mod:`robobore.cutting.fe.hex.scalar3d`) and the 3D loops on both devices.
+"""
+
+from __future__ import annotations
+
+from robobore.cutting.fe.engine.layout import MU_TABLE_MAX
+from robobore.cutting.fe.engine.prm_layout import prm_slots
+
+#: the parameter vector ``prm`` of a 3D model: (name, slots, meaning) in slot order; the
+#: module constant of each name is its first slot, ``N_PRM`` the length
+#: (:func:`robobore.cutting.fe.engine.prm_layout.prm_slots`, bound just below)
+PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
+    # time integration, element numerics, numerical erosion
+    ("P_CFL", 1, "fraction of the stable time step"),
+    ("P_MS", 1, "mass scaling: density factor of the inertial mass"),
+    ("P_HGV", 1, "Flanagan-Belytschko hourglass coefficient, viscous"),
+    ("P_HGS", 1, "Flanagan-Belytschko hourglass coefficient, stiffness"),
+    ("P_BV1", 1, "bulk viscosity, linear"),
+    ("P_BV2", 1, "bulk viscosity, quadratic"),
+    ("P_DIST", 1, "distortion erosion limit (volume ratio, corner Jacobian); 0: off"),
+    ("P_DT_ERODE", 1, "time-step erosion: the smallest element step [s] (given as minus "
+                      "the fraction of the initial one until the first step); 0: off"),
+    ("P_DTMIN", 1, "smallest time step before the run stops [s]"),
+    # contact
+    ("P_MU", 1, "Coulomb coefficient (constant, or the table at the cutting speed)"),
+    ("P_TAU", 1, "cap on the contact shear stress [Pa]"),
+    ("P_PEN", 1, "penalty factor: normal stiffness = factor * nodal mass / dt^2"),
+    # insert geometry
+    ("P_RN", 1, "nose radius [m]"),
+    ("P_KAPPA", 1, "approach angle [rad]"),
+    ("P_KEND", 1, "end-edge angle [rad]"),
+    ("P_RAKE", 1, "rake angle [rad]"),
+    ("P_CLR", 1, "clearance angle [rad]"),
+    ("P_RE", 1, "edge radius [m]"),
+    ("P_TANI", 1, "tan(inclination)"),
+    ("P_TOOL", 1, "insert present (1) or not (0)"),
+    # tool kinematics and support
+    ("P_VC", 1, "cutting speed [m/s]"),
+    ("P_VF", 1, "feed speed [m/s]"),
+    ("P_RADIUS", 1, "radius of the bore [m]"),
+    ("P_SUPPORT", 1, "tool on its support springs (1) or rigid (0)"),
+    ("P_KX", 1, "support stiffness x [N/m]"),
+    ("P_KY", 1, "support stiffness y [N/m]"),
+    ("P_KZ", 1, "support stiffness z [N/m]"),
+    ("P_CX", 1, "support damping x [N s/m]"),
+    ("P_CY", 1, "support damping y [N s/m]"),
+    ("P_CZ", 1, "support damping z [N s/m]"),
+    ("P_MX", 1, "support mass x [kg]"),
+    ("P_MY", 1, "support mass y [kg]"),
+    ("P_MZ", 1, "support mass z [kg]"),
+    # run control
+    ("P_THETA0", 1, "bar angle at the start [rad]"),
+    ("P_SAMPLE_DT", 1, "history sample interval [s]"),
+    ("P_TEND", 1, "end time [s]"),
+    ("P_EROSION", 1, "damage erosion: ERODE_NONE or ERODE_LAYER"),
+    ("P_GATE", 1, "node splitting: a tied pair parts within this distance of the insert [m]"),
+    # friction vs sliding speed (the 2D engine's fields)
+    ("P_MUTAB_N", 1, "friction table points (0: the constant P_MU)"),
+    ("P_MUTAB_V", MU_TABLE_MAX, "friction table velocities [m/s], increasing"),
+    ("P_MUTAB_MU", MU_TABLE_MAX, "friction table coefficients"),
+    ("P_SLIP_TAU", 1, "time constant of the filter on the sliding speed [s]"),
+    # heat conduction (the 2D engine's model)
+    ("P_COND_EVERY", 1, "steps between heat-conduction passes (0: adiabatic)"),
+    ("P_COND_T", 1, "time of the last conduction pass [s]"),
+    ("P_HC", 1, "insert interface conductance [W/(m^2 K)]"),
+    ("P_FHEAT", 1, "fraction of the frictional dissipation that heats the workpiece"),
+    ("P_TTOOL", 1, "insert temperature [K]"),
+)
+globals().update(prm_slots(PRM_FIELDS))
+#: damage erosion: none, or the elements of the separation layer
+ERODE_NONE, ERODE_LAYER = 0, 1
