@@ -61,7 +61,7 @@ from typing import Any
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, kernels2
+from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, kernels2
 from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
 from robobore.errors import ConfigError
 
@@ -89,13 +89,9 @@ def check_gpu_supported(rezone_interval: int, source: str | None = None,
                           expected="0 (off, the default) with --device gpu, or --device cpu")
 
 
-#: FEState arrays used by the kernels (copied to the device)
-_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
-           "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
-           "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
-           "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
-           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair", "vslip",
-           "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
+#: FEState arrays used by the kernels (copied to the device; the persistent kernel's state
+#: tuple, then its scalar settings)
+_ARRAYS = RUN_ARRAYS
 #: the arrays the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "sdx", "sdy", "sdz", "sdxy", "pres",
             "eps_p", "temp", "dmg", "qhx", "qhy", "area0", "ie", "hge", "fex", "fey", "dte",
