@@ -319,9 +319,9 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
     d["mesh"]["element_size_um"] = 20.0
     d["mesh"]["edge_element_um"] = 10.0
     st = setup_orthogonal(parse_config(d)).state
-    # k_run(n_steps, state tuple (the arrays, then erosion, cond_every, theat, rz_every), red,
-    # cflag, clist); a tuple passes as its elements' fields
-    state = tuple(getattr(st, k) for k in gpu2d._ARRAYS) + (0, 0, 0, 0)
+    # k_run(n_steps, state (the arrays, then erosion, cond_every, theat, rz_every), red, cflag,
+    # clist); the state, a namedtuple, passes as its elements' fields
+    state = gpu2d.RunState(*[getattr(st, k) for k in gpu2d._ARRAYS], 0, 0, 0, 0)
     total = (arg(0) + arg(state) + arg(np.zeros(gpu2d.N_RED)) + arg(np.zeros(1, np.int32))
              + arg(np.zeros(1, np.int64)))
     assert arg(state) == sum(arg(v) for v in state)

@@ -61,7 +61,7 @@ from typing import Any
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.ale.rezone import MODE_LAPLACE, MODE_ROWS, MODE_TOOLFRAME
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, kernels2
+from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, RunState, kernels2
 from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
 from robobore.errors import ConfigError
 
@@ -90,7 +90,7 @@ def check_gpu_supported(rezone_interval: int, source: str | None = None,
 
 
 #: FEState arrays used by the kernels (copied to the device; the persistent kernel's state
-#: tuple, then its scalar settings)
+#: RunState holds them, then its scalar settings)
 _ARRAYS = RUN_ARRAYS
 #: the arrays the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "sdx", "sdy", "sdz", "sdxy", "pres",
@@ -183,7 +183,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         tick("finish")
 
     return drive_gpu(st, t_end, names=_ARRAYS, p_tend=K.P_TEND, n_red=N_RED, k_run=k_run,
-                     run_extra=[erosion, cond_every, int(theat), rz_every],
+                     run_state=RunState, run_extra=[erosion, cond_every, int(theat), rz_every],
                      launch_step=launch_step, copy_back=_copy_back, label="simulation (GPU)",
                      chunk_steps=chunk_steps, progress=progress, check=check, profile=profile,
                      persistent=persistent)

@@ -5,7 +5,7 @@ engine (their device versions: :func:`robobore.cutting.fe.engine.gpu.device2d.de
 elements, the heat-conduction kernels, step end, the tool-frame ALE passes) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
 step loop of :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel` with the 2D
-phases, on the state tuple :data:`RUN_STATE`); the host driver is
+phases, on the state :data:`RunState`); the host driver is
 :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring describes the
 step's phases.
 """
@@ -13,6 +13,7 @@ step's phases.
 from __future__ import annotations
 
 import functools
+from collections import namedtuple
 
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
@@ -20,11 +21,10 @@ from robobore.cutting.fe.engine.gpu.persistent import (
     R_BAD,
     R_DTMIN,
     persistent_kernel,
-    positions,
 )
 from robobore.cutting.fe.engine.gpu.shared import bind_cuda
 
-__all__ = ["kernels2", "RUN_ARRAYS", "RUN_STATE", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC",
+__all__ = ["kernels2", "RUN_ARRAYS", "RunState", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC",
            "R_SPLIT", "N_RED"]
 
 # reduction slots on the device (engine.gpu.persistent's R_DTMIN, R_BAD, then the two sums of
@@ -34,17 +34,17 @@ R_FX, R_FY, R_NC = 2, 3, 4
 R_SPLIT = 5
 N_RED = 11
 
-#: FEState arrays used by the kernels (copied to the device), in the persistent kernel's state
-#: tuple
+#: FEState arrays used by the kernels (copied to the device), in the order of the persistent
+#: kernel's state
 RUN_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
               "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx",
               "qhy", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy",
               "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
               "clock", "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair",
               "vslip", "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
-#: the persistent kernel's state tuple: the arrays, then the erosion mode, the conduction
-#: interval [steps] (0: none), 1 with the thermal contact, the ALE interval [steps] (0: none)
-RUN_STATE = RUN_ARRAYS + ("erosion", "cond_every", "theat", "rz_every")
+#: the persistent kernel's state: the arrays, then the erosion mode, the conduction interval
+#: [steps] (0: none), 1 with the thermal contact, the ALE interval [steps] (0: none)
+RunState = namedtuple("RunState", RUN_ARRAYS + ("erosion", "cond_every", "theat", "rz_every"))
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)
@@ -318,18 +318,17 @@ def kernels2():
         finish(tool, prm, clock, ist, hacc, hist, en, red,
                (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
 
-    # the persistent kernel's phases (engine.gpu.persistent), on the state tuple RUN_STATE
-    A = positions(RUN_STATE)
+    # the persistent kernel's phases (engine.gpu.persistent), on the state RunState
 
     @cuda.jit(device=True)
     def node_phase(n, a, kv, dt, red):
         cx, cy, tvx, tvy = kv
-        cfx, cfy = a[A.cfx], a[A.cfy]
-        fcx, fcy, touched = node(n, a[A.x], a[A.y], a[A.vx], a[A.vy], a[A.mass], a[A.fixed],
-                                 a[A.ptr], a[A.nel], a[A.ncorner], a[A.alive], a[A.area0],
-                                 a[A.fex], a[A.fey], cfx, cfy, a[A.fric], a[A.pen],
-                                 a[A.ndead], a[A.ero_ke], a[A.nwork], cx, cy, tvx, tvy,
-                                 a[A.prm], dt, a[A.twin], a[A.tied], a[A.vslip])
+        cfx, cfy = a.cfx, a.cfy
+        fcx, fcy, touched = node(n, a.x, a.y, a.vx, a.vy, a.mass, a.fixed,
+                                 a.ptr, a.nel, a.ncorner, a.alive, a.area0,
+                                 a.fex, a.fey, cfx, cfy, a.fric, a.pen,
+                                 a.ndead, a.ero_ke, a.nwork, cx, cy, tvx, tvy,
+                                 a.prm, dt, a.twin, a.tied, a.vslip)
         if touched:
             cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
         return cfx[n] != 0.0 or cfy[n] != 0.0
@@ -337,7 +336,7 @@ def kernels2():
     @cuda.jit(device=True)
     def lane_sums(a, clist, m, lane, p):
         # one lane's contact force over the listed chunks (kernels.lane_sum)
-        cfx, cfy = a[A.cfx], a[A.cfy]
+        cfx, cfy = a.cfx, a.cfy
         nn = cfx.shape[0]
         sx = 0.0
         sy = 0.0
@@ -354,7 +353,7 @@ def kernels2():
         # the split by tool face, in increasing node order over the listed chunks (the CPU's
         # serial order; the other nodes carry no force), then the tool step
         cx, cy, tvx, tvy = kv
-        x, y, cfx, cfy, prm = a[A.x], a[A.y], a[A.cfx], a[A.cfy], a[A.prm]
+        x, y, cfx, cfy, prm = a.x, a.y, a.cfx, a.cfy, a.prm
         nn = x.shape[0]
         split_reset(red)
         for i in range(m):
@@ -362,7 +361,7 @@ def kernels2():
                 n = clist[i] * LANES + lane
                 if n < nn:
                     split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
-        a[A.en][E_EXT] += tstep(a[A.tool], prm, red[R_FX], red[R_FY], dt)
+        a.en[E_EXT] += tstep(a.tool, prm, red[R_FX], red[R_FY], dt)
         if prm[P_COND_EVERY] > 0.0:
             prm[P_COND_ACC] += dt
 
@@ -370,13 +369,13 @@ def kernels2():
     def ale_phase(a, step, tid, nthr, grid):
         # the tool-frame ALE pass (rezone.rezone, MODE_TOOLFRAME): the same passes in the
         # same order, a barrier wherever one reads what another wrote
-        rz_every = a[A.rz_every]
+        rz_every = a.rz_every
         if not (rz_every > 0 and step % rz_every == 0):
             return
-        x, y, xn, yn, x0, y0 = a[A.x], a[A.y], a[A.xn], a[A.yn], a[A.x0], a[A.y0]
-        vx, vy, acls, aflt, vbuf = a[A.vx], a[A.vy], a[A.acls], a[A.aflt], a[A.vbuf]
-        conn, alive, ptr, nel, area0 = a[A.conn], a[A.alive], a[A.ptr], a[A.nel], a[A.area0]
-        snodes, prm, mat = a[A.snodes], a[A.prm], a[A.mat]
+        x, y, xn, yn, x0, y0 = a.x, a.y, a.xn, a.yn, a.x0, a.y0
+        vx, vy, acls, aflt, vbuf = a.vx, a.vy, a.acls, a.aflt, a.vbuf
+        conn, alive, ptr, nel, area0 = a.conn, a.alive, a.ptr, a.nel, a.area0
+        snodes, prm, mat = a.snodes, a.prm, a.mat
         nn = x.shape[0]
         ne = conn.shape[0]
         nsn = snodes.shape[0]
@@ -402,9 +401,9 @@ def kernels2():
             tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
         grid.sync()
         for e in range(tid, ne, nthr):
-            rflux(e, conn, x, y, xn, yn, alive, a[A.enbr], a[A.bflag], a[A.buf], a[A.sdx],
-                  a[A.sdy], a[A.sdz], a[A.sdxy], a[A.pres], a[A.eps_p], a[A.temp], a[A.dmg],
-                  a[A.qhx], a[A.qhy], area0, mat[TROOM])
+            rflux(e, conn, x, y, xn, yn, alive, a.enbr, a.bflag, a.buf, a.sdx,
+                  a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
+                  a.qhx, a.qhy, area0, mat[TROOM])
         for k in range(tid, nsn, nthr):
             rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
         grid.sync()
@@ -413,24 +412,24 @@ def kernels2():
             vx[n] += vbuf[n, 0]
             vy[n] += vbuf[n, 1]
         for e in range(tid, ne, nthr):
-            rwrite(e, alive, a[A.buf], a[A.sdx], a[A.sdy], a[A.sdz], a[A.sdxy], a[A.pres],
-                   a[A.eps_p], a[A.temp], a[A.dmg], a[A.qhx], a[A.qhy], area0)
+            rwrite(e, alive, a.buf, a.sdx, a.sdy, a.sdz, a.sdxy, a.pres,
+                   a.eps_p, a.temp, a.dmg, a.qhx, a.qhy, area0)
         for n in range(tid, nn, nthr):
             x[n] = xn[n]
             y[n] = yn[n]
         grid.sync()
         rho_s = mat[RHO] * prm[P_MS]
         for n in range(tid, nn, nthr):
-            rmass(n, ptr, nel, area0, rho_s, a[A.mass])
+            rmass(n, ptr, nel, area0, rho_s, a.mass)
         grid.sync()
 
     @cuda.jit(device=True)
     def elem_phase(e, a, dt, red):
-        d, inv = elem(e, a[A.conn], a[A.x], a[A.y], a[A.vx], a[A.vy], a[A.alive], a[A.layer],
-                      a[A.sdx], a[A.sdy], a[A.sdz], a[A.sdxy], a[A.pres], a[A.eps_p],
-                      a[A.temp], a[A.dmg], a[A.qhx], a[A.qhy], a[A.area0], a[A.ie], a[A.hge],
-                      a[A.fex], a[A.fey], a[A.dte], a[A.plast], a[A.rate], a[A.mat], a[A.prm],
-                      dt, a[A.erosion])
+        d, inv = elem(e, a.conn, a.x, a.y, a.vx, a.vy, a.alive, a.layer,
+                      a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p,
+                      a.temp, a.dmg, a.qhx, a.qhy, a.area0, a.ie, a.hge,
+                      a.fex, a.fey, a.dte, a.plast, a.rate, a.mat, a.prm,
+                      dt, a.erosion)
         cuda.atomic.min(red, R_DTMIN, d)
         if inv:
             cuda.atomic.max(red, R_BAD, float(e))
@@ -439,12 +438,12 @@ def kernels2():
     def heat_phase(a, step, dt, tid, nthr, grid):
         # conduction every cond_every steps (the CPU's conduction pass), the phases of the
         # launch path separated by barriers
-        cond_every = a[A.cond_every]
+        cond_every = a.cond_every
         if not (cond_every > 0 and step % cond_every == 0):
             return
-        conn, x, y, alive, enbr = a[A.conn], a[A.x], a[A.y], a[A.alive], a[A.enbr]
-        temp, tbuf, mat, prm = a[A.temp], a[A.tbuf], a[A.mat], a[A.prm]
-        ppair = a[A.ppair]
+        conn, x, y, alive, enbr = a.conn, a.x, a.y, a.alive, a.enbr
+        temp, tbuf, mat, prm = a.temp, a.tbuf, a.mat, a.prm
+        ppair = a.ppair
         ne = conn.shape[0]
         npair = ppair.shape[0]
         for e in range(tid, ne, nthr):
@@ -459,14 +458,14 @@ def kernels2():
         grid.sync()
         if npair > 0:
             for i in range(tid, npair, nthr):
-                pedge(i, ppair, x, y, alive, a[A.tied], temp, tbuf, mat[KCOND],
+                pedge(i, ppair, x, y, alive, a.tied, temp, tbuf, mat[KCOND],
                       mat[RHO] * mat[CP], prm[P_COND_ACC])
             grid.sync()
-        if a[A.theat] != 0:
-            tcq = a[A.tcq]
+        if a.theat != 0:
+            tcq = a.tcq
             for n in range(tid, x.shape[0], nthr):
-                thnode(n, conn, x, y, a[A.ptr], a[A.nel], a[A.ncorner], alive, enbr, a[A.cfx],
-                       a[A.cfy], a[A.fric], a[A.fheat], temp, tbuf, tcq, mat[RHO] * mat[CP],
+                thnode(n, conn, x, y, a.ptr, a.nel, a.ncorner, alive, enbr, a.cfx,
+                       a.cfy, a.fric, a.fheat, temp, tbuf, tcq, mat[RHO] * mat[CP],
                        prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
             grid.sync()
             for e in range(tid, ne, nthr):
@@ -477,13 +476,13 @@ def kernels2():
 
     @cuda.jit(device=True)
     def finish_phase(a, red):
-        finish(a[A.tool], a[A.prm], a[A.clock], a[A.ist], a[A.hacc], a[A.hist], a[A.en], red,
-               (a[A.mass], a[A.vx], a[A.vy], a[A.vx], a[A.ie], a[A.plast], a[A.hge],
-                a[A.alive], a[A.fric], a[A.pen], a[A.ero_ke], a[A.nwork]))
+        finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red,
+               (a.mass, a.vx, a.vy, a.vx, a.ie, a.plast, a.hge,
+                a.alive, a.fric, a.pen, a.ero_ke, a.nwork))
 
     # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
     # elements' gated erosion and the ALE pass read: a barrier after the tool
-    k_run = persistent_kernel(A, n_sums=2, kinematics=kin, node=node_phase,
+    k_run = persistent_kernel(n_sums=2, kinematics=kin, node=node_phase,
                               lane_sums=lane_sums, tool=tool_phase, elem=elem_phase,
                               heat=heat_phase, finish=finish_phase, remesh=ale_phase,
                               sync_after_tool=True)

@@ -10,23 +10,23 @@ and the shared material/contact/support functions (:mod:`robobore.material.johns
 (nodes, contact-force total, tool, elements, step end, the heat-conduction kernels) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
 step loop of :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel` with the 3D
-phases, on the state tuple :data:`RUN_STATE`); the host driver is
+phases, on the state :data:`RunState3`); the host driver is
 :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`.
 """
 
 from __future__ import annotations
 
 import functools
+from collections import namedtuple
 
 from robobore.cutting.fe.engine.gpu.persistent import (
     R_BAD,
     R_DTMIN,
     persistent_kernel,
-    positions,
 )
 from robobore.cutting.fe.engine.gpu.shared import bind_cuda, jc_device_functions
 
-__all__ = ["kernels3", "RUN_ARRAYS", "RUN_STATE", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ",
+__all__ = ["kernels3", "RUN_ARRAYS", "RunState3", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ",
            "R_NC", "N_RED"]
 
 # reduction slots on the device (engine.gpu.persistent's R_DTMIN, R_BAD, then the four sums of
@@ -34,14 +34,14 @@ __all__ = ["kernels3", "RUN_ARRAYS", "RUN_STATE", "R_DTMIN", "R_BAD", "R_FX", "R
 R_FX, R_FY, R_FZ, R_NC = 2, 3, 4, 5
 N_RED = 6
 
-#: the state arrays on the device, in the persistent kernel's state tuple
+#: the state arrays on the device, in the order of the persistent kernel's state
 RUN_ARRAYS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
               "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
               "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
               "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "enbr",
               "tbuf", "theat")
-#: the persistent kernel's state tuple: the arrays, then the erosion mode
-RUN_STATE = RUN_ARRAYS + ("erosion",)
+#: the persistent kernel's state: the arrays, then the erosion mode
+RunState3 = namedtuple("RunState3", RUN_ARRAYS + ("erosion",))
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)
@@ -231,23 +231,22 @@ def kernels3():
             return
         finish(tool, prm, clock, ist, hacc, hist, en, red)
 
-    # the persistent kernel's phases (engine.gpu.persistent), on the state tuple RUN_STATE
-    A = positions(RUN_STATE)
+    # the persistent kernel's phases (engine.gpu.persistent), on the state RunState3
 
     @cuda.jit(device=True)
     def node_phase(n, a, kv, dt, red):
         cx, cy, cz, tvx, tvy, tvz = kv
-        cf = a[A.cf]
-        node(n, a[A.x], a[A.y], a[A.z], a[A.vx], a[A.vy], a[A.vz], a[A.mass], a[A.fixed],
-             a[A.ptr], a[A.nel], a[A.ncorner], a[A.alive], a[A.vol0], a[A.fe], cf, a[A.fric],
-             a[A.pen], a[A.ndead], a[A.ero_ke], a[A.nwork], a[A.prm], cx, cy, cz, tvx, tvy,
-             tvz, dt, a[A.pairs])
+        cf = a.cf
+        node(n, a.x, a.y, a.z, a.vx, a.vy, a.vz, a.mass, a.fixed,
+             a.ptr, a.nel, a.ncorner, a.alive, a.vol0, a.fe, cf, a.fric,
+             a.pen, a.ndead, a.ero_ke, a.nwork, a.prm, cx, cy, cz, tvx, tvy,
+             tvz, dt, a.pairs)
         return cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0
 
     @cuda.jit(device=True)
     def lane_sums(a, clist, m, lane, p):
         # one lane's force and contact-node count over the listed chunks (kernels3d.lane_sum3)
-        cf = a[A.cf]
+        cf = a.cf
         nn = cf.shape[0]
         sx = 0.0
         sy = 0.0
@@ -267,15 +266,15 @@ def kernels3():
 
     @cuda.jit(device=True)
     def tool_phase(a, clist, m, kv, dt, red):
-        a[A.en][E_EXT] += tstep(a[A.tool], a[A.prm], red[R_FX], red[R_FY], red[R_FZ], dt)
+        a.en[E_EXT] += tstep(a.tool, a.prm, red[R_FX], red[R_FY], red[R_FZ], dt)
 
     @cuda.jit(device=True)
     def elem_phase(e, a, dt, red):
-        dte, alive = a[A.dte], a[A.alive]
-        elem(e, a[A.conn], a[A.x], a[A.y], a[A.z], a[A.vx], a[A.vy], a[A.vz], alive,
-             a[A.layer], a[A.sd], a[A.pres], a[A.eps_p], a[A.temp], a[A.dmg], a[A.qh],
-             a[A.vol0], a[A.ie], a[A.hge], a[A.fe], dte, a[A.plast], a[A.rate], a[A.mat],
-             a[A.prm], dt, a[A.erosion])
+        dte, alive = a.dte, a.alive
+        elem(e, a.conn, a.x, a.y, a.z, a.vx, a.vy, a.vz, alive,
+             a.layer, a.sd, a.pres, a.eps_p, a.temp, a.dmg, a.qh,
+             a.vol0, a.ie, a.hge, a.fe, dte, a.plast, a.rate, a.mat,
+             a.prm, dt, a.erosion)
         cuda.atomic.min(red, R_DTMIN, dte[e])
         if alive[e] == -2:
             red[R_BAD] = e
@@ -284,12 +283,12 @@ def kernels3():
     def heat_phase(a, step, dt, tid, nthr, grid):
         # conduction (thermal3d, the CPU's conduction_pass3): the phases of the launch path,
         # separated by barriers
-        prm, clock = a[A.prm], a[A.clock]
+        prm, clock = a.prm, a.clock
         if not is_cond(step, prm):
             return
-        conn, x, y, z, alive = a[A.conn], a[A.x], a[A.y], a[A.z], a[A.alive]
-        enbr, pairs, vol0, temp, tbuf = a[A.enbr], a[A.pairs], a[A.vol0], a[A.temp], a[A.tbuf]
-        mat = a[A.mat]
+        conn, x, y, z, alive = a.conn, a.x, a.y, a.z, a.alive
+        enbr, pairs, vol0, temp, tbuf = a.enbr, a.pairs, a.vol0, a.temp, a.tbuf
+        mat = a.mat
         ne = conn.shape[0]
         dt_th = clock[0] + dt - prm[P_COND_T]
         rcp = mat[RHO] * mat[CP]
@@ -305,22 +304,22 @@ def kernels3():
         grid.sync()
         if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
             for n in range(tid, x.shape[0], nthr):
-                heat_node3(n, conn, x, y, z, a[A.ptr], a[A.nel], a[A.ncorner], alive, enbr,
-                           pairs, vol0, a[A.cf], a[A.fric], temp, a[A.theat], rcp, prm[P_HC],
+                heat_node3(n, conn, x, y, z, a.ptr, a.nel, a.ncorner, alive, enbr,
+                           pairs, vol0, a.cf, a.fric, temp, a.theat, rcp, prm[P_HC],
                            prm[P_FHEAT], prm[P_TTOOL], dt_th)
             grid.sync()
             for e in range(tid, ne, nthr):
-                heat_elem3(e, conn, alive, temp, a[A.theat], rcp)
+                heat_elem3(e, conn, alive, temp, a.theat, rcp)
             grid.sync()
         if tid == 0:
             prm[P_COND_T] = clock[0] + dt
 
     @cuda.jit(device=True)
     def finish_phase(a, red):
-        finish(a[A.tool], a[A.prm], a[A.clock], a[A.ist], a[A.hacc], a[A.hist], a[A.en], red)
+        finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red)
 
     # the elements do not read the tool or the contact forces: no barrier after the tool
-    k_run = persistent_kernel(A, n_sums=4, kinematics=kin, node=node_phase,
+    k_run = persistent_kernel(n_sums=4, kinematics=kin, node=node_phase,
                               lane_sums=lane_sums, tool=tool_phase, elem=elem_phase,
                               heat=heat_phase, finish=finish_phase)
 

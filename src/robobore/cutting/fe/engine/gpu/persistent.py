@@ -2,9 +2,10 @@
 
 :func:`persistent_kernel` builds ``k_run(n_steps, a, red, cflag, clist)``, which runs
 ``n_steps`` whole time steps in one cooperative launch, from one dimension's device
-functions (its phases). ``a`` is the state tuple (the state arrays, then the engine's scalar
-settings; :func:`positions` names its elements, among them ``x``, ``conn``, ``ist``,
-``clock``, ``tool`` and ``prm`` in both engines), ``red`` the reduction slots
+functions (its phases). ``a`` is the engine's state, a namedtuple of the state arrays and
+then its scalar settings (``RunState`` of :mod:`robobore.cutting.fe.engine.gpu.kernels2d`,
+``RunState3`` of :mod:`robobore.cutting.fe.engine.gpu.kernels3d`; both name ``x``, ``conn``,
+``ist``, ``clock``, ``tool`` and ``prm``), ``red`` the reduction slots
 (:data:`R_DTMIN`, :data:`R_BAD`, then the contact-force sums from :data:`R_SUMS`), ``cflag``
 and ``clist`` one flag and one slot per chunk of :data:`~robobore.cutting.fe.engine.kernels.
 N_SUM_LANES` nodes. One step:
@@ -30,18 +31,16 @@ N_SUM_LANES` nodes. One step:
    :mod:`robobore.cutting.fe.engine.history`), the step's minimum and inverted element
    reset; grid barrier.
 
-Every phase takes the state tuple and reads its arrays by position (``a[A.x]`` with ``A`` =
-``positions(names)``), so the loop above is written once for both dimensions; the phases
-call the same scalar functions as the CPU engine.
+Every phase takes the state and reads its arrays by name (``a.x``), so the loop above is
+written once for both dimensions; the phases call the same scalar functions as the CPU engine
+(whose one loop is :mod:`robobore.cutting.fe.engine.step_loop`).
 """
 
 from __future__ import annotations
 
-import types
-
 from robobore.cutting.fe.engine.gpu.shared import MAX_BLOCK, bind_cuda, chunk_list_py
 
-__all__ = ["persistent_kernel", "positions", "R_DTMIN", "R_BAD", "R_SUMS"]
+__all__ = ["persistent_kernel", "R_DTMIN", "R_BAD", "R_SUMS"]
 
 #: reduction slots shared by both engines: the smallest stable step [s] (drive_gpu starts it
 #: at 1e30), the inverted element (-1: none), the first contact-force sum
@@ -52,26 +51,16 @@ R_DTMIN, R_BAD, R_SUMS = 0, 1, 2
 cuda = None
 
 
-def positions(names: tuple[str, ...]) -> types.ModuleType:
-    """The position of each name in the state tuple, as attributes of a namespace that numba
-    reads as compile-time constants: ``a[A.x]`` with ``A = positions(names)`` compiles to a
-    fixed element of the tuple ``a``."""
-    ns = types.ModuleType("state_positions")
-    for i, name in enumerate(names):
-        setattr(ns, name, i)
-    return ns
-
-
 def no_remesh_py(a, step, tid, nthr, grid):
     """The ``remesh`` phase of an engine without mesh motion: nothing."""
     return None
 
 
-def persistent_kernel(A: types.ModuleType, *, n_sums: int, kinematics, node, lane_sums, tool,
-                      elem, heat, finish, remesh=None, sync_after_tool: bool = False):
+def persistent_kernel(*, n_sums: int, kinematics, node, lane_sums, tool, elem, heat, finish,
+                      remesh=None, sync_after_tool: bool = False):
     """The persistent kernel ``k_run(n_steps, a, red, cflag, clist)`` of one engine, from its
-    device functions (the phases of the module docstring); ``A`` = :func:`positions` of its
-    state tuple, ``n_sums`` contact-force sums per lane."""
+    device functions (the phases of the module docstring); ``n_sums`` contact-force sums per
+    lane."""
     global cuda
     cuda = bind_cuda()
     from numba import float64, int64
@@ -103,9 +92,9 @@ def persistent_kernel(A: types.ModuleType, *, n_sums: int, kinematics, node, lan
         nthr = cuda.gridsize(1)
         t = cuda.threadIdx.x
         nb = cuda.blockDim.x
-        nn = a[A.x].shape[0]
-        ne = a[A.conn].shape[0]
-        ist, clock, tool_state, prm = a[A.ist], a[A.clock], a[A.tool], a[A.prm]
+        nn = a.x.shape[0]
+        ne = a.conn.shape[0]
+        ist, clock, tool_state, prm = a.ist, a.clock, a.tool, a.prm
         p = cuda.shared.array((NSUM, LANES), float64)
         cnt = cuda.shared.array(NCNT, int64)
         for _ in range(n_steps):
