@@ -96,16 +96,17 @@ def main() -> int:
         n = (nn + K.N_SUM_LANES - 1) // K.N_SUM_LANES
         return [np.zeros(n, np.int32), np.zeros(n, np.int64)]
 
+    # k_run(n_steps, state (the arrays, then the scalar settings), red, cflag, clist)
     cases = {
         "3D k_run": (gpu._kernels()[-1],
-                     [1] + [np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS]
-                     + [int(st3.prm[K3.P_EROSION]), np.zeros(gpu.N_RED)]
-                     + chunk_arrays(st3.x.shape[0])),
+                     [1, gpu.RunState3(*[np.ascontiguousarray(getattr(st3, n))
+                                         for n in gpu._RUN_ARGS], int(st3.prm[K3.P_EROSION])),
+                      np.zeros(gpu.N_RED)] + chunk_arrays(st3.x.shape[0])),
         "2D k_run": (k2[-2],
-                     [1] + [np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS]
-                     + [int(st2.prm[K.P_EROSION]), 1, 1, int(st2.prm[K.P_RZ_EVERY]),
-                        np.zeros(gpu2d.N_RED)]
-                     + chunk_arrays(st2.x.shape[0])),
+                     [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n))
+                                          for n in gpu2d._ARRAYS], int(st2.prm[K.P_EROSION]),
+                                        1, 1, int(st2.prm[K.P_RZ_EVERY])),
+                      np.zeros(gpu2d.N_RED)] + chunk_arrays(st2.x.shape[0])),
     }
     # the launch-per-kernel path's contact total (with the split by face) and ALE kernels,
     # their arguments by name from the tool-frame state

@@ -319,9 +319,11 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
     d["mesh"]["element_size_um"] = 20.0
     d["mesh"]["edge_element_um"] = 10.0
     st = setup_orthogonal(parse_config(d)).state
-    # k_run(n_steps, *state arrays, erosion, cond_every, theat, rz_every, red, cflag, clist)
-    total = (arg(0) + sum(arg(getattr(st, k)) for k in gpu2d._ARRAYS) + 4 * arg(0)
-             + arg(np.zeros(gpu2d.N_RED)) + arg(np.zeros(1, np.int32))
+    # k_run(n_steps, state (the arrays, then erosion, cond_every, theat, rz_every), red, cflag,
+    # clist); the state, a namedtuple, passes as its elements' fields
+    state = gpu2d.RunState(*[getattr(st, k) for k in gpu2d._ARRAYS], 0, 0, 0, 0)
+    total = (arg(0) + arg(state) + arg(np.zeros(gpu2d.N_RED)) + arg(np.zeros(1, np.int32))
              + arg(np.zeros(1, np.int64)))
+    assert arg(state) == sum(arg(v) for v in state)
     assert arg(np.zeros(3)) == 56 and arg(np.zeros((3, 2))) == 72  # the model counted
     assert total <= 4096, total

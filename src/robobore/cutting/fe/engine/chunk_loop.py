@@ -1,21 +1,23 @@
-"""The compiled time-step loop of the plane-strain engine (:func:`run_chunk`): element,
-node and tool updates, heat passes and the ALE pass, a chunk of steps at a time; each step ends
-with the engines' shared end of step (:mod:`robobore.cutting.fe.engine.history`: stop conditions,
-time-averaged histories, history samples with the energy totals), bound here to the 2D
-layout (:data:`ENGINE2`, :func:`tool_columns_py`, :data:`sum_energies_py`).
+"""The compiled time-step loop of the plane-strain engine (:func:`run_chunk`), a chunk of
+steps at a time: the step loop of both CPU engines (:mod:`robobore.cutting.fe.engine.step_loop`)
+with the 2D phases -- node update and contact with the force by tool face, tool, the
+tool-frame ALE pass, the one-point or B-bar elements, heat passes -- on the state
+:data:`ChunkState`; each step ends with the engines' shared end of step
+(:mod:`robobore.cutting.fe.engine.history`: stop conditions, time-averaged histories, history
+samples with the energy totals), bound here to the 2D layout (:data:`ENGINE2`,
+:func:`tool_columns_py`, :data:`sum_energies_py`).
 """
 
 from __future__ import annotations
 
-import numpy as np
+from collections import namedtuple
+
 from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
 from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.engine.layout import (
-    E_EXT,
     ELEM_Q4BBAR,
-    I_STEP,
     P_ALE_X0,
     P_CFL,
     P_COND_ACC,
@@ -40,6 +42,7 @@ from robobore.cutting.fe.engine.layout import (
     T_GX,
     T_UX,
 )
+from robobore.cutting.fe.engine.step_loop import bind_chunk_loop
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
     parting_conduct,
@@ -81,71 +84,119 @@ def tool_columns_py(tool):
 ENGINE2 = {"NDIM": 2, "N_SPLIT": 6, "N_TOOL_COLUMNS": 1, "T_FORCE": T_FX, "T_DISP": T_UX,
            "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
            "COUNT_STOPPED_STEP": 0}
+_energy_totals = njit(sum_energies_py)
 #: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`)
-_end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), njit(sum_energies_py))
+_end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), _energy_totals)
+
+
+@njit
+def _energy_arrays(s):
+    # the arrays ``es`` of sum_energies_py in the loop's state ``s`` (vz: unread in 2D)
+    return (s.mass, s.vx, s.vy, s.vx, s.ie, s.plast, s.hge, s.alive, s.fric, s.pen, s.ero_ke,
+            s.nwork)
+
+
+#: the state arrays of the loop, in the order of ``FEState.kernel_args()``
+CHUNK_ARGS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
+              "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx",
+              "qhy", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy",
+              "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
+              "clock", "hacc", "hist", "enbr", "snodes", "xn", "yn", "buf", "twin",
+              "tied", "tbuf", "gps", "fheat", "tcq", "ppair", "x0", "y0", "vbuf", "acls",
+              "aflt", "bflag", "vslip")
+#: the state of the loop's phases (numba reads the fields by name)
+ChunkState = namedtuple("ChunkState", CHUNK_ARGS)
+
+
+@njit
+def _nodes(s, kin, dt, split):
+    # node update and contact, the contact-force total in the fixed lane order, the force by
+    # tool face
+    cx, cy, tvx, tvy = kin
+    x, y, cfx, cfy, prm = s.x, s.y, s.cfx, s.cfy, s.prm
+    ncont = node_update(x, y, s.vx, s.vy, s.mass, s.fixed, s.ptr, s.nel, s.ncorner, s.alive,
+                        s.area0, s.fex, s.fey, cfx, cfy, s.fric, s.pen, s.ndead, s.ero_ke,
+                        s.nwork, cx, cy, tvx, tvy, prm, dt, s.twin, s.tied, s.vslip)
+    fwx, fwy = contact_total(cfx, cfy)
+    contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+                  split)
+    return fwx, fwy, 0.0, ncont
+
+
+@njit
+def _tool_step(s, fx, fy, fz, dt):
+    return tool_step(s.tool, s.prm, fx, fy, dt)
+
+
+@njit
+def _remesh(s, step):
+    # the tool-frame ALE pass every prm[P_RZ_EVERY] steps
+    (x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx, sdy,
+     sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, x0, y0, vbuf, acls, aflt, bflag,
+     mat, prm) = (
+        s.x, s.y, s.vx, s.vy, s.mass, s.conn, s.alive, s.ptr, s.nel, s.enbr, s.snodes,
+        s.xn, s.yn, s.buf, s.sdx, s.sdy, s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.qhx,
+        s.qhy, s.area0, s.x0, s.y0, s.vbuf, s.acls, s.aflt, s.bflag, s.mat, s.prm)
+    rz_every = int(prm[P_RZ_EVERY])
+    rho_s = mat[jc.RHO] * prm[P_MS]
+    if rz_every > 0 and step % rz_every == 0 and snodes.shape[0] > 0:
+        rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx,
+               sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
+               prm[P_RZ_MAXMOVE], x0, y0, vbuf, tool_geometry(prm), acls, aflt, bflag,
+               mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
+
+
+@njit
+def _elements(s, dt):
+    prm = s.prm
+    erosion = int(prm[P_EROSION])
+    if int(prm[P_ELEM]) == ELEM_Q4BBAR:
+        return element_update_bbar(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx,
+                                   s.sdy, s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.gps,
+                                   s.area0, s.ie, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat,
+                                   prm, dt, erosion)
+    return element_update(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy, s.sdz,
+                          s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.qhx, s.qhy, s.area0, s.ie,
+                          s.hge, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat, prm, dt, erosion)
+
+
+@njit
+def _heat(s, step, t, dt):
+    # conduction every prm[P_COND_EVERY] steps over the time accumulated since the last pass
+    prm, mat = s.prm, s.mat
+    cond_every = int(prm[P_COND_EVERY])
+    if cond_every > 0:
+        prm[P_COND_ACC] += dt
+        if step % cond_every == 0:
+            conn, x, y, alive, enbr, temp, tbuf = s.conn, s.x, s.y, s.alive, s.enbr, s.temp, s.tbuf
+            rcp = mat[jc.RHO] * mat[jc.CP]
+            conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp, prm[P_COND_ACC])
+            if s.ppair.shape[0] > 0:
+                parting_conduct(s.ppair, x, y, alive, s.tied, temp, tbuf, mat[jc.KCOND], rcp,
+                                prm[P_COND_ACC])
+            if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+                tool_heat(conn, x, y, s.ptr, s.nel, s.ncorner, alive, enbr, s.cfx, s.cfy,
+                          s.fric, s.fheat, temp, tbuf, s.tcq, rcp, prm[P_HC], prm[P_FHEAT],
+                          prm[P_TTOOL], prm[P_COND_ACC])
+            prm[P_COND_ACC] = 0.0
+
+
+#: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 2D phases
+_loop = bind_chunk_loop(state=ChunkState, n_split=ENGINE2["N_SPLIT"],
+                        energy_arrays=_energy_arrays, kinematics=tool_kinematics, nodes=_nodes,
+                        tool_step=_tool_step, remesh=_remesh, elements=_elements, heat=_heat,
+                        end_step=_end_step, energy_totals=_energy_totals)
 
 
 @njit(cache=True)
-def run_chunk(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive,
-              sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey,
-              dte, plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool,
-              en, ist, clock, hacc, hist, enbr, snodes, xn, yn, buf, twin, tied, tbuf,
-              gps, fheat, tcq, ppair, x0, y0, vbuf, acls, aflt, bflag, vslip):
-    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
-
-    ``clock`` = [t, dt, t_acc] (time [s], current step [s], time accumulated in the current
-    sample interval). Each step ends with :func:`robobore.cutting.fe.engine.history.end_step_py`
-    (stop checks, time-averaged histories, samples): stops early with ``ist[I_STATUS]`` =
-    STATUS_DONE at ``prm[P_TEND]`` or an instability status. Returns the number of steps
-    taken.
+def run_chunk(n_steps, *arrays):
+    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba) of the
+    state arrays ``FEState.kernel_args()`` (:data:`CHUNK_ARGS`): the step loop of
+    :mod:`robobore.cutting.fe.engine.step_loop` with the 2D phases (node update and contact,
+    tool, the tool-frame ALE pass, the one-point or B-bar elements, conduction with the
+    parting-line edges and the thermal contact). Each step ends with
+    :func:`robobore.cutting.fe.engine.history.end_step_py` (stop checks, time-averaged
+    histories, samples): stops early with ``ist[I_STATUS]`` = STATUS_DONE at ``prm[P_TEND]``
+    or an instability status. Returns the number of steps taken.
     """
-    erosion = int(prm[P_EROSION])
-    bbar = int(prm[P_ELEM]) == ELEM_Q4BBAR
-    rz_every = int(prm[P_RZ_EVERY])
-    rho_s = mat[jc.RHO] * prm[P_MS]
-    fsplit = np.zeros(6)
-    es = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
-    taken = 0
-    for _s in range(n_steps):
-        dt = clock[1]
-        cx, cy, tvx, tvy = tool_kinematics(tool, prm)
-        ncont = node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex,
-                            fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy, tvx, tvy,
-                            prm, dt, twin, tied, vslip)
-        fwx, fwy = contact_total(cfx, cfy)
-        contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
-                      fsplit)
-        en[E_EXT] += tool_step(tool, prm, fwx, fwy, dt)
-        if rz_every > 0 and ist[I_STEP] % rz_every == 0 and snodes.shape[0] > 0:
-            rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx,
-                   sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
-                   prm[P_RZ_MAXMOVE], x0, y0, vbuf, tool_geometry(prm), acls, aflt, bflag,
-                   mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
-        if bbar:
-            dtmin, bad = element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz,
-                                             sdxy, pres, eps_p, temp, dmg, gps, area0, ie, fex,
-                                             fey, dte, plast, rate, mat, prm, dt, erosion)
-        else:
-            dtmin, bad = element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy,
-                                        pres, eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex,
-                                        fey, dte, plast, rate, mat, prm, dt, erosion)
-        cond_every = int(prm[P_COND_EVERY])
-        if cond_every > 0:
-            prm[P_COND_ACC] += dt
-            if ist[I_STEP] % cond_every == 0:
-                rcp = mat[jc.RHO] * mat[jc.CP]
-                conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp,
-                        prm[P_COND_ACC])
-                if ppair.shape[0] > 0:
-                    parting_conduct(ppair, x, y, alive, tied, temp, tbuf, mat[jc.KCOND], rcp,
-                                    prm[P_COND_ACC])
-                if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-                    tool_heat(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric,
-                              fheat, temp, tbuf, tcq, rcp, prm[P_HC], prm[P_FHEAT],
-                              prm[P_TTOOL], prm[P_COND_ACC])
-                prm[P_COND_ACC] = 0.0
-        taken += 1
-        if not _end_step(dt, bad, dtmin, fwx, fwy, 0.0, ncont, fsplit, ist, clock, prm, tool,
-                         en, hacc, hist, es):
-            return taken
-    return taken
+    return _loop(n_steps, *arrays)

@@ -7,8 +7,9 @@ the insert edge) and the spring-damper step
 (:func:`robobore.cutting.fe.physics.tool_contact.tool_support_step`). The 3D state layout and scalar
 functions (``_py`` original + ``njit``, device-ready) are
 :mod:`robobore.cutting.fe.hex.scalar3d`, re-exported here; this module holds the parallel loops
-(elements, nodes), the energy sums, the contact-force total, the conduction pass and the
-chunk loop :func:`run_chunk3`. The scalar functions:
+(elements, nodes), the energy sums, the contact-force total, the conduction pass, the step
+phases and the chunk loop :func:`run_chunk3` (the step loop of
+:mod:`robobore.cutting.fe.engine.step_loop` with those phases). The scalar functions:
 
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
@@ -31,6 +32,8 @@ frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
 ``theta(t) = theta0 + vc t / R``; see :mod:`robobore.cutting.fe.models.boring3d`.
 """
 from __future__ import annotations
+
+from collections import namedtuple
 
 import numpy as np
 from numba import njit, prange
@@ -58,6 +61,7 @@ from robobore.cutting.fe.engine.kernels import (
     STATUS_NONFINITE,
     STATUS_OK,
 )
+from robobore.cutting.fe.engine.step_loop import bind_chunk_loop
 from robobore.cutting.fe.hex.element import hex_element
 from robobore.cutting.fe.hex.layout3d import (
     ERODE_LAYER,
@@ -223,6 +227,13 @@ def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nw
     _energy_totals3((mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork), en)
 
 
+@njit
+def _energy_arrays3(s):
+    # the arrays ``es`` of sum_energies3_py in the chunk loop's state ``s``
+    return (s.mass, s.vx, s.vy, s.vz, s.ie, s.plast, s.hge, s.alive, s.fric, s.pen, s.ero_ke,
+            s.nwork)
+
+
 def tool_columns3_py(tool):
     """The 3D engine's instantaneous tool history columns: the guide's x [m] (local frame)
     and the bar angle [rad]."""
@@ -273,48 +284,79 @@ def conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0,
     prm[P_COND_T] = t_end_step
 
 
+#: the state arrays of the loop, in the order of ``FEState3.kernel_args()`` (its fields)
+CHUNK_ARGS3 = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner",
+               "conn", "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0",
+               "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
+               "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist",
+               "pairs", "enbr", "tbuf", "theat")
+#: the state of the loop's phases (numba reads the fields by name)
+ChunkState3 = namedtuple("ChunkState3", CHUNK_ARGS3)
+
+
+@njit
+def _nodes3(s, kin, dt, split):
+    # node update and contact, then the contact-force total in the fixed lane order
+    cx, cy, cz, tvx, tvy, tvz = kin
+    node_update3(s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.ptr, s.nel, s.ncorner,
+                 s.alive, s.vol0, s.fe, s.cf, s.fric, s.pen, s.ndead, s.ero_ke, s.nwork, s.prm,
+                 cx, cy, cz, tvx, tvy, tvz, dt, s.pairs)
+    return contact_total3(s.cf)
+
+
+@njit
+def _tool_step3(s, fx, fy, fz, dt):
+    return tool_step(s.tool, s.prm, fx, fy, fz, dt)
+
+
+@njit
+def _elements3(s, dt):
+    # the element update, then its smallest stable step and an inverted element
+    prm = s.prm
+    conn, dte, alive = s.conn, s.dte, s.alive
+    element_update3(conn, s.x, s.y, s.z, s.vx, s.vy, s.vz, alive, s.layer, s.sd, s.pres,
+                    s.eps_p, s.temp, s.dmg, s.qh, s.vol0, s.ie, s.hge, s.fe, dte, s.plast,
+                    s.rate, s.mat, prm, dt, int(prm[P_EROSION]))
+    dtmin = 1e30
+    bad = -1
+    for e in range(conn.shape[0]):
+        if dte[e] < dtmin:
+            dtmin = dte[e]
+        if alive[e] == -2:
+            bad = e
+    return dtmin, bad
+
+
+@njit
+def _heat3(s, step, t, dt):
+    # every prm[P_COND_EVERY] steps (0: adiabatic): conduction and the thermal contact
+    if is_conduction_step(step, s.prm):
+        conduction_pass3(s.conn, s.x, s.y, s.z, s.ptr, s.nel, s.ncorner, s.alive, s.enbr,
+                         s.pairs, s.vol0, s.cf, s.fric, s.temp, s.tbuf, s.theat, s.mat, s.prm,
+                         t + dt)
+
+
+#: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 3D phases
+_loop3 = bind_chunk_loop(state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
+                         energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
+                         nodes=_nodes3, tool_step=_tool_step3, elements=_elements3,
+                         heat=_heat3, end_step=_end_step3, energy_totals=_energy_totals3,
+                         totals_at_chunk_end=True)
+
+
 @njit(cache=True)
-def run_chunk3(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
-               sd, pres, eps_p, temp, dmg, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
-               ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, enbr,
-               tbuf, theat):
-    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba).
+def run_chunk3(n_steps, *arrays):
+    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba) of the
+    state arrays ``FEState3.kernel_args()`` (:data:`CHUNK_ARGS3`): the step loop of
+    :mod:`robobore.cutting.fe.engine.step_loop` with the 3D phases (the parallel node and
+    element loops, the fixed-order contact-force total, the tool).
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
     STATUS_DONE at ``prm[P_TEND]``, or an instability status (each step ends with
-    :func:`robobore.cutting.fe.engine.history.end_step_py`). Returns the steps taken.
+    :func:`robobore.cutting.fe.engine.history.end_step_py`). Returns the steps taken; the
+    energy totals are summed after a chunk that ran to its end.
     Every ``prm[P_COND_EVERY]`` steps (0: adiabatic) heat conduction and the thermal contact
     with the insert run over the time since the last pass (:mod:`~robobore.cutting.fe.
     physics.thermal3d`, :func:`conduction_pass3`).
     """
-    erosion = int(prm[P_EROSION])
-    ne = conn.shape[0]
-    es = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
-    taken = 0
-    for _s in range(n_steps):
-        dt = clock[1]
-        t = clock[0]
-        cx, cy, cz, tvx, tvy, tvz = tool_kinematics(tool, prm)
-        node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf,
-                     fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs)
-        fwx, fwy, fwz, ncont = contact_total3(cf)
-        en[E_EXT] += tool_step(tool, prm, fwx, fwy, fwz, dt)
-        element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
-                        vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
-        if is_conduction_step(ist[I_STEP], prm):
-            conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
-                             fric, temp, tbuf, theat, mat, prm, t + dt)
-        dtmin = 1e30
-        bad = -1
-        for e in range(ne):
-            if dte[e] < dtmin:
-                dtmin = dte[e]
-            if alive[e] == -2:
-                bad = e
-        taken += 1
-        if not _end_step3(dt, bad, dtmin, fwx, fwy, fwz, ncont, hacc, ist, clock, prm, tool,
-                          en, hacc, hist, es):
-            return taken
-    _energy_totals3(es, en)
-    return taken
-
+    return _loop3(n_steps, *arrays)

@@ -59,7 +59,7 @@ from typing import Any
 
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, kernels2
+from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, RunState, kernels2
 from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
 from robobore.errors import ConfigError
 
@@ -77,13 +77,9 @@ def check_gpu_supported(element: str, source: str | None = None) -> None:
                           expected='"q4r" with --device gpu, or --device cpu')
 
 
-#: FEState arrays used by the kernels (copied to the device)
-_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
-           "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy",
-           "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy", "fric",
-           "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock",
-           "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair", "vslip",
-           "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
+#: FEState arrays used by the kernels (copied to the device; the persistent kernel's state
+#: RunState holds them, then its scalar settings)
+_ARRAYS = RUN_ARRAYS
 #: the arrays the kernels change (copied back to the host)
 _MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "sdx", "sdy", "sdz", "sdxy", "pres",
             "eps_p", "temp", "dmg", "qhx", "qhy", "area0", "ie", "hge", "fex", "fey", "dte",
@@ -171,7 +167,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         tick("finish")
 
     return drive_gpu(st, t_end, names=_ARRAYS, p_tend=K.P_TEND, n_red=N_RED, k_run=k_run,
-                     run_extra=[erosion, cond_every, int(theat), rz_every],
+                     run_state=RunState, run_extra=[erosion, cond_every, int(theat), rz_every],
                      launch_step=launch_step, copy_back=_copy_back, label="simulation (GPU)",
                      chunk_steps=chunk_steps, progress=progress, check=check, profile=profile,
                      persistent=persistent)

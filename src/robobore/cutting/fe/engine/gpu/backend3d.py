@@ -33,7 +33,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, kernels3
+from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, RUN_ARRAYS, RunState3, kernels3
 from robobore.cutting.fe.engine.gpu.shared import (
     MAX_BLOCK,
     THREADS,
@@ -134,18 +134,13 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
         tick("finish")
 
     return drive_gpu(st, t_end, names=_RUN_ARGS, p_tend=K3.P_TEND, n_red=N_RED, k_run=k_run,
-                     run_extra=[erosion], launch_step=launch_step, copy_back=_copy_back,
-                     label="3D simulation (GPU)", chunk_steps=chunk_steps, progress=progress,
-                     check=check, profile=profile, persistent=persistent)
+                     run_state=RunState3, run_extra=[erosion], launch_step=launch_step,
+                     copy_back=_copy_back, label="3D simulation (GPU)", chunk_steps=chunk_steps,
+                     progress=progress, check=check, profile=profile, persistent=persistent)
 
 
-#: the state arrays on the device, in the persistent kernel's argument order (then erosion,
-#: red, the chunk flags and the chunk list)
-_RUN_ARGS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
-             "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
-             "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
-             "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "enbr", "tbuf",
-             "theat")
+#: the state arrays on the device, in the persistent kernel's state RunState3 (then erosion)
+_RUN_ARGS = RUN_ARRAYS
 
 
 

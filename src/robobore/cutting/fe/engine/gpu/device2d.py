@@ -16,7 +16,7 @@ from types import SimpleNamespace
 
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.engine.gpu.shared import chunk_list_py, jc_device_functions
+from robobore.cutting.fe.engine.gpu.shared import jc_device_functions
 
 __all__ = ["device_functions2"]
 
@@ -70,7 +70,6 @@ def device_functions2(dev) -> SimpleNamespace:
     thnode = dev(K.tool_heat_node_py)
     thelem = dev(K.tool_heat_elem_py)
     lsum = dev(K.lane_sum_py)
-    chunks = dev(chunk_list_py)
     # the end of a step (robobore.cutting.fe.engine.history) bound to the 2D engine
     from robobore.cutting.fe.engine import chunk_loop as CL
     from robobore.cutting.fe.engine.history import bind_end_step
@@ -80,5 +79,4 @@ def device_functions2(dev) -> SimpleNamespace:
         csplit=csplit, tool_geometry=tool_geometry, tplace=tplace, tfacep=tfacep,
         tsweep=tsweep, tscopy=tscopy, tinter=tinter, rflux=rflux, rvel=rvel, rwrite=rwrite,
         rmass=rmass, SWEEPS=SWEEPS, elem=elem, node=node, kin=kin, tstep=tstep, cent=cent,
-        cond=cond, pedge=pedge, thnode=thnode, thelem=thelem, end_step=end_step, lsum=lsum,
-        chunks=chunks)
+        cond=cond, pedge=pedge, thnode=thnode, thelem=thelem, end_step=end_step, lsum=lsum)

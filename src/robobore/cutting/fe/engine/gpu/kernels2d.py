@@ -3,26 +3,48 @@ engine (their device versions: :func:`robobore.cutting.fe.engine.gpu.device2d.de
 
 :func:`kernels2` returns the launch-per-kernel phases (nodes, contact-force total, tool,
 elements, the heat-conduction kernels, step end, the tool-frame ALE passes) and the
-persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch; the
-host driver is :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring
-describes the step's phases.
+persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
+step loop of :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel` with the 2D
+phases, on the state :data:`RunState`); the host driver is
+:func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring describes the
+step's phases.
 """
 
 from __future__ import annotations
 
 import functools
+from collections import namedtuple
 
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
-from robobore.cutting.fe.engine.gpu.shared import MAX_BLOCK, bind_cuda
+from robobore.cutting.fe.engine.gpu.persistent import (
+    R_BAD,
+    R_DTMIN,
+    persistent_kernel,
+)
+from robobore.cutting.fe.engine.gpu.shared import bind_cuda
 
-__all__ = ["kernels2", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC", "R_SPLIT", "N_RED"]
+__all__ = ["kernels2", "RUN_ARRAYS", "RunState", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC",
+           "R_SPLIT", "N_RED"]
 
-# reduction slots on the device (engine.gpu.shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
-R_DTMIN, R_BAD, R_FX, R_FY, R_NC = 0, 1, 2, 3, 4
+# reduction slots on the device (engine.gpu.persistent's R_DTMIN, R_BAD, then the two sums of
+# its contact-force total; the number of contact nodes, counted by atomic add)
+R_FX, R_FY, R_NC = 2, 3, 4
 #: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
 R_SPLIT = 5
 N_RED = 11
+
+#: FEState arrays used by the kernels (copied to the device), in the order of the persistent
+#: kernel's state
+RUN_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
+              "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx",
+              "qhy", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy",
+              "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
+              "clock", "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair",
+              "vslip", "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
+#: the persistent kernel's state: the arrays, then the erosion mode, the conduction interval
+#: [steps] (0: none), 1 with the thermal contact, the ALE interval [steps] (0: none)
+RunState = namedtuple("RunState", RUN_ARRAYS + ("erosion", "cond_every", "theat", "rz_every"))
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)
@@ -36,25 +58,21 @@ def kernels2():
     k_theat_elems, k_conduct_reset, k_finish, k_run, ale)`` with ``ale`` the tool-frame ALE
     pass's kernels (the launch-per-kernel path)."""
     global cuda
-    cuda = bind_cuda()  # also engine.gpu.shared's, for chunk_list_py
+    cuda = bind_cuda()
     from numba import float64 as _float64
-    from numba import int64 as _int64
 
     from robobore.material import johnson_cook as jc
 
     f = device_functions2(cuda.jit(device=True))
     (csplit, tool_geometry, tplace, tfacep, tsweep, tscopy, tinter, rflux, rvel, rwrite, rmass,
-     SWEEPS, elem, node, kin, tstep, cent, cond, pedge, thnode, thelem, end_step, lsum,
-     chunks) = (
+     SWEEPS, elem, node, kin, tstep, cent, cond, pedge, thnode, thelem, end_step, lsum) = (
         f.csplit, f.tool_geometry, f.tplace, f.tfacep, f.tsweep, f.tscopy, f.tinter, f.rflux,
         f.rvel, f.rwrite, f.rmass, f.SWEEPS, f.elem, f.node, f.kin, f.tstep, f.cent, f.cond,
-        f.pedge, f.thnode, f.thelem, f.end_step, f.lsum, f.chunks)
+        f.pedge, f.thnode, f.thelem, f.end_step, f.lsum)
     LANES = K.N_SUM_LANES
     float64 = _float64
-    int64 = _int64
-    NCNT = MAX_BLOCK + 1
 
-    I_STATUS, I_STEP, ST_OK = K.I_STATUS, K.I_STEP, K.STATUS_OK
+    I_STATUS, ST_OK = K.I_STATUS, K.STATUS_OK
     P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
     P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
     P_TCX, P_NRX, P_NRY, P_NFX, P_NFY = K.P_TCX, K.P_NRX, K.P_NRY, K.P_NFX, K.P_NFY
@@ -300,161 +318,174 @@ def kernels2():
         finish(tool, prm, clock, ist, hacc, hist, en, red,
                (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
 
-    @cuda.jit
-    def k_run(n_steps, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, conn, layer, alive, sdx,
-              sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte,
-              plast, rate, cfx, cfy, fric, pen, ndead, ero_ke, nwork, mat, prm, tool, en, ist,
-              clock, hacc, hist, enbr, twin, tied, tbuf, fheat, tcq, ppair, vslip, snodes, x0,
-              y0, xn, yn, buf, vbuf, acls, aflt, bflag, erosion, cond_every, theat, rz_every,
-              red, cflag, clist):
-        # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
-        # of the kernels above separated by grid-wide barriers (one launch per chunk instead
-        # of five to twelve per step); same functions, same order, same bits
-        grid = cuda.cg.this_grid()
-        tid = cuda.grid(1)
-        nthr = cuda.gridsize(1)
-        t = cuda.threadIdx.x
-        nb = cuda.blockDim.x
+    # the persistent kernel's phases (engine.gpu.persistent), on the state RunState
+
+    @cuda.jit(device=True)
+    def node_phase(n, a, kv, dt, red):
+        cx, cy, tvx, tvy = kv
+        cfx, cfy = a.cfx, a.cfy
+        fcx, fcy, touched = node(n, a.x, a.y, a.vx, a.vy, a.mass, a.fixed,
+                                 a.ptr, a.nel, a.ncorner, a.alive, a.area0,
+                                 a.fex, a.fey, cfx, cfy, a.fric, a.pen,
+                                 a.ndead, a.ero_ke, a.nwork, cx, cy, tvx, tvy,
+                                 a.prm, dt, a.twin, a.tied, a.vslip)
+        if touched:
+            cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
+        return cfx[n] != 0.0 or cfy[n] != 0.0
+
+    @cuda.jit(device=True)
+    def lane_sums(a, clist, m, lane, p):
+        # one lane's contact force over the listed chunks (kernels.lane_sum)
+        cfx, cfy = a.cfx, a.cfy
+        nn = cfx.shape[0]
+        sx = 0.0
+        sy = 0.0
+        for i in range(m):
+            n = clist[i] * LANES + lane
+            if n < nn:
+                sx += cfx[n]
+                sy += cfy[n]
+        p[0, lane] = sx
+        p[1, lane] = sy
+
+    @cuda.jit(device=True)
+    def tool_phase(a, clist, m, kv, dt, red):
+        # the split by tool face, in increasing node order over the listed chunks (the CPU's
+        # serial order; the other nodes carry no force), then the tool step
+        cx, cy, tvx, tvy = kv
+        x, y, cfx, cfy, prm = a.x, a.y, a.cfx, a.cfy, a.prm
+        nn = x.shape[0]
+        split_reset(red)
+        for i in range(m):
+            for lane in range(LANES):
+                n = clist[i] * LANES + lane
+                if n < nn:
+                    split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
+        a.en[E_EXT] += tstep(a.tool, prm, red[R_FX], red[R_FY], dt)
+        if prm[P_COND_EVERY] > 0.0:
+            prm[P_COND_ACC] += dt
+
+    @cuda.jit(device=True)
+    def ale_phase(a, step, tid, nthr, grid):
+        # the tool-frame ALE pass (rezone.rezone): the same passes in the
+        # same order, a barrier wherever one reads what another wrote
+        rz_every = a.rz_every
+        if not (rz_every > 0 and step % rz_every == 0):
+            return
+        x, y, xn, yn, x0, y0 = a.x, a.y, a.xn, a.yn, a.x0, a.y0
+        vx, vy, acls, aflt, vbuf = a.vx, a.vy, a.acls, a.aflt, a.vbuf
+        conn, alive, ptr, nel, area0 = a.conn, a.alive, a.ptr, a.nel, a.area0
+        snodes, prm, mat = a.snodes, a.prm, a.mat
         nn = x.shape[0]
         ne = conn.shape[0]
-        npair = ppair.shape[0]
         nsn = snodes.shape[0]
-        rho_s = mat[RHO] * prm[P_MS]
-        px = cuda.shared.array(LANES, float64)
-        py = cuda.shared.array(LANES, float64)
-        cnt = cuda.shared.array(NCNT, int64)
-        for _ in range(n_steps):
-            if ist[I_STATUS] != ST_OK:
-                return
-            step = ist[I_STEP]
-            dt = clock[1]
-            cx, cy, tvx, tvy = kin(tool, prm)
+        off = prm[P_TCX] - prm[P_ALE_X0]
+        mm = prm[P_RZ_MAXMOVE]
+        tgeo = tool_geometry(prm)
+        for n in range(tid, nn, nthr):
+            xn[n] = x[n]
+            yn[n] = y[n]
+            tplace(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm, tgeo)
+        grid.sync()
+        for n in range(tid, nn, nthr):
+            tfacep(n, xn, yn, x0, y0, acls, aflt, off)
+        grid.sync()
+        for _sw in range(SWEEPS):
             for n in range(tid, nn, nthr):
-                fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,
-                                         area0, fex, fey, cfx, cfy, fric, pen, ndead, ero_ke,
-                                         nwork, cx, cy, tvx, tvy, prm, dt, twin, tied,
-                                         vslip)
-                if touched:
-                    cuda.atomic.add(red, R_NC, 1.0)
-                if cfx[n] != 0.0 or cfy[n] != 0.0:
-                    cflag[n // LANES] = 1  # the chunk of LANES nodes holding n has contact
+                tsweep(n, acls, aflt, vbuf)
             grid.sync()
-            if cuda.blockIdx.x == 0:
-                # block 0: the contact-force total in the CPU's lane order over the chunks
-                # holding a contact node (the others hold zeros), then the tool
-                m = chunks(cflag, clist, cnt, t, nb)
-                for lane in range(t, LANES, nb):
-                    sx = 0.0
-                    sy = 0.0
-                    for i in range(m):
-                        n = clist[i] * LANES + lane
-                        if n < nn:
-                            sx += cfx[n]
-                            sy += cfy[n]
-                    px[lane] = sx
-                    py[lane] = sy
-                cuda.syncthreads()
-                if t == 0:
-                    sx, sy = lanes_total(px, py, red)
-                    # the split by tool face, in increasing node order over the listed
-                    # chunks (the CPU's serial order; the other nodes carry no force)
-                    split_reset(red)
-                    for i in range(m):
-                        for lane in range(LANES):
-                            n = clist[i] * LANES + lane
-                            if n < nn:
-                                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
-                    en[E_EXT] += tstep(tool, prm, sx, sy, dt)
-                    if prm[P_COND_EVERY] > 0.0:
-                        prm[P_COND_ACC] += dt
-            # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
-            # elements' gated erosion and the ALE pass read (as after k_tool): a barrier
+            for n in range(tid, nn, nthr):
+                tscopy(n, acls, aflt, vbuf)
             grid.sync()
-            if rz_every > 0 and step % rz_every == 0:
-                # the tool-frame ALE pass (rezone.rezone): the same passes in
-                # the same order, a barrier wherever one reads what another wrote
-                off = prm[P_TCX] - prm[P_ALE_X0]
-                mm = prm[P_RZ_MAXMOVE]
-                tgeo = tool_geometry(prm)
-                for n in range(tid, nn, nthr):
-                    xn[n] = x[n]
-                    yn[n] = y[n]
-                    tplace(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm, tgeo)
-                grid.sync()
-                for n in range(tid, nn, nthr):
-                    tfacep(n, xn, yn, x0, y0, acls, aflt, off)
-                grid.sync()
-                for _sw in range(SWEEPS):
-                    for n in range(tid, nn, nthr):
-                        tsweep(n, acls, aflt, vbuf)
-                    grid.sync()
-                    for n in range(tid, nn, nthr):
-                        tscopy(n, acls, aflt, vbuf)
-                    grid.sync()
-                for n in range(tid, nn, nthr):
-                    tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
-                grid.sync()
-                for e in range(tid, ne, nthr):
-                    rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz,
-                          sdxy, pres, eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
-                for k in range(tid, nsn, nthr):
-                    rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
-                grid.sync()
-                for k in range(tid, nsn, nthr):
-                    n = snodes[k]
-                    vx[n] += vbuf[n, 0]
-                    vy[n] += vbuf[n, 1]
-                for e in range(tid, ne, nthr):
-                    rwrite(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx,
-                           qhy, area0)
-                for n in range(tid, nn, nthr):
-                    x[n] = xn[n]
-                    y[n] = yn[n]
-                grid.sync()
-                for n in range(tid, nn, nthr):
-                    rmass(n, ptr, nel, area0, rho_s, mass)
-                grid.sync()
+        for n in range(tid, nn, nthr):
+            tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
+        grid.sync()
+        for e in range(tid, ne, nthr):
+            rflux(e, conn, x, y, xn, yn, alive, a.enbr, a.bflag, a.buf, a.sdx,
+                  a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
+                  a.qhx, a.qhy, area0, mat[TROOM])
+        for k in range(tid, nsn, nthr):
+            rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
+        grid.sync()
+        for k in range(tid, nsn, nthr):
+            n = snodes[k]
+            vx[n] += vbuf[n, 0]
+            vy[n] += vbuf[n, 1]
+        for e in range(tid, ne, nthr):
+            rwrite(e, alive, a.buf, a.sdx, a.sdy, a.sdz, a.sdxy, a.pres,
+                   a.eps_p, a.temp, a.dmg, a.qhx, a.qhy, area0)
+        for n in range(tid, nn, nthr):
+            x[n] = xn[n]
+            y[n] = yn[n]
+        grid.sync()
+        rho_s = mat[RHO] * prm[P_MS]
+        for n in range(tid, nn, nthr):
+            rmass(n, ptr, nel, area0, rho_s, a.mass)
+        grid.sync()
+
+    @cuda.jit(device=True)
+    def elem_phase(e, a, dt, red):
+        d, inv = elem(e, a.conn, a.x, a.y, a.vx, a.vy, a.alive, a.layer,
+                      a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p,
+                      a.temp, a.dmg, a.qhx, a.qhy, a.area0, a.ie, a.hge,
+                      a.fex, a.fey, a.dte, a.plast, a.rate, a.mat, a.prm,
+                      dt, a.erosion)
+        cuda.atomic.min(red, R_DTMIN, d)
+        if inv:
+            cuda.atomic.max(red, R_BAD, float(e))
+
+    @cuda.jit(device=True)
+    def heat_phase(a, step, dt, tid, nthr, grid):
+        # conduction every cond_every steps (the CPU's conduction pass), the phases of the
+        # launch path separated by barriers
+        cond_every = a.cond_every
+        if not (cond_every > 0 and step % cond_every == 0):
+            return
+        conn, x, y, alive, enbr = a.conn, a.x, a.y, a.alive, a.enbr
+        temp, tbuf, mat, prm = a.temp, a.tbuf, a.mat, a.prm
+        ppair = a.ppair
+        ne = conn.shape[0]
+        npair = ppair.shape[0]
+        for e in range(tid, ne, nthr):
+            cent(e, conn, x, y, tbuf)
+        grid.sync()
+        for e in range(tid, ne, nthr):
+            cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
+                 prm[P_COND_ACC])
+        grid.sync()
+        for e in range(tid, ne, nthr):
+            temp[e] = tbuf[e, 3]
+        grid.sync()
+        if npair > 0:
+            for i in range(tid, npair, nthr):
+                pedge(i, ppair, x, y, alive, a.tied, temp, tbuf, mat[KCOND],
+                      mat[RHO] * mat[CP], prm[P_COND_ACC])
+            grid.sync()
+        if a.theat != 0:
+            tcq = a.tcq
+            for n in range(tid, x.shape[0], nthr):
+                thnode(n, conn, x, y, a.ptr, a.nel, a.ncorner, alive, enbr, a.cfx,
+                       a.cfy, a.fric, a.fheat, temp, tbuf, tcq, mat[RHO] * mat[CP],
+                       prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
+            grid.sync()
             for e in range(tid, ne, nthr):
-                d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
-                              eps_p, temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
-                              rate, mat, prm, dt, erosion)
-                cuda.atomic.min(red, R_DTMIN, d)
-                if inv:
-                    cuda.atomic.max(red, R_BAD, float(e))
+                thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
             grid.sync()
-            if cond_every > 0 and step % cond_every == 0:
-                for e in range(tid, ne, nthr):
-                    cent(e, conn, x, y, tbuf)
-                grid.sync()
-                for e in range(tid, ne, nthr):
-                    cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND],
-                         mat[RHO] * mat[CP], prm[P_COND_ACC])
-                grid.sync()
-                for e in range(tid, ne, nthr):
-                    temp[e] = tbuf[e, 3]
-                grid.sync()
-                if npair > 0:
-                    for i in range(tid, npair, nthr):
-                        pedge(i, ppair, x, y, alive, tied, temp, tbuf, mat[KCOND],
-                              mat[RHO] * mat[CP], prm[P_COND_ACC])
-                    grid.sync()
-                if theat != 0:
-                    for n in range(tid, nn, nthr):
-                        thnode(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric,
-                               fheat, temp, tbuf, tcq, mat[RHO] * mat[CP], prm[P_HC],
-                               prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
-                    grid.sync()
-                    for e in range(tid, ne, nthr):
-                        thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
-                    grid.sync()
-                if tid == 0:
-                    prm[P_COND_ACC] = 0.0
-            if tid == 0:
-                finish(tool, prm, clock, ist, hacc, hist, en, red,
-                       (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
-                red[R_DTMIN] = 1e30
-                red[R_BAD] = -1.0
-            grid.sync()
+        if tid == 0:
+            prm[P_COND_ACC] = 0.0
+
+    @cuda.jit(device=True)
+    def finish_phase(a, red):
+        finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red,
+               (a.mass, a.vx, a.vy, a.vx, a.ie, a.plast, a.hge,
+                a.alive, a.fric, a.pen, a.ero_ke, a.nwork))
+
+    # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
+    # elements' gated erosion and the ALE pass read: a barrier after the tool
+    k_run = persistent_kernel(n_sums=2, kinematics=kin, node=node_phase,
+                              lane_sums=lane_sums, tool=tool_phase, elem=elem_phase,
+                              heat=heat_phase, finish=finish_phase, remesh=ale_phase,
+                              sync_after_tool=True)
 
     ale = (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
            k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass)

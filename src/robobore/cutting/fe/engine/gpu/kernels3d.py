@@ -8,26 +8,40 @@ and the shared material/contact/support functions (:mod:`robobore.material.johns
 :func:`robobore.material.johnson_cook.rebind` and compiled with
 ``numba.cuda.jit(device=True)``. :func:`kernels3` returns the launch-per-kernel phases
 (nodes, contact-force total, tool, elements, step end, the heat-conduction kernels) and the
-persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch; the
-host driver is :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`.
+persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
+step loop of :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel` with the 3D
+phases, on the state :data:`RunState3`); the host driver is
+:func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`.
 """
 
 from __future__ import annotations
 
 import functools
+from collections import namedtuple
 
-from robobore.cutting.fe.engine.gpu.shared import (
-    MAX_BLOCK,
-    bind_cuda,
-    chunk_list_py,
-    jc_device_functions,
+from robobore.cutting.fe.engine.gpu.persistent import (
+    R_BAD,
+    R_DTMIN,
+    persistent_kernel,
 )
+from robobore.cutting.fe.engine.gpu.shared import bind_cuda, jc_device_functions
 
-__all__ = ["kernels3", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ", "R_NC", "N_RED"]
+__all__ = ["kernels3", "RUN_ARRAYS", "RunState3", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ",
+           "R_NC", "N_RED"]
 
-# reduction slots on the device (engine.gpu.shared.drive_gpu starts R_DTMIN at 1e30, R_BAD at -1)
-R_DTMIN, R_BAD, R_FX, R_FY, R_FZ, R_NC = 0, 1, 2, 3, 4, 5
+# reduction slots on the device (engine.gpu.persistent's R_DTMIN, R_BAD, then the four sums of
+# its contact-force total: the force and the number of contact nodes)
+R_FX, R_FY, R_FZ, R_NC = 2, 3, 4, 5
 N_RED = 6
+
+#: the state arrays on the device, in the order of the persistent kernel's state
+RUN_ARRAYS = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "ncorner", "conn",
+              "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "ie", "hge",
+              "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead", "ero_ke", "nwork",
+              "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist", "pairs", "enbr",
+              "tbuf", "theat")
+#: the persistent kernel's state: the arrays, then the erosion mode
+RunState3 = namedtuple("RunState3", RUN_ARRAYS + ("erosion",))
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)
@@ -48,7 +62,6 @@ def kernels3():
     global cuda
     cuda = bind_cuda()
     from numba import float64 as _float64
-    from numba import int64 as _int64
 
     from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.hex.element import hex_element_py
@@ -83,13 +96,10 @@ def kernels3():
     from robobore.cutting.fe.engine.history import bind_end_step
     RHO, CP, KCOND = jc.RHO, jc.CP, jc.KCOND
     P_COND_T, P_HC, P_FHEAT, P_TTOOL = K3.P_COND_T, K3.P_HC, K3.P_FHEAT, K3.P_TTOOL
-    chunks = dev(chunk_list_py)
     LANES = K3.N_SUM_LANES
     float64 = _float64
-    int64 = _int64
-    NCNT = MAX_BLOCK + 1
 
-    I_STATUS, I_STEP, ST_OK, E_EXT = K3.I_STATUS, K3.I_STEP, K3.STATUS_OK, K3.E_EXT
+    I_STATUS, ST_OK, E_EXT = K3.I_STATUS, K3.STATUS_OK, K3.E_EXT
     # the end of a step (robobore.cutting.fe.engine.history) bound to the 3D engine, without the
     # per-sample energy totals
     end_step = bind_end_step(dev, K3.ENGINE3, dev(K3.tool_columns3_py), dev(no_energy_totals_py))
@@ -221,106 +231,97 @@ def kernels3():
             return
         finish(tool, prm, clock, ist, hacc, hist, en, red)
 
-    @cuda.jit
-    def k_run(n_steps, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, conn, alive, layer,
-              sd, pres, eps_p, temp, dm, qh, vol0, ie, hge, fe, dte, plast, rate, cf, fric, pen,
-              ndead, ero_ke, nwork, mat, prm, tool, en, ist, clock, hacc, hist, pairs, enbr,
-              tbuf, theat, erosion, red, cflag, clist):
-        # ``n_steps`` whole steps in one cooperative launch (a persistent kernel): the phases
-        # of the five kernels above separated by grid-wide barriers, so the host launches
-        # once per chunk instead of five times per step. Same functions, same order, same
-        # bits as the five launches.
-        grid = cuda.cg.this_grid()
-        tid = cuda.grid(1)
-        nthr = cuda.gridsize(1)
-        t = cuda.threadIdx.x
-        nb = cuda.blockDim.x
-        nn = x.shape[0]
+    # the persistent kernel's phases (engine.gpu.persistent), on the state RunState3
+
+    @cuda.jit(device=True)
+    def node_phase(n, a, kv, dt, red):
+        cx, cy, cz, tvx, tvy, tvz = kv
+        cf = a.cf
+        node(n, a.x, a.y, a.z, a.vx, a.vy, a.vz, a.mass, a.fixed,
+             a.ptr, a.nel, a.ncorner, a.alive, a.vol0, a.fe, cf, a.fric,
+             a.pen, a.ndead, a.ero_ke, a.nwork, a.prm, cx, cy, cz, tvx, tvy,
+             tvz, dt, a.pairs)
+        return cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0
+
+    @cuda.jit(device=True)
+    def lane_sums(a, clist, m, lane, p):
+        # one lane's force and contact-node count over the listed chunks (kernels3d.lane_sum3)
+        cf = a.cf
+        nn = cf.shape[0]
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
+        sc = 0
+        for i in range(m):
+            n = clist[i] * LANES + lane
+            if n < nn and (cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0):
+                sx += cf[n, 0]
+                sy += cf[n, 1]
+                sz += cf[n, 2]
+                sc += 1
+        p[0, lane] = sx
+        p[1, lane] = sy
+        p[2, lane] = sz
+        p[3, lane] = sc
+
+    @cuda.jit(device=True)
+    def tool_phase(a, clist, m, kv, dt, red):
+        a.en[E_EXT] += tstep(a.tool, a.prm, red[R_FX], red[R_FY], red[R_FZ], dt)
+
+    @cuda.jit(device=True)
+    def elem_phase(e, a, dt, red):
+        dte, alive = a.dte, a.alive
+        elem(e, a.conn, a.x, a.y, a.z, a.vx, a.vy, a.vz, alive,
+             a.layer, a.sd, a.pres, a.eps_p, a.temp, a.dmg, a.qh,
+             a.vol0, a.ie, a.hge, a.fe, dte, a.plast, a.rate, a.mat,
+             a.prm, dt, a.erosion)
+        cuda.atomic.min(red, R_DTMIN, dte[e])
+        if alive[e] == -2:
+            red[R_BAD] = e
+
+    @cuda.jit(device=True)
+    def heat_phase(a, step, dt, tid, nthr, grid):
+        # conduction (thermal3d, the CPU's conduction_pass3): the phases of the launch path,
+        # separated by barriers
+        prm, clock = a.prm, a.clock
+        if not is_cond(step, prm):
+            return
+        conn, x, y, z, alive = a.conn, a.x, a.y, a.z, a.alive
+        enbr, pairs, vol0, temp, tbuf = a.enbr, a.pairs, a.vol0, a.temp, a.tbuf
+        mat = a.mat
         ne = conn.shape[0]
-        px = cuda.shared.array(LANES, float64)
-        py = cuda.shared.array(LANES, float64)
-        pz = cuda.shared.array(LANES, float64)
-        pn = cuda.shared.array(LANES, float64)
-        cnt = cuda.shared.array(NCNT, int64)
-        for _ in range(n_steps):
-            if ist[I_STATUS] != ST_OK:
-                return
-            dt = clock[1]
-            # the step number, read before the step's first barrier (thread 0 moves it on
-            # after its last): every thread takes the same conduction branch below
-            step = ist[I_STEP]
-            cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
-            for n in range(tid, nn, nthr):
-                node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe,
-                     cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
-                     pairs)
-                if cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0:
-                    cflag[n // LANES] = 1  # the chunk of LANES nodes holding n has contact
+        dt_th = clock[0] + dt - prm[P_COND_T]
+        rcp = mat[RHO] * mat[CP]
+        for e in range(tid, ne, nthr):
+            centroid3(e, conn, x, y, z, tbuf)
+        grid.sync()
+        for e in range(tid, ne, nthr):
+            conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[KCOND], rcp,
+                     dt_th)
+        grid.sync()
+        for e in range(tid, ne, nthr):
+            temp[e] = tbuf[e, 3]
+        grid.sync()
+        if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+            for n in range(tid, x.shape[0], nthr):
+                heat_node3(n, conn, x, y, z, a.ptr, a.nel, a.ncorner, alive, enbr,
+                           pairs, vol0, a.cf, a.fric, temp, a.theat, rcp, prm[P_HC],
+                           prm[P_FHEAT], prm[P_TTOOL], dt_th)
             grid.sync()
-            if cuda.blockIdx.x == 0:
-                # block 0: the contact-force total in the CPU's lane order, visiting only
-                # the chunks that hold a contact node (the others add nothing), then the tool
-                m = chunks(cflag, clist, cnt, t, nb)
-                for lane in range(t, LANES, nb):
-                    sx = 0.0
-                    sy = 0.0
-                    sz = 0.0
-                    sc = 0
-                    for i in range(m):
-                        n = clist[i] * LANES + lane
-                        if n < nn and (cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0):
-                            sx += cf[n, 0]
-                            sy += cf[n, 1]
-                            sz += cf[n, 2]
-                            sc += 1
-                    px[lane] = sx
-                    py[lane] = sy
-                    pz[lane] = sz
-                    pn[lane] = sc
-                cuda.syncthreads()
-                if t == 0:
-                    sx, sy, sz = lanes_total(px, py, pz, pn, red)
-                    en[E_EXT] += tstep(tool, prm, sx, sy, sz, dt)
-            # elements (they do not read the tool or the contact forces: no barrier needed
-            # after block 0's work above)
             for e in range(tid, ne, nthr):
-                elem(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dm, qh,
-                     vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
-                cuda.atomic.min(red, R_DTMIN, dte[e])
-                if alive[e] == -2:
-                    red[R_BAD] = e
+                heat_elem3(e, conn, alive, temp, a.theat, rcp)
             grid.sync()
-            if is_cond(step, prm):
-                # conduction (thermal3d, the CPU's conduction_pass3): the phases of the five
-                # launches of the launch path, separated by barriers
-                dt_th = clock[0] + dt - prm[P_COND_T]
-                rcp = mat[RHO] * mat[CP]
-                for e in range(tid, ne, nthr):
-                    centroid3(e, conn, x, y, z, tbuf)
-                grid.sync()
-                for e in range(tid, ne, nthr):
-                    conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf,
-                             mat[KCOND], rcp, dt_th)
-                grid.sync()
-                for e in range(tid, ne, nthr):
-                    temp[e] = tbuf[e, 3]
-                grid.sync()
-                if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-                    for n in range(tid, nn, nthr):
-                        heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs,
-                                   vol0, cf, fric, temp, theat, rcp, prm[P_HC], prm[P_FHEAT],
-                                   prm[P_TTOOL], dt_th)
-                    grid.sync()
-                    for e in range(tid, ne, nthr):
-                        heat_elem3(e, conn, alive, temp, theat, rcp)
-                    grid.sync()
-                if tid == 0:
-                    prm[P_COND_T] = clock[0] + dt
-            if tid == 0:
-                finish(tool, prm, clock, ist, hacc, hist, en, red)
-                red[R_DTMIN] = 1e30
-                red[R_BAD] = -1.0
-            grid.sync()
+        if tid == 0:
+            prm[P_COND_T] = clock[0] + dt
+
+    @cuda.jit(device=True)
+    def finish_phase(a, red):
+        finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red)
+
+    # the elements do not read the tool or the contact forces: no barrier after the tool
+    k_run = persistent_kernel(n_sums=4, kinematics=kin, node=node_phase,
+                              lane_sums=lane_sums, tool=tool_phase, elem=elem_phase,
+                              heat=heat_phase, finish=finish_phase)
 
     # the persistent kernel last (benchmarks/gpu_compile_check.py compiles it)
     return (k_nodes, k_contact_sum, k_tool, k_elems, k_finish,

@@ -117,20 +117,22 @@ def chunk_list_py(cflag, clist, cnt, t, nb):
     return cnt[nb]
 
 
-def persistent_run(kernel, args: list, n_nodes: int, profile, persistent: bool | None):
-    """``run(n_steps)`` of a persistent kernel (2D or 3D engine) whose arguments are
-    ``n_steps``, ``args``, the chunk flags and the chunk list (allocated here for ``n_nodes``
-    nodes); ``None`` where the caller launches one kernel per phase (``persistent`` False, or
-    None with a ``profile``, or a cooperative launch that cannot be set up -- then with a
-    warning)."""
+def persistent_run(kernel, state: tuple, red, n_nodes: int, profile,
+                   persistent: bool | None):
+    """``run(n_steps)`` of a persistent kernel (2D or 3D engine, built by
+    :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel`) whose arguments are
+    ``n_steps``, the state ``state`` (a namedtuple), the reduction slots ``red``, the chunk
+    flags and the chunk list (allocated here for ``n_nodes`` nodes); ``None`` where the caller
+    launches one kernel per phase (``persistent`` False, or None with a ``profile``, or a
+    cooperative launch that cannot be set up -- then with a warning)."""
     from robobore.cutting.fe.engine.kernels import N_SUM_LANES
 
     auto = persistent is None
     if not (profile is None if auto else persistent):
         return None
     nchunk = (n_nodes + N_SUM_LANES - 1) // N_SUM_LANES
-    args = list(args) + [cuda.to_device(np.zeros(nchunk, np.int32)),
-                         cuda.to_device(np.zeros(nchunk, np.int64))]
+    args = [state, red, cuda.to_device(np.zeros(nchunk, np.int32)),
+            cuda.to_device(np.zeros(nchunk, np.int64))]
     launch = cooperative(kernel, [1] + args, THREADS, fallback=auto)
     if launch is None:
         return None
@@ -199,7 +201,7 @@ def blocks(n: int) -> int:
 
 
 def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: int, k_run,
-              run_extra: list, launch_step: Callable, copy_back: Callable, label: str,
+              run_state, run_extra: list, launch_step: Callable, copy_back: Callable, label: str,
               chunk_steps: int, progress: Callable[[float], None] | None,
               check: Callable | None, profile: dict[str, float] | None,
               persistent: bool | None) -> int:
@@ -210,8 +212,8 @@ def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: i
     status; returns the number of steps taken.
 
     A chunk is one cooperative launch of the persistent kernel ``k_run`` (arguments: the
-    arrays, ``run_extra``, the ``n_red`` reduction slots of the kernels, the smallest stable
-    step in slot 0 and the inverted element in slot 1; see
+    state ``run_state(*arrays, *run_extra)``, a namedtuple, the ``n_red`` reduction slots of
+    the kernels, the smallest stable step in slot 0 and the inverted element in slot 1; see
     :func:`persistent_run`), or ``launch_step(g, dred, step, tick)`` once per step (``g`` the
     device arrays by name, ``step`` the step's number, ``tick`` the :func:`profile_ticker`).
     After each chunk the step counter and clock come back (the whole state, by
@@ -233,7 +235,7 @@ def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: i
     t_start = st.time
     step0 = int(st.ist[K.I_STEP])
     tick = profile_ticker(profile)
-    run = persistent_run(k_run, [g[name] for name in names] + list(run_extra) + [dred],
+    run = persistent_run(k_run, run_state(*[g[name] for name in names], *run_extra), dred,
                          st.x.shape[0], profile, persistent)
     while True:
         if run is not None:

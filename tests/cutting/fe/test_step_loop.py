@@ -1,0 +1,48 @@
+"""The CPU engines' one step loop (robobore.cutting.fe.engine.step_loop): each engine's phases
+read the state by the names of its chunk-loop state, which must follow the order of the
+state's ``kernel_args()`` (the arrays the host driver hands the loop)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from robobore.cutting.fe.engine import chunk_loop as CL
+from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import step_loop as SL
+
+EX = Path(__file__).parents[3] / "examples"
+
+
+def _state2():
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
+
+    cfg = load_fe_config(EX / "fe_orthogonal.toml")
+    cfg.cut.length_mm = 0.01
+    return setup_orthogonal(cfg).state
+
+
+def _state3():
+    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.io.config import load_toml
+
+    d = load_toml(EX / "fe_boring_paper.toml")
+    d["mesh"]["element_size_um"] = 16.6
+    d["cut"]["cut_length_mm"] = 0.02
+    return setup_boring(parse_boring_config(d)).state
+
+
+@pytest.mark.parametrize("build, names", [(_state2, CL.CHUNK_ARGS), (_state3, K3.CHUNK_ARGS3)])
+def test_the_loop_state_names_the_kernel_arguments_in_order(build, names):
+    st = build()
+    args = st.kernel_args()
+    assert len(args) == len(names)
+    for name, arr in zip(names, args, strict=True):
+        assert getattr(st, name) is arr, name
+
+
+def test_both_engines_run_the_one_loop():
+    for loop in (CL._loop, K3._loop3):
+        assert loop.py_func.__code__ is SL.chunk_loop_py.__code__
