@@ -11,7 +11,7 @@ the number taken. One step (``clock`` = [t, dt, t_acc]):
    the GPU (``fz`` = 0 in 2D) and the number of contact nodes; in 2D also the force by tool
    face into ``split``;
 2. the external work ``en[E_EXT]`` += ``tool_step(s, fx, fy, fz, dt)`` (the tool support);
-3. ``remesh(s, step)``: the 2D rezoning / ALE pass at the steps that have one (3D: none);
+3. ``remesh(s, step)``: the 2D tool-frame ALE pass at the steps that have one (3D: none);
 4. ``elements(s, dt)`` -> ``(dtmin, bad)``: the element update, the smallest stable step [s]
    and an inverted element (-1: none);
 5. ``heat(s, step, t, dt)``: the conduction pass at the steps that have one;
