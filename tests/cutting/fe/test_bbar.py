@@ -23,18 +23,20 @@ from conftest import elastic_tc4, strip_mesh
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
 TC4 = load_material("TC4")
+#: the compiled loop and state of the B-bar element
+BBAR = Phases(element="bbar")
 # a distorted convex quad (counter-clockwise) [m]
 QUAD = np.array([[0.0, 0.0], [11e-6, 1e-6], [12e-6, 9e-6], [-1e-6, 10e-6]])
 
 
 def _bbar_prm():
     prm = default_prm()
-    prm[K.P_ELEM] = K.ELEM_Q4BBAR
     prm[K.P_BV1] = 0.0
     prm[K.P_BV2] = 0.0
     return prm
@@ -47,7 +49,7 @@ def _kernel_stiffness(mat: Material, nodes=QUAD) -> np.ndarray:
     v = 1e3 * 1e-6  # u = 1e-15 m = 1e-10 of the element
     Kmat = np.zeros((8, 8))
     for j in range(8):
-        st = make_state(nodes, conn, np.zeros(4, bool), mat, prm=_bbar_prm())
+        st = make_state(nodes, conn, np.zeros(4, bool), mat, prm=_bbar_prm(), phases=BBAR)
         st.vx[:] = 0.0
         st.vy[:] = 0.0
         (st.vx if j % 2 == 0 else st.vy)[j // 2] = v
@@ -160,7 +162,7 @@ def test_homogeneous_flow_follows_the_flow_curve(kind):
     size, dt, n = 10e-6, 2e-9, 4000
     nodes = np.array([[0, 0], [size, 0], [size, size], [0, size]], float)
     conn = np.array([[0, 1, 2, 3]])
-    st = make_state(nodes, conn, np.zeros(4, bool), TC4, prm=_bbar_prm())
+    st = make_state(nodes, conn, np.zeros(4, bool), TC4, prm=_bbar_prm(), phases=BBAR)
     out = []
     for _ in range(n):
         if kind == "shear":
@@ -202,7 +204,7 @@ def test_elastic_bar_period_and_energy_bbar():
     prm[K.P_HGV] = prm[K.P_HGS] = 0.0
     prm[K.P_SAMPLE_DT] = 2e-8
     mat = elastic_tc4()
-    st = make_state(nodes, conn, fixed, mat, prm=prm, n_samples=20000)
+    st = make_state(nodes, conn, fixed, mat, prm=prm, n_samples=20000, phases=BBAR)
     st.vx[:] = v0 * np.sin(0.5 * math.pi * st.x / length)
     st.vx[fixed] = 0.0
     tip = np.argmax(st.x + st.y)

@@ -17,6 +17,7 @@ from conftest import elastic_tc4, strip_mesh
 
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.errors import NumericalError
 from robobore.material import load_material
@@ -179,7 +180,8 @@ def test_heat_conduction_matches_erfc_and_conserves_heat():
     prm = default_prm()
     prm[K.P_MS] = 1e6  # large mechanical step; the thermal mass is never scaled
     prm[K.P_COND_EVERY] = 1
-    st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm)
+    st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm,
+                    phases=Phases(conduction=True))
     xc = st.x[conn].mean(axis=1)
     x0 = 0.5 * lx
     t0k, dT = 293.0, 400.0
@@ -191,7 +193,7 @@ def test_heat_conduction_matches_erfc_and_conserves_heat():
     exact = t0k + 0.5 * dT * erfc((xc - x0) / (2.0 * math.sqrt(alpha * st.time)))
     assert np.max(np.abs(st.temp - exact)) < 0.02 * dT
     assert np.sum(st.temp * st.area0) == pytest.approx(heat0, rel=1e-12)
-    # and without conduction nothing moves
+    # and without conduction (the adiabatic loop) nothing moves
     prm[K.P_COND_EVERY] = 0
     st2 = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm)
     st2.temp[:] = np.where(xc < x0, t0k + dT, t0k)

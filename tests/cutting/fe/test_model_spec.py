@@ -27,6 +27,7 @@ from robobore.cutting.fe.config.spec import (
     WorkpieceFrame,
     build_spec,
 )
+from robobore.cutting.fe.engine import chunk_loop as CL
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.state2d import default_prm
 from robobore.errors import ConfigError
@@ -72,11 +73,38 @@ def test_the_bundled_configs_choose_their_variants():
         b.frame = s.frame  # type: ignore[misc]
 
 
+def test_the_spec_chooses_the_compiled_step():
+    # the element, frame and thermal types pick one loop each; no kernel branches on them
+    cases = [
+        (load_fe_config(EX / "fe_orthogonal.toml"), CL.Phases("q4r", True, True),
+         CL.run_chunk_ale_heat),
+        (parse_config(_base("tool", solver={"heat_conduction": False})),
+         CL.Phases("q4r", True, False), CL.run_chunk_ale),
+        (load_fe_config(EX / "fe_orthogonal_tool_support.toml"),
+         CL.Phases("q4r", False, False), CL.run_chunk_q4r),
+        (parse_config(_base(solver={"element": "q4_bbar"})), CL.Phases("bbar", False, True),
+         CL.run_chunk_bbar_heat),
+        (parse_config(_base(solver={"element": "q4_bbar", "heat_conduction": False})),
+         CL.Phases("bbar", False, False), CL.run_chunk_bbar),
+        (parse_config(_base(solver={"heat_conduction": True})),
+         CL.Phases("q4r", False, True), CL.run_chunk_q4r_heat),
+    ]
+    for cfg, phases, run in cases:
+        spec = _spec(cfg)
+        assert CL.phases_of(spec) == phases
+        assert CL.step_for(spec) is run
+    # six distinct compiled functions, each cached under its own name
+    names = {f.py_func.__qualname__ for f in CL.RUN_CHUNK.values()}
+    assert len(names) == len(CL.RUN_CHUNK) == 6
+    with pytest.raises(ValueError, match="one-point quad only"):
+        CL.run_chunk_for(CL.Phases("bbar", True, False))
+
+
 def test_the_spec_writes_the_model_slots():
     tool = _spec(load_fe_config(EX / "fe_orthogonal.toml")).write_prm(default_prm(), K, 30.0)
     assert tool[K.P_EROSION] == K.ERODE_NONE and tool[K.P_GATE] == -1.0
     assert tool[K.P_DT_ERODE] == 0.0 and tool[K.P_RZ_EVERY] == 10
-    assert tool[K.P_ELEM] == K.ELEM_Q4R and tool[K.P_MUTAB_N] == 6
+    assert tool[K.P_MUTAB_N] == 6
     assert tool[K.P_MUTAB_V + 5] == pytest.approx(40.0 / 60.0)
     assert tool[K.P_SLIP_TAU] == pytest.approx(1e-6 / 0.5) and tool[K.P_COND_EVERY] == 10
     ns = _spec(parse_config(_base(mesh={"separation": "node_split"},
@@ -88,7 +116,6 @@ def test_the_spec_writes_the_model_slots():
     el = _spec(parse_config(_base(solver={"separation_gate_um": 2.0, "element": "q4_bbar"})))
     p = el.write_prm(default_prm(), K, 30.0)
     assert p[K.P_GATE] == pytest.approx(2e-6) and p[K.P_EROSION] == K.ERODE_LAYER
-    assert p[K.P_ELEM] == K.ELEM_Q4BBAR
     none = _spec(parse_config(_base(solver={"erosion": "none"})))
     assert none.write_prm(default_prm(), K, 30.0)[K.P_EROSION] == K.ERODE_NONE
 

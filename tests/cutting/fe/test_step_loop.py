@@ -44,5 +44,7 @@ def test_the_loop_state_names_the_kernel_arguments_in_order(build, names):
 
 
 def test_both_engines_run_the_one_loop():
-    for loop in (CL._loop, K3._loop3):
+    loops = [CL._loop_q4r, CL._loop_q4r_heat, CL._loop_bbar, CL._loop_bbar_heat, CL._loop_ale,
+             CL._loop_ale_heat, K3._loop3]
+    for loop in loops:
         assert loop.py_func.__code__ is SL.chunk_loop_py.__code__

@@ -17,6 +17,7 @@ from conftest import strip_mesh
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine.chunk_driver import advance
+from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.state2d import default_prm, make_state, parting_edges
 from robobore.cutting.fe.mesh.orthogonal import _split_nodes
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal
@@ -41,7 +42,8 @@ def _step_state(nodes, conn, twin, y0, t0k, dT):
     prm = default_prm()
     prm[K.P_MS] = 1e6  # large mechanical step; the thermal mass is never scaled
     prm[K.P_COND_EVERY] = 1
-    st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm, twin=twin)
+    st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm, twin=twin,
+                    phases=Phases(conduction=True))
     yc = st.y[conn].mean(axis=1)
     st.temp[:] = np.where(yc > y0, t0k + dT, t0k)
     return st, yc

@@ -180,7 +180,9 @@ class ModelSpec:
     def write_prm(self, p: np.ndarray, kernels: Any, vc_m_per_min: float) -> np.ndarray:
         """Write the model-choice slots of an engine's parameter vector ``p`` (returned):
         frame, separation, element, erosion, friction and thermal slots. ``kernels`` is the
-        engine's kernel module (its ``P_*`` indices, ``ERODE_*`` and ``ELEM_*`` codes)."""
+        engine's kernel module (its ``P_*`` indices and ``ERODE_*`` codes). The element type,
+        the frame and the thermal model also choose the compiled step
+        (:func:`robobore.cutting.fe.engine.chunk_loop.step_for`)."""
         k = kernels
         fr = self.frame
         if isinstance(fr, ToolFrame):
@@ -203,11 +205,8 @@ class ModelSpec:
             p[k.P_RZ_EVERY] = 0
             p[k.P_RZ_MAXMOVE] = ToolFrame.MAX_MOVE
         if isinstance(element, OnePointQuad):
-            p[k.P_ELEM] = k.ELEM_Q4R
             p[k.P_HGV] = element.hourglass_viscous
             p[k.P_HGS] = element.hourglass_stiffness
-        else:
-            p[k.P_ELEM] = k.ELEM_Q4BBAR
         write_friction(p, self.friction, kernels, vc_m_per_min)
         write_thermal(p, self.thermal, kernels)
         return p

@@ -1,7 +1,8 @@
 """The host driver of the compiled loops: :func:`drive_chunks` runs a chunk loop (2D or 3D)
 to an end time with progress and checks between chunks and turns a non-finite state or a
 collapsing time step into :class:`robobore.errors.NumericalError`; :func:`advance` drives
-the 2D loop (:func:`robobore.cutting.fe.engine.chunk_loop.run_chunk`); :func:`energy_error` is
+the 2D loop of the state's model choices
+(:func:`robobore.cutting.fe.engine.chunk_loop.run_chunk_for`); :func:`energy_error` is
 the energy-balance error checked during a run.
 """
 
@@ -29,7 +30,7 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
                  check: Callable[[Any], None] | None = None,
                  adaptive_threads: bool = True,
                  governor: ThreadGovernor | None = None) -> int:
-    """Run a compiled chunk loop (2D ``run_chunk`` or 3D ``run_chunk3``) until ``t_end`` [s].
+    """Run a compiled chunk loop (2D ``run_chunk_*`` or 3D ``run_chunk3``) until ``t_end`` [s].
 
     Shared by :func:`advance` and :func:`~robobore.cutting.fe.engine.state3d.advance3`: ``st`` has
     ``prm``, ``ist``, ``time`` and ``kernel_args()``; ``p_tend`` is the index of the end time in
@@ -76,14 +77,19 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
 def advance(st: FEState, t_end: float, *, chunk_steps: int = 2000,
             progress: Callable[[float], None] | None = None,
             check: Callable[[FEState], None] | None = None,
-            adaptive_threads: bool = True, governor: ThreadGovernor | None = None) -> int:
+            adaptive_threads: bool = True, governor: ThreadGovernor | None = None,
+            step: Callable[..., int] | None = None) -> int:
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
+
+    ``step``: the compiled chunk function (:func:`~robobore.cutting.fe.engine.chunk_loop.step_for`
+    of the model spec); default the one of ``st.phases``.
 
     ``progress(fraction_done)`` is called between chunks; ``check(state)`` too (it may raise).
     Raises NumericalError (with step, time and cause) on instability. ``adaptive_threads``,
     ``governor``: see :func:`drive_chunks`.
     """
-    return drive_chunks(st, t_end, K.run_chunk, K.P_TEND, chunk_steps=chunk_steps,
+    run = K.run_chunk_for(st.phases) if step is None else step
+    return drive_chunks(st, t_end, run, K.P_TEND, chunk_steps=chunk_steps,
                         label="simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um or less "
                         "mass scaling", progress=progress, check=check,

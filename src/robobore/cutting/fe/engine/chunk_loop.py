@@ -1,29 +1,46 @@
-"""The compiled time-step loop of the plane-strain engine (:func:`run_chunk`), a chunk of
-steps at a time: the step loop of both CPU engines (:mod:`robobore.cutting.fe.engine.step_loop`)
-with the 2D phases -- node update and contact with the force by tool face, tool, the
-tool-frame ALE pass, the one-point or B-bar elements, heat passes -- on the state
-:data:`ChunkState`; each step ends with the engines' shared end of step
-(:mod:`robobore.cutting.fe.engine.history`: stop conditions, time-averaged histories, history
-samples with the energy totals), bound here to the 2D layout (:data:`ENGINE2`,
-:func:`tool_columns_py`, :data:`sum_energies_py`).
+"""The compiled time-step loops of the plane-strain engine, a chunk of steps at a time: the
+step loop of both CPU engines (:mod:`robobore.cutting.fe.engine.step_loop`) with the 2D phases
+-- node update and contact with the force by tool face, tool, the tool-frame ALE pass, the
+one-point or B-bar elements, heat passes -- on the state :data:`ChunkState`; each step ends
+with the engines' shared end of step (:mod:`robobore.cutting.fe.engine.history`: stop
+conditions, time-averaged histories, history samples with the energy totals), bound here to
+the 2D layout (:data:`ENGINE2`, :func:`tool_columns_py`, :data:`sum_energies_py`).
+
+The model choices are compiled in, not branched on: :class:`Phases` (element, tool frame,
+conduction) names one specialised loop, :func:`phases_of` reads it from a
+:class:`~robobore.cutting.fe.config.spec.ModelSpec`, and :func:`step_for` /
+:func:`run_chunk_for` return its compiled chunk function. Each of the six buildable choices
+is its own module-level ``njit(cache=True)`` function (:data:`RUN_CHUNK`), compiled on first
+use and then loaded from numba's cache:
+
+=========================  ==========  ==========  ===========================
+function                   element     frame       thermal
+=========================  ==========  ==========  ===========================
+``run_chunk_q4r``          one-point   workpiece   adiabatic
+``run_chunk_q4r_heat``     one-point   workpiece   conduction
+``run_chunk_bbar``         B-bar       workpiece   adiabatic
+``run_chunk_bbar_heat``    B-bar       workpiece   conduction
+``run_chunk_ale``          one-point   tool        adiabatic
+``run_chunk_ale_heat``     one-point   tool        conduction
+=========================  ==========  ==========  ===========================
 """
 
 from __future__ import annotations
 
 from collections import namedtuple
+from dataclasses import dataclass
+from typing import Any, Literal
 
 from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
 from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.engine.layout import (
-    ELEM_Q4BBAR,
     P_ALE_X0,
     P_CFL,
     P_COND_ACC,
     P_COND_EVERY,
     P_DTMIN,
-    P_ELEM,
     P_EROSION,
     P_FHEAT,
     P_HC,
@@ -42,7 +59,7 @@ from robobore.cutting.fe.engine.layout import (
     T_GX,
     T_UX,
 )
-from robobore.cutting.fe.engine.step_loop import bind_chunk_loop
+from robobore.cutting.fe.engine.step_loop import bind_chunk_loop, no_remesh_py
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
     parting_conduct,
@@ -137,9 +154,8 @@ def _remesh(s, step):
         s.x, s.y, s.vx, s.vy, s.mass, s.conn, s.alive, s.ptr, s.nel, s.enbr, s.snodes,
         s.xn, s.yn, s.buf, s.sdx, s.sdy, s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.qhx,
         s.qhy, s.area0, s.x0, s.y0, s.vbuf, s.acls, s.aflt, s.bflag, s.mat, s.prm)
-    rz_every = int(prm[P_RZ_EVERY])
     rho_s = mat[jc.RHO] * prm[P_MS]
-    if rz_every > 0 and step % rz_every == 0 and snodes.shape[0] > 0:
+    if step % int(prm[P_RZ_EVERY]) == 0 and snodes.shape[0] > 0:
         rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx,
                sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
                prm[P_RZ_MAXMOVE], x0, y0, vbuf, tool_geometry(prm), acls, aflt, bflag,
@@ -147,56 +163,156 @@ def _remesh(s, step):
 
 
 @njit
-def _elements(s, dt):
-    prm = s.prm
-    erosion = int(prm[P_EROSION])
-    if int(prm[P_ELEM]) == ELEM_Q4BBAR:
-        return element_update_bbar(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx,
-                                   s.sdy, s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.gps,
-                                   s.area0, s.ie, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat,
-                                   prm, dt, erosion)
+def _elements_q4r(s, dt):
+    # the one-point quad with hourglass control
     return element_update(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy, s.sdz,
                           s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.qhx, s.qhy, s.area0, s.ie,
-                          s.hge, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat, prm, dt, erosion)
+                          s.hge, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat, s.prm, dt,
+                          int(s.prm[P_EROSION]))
+
+
+@njit
+def _elements_bbar(s, dt):
+    # the B-bar quad
+    return element_update_bbar(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy,
+                               s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.gps, s.area0,
+                               s.ie, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat, s.prm, dt,
+                               int(s.prm[P_EROSION]))
 
 
 @njit
 def _heat(s, step, t, dt):
     # conduction every prm[P_COND_EVERY] steps over the time accumulated since the last pass
     prm, mat = s.prm, s.mat
-    cond_every = int(prm[P_COND_EVERY])
-    if cond_every > 0:
-        prm[P_COND_ACC] += dt
-        if step % cond_every == 0:
-            conn, x, y, alive, enbr, temp, tbuf = s.conn, s.x, s.y, s.alive, s.enbr, s.temp, s.tbuf
-            rcp = mat[jc.RHO] * mat[jc.CP]
-            conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp, prm[P_COND_ACC])
-            if s.ppair.shape[0] > 0:
-                parting_conduct(s.ppair, x, y, alive, s.tied, temp, tbuf, mat[jc.KCOND], rcp,
-                                prm[P_COND_ACC])
-            if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-                tool_heat(conn, x, y, s.ptr, s.nel, s.ncorner, alive, enbr, s.cfx, s.cfy,
-                          s.fric, s.fheat, temp, tbuf, s.tcq, rcp, prm[P_HC], prm[P_FHEAT],
-                          prm[P_TTOOL], prm[P_COND_ACC])
-            prm[P_COND_ACC] = 0.0
+    prm[P_COND_ACC] += dt
+    if step % int(prm[P_COND_EVERY]) == 0:
+        conn, x, y, alive, enbr, temp, tbuf = s.conn, s.x, s.y, s.alive, s.enbr, s.temp, s.tbuf
+        rcp = mat[jc.RHO] * mat[jc.CP]
+        conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp, prm[P_COND_ACC])
+        if s.ppair.shape[0] > 0:
+            parting_conduct(s.ppair, x, y, alive, s.tied, temp, tbuf, mat[jc.KCOND], rcp,
+                            prm[P_COND_ACC])
+        if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
+            tool_heat(conn, x, y, s.ptr, s.nel, s.ncorner, alive, enbr, s.cfx, s.cfy,
+                      s.fric, s.fheat, temp, tbuf, s.tcq, rcp, prm[P_HC], prm[P_FHEAT],
+                      prm[P_TTOOL], prm[P_COND_ACC])
+        prm[P_COND_ACC] = 0.0
 
 
-#: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 2D phases
-_loop = bind_chunk_loop(state=ChunkState, n_split=ENGINE2["N_SPLIT"],
-                        energy_arrays=_energy_arrays, kinematics=tool_kinematics, nodes=_nodes,
-                        tool_step=_tool_step, remesh=_remesh, elements=_elements, heat=_heat,
-                        end_step=_end_step, energy_totals=_energy_totals)
+@njit
+def _no_heat(s, step, t, dt):
+    # adiabatic: no heat pass
+    return None
+
+
+_no_remesh = njit(no_remesh_py)
+
+
+def _bind(elements, remesh, heat):
+    # the step loop of robobore.cutting.fe.engine.step_loop bound to the 2D phases
+    return bind_chunk_loop(state=ChunkState, n_split=ENGINE2["N_SPLIT"],
+                           energy_arrays=_energy_arrays, kinematics=tool_kinematics,
+                           nodes=_nodes, tool_step=_tool_step, remesh=remesh,
+                           elements=elements, heat=heat, end_step=_end_step,
+                           energy_totals=_energy_totals)
+
+
+@dataclass(frozen=True)
+class Phases:
+    """The model choices one compiled 2D loop is specialised for: ``element`` "q4r" (one-point
+    quad) or "bbar" (B-bar quad); ``tool_frame``: the tool-frame ALE pass every
+    ``prm[P_RZ_EVERY]`` steps (one-point quad only); ``conduction``: the heat pass every
+    ``prm[P_COND_EVERY]`` steps (>= 1), else adiabatic."""
+
+    element: Literal["q4r", "bbar"] = "q4r"
+    tool_frame: bool = False
+    conduction: bool = False
+
+
+def phases_of(spec: Any) -> Phases:
+    """The :class:`Phases` of a :class:`~robobore.cutting.fe.config.spec.ModelSpec`: the
+    element from ``spec.frame.element``'s type, the ALE pass for a ``ToolFrame``, the heat
+    pass for ``Conduction``."""
+    from robobore.cutting.fe.config.spec import BBarQuad, Conduction, ToolFrame
+
+    return Phases(element="bbar" if isinstance(spec.frame.element, BBarQuad) else "q4r",
+                  tool_frame=isinstance(spec.frame, ToolFrame),
+                  conduction=isinstance(spec.thermal, Conduction))
+
+
+_loop_q4r = _bind(_elements_q4r, _no_remesh, _no_heat)
+_loop_q4r_heat = _bind(_elements_q4r, _no_remesh, _heat)
+_loop_bbar = _bind(_elements_bbar, _no_remesh, _no_heat)
+_loop_bbar_heat = _bind(_elements_bbar, _no_remesh, _heat)
+_loop_ale = _bind(_elements_q4r, _remesh, _no_heat)
+_loop_ale_heat = _bind(_elements_q4r, _remesh, _heat)
 
 
 @njit(cache=True)
-def run_chunk(n_steps, *arrays):
-    """Advance up to ``n_steps`` central-difference steps (the whole loop in numba) of the
-    state arrays ``FEState.kernel_args()`` (:data:`CHUNK_ARGS`): the step loop of
-    :mod:`robobore.cutting.fe.engine.step_loop` with the 2D phases (node update and contact,
-    tool, the tool-frame ALE pass, the one-point or B-bar elements, conduction with the
-    parting-line edges and the thermal contact). Each step ends with
+def run_chunk_q4r(n_steps, *arrays):
+    """:func:`run_chunk_for` ``Phases("q4r")``: workpiece frame, one-point quad, adiabatic."""
+    return _loop_q4r(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk_q4r_heat(n_steps, *arrays):
+    """Workpiece frame, one-point quad, conduction."""
+    return _loop_q4r_heat(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk_bbar(n_steps, *arrays):
+    """Workpiece frame, B-bar quad, adiabatic."""
+    return _loop_bbar(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk_bbar_heat(n_steps, *arrays):
+    """Workpiece frame, B-bar quad, conduction."""
+    return _loop_bbar_heat(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk_ale(n_steps, *arrays):
+    """Tool frame (the ALE pass), one-point quad, adiabatic."""
+    return _loop_ale(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk_ale_heat(n_steps, *arrays):
+    """Tool frame (the ALE pass), one-point quad, conduction."""
+    return _loop_ale_heat(n_steps, *arrays)
+
+
+#: the compiled chunk function of each buildable :class:`Phases`
+RUN_CHUNK = {
+    Phases("q4r", False, False): run_chunk_q4r,
+    Phases("q4r", False, True): run_chunk_q4r_heat,
+    Phases("bbar", False, False): run_chunk_bbar,
+    Phases("bbar", False, True): run_chunk_bbar_heat,
+    Phases("q4r", True, False): run_chunk_ale,
+    Phases("q4r", True, True): run_chunk_ale_heat,
+}
+
+
+def run_chunk_for(phases: Phases):
+    """The compiled chunk function ``run_chunk(n_steps, *arrays)`` of ``phases``: advances up
+    to ``n_steps`` central-difference steps (the whole loop in numba) of the state arrays
+    ``FEState.kernel_args()`` (:data:`CHUNK_ARGS`) -- node update and contact, tool, the
+    tool-frame ALE pass (tool frame only), the chosen element, conduction with the
+    parting-line edges and the thermal contact (conduction only) -- each step ending with
     :func:`robobore.cutting.fe.engine.history.end_step_py` (stop checks, time-averaged
     histories, samples): stops early with ``ist[I_STATUS]`` = STATUS_DONE at ``prm[P_TEND]``
-    or an instability status. Returns the number of steps taken.
-    """
-    return _loop(n_steps, *arrays)
+    or an instability status. Returns the number of steps taken. ValueError for a choice
+    with no loop (the tool frame with the B-bar element)."""
+    try:
+        return RUN_CHUNK[phases]
+    except KeyError:
+        raise ValueError(f"no compiled 2D loop for {phases} (the tool frame has the "
+                         "one-point quad only)") from None
+
+
+def step_for(spec: Any):
+    """The compiled chunk function of a :class:`~robobore.cutting.fe.config.spec.ModelSpec`
+    (:func:`run_chunk_for` of :func:`phases_of`)."""
+    return run_chunk_for(phases_of(spec))

@@ -8,7 +8,7 @@ and adds the step's contribution to the time-averaged channels; :func:`sample_hi
 writes one history row when a sample interval is complete. Both are plain-Python scalar
 functions in the project's device-ready style: :func:`bind_end_step` binds them to one
 engine's layout (:func:`robobore.material.johnson_cook.rebind`) and compiles them with
-``numba.njit`` for the CPU loops (:func:`robobore.cutting.fe.engine.chunk_loop.run_chunk`,
+``numba.njit`` for the CPU loops (:func:`robobore.cutting.fe.engine.chunk_loop.run_chunk_for`,
 :func:`robobore.cutting.fe.engine.kernels3d.run_chunk3`) or ``numba.cuda.jit(device=True)`` for the
 GPU kernels (:mod:`robobore.cutting.fe.engine.gpu.kernels2d`,
 :mod:`robobore.cutting.fe.engine.gpu.kernels3d`).

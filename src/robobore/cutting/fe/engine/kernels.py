@@ -13,7 +13,8 @@ names of its modules in one place.
 * :mod:`~robobore.cutting.fe.physics.thermal2d`: heat conduction, across the parting line and with
   the tool.
 * :mod:`~robobore.cutting.fe.quad.tool_motion`: the tool's kinematics and its support springs.
-* :mod:`~robobore.cutting.fe.engine.chunk_loop`: the compiled time-step loop (:func:`run_chunk`).
+* :mod:`~robobore.cutting.fe.engine.chunk_loop`: the compiled time-step loops
+  (:func:`run_chunk_for`, :func:`step_for`: one per model choice).
 
 The per-element, per-node, conduction and tool updates are plain-Python scalar functions
 (``*_py``) that allocate nothing; the CPU loops call their ``njit`` versions
@@ -24,7 +25,9 @@ for an NVIDIA GPU.
 from __future__ import annotations
 
 from robobore.cutting.fe.engine.chunk_loop import (
-    run_chunk,
+    Phases,
+    run_chunk_for,
+    step_for,
     sum_energies_py,
 )
 from robobore.cutting.fe.engine.layout import (
@@ -37,8 +40,6 @@ from robobore.cutting.fe.engine.layout import (
     E_KIN,
     E_NODEWORK,
     E_PLAST,
-    ELEM_Q4BBAR,
-    ELEM_Q4R,
     ERODE_LAYER,
     ERODE_NONE,
     FACES,
@@ -92,7 +93,6 @@ from robobore.cutting.fe.engine.layout import (
     P_DIST,
     P_DT_ERODE,
     P_DTMIN,
-    P_ELEM,
     P_EROSION,
     P_FHEAT,
     P_GATE,
@@ -238,7 +238,6 @@ __all__ = [
     "P_TCY",
     "P_COND_EVERY",
     "P_COND_ACC",
-    "P_ELEM",
     "P_HC",
     "P_FHEAT",
     "P_TTOOL",
@@ -250,8 +249,6 @@ __all__ = [
     "P_MUTAB_MU",
     "P_SLIP_TAU",
     "N_PRM",
-    "ELEM_Q4R",
-    "ELEM_Q4BBAR",
     "G_SX",
     "G_SY",
     "G_SZ",
@@ -364,5 +361,7 @@ __all__ = [
     "tool_step_py",
     "tool_kinematics",
     "tool_step",
-    "run_chunk",
+    "Phases",
+    "run_chunk_for",
+    "step_for",
 ]

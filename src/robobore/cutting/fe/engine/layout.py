@@ -4,8 +4,8 @@
 :data:`PRM_FIELDS`, bound as module constants at import), ``tool`` float64 tool state
 (``T_*``), ``en`` float64 energy accumulators (``E_*``), ``ist`` int64 counters/status
 (``I_*``, ``STATUS_*``), ``hist`` (n_samples, N_HIST) histories (``H_*``, the column order of
-:mod:`robobore.cutting.fe.engine.history`); element formulations (``ELEM_*``),
-per-Gauss-point state of the B-bar element (``G_*``), damage erosion (``ERODE_*``).
+:mod:`robobore.cutting.fe.engine.history`); per-Gauss-point state of the B-bar element
+(``G_*``), damage erosion (``ERODE_*``).
 """
 
 from __future__ import annotations
@@ -64,7 +64,6 @@ PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     # heat
     ("P_COND_EVERY", 1, "steps between heat-conduction passes (0: adiabatic)"),
     ("P_COND_ACC", 1, "time accumulated since the last conduction pass [s]"),
-    ("P_ELEM", 1, "element formulation: ELEM_Q4R or ELEM_Q4BBAR"),
     ("P_HC", 1, "tool interface conductance [W/(m^2 K)] (conduction runs)"),
     ("P_FHEAT", 1, "fraction of the frictional dissipation that heats the workpiece"),
     ("P_TTOOL", 1, "tool heat-sink temperature [K]"),
@@ -77,7 +76,6 @@ PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     ("P_SLIP_TAU", 1, "time constant of the filter on the sliding speed [s]"),
 )
 globals().update(prm_slots(PRM_FIELDS))
-ELEM_Q4R, ELEM_Q4BBAR = 0, 1
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
 N_GPS = 5

@@ -15,6 +15,7 @@ import numpy as np
 from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
 from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.errors import ConfigError
 from robobore.material import Material
 
@@ -152,6 +153,9 @@ class FEState:
     bflag: np.ndarray = field(default=None)  # type: ignore[assignment]
     #: friction by sliding speed: each node's filtered sliding speed [m/s] (n_nodes,)
     vslip: np.ndarray = field(default=None)  # type: ignore[assignment]
+    # --- the model choices the compiled loop is specialised for (not a kernel argument)
+    #: element, tool frame, conduction (engine.chunk_loop.Phases; advance runs its loop)
+    phases: Phases = field(default_factory=Phases)
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
@@ -200,8 +204,11 @@ def default_prm() -> np.ndarray:
 def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material: Material,
                prm: np.ndarray | None = None, layer: np.ndarray | None = None,
                n_samples: int = 1, tool_center: tuple[float, float] = (1e3, 1e3),
-               twin: np.ndarray | None = None) -> FEState:
+               twin: np.ndarray | None = None, phases: Phases | None = None) -> FEState:
     """State for a quad mesh ``nodes`` (n, 2) [m], ``conn`` (e, 4) counter-clockwise.
+
+    ``phases``: the model choices of the compiled loop (default: one-point quad, workpiece
+    frame, adiabatic); the B-bar element gets its Gauss-point state.
 
     Lumped nodal masses from the (mass-scaled) density; stresses zero; temperature at
     T_room. The tool starts with its edge centre at ``tool_center`` [m].
@@ -238,6 +245,7 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
     tool = np.zeros(K.N_TOOL)
     tool[K.T_GX], tool[K.T_GY] = tool_center
     z = np.zeros
+    phases = Phases() if phases is None else phases
     st = FEState(
         x=xs, y=ys, vx=z(n), vy=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.bool_),
         ptr=ptr, nel=nel, ncorner=nco, conn=conn,
@@ -255,10 +263,10 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),
         tbuf=z((ne, 4)),
-        gps=z((ne if int(prm[K.P_ELEM]) == K.ELEM_Q4BBAR else 0, 4, K.N_GPS)),
+        gps=z((ne if phases.element == "bbar" else 0, 4, K.N_GPS)),
         fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)),
         acls=np.zeros((0, 7), np.int64), aflt=z((0, 6)), bflag=np.zeros((0, 4), np.int64),
-        vslip=z(n))
+        vslip=z(n), phases=phases)
     init_forces(st)
     return st
 

@@ -21,8 +21,9 @@ the number taken. One step (``clock`` = [t, dt, t_acc]):
 With ``totals_at_chunk_end`` the energy totals are summed after a chunk that ran to its end
 (3D: the host's energy check reads them).
 
-The engines wrap the loop in their own ``njit(cache=True)`` function (``run_chunk``,
-``run_chunk3``), so numba's cache of each sits beside the engine's phases and is renewed
+The engines wrap the loop in their own ``njit(cache=True)`` functions (2D: one per model
+choice, ``run_chunk_*`` of :mod:`robobore.cutting.fe.engine.chunk_loop`; 3D: ``run_chunk3``),
+so numba's cache of each sits beside the engine's phases and is renewed
 when that module changes; like any callee in another module, a change to this module needs
 the cache files cleared (``*.nbi``, ``*.nbc``).
 """

@@ -1,6 +1,6 @@
 """The CPU engines' thread count on a shared machine.
 
-The CPU time loop (2D ``run_chunk``, 3D ``run_chunk3``) launches two parallel regions per time
+The CPU time loop (2D ``run_chunk_*``, 3D ``run_chunk3``) launches two parallel regions per time
 step (node update, element update) and more every few steps (heat conduction, the tool frame's
 remap); on the 2D meshes each region is a few tens of microseconds of work and ends in a
 barrier. When another process holds one of the cores, every region waits for the thread the

@@ -24,6 +24,7 @@ from robobore.cutting.fe.engine.chunk_driver import (
     energy_check,
     energy_error,
 )
+from robobore.cutting.fe.engine.chunk_loop import phases_of, step_for
 from robobore.cutting.fe.engine.state2d import (
     FEState,
     default_prm,
@@ -159,7 +160,8 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         p[K.P_ALE_X0], p[K.P_TCX], p[K.P_TCY] = cx0, cx0, cy0
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p,
                     layer=getattr(mesh, "layer", None), n_samples=s.n_samples,
-                    tool_center=(cx0, cy0), twin=getattr(mesh, "twin", None))
+                    tool_center=(cx0, cy0), twin=getattr(mesh, "twin", None),
+                    phases=phases_of(spec))
     if tool_frame:
         st.acls, st.aflt, st.bflag = mesh.acls.copy(), mesh.aflt.copy(), mesh.bflag.copy()
         st.snodes = np.where(mesh.acls[:, 0] != TF_RIGID)[0].astype(np.int64)
@@ -209,8 +211,10 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
         steps = advance_gpu(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
                             progress=progress, check=check)
     else:
+        # the loop compiled for the spec's element, frame and thermal model
         steps = advance(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
-                        progress=progress, check=check)
+                        progress=progress, check=check,
+                        step=None if setup.spec is None else step_for(setup.spec))
     return time.perf_counter() - t0, steps
 
 

@@ -104,7 +104,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     as in :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu` (per-kernel wall times for
     benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
-    check_gpu_supported("q4r" if int(st.prm[K.P_ELEM]) == K.ELEM_Q4R else "q4_bbar")
+    check_gpu_supported("q4r" if st.phases.element == "q4r" else "q4_bbar")
     # the tool-frame ALE pass every rz_every steps (0: the Lagrangian workpiece frame)
     rz_every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
     require_gpu()
