@@ -76,6 +76,7 @@ def main() -> int:
     from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.engine import kernels as K
     from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.chunk_loop import Phases
     from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
     from robobore.cutting.fe.engine.gpu import backend3d as gpu
     from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
@@ -85,12 +86,13 @@ def main() -> int:
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
     d["mesh"]["element_size_um"] = 16.6
     st3 = setup_boring(parse_boring_config(d)).state
-    k2 = gpu2d._kernels()
-    # the tool-frame model's state: the same argument types as the workpiece frame's, with
-    # the ALE arrays filled
+    # the tool-frame model's state (conduction on): the same argument types as the workpiece
+    # frame's, with the ALE arrays filled; the kernels of its phases (ALE and heat: the
+    # largest persistent kernel)
     cfg = load_fe_config(ROOT / "examples" / "fe_orthogonal_toolframe.toml")
     cfg.cut.length_mm = 0.01
     st2 = setup_orthogonal(cfg).state
+    k2 = gpu2d._kernels(st2.phases)
 
     def chunk_arrays(nn: int) -> list:
         n = (nn + K.N_SUM_LANES - 1) // K.N_SUM_LANES
@@ -102,12 +104,18 @@ def main() -> int:
                      [1, gpu.RunState3(*[np.ascontiguousarray(getattr(st3, n))
                                          for n in gpu._RUN_ARGS], int(st3.prm[K3.P_EROSION])),
                       np.zeros(gpu.N_RED)] + chunk_arrays(st3.x.shape[0])),
-        "2D k_run": (k2[-2],
-                     [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n))
-                                          for n in gpu2d._ARRAYS], int(st2.prm[K.P_EROSION]),
-                                        1, 1, int(st2.prm[K.P_RZ_EVERY])),
-                      np.zeros(gpu2d.N_RED)] + chunk_arrays(st2.x.shape[0])),
     }
+    # the 2D persistent kernel of each GPU model choice (the tool frame and conduction, each
+    # on or off), compiled for the tool-frame state's argument types
+    run2 = [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS],
+                              int(st2.prm[K.P_EROSION]), 1, 1, int(st2.prm[K.P_RZ_EVERY])),
+            np.zeros(gpu2d.N_RED)] + chunk_arrays(st2.x.shape[0])
+    for tool_frame in (True, False):
+        for conduction in (True, False):
+            ph = Phases("q4r", tool_frame, conduction)
+            name = (f"2D k_run ({'tool' if tool_frame else 'workpiece'} frame, "
+                    f"{'conduction' if conduction else 'adiabatic'})")
+            cases[name] = (gpu2d._kernels(ph)[-2], run2)
     # the launch-per-kernel path's contact total (with the split by face) and ALE kernels,
     # their arguments by name from the tool-frame state
     alias = {"dm": "dmg"}

@@ -104,16 +104,18 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     as in :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu` (per-kernel wall times for
     benchmarks; one cooperative launch per chunk, the default without ``profile``).
     """
-    check_gpu_supported("q4r" if st.phases.element == "q4r" else "q4_bbar")
-    # the tool-frame ALE pass every rz_every steps (0: the Lagrangian workpiece frame)
-    rz_every = int(st.prm[K.P_RZ_EVERY]) if st.snodes is not None and st.snodes.shape[0] else 0
+    phases = st.phases
+    check_gpu_supported("q4r" if phases.element == "q4r" else "q4_bbar")
+    # the tool-frame ALE pass every rz_every steps (the tool frame only), conduction every
+    # cond_every steps (conduction only): the kernels of the state's phases
+    rz_every = int(st.prm[K.P_RZ_EVERY]) if phases.tool_frame else 0
+    cond_every = int(st.prm[K.P_COND_EVERY]) if phases.conduction else 0
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,
-     ale) = _kernels()
+     ale) = _kernels(phases)
     gn, ge = blocks(st.x.shape[0]), blocks(st.conn.shape[0])
     erosion = int(st.prm[K.P_EROSION])
-    cond_every = int(st.prm[K.P_COND_EVERY])
     npair = int(st.ppair.shape[0])
     gp, gs = blocks(npair), blocks(int(st.snodes.shape[0]))
     theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
@@ -133,7 +135,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         tick("contact_sum")
         k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
         tick("tool")
-        if rz_every > 0 and step % rz_every == 0:
+        if phases.tool_frame and step % rz_every == 0:
             _ale_launches(g, ale, gn, ge, gs)
             tick("ale")
         k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
@@ -143,7 +145,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                               g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                               g["clock"], erosion, g["ist"], dred)
         tick("elements")
-        if cond_every > 0 and step % cond_every == 0:
+        if phases.conduction and step % cond_every == 0:
             k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
             k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
                                     g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])

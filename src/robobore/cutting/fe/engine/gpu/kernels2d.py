@@ -5,9 +5,11 @@ engine (their device versions: :func:`robobore.cutting.fe.engine.gpu.device2d.de
 elements, the heat-conduction kernels, step end, the tool-frame ALE passes) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
 step loop of :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel` with the 2D
-phases, on the state :data:`RunState`); the host driver is
-:func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring describes the
-step's phases.
+phases, on the state :data:`RunState`), for one
+:class:`~robobore.cutting.fe.engine.chunk_loop.Phases` -- the CPU loop's model choice: the
+ALE phase only in the tool frame, the heat phase only with conduction, compiled in; the host
+driver is :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring
+describes the step's phases.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import functools
 from collections import namedtuple
 
 from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
 from robobore.cutting.fe.engine.gpu.persistent import (
     R_BAD,
@@ -43,7 +46,8 @@ RUN_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "c
               "clock", "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair",
               "vslip", "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
 #: the persistent kernel's state: the arrays, then the erosion mode, the conduction interval
-#: [steps] (0: none), 1 with the thermal contact, the ALE interval [steps] (0: none)
+#: [steps] (read with conduction only), 1 with the thermal contact, the ALE interval [steps]
+#: (read in the tool frame only)
 RunState = namedtuple("RunState", RUN_ARRAYS + ("erosion", "cond_every", "theat", "rz_every"))
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
@@ -51,12 +55,16 @@ RunState = namedtuple("RunState", RUN_ARRAYS + ("erosion", "cond_every", "theat"
 cuda = None
 
 
-@functools.lru_cache(maxsize=1)
-def kernels2():
-    """Compile (lazily, once) the device functions and kernels: ``(k_nodes, k_contact_sum,
-    k_tool, k_elems, k_centroids, k_conduct, k_conduct_end, k_parting, k_theat_nodes,
-    k_theat_elems, k_conduct_reset, k_finish, k_run, ale)`` with ``ale`` the tool-frame ALE
-    pass's kernels (the launch-per-kernel path)."""
+@functools.cache
+def kernels2(phases: Phases):
+    """Compile (lazily, once per ``phases``) the device functions and kernels: ``(k_nodes,
+    k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end, k_parting,
+    k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run, ale)`` with ``ale`` the
+    tool-frame ALE pass's kernels (the launch-per-kernel path). ``phases.element`` must be
+    "q4r" (the GPU engine's element); ``k_run`` has the ALE phase with ``phases.tool_frame``
+    and the heat phase with ``phases.conduction``."""
+    if phases.element != "q4r":
+        raise ValueError(f"no GPU kernels for {phases} (the GPU engine has the one-point quad)")
     global cuda
     cuda = bind_cuda()
     from numba import float64 as _float64
@@ -71,9 +79,10 @@ def kernels2():
         f.pedge, f.thnode, f.thelem, f.end_step, f.lsum)
     LANES = K.N_SUM_LANES
     float64 = _float64
+    CONDUCTION = phases.conduction
 
     I_STATUS, ST_OK = K.I_STATUS, K.STATUS_OK
-    P_COND_EVERY, P_COND_ACC = K.P_COND_EVERY, K.P_COND_ACC
+    P_COND_ACC = K.P_COND_ACC
     P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
     P_TCX, P_NRX, P_NRY, P_NFX, P_NFY = K.P_TCX, K.P_NRX, K.P_NRY, K.P_NFX, K.P_NFY
     P_ALE_X0, P_RZ_MAXMOVE, P_MS = K.P_ALE_X0, K.P_RZ_MAXMOVE, K.P_MS
@@ -230,7 +239,7 @@ def kernels2():
             return
         dt = clock[1]
         en[E_EXT] += tstep(tool, prm, red[R_FX], red[R_FY], dt)
-        if prm[P_COND_EVERY] > 0.0:
+        if CONDUCTION:
             prm[P_COND_ACC] += dt
         red[R_DTMIN] = 1e30
         red[R_BAD] = -1.0
@@ -362,15 +371,14 @@ def kernels2():
                 if n < nn:
                     split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
         a.en[E_EXT] += tstep(a.tool, prm, red[R_FX], red[R_FY], dt)
-        if prm[P_COND_EVERY] > 0.0:
+        if CONDUCTION:
             prm[P_COND_ACC] += dt
 
     @cuda.jit(device=True)
     def ale_phase(a, step, tid, nthr, grid):
-        # the tool-frame ALE pass (rezone.rezone): the same passes in the
+        # the tool-frame ALE pass (rezone.rezone) every rz_every steps: the same passes in the
         # same order, a barrier wherever one reads what another wrote
-        rz_every = a.rz_every
-        if not (rz_every > 0 and step % rz_every == 0):
+        if step % a.rz_every != 0:
             return
         x, y, xn, yn, x0, y0 = a.x, a.y, a.xn, a.yn, a.x0, a.y0
         vx, vy, acls, aflt, vbuf = a.vx, a.vy, a.acls, a.aflt, a.vbuf
@@ -438,8 +446,7 @@ def kernels2():
     def heat_phase(a, step, dt, tid, nthr, grid):
         # conduction every cond_every steps (the CPU's conduction pass), the phases of the
         # launch path separated by barriers
-        cond_every = a.cond_every
-        if not (cond_every > 0 and step % cond_every == 0):
+        if step % a.cond_every != 0:
             return
         conn, x, y, alive, enbr = a.conn, a.x, a.y, a.alive, a.enbr
         temp, tbuf, mat, prm = a.temp, a.tbuf, a.mat, a.prm
@@ -475,6 +482,11 @@ def kernels2():
             prm[P_COND_ACC] = 0.0
 
     @cuda.jit(device=True)
+    def no_heat(a, step, dt, tid, nthr, grid):
+        # adiabatic: no heat phase
+        return None
+
+    @cuda.jit(device=True)
     def finish_phase(a, red):
         finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red,
                (a.mass, a.vx, a.vy, a.vx, a.ie, a.plast, a.hge,
@@ -484,7 +496,9 @@ def kernels2():
     # elements' gated erosion and the ALE pass read: a barrier after the tool
     k_run = persistent_kernel(n_sums=2, kinematics=kin, node=node_phase,
                               lane_sums=lane_sums, tool=tool_phase, elem=elem_phase,
-                              heat=heat_phase, finish=finish_phase, remesh=ale_phase,
+                              heat=heat_phase if phases.conduction else no_heat,
+                              finish=finish_phase,
+                              remesh=ale_phase if phases.tool_frame else None,
                               sync_after_tool=True)
 
     ale = (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
