@@ -48,3 +48,21 @@ def test_both_engines_run_the_one_loop():
              CL._loop_ale_heat, K3._loop3]
     for loop in loops:
         assert loop.py_func.__code__ is SL.chunk_loop_py.__code__
+
+
+def test_a_compiled_pass_without_its_interval_is_refused():
+    import numpy as np
+    from conftest import strip_mesh
+
+    from robobore.cutting.fe.engine.chunk_driver import advance
+    from robobore.cutting.fe.engine.state2d import default_prm, make_state
+    from robobore.errors import ConfigError
+    from robobore.material import load_material
+
+    nodes, conn = strip_mesh(4, 1, 4e-5, 1e-5)
+    for phases, slot in ((CL.Phases(conduction=True), "P_COND_EVERY"),
+                         (CL.Phases(tool_frame=True), "P_RZ_EVERY")):
+        st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), load_material("TC4"),
+                        prm=default_prm(), phases=phases)
+        with pytest.raises(ConfigError, match=slot):
+            advance(st, 1e-9)

@@ -21,7 +21,7 @@ from robobore.cutting.fe.engine.state2d import (
 )
 from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 from robobore.cutting.fe.engine.threads import ThreadGovernor
-from robobore.errors import NumericalError
+from robobore.errors import ConfigError, NumericalError
 
 
 def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: int, *,
@@ -82,12 +82,21 @@ def advance(st: FEState, t_end: float, *, chunk_steps: int = 2000,
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
 
     ``step``: the compiled chunk function (:func:`~robobore.cutting.fe.engine.chunk_loop.step_for`
-    of the model spec); default the one of ``st.phases``.
+    of the model spec); default the one of ``st.phases``. ConfigError when ``st.phases`` has
+    the ALE or heat pass and its interval (``prm[P_RZ_EVERY]``, ``prm[P_COND_EVERY]``) is
+    below one step.
 
     ``progress(fraction_done)`` is called between chunks; ``check(state)`` too (it may raise).
     Raises NumericalError (with step, time and cause) on instability. ``adaptive_threads``,
     ``governor``: see :func:`drive_chunks`.
     """
+    # the intervals the compiled ALE and heat phases divide the step number by
+    for on, slot, name in ((st.phases.tool_frame, K.P_RZ_EVERY, "P_RZ_EVERY"),
+                           (st.phases.conduction, K.P_COND_EVERY, "P_COND_EVERY")):
+        if on and st.prm[slot] < 1:
+            raise ConfigError(f"{st.phases} needs an interval of at least one step",
+                              field=f"prm[{name}]", value=float(st.prm[slot]),
+                              expected=">= 1")
     run = K.run_chunk_for(st.phases) if step is None else step
     return drive_chunks(st, t_end, run, K.P_TEND, chunk_steps=chunk_steps,
                         label="simulation",
