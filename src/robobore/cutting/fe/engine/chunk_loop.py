@@ -208,9 +208,9 @@ def _no_heat(s, step, t, dt):
 _no_remesh = njit(no_remesh_py)
 
 
-def _bind(elements, remesh, heat):
+def _bind(name, elements, remesh, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 2D phases
-    return bind_chunk_loop(state=ChunkState, n_split=ENGINE2["N_SPLIT"],
+    return bind_chunk_loop(name=name, state=ChunkState, n_split=ENGINE2["N_SPLIT"],
                            energy_arrays=_energy_arrays, kinematics=tool_kinematics,
                            nodes=_nodes, tool_step=_tool_step, remesh=remesh,
                            elements=elements, heat=heat, end_step=_end_step,
@@ -240,12 +240,13 @@ def phases_of(spec: Any) -> Phases:
                   conduction=isinstance(spec.thermal, Conduction))
 
 
-_loop_q4r = _bind(_elements_q4r, _no_remesh, _no_heat)
-_loop_q4r_heat = _bind(_elements_q4r, _no_remesh, _heat)
-_loop_bbar = _bind(_elements_bbar, _no_remesh, _no_heat)
-_loop_bbar_heat = _bind(_elements_bbar, _no_remesh, _heat)
-_loop_ale = _bind(_elements_q4r, _remesh, _no_heat)
-_loop_ale_heat = _bind(_elements_q4r, _remesh, _heat)
+# one loop per choice, each under its own name (step_loop.bind_chunk_loop)
+_loop_q4r = _bind("loop2_q4r", _elements_q4r, _no_remesh, _no_heat)
+_loop_q4r_heat = _bind("loop2_q4r_heat", _elements_q4r, _no_remesh, _heat)
+_loop_bbar = _bind("loop2_bbar", _elements_bbar, _no_remesh, _no_heat)
+_loop_bbar_heat = _bind("loop2_bbar_heat", _elements_bbar, _no_remesh, _heat)
+_loop_ale = _bind("loop2_ale", _elements_q4r, _remesh, _no_heat)
+_loop_ale_heat = _bind("loop2_ale_heat", _elements_q4r, _remesh, _heat)
 
 
 @njit(cache=True)

@@ -337,7 +337,7 @@ def _heat3(s, step, t, dt):
 
 
 #: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 3D phases
-_loop3 = bind_chunk_loop(state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
+_loop3 = bind_chunk_loop(name="loop3", state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
                          energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
                          nodes=_nodes3, tool_step=_tool_step3, elements=_elements3,
                          heat=_heat3, end_step=_end_step3, energy_totals=_energy_totals3,

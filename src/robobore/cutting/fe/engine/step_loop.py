@@ -75,20 +75,27 @@ def no_remesh_py(s, step):
     return None
 
 
-def bind_chunk_loop(*, state, n_split: int, energy_arrays, kinematics, nodes, tool_step,
-                    elements, heat, end_step, energy_totals, remesh=None,
+def bind_chunk_loop(*, name: str, state, n_split: int, energy_arrays, kinematics, nodes,
+                    tool_step, elements, heat, end_step, energy_totals, remesh=None,
                     totals_at_chunk_end: bool = False):
     """:func:`chunk_loop_py` bound to one engine and compiled with ``numba.njit``.
 
-    ``state``: the namedtuple class of the state arrays (the order of ``kernel_args()``);
+    ``name``: the bound loop's own ``__qualname__``, distinct for each binding: numba names
+    a compiled function's machine code by its qualified name, a per-process counter and its
+    argument types, so two bindings of one name with the same argument types, each compiled
+    in another process and both loaded from numba's cache into one, could resolve to one
+    machine code; ``state``: the namedtuple class of the state arrays (the order of
+    ``kernel_args()``);
     ``n_split``: the length of the force-by-face buffer (the engine's ``N_SPLIT``);
     ``energy_arrays(s)``: the arrays of ``energy_totals(es, en)``; ``end_step``: the engine's
     :func:`robobore.cutting.fe.engine.history.bind_end_step`; the phases as in the module
     docstring, each already compiled with ``njit``.
     """
-    return njit(rebind(
+    loop = rebind(
         chunk_loop_py, State=state, N_SPLIT=n_split, energy_arrays=energy_arrays,
         kinematics=kinematics, nodes=nodes, tool_step=tool_step,
         remesh=njit(no_remesh_py) if remesh is None else remesh, elements=elements,
         heat=heat, end_step=end_step, energy_totals=energy_totals,
-        TOTALS_AT_CHUNK_END=totals_at_chunk_end))
+        TOTALS_AT_CHUNK_END=totals_at_chunk_end)
+    loop.__name__ = loop.__qualname__ = name
+    return njit(loop)
