@@ -87,6 +87,8 @@ from robobore.material import johnson_cook as jc
 #: state arrays ``es`` = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
 #: ``en`` [J/m] (serial, a fixed order)
 sum_energies_py = jc.rebind(energy_totals_py, NDIM=2)
+# its own name (see history.bind_end_step)
+sum_energies_py.__name__ = sum_energies_py.__qualname__ = "sum_energies_py"
 
 
 def tool_columns_py(tool):

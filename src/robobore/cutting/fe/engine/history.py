@@ -253,5 +253,11 @@ def bind_end_step(dev, engine: dict, tool_columns, energy_totals):
         raise ValueError(f"engine description {sorted(engine)}: expected the names "
                          f"{ENGINE_NAMES}")
     names = dict(engine, tool_columns=tool_columns, energy_totals=energy_totals)
-    sample = dev(rebind(sample_history_py, **names))
-    return dev(rebind(end_step_py, sample_history=sample, **names))
+    # each binding under its engine's own name: numba names machine code by qualified name,
+    # a per-process counter and argument types (the same in 2D and 3D), so bindings sharing
+    # a name, loaded from numba's cache into one process, could run one another's code
+    sample = rebind(sample_history_py, **names)
+    sample.__name__ = sample.__qualname__ = f"sample_history{engine['NDIM']}d"
+    end = rebind(end_step_py, sample_history=dev(sample), **names)
+    end.__name__ = end.__qualname__ = f"end_step{engine['NDIM']}d"
+    return dev(end)

@@ -218,6 +218,8 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
 #: state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
 #: ``en`` (2D engine's indices) [J]
 sum_energies3_py = jc.rebind(energy_totals_py, NDIM=3)
+# its own name (see history.bind_end_step)
+sum_energies3_py.__name__ = sum_energies3_py.__qualname__ = "sum_energies3_py"
 _energy_totals3 = njit(sum_energies3_py)
 
 
