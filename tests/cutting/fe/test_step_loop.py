@@ -6,7 +6,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+from conftest import strip_mesh
 
 from robobore.cutting.fe.engine import chunk_loop as CL
 from robobore.cutting.fe.engine import kernels3d as K3
@@ -51,9 +53,6 @@ def test_both_engines_run_the_one_loop():
 
 
 def test_a_compiled_pass_without_its_interval_is_refused():
-    import numpy as np
-    from conftest import strip_mesh
-
     from robobore.cutting.fe.engine.chunk_driver import advance
     from robobore.cutting.fe.engine.state2d import default_prm, make_state
     from robobore.errors import ConfigError
