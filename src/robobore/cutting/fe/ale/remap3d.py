@@ -177,6 +177,10 @@ def swept_face_py(e, f, conn, x, y, z, xn, yn, zn):
     b = conn[e, face_corner(f, 1)]
     c = conn[e, face_corner(f, 2)]
     d = conn[e, face_corner(f, 3)]
+    if (x[a] == xn[a] and y[a] == yn[a] and z[a] == zn[a] and x[b] == xn[b] and y[b] == yn[b]
+            and z[b] == zn[b] and x[c] == xn[c] and y[c] == yn[c] and z[c] == zn[c]
+            and x[d] == xn[d] and y[d] == yn[d] and z[d] == zn[d]):
+        return 0.0  # a face that does not move sweeps nothing (not a round-off residue)
     return hex_volume(x[a], x[b], x[c], x[d], xn[a], xn[b], xn[c], xn[d],
                       y[a], y[b], y[c], y[d], yn[a], yn[b], yn[c], yn[d],
                       z[a], z[b], z[c], z[d], zn[a], zn[b], zn[c], zn[d])
