@@ -573,9 +573,19 @@ def build_toolframe3d_mesh(insert: BoringInsert, ap: float, f: float,
                 a[nd, 0] = TF_CHAIN if i < na else TF_LINE
                 a[nd, 1] = top[i - 1]
                 a[nd, 2] = top[i + 1] if i < na else -1
-            for nd in range(n_a):  # neighbours into block B do not exist here
-                if a[nd, 0] == TF_INTERIOR and np.any(a[nd, 3:7] >= n_a):
-                    raise AssertionError("block A interior node with a block B neighbour")
+            # edge neighbours within block A (the 2D builder's sorted lists)
+            nbrs: list[set[int]] = [set() for _ in range(n_a)]
+            for el in conn2[:e_a]:
+                for c in range(4):
+                    p0, p1 = int(el[c]), int(el[(c + 1) % 4])
+                    nbrs[p0].add(p1)
+                    nbrs[p1].add(p0)
+            for nd in range(n_a):
+                lst = sorted(nbrs[nd])[:4]
+                if a[nd, 0] == TF_INTERIOR and len(lst) != 4:
+                    raise AssertionError("block A interior node without 4 neighbours")
+                a[nd, 3:7] = -1
+                a[nd, 3:3 + len(lst)] = lst
         nbr = a[:, 1:]
         a[:, 1:] = np.where(nbr >= 0, nbr + o, -1)
         acls[o:o + a.shape[0]] = a
