@@ -50,9 +50,13 @@ block, so ``t`` is clamped to ``t_min`` (:class:`ToolFrame3DSizes`). The clamp a
 fictitious chip of area ``int max(0, t_min - t) dz`` (:func:`clamp_area`): for the paper's
 condition 0.96 % of the true chip area at t_min = 5 um, 3.7 % at 10 um; the mesh's own
 figure (top surface interpolated between slices) is in :attr:`ToolFrameMesh3D.areas`. The
-price of a small ``t_min``: the chip block keeps the reference's rows, so its elements at
-the ends are ``t_min / t(0)`` times thinner than at the tip (the explicit step falls with
-them); see :attr:`ToolFrameMesh3D.min_edge`.
+price of a small ``t_min``: the chip block keeps the reference's rows (spaced towards
+uniform in thin slices, :class:`SectionPlan`), so its elements at the ends are about
+``t_min / t(0)`` times thinner than at the tip and the explicit step falls with them. At
+the paper's condition with 12.5 um elements the hexahedra's stable-step length
+``1 / sqrt(2 b.b)`` is 0.22 um at the thin ends for t_min = 5 um and 0.36 um for 10 um,
+against 1.02 um in the nose-tip slice (10 um elements: 0.18 / 0.31 / 0.89 um; 6.25 um:
+0.12 / 0.22 / 0.57 um); :attr:`ToolFrameMesh3D.min_edge` is the shortest element edge.
 
 **Margins.** ``margin_slices`` slices beyond each end of the engagement carry block A only,
 its top flat at ``y_top(z)``, which lies below the edge there (the insert clears the
@@ -165,8 +169,12 @@ class SectionPlan:
     ``x_in``, ``x_out`` [m] inflow and back faces; ``chip_length`` [m]; ``q1`` fractions of
     the stations ahead of the join point, ``n_arc_a``/``n_arc_b`` arc intervals of blocks A
     and B, ``q_xb`` fractions behind the edge centre, ``eta_a``/``eta_b`` row fractions,
-    ``q_sr`` fractions along the rake face."""
+    ``q_sr`` fractions along the rake face; ``h_ref`` [m] the reference thickness. A slice
+    thinner than the reference spaces its chip rows ``eta_b`` between the reference's
+    grading and uniform rows in proportion ``h / h_ref`` (the chip's first row would
+    otherwise shrink with ``h`` at the same fraction)."""
 
+    h_ref: float
     r: float
     rake: float
     clearance: float
@@ -221,7 +229,7 @@ def section_plan(h_ref: float, r: float, rake: float, clearance: float, *, eleme
     q_sr = _graded_fractions(chip_length, fine, coarse, ratio)
     n_jb = max(6, int(math.ceil(tc / (0.5 * (fine + coarse)))) + 2)
     eta_b = _graded_fractions(1.0, fine / tc, 1.0 / (n_jb - 3), ratio)
-    return SectionPlan(r=r, rake=rake, clearance=clearance, element_size=element_size,
+    return SectionPlan(h_ref=h_ref, r=r, rake=rake, clearance=clearance, element_size=element_size,
                        edge_size=edge_size, chip_ratio=chip_ratio, ratio=ratio, x_in=x_in,
                        x_out=x_out, chip_length=chip_length, q1=q1, n_arc_a=n_arc_a, q_xb=q_xb,
                        eta_a=eta_a, n_arc_b=n_arc_b, q_sr=q_sr, eta_b=eta_b)
@@ -293,8 +301,9 @@ def section_nodes(plan: SectionPlan, h: float, depth: float) -> tuple[np.ndarray
     bot_b = np.vstack([np.column_stack([xs1, np.full(n1 + 1, S[1])]), seg2_bot[1:]])
     top_b = np.vstack([top1, top2[1:]])
     nb = bot_b.shape[0] - 1
-    eta_b = plan.eta_b
-    jb = eta_b.size - 1
+    jb = plan.eta_b.size - 1
+    w = min(1.0, h / plan.h_ref)
+    eta_b = w * plan.eta_b + (1.0 - w) * np.linspace(0.0, 1.0, jb + 1)
     s_top = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(top_a, axis=0).T))])
     x_bot = x_in + (x_out - x_in) * s_top / s_top[-1]
     E = eta_a[None, :]
