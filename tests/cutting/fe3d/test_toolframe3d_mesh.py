@@ -28,6 +28,9 @@ from robobore.cutting.fe.mesh.toolframe3d import (
     ToolFrame3DSizes,
     build_toolframe3d_mesh,
     clamp_area,
+    s_of_y,
+    section_coords,
+    section_nodes,
     uncut_thickness,
 )
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
@@ -197,3 +200,16 @@ def test_node_neighbours_stay_in_their_slice(mesh):
 def test_bad_clamp_is_rejected():
     with pytest.raises(ValueError, match="t_min"):
         build_toolframe3d_mesh(INSERT, AP, F, ToolFrame3DSizes(LE, t_min=0.0))
+
+
+def test_every_slice_is_its_normal_section_mapped_exactly(mesh):
+    # back into each engaged slice's normal-section frame, the nodes are the 2D
+    # construction at the slice's thickness (the bottom at the flat plane y_bottom)
+    r = 20e-6
+    for k in np.flatnonzero(mesh.engaged):
+        z = mesh.z_slices[k]
+        sel = mesh.node_slice == k
+        back = section_coords(INSERT, mesh.nodes[sel], mesh.h2[k])
+        s_bot = float(s_of_y(INSERT, np.array([mesh.y_bottom]), np.array([z]))[0])
+        want, _ = section_nodes(mesh.plan, float(mesh.h2[k]), s_bot - r)
+        assert np.allclose(back, want, rtol=0.0, atol=1e-12), k

@@ -107,8 +107,8 @@ from robobore.cutting.geometry import BoringInsert, chip_area, lead_end, trailin
 
 __all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", "FK_INFLOW",
            "FK_OUTFLOW", "FK_TOOL", "FK_FREE", "FK_BOTTOM", "FK_SIDE", "section_plan",
-           "section_nodes", "slice_map", "uncut_thickness", "clamp_area",
-           "build_toolframe3d_mesh"]
+           "section_nodes", "slice_map", "section_coords", "s_of_y", "uncut_thickness",
+           "clamp_area", "build_toolframe3d_mesh"]
 
 #: kind of a hexahedron face: shared by two elements, inflow face (virgin material enters),
 #: outflow face (machined-surface side back face, chip top face), on the insert (rake face
@@ -375,6 +375,27 @@ def slice_map(insert: BoringInsert, z: float, xy2: np.ndarray, h2: float) -> np.
         arc = np.array([edge_section(float(a), float(z), rn, kap, kend, re)[1] for a in y])
         x = u + tani * arc
     return np.column_stack([x, y, zz])
+
+
+@njit(cache=True)
+def _section_coords(x, y, z, h2, rn, kappa, kend, re, tani, out):
+    for k in range(x.shape[0]):
+        s, arc, _my, _mz = edge_section(y[k], z[k], rn, kappa, kend, re)
+        out[k, 0] = -(x[k] - tani * arc)
+        out[k, 1] = (re - h2[k]) - s
+
+
+def section_coords(insert: BoringInsert, xyz: np.ndarray, h2: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`slice_map`: points (n, 3) of the 3D frame to the 2D
+    normal-section frame (n, 2) of a slice built for normal thickness ``h2`` (scalar or per
+    point) -- the frame in which the 2D tool-frame placement (``ale.rezone.tf_*``) works."""
+    rn, kap, kend, re = _insert_args(insert)
+    xyz = np.ascontiguousarray(xyz, np.float64)
+    h = np.ascontiguousarray(np.broadcast_to(np.asarray(h2, float), (xyz.shape[0],)))
+    out = np.empty((xyz.shape[0], 2))
+    _section_coords(xyz[:, 0].copy(), xyz[:, 1].copy(), xyz[:, 2].copy(), h, rn, kap, kend,
+                    re, math.tan(math.radians(insert.inclination_deg)), out)
+    return out
 
 
 def uncut_thickness(insert: BoringInsert, ap: float, f: float, z: np.ndarray) -> np.ndarray:
