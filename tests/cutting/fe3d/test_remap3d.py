@@ -303,3 +303,36 @@ def test_extruded_mesh_equals_the_2d_remap_times_the_thickness():
     assert np.allclose(r["vel"][mid, 0], vel2[:, 0] + vbuf[:, 0], rtol=1e-12, atol=1e-12)
     assert np.allclose(r["vel"][mid, 1], vel2[:, 1] + vbuf[:, 1], rtol=1e-12, atol=1e-12)
     assert np.allclose(r["vel"][:, 2], 0.0, atol=1e-12)
+
+
+def test_runs_on_the_engine_state_and_keeps_its_lumped_masses():
+    # the pass takes the arrays of FEState3 as they are (face neighbours: the state's
+    # enbr); its lumped masses are the engine's (make_state3) for the remapped vol0
+    from robobore.cutting.fe.ale.remap3d import N_RZ3, remap3d
+    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.state3d import make_state3
+    from robobore.material import load_material
+
+    nodes, conn, _, inner = _box()
+    mat = load_material("TC4")
+    st = make_state3(nodes, conn, np.zeros(nodes.shape[0], np.int64), mat)
+    rho_s = mat.rho * st.prm[K3.P_MS]
+    rng = np.random.default_rng(4)
+    st.vx[:] = rng.normal(size=st.vx.size)
+    st.sd[:] = rng.normal(size=st.sd.shape) * 1e8
+    mass0 = st.mass.copy()
+    p0 = np.array([np.sum(st.mass * v) for v in (st.vx, st.vy, st.vz)])
+    new = _interior_move(nodes, inner, 0.2, 4)
+    buf = np.zeros((st.n_elements, N_RZ3))
+    vbuf = np.zeros((nodes.shape[0], 3))
+    remap3d(st.x, st.y, st.z, new[:, 0].copy(), new[:, 1].copy(), new[:, 2].copy(), st.vx,
+            st.vy, st.vz, st.mass, st.fixed, st.conn, st.alive, st.ptr, st.nel, st.enbr,
+            np.zeros((0, 6), np.int64), st.sd, st.pres, st.eps_p, st.temp, st.dmg, st.qh,
+            st.vol0, rho_s, mat.T_room, VEL_MOMENTUM, buf, vbuf)
+    assert np.array_equal(st.nodes(), new)
+    want = np.zeros(nodes.shape[0])
+    np.add.at(want, conn.ravel(), np.repeat(st.vol0 * rho_s / 8.0, 8))
+    assert np.allclose(st.mass, want, rtol=1e-14, atol=0.0)
+    assert st.mass.sum() == pytest.approx(mass0.sum(), rel=1e-13)
+    p1 = np.array([np.sum(st.mass * v) for v in (st.vx, st.vy, st.vz)])
+    assert np.allclose(p1, p0, rtol=0.0, atol=1e-12 * np.sum(mass0 * np.abs(st.vx)))
