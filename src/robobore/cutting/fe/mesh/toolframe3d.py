@@ -541,13 +541,11 @@ def build_toolframe3d_mesh(insert: BoringInsert, ap: float, f: float,
     idx_a = np.arange(n_a).reshape(na + 1, ja + 1)
     coords, sl, loc = [], [], []
     offs = np.zeros(nk + 1, np.int64)
-    sec_a = None
     for k in range(nk):
         if eng[k]:
             s_bot = float(s_of_y(insert, np.array([y_bot]), np.array([z[k]]))[0])
             sec, _ = section_nodes(plan, float(h2[k]), s_bot - r)
             p3 = slice_map(insert, float(z[k]), sec, float(h2[k]))
-            sec_a = p3[:n_a]
         else:
             p3 = None
         coords.append(p3)
@@ -564,7 +562,6 @@ def build_toolframe3d_mesh(insert: BoringInsert, ap: float, f: float,
         ya = y_bot + plan.eta_a[None, :] * (y_top[k] - y_bot)
         coords[k] = np.column_stack([xa.ravel(), np.broadcast_to(ya, xa.shape).ravel(),
                                      np.full(n_a, z[k])])
-    del sec_a
     for k in range(nk):
         sl.append(np.full(coords[k].shape[0], k, np.int64))
         loc.append(np.arange(coords[k].shape[0], dtype=np.int64))
