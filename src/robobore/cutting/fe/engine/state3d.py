@@ -11,10 +11,11 @@ accumulators).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from robobore.cutting.fe.ale.remap3d import N_RZ3
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.chunk_driver import drive_chunks, energy_error
 from robobore.cutting.fe.engine.threads import ThreadGovernor
@@ -86,10 +87,56 @@ class FEState3:
     enbr: np.ndarray
     tbuf: np.ndarray
     theat: np.ndarray
+    #: tool-frame ALE (``mesh.frame = "tool"``, :mod:`robobore.cutting.fe.ale.rezone3d`; zero
+    #: rows in the workpiece frame, so the loop's arguments are one list): the nodes' places
+    #: when the mesh was built (n,) [m] (each pass puts a node back to its place shifted by
+    #: the insert's travel); ``acls`` (n, 7) int64 node class and in-slice neighbours,
+    #: ``aflt`` (n, 6) the placement's geometric data, ``bflag`` (e, 6) int64 the remap's
+    #: flux flag of each face (:mod:`robobore.cutting.fe.mesh.toolframe3d`); scratch: new
+    #: node places ``xn, yn, zn`` (n,), remapped element fields ``buf`` (e, remap3d.N_RZ3),
+    #: nodal velocities ``vbuf`` (n, 3) and the placement's work array ``scratch`` (n, 3)
+    x0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    y0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    z0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    acls: np.ndarray = field(default_factory=lambda: np.zeros((0, 7), np.int64))
+    aflt: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    bflag: np.ndarray = field(default_factory=lambda: np.zeros((0, 6), np.int64))
+    xn: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    yn: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    zn: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    buf: np.ndarray = field(default_factory=lambda: np.zeros((0, N_RZ3)))
+    vbuf: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    scratch: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def kernel_args(self) -> tuple:
         """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
         return tuple(getattr(self, f.name) for f in fields(self))
+
+    @property
+    def tool_frame(self) -> bool:
+        """Whether the state carries the tool-frame ALE arrays (the loop with the ALE pass,
+        :func:`kernels3d.run_chunk3_ale`, runs it)."""
+        return self.x0.shape[0] > 0
+
+    def attach_tool_frame(self, acls: np.ndarray, aflt: np.ndarray, bflag: np.ndarray) -> None:
+        """Give the state the tool-frame ALE arrays: the current node positions as the
+        nodes' places, the node classes ``acls`` (n, 7), the placement data ``aflt`` (n, 6),
+        the faces' flux flags ``bflag`` (e, 6), and the scratch arrays."""
+        n = self.x.shape[0]
+        ne = self.conn.shape[0]
+        acls = np.ascontiguousarray(acls, np.int64)
+        aflt = np.ascontiguousarray(aflt, np.float64)
+        bflag = np.ascontiguousarray(bflag, np.int64)
+        if acls.shape != (n, 7) or aflt.shape != (n, 6) or bflag.shape != (ne, 6):
+            raise ConfigError("tool-frame arrays do not match the mesh", field="acls, aflt, "
+                              "bflag", value=f"{acls.shape}, {aflt.shape}, {bflag.shape}",
+                              expected=f"({n}, 7), ({n}, 6), ({ne}, 6)")
+        self.x0, self.y0, self.z0 = self.x.copy(), self.y.copy(), self.z.copy()
+        self.acls, self.aflt, self.bflag = acls, aflt, bflag
+        self.xn, self.yn, self.zn = np.zeros(n), np.zeros(n), np.zeros(n)
+        self.buf = np.zeros((ne, N_RZ3))
+        self.vbuf = np.zeros((n, 3))
+        self.scratch = np.zeros((n, 3))
 
     @property
     def twin(self) -> np.ndarray:
@@ -246,13 +293,21 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              check: Callable[[FEState3], None] | None = None,
              adaptive_threads: bool = True, governor: ThreadGovernor | None = None) -> int:
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
+    The loop is :func:`kernels3d.run_chunk3`, or :func:`kernels3d.run_chunk3_ale` (with the
+    tool-frame ALE pass every ``prm[P_RZ_EVERY]`` steps) for a state with the tool-frame
+    arrays (:meth:`FEState3.attach_tool_frame`).
 
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
     ``adaptive_threads``, ``governor``: see
     :func:`~robobore.cutting.fe.engine.chunk_driver.drive_chunks`.
     """
-    return drive_chunks(st, t_end, K3.run_chunk3, K3.P_TEND, chunk_steps=chunk_steps,
+    if st.tool_frame and st.prm[K3.P_RZ_EVERY] < 1:
+        raise ConfigError("the tool-frame ALE pass needs an interval of at least one step",
+                          field="prm[P_RZ_EVERY]", value=float(st.prm[K3.P_RZ_EVERY]),
+                          expected=">= 1")
+    run = K3.run_chunk3_ale if st.tool_frame else K3.run_chunk3
+    return drive_chunks(st, t_end, run, K3.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "
                         "scaling or a softer contact.penalty_factor",
