@@ -67,7 +67,7 @@ __all__ = [
     "VEL_TAYLOR", "dv_py", "hex_volume_py", "hex_volume", "face_corner_py", "swept_face_py",
     "swept_face", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
     "rz3_taylor_py", "rz3_taylor", "rz3_write_py", "rz3_write", "rz3_node_mass_py",
-    "rz3_node_mass", "remap3d", "remap3d_py", "element_volumes3",
+    "rz3_node_mass", "remap3d", "remap3d_py", "remap3d_inputs", "remap3d_outputs", "element_volumes3",
 ]
 
 #: corners of each face, cyclic with the right-hand normal pointing out of the element; the
@@ -506,6 +506,57 @@ def element_volumes3(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
     return out
 
 
+def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,
+                   vel: np.ndarray | None = None, fixed: np.ndarray | None = None,
+                   fnbr: np.ndarray | None = None, bflag: np.ndarray | None = None,
+                   alive: np.ndarray | None = None, t_room: float = 293.15) -> dict:
+    """The arrays :func:`remap3d` takes, built from the node positions ``old`` (n, 3), the
+    hexahedra ``conn`` and the ``fields`` dict of :func:`remap3d_py` (same defaults): keys
+    ``x, y, z, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag, sd, pres, eps_p,
+    temp, dmg, qh, vol0, buf, vbuf`` (fresh copies)."""
+    from robobore.cutting.fe.physics.thermal3d import face_neighbours
+
+    old = np.ascontiguousarray(old, np.float64)
+    conn = np.ascontiguousarray(conn, np.int64)
+    n, ne = old.shape[0], conn.shape[0]
+
+    def get(key, shape, default):
+        if key in fields:
+            return np.array(fields[key], np.float64).reshape(shape).copy()
+        return np.full(shape, default, np.float64)
+
+    v = np.zeros((n, 3)) if vel is None else np.array(vel, np.float64)
+    counts = np.bincount(conn.ravel(), minlength=n)
+    ptr = np.zeros(n + 1, np.int64)
+    ptr[1:] = np.cumsum(counts)
+    return {
+        "x": old[:, 0].copy(), "y": old[:, 1].copy(), "z": old[:, 2].copy(),
+        "vx": v[:, 0].copy(), "vy": v[:, 1].copy(), "vz": v[:, 2].copy(),
+        "mass": np.zeros(n),
+        "fixed": np.zeros(n, np.int64) if fixed is None else np.array(fixed, np.int64),
+        "conn": conn,
+        "alive": np.ones(ne, np.int64) if alive is None else np.array(alive, np.int64),
+        "ptr": ptr, "nel": (np.argsort(conn.ravel(), kind="stable") // 8).astype(np.int64),
+        "fnbr": face_neighbours(conn) if fnbr is None else np.asarray(fnbr, np.int64),
+        "bflag": np.zeros((0, 6), np.int64) if bflag is None else np.asarray(bflag, np.int64),
+        "sd": get("sd", (ne, 6), 0.0), "pres": get("pres", (ne,), 0.0),
+        "eps_p": get("eps_p", (ne,), 0.0), "temp": get("temp", (ne,), t_room),
+        "dmg": get("dmg", (ne,), 0.0), "qh": get("qh", (ne, 12), 0.0),
+        "vol0": (np.array(fields["vol0"], np.float64) if "vol0" in fields
+                 else element_volumes3(old, conn)),
+        "buf": np.zeros((ne, N_RZ3)), "vbuf": np.zeros((n, 3)),
+    }
+
+
+def remap3d_outputs(a: dict, moved: int) -> dict:
+    """The result dict of :func:`remap3d_py` from the arrays of :func:`remap3d_inputs` after
+    a pass."""
+    return {"sd": a["sd"], "pres": a["pres"], "eps_p": a["eps_p"], "temp": a["temp"],
+            "dmg": a["dmg"], "qh": a["qh"], "vol0": a["vol0"],
+            "vel": np.stack([a["vx"], a["vy"], a["vz"]], axis=1), "mass": a["mass"],
+            "moved": int(moved), "nodes": np.stack([a["x"], a["y"], a["z"]], axis=1)}
+
+
 def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
                *, vel: np.ndarray | None = None, fixed: np.ndarray | None = None,
                fnbr: np.ndarray | None = None, bflag: np.ndarray | None = None,
@@ -519,45 +570,14 @@ def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
     nodal velocities (zero); ``fixed`` (n,) bit mask; ``fnbr`` (e, 6) face neighbours
     (default :func:`robobore.cutting.fe.physics.thermal3d.face_neighbours`); ``bflag``
     (e, 6) outline flux types (default: all closed). Returns the remapped copies in a dict
-    with the same keys plus ``vel`` (n, 3), ``mass`` (n,) and ``moved``.
+    with the same keys plus ``vel`` (n, 3), ``mass`` (n,), ``moved`` and ``nodes`` (n, 3).
     """
-    from robobore.cutting.fe.physics.thermal3d import face_neighbours
-
-    old = np.ascontiguousarray(old, np.float64)
+    a = remap3d_inputs(old, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
+                       alive=alive, t_room=t_room)
     new = np.ascontiguousarray(new, np.float64)
-    conn = np.ascontiguousarray(conn, np.int64)
-    n, ne = old.shape[0], conn.shape[0]
-    vols = element_volumes3(old, conn)
-
-    def get(key, shape, default):
-        if key in fields:
-            return np.array(fields[key], np.float64).reshape(shape).copy()
-        return np.full(shape, default, np.float64)
-
-    sd = get("sd", (ne, 6), 0.0)
-    pres = get("pres", (ne,), 0.0)
-    eps_p = get("eps_p", (ne,), 0.0)
-    temp = get("temp", (ne,), t_room)
-    dmg = get("dmg", (ne,), 0.0)
-    qh = get("qh", (ne, 12), 0.0)
-    vol0 = np.array(fields["vol0"], np.float64) if "vol0" in fields else vols.copy()
-    v = np.zeros((n, 3)) if vel is None else np.array(vel, np.float64)
-    fx = np.zeros(n, np.int64) if fixed is None else np.asarray(fixed, np.int64)
-    fn = face_neighbours(conn) if fnbr is None else np.asarray(fnbr, np.int64)
-    bf = np.zeros((0, 6), np.int64) if bflag is None else np.asarray(bflag, np.int64)
-    al = np.ones(ne, np.int64) if alive is None else np.asarray(alive, np.int64)
-    counts = np.bincount(conn.ravel(), minlength=n)
-    ptr = np.zeros(n + 1, np.int64)
-    ptr[1:] = np.cumsum(counts)
-    nel = (np.argsort(conn.ravel(), kind="stable") // 8).astype(np.int64)
-    x, y, z = old[:, 0].copy(), old[:, 1].copy(), old[:, 2].copy()
-    vx, vy, vz = v[:, 0].copy(), v[:, 1].copy(), v[:, 2].copy()
-    mass = np.zeros(n)
-    buf = np.zeros((ne, N_RZ3))
-    vbuf = np.zeros((n, 3))
-    moved = remap3d(x, y, z, new[:, 0].copy(), new[:, 1].copy(), new[:, 2].copy(), vx, vy, vz,
-                    mass, fx, conn, al, ptr, nel, fn, bf, sd, pres, eps_p, temp, dmg, qh, vol0,
-                    float(rho_s), float(t_room), int(vel_mode), buf, vbuf)
-    return {"sd": sd, "pres": pres, "eps_p": eps_p, "temp": temp, "dmg": dmg, "qh": qh,
-            "vol0": vol0, "vel": np.stack([vx, vy, vz], axis=1), "mass": mass,
-            "moved": int(moved), "nodes": np.stack([x, y, z], axis=1)}
+    moved = remap3d(a["x"], a["y"], a["z"], new[:, 0].copy(), new[:, 1].copy(),
+                    new[:, 2].copy(), a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
+                    a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
+                    a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
+                    float(rho_s), float(t_room), int(vel_mode), a["buf"], a["vbuf"])
+    return remap3d_outputs(a, moved)

@@ -56,7 +56,12 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.ale import rezone as RZ
-from robobore.cutting.fe.ale.remap3d import remap3d
+from robobore.cutting.fe.ale.remap3d import (
+    VEL_MOMENTUM,
+    remap3d,
+    remap3d_inputs,
+    remap3d_outputs,
+)
 from robobore.cutting.fe.ale.rezone import (
     TF_CHAIN,
     TF_FACE,
@@ -84,7 +89,7 @@ from robobore.material.johnson_cook import rebind
 __all__ = ["OFF_NMIN2", "keep_py", "off_insert_py", "off_insert", "tf_place_plane_py",
            "tf_place_plane", "place3_py", "place3", "tf_face3_py", "tf_face3",
            "toolframe3d_targets", "toolframe3d_targets_loops", "rezone3d", "toolframe3d_ale_data",
-           "toolframe3d_targets_py"]
+           "toolframe3d_targets_py", "rezone3d_py"]
 
 #: the least squared in-plane part of the insert normal the "off tool" push divides by
 OFF_NMIN2 = 0.25
@@ -248,6 +253,40 @@ def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarr
                         float(max_move), np.ascontiguousarray(prm, np.float64),
                         float(tip[0]), float(tip[1]), float(tip[2]), np.zeros((n, 3)))
     return np.stack([xn, yn, zn], axis=1)
+
+
+def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: np.ndarray,
+                aflt: np.ndarray, fields: dict, *, vel: np.ndarray | None = None,
+                fixed: np.ndarray | None = None, fnbr: np.ndarray | None = None,
+                bflag: np.ndarray | None = None, alive: np.ndarray | None = None,
+                rho_s: float = 1.0, t_room: float = 293.15, vel_mode: int = VEL_MOMENTUM,
+                off_x: float = 0.0, off_z: float = 0.0, max_move: float = 0.25,
+                prm: np.ndarray | None = None,
+                tip: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> dict:
+    """Allocating wrapper of :func:`rezone3d` for tests and scripts: ``nodes`` (n, 3) the
+    current positions, ``places`` (n, 3) the places at the start, ``acls``/``aflt`` the
+    tool-frame data (``aflt`` updated in place), ``fields`` and the keyword arguments of
+    :func:`robobore.cutting.fe.ale.remap3d.remap3d_py` (same defaults), ``prm`` the 3D
+    engine's parameter vector (None: no insert), ``tip`` the insert tip's current position.
+    Returns the dict of :func:`~robobore.cutting.fe.ale.remap3d.remap3d_py`."""
+    from robobore.cutting.fe.hex.layout3d import N_PRM
+
+    a = remap3d_inputs(nodes, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
+                       alive=alive, t_room=t_room)
+    places = np.ascontiguousarray(places, np.float64)
+    if prm is None:
+        prm = np.zeros(N_PRM)
+    n = places.shape[0]
+    moved = rezone3d(a["x"], a["y"], a["z"], a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
+                     a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
+                     a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
+                     float(rho_s), float(t_room), int(vel_mode), np.empty(n), np.empty(n),
+                     np.empty(n), a["buf"], a["vbuf"], np.zeros((n, 3)), places[:, 0].copy(),
+                     places[:, 1].copy(), places[:, 2].copy(),
+                     np.ascontiguousarray(acls, np.int64), aflt, float(off_x), float(off_z),
+                     float(max_move), np.ascontiguousarray(prm, np.float64), float(tip[0]),
+                     float(tip[1]), float(tip[2]))
+    return remap3d_outputs(a, moved)
 
 
 def toolframe3d_ale_data(mesh) -> tuple[np.ndarray, np.ndarray]:

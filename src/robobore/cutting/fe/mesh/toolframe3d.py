@@ -108,7 +108,8 @@ from robobore.cutting.geometry import BoringInsert, chip_area, lead_end, trailin
 __all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", "FK_INFLOW",
            "FK_OUTFLOW", "FK_TOOL", "FK_FREE", "FK_BOTTOM", "FK_SIDE", "section_plan",
            "section_nodes", "slice_map", "section_coords", "s_of_y", "uncut_thickness",
-           "clamp_area", "build_toolframe3d_mesh"]
+           "clamp_area", "build_toolframe3d_mesh",
+           "extrude_toolframe_mesh", "tip_slice_nodes", "reference_blocks"]
 
 #: kind of a hexahedron face: shared by two elements, inflow face (virgin material enters),
 #: outflow face (machined-surface side back face, chip top face), on the insert (rake face
@@ -429,7 +430,9 @@ class ToolFrameMesh3D:
     inflow face and bottom; ``z_slices`` (k,) [m], ``engaged`` (k,) slices with a chip block;
     ``t`` (k,) true vertical uncut thickness, ``t_mesh`` (k,) the clamped one; ``h2`` (k,)
     the normal-section thickness each slice was built for; ``reference`` the 2D mesh of the
-    reference slice (z = 0); ``areas`` the chip areas [m^2] (``chip``: mechanistic,
+    reference slice (z = 0); ``plan`` the slices' common topology (None for an extruded
+    mesh, :func:`extrude_toolframe_mesh`); ``blocks`` the 2D block sizes
+    (:func:`reference_blocks`); ``areas`` the chip areas [m^2] (``chip``: mechanistic,
     ``mesh_above_edge``: the mesh's material above the edge profile, ``clamp``: the
     clamp's analytic part, ``clamp_mesh``: mesh minus chip); ``min_edge`` the shortest
     element edge [m]; ``sizes`` the size control.
@@ -453,7 +456,7 @@ class ToolFrameMesh3D:
     h2: np.ndarray
     y_bottom: float
     reference: ToolFrameMesh
-    plan: SectionPlan
+    plan: SectionPlan | None
     sizes: ToolFrame3DSizes
     blocks: dict
     areas: dict = field(default_factory=dict)
@@ -568,21 +571,7 @@ def build_toolframe3d_mesh(insert: BoringInsert, ap: float, f: float,
     nodes = np.vstack(coords)
     node_slice = np.concatenate(sl)
     node_local = np.concatenate(loc)
-    # ---- hexahedra: 2D quads (counter-clockwise in the 2D frame, clockwise after the
-    # mirror in x) reversed at slice k, the same at k + 1
-    rev = conn2[:, [0, 3, 2, 1]]
-    conns, chip, eslice, e2d = [], [], [], []
-    for k in range(nk - 1):
-        ne_k = conn2.shape[0] if (eng[k] and eng[k + 1]) else e_a
-        q = rev[:ne_k]
-        conns.append(np.hstack([q + offs[k], q + offs[k + 1]]))
-        chip.append(np.arange(ne_k) >= e_a)
-        eslice.append(np.full(ne_k, k, np.int64))
-        e2d.append(np.arange(ne_k, dtype=np.int64))
-    conn = np.vstack(conns).astype(np.int64)
-    chip = np.concatenate(chip)
-    elem_slice = np.concatenate(eslice)
-    elem_2d = np.concatenate(e2d)
+    conn, chip, elem_slice, elem_2d = _stack_hexahedra(conn2, eng, offs, e_a)
     # ---- node classes and in-slice neighbours
     acls = np.full((nodes.shape[0], 7), -1, np.int64)
     for k in range(nk):
@@ -613,24 +602,125 @@ def build_toolframe3d_mesh(insert: BoringInsert, ap: float, f: float,
                     raise AssertionError("block A interior node without 4 neighbours")
                 a[nd, 3:7] = -1
                 a[nd, 3:3 + len(lst)] = lst
-        nbr = a[:, 1:]
-        a[:, 1:] = np.where(nbr >= 0, nbr + o, -1)
-        acls[o:o + a.shape[0]] = a
+        acls[o:o + a.shape[0]] = _offset_acls(a, o)
     node_class = acls[:, 0].copy()
     rigid = node_class == TF_RIGID
     # ---- face kinds and flux flags
     fkind, bflag = _face_kinds(conn, chip, elem_slice, elem_2d, eng, ref, blk)
     # ---- chip areas: the mesh's material above the edge profile
     areas = _chip_areas(insert, ap, f, sizes.t_min, z, eng, nodes, node_slice, offs, ref, blk)
-    edges = np.concatenate([np.linalg.norm(nodes[conn[:, a]] - nodes[conn[:, b]], axis=1)
-                            for a, b in ((0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6),
-                                         (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7))])
     return ToolFrameMesh3D(
         nodes=nodes, conn=conn, chip=chip, node_slice=node_slice, node_local=node_local,
         node_class=node_class, acls=acls, elem_slice=elem_slice, fkind=fkind, bflag=bflag,
         rigid=rigid, z_slices=z, engaged=eng, t=t_true, t_mesh=y_top - insert.drop(z), h2=h2,
         y_bottom=y_bot, reference=ref, plan=plan, sizes=sizes, blocks=blk, areas=areas,
-        min_edge=float(edges.min()))
+        min_edge=_min_edge(nodes, conn))
+
+
+def _stack_hexahedra(conn2: np.ndarray, eng: np.ndarray, offs: np.ndarray, e_a: int):
+    """Hexahedra between slices k and k + 1 (all the 2D quads ``conn2`` where both slices
+    are engaged, block A's ``e_a`` first ones otherwise): the quads (counter-clockwise in the
+    2D frame, clockwise after the mirror in x) reversed at slice k, the same at k + 1; slice k
+    starts at node ``offs[k]``. Returns ``(conn, chip, elem_slice, elem_2d)``."""
+    rev = conn2[:, [0, 3, 2, 1]]
+    conns, chip, eslice, e2d = [], [], [], []
+    for k in range(eng.size - 1):
+        ne_k = conn2.shape[0] if (eng[k] and eng[k + 1]) else e_a
+        q = rev[:ne_k]
+        conns.append(np.hstack([q + offs[k], q + offs[k + 1]]))
+        chip.append(np.arange(ne_k) >= e_a)
+        eslice.append(np.full(ne_k, k, np.int64))
+        e2d.append(np.arange(ne_k, dtype=np.int64))
+    return (np.vstack(conns).astype(np.int64), np.concatenate(chip), np.concatenate(eslice),
+            np.concatenate(e2d))
+
+
+def _offset_acls(a: np.ndarray, o: int) -> np.ndarray:
+    """A slice's ``acls`` (its 2D ones) with the neighbours shifted to global indices."""
+    a = a.copy()
+    nbr = a[:, 1:]
+    a[:, 1:] = np.where(nbr >= 0, nbr + o, -1)
+    return a
+
+
+def _min_edge(nodes: np.ndarray, conn: np.ndarray) -> float:
+    """The shortest hexahedron edge [m]."""
+    edges = np.concatenate([np.linalg.norm(nodes[conn[:, a]] - nodes[conn[:, b]], axis=1)
+                            for a, b in ((0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6),
+                                         (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7))])
+    return float(edges.min())
+
+
+def reference_blocks(ref: ToolFrameMesh) -> dict:
+    """The block sizes ``{"na", "ja", "nb", "jb", "n1", "i_s"}`` of a 2D tool-frame mesh
+    (:func:`build_toolframe_mesh`), read from its node lists: block A (``(na + 1) (ja + 1)``
+    nodes, i-major) first; the machined surface is block A's top row from column ``i_s``;
+    block B has ``nb + 1`` columns of ``jb + 1`` nodes, its first ``n1 + 1`` bottom nodes
+    shared with block A's top row."""
+    mach = np.asarray(ref.machined_nodes)
+    ja = int(mach[1] - mach[0]) - 1
+    n_a = int(mach[-1]) + 1
+    na = n_a // (ja + 1) - 1
+    i_s = na + 1 - mach.size
+    nb = int(np.asarray(ref.chip_top_nodes).size) - 1
+    jb = int(np.asarray(ref.outflow_nodes).size) - 1
+    n1 = nb + 1 - int(np.asarray(ref.chip_under_nodes).size)
+    if (n_a != (na + 1) * (ja + 1) or n1 != i_s or int((~ref.chip).sum()) != na * ja
+            or int(ref.chip.sum()) != nb * jb
+            or ref.nodes.shape[0] != n_a + (nb + 1) * (jb + 1) - (n1 + 1)):
+        raise ValueError("the 2D mesh is not a two-block tool-frame mesh of "
+                         "build_toolframe_mesh")
+    return {"na": na, "ja": ja, "nb": nb, "jb": jb, "n1": n1, "i_s": i_s}
+
+
+def tip_slice_nodes(xy2: np.ndarray, h2: float) -> np.ndarray:
+    """Points (n, 2) of a 2D section built for uncut thickness ``h2`` (frame of
+    :func:`build_toolframe_mesh`) to the (x, y) of the nose-tip plane z = 0: there
+    :func:`slice_map` is the mirror ``x = -x2`` and the shift ``y = y2 + h2`` (the cut line
+    ``y2 = -h2`` to the tip reference ``y = 0``, the edge centre to ``y = r``), in closed
+    form."""
+    xy2 = np.asarray(xy2, np.float64)
+    return np.column_stack([-xy2[:, 0], xy2[:, 1] + h2])
+
+
+def extrude_toolframe_mesh(ref: ToolFrameMesh, z: np.ndarray) -> ToolFrameMesh3D:
+    """The 2D tool-frame mesh ``ref`` extruded along z: every slice at ``z`` [m] (strictly
+    increasing, at least two) is ``ref`` carried into the 3D frame as the nose-tip slice of
+    :func:`build_toolframe3d_mesh` is (:func:`tip_slice_nodes`: the tip reference at the
+    origin, the cutting velocity along +x), every slice engaged (the chip block in each),
+    the z-faces of the first and last slices ``FK_SIDE``. The model of a straight edge
+    across a slab (plane strain between the side planes when they are held in z): the 3D
+    counterpart of the 2D model on ``ref``, for cross-checks of the 3D engine against the 2D
+    one. ``t``, ``t_mesh``, ``h2`` are ``ref.h`` in every slice, ``sizes`` the 2D mesh's
+    element and edge sizes with the largest slice step and ``t_min = ref.h``, ``plan``
+    None; ``areas["chip"]`` the uncut chip area ``ref.h (z[-1] - z[0])``."""
+    z = np.asarray(z, np.float64).ravel()
+    if z.size < 2 or not np.all(np.diff(z) > 0.0):
+        raise ValueError(f"extrusion planes z must be >= 2 strictly increasing values [m], "
+                         f"got {z.tolist()}")
+    blk = reference_blocks(ref)
+    h = float(ref.h)
+    nk = z.size
+    n2d = ref.nodes.shape[0]
+    e_a = blk["na"] * blk["ja"]
+    eng = np.ones(nk, bool)
+    xy = tip_slice_nodes(ref.nodes, h)
+    nodes = np.column_stack([np.tile(xy, (nk, 1)), np.repeat(z, n2d)])
+    offs = np.arange(nk + 1, dtype=np.int64) * n2d
+    conn, chip, elem_slice, elem_2d = _stack_hexahedra(ref.conn, eng, offs, e_a)
+    acls = np.vstack([_offset_acls(ref.acls, int(offs[k])) for k in range(nk)])
+    node_class = acls[:, 0].copy()
+    fkind, bflag = _face_kinds(conn, chip, elem_slice, elem_2d, eng, ref, blk)
+    sizes = ToolFrame3DSizes(element_size=ref.element_size, edge_size=ref.edge_size,
+                             slice_spacing=float(np.diff(z).max()), t_min=h, margin_slices=0)
+    return ToolFrameMesh3D(
+        nodes=nodes, conn=conn, chip=chip, node_slice=np.repeat(np.arange(nk), n2d),
+        node_local=np.tile(np.arange(n2d, dtype=np.int64), nk), node_class=node_class,
+        acls=acls, elem_slice=elem_slice, fkind=fkind, bflag=bflag,
+        rigid=node_class == TF_RIGID, z_slices=z.copy(), engaged=eng, t=np.full(nk, h),
+        t_mesh=np.full(nk, h), h2=np.full(nk, h), y_bottom=float(xy[:, 1].min()),
+        reference=ref, plan=None, sizes=sizes, blocks=blk,
+        areas={"chip": h * float(z[-1] - z[0])}, min_edge=_min_edge(nodes, conn))
 
 
 def _face_kinds(conn, chip, elem_slice, elem_2d, eng, ref: ToolFrameMesh, blk: dict):
