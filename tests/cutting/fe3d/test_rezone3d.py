@@ -6,9 +6,10 @@ Checks: on an extruded mesh every slice is placed exactly as the 2D placement
 (mirrored) node displacement, with and without the insert's "off tool" push; nodes stay in
 their planes; surface-chain nodes stay on their (curved) surface polyline; a zero motion
 moves nothing and the pass then changes no field; the remap conserves mass, volume and
-the fields' volume integrals through closed faces; ``toolframe3d_ale_data`` of an extruded
-mesh is the 2D ``aflt`` slice by slice; on the paper condition's sliced mesh a pass after a
-random Lagrangian perturbation leaves every hexahedron with a positive volume. Tolerances
+the fields' volume integrals through closed faces, and through the open faces the mass
+changes by what they sweep; ``toolframe3d_ale_data`` of an extruded mesh is the 2D ``aflt``
+slice by slice; on the paper condition's sliced mesh a pass after a random Lagrangian
+perturbation leaves every hexahedron with a positive volume. Tolerances
 are round-off bounds, stated per test.
 """
 
@@ -19,7 +20,8 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.ale.remap3d import FACES_OUT, element_volumes3
+from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_VIRGIN
+from robobore.cutting.fe.ale.remap3d import FACES_OUT, element_volumes3, swept_face_py
 from robobore.cutting.fe.ale.rezone import (
     TF_CHAIN,
     TF_FACE,
@@ -435,3 +437,39 @@ end slices are a tenth of the shortest edge apart) and an insert travel of
         width = paper.z_slices[-1] - paper.z_slices[0]
         height = paper.nodes[:, 1].max() - paper.y_bottom
         assert abs(r["vol0"].sum() - v_old.sum()) <= 2.0 * off_x * width * height
+
+
+def test_insert_travel_through_material_at_rest_balances_mass(paper):
+    """The insert travels 0.3 um through material at rest (the nodes where the last pass left
+    them): the inflow face sweeps exactly its area times the travel, and the reference
+    volume changes by exactly what the flux-carrying outline faces sweep (virgin material in,
+    the outflow faces' material out; 1e-12 relative), the density being uniform."""
+    acls, aflt = toolframe3d_ale_data(paper)
+    off_x = 0.3e-6
+    prm = _prm(INSERT)
+    tip = (off_x, 0.0, 0.0)
+    new = toolframe3d_targets_py(paper.nodes, paper.nodes, acls, aflt.copy(), off_x=off_x,
+                                 prm=prm, tip=tip)
+    conn = paper.conn
+    old = paper.nodes
+    args = (conn, old[:, 0].copy(), old[:, 1].copy(), old[:, 2].copy(), new[:, 0].copy(),
+            new[:, 1].copy(), new[:, 2].copy())
+    flux_in = flux_out = 0.0
+    area_in = 0.0
+    for e, f in zip(*np.nonzero(paper.bflag != BF_CLOSED), strict=True):
+        dv = swept_face_py(int(e), int(f), *args)
+        if paper.bflag[e, f] == BF_VIRGIN:
+            flux_in += dv
+            q = old[conn[e, FACES_OUT[f]]][:, 1:]  # the face in the y-z plane
+            area_in += 0.5 * abs(np.sum(q[:, 0] * np.roll(q[:, 1], -1)
+                                        - np.roll(q[:, 0], -1) * q[:, 1]))
+        else:
+            flux_out += dv
+    assert flux_in == pytest.approx(area_in * off_x, rel=1e-12)
+    assert flux_out < 0.0  # the outflow faces follow the insert: material leaves
+    v_old = element_volumes3(old, conn)
+    r = rezone3d_py(old, old, conn, acls, aflt, {"vol0": v_old}, bflag=paper.bflag,
+                    rho_s=RHO_S, off_x=off_x, prm=prm, tip=tip)
+    assert np.array_equal(r["nodes"], new)
+    assert abs(r["vol0"].sum() - (v_old.sum() + flux_in + flux_out)) <= 1e-12 * v_old.sum()
+    assert np.all(r["vol0"] > 0.0)

@@ -36,11 +36,12 @@ gap deficit). The insert's signed distance is
 state, the reference volumes, the nodal velocities and the lumped masses from the old
 positions to the placed ones (which it copies into ``x, y, z``).
 
-Frames and places: ``x0, y0, z0`` are the node positions of the tool-frame mesh with the
-insert tip at ``(cx, cy, cz) - (off_x, 0, off_z)``; at the start the engine takes
-``x0, y0, z0`` = the mesh's nodes, ``off_x = off_z = 0`` and the tip at its start position,
-and later ``off_x = cx - cx_start``, ``off_z = cz - cz_start`` (the insert's travel). A
-support deflection of the insert in y is not followed (the places have no y offset).
+Frames and places: ``x0, y0, z0`` are the nodes' places at the start in the frame of the
+tip position ``(cx, cy, cz)``: the mesh's nodes (built with the insert tip at the origin)
+plus the tip's start position ``(cx_s, cy_s, cz_s)``; ``off_x = cx - cx_s`` and
+``off_z = cz - cz_s`` the insert's travel since then, so a node's place now is
+``(x0 + off_x, y0, z0 + off_z)``. ``cy`` enters the "off tool" gap only: a support
+deflection of the insert in y moves the insert, not the places.
 
 The passes are scalar functions of one node (``*_py`` originals, ``njit`` versions without
 the suffix), each reading only what the previous pass wrote and allocating nothing, run from

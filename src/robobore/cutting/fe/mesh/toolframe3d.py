@@ -73,22 +73,39 @@ kind (:data:`FK_INTERIOR` ... :data:`FK_SIDE`) and the remap's flux flag
 :mod:`robobore.cutting.fe.ale.remap3d`), in the face numbering of
 :data:`robobore.cutting.fe.ale.remap3d.FACES_OUT`.
 
+**The ALE pass** on this mesh is :func:`robobore.cutting.fe.ale.rezone3d.rezone3d` (nodes
+kept in their planes, the 2D tool-frame placement in each plane, the 3D insert's "off tool"
+push, then :func:`robobore.cutting.fe.ale.remap3d.remap3d`), with the per-slice ``aflt`` of
+:func:`robobore.cutting.fe.ale.rezone3d.toolframe3d_ale_data`. :func:`extrude_toolframe_mesh`
+builds the same kind of mesh from one 2D tool-frame mesh in every plane (a straight edge
+across a slab), for the plane-strain cross-check against the 2D engine.
+
 **What the model still needs** (not in this module):
 
-1. The in-plane placement per slice: the 2D ``tf_*`` passes of
-   :mod:`robobore.cutting.fe.ale.rezone` in each slice's normal-section frame (the inverse of
-   :func:`slice_map`), nodes kept in their plane (Eulerian in z). The chip's side faces at
-   the end slices are free surfaces along z; keeping them in their planes blocks the side
-   flow there, letting them move in z needs the remap (which handles any motion) and a
-   placement that follows them. The per-slice geometric data of the 2D ``aflt`` (face
-   fractions, line directions, local sizes) are to be computed per slice.
-2. The contact: the engine's analytic insert (``hex/scalar3d.py``, ``insert_gap3_py``) with
-   the tool-surface nodes of ``node_class``.
-3. The chunk-loop ALE pass: every ``ale_interval`` steps the placement, then
-   :func:`robobore.cutting.fe.ale.remap3d.remap3d`, the state's ``enbr`` as ``fnbr`` and
-   :attr:`ToolFrameMesh3D.bflag`; the inflow face and the bottom held (v = 0), the insert
-   moving at +vc.
-4. The GPU port: the remap's scalar passes compile for the device as the 2D ones do.
+1. The chip's side faces at the end slices are free surfaces along z, but the placement
+   keeps every node in its plane: the side bulge of the chip there is put back each pass
+   (the closed faces' swept volume is no flux), which blocks the side flow at the ends.
+   Letting those faces move in z needs a placement that follows them (the remap handles
+   any motion).
+2. In the thin end slices the chip block's elements are sheared: their height across the
+   rows is down to 0.095 of their shortest edge at the paper's condition (0.43 in the 2D
+   mesh), and the placement's move limit ``max_move`` is a fraction of the shortest edge
+   (the 2D meaning of ``aflt[:, 3]``), so a move near the limit there would sweep more than
+   the element's height (remap Courant number above 1). The Lagrangian drift between ALE
+   passes is far below it; a limit on the height would make it safe by construction.
+3. Block A's top faces in the hexahedra between a margin slice and the first (last) engaged
+   slice are on the 3D outline, but in the engaged slice their nodes are in-plane interior
+   nodes (the chip block's join line): they are placed as interior nodes and the volume
+   their faces sweep is dropped as a closed face's.
+4. The engine: the contact with the analytic insert (``hex/scalar3d.py``,
+   ``insert_gap3_py``) on this mesh, and the chunk-loop ALE pass (every ``ale_interval``
+   steps :func:`~robobore.cutting.fe.ale.rezone3d.rezone3d` with the state's ``enbr`` as
+   ``fnbr`` and :attr:`ToolFrameMesh3D.bflag`; the inflow face and the bottom held, the
+   insert moving at +vc).
+5. The GPU port: the placement's and the remap's scalar passes compile for the device as
+   the 2D ones do (``tf_place_py`` rebound with the device ``_limit`` and
+   :func:`~robobore.cutting.fe.ale.rezone3d.keep_py`, ``off_insert_py`` with the device
+   ``insert_gap3``).
 """
 
 from __future__ import annotations
