@@ -4,16 +4,17 @@ Usage::
 
     python benchmarks/fe3d_toolframe_short.py [--config examples/fe_boring_paper.toml]
         [--steps 3000] [--mass-scaling 400] [--element-um 12.5] [--t-min-um 5]
-        [--out results.json]
+        [--setup-only] [--out results.json]
 
-Runs the config with ``[mesh] frame = "tool"`` for about ``--steps`` explicit steps (the cut
-length set to the insert travel those steps take at the initial time step, which may be
-below the config's one-element minimum: set after the config is validated) and prints the
-step size, the steps per second (ALE passes included), the mesh facts and the forces over
-the last half of the travel (``simulate_boring``'s window). A few thousand steps are a
-micrometre or so of travel at the paper's condition: the forces are those of the start of
-the cut from the pre-shaped chip, not steady values. Results go to ``--out`` (JSON) when
-given.
+``--setup-only``: no run; the mesh facts, the initial time step and the steps the config's
+whole cut would take at it. Otherwise runs the config with ``[mesh] frame = "tool"`` for
+about ``--steps`` explicit steps (the cut length set to the insert travel those steps take
+at the initial time step, which may be below the config's one-element minimum: set after
+the config is validated) and prints the step size, the steps per second (ALE passes
+included), the mesh facts and the forces over the last half of the travel
+(``simulate_boring``'s window). A few thousand steps are a micrometre or so of travel at the
+paper's condition: the forces are those of the start of the cut from the pre-shaped chip,
+not steady values. Results go to ``--out`` (JSON) when given.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ def main() -> None:
     ap.add_argument("--mass-scaling", type=float, default=400.0)
     ap.add_argument("--element-um", type=float, default=None)
     ap.add_argument("--t-min-um", type=float, default=None)
+    ap.add_argument("--setup-only", action="store_true")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
 
@@ -51,8 +53,18 @@ def main() -> None:
         d["mesh"]["t_min_um"] = a.t_min_um
     d.setdefault("solver", {})["mass_scaling"] = a.mass_scaling
     cfg = parse_boring_config(d, source=a.config)
-    dt = float(setup_boring(cfg, a.config).state.clock[1])
+    setup = setup_boring(cfg, a.config)
+    dt = float(setup.state.clock[1])
     vc = math.pi * cfg.cut.bore_diameter_mm * 1e-3 * cfg.cut.speed_rpm / 60.0
+    if a.setup_only:
+        from robobore.cutting.fe.models.toolframe3d import toolframe_mesh_summary
+
+        out = {"element_size_um": cfg.mesh.element_size_um, "mass_scaling": a.mass_scaling,
+               "toolframe_mesh": toolframe_mesh_summary(setup.mesh), "time_step_s": dt,
+               "cut_length_mm": cfg.cut.cut_length_mm,
+               "steps_for_the_cut": cfg.cut.cut_length_mm * 1e-3 / (vc * dt)}
+        print(json.dumps(out, indent=1))
+        return
     cfg.cut.cut_length_mm = a.steps * dt * vc * 1e3
     r = simulate_boring(cfg, source=a.config).summary
     keys = ("force_rotating_N", "force_rotating_std_N", "averaging_window_mm", "energy_error",
