@@ -127,3 +127,21 @@ def test_tool_frame_short_run():
     assert np.all(np.isfinite(st.sd))
     assert -st.tool[K3.T_FX] > 0.0
     assert energy_error(st.en) < 0.05
+
+
+def test_tool_frame_summary_has_the_mesh_facts():
+    cfg = parse_boring_config(_cfg(t_min_um=8.0))
+    cfg.solver.mass_scaling = 400.0
+    s = setup_boring(cfg)
+    cfg.cut.cut_length_mm = 150 * float(s.state.clock[1]) * s.vc * 1e3
+    r = simulate_boring(cfg).summary
+    tf = r["toolframe_mesh"]
+    assert r["frame"] == "tool" and r["separation"] is None and "mesh_shape" not in r
+    assert (tf["nodes"], tf["hexahedra"]) == (s.mesh.n_nodes, s.mesh.n_elements)
+    assert tf["t_min_um"] == pytest.approx(8.0)
+    assert tf["chip_area_mm2"] == pytest.approx(r["chip_area_mm2"], rel=1e-12)
+    assert 0.0 < tf["clamp_area_fraction"] < 0.1
+    # a few passes of a short travel: the inflow and outflow change the mass by far less
+    # than a percent
+    assert tf["mass_ratio"] == pytest.approx(1.0, abs=1e-2)
+    assert r["eroded_damage"] == 0 and r["eroded_distortion"] == 0

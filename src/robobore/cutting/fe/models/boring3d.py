@@ -213,6 +213,7 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     setup = setup_boring(cfg, source)
     st = setup.state
     dt0 = float(st.clock[1])
+    mass0 = float(np.sum(st.mass))
     limit = cfg.solver.energy_error_limit
 
     check = energy_check(setup.t_contact, setup.t_end, limit)
@@ -296,6 +297,8 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         from robobore.cutting.fe.models.toolframe3d import toolframe_mesh_summary
 
         summary["toolframe_mesh"] = toolframe_mesh_summary(setup.mesh)
+        # material in the mesh at the end over the start (inflow - outflow of the passes)
+        summary["toolframe_mesh"]["mass_ratio"] = float(np.sum(st.mass)) / mass0
     else:
         summary["mesh_shape"] = list(setup.mesh.shape)
     if cfg.tool_support is not None:

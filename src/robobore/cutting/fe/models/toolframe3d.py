@@ -113,7 +113,8 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
 def toolframe_mesh_summary(mesh: ToolFrameMesh3D) -> dict[str, Any]:
     """The mesh facts of a tool-frame run for its JSON: nodes, hexahedra, slices (engaged,
     margin), the clamp ``t_min``, the shortest element edge and the chip areas of
-    :attr:`ToolFrameMesh3D.areas` [mm^2]."""
+    :attr:`ToolFrameMesh3D.areas` [mm^2] (a run adds ``mass_ratio``: the mass in the mesh
+    at the end over that at the start)."""
     a = mesh.areas
     return {
         "nodes": mesh.n_nodes,
