@@ -145,3 +145,5 @@ def test_tool_frame_summary_has_the_mesh_facts():
     # than a percent
     assert tf["mass_ratio"] == pytest.approx(1.0, abs=1e-2)
     assert r["eroded_damage"] == 0 and r["eroded_distortion"] == 0
+    # the pre-shaped chip stands above the pre-bore surface (y = ap)
+    assert r["chip_max_height_um"] > 10.0

@@ -251,7 +251,10 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     n_el = st.n_elements
     cut_mm = (hh[:, K3.H_TIPX] - setup.x_cut_start) * 1e3
     alive = st.alive == 1
-    ytop_max = float(np.max(setup.mesh.nodes[:, 1]))
+    # the pre-bore surface's highest point: the workpiece block's top; ap in the tool frame
+    # (whose initial mesh carries the pre-shaped chip above it)
+    ytop_max = (setup.ap if cfg.mesh.frame == "tool"
+                else float(np.max(setup.mesh.nodes[:, 1])))
     summary: dict[str, Any] = {
         "force_rotating_N": {"tangential": ft_m, "radial": fr_m, "feed": fz_m},
         "force_rotating_std_N": {"tangential": float(np.std(Ft[win])),
