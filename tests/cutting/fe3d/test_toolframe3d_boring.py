@@ -147,3 +147,17 @@ def test_tool_frame_summary_has_the_mesh_facts():
     assert r["eroded_damage"] == 0 and r["eroded_distortion"] == 0
     # the pre-shaped chip stands above the pre-bore surface (y = ap)
     assert r["chip_max_height_um"] > 10.0
+
+
+def test_the_tool_frame_loop_is_the_one_step_loop():
+    from robobore.cutting.fe.engine import step_loop as SL
+
+    assert K3._loop3_ale.py_func.__code__ is SL.chunk_loop_py.__code__
+    assert K3._loop3_ale.__qualname__ != K3._loop3.__qualname__
+
+
+def test_a_tool_frame_state_needs_its_interval():
+    s = setup_boring(parse_boring_config(_cfg(t_min_um=8.0)))
+    s.state.prm[K3.P_RZ_EVERY] = 0
+    with pytest.raises(ConfigError, match="P_RZ_EVERY"):
+        advance3(s.state, 1e-9)
