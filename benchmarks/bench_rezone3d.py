@@ -72,9 +72,9 @@ def main() -> None:
         return rezone3d(a["x"], a["y"], a["z"], a["vx"], a["vy"], a["vz"], a["mass"],
                         a["fixed"], a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"],
                         a["bflag"], a["sd"], a["pres"], a["eps_p"], a["temp"], a["dmg"],
-                        a["qh"], a["vol0"], rho_s, 293.15, 0, xn, yn, zn, a["buf"], a["vbuf"],
-                        scratch, x0, y0, z0, acls, aflt, off_x, 0.0, 0.25, prm, off_x, 0.0,
-                        0.0)
+                        a["qh"], a["vol0"], rho_s, a["msf"], 293.15, 0, xn, yn, zn, a["buf"],
+                        a["vbuf"], scratch, x0, y0, z0, acls, aflt, off_x, 0.0, 0.25, prm,
+                        off_x, 0.0, 0.0)
 
     def run_targets(a, aflt):
         toolframe3d_targets(a["x"], a["y"], a["z"], xn, yn, zn, x0, y0, z0, acls, aflt, off_x,
@@ -84,7 +84,7 @@ def main() -> None:
         remap3d(a["x"], a["y"], a["z"], xn, yn, zn, a["vx"], a["vy"], a["vz"], a["mass"],
                 a["fixed"], a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"],
                 a["sd"], a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
-                rho_s, 293.15, 0, a["buf"], a["vbuf"])
+                rho_s, a["msf"], 293.15, 0, a["buf"], a["vbuf"])
 
     print(f"paper mesh, {args.element_um:g} um elements: {n} nodes, {ne} hexahedra; "
           f"{numba.get_num_threads()} thread(s)")

@@ -328,7 +328,7 @@ def test_runs_on_the_engine_state_and_keeps_its_lumped_masses():
     remap3d(st.x, st.y, st.z, new[:, 0].copy(), new[:, 1].copy(), new[:, 2].copy(), st.vx,
             st.vy, st.vz, st.mass, st.fixed, st.conn, st.alive, st.ptr, st.nel, st.enbr,
             np.zeros((0, 6), np.int64), st.sd, st.pres, st.eps_p, st.temp, st.dmg, st.qh,
-            st.vol0, rho_s, mat.T_room, VEL_MOMENTUM, buf, vbuf)
+            st.vol0, rho_s, np.zeros(0), mat.T_room, VEL_MOMENTUM, buf, vbuf)
     assert np.array_equal(st.nodes(), new)
     want = np.zeros(nodes.shape[0])
     np.add.at(want, conn.ravel(), np.repeat(st.vol0 * rho_s / 8.0, 8))

@@ -299,12 +299,24 @@ def rz3_flux_py(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, bu
 rz3_flux = njit(cache=True, inline="always")(rz3_flux_py)
 
 
-def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, buf, vx, vy, vz, fixed, vbuf):
+def factor_py(msf, e):
+    """The inertia factor of element ``e``: ``msf[e]``, or 1 where ``msf`` is empty (no
+    element-attached mass scaling)."""
+    if msf.shape[0] == 0:
+        return 1.0
+    return msf[e]
+
+
+_factor = njit(cache=True, inline="always")(factor_py)
+
+
+def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf):
     """:data:`VEL_MOMENTUM`, node ``n``: its new velocity into ``vbuf[n]`` (after
     :func:`rz3_flux_py` of every element, before :func:`rz3_write_py`): old nodal momentum
     plus an eighth of each of its elements' momentum change, over the new lumped mass (all
-    per unit mass-scaled density). Fixed components keep their values. Returns 1 when the
-    velocity changes."""
+    per unit mass-scaled density; each element's share times its inertia factor ``msf[e]``,
+    which stays with the element as the material moves through it). Fixed components keep
+    their values. Returns 1 when the velocity changes."""
     m_old = 0.0
     m_new = 0.0
     dpx = 0.0
@@ -314,11 +326,12 @@ def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, buf, vx, vy, vz, fixed, vbuf
         e = nel[q]
         if alive[e] != 1:
             continue
-        m_old += 0.125 * vol0[e]
-        m_new += 0.125 * buf[e, B_VOL0]
-        dpx += 0.125 * (buf[e, B_PNEW] - buf[e, B_POLD])
-        dpy += 0.125 * (buf[e, B_PNEW + 1] - buf[e, B_POLD + 1])
-        dpz += 0.125 * (buf[e, B_PNEW + 2] - buf[e, B_POLD + 2])
+        w = 0.125 * _factor(msf, e)
+        m_old += w * vol0[e]
+        m_new += w * buf[e, B_VOL0]
+        dpx += w * (buf[e, B_PNEW] - buf[e, B_POLD])
+        dpy += w * (buf[e, B_PNEW + 1] - buf[e, B_POLD + 1])
+        dpz += w * (buf[e, B_PNEW + 2] - buf[e, B_POLD + 2])
     vbuf[n, 0] = vx[n]
     vbuf[n, 1] = vy[n]
     vbuf[n, 2] = vz[n]
@@ -439,13 +452,14 @@ def rz3_write_py(e, alive, buf, sd, pres, eps_p, temp, dmg, qh, vol0):
 rz3_write = njit(cache=True, inline="always")(rz3_write_py)
 
 
-def rz3_node_mass_py(n, ptr, nel, alive, vol0, rho_s, mass):
-    """Lumped mass of node ``n`` from its live elements' (remapped) reference volumes."""
+def rz3_node_mass_py(n, ptr, nel, alive, vol0, rho_s, msf, mass):
+    """Lumped mass of node ``n`` from its live elements' (remapped) reference volumes, each
+    times its element's inertia factor ``msf[e]`` (an empty ``msf``: 1)."""
     m = 0.0
     for q in range(ptr[n], ptr[n + 1]):
         e = nel[q]
         if alive[e] == 1:
-            m += 0.125 * rho_s * vol0[e]
+            m += 0.125 * rho_s * vol0[e] * _factor(msf, e)
     mass[n] = m
 
 
@@ -454,12 +468,13 @@ rz3_node_mass = njit(cache=True, inline="always")(rz3_node_mass_py)
 
 @njit(parallel=True, cache=True)
 def remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag,
-            sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, t_room, vel_mode, buf, vbuf):
+            sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode, buf, vbuf):
     """One remap pass from ``x, y, z`` to the new positions ``xn, yn, zn`` (then copied into
     ``x, y, z``): element state, reference volumes, nodal velocities and lumped masses.
     ``buf`` (e, :data:`N_RZ3`) and ``vbuf`` (n, 3) are work arrays; ``rho_s`` the
-    mass-scaled density [kg/m^3], ``t_room`` the virgin material's temperature [K],
-    ``vel_mode`` :data:`VEL_MOMENTUM` or :data:`VEL_TAYLOR`. Returns the number of nodes
+    mass-scaled density [kg/m^3], ``msf`` (e,) the elements' inertia factors (the lumped
+    masses are ``rho_s vol0 msf / 8`` a corner; empty: 1), ``t_room`` the virgin
+    material's temperature [K], ``vel_mode`` :data:`VEL_MOMENTUM` or :data:`VEL_TAYLOR`. Returns the number of nodes
     whose velocity was remapped. Allocates nothing."""
     nn = x.shape[0]
     ne = conn.shape[0]
@@ -473,7 +488,7 @@ def remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel,
                                 fixed, vbuf)
     else:
         for n in prange(nn):
-            moved += rz3_momentum(n, ptr, nel, conn, alive, vol0, buf, vx, vy, vz, fixed, vbuf)
+            moved += rz3_momentum(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf)
     for n in prange(nn):
         vx[n] = vbuf[n, 0]
         vy[n] = vbuf[n, 1]
@@ -485,7 +500,7 @@ def remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel,
         y[n] = yn[n]
         z[n] = zn[n]
     for n in prange(nn):
-        rz3_node_mass(n, ptr, nel, alive, vol0, rho_s, mass)
+        rz3_node_mass(n, ptr, nel, alive, vol0, rho_s, msf, mass)
     return moved
 
 
@@ -513,7 +528,8 @@ def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,
     """The arrays :func:`remap3d` takes, built from the node positions ``old`` (n, 3), the
     hexahedra ``conn`` and the ``fields`` dict of :func:`remap3d_py` (same defaults): keys
     ``x, y, z, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag, sd, pres, eps_p,
-    temp, dmg, qh, vol0, buf, vbuf`` (fresh copies)."""
+    temp, dmg, qh, vol0, msf, buf, vbuf`` (fresh copies; ``msf`` from ``fields``, else
+    empty)."""
     from robobore.cutting.fe.physics.thermal3d import face_neighbours
 
     old = np.ascontiguousarray(old, np.float64)
@@ -544,6 +560,7 @@ def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,
         "dmg": get("dmg", (ne,), 0.0), "qh": get("qh", (ne, 12), 0.0),
         "vol0": (np.array(fields["vol0"], np.float64) if "vol0" in fields
                  else element_volumes3(old, conn)),
+        "msf": (np.array(fields["msf"], np.float64) if "msf" in fields else np.zeros(0)),
         "buf": np.zeros((ne, N_RZ3)), "vbuf": np.zeros((n, 3)),
     }
 
@@ -565,8 +582,8 @@ def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
     """Allocating wrapper of :func:`remap3d` for tests and scripts.
 
     ``old``, ``new`` (n, 3) node positions [m]; ``conn`` (e, 8) VTK order; ``fields``: any of
-    ``sd`` (e, 6), ``pres``, ``eps_p``, ``temp``, ``dmg`` (e,), ``qh`` (e, 12), ``vol0`` (e,)
-    (missing: zero; ``vol0`` missing: the old volumes, ``temp``: ``t_room``); ``vel`` (n, 3)
+    ``sd`` (e, 6), ``pres``, ``eps_p``, ``temp``, ``dmg`` (e,), ``qh`` (e, 12), ``vol0`` (e,),
+    ``msf`` (e,) inertia factors (missing: zero; ``vol0`` missing: the old volumes, ``temp``: ``t_room``, ``msf``: 1); ``vel`` (n, 3)
     nodal velocities (zero); ``fixed`` (n,) bit mask; ``fnbr`` (e, 6) face neighbours
     (default :func:`robobore.cutting.fe.physics.thermal3d.face_neighbours`); ``bflag``
     (e, 6) outline flux types (default: all closed). Returns the remapped copies in a dict
@@ -579,5 +596,6 @@ def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
                     new[:, 2].copy(), a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
                     a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
                     a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
-                    float(rho_s), float(t_room), int(vel_mode), a["buf"], a["vbuf"])
+                    float(rho_s), a["msf"], float(t_room), int(vel_mode), a["buf"],
+                    a["vbuf"])
     return remap3d_outputs(a, moved)

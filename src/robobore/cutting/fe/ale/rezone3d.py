@@ -212,7 +212,7 @@ _targets = njit(inline="always")(toolframe3d_targets_loops)
 
 @njit(parallel=True, cache=True)
 def rezone3d(x, y, z, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag, sd, pres,
-             eps_p, temp, dmg, qh, vol0, rho_s, t_room, vel_mode, xn, yn, zn, buf, vbuf,
+             eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode, xn, yn, zn, buf, vbuf,
              scratch, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm, cx, cy, cz):
     """One tool-frame ALE pass of the 3D engine: the placement (:func:`toolframe3d_targets`)
     into ``xn, yn, zn``, then :func:`robobore.cutting.fe.ale.remap3d.remap3d` (arguments as
@@ -228,8 +228,8 @@ def rezone3d(x, y, z, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bfla
     _targets(x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm, cx, cy,
              cz, scratch)
     return remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr,
-                   bflag, sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, t_room, vel_mode, buf,
-                   vbuf)
+                   bflag, sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode,
+                   buf, vbuf)
 
 
 def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarray,
@@ -281,9 +281,9 @@ def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: n
     moved = rezone3d(a["x"], a["y"], a["z"], a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
                      a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
                      a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
-                     float(rho_s), float(t_room), int(vel_mode), np.empty(n), np.empty(n),
-                     np.empty(n), a["buf"], a["vbuf"], np.zeros((n, 3)), places[:, 0].copy(),
-                     places[:, 1].copy(), places[:, 2].copy(),
+                     float(rho_s), a["msf"], float(t_room), int(vel_mode), np.empty(n),
+                     np.empty(n), np.empty(n), a["buf"], a["vbuf"], np.zeros((n, 3)),
+                     places[:, 0].copy(), places[:, 1].copy(), places[:, 2].copy(),
                      np.ascontiguousarray(acls, np.int64), aflt, float(off_x), float(off_z),
                      float(max_move), np.ascontiguousarray(prm, np.float64), float(tip[0]),
                      float(tip[1]), float(tip[2]))

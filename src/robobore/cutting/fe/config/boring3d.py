@@ -141,6 +141,10 @@ class SolverSection(SolverSettings):
     #: to its place in the insert's frame and remap the element state and node velocities
     #: (the 2D key)
     ale_interval: int = Field(default=10, ge=1, le=10**4)
+    #: tool frame: inertia added to the elements whose stable step is below the smallest of
+    #: the nose-tip section (the thin chip elements at the ends of the engaged edge), so that
+    #: the mesh runs at the time step of its nose-tip section (docs/fe3d.md)
+    thin_element_mass_scaling: bool = True
 
 
 def _triple(v: Any) -> list[float]:

@@ -416,6 +416,9 @@ class ToolFrame3D:
     velocities are remapped by the 2D engine's Taylor step."""
 
     ale_interval: int
+    #: inertia factors on the elements whose stable step is below the nose-tip section's
+    #: smallest (:func:`robobore.cutting.fe.models.toolframe3d.thin_element_factors`)
+    thin_element_mass_scaling: bool = True
     #: largest node move of an ALE pass, fraction of the local element size (the 2D value)
     MAX_MOVE = ToolFrame.MAX_MOVE
 
@@ -471,7 +474,7 @@ BORING_MODEL_KEYS = (
     "mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm", "mesh.separation",
     "solver.erosion", "solver.erode_time_step_fraction", "mesh.edge_element_um",
     "mesh.slice_spacing_um", "mesh.t_min_um", "mesh.margin_slices", "mesh.initial_chip_ratio",
-    "solver.ale_interval",
+    "solver.ale_interval", "solver.thin_element_mass_scaling",
     "solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
     "contact.friction_heat_fraction", "contact.tool_temperature_K",
 )
@@ -486,7 +489,8 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
     keys = _Keys(cfg, BORING_MODEL_KEYS)
     sep: NodeSplit | EdgePathLayer | None
     tool_keys = ("mesh.edge_element_um", "mesh.slice_spacing_um", "mesh.t_min_um",
-                 "mesh.margin_slices", "mesh.initial_chip_ratio", "solver.ale_interval")
+                 "mesh.margin_slices", "mesh.initial_chip_ratio", "solver.ale_interval",
+                 "solver.thin_element_mass_scaling")
     tool_frame = None
     if cfg.mesh.frame == "tool":
         keys.exclude("tool3d", "mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm",
@@ -495,7 +499,9 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
                      "solver.erode_time_step_fraction")
         for key in tool_keys:
             keys.get(key)
-        tool_frame = ToolFrame3D(ale_interval=int(keys.get("solver.ale_interval")))
+        tool_frame = ToolFrame3D(
+            ale_interval=int(keys.get("solver.ale_interval")),
+            thin_element_mass_scaling=bool(keys.get("solver.thin_element_mass_scaling")))
         sep = None
     else:
         keys.exclude("workpiece", *tool_keys)

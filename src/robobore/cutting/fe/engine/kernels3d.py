@@ -35,6 +35,7 @@ frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
 """
 from __future__ import annotations
 
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -301,7 +302,7 @@ CHUNK_ARGS3 = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "
                "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
                "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist",
                "pairs", "enbr", "tbuf", "theat", "x0", "y0", "z0", "acls", "aflt", "bflag",
-               "xn", "yn", "zn", "buf", "vbuf", "scratch")
+               "xn", "yn", "zn", "buf", "vbuf", "scratch", "msf")
 #: the state of the loop's phases (numba reads the fields by name)
 ChunkState3 = namedtuple("ChunkState3", CHUNK_ARGS3)
 
@@ -340,6 +341,21 @@ def _elements3(s, dt):
 
 
 @njit
+def _elements3_ale(s, dt):
+    # the element update, then the smallest stable step with the elements' inertia factors
+    # (tool frame: mass scaling attached to the mesh, FEState3.msf; empty: 1)
+    dtmin, bad = _elements3(s, dt)
+    msf, dte = s.msf, s.dte
+    if msf.shape[0] > 0:
+        dtmin = 1e30
+        for e in range(dte.shape[0]):
+            d = dte[e] * math.sqrt(msf[e])
+            if d < dtmin:
+                dtmin = d
+    return dtmin, bad
+
+
+@njit
 def _heat3(s, step, t, dt):
     # every prm[P_COND_EVERY] steps (0: adiabatic): conduction and the thermal contact
     if is_conduction_step(step, s.prm):
@@ -357,24 +373,24 @@ def _remesh3(s, step):
         cx, cy, cz, _vx, _vy, _vz = tool_kinematics(s.tool, prm)
         rezone3d(s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.conn, s.alive, s.ptr,
                  s.nel, s.enbr, s.bflag, s.sd, s.pres, s.eps_p, s.temp, s.dmg, s.qh, s.vol0,
-                 mat[jc.RHO] * prm[P_MS], mat[jc.TROOM], int(prm[P_RZ_VEL]), s.xn, s.yn,
+                 mat[jc.RHO] * prm[P_MS], s.msf, mat[jc.TROOM], int(prm[P_RZ_VEL]), s.xn, s.yn,
                  s.zn, s.buf, s.vbuf, s.scratch, s.x0, s.y0, s.z0, s.acls, s.aflt,
                  cx - prm[P_ALE_X0], cz - prm[P_ALE_Z0], prm[P_RZ_MAXMOVE], prm, cx, cy, cz)
 
 
-def _bind3(name, remesh):
+def _bind3(name, remesh, elements):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases
     return bind_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
                            energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
                            nodes=_nodes3, tool_step=_tool_step3, remesh=remesh,
-                           elements=_elements3, heat=_heat3, end_step=_end_step3,
+                           elements=elements, heat=_heat3, end_step=_end_step3,
                            energy_totals=_energy_totals3, totals_at_chunk_end=True)
 
 
 #: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 3D phases:
 #: workpiece frame (no remesh phase) and tool frame (the ALE pass)
-_loop3 = _bind3("loop3", None)
-_loop3_ale = _bind3("loop3_ale", _remesh3)
+_loop3 = _bind3("loop3", None, _elements3)
+_loop3_ale = _bind3("loop3_ale", _remesh3, _elements3_ale)
 
 
 @njit(cache=True)

@@ -22,9 +22,10 @@ from robobore.cutting.fe.engine.threads import ThreadGovernor
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
 from robobore.errors import ConfigError
 from robobore.material import Material
+from robobore.material.johnson_cook import RHO as MAT_RHO
 
-__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "advance3", "energy_error",
-           "hex_volumes", "split_node_layer"]
+__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "element_steps3",
+           "advance3", "energy_error", "hex_volumes", "split_node_layer"]
 
 #: node sign pattern of the reference hexahedron (VTK order), shape (8, 3)
 HEX_SIGNS = np.array([(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),
@@ -107,6 +108,10 @@ class FEState3:
     buf: np.ndarray = field(default_factory=lambda: np.zeros((0, N_RZ3)))
     vbuf: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     scratch: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    #: element-attached inertia factors (e,) >= 1 of the tool-frame mesh (empty: none): each
+    #: element's corners carry ``rho_s vol0 msf / 8`` of inertia and its stable step is
+    #: ``sqrt(msf)`` times its material one (:meth:`set_inertia_factors`)
+    msf: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def kernel_args(self) -> tuple:
         """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
@@ -137,6 +142,29 @@ class FEState3:
         self.buf = np.zeros((ne, N_RZ3))
         self.vbuf = np.zeros((n, 3))
         self.scratch = np.zeros((n, 3))
+
+    def set_inertia_factors(self, msf: np.ndarray) -> None:
+        """Give the tool-frame state the element inertia factors ``msf`` (e,) >= 1 (mass
+        scaling attached to the mesh, not to the material that flows through it): the lumped
+        masses become ``rho_s vol0 msf / 8`` a corner (the ALE pass keeps them so), the
+        stable step of each element ``sqrt(msf)`` times its material one; the initial step
+        is recomputed."""
+        if not self.tool_frame:
+            raise ConfigError("inertia factors need the tool-frame arrays",
+                              field="msf", value="workpiece-frame state",
+                              expected="a state with attach_tool_frame")
+        msf = np.ascontiguousarray(msf, np.float64)
+        if msf.shape != self.vol0.shape or not np.all(msf >= 1.0):
+            raise ConfigError("inertia factors must be >= 1, one per element", field="msf",
+                              value=f"shape {msf.shape}, min {float(np.min(msf, initial=1))}",
+                              expected=f"({self.vol0.shape[0]},), >= 1")
+        self.msf = msf
+        rho_s = self.mat[MAT_RHO] * self.prm[K3.P_MS]
+        mass = np.zeros_like(self.mass)
+        np.add.at(mass, self.conn.ravel(),
+                  np.repeat(self.vol0 * rho_s * msf / 8.0, 8))
+        self.mass[:] = mass
+        init_forces3(self)
 
     @property
     def twin(self) -> np.ndarray:
@@ -271,14 +299,24 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
     return st
 
 
-def init_forces3(st: FEState3) -> float:
-    """Stable step of the current configuration (no stress update); sets ``clock[1]``."""
+def element_steps3(st: FEState3) -> np.ndarray:
+    """The material stable step (e,) [s] of each element in the current configuration, at
+    rest (the element update's own estimate, without the inertia factors; the state is not
+    changed)."""
     dte = np.zeros_like(st.dte)
     K3.element_update3(st.conn, st.x, st.y, st.z, st.vx * 0.0, st.vy * 0.0, st.vz * 0.0,
                        st.alive.copy(), st.layer, st.sd.copy(), st.pres.copy(), st.eps_p.copy(),
                        st.temp.copy(), st.dmg.copy(), st.qh.copy(), st.vol0, st.ie.copy(),
                        st.hge.copy(), np.zeros_like(st.fe), dte, st.plast.copy(),
                        st.rate.copy(), st.mat, st.prm, 1e-30, K3.ERODE_NONE)
+    return dte
+
+
+def init_forces3(st: FEState3) -> float:
+    """Stable step of the current configuration (no stress update); sets ``clock[1]``."""
+    dte = element_steps3(st)
+    if st.msf.shape[0] > 0:
+        dte = dte * np.sqrt(st.msf)
     dt = st.prm[K3.P_CFL] * float(np.min(dte))
     st.clock[1] = dt
     if st.prm[K3.P_DTMIN] <= 0:

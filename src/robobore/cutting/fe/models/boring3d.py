@@ -213,7 +213,7 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     setup = setup_boring(cfg, source)
     st = setup.state
     dt0 = float(st.clock[1])
-    mass0 = float(np.sum(st.mass))
+    mass0 = float(np.sum(st.vol0))
     limit = cfg.solver.energy_error_limit
 
     check = energy_check(setup.t_contact, setup.t_end, limit)
@@ -301,7 +301,13 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
 
         summary["toolframe_mesh"] = toolframe_mesh_summary(setup.mesh)
         # material in the mesh at the end over the start (inflow - outflow of the passes)
-        summary["toolframe_mesh"]["mass_ratio"] = float(np.sum(st.mass)) / mass0
+        summary["toolframe_mesh"]["mass_ratio"] = float(np.sum(st.vol0)) / mass0
+        if st.msf.shape[0] > 0:
+            # the inertia added to the thin chip elements (thin_element_factors)
+            summary["toolframe_mesh"]["inertia_factor_max"] = float(np.max(st.msf))
+            summary["toolframe_mesh"]["inertia_factor_elements"] = int(np.sum(st.msf > 1.0))
+            summary["toolframe_mesh"]["added_inertia_fraction"] = float(
+                np.sum(st.vol0 * (st.msf - 1.0)) / np.sum(st.vol0))
     else:
         summary["mesh_shape"] = list(setup.mesh.shape)
     if cfg.tool_support is not None:

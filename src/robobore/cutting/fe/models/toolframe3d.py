@@ -14,9 +14,17 @@ last slice, faces ``FK_SIDE``). Every ``solver.ale_interval`` steps the compiled
 (:func:`robobore.cutting.fe.engine.kernels3d.run_chunk3_ale`) moves the mesh back to its
 place in the insert's frame -- the places ``x0, y0, z0`` shifted by the insert tip's travel
 since the start -- and remaps the state (:func:`robobore.cutting.fe.ale.rezone3d.rezone3d`).
-No damage or time-step erosion; the energy balance is the 2D tool frame's (the cumulative
-element accounts stay with their elements through the remap, checked from the start of the
-run).
+Thin elements: the clamped chip at both ends of the engaged edge is a few micrometres thick
+in the rows of the nose-tip section, so its hexahedra have stable steps several times shorter
+than any element of the nose-tip section, and they alone would set the explicit step.
+With ``solver.thin_element_mass_scaling`` (default) those elements get inertia factors
+(:func:`thin_element_factors`): mass scaling attached to the mesh -- to the place in the
+insert's frame, not to the material flowing through it -- so that no element's stable step is
+below the smallest of the nose-tip section. The factored elements lie at the chip's thin
+ends, where the chip moves at about the cutting speed, far below their scaled wave speed (the
+run's kinetic energy is reported). No damage or time-step erosion; the energy balance is the
+2D tool frame's (the cumulative element accounts stay with their elements through the remap,
+checked from the start of the run).
 """
 
 from __future__ import annotations
@@ -30,7 +38,7 @@ from robobore.cutting.fe.ale.remap3d import FACES_OUT
 from robobore.cutting.fe.config.boring3d import BoringFEConfig
 from robobore.cutting.fe.config.spec import build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
-from robobore.cutting.fe.engine.state3d import FEState3, make_state3
+from robobore.cutting.fe.engine.state3d import FEState3, element_steps3, make_state3
 from robobore.cutting.fe.mesh.toolframe3d import (
     FK_SIDE,
     ToolFrame3DSizes,
@@ -40,8 +48,8 @@ from robobore.cutting.fe.mesh.toolframe3d import (
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
-__all__ = ["toolframe_fixed", "attach_toolframe", "setup_boring_toolframe",
-           "toolframe_mesh_summary"]
+__all__ = ["toolframe_fixed", "attach_toolframe", "thin_element_factors",
+           "setup_boring_toolframe", "toolframe_mesh_summary"]
 
 
 def toolframe_fixed(mesh: ToolFrameMesh3D) -> np.ndarray:
@@ -67,6 +75,19 @@ def attach_toolframe(st: FEState3, mesh: ToolFrameMesh3D, tip: tuple[float, floa
     st.attach_tool_frame(acls, aflt, mesh.bflag)
     st.prm[K3.P_ALE_X0] = tip[0]
     st.prm[K3.P_ALE_Z0] = tip[2]
+
+
+def thin_element_factors(st: FEState3, mesh: ToolFrameMesh3D) -> np.ndarray:
+    """Inertia factors (e,) >= 1 of the tool-frame mesh: ``(dt_tip / dt_e)^2`` for each
+    element whose material stable step ``dt_e`` (:func:`robobore.cutting.fe.engine.state3d.
+    element_steps3`, the mesh as built) is below ``dt_tip``, the smallest step of the
+    hexahedra on either side of the nose-tip slice (z = 0, the 2D section the mesh is built
+    from); 1 elsewhere. With them the mesh's stable step is the nose-tip section's."""
+    dte = element_steps3(st)
+    k0 = int(np.argmin(np.abs(mesh.z_slices)))
+    tip = (mesh.elem_slice == k0) | (mesh.elem_slice == k0 - 1)
+    dt_tip = float(np.min(dte[tip]))
+    return np.maximum(1.0, (dt_tip / dte) ** 2)
 
 
 def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
@@ -105,6 +126,8 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
     st = make_state3(mesh.nodes, mesh.conn, toolframe_fixed(mesh), mat, prm=p,
                      n_samples=s.n_samples, tool_tip=tip)
     attach_toolframe(st, mesh, tip)
+    if spec.tool_frame.thin_element_mass_scaling:
+        st.set_inertia_factors(thin_element_factors(st, mesh))
     check_support_step(cfg, st, source)
     return BoringSetup(cfg=cfg, material=mat, insert=ins, mesh=mesh, state=st, ap=ap, f=f,
                        vc=vc, t_end=t_end, t_contact=0.0, spec=spec, x_cut_start=tip[0])
