@@ -176,3 +176,16 @@ def test_the_spec_chooses_the_loop():
         advance3(w.state, 1e-9, step=K3.run_chunk3_ale)
     with pytest.raises(ConfigError, match="frame"):
         advance3(s.state, 1e-9, step=K3.run_chunk3)
+
+
+def test_cli_refuses_the_gpu_with_the_tool_frame(tmp_path):
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+    from robobore.io.config import dump_toml
+
+    cfg = tmp_path / "tf.toml"
+    cfg.write_text(dump_toml(_cfg()))
+    res = CliRunner().invoke(app, ["fe", "boring", str(cfg), "--device", "gpu"])
+    assert res.exit_code == 2
+    assert "CPU only" in res.output and "--device" in res.output
