@@ -12,7 +12,8 @@ about ``--steps`` explicit steps (the cut length set to the insert travel those 
 at the initial time step, which may be below the config's one-element minimum: set after
 the config is validated) and prints the step size, the steps per second (ALE passes
 included), the mesh facts and the forces over the last half of the travel
-(``simulate_boring``'s window). A few thousand steps are a micrometre or so of travel at the
+(``simulate_boring``'s window), with the history of the rotating-frame forces against the
+travel (the run's samples). A few thousand steps are a micrometre or so of travel at the
 paper's condition: the forces are those of the start of the cut from the pre-shaped chip,
 not steady values. Results go to ``--out`` (JSON) when given.
 """
@@ -66,7 +67,8 @@ def main() -> None:
         print(json.dumps(out, indent=1))
         return
     cfg.cut.cut_length_mm = a.steps * dt * vc * 1e3
-    r = simulate_boring(cfg, source=a.config).summary
+    res = simulate_boring(cfg, source=a.config)
+    r = res.summary
     keys = ("force_rotating_N", "force_rotating_std_N", "averaging_window_mm", "energy_error",
             "hourglass_fraction", "steps", "time_step_s", "wall_time_s",
             "element_updates_per_s", "n_elements", "n_nodes", "toolframe_mesh",
@@ -76,6 +78,9 @@ def main() -> None:
     out["mass_scaling"] = a.mass_scaling
     out["travel_um"] = cfg.cut.cut_length_mm * 1e3
     out["config"] = a.config
+    h = res.history
+    out["history"] = {k: [float(v) for v in h[k]] for k in (
+        "cut_length_mm", "force_tangential_N", "force_radial_N", "force_feed_N")}
     text = json.dumps(out, indent=1)
     print(text)
     if a.out:

@@ -161,3 +161,31 @@ def test_a_tool_frame_state_needs_its_interval():
     s.state.prm[K3.P_RZ_EVERY] = 0
     with pytest.raises(ConfigError, match="P_RZ_EVERY"):
         advance3(s.state, 1e-9)
+
+
+def test_the_spec_chooses_the_loop():
+    s = setup_boring(parse_boring_config(_cfg(t_min_um=8.0)))
+    assert K3.run_chunk3_for(s.spec) is K3.run_chunk3_ale
+    d = load_toml(EX / "fe_boring_paper.toml")
+    d["mesh"]["element_size_um"] = 16.6
+    d["cut"]["cut_length_mm"] = 0.02
+    w = setup_boring(parse_boring_config(d))
+    assert K3.run_chunk3_for(w.spec) is K3.run_chunk3
+    # a loop that does not match the state's frame is refused
+    with pytest.raises(ConfigError, match="frame"):
+        advance3(w.state, 1e-9, step=K3.run_chunk3_ale)
+    with pytest.raises(ConfigError, match="frame"):
+        advance3(s.state, 1e-9, step=K3.run_chunk3)
+
+
+def test_cli_refuses_the_gpu_with_the_tool_frame(tmp_path):
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+    from robobore.io.config import dump_toml
+
+    cfg = tmp_path / "tf.toml"
+    cfg.write_text(dump_toml(_cfg()))
+    res = CliRunner().invoke(app, ["fe", "boring", str(cfg), "--device", "gpu"])
+    assert res.exit_code == 2
+    assert "CPU only" in res.output and "--device" in res.output

@@ -86,6 +86,8 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     if device not in ("cpu", "gpu"):
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
+    cfg = load_boring_config(config)
+    check_boring_device(cfg, device, str(config))
     if device == "gpu":
         from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
@@ -93,8 +95,6 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     from robobore.io.outputs import check_output_dir
 
     check_output_dir(vtk, "--vtk", "the VTU meshes")
-    cfg = load_boring_config(config)
-    check_boring_device(cfg, device, str(config))
     with fraction_progress("FE boring (3D)", enabled=not as_json) as prog:
         res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
     result = dict(res.summary)

@@ -200,8 +200,8 @@ __all__ = [
     "E_EXT", "E_FRIC", "E_HG", "E_INT", "E_KIN", "E_PLAST", "I_BADELEM", "I_SAMPLE",
     "I_STATUS", "I_STEP", "N_SUM_LANES", "P_GATE", "STATUS_DONE", "STATUS_DT_COLLAPSE",
     "STATUS_INVERTED", "STATUS_NONFINITE", "STATUS_NO_ELEMENTS", "sum_energies3",
-    "contact_total3", "run_chunk3_ale", "P_RZ_EVERY", "P_RZ_MAXMOVE", "P_RZ_VEL", "P_ALE_X0",
-    "P_ALE_Z0",
+    "contact_total3", "run_chunk3_ale", "run_chunk3_for", "P_RZ_EVERY", "P_RZ_MAXMOVE",
+    "P_RZ_VEL", "P_ALE_X0", "P_ALE_Z0",
 ]
 
 
@@ -421,3 +421,10 @@ def run_chunk3_ale(n_steps, *arrays):
     ``prm[P_ALE_Z0]``) and the state remapped; the state's ALE arrays must be attached
     (:meth:`robobore.cutting.fe.engine.state3d.FEState3.attach_tool_frame`)."""
     return _loop3_ale(n_steps, *arrays)
+
+
+def run_chunk3_for(spec):
+    """The compiled 3D chunk function of a
+    :class:`~robobore.cutting.fe.config.spec.BoringSpec`: :func:`run_chunk3_ale` for the
+    tool frame (``spec.tool_frame``), else :func:`run_chunk3`."""
+    return run_chunk3 if getattr(spec, "tool_frame", None) is None else run_chunk3_ale

@@ -329,11 +329,14 @@ def init_forces3(st: FEState3) -> float:
 def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              progress: Callable[[float], None] | None = None,
              check: Callable[[FEState3], None] | None = None,
-             adaptive_threads: bool = True, governor: ThreadGovernor | None = None) -> int:
+             adaptive_threads: bool = True, governor: ThreadGovernor | None = None,
+             step: Callable[..., int] | None = None) -> int:
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
-    The loop is :func:`kernels3d.run_chunk3`, or :func:`kernels3d.run_chunk3_ale` (with the
-    tool-frame ALE pass every ``prm[P_RZ_EVERY]`` steps) for a state with the tool-frame
-    arrays (:meth:`FEState3.attach_tool_frame`).
+    ``step``: the compiled chunk function (:func:`kernels3d.run_chunk3_for` of the model
+    spec); default :func:`kernels3d.run_chunk3`, or :func:`kernels3d.run_chunk3_ale` (with
+    the tool-frame ALE pass every ``prm[P_RZ_EVERY]`` steps) for a state with the tool-frame
+    arrays (:meth:`FEState3.attach_tool_frame`). ConfigError when the loop and the state's
+    frame disagree.
 
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
@@ -344,7 +347,12 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
         raise ConfigError("the tool-frame ALE pass needs an interval of at least one step",
                           field="prm[P_RZ_EVERY]", value=float(st.prm[K3.P_RZ_EVERY]),
                           expected=">= 1")
-    run = K3.run_chunk3_ale if st.tool_frame else K3.run_chunk3
+    run = (K3.run_chunk3_ale if st.tool_frame else K3.run_chunk3) if step is None else step
+    if (run is K3.run_chunk3_ale) != st.tool_frame:
+        raise ConfigError("the 3D loop and the state's frame disagree", field="step",
+                          value=getattr(run, "__name__", str(run)),
+                          expected="run_chunk3_ale for a state with the tool-frame arrays, "
+                          "run_chunk3 without")
     return drive_chunks(st, t_end, run, K3.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "

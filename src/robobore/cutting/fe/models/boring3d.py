@@ -226,7 +226,8 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
                              progress=progress, check=check)
     elif device == "cpu":
         steps = advance3(st, setup.t_end, chunk_steps=cfg.solver.chunk_steps,
-                         progress=progress, check=check)
+                         progress=progress, check=check,
+                         step=None if setup.spec is None else K3.run_chunk3_for(setup.spec))
     else:
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
