@@ -5,7 +5,8 @@ Usage::
     python benchmarks/bench_fe3d.py speed [--elements 30000] [--steps 200]
     python benchmarks/bench_fe3d.py paper [--sizes 16.7 12.5] [--cut-mm 0.15]
         [--mass-scaling 400] [--coefficients FILE] [--friction LAW|table|0.3]
-        [--separation erosion_layer|node_split] [--no-support] [--out results.json]
+        [--separation erosion_layer|node_split] [--frame workpiece|tool] [--no-support]
+        [--out results.json]
 
 ``speed`` prints element-updates per second of the full time step (nodes, contact, elements,
 tool, heat conduction every 10 steps) on a wall block of about ``--elements`` hexahedra, on
@@ -20,7 +21,8 @@ reports the mesh-refinement change between successive meshes, then (unless
 ``--no-support``) runs the finest mesh with the tool on a quasi-static 3-axis support
 (natural frequency 100 kHz, zeta 0.5) and compares the mean Z deflection with feed force /
 kZ. The physics is the example's, i.e. the engine's defaults (docs/fe3d.md, "Physics and
-validation"), unless ``--friction`` names another friction law, "table" or a constant.
+validation"), unless ``--friction`` names another friction law, "table" or a constant;
+``--frame tool`` runs the tool-frame ALE mesh (docs/fe3d.md, "Tool-frame 3D model").
 Results go to ``--out`` (atomic JSON) when given.
 """
 
@@ -88,7 +90,7 @@ def speed(n_elements: int, steps: int) -> dict:
 
 def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None,
           friction: str | None = None, separation: str | None = None,
-          support: bool = True) -> dict:
+          support: bool = True, frame: str | None = None) -> dict:
     from robobore.cutting.fe.models.boring3d import (
         compare_with_mechanistic,
         parse_boring_config,
@@ -105,7 +107,10 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
         base.setdefault("contact", {})["friction"] = value
     if separation is not None:
         base["mesh"]["separation"] = separation
-    res: dict = {"runs": [], "cut_length_mm": cut_mm, "mass_scaling": ms}
+    if frame is not None:
+        base["mesh"]["frame"] = frame
+    res: dict = {"runs": [], "cut_length_mm": cut_mm, "mass_scaling": ms,
+                 "frame": base["mesh"].get("frame", "workpiece")}
     for le in sizes:
         d = json.loads(json.dumps(base))
         d["mesh"]["element_size_um"] = le
@@ -181,6 +186,8 @@ def main() -> None:
                     help='a friction law, "table" or a Coulomb coefficient (default: the '
                          "example's, i.e. the engine's default law)")
     ap.add_argument("--separation", choices=["erosion_layer", "node_split"], default=None)
+    ap.add_argument("--frame", choices=["workpiece", "tool"], default=None,
+                    help="the mesh frame (default: the example's)")
     ap.add_argument("--no-support", action="store_true",
                     help="skip the run of the finest mesh on the quasi-static support")
     ap.add_argument("--out", default=None)
@@ -189,7 +196,7 @@ def main() -> None:
         out = speed(a.elements, a.steps)
     else:
         out = paper(a.sizes, a.cut_mm, a.mass_scaling, a.coefficients, a.friction,
-                    a.separation, support=not a.no_support)
+                    a.separation, support=not a.no_support, frame=a.frame)
     if a.out:
         from robobore.io.results import write_json
 

@@ -27,17 +27,26 @@ _ROWS = [
     ("hourglass_fraction", "hourglass / internal energy"),
     ("eroded_damage", "elements eroded (damage)"),
     ("eroded_distortion", "elements eroded (distortion/time step)"),
+    ("frame", "mesh frame (workpiece / tool)"),
     ("separation", "chip separation"),
     ("pairs_parted", "node pairs parted (node splitting)"),
     ("friction_law", "friction law"),
     ("friction_coefficient", "Coulomb friction (nominal: at the cutting speed)"),
     ("sliding_speed_mean_m_per_s", "sliding speed of the contact nodes, mean [m/s]"),
     ("n_elements", "elements"),
+    ("time_step_s", "initial time step [s]"),
     ("steps", "time steps"),
     ("wall_time_s", "wall time [s]"),
     ("element_updates_per_s", "element updates per second"),
     ("device", "device"),
 ]
+
+#: the tool-frame model's status, printed with every tool-frame run (docs/fe3d.md,
+#: "Tool-frame 3D model")
+TOOL_FRAME_STATUS = (
+    'mesh.frame = "tool": the 3D tool-frame ALE model is not validated: its forces have not '
+    "been compared with the mechanistic model over a full cut (docs/fe3d.md, \"Tool-frame 3D "
+    "model\").")
 
 #: the model's validation status, printed with every run (docs/fe3d.md, "Limits")
 THRUST_LIMIT = (
@@ -66,6 +75,7 @@ def boring_cmd(
 @handle_errors
 def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     from robobore.cutting.fe.models.boring3d import (
+        check_boring_device,
         compare_with_mechanistic,
         load_boring_config,
         simulate_boring,
@@ -76,6 +86,8 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     if device not in ("cpu", "gpu"):
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
+    cfg = load_boring_config(config)
+    check_boring_device(cfg, device, str(config))
     if device == "gpu":
         from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
 
@@ -83,12 +95,11 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     from robobore.io.outputs import check_output_dir
 
     check_output_dir(vtk, "--vtk", "the VTU meshes")
-    cfg = load_boring_config(config)
     with fraction_progress("FE boring (3D)", enabled=not as_json) as prog:
         res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
     result = dict(res.summary)
     result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients)
-    result["warnings"] = [THRUST_LIMIT]
+    result["warnings"] = [TOOL_FRAME_STATUS if cfg.mesh.frame == "tool" else THRUST_LIMIT]
     if vtk is not None:
         result["files"] = {"vtk": [str(p) for p in write_vtk(res, vtk)]}
 
@@ -99,6 +110,12 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
             if isinstance(v, dict):
                 v = ", ".join(f"{x:.4g}" if isinstance(x, float) else str(x) for x in v.values())
             rows.append((label, v))
+        tf = r.get("toolframe_mesh")
+        if tf is not None:
+            rows.append(("tool-frame mesh: nodes, hexahedra, slices",
+                         f"{tf['nodes']}, {tf['hexahedra']}, {tf['slices']}"))
+            rows.append(("tool-frame mesh: t_min [um], clamp's chip area / chip area",
+                         f"{tf['t_min_um']:.3g}, {100 * tf['clamp_area_fraction']:.2f} %"))
         stdout.print(kv_table("FE boring (3D)", rows))
         mc = r["mechanistic_comparison"]
         stdout.print(kv_table("FE vs mechanistic model", [

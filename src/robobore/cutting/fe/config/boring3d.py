@@ -102,6 +102,29 @@ class MeshSection(Strict):
     #: node splitting: element rows of the chip above the parting surface (0 = about one
     #: per element size of the thickest chip section, at least 3)
     chip_rows: int = Field(default=0, ge=0, le=50)
+    #: the mesh's frame: "workpiece" (Lagrangian block of the bore wall, chip and wall part
+    #: by ``separation``) or "tool" (the z-sliced tool-frame ALE mesh of
+    #: robobore.cutting.fe.mesh.toolframe3d: it travels with the insert, material flows in
+    #: ahead of the edge and out behind the flank and through the chip's top face, no
+    #: separation criterion and no erosion; CPU only). With "tool", ``cut.cut_length_mm`` is
+    #: the insert's travel and the workpiece keys (``depth_factor``, ``side_margin_um``,
+    #: ``ahead_mm``, ``separation``, ``separation_height_um``, ``chip_rows``,
+    #: ``solver.erosion``, ``solver.separation_gate_um``,
+    #: ``solver.erode_time_step_fraction``) are an error
+    frame: Literal["workpiece", "tool"] = "workpiece"
+    #: tool frame: element round the edge [um] (None: element_size_um / 4, the 2D model's)
+    edge_element_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: largest step between slices along the feed [um] (None: element_size_um)
+    slice_spacing_um: float | None = Field(default=None, gt=0.0)
+    #: tool frame: the uncut thickness is clamped to at least this at both ends of the
+    #: engaged edge [um] (a slice needs a chip block; the clamp's fictitious chip area is
+    #: reported)
+    t_min_um: float = Field(default=5.0, gt=0.0)
+    #: tool frame: slices of workpiece only beyond each end of the engaged edge
+    margin_slices: int = Field(default=3, ge=1, le=50)
+    #: tool frame: chip thickness / uncut thickness of the pre-shaped chip the run starts
+    #: from (the 2D key)
+    initial_chip_ratio: float = Field(default=1.6, ge=1.0, le=5.0)
 
 
 class SolverSection(SolverSettings):
@@ -114,6 +137,14 @@ class SolverSection(SolverSettings):
     chunk_steps: int = Field(default=500, ge=10, le=10**7)
     #: node splitting: a tied pair parts within this distance of the insert [um]
     separation_gate_um: float = Field(default=0.0, ge=0.0)
+    #: tool frame (mesh.frame = "tool"): steps between the passes that move the mesh back
+    #: to its place in the insert's frame and remap the element state and node velocities
+    #: (the 2D key)
+    ale_interval: int = Field(default=10, ge=1, le=10**4)
+    #: tool frame: inertia added to the elements whose stable step is below the smallest of
+    #: the nose-tip section (the thin chip elements at the ends of the engaged edge), so that
+    #: the mesh runs at the time step of its nose-tip section (docs/fe3d.md)
+    thin_element_mass_scaling: bool = True
 
 
 def _triple(v: Any) -> list[float]:
@@ -198,6 +229,8 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
         raise ConfigError("edge radius not smaller than the nose radius", file=source,
                           field="insert.edge_radius_um", value=cfg.insert.edge_radius_um,
                           expected=f"< {cfg.insert.nose_radius_mm * 1e3:g} um")
+    if cfg.mesh.frame == "tool":
+        _check_tool_frame(cfg, source)
     if cfg.cut.bore_diameter_mm < 20 * cfg.cut.cut_length_mm:
         raise ConfigError("bore too small for the locally flat wall model", file=source,
                           field="cut.bore_diameter_mm", value=cfg.cut.bore_diameter_mm,
@@ -211,6 +244,29 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
     build_boring_spec(cfg, mat, vc_m_per_min, source)
     check_fe3d(cfg, source)  # refuse a mesh that cannot fit in memory, before meshing
     return cfg
+
+
+def _check_tool_frame(cfg: BoringFEConfig, source: str | None) -> None:
+    """The tool frame's cross-field rules: an edge radius, the clamp below ap, the edge
+    element at most the element size, a travel of at least one element."""
+    m = cfg.mesh
+    ap_um = cfg.cut.depth_of_cut_mm * 1e3
+    if cfg.insert.edge_radius_um <= 0.0:
+        raise ConfigError("the tool-frame mesh needs an edge radius", file=source,
+                          field="insert.edge_radius_um", value=cfg.insert.edge_radius_um,
+                          expected='> 0 um with mesh.frame = "tool"')
+    if m.t_min_um >= ap_um:
+        raise ConfigError("uncut-thickness clamp not below the depth of cut", file=source,
+                          field="mesh.t_min_um", value=m.t_min_um,
+                          expected=f"< cut.depth_of_cut_mm = {ap_um:g} um")
+    if m.edge_element_um is not None and m.edge_element_um > m.element_size_um:
+        raise ConfigError("edge element larger than the element size", file=source,
+                          field="mesh.edge_element_um", value=m.edge_element_um,
+                          expected=f"<= mesh.element_size_um = {m.element_size_um:g} um")
+    if cfg.cut.cut_length_mm * 1e3 < m.element_size_um:
+        raise ConfigError("insert travel shorter than one element", file=source,
+                          field="cut.cut_length_mm", value=cfg.cut.cut_length_mm,
+                          expected=f">= mesh.element_size_um = {m.element_size_um:g} um")
 
 
 def load_boring_config(path: str | Path) -> BoringFEConfig:

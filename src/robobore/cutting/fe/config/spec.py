@@ -39,7 +39,7 @@ __all__ = [
     "CoulombFriction", "SlidingSpeedFriction", "Adiabatic", "Conduction", "PlainHardening",
     "HardeningHold", "ModelSpec", "build_spec", "friction_spec", "thermal_spec", "write_friction",
     "write_thermal", "MODEL_KEYS", "HexElement", "EdgePathLayer", "BoringSpec",
-    "build_boring_spec", "BORING_MODEL_KEYS",
+    "build_boring_spec", "BORING_MODEL_KEYS", "ToolFrame3D",
 ]
 
 
@@ -270,6 +270,8 @@ _VARIANT_TEXT = {
     "erosion_layer": 'mesh.separation = "erosion_layer" (no parting line: the layer, its '
                      "position and erosion)",
     "workpiece": 'mesh.frame = "workpiece" (no tool-frame ALE mesh)',
+    "tool3d": 'mesh.frame = "tool" (the 3D tool-frame ALE model: no workpiece block, no '
+              "separation, no damage or time-step erosion)",
     "bbar": 'solver.element = "q4_bbar" (no hourglass modes: no hourglass coefficients)',
     "adiabatic": "solver.heat_conduction = false (adiabatic: no conduction interval, no "
                  "thermal contact with the tool)",
@@ -406,31 +408,61 @@ def build_spec(cfg: Any, material: Material, source: str | None = None) -> Model
 
 
 @dataclass(frozen=True)
-class BoringSpec:
-    """The model choices of a 3D boring config: the workpiece frame (the only one of the 3D
-    engine) with its separation -- :class:`NodeSplit` (parting surface, gate) or
-    :class:`EdgePathLayer` --, damage erosion of the layer elements on the edge path (both
-    separations have them) on or off, the hexahedron, time-step erosion, friction, thermal
-    model and hardening."""
+class ToolFrame3D:
+    """The 3D tool-frame ALE mesh (:mod:`robobore.cutting.fe.mesh.toolframe3d`): moved back to
+    its place in the insert's frame every ``ale_interval`` steps; no separation, no damage or
+    time-step erosion (as the 2D :class:`ToolFrame`); the hexahedron. Node moves of a pass
+    are limited to ``ToolFrame.MAX_MOVE`` of the local element size and the nodal
+    velocities are remapped by the 2D engine's Taylor step."""
 
-    separation: NodeSplit | EdgePathLayer
+    ale_interval: int
+    #: inertia factors on the elements whose stable step is below the nose-tip section's
+    #: smallest (:func:`robobore.cutting.fe.models.toolframe3d.thin_element_factors`)
+    thin_element_mass_scaling: bool = True
+    #: largest node move of an ALE pass, fraction of the local element size (the 2D value)
+    MAX_MOVE = ToolFrame.MAX_MOVE
+
+
+@dataclass(frozen=True)
+class BoringSpec:
+    """The model choices of a 3D boring config: the frame -- the workpiece frame
+    (``tool_frame`` None) with its separation, :class:`NodeSplit` (parting surface, gate) or
+    :class:`EdgePathLayer`, and damage erosion of the layer elements on the edge path (both
+    separations have them) on or off and time-step erosion; or the tool frame
+    (:class:`ToolFrame3D`: ``separation`` None, no erosion) --, the hexahedron, friction,
+    thermal model and hardening."""
+
+    separation: NodeSplit | EdgePathLayer | None
     damage_erosion: bool
     element: HexElement
     erode_time_step_fraction: float
     friction: CoulombFriction | SlidingSpeedFriction
     thermal: Adiabatic | Conduction
     hardening: PlainHardening | HardeningHold
+    tool_frame: ToolFrame3D | None = None
 
     def write_prm(self, p: np.ndarray, kernels: Any, vc_m_per_min: float) -> np.ndarray:
         """Write the model-choice slots of the 3D parameter vector ``p`` (returned);
-        ``kernels`` the 3D kernel module."""
+        ``kernels`` the 3D kernel module. The frame also chooses the compiled step
+        (:func:`robobore.cutting.fe.engine.kernels3d.run_chunk3_for`)."""
         k = kernels
         p[k.P_HGV] = self.element.hourglass_viscous
         p[k.P_HGS] = self.element.hourglass_stiffness
-        p[k.P_DT_ERODE] = -self.erode_time_step_fraction
-        p[k.P_EROSION] = k.ERODE_LAYER if self.damage_erosion else k.ERODE_NONE
-        sep = self.separation
-        p[k.P_GATE] = sep.gate_um * 1e-6 if isinstance(sep, NodeSplit) else -1.0
+        tf = self.tool_frame
+        if tf is not None:
+            from robobore.cutting.fe.ale.remap3d import VEL_TAYLOR
+
+            p[k.P_DT_ERODE] = 0.0
+            p[k.P_EROSION] = k.ERODE_NONE
+            p[k.P_GATE] = -1.0
+            p[k.P_RZ_EVERY] = tf.ale_interval
+            p[k.P_RZ_MAXMOVE] = tf.MAX_MOVE
+            p[k.P_RZ_VEL] = VEL_TAYLOR
+        else:
+            p[k.P_DT_ERODE] = -self.erode_time_step_fraction
+            p[k.P_EROSION] = k.ERODE_LAYER if self.damage_erosion else k.ERODE_NONE
+            sep = self.separation
+            p[k.P_GATE] = sep.gate_um * 1e-6 if isinstance(sep, NodeSplit) else -1.0
         write_friction(p, self.friction, kernels, vc_m_per_min)
         write_thermal(p, self.thermal, kernels)
         return p
@@ -439,6 +471,10 @@ class BoringSpec:
 #: the keys of a 3D boring config that belong to one model variant (see MODEL_KEYS)
 BORING_MODEL_KEYS = (
     "mesh.separation_height_um", "mesh.chip_rows", "solver.separation_gate_um",
+    "mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm", "mesh.separation",
+    "solver.erosion", "solver.erode_time_step_fraction", "mesh.edge_element_um",
+    "mesh.slice_spacing_um", "mesh.t_min_um", "mesh.margin_slices", "mesh.initial_chip_ratio",
+    "solver.ale_interval", "solver.thin_element_mass_scaling",
     "solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
     "contact.friction_heat_fraction", "contact.tool_temperature_K",
 )
@@ -451,15 +487,35 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
     config gives that the chosen variants have no place for (for example
     ``solver.separation_gate_um`` with ``mesh.separation = "erosion_layer"``)."""
     keys = _Keys(cfg, BORING_MODEL_KEYS)
-    sep: NodeSplit | EdgePathLayer
-    if cfg.mesh.separation == "node_split":
-        keys.get("mesh.chip_rows")
-        sep = NodeSplit(height_um=float(keys.get("mesh.separation_height_um")),
-                        gate_um=float(keys.get("solver.separation_gate_um")))
+    sep: NodeSplit | EdgePathLayer | None
+    tool_keys = ("mesh.edge_element_um", "mesh.slice_spacing_um", "mesh.t_min_um",
+                 "mesh.margin_slices", "mesh.initial_chip_ratio", "solver.ale_interval",
+                 "solver.thin_element_mass_scaling")
+    tool_frame = None
+    if cfg.mesh.frame == "tool":
+        keys.exclude("tool3d", "mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm",
+                     "mesh.separation", "mesh.separation_height_um", "mesh.chip_rows",
+                     "solver.erosion", "solver.separation_gate_um",
+                     "solver.erode_time_step_fraction")
+        for key in tool_keys:
+            keys.get(key)
+        tool_frame = ToolFrame3D(
+            ale_interval=int(keys.get("solver.ale_interval")),
+            thin_element_mass_scaling=bool(keys.get("solver.thin_element_mass_scaling")))
+        sep = None
     else:
-        keys.exclude("erosion_layer", "mesh.separation_height_um", "mesh.chip_rows",
-                     "solver.separation_gate_um")
-        sep = EdgePathLayer()
+        keys.exclude("workpiece", *tool_keys)
+        for key in ("mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm",
+                    "mesh.separation", "solver.erosion", "solver.erode_time_step_fraction"):
+            keys.get(key)
+        if cfg.mesh.separation == "node_split":
+            keys.get("mesh.chip_rows")
+            sep = NodeSplit(height_um=float(keys.get("mesh.separation_height_um")),
+                            gate_um=float(keys.get("solver.separation_gate_um")))
+        else:
+            keys.exclude("erosion_layer", "mesh.separation_height_um", "mesh.chip_rows",
+                         "solver.separation_gate_um")
+            sep = EdgePathLayer()
     if cfg.solver.heat_conduction:
         for key in ("solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
                     "contact.friction_heat_fraction", "contact.tool_temperature_K"):
@@ -472,10 +528,11 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
     limit = material.hardening_strain_limit
     keys.check(source)
     return BoringSpec(
-        separation=sep, damage_erosion=s.erosion == "layer",
+        separation=sep, damage_erosion=tool_frame is None and s.erosion == "layer",
         element=HexElement(float(s.hourglass_viscous), float(s.hourglass_stiffness)),
         erode_time_step_fraction=float(s.erode_time_step_fraction),
         friction=friction_spec(cfg.contact, vc_m_per_min),
         thermal=thermal_spec(s, cfg.contact, material),
         hardening=(HardeningHold(float(limit)) if limit is not None and math.isfinite(limit)
-                   else PlainHardening()))
+                   else PlainHardening()),
+        tool_frame=tool_frame)

@@ -8,8 +8,10 @@ the insert edge) and the spring-damper step
 functions (``_py`` original + ``njit``, device-ready) are
 :mod:`robobore.cutting.fe.hex.scalar3d`, re-exported here; this module holds the parallel loops
 (elements, nodes), the energy sums, the contact-force total, the conduction pass, the step
-phases and the chunk loop :func:`run_chunk3` (the step loop of
-:mod:`robobore.cutting.fe.engine.step_loop` with those phases). The scalar functions:
+phases and the chunk loops :func:`run_chunk3` (the step loop of
+:mod:`robobore.cutting.fe.engine.step_loop` with those phases; workpiece frame) and
+:func:`run_chunk3_ale` (the same with the tool-frame ALE pass of
+:mod:`robobore.cutting.fe.ale.rezone3d` as its remesh phase). The scalar functions:
 
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
@@ -33,11 +35,13 @@ frame (X horizontal, Y vertical, Z feed) and rotates with the bar angle
 """
 from __future__ import annotations
 
+import math
 from collections import namedtuple
 
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe.ale.rezone3d import rezone3d
 from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
 from robobore.cutting.fe.engine.kernels import (
     E_ERODED,
@@ -67,6 +71,8 @@ from robobore.cutting.fe.hex.layout3d import (
     ERODE_LAYER,
     ERODE_NONE,
     N_PRM,
+    P_ALE_X0,
+    P_ALE_Z0,
     P_BV1,
     P_BV2,
     P_CFL,
@@ -103,6 +109,9 @@ from robobore.cutting.fe.hex.layout3d import (
     P_RAKE,
     P_RE,
     P_RN,
+    P_RZ_EVERY,
+    P_RZ_MAXMOVE,
+    P_RZ_VEL,
     P_SAMPLE_DT,
     P_SLIP_TAU,
     P_SUPPORT,
@@ -191,7 +200,8 @@ __all__ = [
     "E_EXT", "E_FRIC", "E_HG", "E_INT", "E_KIN", "E_PLAST", "I_BADELEM", "I_SAMPLE",
     "I_STATUS", "I_STEP", "N_SUM_LANES", "P_GATE", "STATUS_DONE", "STATUS_DT_COLLAPSE",
     "STATUS_INVERTED", "STATUS_NONFINITE", "STATUS_NO_ELEMENTS", "sum_energies3",
-    "contact_total3",
+    "contact_total3", "run_chunk3_ale", "run_chunk3_for", "P_RZ_EVERY", "P_RZ_MAXMOVE",
+    "P_RZ_VEL", "P_ALE_X0", "P_ALE_Z0",
 ]
 
 
@@ -291,7 +301,8 @@ CHUNK_ARGS3 = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "
                "conn", "alive", "layer", "sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0",
                "ie", "hge", "fe", "dte", "plast", "rate", "cf", "fric", "pen", "ndead",
                "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist", "clock", "hacc", "hist",
-               "pairs", "enbr", "tbuf", "theat")
+               "pairs", "enbr", "tbuf", "theat", "x0", "y0", "z0", "acls", "aflt", "bflag",
+               "xn", "yn", "zn", "buf", "vbuf", "scratch", "msf")
 #: the state of the loop's phases (numba reads the fields by name)
 ChunkState3 = namedtuple("ChunkState3", CHUNK_ARGS3)
 
@@ -330,6 +341,21 @@ def _elements3(s, dt):
 
 
 @njit
+def _elements3_ale(s, dt):
+    # the element update, then the smallest stable step with the elements' inertia factors
+    # (tool frame: mass scaling attached to the mesh, FEState3.msf; empty: 1)
+    dtmin, bad = _elements3(s, dt)
+    msf, dte = s.msf, s.dte
+    if msf.shape[0] > 0:
+        dtmin = 1e30
+        for e in range(dte.shape[0]):
+            d = dte[e] * math.sqrt(msf[e])
+            if d < dtmin:
+                dtmin = d
+    return dtmin, bad
+
+
+@njit
 def _heat3(s, step, t, dt):
     # every prm[P_COND_EVERY] steps (0: adiabatic): conduction and the thermal contact
     if is_conduction_step(step, s.prm):
@@ -338,12 +364,33 @@ def _heat3(s, step, t, dt):
                          t + dt)
 
 
-#: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 3D phases
-_loop3 = bind_chunk_loop(name="loop3", state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
-                         energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
-                         nodes=_nodes3, tool_step=_tool_step3, elements=_elements3,
-                         heat=_heat3, end_step=_end_step3, energy_totals=_energy_totals3,
-                         totals_at_chunk_end=True)
+@njit
+def _remesh3(s, step):
+    # the tool-frame ALE pass every prm[P_RZ_EVERY] steps: each node back to its place
+    # shifted by the insert's travel since the mesh was built, then the remap
+    prm, mat = s.prm, s.mat
+    if step % int(prm[P_RZ_EVERY]) == 0:
+        cx, cy, cz, _vx, _vy, _vz = tool_kinematics(s.tool, prm)
+        rezone3d(s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.conn, s.alive, s.ptr,
+                 s.nel, s.enbr, s.bflag, s.sd, s.pres, s.eps_p, s.temp, s.dmg, s.qh, s.vol0,
+                 mat[jc.RHO] * prm[P_MS], s.msf, mat[jc.TROOM], int(prm[P_RZ_VEL]), s.xn, s.yn,
+                 s.zn, s.buf, s.vbuf, s.scratch, s.x0, s.y0, s.z0, s.acls, s.aflt,
+                 cx - prm[P_ALE_X0], cz - prm[P_ALE_Z0], prm[P_RZ_MAXMOVE], prm, cx, cy, cz)
+
+
+def _bind3(name, remesh, elements):
+    # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases
+    return bind_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
+                           energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
+                           nodes=_nodes3, tool_step=_tool_step3, remesh=remesh,
+                           elements=elements, heat=_heat3, end_step=_end_step3,
+                           energy_totals=_energy_totals3, totals_at_chunk_end=True)
+
+
+#: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 3D phases:
+#: workpiece frame (no remesh phase) and tool frame (the ALE pass)
+_loop3 = _bind3("loop3", None, _elements3)
+_loop3_ale = _bind3("loop3_ale", _remesh3, _elements3_ale)
 
 
 @njit(cache=True)
@@ -362,3 +409,22 @@ def run_chunk3(n_steps, *arrays):
     physics.thermal3d`, :func:`conduction_pass3`).
     """
     return _loop3(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk3_ale(n_steps, *arrays):
+    """:func:`run_chunk3` with the tool-frame ALE pass
+    (:func:`robobore.cutting.fe.ale.rezone3d.rezone3d`) as the loop's ``remesh`` phase every
+    ``prm[P_RZ_EVERY]`` steps (>= 1): the mesh of
+    :mod:`robobore.cutting.fe.mesh.toolframe3d` put back to its place in the insert's frame
+    (the places ``x0, y0, z0`` shifted by the insert tip's travel since ``prm[P_ALE_X0]``,
+    ``prm[P_ALE_Z0]``) and the state remapped; the state's ALE arrays must be attached
+    (:meth:`robobore.cutting.fe.engine.state3d.FEState3.attach_tool_frame`)."""
+    return _loop3_ale(n_steps, *arrays)
+
+
+def run_chunk3_for(spec):
+    """The compiled 3D chunk function of a
+    :class:`~robobore.cutting.fe.config.spec.BoringSpec`: :func:`run_chunk3_ale` for the
+    tool frame (``spec.tool_frame``), else :func:`run_chunk3`."""
+    return run_chunk3 if getattr(spec, "tool_frame", None) is None else run_chunk3_ale

@@ -11,19 +11,21 @@ accumulators).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from robobore.cutting.fe.ale.remap3d import N_RZ3
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.chunk_driver import drive_chunks, energy_error
 from robobore.cutting.fe.engine.threads import ThreadGovernor
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
 from robobore.errors import ConfigError
 from robobore.material import Material
+from robobore.material.johnson_cook import RHO as MAT_RHO
 
-__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "advance3", "energy_error",
-           "hex_volumes", "split_node_layer"]
+__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "element_steps3",
+           "advance3", "energy_error", "hex_volumes", "split_node_layer"]
 
 #: node sign pattern of the reference hexahedron (VTK order), shape (8, 3)
 HEX_SIGNS = np.array([(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),
@@ -86,10 +88,83 @@ class FEState3:
     enbr: np.ndarray
     tbuf: np.ndarray
     theat: np.ndarray
+    #: tool-frame ALE (``mesh.frame = "tool"``, :mod:`robobore.cutting.fe.ale.rezone3d`; zero
+    #: rows in the workpiece frame, so the loop's arguments are one list): the nodes' places
+    #: when the mesh was built (n,) [m] (each pass puts a node back to its place shifted by
+    #: the insert's travel); ``acls`` (n, 7) int64 node class and in-slice neighbours,
+    #: ``aflt`` (n, 6) the placement's geometric data, ``bflag`` (e, 6) int64 the remap's
+    #: flux flag of each face (:mod:`robobore.cutting.fe.mesh.toolframe3d`); scratch: new
+    #: node places ``xn, yn, zn`` (n,), remapped element fields ``buf`` (e, remap3d.N_RZ3),
+    #: nodal velocities ``vbuf`` (n, 3) and the placement's work array ``scratch`` (n, 3)
+    x0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    y0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    z0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    acls: np.ndarray = field(default_factory=lambda: np.zeros((0, 7), np.int64))
+    aflt: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    bflag: np.ndarray = field(default_factory=lambda: np.zeros((0, 6), np.int64))
+    xn: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    yn: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    zn: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    buf: np.ndarray = field(default_factory=lambda: np.zeros((0, N_RZ3)))
+    vbuf: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    scratch: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    #: element-attached inertia factors (e,) >= 1 of the tool-frame mesh (empty: none): each
+    #: element's corners carry ``rho_s vol0 msf / 8`` of inertia and its stable step is
+    #: ``sqrt(msf)`` times its material one (:meth:`set_inertia_factors`)
+    msf: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def kernel_args(self) -> tuple:
         """Arrays in the order of :func:`kernels3d.run_chunk3` (after ``n_steps``)."""
         return tuple(getattr(self, f.name) for f in fields(self))
+
+    @property
+    def tool_frame(self) -> bool:
+        """Whether the state carries the tool-frame ALE arrays (the loop with the ALE pass,
+        :func:`kernels3d.run_chunk3_ale`, runs it)."""
+        return self.x0.shape[0] > 0
+
+    def attach_tool_frame(self, acls: np.ndarray, aflt: np.ndarray, bflag: np.ndarray) -> None:
+        """Give the state the tool-frame ALE arrays: the current node positions as the
+        nodes' places, the node classes ``acls`` (n, 7), the placement data ``aflt`` (n, 6),
+        the faces' flux flags ``bflag`` (e, 6), and the scratch arrays."""
+        n = self.x.shape[0]
+        ne = self.conn.shape[0]
+        acls = np.ascontiguousarray(acls, np.int64)
+        aflt = np.ascontiguousarray(aflt, np.float64)
+        bflag = np.ascontiguousarray(bflag, np.int64)
+        if acls.shape != (n, 7) or aflt.shape != (n, 6) or bflag.shape != (ne, 6):
+            raise ConfigError("tool-frame arrays do not match the mesh", field="acls, aflt, "
+                              "bflag", value=f"{acls.shape}, {aflt.shape}, {bflag.shape}",
+                              expected=f"({n}, 7), ({n}, 6), ({ne}, 6)")
+        self.x0, self.y0, self.z0 = self.x.copy(), self.y.copy(), self.z.copy()
+        self.acls, self.aflt, self.bflag = acls, aflt, bflag
+        self.xn, self.yn, self.zn = np.zeros(n), np.zeros(n), np.zeros(n)
+        self.buf = np.zeros((ne, N_RZ3))
+        self.vbuf = np.zeros((n, 3))
+        self.scratch = np.zeros((n, 3))
+
+    def set_inertia_factors(self, msf: np.ndarray) -> None:
+        """Give the tool-frame state the element inertia factors ``msf`` (e,) >= 1 (mass
+        scaling attached to the mesh, not to the material that flows through it): the lumped
+        masses become ``rho_s vol0 msf / 8`` a corner (the ALE pass keeps them so), the
+        stable step of each element ``sqrt(msf)`` times its material one; the initial step
+        is recomputed."""
+        if not self.tool_frame:
+            raise ConfigError("inertia factors need the tool-frame arrays",
+                              field="msf", value="workpiece-frame state",
+                              expected="a state with attach_tool_frame")
+        msf = np.ascontiguousarray(msf, np.float64)
+        if msf.shape != self.vol0.shape or not np.all(msf >= 1.0):
+            raise ConfigError("inertia factors must be >= 1, one per element", field="msf",
+                              value=f"shape {msf.shape}, min {float(np.min(msf, initial=1))}",
+                              expected=f"({self.vol0.shape[0]},), >= 1")
+        self.msf = msf
+        rho_s = self.mat[MAT_RHO] * self.prm[K3.P_MS]
+        mass = np.zeros_like(self.mass)
+        np.add.at(mass, self.conn.ravel(),
+                  np.repeat(self.vol0 * rho_s * msf / 8.0, 8))
+        self.mass[:] = mass
+        init_forces3(self)
 
     @property
     def twin(self) -> np.ndarray:
@@ -224,14 +299,24 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
     return st
 
 
-def init_forces3(st: FEState3) -> float:
-    """Stable step of the current configuration (no stress update); sets ``clock[1]``."""
+def element_steps3(st: FEState3) -> np.ndarray:
+    """The material stable step (e,) [s] of each element in the current configuration, at
+    rest (the element update's own estimate, without the inertia factors; the state is not
+    changed)."""
     dte = np.zeros_like(st.dte)
     K3.element_update3(st.conn, st.x, st.y, st.z, st.vx * 0.0, st.vy * 0.0, st.vz * 0.0,
                        st.alive.copy(), st.layer, st.sd.copy(), st.pres.copy(), st.eps_p.copy(),
                        st.temp.copy(), st.dmg.copy(), st.qh.copy(), st.vol0, st.ie.copy(),
                        st.hge.copy(), np.zeros_like(st.fe), dte, st.plast.copy(),
                        st.rate.copy(), st.mat, st.prm, 1e-30, K3.ERODE_NONE)
+    return dte
+
+
+def init_forces3(st: FEState3) -> float:
+    """Stable step of the current configuration (no stress update); sets ``clock[1]``."""
+    dte = element_steps3(st)
+    if st.msf.shape[0] > 0:
+        dte = dte * np.sqrt(st.msf)
     dt = st.prm[K3.P_CFL] * float(np.min(dte))
     st.clock[1] = dt
     if st.prm[K3.P_DTMIN] <= 0:
@@ -244,15 +329,31 @@ def init_forces3(st: FEState3) -> float:
 def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              progress: Callable[[float], None] | None = None,
              check: Callable[[FEState3], None] | None = None,
-             adaptive_threads: bool = True, governor: ThreadGovernor | None = None) -> int:
+             adaptive_threads: bool = True, governor: ThreadGovernor | None = None,
+             step: Callable[..., int] | None = None) -> int:
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
+    ``step``: the compiled chunk function (:func:`kernels3d.run_chunk3_for` of the model
+    spec); default :func:`kernels3d.run_chunk3`, or :func:`kernels3d.run_chunk3_ale` (with
+    the tool-frame ALE pass every ``prm[P_RZ_EVERY]`` steps) for a state with the tool-frame
+    arrays (:meth:`FEState3.attach_tool_frame`). ConfigError when the loop and the state's
+    frame disagree.
 
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
     ``adaptive_threads``, ``governor``: see
     :func:`~robobore.cutting.fe.engine.chunk_driver.drive_chunks`.
     """
-    return drive_chunks(st, t_end, K3.run_chunk3, K3.P_TEND, chunk_steps=chunk_steps,
+    if st.tool_frame and st.prm[K3.P_RZ_EVERY] < 1:
+        raise ConfigError("the tool-frame ALE pass needs an interval of at least one step",
+                          field="prm[P_RZ_EVERY]", value=float(st.prm[K3.P_RZ_EVERY]),
+                          expected=">= 1")
+    run = (K3.run_chunk3_ale if st.tool_frame else K3.run_chunk3) if step is None else step
+    if (run is K3.run_chunk3_ale) != st.tool_frame:
+        raise ConfigError("the 3D loop and the state's frame disagree", field="step",
+                          value=getattr(run, "__name__", str(run)),
+                          expected="run_chunk3_ale for a state with the tool-frame arrays, "
+                          "run_chunk3 without")
+    return drive_chunks(st, t_end, run, K3.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "
                         "scaling or a softer contact.penalty_factor",

@@ -69,6 +69,15 @@ PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     ("P_HC", 1, "insert interface conductance [W/(m^2 K)]"),
     ("P_FHEAT", 1, "fraction of the frictional dissipation that heats the workpiece"),
     ("P_TTOOL", 1, "insert temperature [K]"),
+    # tool-frame ALE (mesh.frame = "tool"; robobore.cutting.fe.ale.rezone3d)
+    ("P_RZ_EVERY", 1, "steps between tool-frame ALE passes (0: workpiece frame, no pass)"),
+    ("P_RZ_MAXMOVE", 1, "largest node move of an ALE pass, fraction of the local element "
+                        "size"),
+    ("P_RZ_VEL", 1, "nodal velocity remap of an ALE pass (remap3d.VEL_TAYLOR or "
+                    "VEL_MOMENTUM)"),
+    ("P_ALE_X0", 1, "insert tip's x when the mesh was built [m] (the mesh's travel is "
+                    "measured from it)"),
+    ("P_ALE_Z0", 1, "insert tip's z when the mesh was built [m]"),
 )
 globals().update(prm_slots(PRM_FIELDS))
 #: damage erosion: none, or the elements of the separation layer

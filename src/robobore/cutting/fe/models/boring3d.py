@@ -65,7 +65,8 @@ from robobore.material import Material, load_material
 
 __all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "BoringMesh",
            "build_boring_mesh", "parting_surface", "BoringSetup", "setup_boring", "simulate_boring",
-           "BoringFEResult", "compare_with_mechanistic", "write_vtk"]
+           "BoringFEResult", "compare_with_mechanistic", "write_vtk", "boring_prm",
+           "check_support_step", "check_boring_device"]
 
 
 @dataclass
@@ -82,10 +83,60 @@ class BoringSetup:
     t_contact: float
     #: the model choices the state was built from
     spec: BoringSpec | None = None
+    #: the insert tip's x [m] at which the cut length is 0
+    x_cut_start: float = 0.0
+
+
+def boring_prm(cfg: BoringFEConfig, spec: BoringSpec, ins: BoringInsert, vc: float,
+               f: float) -> np.ndarray:
+    """The 3D parameter vector of a boring config (either frame) before the run's times:
+    numerics, the spec's model choices, contact, insert, kinematics and tool support."""
+    s = cfg.solver
+    R = 0.5 * cfg.cut.bore_diameter_mm * 1e-3
+    n_rps = cfg.cut.speed_rpm / 60.0
+    p = spec.write_prm(apply_numerics(default_prm3(), s, K3), K3, vc * 60.0)
+    p[K3.P_PEN] = cfg.contact.penalty_factor
+    p[K3.P_TOOL] = 1.0
+    p[K3.P_RN] = ins.nose_radius_m
+    p[K3.P_KAPPA] = math.radians(ins.approach_angle_deg)
+    p[K3.P_KEND] = math.radians(ins.end_edge_angle_deg)
+    p[K3.P_RAKE] = math.radians(ins.rake_deg)
+    p[K3.P_CLR] = math.radians(ins.clearance_deg)
+    p[K3.P_RE] = ins.edge_radius_m
+    p[K3.P_TANI] = math.tan(math.radians(ins.inclination_deg))
+    p[K3.P_VC] = vc
+    p[K3.P_VF] = f * n_rps
+    p[K3.P_RADIUS] = R
+    ts = cfg.tool_support
+    if ts is not None:
+        p[K3.P_SUPPORT] = 1.0
+        p[K3.P_KX], p[K3.P_KY], p[K3.P_KZ] = ts.total_stiffness()
+        p[K3.P_CX], p[K3.P_CY], p[K3.P_CZ] = ts.damping_N_s_per_m
+        p[K3.P_MX], p[K3.P_MY], p[K3.P_MZ] = ts.mass_kg
+        p[K3.P_THETA0] = math.radians(ts.theta0_deg)
+    return p
+
+
+def check_support_step(cfg: BoringFEConfig, st: FEState3, source: str | None) -> None:
+    """ConfigError when the tool support is too stiff for the state's explicit step."""
+    ts = cfg.tool_support
+    if ts is not None:
+        dt = float(st.clock[1])
+        for i, (k, m) in enumerate(zip(ts.total_stiffness(), ts.mass_kg, strict=True)):
+            if dt * math.sqrt(k / m) > 0.5:
+                raise ConfigError("tool support too stiff for the explicit time step", source,
+                                  field=f"tool_support.stiffness_N_per_m[{i}]", value=k,
+                                  expected=f"k < {0.25 * m / dt**2:.3g} N/m for mass {m} kg "
+                                  f"and time step {dt:.3g} s")
 
 
 def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
-    """Mesh, insert, support and state for ``cfg``."""
+    """Mesh, insert, support and state for ``cfg`` (``mesh.frame = "tool"``:
+    :func:`robobore.cutting.fe.models.toolframe3d.setup_boring_toolframe`)."""
+    if cfg.mesh.frame == "tool":
+        from robobore.cutting.fe.models.toolframe3d import setup_boring_toolframe
+
+        return setup_boring_toolframe(cfg, source)
     mat = load_material(cfg.material.name, source=source,
                         hardening_strain_limit=cfg.material.strain_limit())
     ins = cfg.insert.to_insert()
@@ -103,43 +154,19 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
                              else None, chip_rows=cfg.mesh.chip_rows)
     s = cfg.solver
     spec = build_boring_spec(cfg, mat, vc * 60.0, source)
-    p = spec.write_prm(apply_numerics(default_prm3(), s, K3), K3, vc * 60.0)
-    p[K3.P_PEN] = cfg.contact.penalty_factor
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN] = ins.nose_radius_m
-    p[K3.P_KAPPA] = math.radians(ins.approach_angle_deg)
-    p[K3.P_KEND] = math.radians(ins.end_edge_angle_deg)
-    p[K3.P_RAKE] = math.radians(ins.rake_deg)
-    p[K3.P_CLR] = math.radians(ins.clearance_deg)
-    p[K3.P_RE] = ins.edge_radius_m
-    p[K3.P_TANI] = math.tan(math.radians(ins.inclination_deg))
-    p[K3.P_VC] = vc
-    p[K3.P_VF] = f * n_rps
-    p[K3.P_RADIUS] = R
+    p = boring_prm(cfg, spec, ins, vc, f)
     gap0 = 0.5 * le
     x0 = -(ins.edge_radius_m + gap0)
     t_contact = gap0 / vc
     t_end = (L + ins.edge_radius_m + gap0) / vc
     p[K3.P_SAMPLE_DT] = t_end / s.n_samples
-    ts = cfg.tool_support
-    if ts is not None:
-        p[K3.P_SUPPORT] = 1.0
-        p[K3.P_KX], p[K3.P_KY], p[K3.P_KZ] = ts.total_stiffness()
-        p[K3.P_CX], p[K3.P_CY], p[K3.P_CZ] = ts.damping_N_s_per_m
-        p[K3.P_MX], p[K3.P_MY], p[K3.P_MZ] = ts.mass_kg
-        p[K3.P_THETA0] = math.radians(ts.theta0_deg)
     st = make_state3(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, n_samples=s.n_samples,
                      tool_tip=(x0, 0.0, 0.0), layer=mesh.layer, twin=mesh.twin)
-    if ts is not None:
-        dt = float(st.clock[1])
-        for i, (k, m) in enumerate(zip(ts.total_stiffness(), ts.mass_kg, strict=True)):
-            if dt * math.sqrt(k / m) > 0.5:
-                raise ConfigError("tool support too stiff for the explicit time step", source,
-                                  field=f"tool_support.stiffness_N_per_m[{i}]", value=k,
-                                  expected=f"k < {0.25 * m / dt**2:.3g} N/m for mass {m} kg "
-                                  f"and time step {dt:.3g} s")
+    check_support_step(cfg, st, source)
     return BoringSetup(cfg=cfg, material=mat, insert=ins, mesh=mesh, state=st, ap=ap, f=f,
-                       vc=vc, t_end=t_end, t_contact=t_contact, spec=spec)
+                       vc=vc, t_end=t_end, t_contact=t_contact, spec=spec,
+                       x_cut_start=-(ins.edge_radius_m
+                                     + 0.5 * cfg.mesh.element_size_um * 1e-6))
 
 
 @dataclass
@@ -164,6 +191,14 @@ def _mean_amp(v: np.ndarray) -> tuple[float, float]:
     return float(np.mean(v)), float(0.5 * (np.max(v) - np.min(v)))
 
 
+def check_boring_device(cfg: BoringFEConfig, device: str, source: str | None = None) -> None:
+    """ConfigError for the GPU with the tool frame (its ALE pass runs on the CPU only)."""
+    if device == "gpu" and cfg.mesh.frame == "tool":
+        raise ConfigError("the 3D tool-frame model runs on the CPU only", file=source,
+                          field="--device", value=device,
+                          expected='cpu with mesh.frame = "tool"')
+
+
 def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
                     progress: Callable[[float], None] | None = None,
                     device: str = "cpu") -> BoringFEResult:
@@ -174,9 +209,11 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     """
     from robobore.cutting.forces import rotating_to_boring
 
+    check_boring_device(cfg, device, source)
     setup = setup_boring(cfg, source)
     st = setup.state
     dt0 = float(st.clock[1])
+    mass0 = float(np.sum(st.vol0))
     limit = cfg.solver.energy_error_limit
 
     check = energy_check(setup.t_contact, setup.t_end, limit)
@@ -189,7 +226,8 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
                              progress=progress, check=check)
     elif device == "cpu":
         steps = advance3(st, setup.t_end, chunk_steps=cfg.solver.chunk_steps,
-                         progress=progress, check=check)
+                         progress=progress, check=check,
+                         step=None if setup.spec is None else K3.run_chunk3_for(setup.spec))
     else:
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
@@ -212,10 +250,12 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         * Fr + rotating_to_boring(0.0, 0.0, 1.0, thr) * Fz
     en = st.en
     n_el = st.n_elements
-    cut_mm = (hh[:, K3.H_TIPX] - (-(setup.insert.edge_radius_m
-                                    + 0.5 * cfg.mesh.element_size_um * 1e-6))) * 1e3
+    cut_mm = (hh[:, K3.H_TIPX] - setup.x_cut_start) * 1e3
     alive = st.alive == 1
-    ytop_max = float(np.max(setup.mesh.nodes[:, 1]))
+    # the pre-bore surface's highest point: the workpiece block's top; ap in the tool frame
+    # (whose initial mesh carries the pre-shaped chip above it)
+    ytop_max = (setup.ap if cfg.mesh.frame == "tool"
+                else float(np.max(setup.mesh.nodes[:, 1])))
     summary: dict[str, Any] = {
         "force_rotating_N": {"tangential": ft_m, "radial": fr_m, "feed": fz_m},
         "force_rotating_std_N": {"tangential": float(np.std(Ft[win])),
@@ -245,18 +285,32 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         "time_step_s": dt0,
         "n_elements": n_el,
         "n_nodes": int(st.x.shape[0]),
-        "mesh_shape": list(setup.mesh.shape),
+        "frame": cfg.mesh.frame,
         "element_size_um": cfg.mesh.element_size_um,
         "cutting_speed_m_per_min": setup.vc * 60.0,
         "friction_coefficient": float(st.prm[K3.P_MU]),
         "friction_law": cfg.friction_law(),
         "sliding_speed_mean_m_per_s": _mean_sliding_speed(st),
-        "separation": cfg.mesh.separation,
+        "separation": cfg.mesh.separation if cfg.mesh.frame == "workpiece" else None,
         "pairs_parted": int(np.sum((st.twin >= 0) & (st.tied == 0)) // 2),
         "eroded_damage": int(np.sum(st.alive == 0)),
         "eroded_distortion": int(np.sum(st.alive == -1)),
         "device": device,
     }
+    if cfg.mesh.frame == "tool":
+        from robobore.cutting.fe.models.toolframe3d import toolframe_mesh_summary
+
+        summary["toolframe_mesh"] = toolframe_mesh_summary(setup.mesh)
+        # material in the mesh at the end over the start (inflow - outflow of the passes)
+        summary["toolframe_mesh"]["mass_ratio"] = float(np.sum(st.vol0)) / mass0
+        if st.msf.shape[0] > 0:
+            # the inertia added to the thin chip elements (thin_element_factors)
+            summary["toolframe_mesh"]["inertia_factor_max"] = float(np.max(st.msf))
+            summary["toolframe_mesh"]["inertia_factor_elements"] = int(np.sum(st.msf > 1.0))
+            summary["toolframe_mesh"]["added_inertia_fraction"] = float(
+                np.sum(st.vol0 * (st.msf - 1.0)) / np.sum(st.vol0))
+    else:
+        summary["mesh_shape"] = list(setup.mesh.shape)
     if cfg.tool_support is not None:
         k = cfg.tool_support.total_stiffness()
         uz = hh[:, K3.H_UZ] * 1e6

@@ -10,6 +10,15 @@ contact functions, so in the resolved regime the two must give the same forces p
 width; ``benchmarks/validate_fe3d_planestrain.py`` prints the comparison and
 ``tests/cutting/fe3d/test_fe3d_planestrain.py`` holds it (docs/fe3d.md, "Plane-strain
 cross-check").
+
+The **tool-frame slab** (:func:`setup_slab3_toolframe`, :func:`simulate_slab3_toolframe`) does
+the same for the 2D tool-frame ALE model (``mesh.frame = "tool"``): the 2D tool-frame mesh of
+the config, extruded across the slab
+(:func:`robobore.cutting.fe.mesh.toolframe3d.extrude_toolframe_mesh`), z held on both side
+faces, run by the 3D engine's tool-frame loop (:func:`robobore.cutting.fe.engine.kernels3d.
+run_chunk3_ale`: the ALE pass of :mod:`robobore.cutting.fe.ale.rezone3d` every
+``solver.ale_interval`` steps) with the same straight-edged insert; the cross-check of the 3D
+tool-frame plumbing (``tests/cutting/fe3d/test_toolframe3d_slab.py``).
 """
 
 from __future__ import annotations
@@ -43,7 +52,8 @@ from robobore.cutting.fe.engine.state3d import (
 from robobore.errors import ConfigError
 from robobore.material import load_material
 
-__all__ = ["SlabSetup", "setup_slab3", "simulate_slab3"]
+__all__ = ["SlabSetup", "setup_slab3", "simulate_slab3", "setup_slab3_toolframe",
+           "simulate_slab3_toolframe"]
 
 
 @dataclass
@@ -124,13 +134,81 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     return SlabSetup(state=st, t_end=t_end, width=width, vc=vc, cut_length=L)
 
 
+def _straight_insert(p: np.ndarray, cfg: FEConfig, vc: float) -> np.ndarray:
+    # the insert with a straight edge over the slab: nose radius 1 m, the 2D wedge in every
+    # normal section
+    p[K3.P_PEN] = cfg.contact.penalty_factor
+    p[K3.P_TOOL] = 1.0
+    p[K3.P_RN] = 1.0
+    p[K3.P_KAPPA] = 0.5 * math.pi
+    p[K3.P_KEND] = 0.49 * math.pi
+    p[K3.P_RAKE] = math.radians(cfg.tool.rake_deg)
+    p[K3.P_CLR] = math.radians(cfg.tool.clearance_deg)
+    p[K3.P_RE] = cfg.tool.edge_radius_um * 1e-6
+    p[K3.P_VC] = vc
+    return p
+
+
+def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
+    """3D plane-strain slab of the 2D tool-frame config ``cfg``: its 2D tool-frame mesh
+    (the mesh :func:`robobore.cutting.fe.models.orthogonal.setup_orthogonal` builds)
+    extruded over ``n_z`` hexahedra of the element size across (z centred on the insert's
+    tip), the 2D config's model choices on the hexahedron (friction, heat, hardening, ALE
+    interval), the tool-frame boundary conditions of
+    :func:`robobore.cutting.fe.models.toolframe3d.toolframe_fixed`."""
+    from robobore.cutting.fe.config.spec import ToolFrame, ToolFrame3D
+    from robobore.cutting.fe.mesh.toolframe3d import extrude_toolframe_mesh
+    from robobore.cutting.fe.models.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.models.toolframe3d import attach_toolframe, toolframe_fixed
+
+    if cfg.mesh.frame != "tool":
+        raise ConfigError("the tool-frame slab needs the 2D tool-frame model",
+                          field="mesh.frame", value=cfg.mesh.frame, expected='"tool"')
+    setup2 = setup_orthogonal(cfg)
+    spec2 = setup2.spec
+    assert spec2 is not None and isinstance(spec2.frame, ToolFrame)
+    le = cfg.mesh.element_size_um * 1e-6
+    width = n_z * le
+    mesh = extrude_toolframe_mesh(setup2.mesh, np.linspace(-0.5 * width, 0.5 * width, n_z + 1))
+    vc = cfg.cut.cutting_speed_m_per_min / 60.0
+    spec = BoringSpec(separation=None, damage_erosion=False,
+                      element=HexElement(spec2.frame.element.hourglass_viscous,
+                                         spec2.frame.element.hourglass_stiffness),
+                      erode_time_step_fraction=0.0, friction=spec2.friction,
+                      thermal=spec2.thermal, hardening=spec2.hardening,
+                      tool_frame=ToolFrame3D(ale_interval=spec2.frame.ale_interval))
+    p = _straight_insert(spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
+                                        cfg.cut.cutting_speed_m_per_min), cfg, vc)
+    L = cfg.cut.length_mm * 1e-3
+    t_end = L / vc
+    p[K3.P_SAMPLE_DT] = t_end / cfg.solver.n_samples
+    tip = (0.0, 0.0, 0.0)
+    st = make_state3(mesh.nodes, mesh.conn, toolframe_fixed(mesh), setup2.material, prm=p,
+                     n_samples=cfg.solver.n_samples, tool_tip=tip)
+    attach_toolframe(st, mesh, tip)
+    return SlabSetup(state=st, t_end=t_end, width=width, vc=vc, cut_length=L)
+
+
+def simulate_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
+                             progress: Any = None) -> dict[str, Any]:
+    """Run the tool-frame slab (:func:`setup_slab3_toolframe`); the outputs of
+    :func:`simulate_slab3`."""
+    s = setup_slab3_toolframe(cfg, n_z=n_z)
+    return _slab_summary(s, advance3(s.state, s.t_end, chunk_steps=cfg.solver.chunk_steps,
+                                     progress=progress), steady_fraction)
+
+
 def simulate_slab3(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
                    **kw: Any) -> dict[str, Any]:
     """Run the slab; forces on the tool per unit width [N/mm] averaged over the last
     ``steady_fraction`` of the cut, energy error, hourglass fraction, eroded elements."""
     s = setup_slab3(cfg, n_z=n_z, **kw)
+    return _slab_summary(s, advance3(s.state, s.t_end), steady_fraction)
+
+
+def _slab_summary(s: SlabSetup, steps: int, steady_fraction: float) -> dict[str, Any]:
+    # forces per unit width over the window, energy balance, counts
     st = s.state
-    steps = advance3(st, s.t_end)
     hh = st.hist[np.isfinite(st.hist[:, K3.H_T])]
     win = hh[:, K3.H_T] >= s.t_end - steady_fraction * s.cut_length / s.vc
     w_mm = s.width * 1e3
@@ -143,4 +221,5 @@ def simulate_slab3(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
         "eroded": int(np.sum(st.alive != 1)),
         "n_elements": st.n_elements,
         "steps": int(steps),
+        "final_time_step_s": float(st.clock[1]),
     }

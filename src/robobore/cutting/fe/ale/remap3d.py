@@ -1,0 +1,601 @@
+"""First-order conservative (donor-cell) remap of a hexahedral mesh: the 3D counterpart of
+:mod:`robobore.cutting.fe.ale.remap`, for the 3D tool-frame ALE boring model
+(:mod:`robobore.cutting.fe.mesh.toolframe3d` builds its mesh).
+
+A remap pass takes the mesh from the positions the Lagrangian steps left (``x, y, z``) to
+the relocated ones (``xn, yn, zn``) and transports the state through the moving element
+faces (Benson 1992, "Computational methods in Lagrangian and Eulerian hydrocodes", CMAME
+99, sec. 4.2):
+
+* **Swept volume.** Each node moves on a straight line from its old to its new place, so a
+  face (bilinear in its two parameters) sweeps the region of the map
+  ``(s, t, tau) -> (1 - tau) X_old(s, t) + tau X_new(s, t)``, which is trilinear: the 8-node
+  hexahedron with the old face as its bottom and the new face as its top. Its signed volume
+  is computed with the Flanagan-Belytschko volume derivatives of :mod:`robobore.cutting.fe.hex.element`
+  (``V = sum_I x_I dV/dx_I``; exact for a trilinear hexahedron), in coordinates relative to
+  the face's first old corner (round-off of the order of the face, not of the distance to
+  the origin). Being the exact flux integral ``int_0^1 int_face v . n dA dtau``, the six
+  swept volumes of an element sum exactly to its volume change (Reynolds transport).
+* **Donor cell.** For each face with outward swept volume ``dV``: ``dV > 0`` (the element
+  grows into its neighbour) brings the neighbour's state, ``dV < 0`` gives away the
+  element's own. Element-centred intensive fields are remapped as volume-weighted averages:
+  deviatoric stress (6), pressure, plastic strain, temperature, damage and the 12 stored
+  hourglass components (treated like the 2D remap treats its two); the element mass, held
+  as the reference volume ``vol0`` (= mass / mass-scaled density), is transported with the
+  donor's density ``vol0_u / V_u``. The cumulative energy accounts (``ie``, ``plast``,
+  ``hge``) stay with their elements, as in 2D (their totals are what the energy balance
+  uses). Only faces shared by two live elements carry a flux, plus the outline faces that
+  ``bflag`` opens (:data:`BF_VIRGIN`: virgin material -- no stress, strain, damage, at the
+  room temperature, with its reference density and at rest -- flows in, the element's own
+  state flows out; :data:`BF_OPEN`: outflow, a backflow brings the element's own state).
+  Intensive fields are divided by the volume the fluxes account for, so a uniform field
+  stays uniform and the volume integral of every field is conserved to round-off.
+* **Nodal velocities**, two ways (``vel_mode``):
+  :data:`VEL_MOMENTUM` (conservative) -- each element's momentum (its mass times the mean
+  of its eight nodal velocities; with lumped masses of 1/8 the element momenta sum to the
+  nodal momentum) is transported with the mass fluxes like the other fields, and the change
+  of each element's momentum goes back to its nodes in eighths, each node's velocity being
+  its new momentum over its new lumped mass. Total momentum is conserved to round-off
+  (through closed boundaries), a uniform velocity stays uniform, a zero move changes
+  nothing. :data:`VEL_TAYLOR` -- the 2D engine's scheme
+  (:func:`robobore.cutting.fe.ale.remap.rz_velocity_py`): a first-order Taylor step with the
+  mean old velocity gradient of the node's elements (not conservative). Fixed velocity
+  components (``fixed`` bits 1 x, 2 y, 4 z) keep their values in both.
+
+The passes are scalar functions of one element or node (``*_py`` originals, ``njit``
+versions without the suffix), read only what the previous pass wrote and allocate nothing,
+so the CPU chunk loop calls them from ``prange`` loops (:func:`remap3d`) and a GPU kernel
+can compile the same source. :func:`remap3d_py` is the allocating wrapper for tests and
+scripts.
+
+Face numbering: face ``f`` of an element has the node set of
+:data:`robobore.cutting.fe.physics.thermal3d.HEX_FACES` ``[f]`` (so the neighbour table of
+:func:`robobore.cutting.fe.physics.thermal3d.face_neighbours` serves as ``fnbr``), taken in
+the cyclic order of :data:`FACES_OUT` whose right-hand normal points out of the element.
+"""
+# ruff: noqa: E501
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
+
+__all__ = [
+    "BF_CLOSED", "BF_OPEN", "BF_VIRGIN", "FACES_OUT", "N_RZ3", "N_INTENSIVE3", "VEL_MOMENTUM",
+    "VEL_TAYLOR", "dv_py", "hex_volume_py", "hex_volume", "face_corner_py", "swept_face_py",
+    "swept_face", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
+    "rz3_taylor_py", "rz3_taylor", "rz3_write_py", "rz3_write", "rz3_node_mass_py",
+    "rz3_node_mass", "remap3d", "remap3d_py", "remap3d_inputs", "remap3d_outputs", "element_volumes3",
+]
+
+#: corners of each face, cyclic with the right-hand normal pointing out of the element; the
+#: node sets (and the face numbers) of ``thermal3d.HEX_FACES``: xi = -1, xi = +1, eta = -1,
+#: eta = +1, zeta = -1, zeta = +1
+FACES_OUT = np.array([(0, 4, 7, 3), (1, 2, 6, 5), (0, 1, 5, 4), (3, 7, 6, 2), (0, 3, 2, 1),
+                      (4, 5, 6, 7)], np.int64)
+_CODES = tuple(int(sum(int(c) << (3 * (3 - j)) for j, c in enumerate(f))) for f in FACES_OUT)
+_C0, _C1, _C2, _C3, _C4, _C5 = _CODES
+#: remapped intensive element fields (volume-weighted averages): sd (6), pres, eps_p, temp,
+#: dmg, qh (12); then in ``buf``: the new reference volume, the new momentum / rho_s (3),
+#: the old momentum / rho_s (3)
+N_INTENSIVE3 = 22
+B_VOL0 = N_INTENSIVE3
+B_PNEW = N_INTENSIVE3 + 1
+B_POLD = N_INTENSIVE3 + 4
+N_RZ3 = N_INTENSIVE3 + 7
+#: nodal velocity remap: conservative element-centred momentum, or the 2D Taylor step
+VEL_MOMENTUM, VEL_TAYLOR = 0, 1
+
+
+def face_corner_py(f, j):
+    """Corner (0-7) number ``j`` (0-3) of face ``f`` (0-5) of :data:`FACES_OUT`."""
+    if f == 0:
+        code = _C0
+    elif f == 1:
+        code = _C1
+    elif f == 2:
+        code = _C2
+    elif f == 3:
+        code = _C3
+    elif f == 4:
+        code = _C4
+    else:
+        code = _C5
+    return (code >> (3 * (3 - j))) & 7
+
+
+def dv_py(c, p0, p1, p2, p3, p4, p5, p6, p7, q0, q1, q2, q3, q4, q5, q6, q7):
+    """``dV/dx_c`` of a trilinear hexahedron's volume with respect to corner ``c``'s x, given
+    the corners' y (``p``) and z (``q``); cyclic: ``dV/dy_c = dv(c, z, x)``, ``dV/dz_c =
+    dv(c, x, y)`` (Flanagan & Belytschko 1981, eq. 79: the coefficients of
+    :func:`robobore.cutting.fe.hex.element.hex_element_py`)."""
+    if c == 0:
+        return (p1*(-q2-q3+q4+q5) + p2*(q1-q3) + p3*(q1+q2-q4-q7) + p4*(-q1+q3-q5+q7) + p5*(-q1+q4) + p7*(q3-q4)) / 12.0
+    elif c == 1:
+        return (p0*(q2+q3-q4-q5) + p2*(-q0-q3+q5+q6) + p3*(-q0+q2) + p4*(q0-q5) + p5*(q0-q2+q4-q6) + p6*(-q2+q5)) / 12.0
+    elif c == 2:
+        return (p0*(-q1+q3) + p1*(q0+q3-q5-q6) + p3*(-q0-q1+q6+q7) + p5*(q1-q6) + p6*(q1-q3+q5-q7) + p7*(-q3+q6)) / 12.0
+    elif c == 3:
+        return (p0*(-q1-q2+q4+q7) + p1*(q0-q2) + p2*(q0+q1-q6-q7) + p4*(-q0+q7) + p6*(q2-q7) + p7*(-q0+q2-q4+q6)) / 12.0
+    elif c == 4:
+        return (p0*(q1-q3+q5-q7) + p1*(-q0+q5) + p3*(q0-q7) + p5*(-q0-q1+q6+q7) + p6*(-q5+q7) + p7*(q0+q3-q5-q6)) / 12.0
+    elif c == 5:
+        return (p0*(q1-q4) + p1*(-q0+q2-q4+q6) + p2*(-q1+q6) + p4*(q0+q1-q6-q7) + p6*(-q1-q2+q4+q7) + p7*(q4-q6)) / 12.0
+    elif c == 6:
+        return (p1*(q2-q5) + p2*(-q1+q3-q5+q7) + p3*(-q2+q7) + p4*(q5-q7) + p5*(q1+q2-q4-q7) + p7*(-q2-q3+q4+q5)) / 12.0
+    return (p0*(-q3+q4) + p2*(q3-q6) + p3*(q0-q2+q4-q6) + p4*(-q0-q3+q5+q6) + p5*(-q4+q6) + p6*(q2+q3-q4-q5)) / 12.0
+
+
+dv = njit(cache=True, inline="always")(dv_py)
+
+
+def hex_volume_py(x0, x1, x2, x3, x4, x5, x6, x7, y0, y1, y2, y3, y4, y5, y6, y7,
+                  z0, z1, z2, z3, z4, z5, z6, z7):
+    """Signed volume of the trilinear hexahedron with corners 0-7 in VTK order (positive for
+    the node order of :mod:`robobore.cutting.fe.hex.element`): ``sum_I x_I dV/dx_I`` with the
+    element's volume derivatives (:func:`dv_py`), exact for any trilinear hexahedron;
+    evaluated in coordinates relative to corner 0."""
+    x1 -= x0
+    x2 -= x0
+    x3 -= x0
+    x4 -= x0
+    x5 -= x0
+    x6 -= x0
+    x7 -= x0
+    y1 -= y0
+    y2 -= y0
+    y3 -= y0
+    y4 -= y0
+    y5 -= y0
+    y6 -= y0
+    y7 -= y0
+    z1 -= z0
+    z2 -= z0
+    z3 -= z0
+    z4 -= z0
+    z5 -= z0
+    z6 -= z0
+    z7 -= z0
+    v = 0.0
+    for c in range(1, 8):
+        xc = x1 if c == 1 else x2 if c == 2 else x3 if c == 3 else x4 if c == 4 else \
+            x5 if c == 5 else x6 if c == 6 else x7
+        v += xc * dv(c, 0.0, y1, y2, y3, y4, y5, y6, y7, 0.0, z1, z2, z3, z4, z5, z6, z7)
+    return v
+
+
+hex_volume = njit(cache=True, inline="always")(hex_volume_py)
+
+
+def swept_face_py(e, f, conn, x, y, z, xn, yn, zn):
+    """Volume swept outward by face ``f`` of element ``e`` moving from ``x, y, z`` to
+    ``xn, yn, zn`` (the trilinear hexahedron old face -> new face, see the module
+    docstring); negative when the face moves into the element."""
+    a = conn[e, face_corner(f, 0)]
+    b = conn[e, face_corner(f, 1)]
+    c = conn[e, face_corner(f, 2)]
+    d = conn[e, face_corner(f, 3)]
+    if (x[a] == xn[a] and y[a] == yn[a] and z[a] == zn[a] and x[b] == xn[b] and y[b] == yn[b]
+            and z[b] == zn[b] and x[c] == xn[c] and y[c] == yn[c] and z[c] == zn[c]
+            and x[d] == xn[d] and y[d] == yn[d] and z[d] == zn[d]):
+        return 0.0  # a face that does not move sweeps nothing (not a round-off residue)
+    return hex_volume(x[a], x[b], x[c], x[d], xn[a], xn[b], xn[c], xn[d],
+                      y[a], y[b], y[c], y[d], yn[a], yn[b], yn[c], yn[d],
+                      z[a], z[b], z[c], z[d], zn[a], zn[b], zn[c], zn[d])
+
+
+face_corner = njit(cache=True, inline="always")(face_corner_py)
+swept_face = njit(cache=True, inline="always")(swept_face_py)
+
+
+def _elem_volume_py(e, conn, x, y, z):
+    i0, i1, i2, i3 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
+    i4, i5, i6, i7 = conn[e, 4], conn[e, 5], conn[e, 6], conn[e, 7]
+    return hex_volume(x[i0], x[i1], x[i2], x[i3], x[i4], x[i5], x[i6], x[i7],
+                      y[i0], y[i1], y[i2], y[i3], y[i4], y[i5], y[i6], y[i7],
+                      z[i0], z[i1], z[i2], z[i3], z[i4], z[i5], z[i6], z[i7])
+
+
+_elem_volume = njit(cache=True, inline="always")(_elem_volume_py)
+
+
+def _gather_py(e, w, u, sd, pres, eps_p, temp, dmg, qh, buf):
+    """``buf[e, :N_INTENSIVE3] += w * (fields of element u)``."""
+    for k in range(6):
+        buf[e, k] += w * sd[u, k]
+    buf[e, 6] += w * pres[u]
+    buf[e, 7] += w * eps_p[u]
+    buf[e, 8] += w * temp[u]
+    buf[e, 9] += w * dmg[u]
+    for k in range(12):
+        buf[e, 10 + k] += w * qh[u, k]
+
+
+_gather = njit(cache=True, inline="always")(_gather_py)
+
+
+def _mean_velocity_py(u, k, conn, vx, vy, vz):
+    """Component ``k`` of the mean of element ``u``'s nodal velocities."""
+    s = 0.0
+    for c in range(8):
+        n = conn[u, c]
+        if k == 0:
+            s += vx[n]
+        elif k == 1:
+            s += vy[n]
+        else:
+            s += vz[n]
+    return 0.125 * s
+
+
+_mean_velocity = njit(cache=True, inline="always")(_mean_velocity_py)
+
+
+def rz3_flux_py(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, buf, sd, pres,
+                eps_p, temp, dmg, qh, vol0, t_room):
+    """Donor-cell remap of element ``e`` (old geometry ``x, y, z`` -> new ``xn, yn, zn``):
+    its new intensive fields, reference volume and momentum into ``buf[e]`` (layout: see
+    :data:`N_RZ3`). Reads the old state only, so all elements can run at once. ``fnbr``
+    (e, 6) the element across each face (< 0: none); ``bflag`` (e, 6) the flux type of each
+    outline face (``BF_*``; an empty array: all closed)."""
+    for f in range(N_RZ3):
+        buf[e, f] = 0.0
+    if alive[e] != 1:
+        return
+    v_old = _elem_volume(e, conn, x, y, z)
+    v_new = v_old
+    _gather(e, v_old, e, sd, pres, eps_p, temp, dmg, qh, buf)
+    m_new = vol0[e]
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for k in range(3):
+        pk = vol0[e] * _mean_velocity(e, k, conn, vx, vy, vz)
+        buf[e, B_POLD + k] = pk
+        if k == 0:
+            px = pk
+        elif k == 1:
+            py = pk
+        else:
+            pz = pk
+    for f in range(6):
+        sw = swept_face(e, f, conn, x, y, z, xn, yn, zn)
+        if sw == 0.0:
+            continue
+        nb = np.int64(fnbr[e, f])
+        u = nb
+        if nb < 0:
+            if bflag.shape[0] == 0 or bflag[e, f] == BF_CLOSED:
+                continue
+            v_new += sw
+            if sw > 0.0 and bflag[e, f] == BF_VIRGIN:
+                buf[e, 8] += sw * t_room  # virgin: no stress, strain, damage; at rest
+                m_new += sw
+                continue
+            u = np.int64(e)
+        elif alive[nb] != 1:
+            continue
+        else:
+            v_new += sw
+            if sw <= 0.0:
+                u = np.int64(e)
+        _gather(e, sw, u, sd, pres, eps_p, temp, dmg, qh, buf)
+        dm = sw * vol0[u] / _elem_volume(u, conn, x, y, z)
+        m_new += dm
+        px += dm * _mean_velocity(u, 0, conn, vx, vy, vz)
+        py += dm * _mean_velocity(u, 1, conn, vx, vy, vz)
+        pz += dm * _mean_velocity(u, 2, conn, vx, vy, vz)
+    inv = 1.0 / v_new
+    for f in range(N_INTENSIVE3):
+        buf[e, f] *= inv
+    buf[e, B_VOL0] = m_new
+    buf[e, B_PNEW] = px
+    buf[e, B_PNEW + 1] = py
+    buf[e, B_PNEW + 2] = pz
+
+
+rz3_flux = njit(cache=True, inline="always")(rz3_flux_py)
+
+
+def factor_py(msf, e):
+    """The inertia factor of element ``e``: ``msf[e]``, or 1 where ``msf`` is empty (no
+    element-attached mass scaling)."""
+    if msf.shape[0] == 0:
+        return 1.0
+    return msf[e]
+
+
+_factor = njit(cache=True, inline="always")(factor_py)
+
+
+def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf):
+    """:data:`VEL_MOMENTUM`, node ``n``: its new velocity into ``vbuf[n]`` (after
+    :func:`rz3_flux_py` of every element, before :func:`rz3_write_py`): old nodal momentum
+    plus an eighth of each of its elements' momentum change, over the new lumped mass (all
+    per unit mass-scaled density; each element's share times its inertia factor ``msf[e]``,
+    which stays with the element as the material moves through it). Fixed components keep
+    their values. Returns 1 when the velocity changes."""
+    m_old = 0.0
+    m_new = 0.0
+    dpx = 0.0
+    dpy = 0.0
+    dpz = 0.0
+    for q in range(ptr[n], ptr[n + 1]):
+        e = nel[q]
+        if alive[e] != 1:
+            continue
+        w = 0.125 * _factor(msf, e)
+        m_old += w * vol0[e]
+        m_new += w * buf[e, B_VOL0]
+        dpx += w * (buf[e, B_PNEW] - buf[e, B_POLD])
+        dpy += w * (buf[e, B_PNEW + 1] - buf[e, B_POLD + 1])
+        dpz += w * (buf[e, B_PNEW + 2] - buf[e, B_POLD + 2])
+    vbuf[n, 0] = vx[n]
+    vbuf[n, 1] = vy[n]
+    vbuf[n, 2] = vz[n]
+    if m_new <= 0.0 or (dpx == 0.0 and dpy == 0.0 and dpz == 0.0 and m_new == m_old):
+        return 0
+    inv = 1.0 / m_new
+    fx = fixed[n]
+    if (fx & 1) == 0:
+        vbuf[n, 0] = (m_old * vx[n] + dpx) * inv
+    if (fx & 2) == 0:
+        vbuf[n, 1] = (m_old * vy[n] + dpy) * inv
+    if (fx & 4) == 0:
+        vbuf[n, 2] = (m_old * vz[n] + dpz) * inv
+    return 1
+
+
+rz3_momentum = njit(cache=True, inline="always")(rz3_momentum_py)
+
+
+def rz3_taylor_py(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive, fixed, vbuf):
+    """:data:`VEL_TAYLOR`, node ``n``: its new velocity into ``vbuf[n]``: the old one plus
+    the mean old velocity gradient of its live elements (the mean gradient
+    ``b_I = dV/dx_I / V`` of each) times the node's move, the 2D engine's
+    :func:`robobore.cutting.fe.ale.remap.rz_velocity_py` in 3D. Returns 1 when the node
+    moves."""
+    vbuf[n, 0] = vx[n]
+    vbuf[n, 1] = vy[n]
+    vbuf[n, 2] = vz[n]
+    dx = xn[n] - x[n]
+    dy = yn[n] - y[n]
+    dz = zn[n] - z[n]
+    if dx == 0.0 and dy == 0.0 and dz == 0.0:
+        return 0
+    gx0 = 0.0
+    gx1 = 0.0
+    gx2 = 0.0
+    gy0 = 0.0
+    gy1 = 0.0
+    gy2 = 0.0
+    gz0 = 0.0
+    gz1 = 0.0
+    gz2 = 0.0
+    cnt = 0
+    for q in range(ptr[n], ptr[n + 1]):
+        e = nel[q]
+        if alive[e] != 1:
+            continue
+        vol = _elem_volume(e, conn, x, y, z)
+        for c in range(8):
+            m = conn[e, c]
+            bx, by, bz = _corner_gradient(e, c, conn, x, y, z)
+            bx /= vol
+            by /= vol
+            bz /= vol
+            gx0 += vx[m] * bx
+            gx1 += vx[m] * by
+            gx2 += vx[m] * bz
+            gy0 += vy[m] * bx
+            gy1 += vy[m] * by
+            gy2 += vy[m] * bz
+            gz0 += vz[m] * bx
+            gz1 += vz[m] * by
+            gz2 += vz[m] * bz
+        cnt += 1
+    if cnt == 0:
+        return 0
+    inv = 1.0 / cnt
+    fx = fixed[n]
+    if (fx & 1) == 0:
+        vbuf[n, 0] = vx[n] + (gx0 * dx + gx1 * dy + gx2 * dz) * inv
+    if (fx & 2) == 0:
+        vbuf[n, 1] = vy[n] + (gy0 * dx + gy1 * dy + gy2 * dz) * inv
+    if (fx & 4) == 0:
+        vbuf[n, 2] = vz[n] + (gz0 * dx + gz1 * dy + gz2 * dz) * inv
+    return 1
+
+
+def _corner_gradient_py(e, c, conn, x, y, z):
+    """``dV/dx_c`` (3 components) of hexahedron ``e``'s volume with respect to its corner
+    ``c`` (:func:`dv_py`, in coordinates relative to corner 0)."""
+    i0 = conn[e, 0]
+    ox = x[i0]
+    oy = y[i0]
+    oz = z[i0]
+    i1, i2, i3 = conn[e, 1], conn[e, 2], conn[e, 3]
+    i4, i5, i6, i7 = conn[e, 4], conn[e, 5], conn[e, 6], conn[e, 7]
+    x1, x2, x3, x4 = x[i1] - ox, x[i2] - ox, x[i3] - ox, x[i4] - ox
+    x5, x6, x7 = x[i5] - ox, x[i6] - ox, x[i7] - ox
+    y1, y2, y3, y4 = y[i1] - oy, y[i2] - oy, y[i3] - oy, y[i4] - oy
+    y5, y6, y7 = y[i5] - oy, y[i6] - oy, y[i7] - oy
+    z1, z2, z3, z4 = z[i1] - oz, z[i2] - oz, z[i3] - oz, z[i4] - oz
+    z5, z6, z7 = z[i5] - oz, z[i6] - oz, z[i7] - oz
+    gx = dv(c, 0.0, y1, y2, y3, y4, y5, y6, y7, 0.0, z1, z2, z3, z4, z5, z6, z7)
+    gy = dv(c, 0.0, z1, z2, z3, z4, z5, z6, z7, 0.0, x1, x2, x3, x4, x5, x6, x7)
+    gz = dv(c, 0.0, x1, x2, x3, x4, x5, x6, x7, 0.0, y1, y2, y3, y4, y5, y6, y7)
+    return gx, gy, gz
+
+
+_corner_gradient = njit(cache=True, inline="always")(_corner_gradient_py)
+rz3_taylor = njit(cache=True, inline="always")(rz3_taylor_py)
+
+
+def rz3_write_py(e, alive, buf, sd, pres, eps_p, temp, dmg, qh, vol0):
+    """Live element ``e`` takes its remapped fields from ``buf[e]``."""
+    if alive[e] != 1:
+        return
+    for k in range(6):
+        sd[e, k] = buf[e, k]
+    pres[e] = buf[e, 6]
+    eps_p[e] = buf[e, 7]
+    temp[e] = buf[e, 8]
+    dmg[e] = buf[e, 9]
+    for k in range(12):
+        qh[e, k] = buf[e, 10 + k]
+    vol0[e] = buf[e, B_VOL0]
+
+
+rz3_write = njit(cache=True, inline="always")(rz3_write_py)
+
+
+def rz3_node_mass_py(n, ptr, nel, alive, vol0, rho_s, msf, mass):
+    """Lumped mass of node ``n`` from its live elements' (remapped) reference volumes, each
+    times its element's inertia factor ``msf[e]`` (an empty ``msf``: 1)."""
+    m = 0.0
+    for q in range(ptr[n], ptr[n + 1]):
+        e = nel[q]
+        if alive[e] == 1:
+            m += 0.125 * rho_s * vol0[e] * _factor(msf, e)
+    mass[n] = m
+
+
+rz3_node_mass = njit(cache=True, inline="always")(rz3_node_mass_py)
+
+
+@njit(parallel=True, cache=True)
+def remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag,
+            sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode, buf, vbuf):
+    """One remap pass from ``x, y, z`` to the new positions ``xn, yn, zn`` (then copied into
+    ``x, y, z``): element state, reference volumes, nodal velocities and lumped masses.
+    ``buf`` (e, :data:`N_RZ3`) and ``vbuf`` (n, 3) are work arrays; ``rho_s`` the
+    mass-scaled density [kg/m^3], ``msf`` (e,) the elements' inertia factors (the lumped
+    masses are ``rho_s vol0 msf / 8`` a corner; empty: 1), ``t_room`` the virgin
+    material's temperature [K], ``vel_mode`` :data:`VEL_MOMENTUM` or :data:`VEL_TAYLOR`. Returns the number of nodes
+    whose velocity was remapped. Allocates nothing."""
+    nn = x.shape[0]
+    ne = conn.shape[0]
+    for e in prange(ne):
+        rz3_flux(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, buf, sd, pres,
+                 eps_p, temp, dmg, qh, vol0, t_room)
+    moved = 0
+    if vel_mode == VEL_TAYLOR:
+        for n in prange(nn):
+            moved += rz3_taylor(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive,
+                                fixed, vbuf)
+    else:
+        for n in prange(nn):
+            moved += rz3_momentum(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf)
+    for n in prange(nn):
+        vx[n] = vbuf[n, 0]
+        vy[n] = vbuf[n, 1]
+        vz[n] = vbuf[n, 2]
+    for e in prange(ne):
+        rz3_write(e, alive, buf, sd, pres, eps_p, temp, dmg, qh, vol0)
+    for n in prange(nn):
+        x[n] = xn[n]
+        y[n] = yn[n]
+        z[n] = zn[n]
+    for n in prange(nn):
+        rz3_node_mass(n, ptr, nel, alive, vol0, rho_s, msf, mass)
+    return moved
+
+
+@njit(cache=True)
+def _volumes(conn, x, y, z, out):
+    for e in range(conn.shape[0]):
+        out[e] = _elem_volume(e, conn, x, y, z)
+
+
+def element_volumes3(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Volumes (e,) [m^3] of the hexahedra ``conn`` (e, 8) over ``nodes`` (n, 3), by
+    :func:`hex_volume_py` (equal to :func:`robobore.cutting.fe.engine.state3d.hex_volumes`
+    to round-off)."""
+    nodes = np.ascontiguousarray(nodes, np.float64)
+    out = np.empty(conn.shape[0])
+    _volumes(np.ascontiguousarray(conn, np.int64), nodes[:, 0].copy(), nodes[:, 1].copy(),
+             nodes[:, 2].copy(), out)
+    return out
+
+
+def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,
+                   vel: np.ndarray | None = None, fixed: np.ndarray | None = None,
+                   fnbr: np.ndarray | None = None, bflag: np.ndarray | None = None,
+                   alive: np.ndarray | None = None, t_room: float = 293.15) -> dict:
+    """The arrays :func:`remap3d` takes, built from the node positions ``old`` (n, 3), the
+    hexahedra ``conn`` and the ``fields`` dict of :func:`remap3d_py` (same defaults): keys
+    ``x, y, z, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag, sd, pres, eps_p,
+    temp, dmg, qh, vol0, msf, buf, vbuf`` (fresh copies; ``msf`` from ``fields``, else
+    empty)."""
+    from robobore.cutting.fe.physics.thermal3d import face_neighbours
+
+    old = np.ascontiguousarray(old, np.float64)
+    conn = np.ascontiguousarray(conn, np.int64)
+    n, ne = old.shape[0], conn.shape[0]
+
+    def get(key, shape, default):
+        if key in fields:
+            return np.array(fields[key], np.float64).reshape(shape).copy()
+        return np.full(shape, default, np.float64)
+
+    v = np.zeros((n, 3)) if vel is None else np.array(vel, np.float64)
+    counts = np.bincount(conn.ravel(), minlength=n)
+    ptr = np.zeros(n + 1, np.int64)
+    ptr[1:] = np.cumsum(counts)
+    return {
+        "x": old[:, 0].copy(), "y": old[:, 1].copy(), "z": old[:, 2].copy(),
+        "vx": v[:, 0].copy(), "vy": v[:, 1].copy(), "vz": v[:, 2].copy(),
+        "mass": np.zeros(n),
+        "fixed": np.zeros(n, np.int64) if fixed is None else np.array(fixed, np.int64),
+        "conn": conn,
+        "alive": np.ones(ne, np.int64) if alive is None else np.array(alive, np.int64),
+        "ptr": ptr, "nel": (np.argsort(conn.ravel(), kind="stable") // 8).astype(np.int64),
+        "fnbr": face_neighbours(conn) if fnbr is None else np.asarray(fnbr, np.int64),
+        "bflag": np.zeros((0, 6), np.int64) if bflag is None else np.asarray(bflag, np.int64),
+        "sd": get("sd", (ne, 6), 0.0), "pres": get("pres", (ne,), 0.0),
+        "eps_p": get("eps_p", (ne,), 0.0), "temp": get("temp", (ne,), t_room),
+        "dmg": get("dmg", (ne,), 0.0), "qh": get("qh", (ne, 12), 0.0),
+        "vol0": (np.array(fields["vol0"], np.float64) if "vol0" in fields
+                 else element_volumes3(old, conn)),
+        "msf": (np.array(fields["msf"], np.float64) if "msf" in fields else np.zeros(0)),
+        "buf": np.zeros((ne, N_RZ3)), "vbuf": np.zeros((n, 3)),
+    }
+
+
+def remap3d_outputs(a: dict, moved: int) -> dict:
+    """The result dict of :func:`remap3d_py` from the arrays of :func:`remap3d_inputs` after
+    a pass."""
+    return {"sd": a["sd"], "pres": a["pres"], "eps_p": a["eps_p"], "temp": a["temp"],
+            "dmg": a["dmg"], "qh": a["qh"], "vol0": a["vol0"],
+            "vel": np.stack([a["vx"], a["vy"], a["vz"]], axis=1), "mass": a["mass"],
+            "moved": int(moved), "nodes": np.stack([a["x"], a["y"], a["z"]], axis=1)}
+
+
+def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
+               *, vel: np.ndarray | None = None, fixed: np.ndarray | None = None,
+               fnbr: np.ndarray | None = None, bflag: np.ndarray | None = None,
+               alive: np.ndarray | None = None, rho_s: float = 1.0, t_room: float = 293.15,
+               vel_mode: int = VEL_MOMENTUM) -> dict:
+    """Allocating wrapper of :func:`remap3d` for tests and scripts.
+
+    ``old``, ``new`` (n, 3) node positions [m]; ``conn`` (e, 8) VTK order; ``fields``: any of
+    ``sd`` (e, 6), ``pres``, ``eps_p``, ``temp``, ``dmg`` (e,), ``qh`` (e, 12), ``vol0`` (e,),
+    ``msf`` (e,) inertia factors (missing: zero; ``vol0`` missing: the old volumes, ``temp``: ``t_room``, ``msf``: 1); ``vel`` (n, 3)
+    nodal velocities (zero); ``fixed`` (n,) bit mask; ``fnbr`` (e, 6) face neighbours
+    (default :func:`robobore.cutting.fe.physics.thermal3d.face_neighbours`); ``bflag``
+    (e, 6) outline flux types (default: all closed). Returns the remapped copies in a dict
+    with the same keys plus ``vel`` (n, 3), ``mass`` (n,), ``moved`` and ``nodes`` (n, 3).
+    """
+    a = remap3d_inputs(old, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
+                       alive=alive, t_room=t_room)
+    new = np.ascontiguousarray(new, np.float64)
+    moved = remap3d(a["x"], a["y"], a["z"], new[:, 0].copy(), new[:, 1].copy(),
+                    new[:, 2].copy(), a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
+                    a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
+                    a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
+                    float(rho_s), a["msf"], float(t_room), int(vel_mode), a["buf"],
+                    a["vbuf"])
+    return remap3d_outputs(a, moved)
