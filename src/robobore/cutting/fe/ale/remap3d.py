@@ -582,13 +582,11 @@ def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
     """Allocating wrapper of :func:`remap3d` for tests and scripts.
 
     ``old``, ``new`` (n, 3) node positions [m]; ``conn`` (e, 8) VTK order; ``fields``: any of
-    ``sd`` (e, 6), ``pres``, ``eps_p``, ``temp``, ``dmg`` (e,), ``qh`` (e, 12), ``vol0`` (e,),
-    ``msf`` (e,) inertia factors (missing: zero; ``vol0`` missing: the old volumes, ``temp``: ``t_room``, ``msf``: 1); ``vel`` (n, 3)
-    nodal velocities (zero); ``fixed`` (n,) bit mask; ``fnbr`` (e, 6) face neighbours
-    (default :func:`robobore.cutting.fe.physics.thermal3d.face_neighbours`); ``bflag``
-    (e, 6) outline flux types (default: all closed). Returns the remapped copies in a dict
-    with the same keys plus ``vel`` (n, 3), ``mass`` (n,), ``moved`` and ``nodes`` (n, 3).
-    """
+    ``sd`` (e, 6), ``pres``, ``eps_p``, ``temp``, ``dmg`` (e,), ``qh`` (e, 12), ``vol0``,
+    ``msf`` (e,) (missing: zero, ``vol0`` the old volumes, ``temp`` ``t_room``, ``msf`` 1);
+    ``vel`` (n, 3) (zero); ``fixed`` (n,) bit mask; ``fnbr`` (e, 6) face neighbours (default
+    ``thermal3d.face_neighbours``); ``bflag`` (e, 6) outline flux types (default: closed).
+    Returns the remapped copies: the same keys plus ``vel``, ``mass``, ``moved``, ``nodes``."""
     a = remap3d_inputs(old, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
                        alive=alive, t_room=t_room)
     new = np.ascontiguousarray(new, np.float64)

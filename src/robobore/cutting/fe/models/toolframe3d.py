@@ -5,7 +5,7 @@ The mesh is :func:`robobore.cutting.fe.mesh.toolframe3d.build_toolframe3d_mesh` 
 config's insert, depth of cut and feed: the 2D tool-frame mesh stacked in z-slices under the
 insert's nose, built round the insert with its tip at the origin of the local frame of
 :mod:`robobore.cutting.fe.models.boring3d`. Everything but the mesh and the separation is the
-workpiece-frame boring model's (:func:`~robobore.cutting.fe.models.boring3d.boring_prm`:
+workpiece-frame boring model's (:func:`~robobore.cutting.fe.models.boring_setup.boring_prm`:
 material, hardening hold, friction, heat conduction, numerics, insert, kinematics, tool
 support): the insert moves along +x at the cutting speed and along +z at the feed speed, the
 material is at rest in the workpiece. Boundary conditions: the inflow face and the bottom
@@ -45,6 +45,7 @@ from robobore.cutting.fe.mesh.toolframe3d import (
     ToolFrameMesh3D,
     build_toolframe3d_mesh,
 )
+from robobore.cutting.fe.models.boring_setup import BoringSetup, boring_prm, check_support_step
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
@@ -93,7 +94,6 @@ def thin_element_factors(st: FEState3, mesh: ToolFrameMesh3D) -> np.ndarray:
 def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
     """Mesh, insert, support and state of the boring config ``cfg`` with
     ``mesh.frame = "tool"`` (a :class:`robobore.cutting.fe.models.boring3d.BoringSetup`)."""
-    from robobore.cutting.fe.models.boring3d import BoringSetup, boring_prm, check_support_step
 
     mat: Material = load_material(cfg.material.name, source=source,
                                   hardening_strain_limit=cfg.material.strain_limit())
