@@ -16,7 +16,7 @@ share of ``(c - 1) / c``... at most, and 1/2 on two cores. Other load on the mac
 every figure: the load average is printed; take figures with nothing else running.
 
     python benchmarks/bench_fe_shared.py [--engine 2d|3d|both] [--length-mm 0.03]
-        [--steps-3d 600] [--element-um-3d 12.5] [--threads N]
+        [--steps-3d 9700] [--element-um-3d 12.5] [--threads N]
 """
 
 from __future__ import annotations
@@ -118,7 +118,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--engine", choices=("2d", "3d", "both"), default="both")
     ap.add_argument("--length-mm", type=float, default=0.03, help="2D cut length [mm]")
-    ap.add_argument("--steps-3d", type=int, default=600)
+    ap.add_argument("--steps-3d", type=int, default=9700,
+                    help="3D steps (enough chunks for the thread governor to settle)")
     ap.add_argument("--element-um-3d", type=float, default=12.5)
     ap.add_argument("--threads", type=int, default=None)
     args = ap.parse_args()
