@@ -7,7 +7,10 @@ Builds REV in a temporary git worktree and runs the same cases on both trees, in
 config (`examples/fe_orthogonal.toml`, 0.3 mm) and the 3D paper condition
 (`examples/fe_boring_paper.toml`, 12.5 um elements, 0.05 mm of cut, no tool support). Each run
 is a fresh `python -m robobore fe orthogonal|boring CONFIG --json` process with PYTHONPATH on
-that tree's `src`; one short warm-up run per tree and case fills the numba caches first. Prints
+that tree's `src` and a numba cache of its own in a temporary folder (numba checks a cached
+function against its own source file only, so a checkout's `__pycache__` can hold code compiled
+against an older version of a function it calls; the figures are of the trees as they are); one
+short warm-up run per tree and case fills those caches first. `--cases` picks cases. Prints
 the element updates per second (median of the repeats) of both trees, their ratio, and whether
 the forces agree to 1e-9 (a restructure must not change them). The machine load (1-minute
 average) is printed with each run: take figures with nothing else running.
@@ -52,8 +55,8 @@ def _config(case: str, tmp: Path, warmup: bool) -> Path:
     return p
 
 
-def _run(tree: Path, case: str, cfg: Path) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(tree / "src"))
+def _run(tree: Path, case: str, cfg: Path, cache: Path) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(tree / "src"), NUMBA_CACHE_DIR=str(cache))
     sub = CASES[case][2]
     out = subprocess.run([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
                          capture_output=True, text=True, env=env, check=False)
@@ -72,6 +75,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--ref", required=True, help="git revision to compare with (e.g. a tag)")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", default=None, help="write the figures to this file")
+    ap.add_argument("--cases", nargs="+", choices=list(CASES), default=list(CASES),
+                    metavar="CASE", help=f"cases to run (default all: {', '.join(CASES)})")
     a = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as t:
         tmp = Path(t)
@@ -81,13 +86,14 @@ def main(argv: list[str] | None = None) -> None:
         try:
             trees = {"ref": ref_tree, "this": ROOT}
             res: dict = {"ref": a.ref, "cases": {}}
-            for case in CASES:
-                for tree in trees.values():
-                    _run(tree, case, _config(case, tmp, warmup=True))
+            caches = {name: tmp / f"numba_{name}" for name in trees}
+            for case in a.cases:
+                for name, tree in trees.items():
+                    _run(tree, case, _config(case, tmp, warmup=True), caches[name])
                 runs: dict[str, list] = {"ref": [], "this": []}
                 for i in range(a.repeats):
                     for name, tree in trees.items():
-                        r = _run(tree, case, _config(case, tmp, warmup=False))
+                        r = _run(tree, case, _config(case, tmp, warmup=False), caches[name])
                         runs[name].append(r)
                         print(f"{case:18s} {name:4s} #{i + 1}: {r['rate'] / 1e6:6.2f} M/s "
                               f"(load {r['load']:.1f})", flush=True)

@@ -65,12 +65,12 @@ from robobore.cutting.fe.ale.rezone import (
     TF_RIGID,
 )
 from robobore.cutting.fe.engine import kernels as K
-from robobore.cutting.fe.mesh.orthogonal import QuadMeshSizes
+from robobore.cutting.fe.mesh.orthogonal import MeshSizes
 from robobore.cutting.fe.models.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 
 
 @dataclass
-class ToolFrameMesh(QuadMeshSizes):
+class ToolFrameMesh(MeshSizes):
     """Quad mesh (``nodes`` (n, 2) [m], ``conn`` (e, 4) counter-clockwise) of the tool-frame
     model with its ALE data: ``acls`` (n, 7) int = class, two surface/face neighbours, four
     edge neighbours (-1 pad); ``aflt`` (n, 6) = face fraction (outflow-face nodes) or the
@@ -119,6 +119,50 @@ def _graded_steps(length: float, first: float, largest: float, ratio: float) -> 
     return pos * (length / pos[-1])
 
 
+def key_points(h: float, r: float, rake: float, chip_ratio: float, hj: float | None = None):
+    """The key points of the tool-frame section (edge-centre frame, SI units): returns
+    ``(hj, tc, cx, cy, nr, tr, T, th_s, S, th_t, R)``: the join height ``hj`` (default
+    min(r, h) / 2), the chip thickness ``tc``, the edge centre (cx, cy), the rake normal
+    ``nr`` (towards the chip) and tangent ``tr`` (up the rake face), the rake tangent point
+    ``T``, the join point ``S`` on the front of the arc at height ``hj`` above the lowest
+    point and its angle ``th_s``, the arc's end angle ``th_t`` at the rake face, and the chip
+    root ``R`` where the chip's back line (offset ``tc`` from the rake face) meets y = 0."""
+    hj = min(0.5 * r, 0.5 * h) if hj is None else hj
+    tc = chip_ratio * h
+    cx, cy = 0.0, -h + r
+    nr = np.array([-math.cos(rake), math.sin(rake)])
+    tr = np.array([math.sin(rake), math.cos(rake)])
+    T = np.array([cx, cy]) + r * nr
+    th_s = math.acos(1.0 - hj / r)
+    S = np.array([cx - r * math.sin(th_s), -h + hj])
+    th_t = 0.5 * math.pi + rake
+    s_R = (-T[1] - tc * nr[1]) / tr[1]
+    R = T + s_R * tr + tc * nr
+    return hj, tc, cx, cy, nr, tr, T, th_s, S, th_t, R
+
+
+def free_surface_join(x_in: float, R: np.ndarray, Ot: np.ndarray, S: np.ndarray,
+                      th_s: float) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """The chip block's free surface, the polyline inflow top -> chip root ``R`` -> chip top
+    ``Ot``, its cumulative arc lengths, and the arc length of the point P where the mesh line
+    from the join point ``S`` (bisecting the corner between the join line and the edge arc
+    at angle ``th_s``) meets it; ``None`` for P where the line misses the polyline."""
+    poly = np.array([[x_in, 0.0], R, Ot])
+    seg = np.hypot(*np.diff(poly, axis=0).T)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    bis = np.array([-math.cos(th_s), math.sin(th_s)]) + np.array([-1.0, 0.0])
+    bis /= np.linalg.norm(bis)
+    for k in range(2):
+        a, d = poly[k], poly[k + 1] - poly[k]
+        m = np.array([[bis[0], -d[0]], [bis[1], -d[1]]])
+        if abs(np.linalg.det(m)) < 1e-18:
+            continue
+        t, u = np.linalg.solve(m, a - S)
+        if t > 0.0 and 0.0 <= u <= 1.0:
+            return poly, cum, cum[k] + u * seg[k]
+    return poly, cum, None
+
+
 def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
                          element_size: float, edge_size: float, chip_ratio: float = 1.6,
                          join_height: float | None = None, ahead: float | None = None,
@@ -149,17 +193,7 @@ def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
     behind = max(2.0 * h, 120e-6) if behind is None else behind
     depth = max(2.5 * h, 120e-6) if depth is None else depth
     chip_length = max(1.5 * tc, 80e-6) if chip_length is None else chip_length
-    cx, cy = 0.0, -h + r
-    nr = np.array([-math.cos(rake), math.sin(rake)])  # rake normal (towards the chip)
-    tr = np.array([math.sin(rake), math.cos(rake)])  # up the rake face
-    T = np.array([cx, cy]) + r * nr  # rake tangent point
-    # join point S on the front of the arc at height hj above the lowest point
-    th_s = math.acos(1.0 - hj / r)
-    S = np.array([cx - r * math.sin(th_s), -h + hj])
-    th_t = 0.5 * math.pi + rake
-    # chip root R: the chip's back line (offset tc from the rake face) meets y = 0
-    s_R = (-T[1] - tc * nr[1]) / tr[1]
-    R = T + s_R * tr + tc * nr
+    _, _, cx, cy, nr, tr, T, th_s, S, th_t, R = key_points(h, r, rake, chip_ratio, hj)
     if R[0] >= S[0] - h:
         raise ValueError("chip ratio too small for this rake angle and edge radius")
     Ob = T + chip_length * tr
@@ -197,21 +231,7 @@ def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
     # S bisects the corner between the join line and the arc and meets it at P; the top's
     # stations run inflow top -> P with the fractions of the bottom's segment 1 and P -> Ot
     # with those of its segment 2 (each blended half and half with uniform spacing)
-    poly = np.array([[x_in, 0.0], R, Ot])
-    seg = np.hypot(*np.diff(poly, axis=0).T)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
-    bis = np.array([-math.cos(th_s), math.sin(th_s)]) + np.array([-1.0, 0.0])
-    bis /= np.linalg.norm(bis)
-    s_p = None
-    for k in range(2):
-        a, d = poly[k], poly[k + 1] - poly[k]
-        m = np.array([[bis[0], -d[0]], [bis[1], -d[1]]])
-        if abs(np.linalg.det(m)) < 1e-18:
-            continue
-        t, u = np.linalg.solve(m, a - S)
-        if t > 0.0 and 0.0 <= u <= 1.0:
-            s_p = cum[k] + u * seg[k]
-            break
+    poly, cum, s_p = free_surface_join(x_in, R, Ot, S, th_s)
     if s_p is None:
         raise ValueError("cannot place the chip block's mesh line from the join point")
 

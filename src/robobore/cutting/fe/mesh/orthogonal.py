@@ -39,8 +39,8 @@ def _graded(length: float, h0: float, ratio: float) -> np.ndarray:
     return np.array(sizes)
 
 
-class QuadMeshSizes:
-    """``n_nodes`` and ``n_elements`` of a mesh with ``nodes`` (n, 2) and ``conn`` (e, 4)."""
+class MeshSizes:
+    """``n_nodes`` and ``n_elements`` of a mesh with ``nodes`` (n, dim), ``conn`` (e, corners)."""
 
     nodes: np.ndarray
     conn: np.ndarray
@@ -55,7 +55,7 @@ class QuadMeshSizes:
 
 
 @dataclass(frozen=True)
-class CuttingMesh(QuadMeshSizes):
+class CuttingMesh(MeshSizes):
     """Quad mesh: ``nodes`` (n_nodes, 2) [m], ``conn`` (n_elem, 4) counter-clockwise.
 
     ``layer`` (n_elem,) bool: separation-layer elements; ``chip`` (n_elem,) bool: elements

@@ -117,11 +117,11 @@ import numpy as np
 
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
 from robobore.cutting.fe.ale.rezone import TF_CHAIN, TF_INTERIOR, TF_LINE, TF_RIGID
-from robobore.cutting.fe.ale.toolframe import ToolFrameMesh, build_toolframe_mesh
+from robobore.cutting.fe.ale.toolframe import ToolFrameMesh, build_toolframe_mesh, key_points
+from robobore.cutting.fe.mesh.orthogonal import MeshSizes
 from robobore.cutting.fe.mesh.toolframe3d_section import (
     SectionPlan,
     clamp_area,
-    key_points,
     s_of_y,
     section_coords,
     section_nodes,
@@ -172,7 +172,7 @@ class ToolFrame3DSizes:
 
 
 @dataclass
-class ToolFrameMesh3D:
+class ToolFrameMesh3D(MeshSizes):
     """The z-sliced tool-frame mesh (SI, the 3D frame of the module docstring).
 
     ``nodes`` (n, 3); ``conn`` (e, 8) VTK order (positive volumes); ``chip`` (e,) block B;
@@ -216,14 +216,6 @@ class ToolFrameMesh3D:
     blocks: dict
     areas: dict = field(default_factory=dict)
     min_edge: float = 0.0
-
-    @property
-    def n_nodes(self) -> int:
-        return int(self.nodes.shape[0])
-
-    @property
-    def n_elements(self) -> int:
-        return int(self.conn.shape[0])
 
 
 def _slice_positions(z0: float, z1: float, dz: float, margin: int) -> tuple[np.ndarray, np.ndarray]:

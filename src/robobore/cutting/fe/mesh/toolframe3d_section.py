@@ -14,10 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from robobore.cutting.fe.ale.toolframe import free_surface_join, key_points
 from robobore.cutting.fe.hex.scalar3d import edge_section
 from robobore.cutting.geometry import BoringInsert, lead_end, trailing_intersection
 
-__all__ = ["SectionPlan", "key_points", "section_plan", "section_nodes", "slice_map",
+__all__ = ["SectionPlan", "section_plan", "section_nodes", "slice_map",
            "section_coords", "s_of_y", "uncut_thickness", "clamp_area"]
 
 
@@ -69,23 +70,6 @@ class SectionPlan:
     n_arc_b: int
     q_sr: np.ndarray
     eta_b: np.ndarray
-
-
-def key_points(h, r, rake, chip_ratio):
-    """Join height, the rake tangent point T, the join point S (and its angle), the rake
-    normal/tangent, the chip root R and the tip angle of the arc (2D builder's)."""
-    hj = min(0.5 * r, 0.5 * h)
-    tc = chip_ratio * h
-    cx, cy = 0.0, -h + r
-    nr = np.array([-math.cos(rake), math.sin(rake)])
-    tr = np.array([math.sin(rake), math.cos(rake)])
-    T = np.array([cx, cy]) + r * nr
-    th_s = math.acos(1.0 - hj / r)
-    S = np.array([cx - r * math.sin(th_s), -h + hj])
-    th_t = 0.5 * math.pi + rake
-    s_R = (-T[1] - tc * nr[1]) / tr[1]
-    R = T + s_R * tr + tc * nr
-    return hj, tc, cx, cy, nr, tr, T, th_s, S, th_t, R
 
 
 def section_plan(h_ref: float, r: float, rake: float, clearance: float, *, element_size: float,
@@ -147,21 +131,7 @@ def section_nodes(plan: SectionPlan, h: float, depth: float) -> tuple[np.ndarray
     rake_pts = T[None, :] + sr[1:, None] * tr[None, :]
     seg2_bot = np.vstack([arc_b, rake_pts])
     n2 = seg2_bot.shape[0] - 1
-    poly = np.array([[x_in, 0.0], R, Ot])
-    seg = np.hypot(*np.diff(poly, axis=0).T)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
-    bis = np.array([-math.cos(th_s), math.sin(th_s)]) + np.array([-1.0, 0.0])
-    bis /= np.linalg.norm(bis)
-    s_p = None
-    for k in range(2):
-        a, d = poly[k], poly[k + 1] - poly[k]
-        m = np.array([[bis[0], -d[0]], [bis[1], -d[1]]])
-        if abs(np.linalg.det(m)) < 1e-18:
-            continue
-        t, u = np.linalg.solve(m, a - S)
-        if t > 0.0 and 0.0 <= u <= 1.0:
-            s_p = cum[k] + u * seg[k]
-            break
+    poly, cum, s_p = free_surface_join(x_in, R, Ot, S, th_s)
     if s_p is None:
         raise ValueError(f"cannot place the chip block's mesh line from the join point for "
                          f"h = {h} m")
