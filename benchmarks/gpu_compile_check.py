@@ -100,11 +100,14 @@ def main() -> int:
 
     # k_run(n_steps, state (the arrays, then the scalar settings), red, cflag, clist)
     cases = {
-        "3D k_run": (gpu._kernels()[-1],
-                     [1, gpu.RunState3(*[np.ascontiguousarray(getattr(st3, n))
-                                         for n in gpu._RUN_ARGS], int(st3.prm[K3.P_EROSION])),
-                      np.zeros(gpu.N_RED)] + chunk_arrays(st3.x.shape[0])),
     }
+    # the 3D persistent kernel with and without the heat phase
+    run3 = [1, gpu.RunState3(*[np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS],
+                             int(st3.prm[K3.P_EROSION])),
+            np.zeros(gpu.N_RED)] + chunk_arrays(st3.x.shape[0])
+    for conduction in (True, False):
+        name = f"3D k_run ({'conduction' if conduction else 'adiabatic'})"
+        cases[name] = (gpu._kernels(conduction)[-1], run3)
     # the 2D persistent kernel of each GPU model choice (the tool frame and conduction, each
     # on or off), compiled for the tool-frame state's argument types
     run2 = [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS],

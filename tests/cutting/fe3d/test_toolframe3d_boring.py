@@ -164,18 +164,34 @@ def test_a_tool_frame_state_needs_its_interval():
 
 
 def test_the_spec_chooses_the_loop():
+    # conduction (the default): the loops with the heat pass
     s = setup_boring(parse_boring_config(_cfg(t_min_um=8.0)))
-    assert K3.run_chunk3_for(s.spec) is K3.run_chunk3_ale
+    assert K3.run_chunk3_for(s.spec) is K3.run_chunk3_ale_heat
     d = load_toml(EX / "fe_boring_paper.toml")
     d["mesh"]["element_size_um"] = 16.6
     d["cut"]["cut_length_mm"] = 0.02
     w = setup_boring(parse_boring_config(d))
-    assert K3.run_chunk3_for(w.spec) is K3.run_chunk3
+    assert K3.run_chunk3_for(w.spec) is K3.run_chunk3_heat
     # a loop that does not match the state's frame is refused
     with pytest.raises(ConfigError, match="frame"):
-        advance3(w.state, 1e-9, step=K3.run_chunk3_ale)
+        advance3(w.state, 1e-9, step=K3.run_chunk3_ale_heat)
     with pytest.raises(ConfigError, match="frame"):
-        advance3(s.state, 1e-9, step=K3.run_chunk3)
+        advance3(s.state, 1e-9, step=K3.run_chunk3_heat)
+    # adiabatic: the loops without it; a loop of the other thermal model is refused
+    d["solver"]["heat_conduction"] = False
+    a = setup_boring(parse_boring_config(d))
+    assert K3.run_chunk3_for(a.spec) is K3.run_chunk3
+    with pytest.raises(ConfigError, match="thermal model"):
+        advance3(a.state, 1e-9, step=K3.run_chunk3_heat)
+    with pytest.raises(ConfigError, match="thermal model"):
+        advance3(w.state, 1e-9, step=K3.run_chunk3)
+    dt = _cfg(t_min_um=8.0)
+    dt["solver"]["heat_conduction"] = False
+    assert K3.run_chunk3_for(setup_boring(parse_boring_config(dt)).spec) is K3.run_chunk3_ale
+    # an interval below one step is neither adiabatic nor a heat pass
+    w.state.prm[K3.P_COND_EVERY] = 0.5
+    with pytest.raises(ConfigError, match="P_COND_EVERY"):
+        advance3(w.state, 1e-9)
 
 
 def test_cli_refuses_the_gpu_with_the_tool_frame(tmp_path):

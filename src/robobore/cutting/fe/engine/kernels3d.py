@@ -200,7 +200,8 @@ __all__ = [
     "E_EXT", "E_FRIC", "E_HG", "E_INT", "E_KIN", "E_PLAST", "I_BADELEM", "I_SAMPLE",
     "I_STATUS", "I_STEP", "N_SUM_LANES", "P_GATE", "STATUS_DONE", "STATUS_DT_COLLAPSE",
     "STATUS_INVERTED", "STATUS_NONFINITE", "STATUS_NO_ELEMENTS", "sum_energies3",
-    "contact_total3", "run_chunk3_ale", "run_chunk3_for", "P_RZ_EVERY", "P_RZ_MAXMOVE",
+    "contact_total3", "run_chunk3_ale", "run_chunk3_heat", "run_chunk3_ale_heat", "RUN_CHUNK3",
+    "run_chunk3_for", "P_RZ_EVERY", "P_RZ_MAXMOVE",
     "P_RZ_VEL", "P_ALE_X0", "P_ALE_Z0",
 ]
 
@@ -357,7 +358,7 @@ def _elements3_ale(s, dt):
 
 @njit
 def _heat3(s, step, t, dt):
-    # every prm[P_COND_EVERY] steps (0: adiabatic): conduction and the thermal contact
+    # every prm[P_COND_EVERY] (>= 1) steps: conduction and the thermal contact
     if is_conduction_step(step, s.prm):
         conduction_pass3(s.conn, s.x, s.y, s.z, s.ptr, s.nel, s.ncorner, s.alive, s.enbr,
                          s.pairs, s.vol0, s.cf, s.fric, s.temp, s.tbuf, s.theat, s.mat, s.prm,
@@ -378,19 +379,28 @@ def _remesh3(s, step):
                  cx - prm[P_ALE_X0], cz - prm[P_ALE_Z0], prm[P_RZ_MAXMOVE], prm, cx, cy, cz)
 
 
-def _bind3(name, remesh, elements):
+@njit
+def _no_heat3(s, step, t, dt):
+    # adiabatic: no heat pass
+    return None
+
+
+def _bind3(name, remesh, elements, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases
     return bind_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
                            energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
                            nodes=_nodes3, tool_step=_tool_step3, remesh=remesh,
-                           elements=elements, heat=_heat3, end_step=_end_step3,
+                           elements=elements, heat=heat, end_step=_end_step3,
                            energy_totals=_energy_totals3, totals_at_chunk_end=True)
 
 
-#: the step loop of :mod:`robobore.cutting.fe.engine.step_loop` bound to the 3D phases:
-#: workpiece frame (no remesh phase) and tool frame (the ALE pass)
-_loop3 = _bind3("loop3", None, _elements3)
-_loop3_ale = _bind3("loop3_ale", _remesh3, _elements3_ale)
+# the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases, one per
+# choice under its own name: workpiece frame (no remesh phase) or tool frame (the ALE pass),
+# adiabatic or with the heat pass
+_loop3 = _bind3("loop3", None, _elements3, _no_heat3)
+_loop3_heat = _bind3("loop3_heat", None, _elements3, _heat3)
+_loop3_ale = _bind3("loop3_ale", _remesh3, _elements3_ale, _no_heat3)
+_loop3_ale_heat = _bind3("loop3_ale_heat", _remesh3, _elements3_ale, _heat3)
 
 
 @njit(cache=True)
@@ -398,17 +408,23 @@ def run_chunk3(n_steps, *arrays):
     """Advance up to ``n_steps`` central-difference steps (the whole loop in numba) of the
     state arrays ``FEState3.kernel_args()`` (:data:`CHUNK_ARGS3`): the step loop of
     :mod:`robobore.cutting.fe.engine.step_loop` with the 3D phases (the parallel node and
-    element loops, the fixed-order contact-force total, the tool).
+    element loops, the fixed-order contact-force total, the tool); workpiece frame,
+    adiabatic.
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
     STATUS_DONE at ``prm[P_TEND]``, or an instability status (each step ends with
     :func:`robobore.cutting.fe.engine.history.end_step_py`). Returns the steps taken; the
     energy totals are summed after a chunk that ran to its end.
-    Every ``prm[P_COND_EVERY]`` steps (0: adiabatic) heat conduction and the thermal contact
-    with the insert run over the time since the last pass (:mod:`~robobore.cutting.fe.
-    physics.thermal3d`, :func:`conduction_pass3`).
     """
     return _loop3(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk3_heat(n_steps, *arrays):
+    """:func:`run_chunk3` with the heat pass: every ``prm[P_COND_EVERY]`` (>= 1) steps heat
+    conduction and the thermal contact with the insert over the time since the last pass
+    (:mod:`~robobore.cutting.fe.physics.thermal3d`, :func:`conduction_pass3`)."""
+    return _loop3_heat(n_steps, *arrays)
 
 
 @njit(cache=True)
@@ -419,12 +435,30 @@ def run_chunk3_ale(n_steps, *arrays):
     :mod:`robobore.cutting.fe.mesh.toolframe3d` put back to its place in the insert's frame
     (the places ``x0, y0, z0`` shifted by the insert tip's travel since ``prm[P_ALE_X0]``,
     ``prm[P_ALE_Z0]``) and the state remapped; the state's ALE arrays must be attached
-    (:meth:`robobore.cutting.fe.engine.state3d.FEState3.attach_tool_frame`)."""
+    (:meth:`robobore.cutting.fe.engine.state3d.FEState3.attach_tool_frame`). Adiabatic."""
     return _loop3_ale(n_steps, *arrays)
+
+
+@njit(cache=True)
+def run_chunk3_ale_heat(n_steps, *arrays):
+    """:func:`run_chunk3_ale` with the heat pass of :func:`run_chunk3_heat`."""
+    return _loop3_ale_heat(n_steps, *arrays)
+
+
+#: the compiled 3D chunk function of each choice (tool frame, conduction)
+RUN_CHUNK3 = {
+    (False, False): run_chunk3,
+    (False, True): run_chunk3_heat,
+    (True, False): run_chunk3_ale,
+    (True, True): run_chunk3_ale_heat,
+}
 
 
 def run_chunk3_for(spec):
     """The compiled 3D chunk function of a
-    :class:`~robobore.cutting.fe.config.spec.BoringSpec`: :func:`run_chunk3_ale` for the
-    tool frame (``spec.tool_frame``), else :func:`run_chunk3`."""
-    return run_chunk3 if getattr(spec, "tool_frame", None) is None else run_chunk3_ale
+    :class:`~robobore.cutting.fe.config.spec.BoringSpec`: the tool frame's ALE pass for
+    ``spec.tool_frame``, the heat pass for a ``Conduction`` thermal model
+    (:data:`RUN_CHUNK3`)."""
+    from robobore.cutting.fe.config.spec import Conduction
+
+    return RUN_CHUNK3[(spec.tool_frame is not None, isinstance(spec.thermal, Conduction))]

@@ -326,6 +326,16 @@ def init_forces3(st: FEState3) -> float:
     return dt
 
 
+def heat_pass(prm: np.ndarray) -> bool:
+    """Whether a 3D state's parameter vector asks for the heat pass (``prm[P_COND_EVERY]``
+    >= 1 steps) or none (0: adiabatic); ConfigError for an interval between."""
+    every = float(prm[K3.P_COND_EVERY])
+    if every != 0.0 and every < 1.0:
+        raise ConfigError("the heat pass needs an interval of at least one step (0: adiabatic)",
+                          field="prm[P_COND_EVERY]", value=every, expected="0 or >= 1")
+    return every >= 1.0
+
+
 def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              progress: Callable[[float], None] | None = None,
              check: Callable[[FEState3], None] | None = None,
@@ -333,10 +343,11 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              step: Callable[..., int] | None = None) -> int:
     """Run the compiled loop until time ``t_end`` [s]; returns the number of steps taken.
     ``step``: the compiled chunk function (:func:`kernels3d.run_chunk3_for` of the model
-    spec); default :func:`kernels3d.run_chunk3`, or :func:`kernels3d.run_chunk3_ale` (with
-    the tool-frame ALE pass every ``prm[P_RZ_EVERY]`` steps) for a state with the tool-frame
-    arrays (:meth:`FEState3.attach_tool_frame`). ConfigError when the loop and the state's
-    frame disagree.
+    spec); default the one of the state (:data:`kernels3d.RUN_CHUNK3`): with the tool-frame
+    ALE pass every ``prm[P_RZ_EVERY]`` steps for a state with the tool-frame arrays
+    (:meth:`FEState3.attach_tool_frame`), with the heat pass for a state whose
+    ``prm[P_COND_EVERY]`` is at least one step. ConfigError when a given loop and the state
+    disagree.
 
     ``progress(fraction_done)`` and ``check(state)`` (may raise) are called between chunks.
     Raises NumericalError (step, time, cause, what to change) on instability.
@@ -347,12 +358,14 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
         raise ConfigError("the tool-frame ALE pass needs an interval of at least one step",
                           field="prm[P_RZ_EVERY]", value=float(st.prm[K3.P_RZ_EVERY]),
                           expected=">= 1")
-    run = (K3.run_chunk3_ale if st.tool_frame else K3.run_chunk3) if step is None else step
-    if (run is K3.run_chunk3_ale) != st.tool_frame:
-        raise ConfigError("the 3D loop and the state's frame disagree", field="step",
-                          value=getattr(run, "__name__", str(run)),
-                          expected="run_chunk3_ale for a state with the tool-frame arrays, "
-                          "run_chunk3 without")
+    choice = (bool(st.tool_frame), heat_pass(st.prm))
+    run = K3.RUN_CHUNK3[choice] if step is None else step
+    if run is not K3.RUN_CHUNK3[choice]:
+        raise ConfigError("the 3D loop and the state's frame or thermal model disagree",
+                          field="step", value=getattr(run, "__name__", str(run)),
+                          expected=f"{K3.RUN_CHUNK3[choice].__name__} for a state "
+                          f"{'with' if choice[0] else 'without'} the tool-frame arrays and "
+                          f"{'with' if choice[1] else 'without'} a heat-pass interval")
     return drive_chunks(st, t_end, run, K3.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um, less mass "

@@ -86,9 +86,12 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     host-side launch cost).
     """
     from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine.state3d import heat_pass
 
     require_gpu()
-    k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_thermal, k_run = _kernels()
+    # the kernels of the state's thermal model: the heat phase for a heat-pass interval
+    conduction = heat_pass(st.prm)
+    k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_thermal, k_run = _kernels(conduction)
     k_centroids, k_conduct, k_copy_temp, k_heat_nodes, k_heat_elems, k_cond_done = k_thermal
     gn, ge = blocks(st.x.shape[0]), blocks(st.conn.shape[0])
     erosion = int(st.prm[K3.P_EROSION])
@@ -113,7 +116,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                               g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                               g["clock"], erosion, g["ist"], dred)
         tick("elements")
-        if K3.is_conduction_step_py(step, st.prm):
+        if conduction and K3.is_conduction_step_py(step, st.prm):
             k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
             k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
                                     g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],

@@ -54,11 +54,13 @@ def no_energy_totals_py(es, en):
     return False
 
 
-@functools.lru_cache(maxsize=1)
-def kernels3():
-    """Compile (lazily, once) the device functions and kernels: ``(k_nodes, k_contact_sum,
-    k_tool, k_elems, k_finish, (k_centroids, k_conduct, k_copy_temp, k_heat_nodes,
-    k_heat_elems, k_cond_done), k_run)``."""
+@functools.lru_cache(maxsize=2)
+def kernels3(conduction: bool):
+    """Compile (lazily, once per choice) the device functions and kernels: ``(k_nodes,
+    k_contact_sum, k_tool, k_elems, k_finish, (k_centroids, k_conduct, k_copy_temp,
+    k_heat_nodes, k_heat_elems, k_cond_done), k_run)``; ``k_run`` has the heat phase (every
+    ``prm[P_COND_EVERY]`` >= 1 steps) with ``conduction``, none without (adiabatic), as the
+    CPU's ``kernels3d.RUN_CHUNK3``."""
     global cuda
     cuda = bind_cuda()
     from numba import float64 as _float64
@@ -279,10 +281,14 @@ def kernels3():
         if alive[e] == -2:
             red[R_BAD] = e
 
+    CONDUCTION = bool(conduction)
+
     @cuda.jit(device=True)
     def heat_phase(a, step, dt, tid, nthr, grid):
         # conduction (thermal3d, the CPU's conduction_pass3): the phases of the launch path,
-        # separated by barriers
+        # separated by barriers; none in the adiabatic kernel
+        if not CONDUCTION:
+            return
         prm, clock = a.prm, a.clock
         if not is_cond(step, prm):
             return
