@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/fe3d_toolframe_short.py [--config examples/fe_boring_paper.toml]
         [--steps 3000] [--mass-scaling 400] [--element-um 12.5] [--t-min-um 5]
-        [--setup-only] [--no-inertia-factors] [--out results.json]
+        [--setup-only] [--no-inertia-factors] [--normal-damping Z] [--out results.json]
 
 ``--setup-only``: no run; the mesh facts, the initial time step and the steps the config's
 whole cut would take at it. Otherwise runs the config with ``[mesh] frame = "tool"`` for
@@ -38,6 +38,8 @@ def main() -> None:
     ap.add_argument("--setup-only", action="store_true")
     ap.add_argument("--no-inertia-factors", action="store_true",
                     help="solver.thin_element_mass_scaling = false")
+    ap.add_argument("--normal-damping", type=float, default=None,
+                    help="contact.normal_damping (default: the config's, 1 in the tool frame)")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
 
@@ -57,6 +59,8 @@ def main() -> None:
     d.setdefault("solver", {})["mass_scaling"] = a.mass_scaling
     if a.no_inertia_factors:
         d["solver"]["thin_element_mass_scaling"] = False
+    if a.normal_damping is not None:
+        d.setdefault("contact", {})["normal_damping"] = a.normal_damping
     cfg = parse_boring_config(d, source=a.config)
     setup = setup_boring(cfg, a.config)
     dt = float(setup.state.clock[1])

@@ -130,12 +130,15 @@ def check_fe2d(cfg: Any, source: str | None = None) -> None:
 
 
 def fe3d_elements(cfg: Any) -> float:
-    """Element count of a 3D boring FE config (:class:`BoringFEConfig`): the block the mesh
-    builder fills, ``(cut_length + ahead)`` along the cut, from half a feed behind the
-    insert to the end of its engaged edge plus two side margins along the feed, and ``ap +
-    max(depth_factor ap, 4 le)`` deep, over ``le^3``."""
+    """Element count of a 3D boring FE config (:class:`BoringFEConfig`). Workpiece frame: the
+    block the mesh builder fills, ``(cut_length + ahead)`` along the cut, from half a feed
+    behind the insert to the end of its engaged edge plus two side margins along the feed,
+    and ``ap + max(depth_factor ap, 4 le)`` deep, over ``le^3``. Tool frame
+    (``mesh.frame = "tool"``): :func:`toolframe3d_elements`."""
     from robobore.cutting.geometry import lead_end
 
+    if getattr(cfg.mesh, "frame", "workpiece") == "tool":
+        return toolframe3d_elements(cfg)
     le = float(cfg.mesh.element_size_um) * 1e-6
     ap = float(cfg.cut.depth_of_cut_mm) * 1e-3
     f = float(cfg.cut.feed_mm_per_rev) * 1e-3
@@ -144,6 +147,32 @@ def fe3d_elements(cfg: Any) -> float:
     width = 0.5 * f + float(lead_end(cfg.insert.to_insert(), ap)) + 2.0 * side
     depth = ap + max(float(cfg.mesh.depth_factor) * ap, 4.0 * le)
     return L * width * depth / le**3
+
+
+def toolframe3d_elements(cfg: Any) -> float:
+    """Hexahedra of a tool-frame 3D boring config's mesh: the count of
+    :func:`robobore.cutting.fe.mesh.toolframe3d.toolframe3d_counts` (exact, from the slices'
+    layout and the reference section, without the 3D mesh). A lower bound is taken first and
+    returned when it alone does not fit in memory (no section is then built): every slice's
+    section spans at least 180 x 120 um (inflow face 60 um ahead of the chip root and back
+    face 120 um behind the edge, 120 um deep) in elements no larger than ``le``, and the
+    slices are at most the slice spacing apart over the engaged edge. Where the geometry
+    leaves the model's range the lower bound is returned (the setup says why)."""
+    from robobore.cutting.fe.mesh.toolframe3d_layout import ToolFrame3DSizes, toolframe3d_counts
+    from robobore.cutting.geometry import lead_end, trailing_intersection
+
+    ins = cfg.insert.to_insert()
+    ap = float(cfg.cut.depth_of_cut_mm) * 1e-3
+    f = float(cfg.cut.feed_mm_per_rev) * 1e-3
+    sizes = ToolFrame3DSizes.of_config(cfg.mesh)
+    span = max(float(lead_end(ins, ap)) - float(trailing_intersection(ins, ap, f)), sizes.dz)
+    lower = 180e-6 * 120e-6 / sizes.element_size**2 * span / sizes.dz
+    if lower * FE3D_BYTES_PER_ELEMENT > available_memory_bytes():
+        return lower
+    try:
+        return float(toolframe3d_counts(ins, ap, f, sizes)[1])
+    except ValueError:
+        return lower
 
 
 def check_fe3d(cfg: Any, source: str | None = None) -> None:
@@ -183,6 +212,7 @@ __all__ = [
     "fmt_bytes",
     "fe2d_elements",
     "fe3d_elements",
+    "toolframe3d_elements",
     "check_fe2d",
     "check_fe3d",
     "timedomain_bytes",

@@ -58,7 +58,7 @@ def test_boring_config_defaults_to_the_validated_law():
 @pytest.mark.parametrize("contact, match", [
     ({"friction": "coulomb_0.3"}, "unknown friction"),
     ({"friction": 2.5}, "0..2"),
-    ({"normal_damping": 0.5}, "normal_damping: not used by the 3D"),
+    ({"normal_damping": 1.5}, "normal_damping"),
     ({"thermal_conductance_W_per_m2K": 1e12}, "thermal_conductance_W_per_m2K"),
     ({"friction_heat_fraction": 1.5}, "friction_heat_fraction"),
     ({"friction": 0.3, "friction_velocity": "sliding"}, "constant coefficient"),

@@ -205,3 +205,18 @@ def test_cli_refuses_the_gpu_with_the_tool_frame(tmp_path):
     res = CliRunner().invoke(app, ["fe", "boring", str(cfg), "--device", "gpu"])
     assert res.exit_code == 2
     assert "CPU only" in res.output and "--device" in res.output
+
+
+def test_contact_normal_damping_as_in_2d():
+    """``contact.normal_damping``: default 1 (critical) in the tool frame, 0 in the workpiece
+    frame (the 2D engine's defaults); a given value in either."""
+    assert setup_boring(parse_boring_config(_cfg(t_min_um=8.0))).state.prm[K3.P_CDAMP] == 1.0
+    d = load_toml(EX / "fe_boring_paper.toml")
+    d["mesh"]["element_size_um"] = 16.6
+    d["cut"]["cut_length_mm"] = 0.02
+    assert setup_boring(parse_boring_config(d)).state.prm[K3.P_CDAMP] == 0.0
+    d["contact"] = {**d.get("contact", {}), "normal_damping": 0.4}
+    assert setup_boring(parse_boring_config(d)).state.prm[K3.P_CDAMP] == 0.4
+    t = _cfg(t_min_um=8.0)
+    t["contact"] = {**t.get("contact", {}), "normal_damping": 0.0}
+    assert setup_boring(parse_boring_config(t)).state.prm[K3.P_CDAMP] == 0.0

@@ -8,6 +8,7 @@ boundary faces. Tolerances are stated per test.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -40,6 +41,7 @@ AP, F = 0.05e-3, 0.15e-3
 INSERT = BoringInsert(nose_radius_m=0.4e-3, approach_angle_deg=90.0, end_edge_angle_deg=5.0,
                       rake_deg=7.0, clearance_deg=7.0, edge_radius_m=20e-6, inclination_deg=0.0)
 LE = 12.5e-6
+EXAMPLES = Path(__file__).parents[3] / "examples"
 
 
 @pytest.fixture(scope="module")
@@ -213,3 +215,41 @@ def test_every_slice_is_its_normal_section_mapped_exactly(mesh):
         s_bot = float(s_of_y(INSERT, np.array([mesh.y_bottom]), np.array([z]))[0])
         want, _ = section_nodes(mesh.plan, float(mesh.h2[k]), s_bot - r)
         assert np.allclose(back, want, rtol=0.0, atol=1e-12), k
+
+
+def test_counts_without_building_the_mesh(mesh):
+    """toolframe3d_counts (the memory check's estimate) gives the built mesh's node and
+    hexahedron counts, here and with other slice spacing, margins and edge size."""
+    from robobore.cutting.fe.mesh.toolframe3d_layout import toolframe3d_counts
+
+    assert toolframe3d_counts(INSERT, AP, F, ToolFrame3DSizes(LE)) == (mesh.n_nodes,
+                                                                       mesh.n_elements)
+    other = ToolFrame3DSizes(16.6e-6, slice_spacing=10e-6, margin_slices=1, edge_size=5e-6)
+    m2 = build_toolframe3d_mesh(INSERT, AP, F, other)
+    assert toolframe3d_counts(INSERT, AP, F, other) == (m2.n_nodes, m2.n_elements)
+
+
+def test_memory_estimate_of_a_tool_frame_config(monkeypatch):
+    """io.memory.fe3d_elements of a tool-frame boring config is its mesh's hexahedron count;
+    a size whose lower bound alone does not fit is refused without building a section."""
+    import robobore.cutting.fe.mesh.toolframe3d_layout as layout
+    import robobore.io.memory as memory
+    from robobore.cutting.fe.models.boring3d import parse_boring_config
+    from robobore.errors import ConfigError
+    from robobore.io.config import load_toml
+
+    d = load_toml(EXAMPLES / "fe_boring_paper.toml")
+    d["mesh"].update(frame="tool", element_size_um=16.6)
+    cfg = parse_boring_config(d)
+    ins = cfg.insert.to_insert()
+    built = build_toolframe3d_mesh(ins, cfg.cut.depth_of_cut_mm * 1e-3,
+                                   cfg.cut.feed_mm_per_rev * 1e-3, ToolFrame3DSizes(16.6e-6))
+    assert memory.fe3d_elements(cfg) == built.n_elements > 10_000
+
+    def never(*a, **k):
+        raise AssertionError("a section was built")
+
+    monkeypatch.setattr(layout, "slice_layout", never)
+    d["mesh"]["element_size_um"] = 0.01
+    with pytest.raises(ConfigError, match="mesh.element_size_um"):
+        parse_boring_config(d, "fine.toml")

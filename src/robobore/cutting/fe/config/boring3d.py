@@ -55,29 +55,16 @@ class CutSection(Strict):
     cut_length_mm: float = Field(default=0.3, gt=0.0, le=20.0)
 
 
-#: keys of the 2D engine's [contact] that the 3D model does not use: its contact law has no
-#: normal damping
-_CONTACT_2D_ONLY = ("normal_damping",)
-
-
 class ContactSection(ContactSection2D):
     """The 2D engine's ``[contact]``
-    (:class:`robobore.cutting.fe.config.orthogonal.ContactSection`): the same friction keys, values
-    and defaults -- ``friction`` a bundled friction law (default ``rech2013_calibrated``: the Rech
+    (:class:`robobore.cutting.fe.config.orthogonal.ContactSection`): the same keys, values and
+    defaults -- ``friction`` a bundled friction law (default ``rech2013_calibrated``: the Rech
     et al. 2013 table x 1.5 read at each contact node's filtered sliding speed, no shear cap),
     "table" or a constant Coulomb coefficient; ``friction_velocity``, ``friction_table_*``,
-    ``sliding_filter_um``, ``shear_limit_MPa``, ``penalty_factor`` and the thermal contact
+    ``sliding_filter_um``, ``shear_limit_MPa``, ``penalty_factor``, ``normal_damping``
+    (default 1 in the tool frame, 0 in the workpiece frame, as in 2D) and the thermal contact
     (``thermal_conductance_W_per_m2K``, ``friction_heat_fraction``, ``tool_temperature_K``, used
-    with ``solver.heat_conduction``) -- without ``normal_damping`` (the 3D contact has no normal
-    damping)."""
-
-    @model_validator(mode="after")
-    def _no_2d_only(self) -> ContactSection:
-        bad = sorted(set(_CONTACT_2D_ONLY) & self.model_fields_set)
-        if bad:
-            raise ValueError(f"{', '.join(bad)}: not used by the 3D boring model (its contact "
-                             "has no normal damping); remove the key")
-        return self
+    with ``solver.heat_conduction``)."""
 
 
 class MeshSection(Strict):

@@ -194,6 +194,13 @@ class ContactSection(Strict):
         return (np.asarray(self.friction_table_velocity_m_per_min, float),
                 np.asarray(self.friction_table_mu, float))
 
+    def damping_for(self, tool_frame: bool) -> float:
+        """``normal_damping``, or its default for the frame: 1 (critical) in the tool frame,
+        0 in the workpiece frame."""
+        if self.normal_damping is not None:
+            return float(self.normal_damping)
+        return 1.0 if tool_frame else 0.0
+
     def coefficient_at(self, vc_m_per_min: float) -> float:
         """Coulomb coefficient at a cutting speed [m/min]: the constant given, or the table
         there (with ``friction_velocity = "sliding"`` the nominal value: each contact node

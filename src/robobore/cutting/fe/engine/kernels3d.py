@@ -16,7 +16,7 @@ phases and the chunk loops :func:`run_chunk3` (the step loop of
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
 * :func:`contact_force3_py` -- the 2D contact law (:func:`tool_contact.contact_force_py`: mass-
-  proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
+  proportional penalty, viscous normal damping, Coulomb friction, shear-stress cap) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
   (:func:`robobore.cutting.fe.engine.kernels.friction_at_py`, the same code re-bound to the 3D
@@ -75,6 +75,7 @@ from robobore.cutting.fe.hex.layout3d import (
     P_ALE_Z0,
     P_BV1,
     P_BV2,
+    P_CDAMP,
     P_CFL,
     P_CLR,
     P_COND_EVERY,
@@ -185,6 +186,7 @@ from robobore.material import johnson_cook as jc
 __all__ = [
     "N_PRM", "P_CFL", "P_MS", "P_HGV", "P_HGS", "P_BV1", "P_BV2", "P_DIST", "P_DT_ERODE",
     "P_DTMIN", "P_MU", "P_MUTAB_N", "P_MUTAB_V", "P_MUTAB_MU", "P_SLIP_TAU", "P_TAU", "P_PEN",
+    "P_CDAMP",
     "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR", "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF",
     "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY", "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY",
     "P_MZ", "P_THETA0", "P_SAMPLE_DT", "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER",

@@ -29,6 +29,8 @@ PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     ("P_MU", 1, "Coulomb coefficient (constant, or the table at the cutting speed)"),
     ("P_TAU", 1, "cap on the contact shear stress [Pa]"),
     ("P_PEN", 1, "penalty factor: normal stiffness = factor * nodal mass / dt^2"),
+    ("P_CDAMP", 1, "viscous normal contact damping, fraction of the penalty spring's critical "
+                   "damping (0: none)"),
     # insert geometry
     ("P_RN", 1, "nose radius [m]"),
     ("P_KAPPA", 1, "approach angle [rad]"),

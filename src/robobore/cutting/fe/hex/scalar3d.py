@@ -8,7 +8,7 @@ kernels of :mod:`robobore.cutting.fe.engine.gpu.kernels3d` the device versions o
 * :func:`insert_gap3_py` -- signed distance of a point to a boring insert with nose radius,
   approach and end-edge angles, rake, clearance, edge radius and inclination;
 * :func:`contact_force3_py` -- the 2D contact law (:func:`tool_contact.contact_force_py`: mass-
-  proportional penalty, Coulomb friction, shear-stress cap; without its normal damping) with a
+  proportional penalty, viscous normal damping, Coulomb friction, shear-stress cap) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
   (:func:`robobore.cutting.fe.engine.kernels.friction_at_py`, the same code re-bound to the 3D
@@ -30,6 +30,7 @@ from numba import njit
 from robobore.cutting.fe.engine import kernels as _K2
 from robobore.cutting.fe.hex.layout3d import (
     MU_TABLE_MAX,
+    P_CDAMP,
     P_CLR,
     P_COND_EVERY,
     P_CX,
@@ -158,23 +159,30 @@ def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
 
 
 def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_max, pen_factor,
-                      dt, fox, foy, foz):
+                      dt, damping, fox, foy, foz):
     """Contact force on a node touching the rigid insert [N] (3D form of the 2D law).
 
-    Normal: penalty ``Fn = pen_factor * mass / dt^2 * (-gap)`` (as
-    :func:`tool_contact.contact_force_py`). Tangential: the same return mapping on the trial
+    Normal: penalty ``pen_factor * mass / dt^2 * (-gap)`` plus the viscous damping ``-c v_n``
+    on the relative normal velocity, ``c = 2 damping sqrt(k m)`` (``damping``: fraction of
+    the penalty spring's critical damping; 0: none), the total kept >= 0 (no adhesion), as
+    :func:`tool_contact.contact_force_py`. Tangential: the same return mapping on the trial
     sliding velocity (the tangential part of ``v_r + dt fo / mass``, ``fo`` = ``(fox, foy,
     foz)`` the node's element forces this step [N]): the force that stops it in one step,
     limited by Coulomb ``mu Fn`` and by the shear cap ``tau_max * trib_area`` (the node's
     tributary contact area [m^2]), opposite to the trial sliding direction. ``(vrx, vry,
     vrz)`` node velocity relative to the tool [m/s].
 
-    Returns ``(fx, fy, fz, fn, ft, tx, ty, tz)``: force, normal magnitude, tangential
-    magnitude and the unit sliding direction (zero vector when not sliding).
+    Returns ``(fx, fy, fz, fn, ft, tx, ty, tz, fd)``: force, normal magnitude, tangential
+    magnitude, the unit sliding direction (zero vector when not sliding) and the damping part
+    of the normal magnitude.
     """
     if gap >= 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    fn = pen_factor * mass / (dt * dt) * (-gap)
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    fp = pen_factor * mass / (dt * dt) * (-gap)
+    fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * (vrx * nx + vry * ny + vrz * nz)
+    if fp + fd < 0.0:
+        fd = -fp
+    fn = fp + fd
     wx = vrx + dt * fox / mass
     wy = vry + dt * foy / mass
     wz = vrz + dt * foz / mass
@@ -184,7 +192,7 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
     vtz = wz - vn * nz
     vt = math.sqrt(vtx * vtx + vty * vty + vtz * vtz)
     if vt <= 0.0:
-        return fn * nx, fn * ny, fn * nz, fn, 0.0, 0.0, 0.0, 0.0
+        return fn * nx, fn * ny, fn * nz, fn, 0.0, 0.0, 0.0, 0.0, fd
     tx = vtx / vt
     ty = vty / vt
     tz = vtz / vt
@@ -193,7 +201,7 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
     if tau_max * trib_area < fcap:
         fcap = tau_max * trib_area
     ft = fstick if fstick < fcap else fcap
-    return (fn * nx - ft * tx, fn * ny - ft * ty, fn * nz - ft * tz, fn, ft, tx, ty, tz)
+    return (fn * nx - ft * tx, fn * ny - ft * ty, fn * nz - ft * tz, fn, ft, tx, ty, tz, fd)
 
 
 insert_gap3 = njit(cache=True)(insert_gap3_py)
@@ -317,11 +325,13 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
                 vs = cf[n, 3] + a * (math.sqrt(sx * sx + sy * sy + sz * sz) - cf[n, 3])
                 cf[n, 3] = vs
                 mu = friction_at3(prm, vs)
-            fcx, fcy, fcz, fn, ft, tx, ty, tz = contact_force3(
+            fcx, fcy, fcz, fn, ft, tx, ty, tz, fd = contact_force3(
                 gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, mu, prm[P_TAU], prm[P_PEN],
-                dt, 0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy, 0.0 if (fb & 4) else fz)
+                dt, prm[P_CDAMP], 0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy,
+                0.0 if (fb & 4) else fz)
             vt0 = vrx * tx + vry * ty + vrz * tz
-            pen[n] = share * 0.5 * fn * (-gap)
+            vn0 = vrx * gnx + vry * gny + vrz * gnz
+            pen[n] = share * 0.5 * (fn - fd) * (-gap)
     cf[n, 0] = share * fcx
     cf[n, 1] = share * fcy
     cf[n, 2] = share * fcz
@@ -342,6 +352,9 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
                                   + fcz * 0.5 * (oz + nvz))
         vt1 = (nvx - tvx) * tx + (nvy - tvy) * ty + (nvz - tvz) * tz
         fric[n] += share * dt * ft * 0.5 * (vt0 + vt1)
+        if fd != 0.0:  # contact damping: booked with the frictional dissipation
+            vn1 = (nvx - tvx) * gnx + (nvy - tvy) * gny + (nvz - tvz) * gnz
+            fric[n] -= share * dt * fd * 0.5 * (vn0 + vn1)
 
 
 hex_node = njit(cache=True)(hex_node_py)

@@ -110,15 +110,15 @@ across a slab), for the plane-strain cross-check against the 2D engine.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
 from robobore.cutting.fe.ale.rezone import TF_CHAIN, TF_INTERIOR, TF_LINE, TF_RIGID
-from robobore.cutting.fe.ale.toolframe import ToolFrameMesh, build_toolframe_mesh, key_points
+from robobore.cutting.fe.ale.toolframe import ToolFrameMesh
 from robobore.cutting.fe.mesh.orthogonal import MeshSizes
+from robobore.cutting.fe.mesh.toolframe3d_layout import ToolFrame3DSizes, slice_layout
 from robobore.cutting.fe.mesh.toolframe3d_section import (
     SectionPlan,
     clamp_area,
@@ -129,7 +129,7 @@ from robobore.cutting.fe.mesh.toolframe3d_section import (
     slice_map,
     uncut_thickness,
 )
-from robobore.cutting.geometry import BoringInsert, chip_area, lead_end, trailing_intersection
+from robobore.cutting.geometry import BoringInsert, chip_area
 
 __all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", "FK_INFLOW",
            "FK_OUTFLOW", "FK_TOOL", "FK_FREE", "FK_BOTTOM", "FK_SIDE", "section_plan",
@@ -143,32 +143,6 @@ __all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", 
 #: chip's side faces at the end slices, the top of the margins), rigid bottom, the side
 #: planes of the block (first and last slice)
 FK_INTERIOR, FK_INFLOW, FK_OUTFLOW, FK_TOOL, FK_FREE, FK_BOTTOM, FK_SIDE = range(7)
-
-
-@dataclass(frozen=True)
-class ToolFrame3DSizes:
-    """Element size control (SI): ``element_size`` the largest in-plane element,
-    ``edge_size`` the element round the edge (default element_size / 4, the 2D model's),
-    ``slice_spacing`` the largest z step between slices (default element_size), ``t_min``
-    the clamp of the uncut thickness at the ends of the engagement (default 5 um),
-    ``margin_slices`` block-A-only slices beyond each end, ``chip_ratio`` the pre-shaped
-    chip's thickness / uncut thickness, ``ratio`` the element growth ratio."""
-
-    element_size: float
-    edge_size: float | None = None
-    slice_spacing: float | None = None
-    t_min: float = 5e-6
-    margin_slices: int = 3
-    chip_ratio: float = 1.6
-    ratio: float = 1.15
-
-    @property
-    def edge(self) -> float:
-        return self.element_size / 4.0 if self.edge_size is None else self.edge_size
-
-    @property
-    def dz(self) -> float:
-        return self.element_size if self.slice_spacing is None else self.slice_spacing
 
 
 @dataclass
@@ -218,70 +192,16 @@ class ToolFrameMesh3D(MeshSizes):
     min_edge: float = 0.0
 
 
-def _slice_positions(z0: float, z1: float, dz: float, margin: int) -> tuple[np.ndarray, np.ndarray]:
-    """Slices on [z0, z1] with z = 0 among them (z0 < 0 < z1), steps <= dz, plus ``margin``
-    slices of step dz beyond each end. Returns (z, engaged)."""
-    n_lo = max(1, int(math.ceil(-z0 / dz)))
-    n_hi = max(1, int(math.ceil(z1 / dz)))
-    zs = np.concatenate([np.linspace(z0, 0.0, n_lo + 1), np.linspace(0.0, z1, n_hi + 1)[1:]])
-    lo = z0 - dz * np.arange(margin, 0, -1)
-    hi = z1 + dz * np.arange(1, margin + 1)
-    z = np.concatenate([lo, zs, hi])
-    eng = np.concatenate([np.zeros(margin, bool), np.ones(zs.size, bool), np.zeros(margin, bool)])
-    return z, eng
-
-
 def build_toolframe3d_mesh(insert: BoringInsert, ap: float, f: float,
                            sizes: ToolFrame3DSizes) -> ToolFrameMesh3D:
     """The z-sliced tool-frame mesh for the boring insert at depth of cut ``ap`` and feed
     ``f`` [m] (see the module docstring). Raises ValueError when the geometry leaves the
     model's range (no engagement on both sides of the tip, a chip reaching past the nose)."""
-    if insert.edge_radius_m <= 0.0:
-        raise ValueError("the tool-frame mesh needs an edge radius > 0")
-    if not (0.0 < sizes.t_min < ap):
-        raise ValueError(f"t_min = {sizes.t_min} m must lie in (0, ap = {ap} m)")
+    lay = slice_layout(insert, ap, f, sizes)
+    z, eng, t_true, y_top, h2 = lay.z, lay.eng, lay.t_true, lay.y_top, lay.h2
+    plan, ref, blk, y_bot = lay.plan, lay.ref, lay.blk, lay.y_bot
     r = insert.edge_radius_m
-    rake = math.radians(insert.rake_deg)
-    clr = math.radians(insert.clearance_deg)
-    z_t = trailing_intersection(insert, ap, f)
-    z_l = lead_end(insert, ap)
-    if not (z_t < 0.0 < z_l):
-        raise ValueError("the engaged edge must contain the nose tip (z = 0)")
-    dz = sizes.dz
-    z, eng = _slice_positions(z_t, z_l, dz, sizes.margin_slices)
     nk = z.size
-    t_true = uncut_thickness(insert, ap, f, z)
-    t_c = np.where(eng, np.maximum(t_true, sizes.t_min), t_true)
-    y_top = insert.drop(z) + t_c  # the mesh's free surface ahead of the edge
-    y_top[~eng] = np.minimum(ap, insert.drop(z[~eng] + f))
-    # normal-section thickness of each engaged slice: the free surface's distance from the
-    # apex line, taken from the edge profile's (s = r)
-    h2 = np.full(nk, np.nan)
-    h2[eng] = r - s_of_y(insert, y_top[eng], z[eng])
-    k0 = int(np.flatnonzero(eng & (z == 0.0))[0])
-    h_ref = float(h2[k0])
-    h_max = float(np.nanmax(h2))
-    fine, coarse = sizes.edge, sizes.element_size
-    # extents shared by the slices: the 2D builder's defaults for the thickest slice
-    chip_length = max(1.5 * sizes.chip_ratio * h_max, 80e-6)
-    x_in = min(key_points(float(hk), r, rake, sizes.chip_ratio)[10][0]
-               - max(1.5 * float(hk), 60e-6) for hk in h2[eng])
-    x_out = max(2.0 * h_max, 120e-6)
-    depth = max(2.5 * h_max, 120e-6)
-    y_bot = -depth  # flat bottom, the reference slice's depth below its cut line y = 0
-    plan = section_plan(h_ref, r, rake, clr, element_size=coarse, edge_size=fine,
-                        chip_ratio=sizes.chip_ratio, ratio=sizes.ratio, x_in=x_in, x_out=x_out,
-                        depth=depth, chip_length=chip_length)
-    ref = build_toolframe_mesh(h_ref, r, rake, clr, element_size=coarse, edge_size=fine,
-                               chip_ratio=sizes.chip_ratio,
-                               ahead=key_points(h_ref, r, rake, sizes.chip_ratio)[10][0] - x_in,
-                               behind=x_out, depth=depth, chip_length=chip_length,
-                               ratio=sizes.ratio)
-    ref_nodes, blk = section_nodes(plan, h_ref, depth)
-    if ref_nodes.shape != ref.nodes.shape or not np.allclose(ref_nodes, ref.nodes, rtol=0.0,
-                                                            atol=1e-9 * fine):
-        raise AssertionError("section_nodes does not reproduce build_toolframe_mesh at the "
-                             "reference thickness")
     na, ja = blk["na"], blk["ja"]
     n_a = (na + 1) * (ja + 1)  # block A nodes come first in the 2D order
     n2d = ref.nodes.shape[0]

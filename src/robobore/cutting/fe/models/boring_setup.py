@@ -52,6 +52,7 @@ def boring_prm(cfg: BoringFEConfig, spec: BoringSpec, ins: BoringInsert, vc: flo
     n_rps = cfg.cut.speed_rpm / 60.0
     p = spec.write_prm(apply_numerics(default_prm3(), s, K3), K3, vc * 60.0)
     p[K3.P_PEN] = cfg.contact.penalty_factor
+    p[K3.P_CDAMP] = cfg.contact.damping_for(spec.tool_frame is not None)
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = ins.nose_radius_m
     p[K3.P_KAPPA] = math.radians(ins.approach_angle_deg)

@@ -129,8 +129,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     spec = build_spec(cfg, mat, source)
     p = spec.write_prm(apply_numerics(default_prm(), s, K), K, cfg.cut.cutting_speed_m_per_min)
     p[K.P_PEN] = cfg.contact.penalty_factor
-    nd = cfg.contact.normal_damping
-    p[K.P_CDAMP] = (1.0 if cm.frame == "tool" else 0.0) if nd is None else nd
+    p[K.P_CDAMP] = cfg.contact.damping_for(cm.frame == "tool")
     p[K.P_R] = r
     p[K.P_NRX], p[K.P_NRY] = -math.cos(rake), math.sin(rake)
     p[K.P_NFX], p[K.P_NFY] = math.sin(clr), -math.cos(clr)

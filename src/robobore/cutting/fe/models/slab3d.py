@@ -114,17 +114,9 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
                       erode_time_step_fraction=frame.erode_time_step_fraction,
                       friction=spec2.friction, thermal=spec2.thermal,
                       hardening=spec2.hardening)
-    p = spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
-                       cfg.cut.cutting_speed_m_per_min)
-    p[K3.P_PEN] = cfg.contact.penalty_factor
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN] = 1.0
-    p[K3.P_KAPPA] = 0.5 * math.pi
-    p[K3.P_KEND] = 0.49 * math.pi
-    p[K3.P_RAKE] = math.radians(cfg.tool.rake_deg)
-    p[K3.P_CLR] = math.radians(cfg.tool.clearance_deg)
-    p[K3.P_RE] = re
-    p[K3.P_VC] = vc
+    p = _straight_insert(spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
+                                        cfg.cut.cutting_speed_m_per_min), cfg, vc,
+                         tool_frame=False)
     gap0 = 0.5 * le
     t_end = (L + re + gap0) / vc
     n_samples = cfg.solver.n_samples
@@ -134,10 +126,11 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     return SlabSetup(state=st, t_end=t_end, width=width, vc=vc, cut_length=L)
 
 
-def _straight_insert(p: np.ndarray, cfg: FEConfig, vc: float) -> np.ndarray:
+def _straight_insert(p: np.ndarray, cfg: FEConfig, vc: float, *, tool_frame: bool) -> np.ndarray:
     # the insert with a straight edge over the slab: nose radius 1 m, the 2D wedge in every
-    # normal section
+    # normal section; the 2D config's contact
     p[K3.P_PEN] = cfg.contact.penalty_factor
+    p[K3.P_CDAMP] = cfg.contact.damping_for(tool_frame)
     p[K3.P_TOOL] = 1.0
     p[K3.P_RN] = 1.0
     p[K3.P_KAPPA] = 0.5 * math.pi
@@ -178,7 +171,8 @@ def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
                       thermal=spec2.thermal, hardening=spec2.hardening,
                       tool_frame=ToolFrame3D(ale_interval=spec2.frame.ale_interval))
     p = _straight_insert(spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
-                                        cfg.cut.cutting_speed_m_per_min), cfg, vc)
+                                        cfg.cut.cutting_speed_m_per_min), cfg, vc,
+                         tool_frame=True)
     L = cfg.cut.length_mm * 1e-3
     t_end = L / vc
     p[K3.P_SAMPLE_DT] = t_end / cfg.solver.n_samples

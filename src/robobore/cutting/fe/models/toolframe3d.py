@@ -104,12 +104,7 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
     R = 0.5 * cfg.cut.bore_diameter_mm * 1e-3
     vc = 2 * math.pi * R * cfg.cut.speed_rpm / 60.0
     m = cfg.mesh
-    um = 1e-6
-    sizes = ToolFrame3DSizes(
-        element_size=m.element_size_um * um,
-        edge_size=None if m.edge_element_um is None else m.edge_element_um * um,
-        slice_spacing=None if m.slice_spacing_um is None else m.slice_spacing_um * um,
-        t_min=m.t_min_um * um, margin_slices=m.margin_slices, chip_ratio=m.initial_chip_ratio)
+    sizes = ToolFrame3DSizes.of_config(m)
     try:
         mesh = build_toolframe3d_mesh(ins, ap, f, sizes)
     except ValueError as exc:
