@@ -108,7 +108,7 @@ _energy_totals = njit(sum_energies_py)
 _end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), _energy_totals)
 
 
-@njit
+@njit(inline="always")
 def _energy_arrays(s):
     # the arrays ``es`` of sum_energies_py in the loop's state ``s`` (vz: unread in 2D)
     return (s.mass, s.vx, s.vy, s.vx, s.ie, s.plast, s.hge, s.alive, s.fric, s.pen, s.ero_ke,
@@ -127,7 +127,7 @@ CHUNK_ARGS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "c
 ChunkState = namedtuple("ChunkState", CHUNK_ARGS)
 
 
-@njit
+@njit(inline="always")
 def _nodes(s, kin, dt, split):
     # node update and contact, the contact-force total in the fixed lane order, the force by
     # tool face
@@ -142,12 +142,12 @@ def _nodes(s, kin, dt, split):
     return fwx, fwy, 0.0, ncont
 
 
-@njit
+@njit(inline="always")
 def _tool_step(s, fx, fy, fz, dt):
     return tool_step(s.tool, s.prm, fx, fy, dt)
 
 
-@njit
+@njit(inline="always")
 def _remesh(s, step):
     # the tool-frame ALE pass every prm[P_RZ_EVERY] steps
     (x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx, sdy,
@@ -164,7 +164,7 @@ def _remesh(s, step):
                mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
 
 
-@njit
+@njit(inline="always")
 def _elements_q4r(s, dt):
     # the one-point quad with hourglass control
     return element_update(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy, s.sdz,
@@ -173,7 +173,7 @@ def _elements_q4r(s, dt):
                           int(s.prm[P_EROSION]))
 
 
-@njit
+@njit(inline="always")
 def _elements_bbar(s, dt):
     # the B-bar quad
     return element_update_bbar(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy,
@@ -182,7 +182,7 @@ def _elements_bbar(s, dt):
                                int(s.prm[P_EROSION]))
 
 
-@njit
+@njit(inline="always")
 def _heat(s, step, t, dt):
     # conduction every prm[P_COND_EVERY] steps over the time accumulated since the last pass
     prm, mat = s.prm, s.mat
@@ -201,13 +201,13 @@ def _heat(s, step, t, dt):
         prm[P_COND_ACC] = 0.0
 
 
-@njit
+@njit(inline="always")
 def _no_heat(s, step, t, dt):
     # adiabatic: no heat pass
     return None
 
 
-_no_remesh = njit(no_remesh_py)
+_no_remesh = njit(inline="always")(no_remesh_py)
 
 
 def _bind(name, elements, remesh, heat):

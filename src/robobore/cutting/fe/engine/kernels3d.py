@@ -242,7 +242,7 @@ def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nw
     _energy_totals3((mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork), en)
 
 
-@njit
+@njit(inline="always")
 def _energy_arrays3(s):
     # the arrays ``es`` of sum_energies3_py in the chunk loop's state ``s``
     return (s.mass, s.vx, s.vy, s.vz, s.ie, s.plast, s.hge, s.alive, s.fric, s.pen, s.ero_ke,
@@ -310,7 +310,7 @@ CHUNK_ARGS3 = ("x", "y", "z", "vx", "vy", "vz", "mass", "fixed", "ptr", "nel", "
 ChunkState3 = namedtuple("ChunkState3", CHUNK_ARGS3)
 
 
-@njit
+@njit(inline="always")
 def _nodes3(s, kin, dt, split):
     # node update and contact, then the contact-force total in the fixed lane order
     cx, cy, cz, tvx, tvy, tvz = kin
@@ -320,12 +320,12 @@ def _nodes3(s, kin, dt, split):
     return contact_total3(s.cf)
 
 
-@njit
+@njit(inline="always")
 def _tool_step3(s, fx, fy, fz, dt):
     return tool_step(s.tool, s.prm, fx, fy, fz, dt)
 
 
-@njit
+@njit(inline="always")
 def _elements3(s, dt):
     # the element update, then its smallest stable step and an inverted element
     prm = s.prm
@@ -343,7 +343,7 @@ def _elements3(s, dt):
     return dtmin, bad
 
 
-@njit
+@njit(inline="always")
 def _elements3_ale(s, dt):
     # the element update, then the smallest stable step with the elements' inertia factors
     # (tool frame: mass scaling attached to the mesh, FEState3.msf; empty: 1)
@@ -358,7 +358,7 @@ def _elements3_ale(s, dt):
     return dtmin, bad
 
 
-@njit
+@njit(inline="always")
 def _heat3(s, step, t, dt):
     # every prm[P_COND_EVERY] (>= 1) steps: conduction and the thermal contact
     if is_conduction_step(step, s.prm):
@@ -367,7 +367,7 @@ def _heat3(s, step, t, dt):
                          t + dt)
 
 
-@njit
+@njit(inline="always")
 def _remesh3(s, step):
     # the tool-frame ALE pass every prm[P_RZ_EVERY] steps: each node back to its place
     # shifted by the insert's travel since the mesh was built, then the remap
@@ -381,7 +381,7 @@ def _remesh3(s, step):
                  cx - prm[P_ALE_X0], cz - prm[P_ALE_Z0], prm[P_RZ_MAXMOVE], prm, cx, cy, cz)
 
 
-@njit
+@njit(inline="always")
 def _no_heat3(s, step, t, dt):
     # adiabatic: no heat pass
     return None

@@ -21,11 +21,16 @@ the number taken. One step (``clock`` = [t, dt, t_acc]):
 With ``totals_at_chunk_end`` the energy totals are summed after a chunk that ran to its end
 (3D: the host's energy check reads them).
 
-The engines wrap the loop in their own ``njit(cache=True)`` functions (2D: one per model
-choice, ``run_chunk_*`` of :mod:`robobore.cutting.fe.engine.chunk_loop`; 3D: ``run_chunk3``),
-so numba's cache of each sits beside the engine's phases and is renewed
-when that module changes; like any callee in another module, a change to this module needs
-the cache files cleared (``*.nbi``, ``*.nbc``).
+The phases are compiled with ``njit(inline="always")``: inlined into the loop, they read the
+state's arrays in place. As separate functions each call would pass the whole state (about 64
+arrays, with their reference counts) five times a step, about 1 % of a 2D step (the 2D
+contract config on one thread, side by side with the loop of separate phases).
+
+The engines wrap the loop in their own ``njit(cache=True)`` functions, one per model choice
+(2D: ``run_chunk_*`` of :mod:`robobore.cutting.fe.engine.chunk_loop`; 3D: ``run_chunk3*`` of
+:mod:`robobore.cutting.fe.engine.kernels3d`), so numba's cache of each sits beside the
+engine's phases and is renewed when that module changes; like any callee in another module,
+a change to this module needs the cache files cleared (``*.nbi``, ``*.nbc``).
 """
 
 from __future__ import annotations
@@ -89,12 +94,12 @@ def bind_chunk_loop(*, name: str, state, n_split: int, energy_arrays, kinematics
     ``n_split``: the length of the force-by-face buffer (the engine's ``N_SPLIT``);
     ``energy_arrays(s)``: the arrays of ``energy_totals(es, en)``; ``end_step``: the engine's
     :func:`robobore.cutting.fe.engine.history.bind_end_step`; the phases as in the module
-    docstring, each already compiled with ``njit``.
+    docstring, each already compiled with ``njit(inline="always")``.
     """
     loop = rebind(
         chunk_loop_py, State=state, N_SPLIT=n_split, energy_arrays=energy_arrays,
         kinematics=kinematics, nodes=nodes, tool_step=tool_step,
-        remesh=njit(no_remesh_py) if remesh is None else remesh, elements=elements,
+        remesh=njit(inline="always")(no_remesh_py) if remesh is None else remesh, elements=elements,
         heat=heat, end_step=end_step, energy_totals=energy_totals,
         TOTALS_AT_CHUNK_END=totals_at_chunk_end)
     loop.__name__ = loop.__qualname__ = name
