@@ -179,9 +179,11 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
     if gap >= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     fp = pen_factor * mass / (dt * dt) * (-gap)
-    fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * (vrx * nx + vry * ny + vrz * nz)
-    if fp + fd < 0.0:
-        fd = -fp
+    fd = 0.0
+    if damping > 0.0:
+        fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * (vrx * nx + vry * ny + vrz * nz)
+        if fp + fd < 0.0:
+            fd = -fp
     fn = fp + fd
     wx = vrx + dt * fox / mass
     wy = vry + dt * foy / mass
@@ -294,6 +296,11 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
     tx = 0.0
     ty = 0.0
     tz = 0.0
+    fd = 0.0
+    vn0 = 0.0
+    gnx = 0.0
+    gny = 0.0
+    gnz = 0.0
     gap = 1.0
     fb = fixed[n]  # held velocity components: no element force in the trial slip, no update
     px = x[n] - cx
@@ -330,7 +337,8 @@ def hex_node_py(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, v
                 dt, prm[P_CDAMP], 0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy,
                 0.0 if (fb & 4) else fz)
             vt0 = vrx * tx + vry * ty + vrz * tz
-            vn0 = vrx * gnx + vry * gny + vrz * gnz
+            if fd != 0.0:
+                vn0 = vrx * gnx + vry * gny + vrz * gnz
             pen[n] = share * 0.5 * (fn - fd) * (-gap)
     cf[n, 0] = share * fcx
     cf[n, 1] = share * fcy
