@@ -1,6 +1,7 @@
 """FE throughput of this checkout against another git revision, measured in the same run.
 
     python benchmarks/bench_fe_before_after.py --ref REV [--repeats 3] [--json OUT]
+        [--cases CASE ...] [--paired [--paired-length X]]
 
 Builds REV in a temporary git worktree and runs the same cases on both trees, interleaved
 (ref, this, ref, this, ...) so that a change of machine load hits both alike: the 2D contract
@@ -14,6 +15,11 @@ short warm-up run per tree and case fills those caches first. `--cases` picks ca
 the element updates per second (median of the repeats) of both trees, their ratio, and whether
 the forces agree to 1e-9 (a restructure must not change them). The machine load (1-minute
 average) is printed with each run: take figures with nothing else running.
+
+`--paired`: each repeat runs the two trees at once, one numba thread each, so both see the
+same machine state, and the ratio is the median of the pairs' ratios. On the 2-core machine
+the two-thread medians above move by about 4 % from run to run, the paired ratios by about
+1 % (the 3D paper condition at 0.15 mm: `--paired --paired-length 3`).
 """
 
 from __future__ import annotations
@@ -41,12 +47,14 @@ CASES = {
 }
 
 
-def _config(case: str, tmp: Path, warmup: bool) -> Path:
+def _config(case: str, tmp: Path, warmup: bool, scale: float = 1.0) -> Path:
     example, over, _ = CASES[case]
     d = load_toml(ROOT / "examples" / example)
     d.pop("tool_support", None)
     for (sec, key), v in over.items():
         d.setdefault(sec, {})[key] = v
+    length = next(iter(over))
+    d[length[0]][length[1]] *= scale
     if warmup:
         sec, key = next(iter(over))
         d[sec][key] = 0.02
@@ -55,19 +63,36 @@ def _config(case: str, tmp: Path, warmup: bool) -> Path:
     return p
 
 
-def _run(tree: Path, case: str, cfg: Path, cache: Path) -> dict:
+def _start(tree: Path, case: str, cfg: Path, cache: Path, threads: int | None = None):
     env = dict(os.environ, PYTHONPATH=str(tree / "src"), NUMBA_CACHE_DIR=str(cache))
+    if threads is not None:
+        env["NUMBA_NUM_THREADS"] = str(threads)
     sub = CASES[case][2]
-    out = subprocess.run([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
-                         capture_output=True, text=True, env=env, check=False)
-    if out.returncode != 0:
-        raise SystemExit(f"{tree}: {case} failed:\n{out.stderr[-3000:]}")
-    r = json.loads(out.stdout)
+    return subprocess.Popen([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+
+
+def _result(proc, tree: Path, case: str) -> dict:
+    stdout, stderr = proc.communicate()
+    if proc.returncode != 0:
+        raise SystemExit(f"{tree}: {case} failed:\n{stderr[-3000:]}")
+    r = json.loads(stdout)
     forces = (r.get("force_rotating_N")
               or {"cutting": r.get("cutting_force_N_per_mm"),
                   "feed": r.get("feed_force_N_per_mm")})
     rate = r["element_updates_per_s"]
     return {"rate": float(rate), "forces": forces, "load": os.getloadavg()[0]}
+
+
+def _run(tree: Path, case: str, cfg: Path, cache: Path) -> dict:
+    return _result(_start(tree, case, cfg, cache), tree, case)
+
+
+def _pair(trees: dict, case: str, cfg: Path, caches: dict) -> dict:
+    # both trees at once, one numba thread each: one core each, the same machine state
+    procs = {name: _start(tree, case, cfg, caches[name], threads=1)
+             for name, tree in trees.items()}
+    return {name: _result(p, trees[name], case) for name, p in procs.items()}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -77,6 +102,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--json", default=None, help="write the figures to this file")
     ap.add_argument("--cases", nargs="+", choices=list(CASES), default=list(CASES),
                     metavar="CASE", help=f"cases to run (default all: {', '.join(CASES)})")
+    ap.add_argument("--paired", action="store_true",
+                    help="run the two trees at once, one numba thread each (one core each), "
+                    "and report the median of the pairs' ratios: steadier than two-thread "
+                    "runs one after the other")
+    ap.add_argument("--paired-length", type=float, default=1.0,
+                    help="the cases' cut length times this (default 1)")
     a = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as t:
         tmp = Path(t)
@@ -91,21 +122,37 @@ def main(argv: list[str] | None = None) -> None:
                 for name, tree in trees.items():
                     _run(tree, case, _config(case, tmp, warmup=True), caches[name])
                 runs: dict[str, list] = {"ref": [], "this": []}
+                ratios = []
+                cfg = _config(case, tmp, warmup=False, scale=a.paired_length)
                 for i in range(a.repeats):
+                    if a.paired:
+                        pr = _pair(trees, case, cfg, caches)
+                        for name in trees:
+                            runs[name].append(pr[name])
+                        ratios.append(pr["this"]["rate"] / pr["ref"]["rate"])
+                        print(f"{case:18s} pair #{i + 1}: ref {pr['ref']['rate'] / 1e6:6.2f}, "
+                              f"this {pr['this']['rate'] / 1e6:6.2f} M/s, this / ref "
+                              f"{ratios[-1]:.3f}", flush=True)
+                        continue
                     for name, tree in trees.items():
-                        r = _run(tree, case, _config(case, tmp, warmup=False), caches[name])
+                        r = _run(tree, case, cfg, caches[name])
                         runs[name].append(r)
                         print(f"{case:18s} {name:4s} #{i + 1}: {r['rate'] / 1e6:6.2f} M/s "
                               f"(load {r['load']:.1f})", flush=True)
                 med = {k: statistics.median(r["rate"] for r in v) for k, v in runs.items()}
-                fa, fb = runs["ref"][0]["forces"], runs["this"][0]["forces"]
-                same = all(abs(fa[k] - fb[k]) <= 1e-9 * max(abs(fa[k]), 1e-300) for k in fa)
+                ratio = statistics.median(ratios) if a.paired else med["this"] / med["ref"]
+                same = all(
+                    abs(fa[k] - fb[k]) <= 1e-9 * max(abs(fa[k]), 1e-300)
+                    for ra, rb in zip(runs["ref"], runs["this"])
+                    for fa, fb in [(ra["forces"], rb["forces"])] for k in fa)
                 res["cases"][case] = {"ref_M_per_s": med["ref"] / 1e6,
                                       "this_M_per_s": med["this"] / 1e6,
-                                      "ratio": med["this"] / med["ref"],
+                                      "ratio": ratio, "paired": a.paired,
+                                      "pair_ratios": ratios,
                                       "forces_equal_1e-9": same, "runs": runs}
                 print(f"{case:18s} ref {med['ref'] / 1e6:.2f} M/s, this "
-                      f"{med['this'] / 1e6:.2f} M/s, ratio {med['this'] / med['ref']:.3f}, "
+                      f"{med['this'] / 1e6:.2f} M/s, ratio {ratio:.3f}"
+                      f"{' (median of the pairs)' if a.paired else ''}, "
                       f"forces equal to 1e-9: {same}", flush=True)
         finally:
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force",
