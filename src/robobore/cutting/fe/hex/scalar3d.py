@@ -62,7 +62,7 @@ from robobore.cutting.fe.hex.layout3d import (
     P_VC,
     P_VF,
 )
-from robobore.cutting.fe.physics.tool_contact import tool_gap, tool_support_step
+from robobore.cutting.fe.physics.tool_contact import normal_force, tool_gap, tool_support_step
 from robobore.material.johnson_cook import rebind
 
 __all__ = [
@@ -162,12 +162,11 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
                       dt, damping, fox, foy, foz):
     """Contact force on a node touching the rigid insert [N] (3D form of the 2D law).
 
-    Normal: penalty ``pen_factor * mass / dt^2 * (-gap)`` plus the viscous damping ``-c v_n``
-    on the relative normal velocity, ``c = 2 damping sqrt(k m)`` (``damping``: fraction of
-    the penalty spring's critical damping; 0: none), the total kept >= 0 (no adhesion), as
-    :func:`tool_contact.contact_force_py`. Tangential: the same return mapping on the trial
-    sliding velocity (the tangential part of ``v_r + dt fo / mass``, ``fo`` = ``(fox, foy,
-    foz)`` the node's element forces this step [N]): the force that stops it in one step,
+    Normal: :func:`tool_contact.normal_force_py` (penalty plus viscous damping on the
+    relative normal velocity, kept >= 0), as :func:`tool_contact.contact_force_py`.
+    Tangential: the same return mapping on the trial sliding velocity (the tangential part
+    of ``v_r + dt fo / mass``, ``fo`` = ``(fox, foy, foz)`` the node's element forces this
+    step [N]): the force that stops it in one step,
     limited by Coulomb ``mu Fn`` and by the shear cap ``tau_max * trib_area`` (the node's
     tributary contact area [m^2]), opposite to the trial sliding direction. ``(vrx, vry,
     vrz)`` node velocity relative to the tool [m/s].
@@ -178,13 +177,7 @@ def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_m
     """
     if gap >= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    fp = pen_factor * mass / (dt * dt) * (-gap)
-    fd = 0.0
-    if damping > 0.0:
-        fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * (vrx * nx + vry * ny + vrz * nz)
-        if fp + fd < 0.0:
-            fd = -fp
-    fn = fp + fd
+    fn, fd = normal_force(gap, vrx * nx + vry * ny + vrz * nz, mass, pen_factor, dt, damping)
     wx = vrx + dt * fox / mass
     wy = vry + dt * foy / mass
     wz = vrz + dt * foz / mass

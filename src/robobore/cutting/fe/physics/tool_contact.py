@@ -7,8 +7,9 @@ Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` ver
 * :func:`tool_face_py` -- the face of the tool (rake, edge arc, flank) closest to a point;
 * :func:`tool_gap_py` -- signed distance of a point to the analytic rigid tool (rake face,
   edge-radius arc, flank with clearance) and the outward normal;
-* :func:`contact_force_py` -- penalty normal force (optionally damped), Coulomb friction with
-  a shear-stress cap;
+* :func:`normal_force_py` -- penalty normal force (optionally damped), shared by the 2D and
+  3D contact laws;
+* :func:`contact_force_py` -- that normal force, Coulomb friction with a shear-stress cap;
 * :func:`tool_support_step_py` -- one central-difference step of a mass on a spring/damper.
 
 All take and return floats and allocate nothing (device-function ready; see
@@ -76,6 +77,22 @@ def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
     return d - r, dx / d, dy / d
 
 
+def normal_force_py(gap, vn, mass, pen_factor, dt, damping):
+    """Normal contact force of the penalty law [N, or N per m of width in 2D]: the penalty
+    ``pen_factor * mass / dt**2 * (-gap)`` plus the viscous damping ``-c vn`` with
+    ``c = 2 damping sqrt(k m)`` (``vn`` the relative normal velocity [m/s]; ``damping`` the
+    fraction of the penalty spring's critical damping, 0: none, and then not computed), the
+    total kept >= 0 (no adhesion). For ``gap`` < 0. Returns ``(fn, fd)``: the normal force
+    and its damping part. Shared by the 2D and 3D contact laws."""
+    fp = pen_factor * mass / (dt * dt) * (-gap)
+    fd = 0.0
+    if damping > 0.0:
+        fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * vn
+        if fp + fd < 0.0:
+            fd = -fp
+    return fp + fd, fd
+
+
 def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
                      damping, fox, foy):
     """Contact force on a node touching the rigid tool [N per m of width].
@@ -100,11 +117,7 @@ def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_fac
     """
     if gap >= 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0
-    fp = pen_factor * mass / (dt * dt) * (-gap)
-    fd = -2.0 * damping * math.sqrt(pen_factor) * mass / dt * (vrx * nx + vry * ny)
-    if fp + fd < 0.0:
-        fd = -fp
-    fn = fp + fd
+    fn, fd = normal_force(gap, vrx * nx + vry * ny, mass, pen_factor, dt, damping)
     tx = -ny
     ty = nx
     vt = vrx * tx + vry * ty + dt * (fox * tx + foy * ty) / mass
@@ -131,5 +144,6 @@ def tool_support_step_py(u, v, force, k, c, m, dt):
 
 tool_face = njit(cache=True, inline="always")(tool_face_py)
 tool_gap = njit(cache=True)(tool_gap_py)
+normal_force = njit(cache=True, inline="always")(normal_force_py)
 contact_force = njit(cache=True)(contact_force_py)
 tool_support_step = njit(cache=True)(tool_support_step_py)

@@ -26,6 +26,7 @@ def device_functions2(dev) -> SimpleNamespace:
     (``dev`` = ``numba.cuda.jit(device=True)``)."""
     from robobore.cutting.fe.physics.tool_contact import (
         contact_force_py,
+        normal_force_py,
         tool_face_py,
         tool_gap_py,
         tool_support_step_py,
@@ -51,7 +52,7 @@ def device_functions2(dev) -> SimpleNamespace:
     rwrite = dev(RZ.rz_write_py)
     rmass = dev(RZ.rz_node_mass_py)
     SWEEPS = RZ.TF_SWEEPS
-    cf = dev(contact_force_py)
+    cf = dev(jc.rebind(contact_force_py, normal_force=dev(normal_force_py)))
     sup = dev(tool_support_step_py)
     retire = dev(K.quad_retire_py)
     elem = dev(jc.rebind(

@@ -69,6 +69,7 @@ def kernels3(conduction: bool):
     from robobore.cutting.fe.hex.element import hex_element_py
     from robobore.cutting.fe.physics import thermal3d as T3
     from robobore.cutting.fe.physics.tool_contact import (
+        normal_force_py,
         tool_face_py,
         tool_gap_py,
         tool_support_step_py,
@@ -81,7 +82,7 @@ def kernels3(conduction: bool):
     tg = dev(jc.rebind(tool_gap_py, tool_face=dev(tool_face_py)))
     sec = dev(K3.edge_section_py)
     gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg, edge_section=sec))
-    cf3 = dev(K3.contact_force3_py)
+    cf3 = dev(jc.rebind(K3.contact_force3_py, normal_force=dev(normal_force_py)))
     fat3 = dev(K3.friction_at3_py)
     node = dev(jc.rebind(K3.hex_node_py, insert_gap3=gap3, contact_force3=cf3,
                          friction_at3=fat3))
