@@ -17,9 +17,11 @@ the forces agree to 1e-9 (a restructure must not change them). The machine load 
 average) is printed with each run: take figures with nothing else running.
 
 `--paired`: each repeat runs the two trees at once, one numba thread each, so both see the
-same machine state, and the ratio is the median of the pairs' ratios. On the 2-core machine
-the two-thread medians above move by about 4 % from run to run, the paired ratios by about
-1 % (the 3D paper condition at 0.15 mm: `--paired --paired-length 3`).
+same machine state, and the ratio is the median of the pairs' ratios; `--paired-length X`
+runs the cases' cut lengths times X. On the 2-core machine two-thread runs one after the
+other move by about 4 %; the 2D contract config's pairs (0.15 mm) stay within 0.6 % of each
+other, the 3D paper condition's (0.1 mm) within about 2 % with an occasional outlier of 5 %:
+read the median of three or more (`benchmarks/measured/fe_before_after/`).
 """
 
 from __future__ import annotations
@@ -53,11 +55,8 @@ def _config(case: str, tmp: Path, warmup: bool, scale: float = 1.0) -> Path:
     d.pop("tool_support", None)
     for (sec, key), v in over.items():
         d.setdefault(sec, {})[key] = v
-    length = next(iter(over))
-    d[length[0]][length[1]] *= scale
-    if warmup:
-        sec, key = next(iter(over))
-        d[sec][key] = 0.02
+    sec, key = next(iter(over))  # the cut length
+    d[sec][key] = 0.02 if warmup else d[sec][key] * scale
     p = tmp / (case.replace(" ", "_") + ("_warm" if warmup else "") + ".toml")
     p.write_text(dump_toml(d))
     return p
@@ -82,6 +81,10 @@ def _result(proc, tree: Path, case: str) -> dict:
                   "feed": r.get("feed_force_N_per_mm")})
     rate = r["element_updates_per_s"]
     return {"rate": float(rate), "forces": forces, "load": os.getloadavg()[0]}
+
+
+def _same_forces(fa: dict, fb: dict) -> bool:
+    return all(abs(fa[k] - fb[k]) <= 1e-9 * max(abs(fa[k]), 1e-300) for k in fa)
 
 
 def _run(tree: Path, case: str, cfg: Path, cache: Path) -> dict:
@@ -141,10 +144,8 @@ def main(argv: list[str] | None = None) -> None:
                               f"(load {r['load']:.1f})", flush=True)
                 med = {k: statistics.median(r["rate"] for r in v) for k, v in runs.items()}
                 ratio = statistics.median(ratios) if a.paired else med["this"] / med["ref"]
-                same = all(
-                    abs(fa[k] - fb[k]) <= 1e-9 * max(abs(fa[k]), 1e-300)
-                    for ra, rb in zip(runs["ref"], runs["this"])
-                    for fa, fb in [(ra["forces"], rb["forces"])] for k in fa)
+                same = all(_same_forces(ra["forces"], rb["forces"])
+                           for ra, rb in zip(runs["ref"], runs["this"], strict=True))
                 res["cases"][case] = {"ref_M_per_s": med["ref"] / 1e6,
                                       "this_M_per_s": med["this"] / 1e6,
                                       "ratio": ratio, "paired": a.paired,

@@ -47,7 +47,8 @@ def main() -> None:
     d["mesh"]["frame"] = "tool"
     d["mesh"]["element_size_um"] = a.element_um
     d.setdefault("solver", {})["mass_scaling"] = a.mass_scaling
-    d["cut"]["cut_length_mm"] = max(float(d["cut"]["cut_length_mm"]), 2e-3 * a.travel_um)
+    # the run stops at the checkpoints; the config's cut must reach the last of them
+    d["cut"]["cut_length_mm"] = max(float(d["cut"]["cut_length_mm"]), 1e-3 * a.travel_um)
     d.pop("tool_support", None)
     cfg = parse_boring_config(d, source=a.config)
     setup = setup_boring(cfg, a.config)
