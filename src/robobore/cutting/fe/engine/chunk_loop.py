@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from collections import namedtuple
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Literal
 
 from numba import njit
@@ -104,8 +105,11 @@ ENGINE2 = {"NDIM": 2, "N_SPLIT": 6, "N_TOOL_COLUMNS": 1, "T_FORCE": T_FX, "T_DIS
            "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
            "COUNT_STOPPED_STEP": 0}
 _energy_totals = njit(sum_energies_py)
-#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`)
-_end_step = bind_end_step(njit, ENGINE2, njit(tool_columns_py), _energy_totals)
+_njit_inline = partial(njit, inline="always")
+#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`),
+#: inlined into the loop: as a call it costs about 0.5 % of a step of the 2D contract config
+#: (one thread, paired with the same loop inlined; ``benchmarks/bench_fe_before_after.py``)
+_end_step = bind_end_step(_njit_inline, ENGINE2, njit(tool_columns_py), _energy_totals)
 
 
 @njit(inline="always")
