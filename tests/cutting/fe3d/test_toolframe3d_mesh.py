@@ -20,6 +20,7 @@ from robobore.cutting.fe.engine.state3d import HEX_SIGNS
 from robobore.cutting.fe.hex.scalar3d import insert_gap3_py
 from robobore.cutting.fe.mesh.toolframe3d import (
     FK_BOTTOM,
+    FK_CHIP_SIDE,
     FK_FREE,
     FK_INFLOW,
     FK_INTERIOR,
@@ -162,10 +163,18 @@ def test_boundary_faces_are_flagged_once(mesh):
     assert np.all(kinds[~boundary] == FK_INTERIOR)
     assert np.all(kinds[boundary] != FK_INTERIOR)
     assert set(np.unique(kinds[boundary]).tolist()) == {FK_INFLOW, FK_OUTFLOW, FK_TOOL,
-                                                       FK_FREE, FK_BOTTOM, FK_SIDE}
+                                                       FK_FREE, FK_BOTTOM, FK_SIDE,
+                                                       FK_CHIP_SIDE}
     assert np.array_equal(mesh.bflag == BF_VIRGIN, kinds == FK_INFLOW)
-    assert np.array_equal(mesh.bflag == BF_OPEN, kinds == FK_OUTFLOW)
-    assert np.all(mesh.bflag[(kinds != FK_INFLOW) & (kinds != FK_OUTFLOW)] == BF_CLOSED)
+    outflow = (kinds == FK_OUTFLOW) | (kinds == FK_CHIP_SIDE)
+    assert np.array_equal(mesh.bflag == BF_OPEN, outflow)
+    assert np.all(mesh.bflag[(kinds != FK_INFLOW) & ~outflow] == BF_CLOSED)
+    # the chip's sides: z-faces of chip elements at the first and last engaged slices
+    e, f = np.nonzero(kinds == FK_CHIP_SIDE)
+    assert np.all(mesh.chip[e]) and np.all((f == 4) | (f == 5))
+    k = mesh.elem_slice[e] + (f == 5)
+    first, last = np.flatnonzero(mesh.engaged)[[0, -1]]
+    assert set(np.unique(k).tolist()) == {first, last}
     # the boundary is closed: its outward vector area sums to zero
     P = mesh.nodes
     e, f = np.nonzero(boundary)

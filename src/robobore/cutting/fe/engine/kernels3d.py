@@ -98,6 +98,7 @@ from robobore.cutting.fe.hex.layout3d import (
     P_KY,
     P_KZ,
     P_MS,
+    P_MSF_DT,
     P_MU,
     P_MUTAB_MU,
     P_MUTAB_N,
@@ -204,7 +205,8 @@ __all__ = [
     "STATUS_INVERTED", "STATUS_NONFINITE", "STATUS_NO_ELEMENTS", "sum_energies3",
     "contact_total3", "run_chunk3_ale", "run_chunk3_heat", "run_chunk3_ale_heat", "RUN_CHUNK3",
     "run_chunk3_for", "P_RZ_EVERY", "P_RZ_MAXMOVE",
-    "P_RZ_VEL", "P_ALE_X0", "P_ALE_Z0",
+    "P_RZ_VEL", "P_ALE_X0", "P_ALE_Z0", "P_MSF_DT", "renew_inertia_factors_py",
+    "renew_inertia_factors",
 ]
 
 
@@ -367,12 +369,32 @@ def _heat3(s, step, t, dt):
                          t + dt)
 
 
+def renew_inertia_factors_py(msf, dte, alive, dt_target):
+    """The tool frame's inertia factors renewed from the elements' material stable steps
+    ``dte`` [s] of the last element pass: ``msf[e] = max(1, (dt_target / dte[e])^2)`` for
+    every live element, so each element's stable step is at least ``dt_target`` (mass
+    scaling attached to the place in the insert's frame, renewed as the mesh deforms: the
+    squeezed chip elements of the thin end slices keep the nose-tip section's step; others
+    fall back to 1). Dead elements and elements without a step keep theirs."""
+    for e in range(msf.shape[0]):
+        d = dte[e]
+        if alive[e] == 1 and d > 0.0 and d < 1e30:
+            r = dt_target / d
+            msf[e] = r * r if r > 1.0 else 1.0
+
+
+renew_inertia_factors = njit(cache=True, inline="always")(renew_inertia_factors_py)
+
+
 @njit(inline="always")
 def _remesh3(s, step):
-    # the tool-frame ALE pass every prm[P_RZ_EVERY] steps: each node back to its place
-    # shifted by the insert's travel since the mesh was built, then the remap
+    # the tool-frame ALE pass every prm[P_RZ_EVERY] steps: the inertia factors renewed (the
+    # remap assembles the lumped masses with them), each node back to its place shifted by
+    # the insert's travel since the mesh was built, then the remap
     prm, mat = s.prm, s.mat
     if step % int(prm[P_RZ_EVERY]) == 0:
+        if prm[P_MSF_DT] > 0.0 and s.msf.shape[0] > 0:
+            renew_inertia_factors(s.msf, s.dte, s.alive, prm[P_MSF_DT])
         cx, cy, cz, _vx, _vy, _vz = tool_kinematics(s.tool, prm)
         rezone3d(s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.conn, s.alive, s.ptr,
                  s.nel, s.enbr, s.bflag, s.sd, s.pres, s.eps_p, s.temp, s.dmg, s.qh, s.vol0,

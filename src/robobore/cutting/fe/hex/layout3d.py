@@ -80,6 +80,8 @@ PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     ("P_ALE_X0", 1, "insert tip's x when the mesh was built [m] (the mesh's travel is "
                     "measured from it)"),
     ("P_ALE_Z0", 1, "insert tip's z when the mesh was built [m]"),
+    ("P_MSF_DT", 1, "the stable step [s] the inertia factors give every element, renewed at "
+                    "each ALE pass (0: no factors)"),
 )
 globals().update(prm_slots(PRM_FIELDS))
 #: damage erosion: none, or the elements of the separation layer

@@ -60,16 +60,19 @@ against 1.02 um in the nose-tip slice (10 um elements: 0.18 / 0.31 / 0.89 um; 6.
 
 **Margins.** ``margin_slices`` slices beyond each end of the engagement carry block A only,
 its top flat at ``y_top(z)``, which lies below the edge there (the insert clears the
-surface): the chip block's hexahedra stop at the end slices, whose z-faces are free
-surfaces (the chip's sides).
+surface): the chip block's hexahedra stop at the end slices, whose z-faces are the chip's
+sides (:data:`FK_CHIP_SIDE`). They are outflow faces (``BF_OPEN``): the placement keeps
+their nodes in their planes, so the material that flows sideways past an end slice (the
+chip's side flow) leaves the model there, as through the chip's top face (the run's
+``mass_ratio`` counts it with the other outflow).
 
 **Node classes and faces.** Every node carries its slice, its 2D node class
 (``TF_RIGID / TF_CHAIN / TF_LINE / TF_FACE / TF_INTERIOR`` of
 :mod:`robobore.cutting.fe.ale.rezone`) and the 2D class's neighbours within its slice (as
 global indices), so the in-plane tool-frame placement of each slice is the 2D one; in a
 margin slice block A's top row is a free-surface chain. Every hexahedron face carries a
-kind (:data:`FK_INTERIOR` ... :data:`FK_SIDE`) and the remap's flux flag
-(``BF_VIRGIN`` on the inflow face, ``BF_OPEN`` on the outflow faces,
+kind (:data:`FK_INTERIOR` ... :data:`FK_CHIP_SIDE`) and the remap's flux flag
+(``BF_VIRGIN`` on the inflow face, ``BF_OPEN`` on the outflow faces and the chip's sides,
 :mod:`robobore.cutting.fe.ale.remap3d`), in the face numbering of
 :data:`robobore.cutting.fe.ale.remap3d.FACES_OUT`.
 
@@ -80,30 +83,23 @@ push, then :func:`robobore.cutting.fe.ale.remap3d.remap3d`), with the per-slice 
 builds the same kind of mesh from one 2D tool-frame mesh in every plane (a straight edge
 across a slab), for the plane-strain cross-check against the 2D engine.
 
-**What the model still needs** (not in this module):
+**Open points of the mesh and its placement.**
 
-1. The chip's side faces at the end slices are free surfaces along z, but the placement
-   keeps every node in its plane: the side bulge of the chip there is put back each pass
-   (the closed faces' swept volume is no flux), which blocks the side flow at the ends.
-   Letting those faces move in z needs a placement that follows them (the remap handles
-   any motion).
-2. In the thin end slices the chip block's elements are sheared: their height across the
+1. In the thin end slices the chip block's elements are sheared: their height across the
    rows is down to 0.095 of their shortest edge at the paper's condition (0.43 in the 2D
    mesh), and the placement's move limit ``max_move`` is a fraction of the shortest edge
    (the 2D meaning of ``aflt[:, 3]``), so a move near the limit there would sweep more than
    the element's height (remap Courant number above 1). The Lagrangian drift between ALE
-   passes is far below it; a limit on the height would make it safe by construction.
-3. Block A's top faces in the hexahedra between a margin slice and the first (last) engaged
+   passes is far below it; a limit on the height would make it safe by construction. The
+   same thin rows lose height as the chip forms (a drift of 0.1 um is a third of a row at
+   the clamp), which the engine's renewed inertia factors absorb
+   (:func:`robobore.cutting.fe.engine.kernels3d.renew_inertia_factors_py`).
+2. Block A's top faces in the hexahedra between a margin slice and the first (last) engaged
    slice are on the 3D outline, but in the engaged slice their nodes are in-plane interior
    nodes (the chip block's join line): they are placed as interior nodes and the volume
    their faces sweep is dropped as a closed face's.
-4. The engine: the contact with the analytic insert (``hex/scalar3d.py``,
-   ``insert_gap3_py``) on this mesh, and the chunk-loop ALE pass (every ``ale_interval``
-   steps :func:`~robobore.cutting.fe.ale.rezone3d.rezone3d` with the state's ``enbr`` as
-   ``fnbr`` and :attr:`ToolFrameMesh3D.bflag`; the inflow face and the bottom held, the
-   insert moving at +vc).
-5. The GPU port: the placement's and the remap's scalar passes compile for the device as
-   the 2D ones do (``tf_place_py`` rebound with the device ``_limit`` and
+3. No GPU port: the placement's and the remap's scalar passes would compile for the device
+   as the 2D ones do (``tf_place_py`` rebound with the device ``_limit`` and
    :func:`~robobore.cutting.fe.ale.rezone3d.keep_py`, ``off_insert_py`` with the device
    ``insert_gap3``).
 """
@@ -132,7 +128,8 @@ from robobore.cutting.fe.mesh.toolframe3d_section import (
 from robobore.cutting.geometry import BoringInsert, chip_area
 
 __all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", "FK_INFLOW",
-           "FK_OUTFLOW", "FK_TOOL", "FK_FREE", "FK_BOTTOM", "FK_SIDE", "section_plan",
+           "FK_OUTFLOW", "FK_TOOL", "FK_FREE", "FK_BOTTOM", "FK_SIDE", "FK_CHIP_SIDE",
+           "section_plan",
            "section_nodes", "slice_map", "section_coords", "s_of_y", "uncut_thickness",
            "clamp_area", "build_toolframe3d_mesh",
            "extrude_toolframe_mesh", "tip_slice_nodes", "reference_blocks"]
@@ -140,9 +137,9 @@ __all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", 
 #: kind of a hexahedron face: shared by two elements, inflow face (virgin material enters),
 #: outflow face (machined-surface side back face, chip top face), on the insert (rake face
 #: and edge arc), free surface (the chip's free side and back, the machined surface, the
-#: chip's side faces at the end slices, the top of the margins), rigid bottom, the side
-#: planes of the block (first and last slice)
-FK_INTERIOR, FK_INFLOW, FK_OUTFLOW, FK_TOOL, FK_FREE, FK_BOTTOM, FK_SIDE = range(7)
+#: top of the margins), rigid bottom, the side planes of the block (first and last slice),
+#: the chip's side faces at the first and last engaged slices (outflow of the side flow)
+FK_INTERIOR, FK_INFLOW, FK_OUTFLOW, FK_TOOL, FK_FREE, FK_BOTTOM, FK_SIDE, FK_CHIP_SIDE = range(8)
 
 
 @dataclass
@@ -449,9 +446,11 @@ def _face_kinds(conn, chip, elem_slice, elem_2d, eng, ref: ToolFrameMesh, blk: d
             if fn[e, fc] >= 0:
                 continue
             kk = k if fc == 4 else k + 1
-            fkind[e, fc] = FK_SIDE if kk in (0, nk - 1) else FK_FREE
+            # block A has a z-neighbour in every slice but the block's side planes, so a
+            # z-face without one inside them is the chip block's side at an end slice
+            fkind[e, fc] = FK_SIDE if kk in (0, nk - 1) else FK_CHIP_SIDE
     bflag[fkind == FK_INFLOW] = BF_VIRGIN
-    bflag[fkind == FK_OUTFLOW] = BF_OPEN
+    bflag[(fkind == FK_OUTFLOW) | (fkind == FK_CHIP_SIDE)] = BF_OPEN
     return fkind, bflag
 
 
