@@ -19,9 +19,10 @@ average) is printed with each run: take figures with nothing else running.
 `--paired`: each repeat runs the two trees at once, one numba thread each, so both see the
 same machine state, and the ratio is the median of the pairs' ratios; `--paired-length X`
 runs the cases' cut lengths times X. On the 2-core machine two-thread runs one after the
-other move by about 4 %; the 2D contract config's pairs (0.15 mm) stay within 0.6 % of each
-other, the 3D paper condition's (0.1 mm) within about 2 % with an occasional outlier of 5 %:
-read the median of three or more (`benchmarks/measured/fe_before_after/`).
+other move by about 4 %; the 2D contract config's pairs (0.15 mm) stay within about 1 % of
+each other (the checkout against itself, `--ref HEAD`: 0.998-1.003), the 3D paper
+condition's (0.1 mm) within about 2 % with an occasional outlier of 5 %: read the median of
+three or more (`benchmarks/measured/fe_before_after/`).
 """
 
 from __future__ import annotations

@@ -5,9 +5,9 @@ step (node update, element update) and more every few steps (heat conduction, th
 remap); on the 2D meshes each region is a few tens of microseconds of work and ends in a
 barrier. When another process holds one of the cores, every region waits for the thread the
 operating system has descheduled, and the run collapses: on two cores beside one CPU-bound
-process the 2D contract model on two fixed threads ran at 25 % of its quiet throughput (4 % on
-a busier machine), with the governor at 61 %; the 3D boring model at 32 % and 53 % (docs/fe.md,
-"Throughput on a shared machine"; ``benchmarks/bench_fe_shared.py``).
+process the 2D contract model on two fixed threads ran at 4-25 % of its quiet throughput
+(depending on the host), with the governor at 56-61 %; the 3D boring model at 11-32 % and
+43-53 % (docs/fe.md, "Throughput on a shared machine"; ``benchmarks/bench_fe_shared.py``).
 
 :class:`ThreadGovernor` chooses, chunk by chunk, between all of numba's threads and one: it
 times every chunk, runs on the count that currently delivers more steps per second, and
