@@ -78,24 +78,30 @@ def attach_toolframe(st: FEState3, mesh: ToolFrameMesh3D, tip: tuple[float, floa
     st.prm[K3.P_ALE_Z0] = tip[2]
 
 
-def tip_section_step(st: FEState3, mesh: ToolFrameMesh3D) -> float:
-    """``dt_tip`` [s]: the smallest material stable step
-    (:func:`robobore.cutting.fe.engine.state3d.element_steps3`, the mesh as built) of the
+def tip_section_step(st: FEState3, mesh: ToolFrameMesh3D, dte: np.ndarray | None = None) -> float:
+    """``dt_tip`` [s]: the smallest material stable step ``dte`` (default
+    :func:`robobore.cutting.fe.engine.state3d.element_steps3`, the mesh as built) of the
     hexahedra on either side of the nose-tip slice (z = 0, the 2D section the mesh is built
     from)."""
-    dte = element_steps3(st)
+    dte = element_steps3(st) if dte is None else dte
     k0 = int(np.argmin(np.abs(mesh.z_slices)))
     tip = (mesh.elem_slice == k0) | (mesh.elem_slice == k0 - 1)
     return float(np.min(dte[tip]))
 
 
-def thin_element_factors(st: FEState3, mesh: ToolFrameMesh3D) -> np.ndarray:
+def thin_element_factors(st: FEState3, mesh: ToolFrameMesh3D,
+                         dte: np.ndarray | None = None) -> np.ndarray:
     """Inertia factors (e,) >= 1 of the tool-frame mesh as built: ``(dt_tip / dt_e)^2`` for
-    each element whose material stable step ``dt_e`` is below :func:`tip_section_step`; 1
-    elsewhere. With them the mesh's stable step is the nose-tip section's; the ALE pass
-    renews them by the same rule (:func:`robobore.cutting.fe.engine.kernels3d.
-    renew_inertia_factors_py`, ``prm[P_MSF_DT] = dt_tip``)."""
-    return np.maximum(1.0, (tip_section_step(st, mesh) / element_steps3(st)) ** 2)
+    each element whose material stable step ``dt_e`` (``dte``, default
+    :func:`~robobore.cutting.fe.engine.state3d.element_steps3`) is below
+    :func:`tip_section_step`; 1 elsewhere. With them the mesh's stable step is the nose-tip
+    section's. The rule is the one the ALE pass renews them by
+    (:func:`robobore.cutting.fe.engine.kernels3d.renew_inertia_factors_py`,
+    ``prm[P_MSF_DT] = dt_tip``)."""
+    dte = element_steps3(st) if dte is None else dte
+    msf = np.ones_like(dte)
+    K3.renew_inertia_factors(msf, dte, st.alive, tip_section_step(st, mesh, dte))
+    return msf
 
 
 def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
@@ -129,8 +135,9 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
                      n_samples=s.n_samples, tool_tip=tip)
     attach_toolframe(st, mesh, tip)
     if spec.tool_frame.thin_element_mass_scaling:
-        st.set_inertia_factors(thin_element_factors(st, mesh))
-        st.prm[K3.P_MSF_DT] = tip_section_step(st, mesh)
+        dte = element_steps3(st)  # the mesh as built, once for both
+        st.set_inertia_factors(thin_element_factors(st, mesh, dte))
+        st.prm[K3.P_MSF_DT] = tip_section_step(st, mesh, dte)
     check_support_step(cfg, st, source)
     return BoringSetup(cfg=cfg, material=mat, insert=ins, mesh=mesh, state=st, ap=ap, f=f,
                        vc=vc, t_end=t_end, t_contact=0.0, spec=spec, x_cut_start=tip[0])
