@@ -6,7 +6,8 @@
 Builds REV in a temporary git worktree and runs the same cases on both trees, interleaved
 (ref, this, ref, this, ...) so that a change of machine load hits both alike: the 2D contract
 config (`examples/fe_orthogonal.toml`, 0.3 mm) and the 3D paper condition
-(`examples/fe_boring_paper.toml`, 12.5 um elements, 0.05 mm of cut, no tool support). Each run
+(`examples/fe_boring_paper.toml` on the workpiece frame at mass scaling 100, 12.5 um elements,
+0.05 mm of cut, no tool support). Each run
 is a fresh `python -m robobore fe orthogonal|boring CONFIG --json` process with PYTHONPATH on
 that tree's `src` and a numba cache of its own in a temporary folder (numba checks a cached
 function against its own source file only, so a checkout's `__pycache__` can hold code compiled
@@ -44,8 +45,11 @@ from robobore.io.config import dump_toml, load_toml  # noqa: E402
 #: case -> (example, overrides, CLI subcommand, force keys)
 CASES = {
     "2D contract": ("fe_orthogonal.toml", {("cut", "length_mm"): 0.3}, "orthogonal"),
+    # the workpiece frame at mass scaling 100, as in the stored reference runs
     "3D paper 12.5 um": ("fe_boring_paper.toml", {("cut", "cut_length_mm"): 0.05,
-                                                  ("mesh", "element_size_um"): 12.5},
+                                                  ("mesh", "element_size_um"): 12.5,
+                                                  ("mesh", "frame"): "workpiece",
+                                                  ("solver", "mass_scaling"): 100.0},
                          "boring"),
 }
 

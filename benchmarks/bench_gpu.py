@@ -157,6 +157,7 @@ def _boring_dict(le: float, ms: float, cut_mm: float):
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
+    d["mesh"]["frame"] = "workpiece"  # the GPU engine's frame (the tool frame is CPU only)
     d["mesh"]["element_size_um"] = le
     d["cut"]["cut_length_mm"] = cut_mm
     d["solver"]["mass_scaling"] = ms

@@ -51,6 +51,7 @@ def fe_distribution(size_um: float, cut_mm: float, mass_scaling: float,
     run's setup facts."""
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
     d.pop("tool_support", None)
+    d["mesh"]["frame"] = "workpiece"  # the model whose missing thrust this locates
     d["mesh"]["element_size_um"] = size_um
     d["cut"]["cut_length_mm"] = cut_mm
     d.setdefault("solver", {})["mass_scaling"] = mass_scaling

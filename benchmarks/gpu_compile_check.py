@@ -85,6 +85,7 @@ def main() -> int:
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
     d["mesh"]["element_size_um"] = 16.6
+    d["mesh"]["frame"] = "workpiece"  # the GPU engine's frame (the tool frame is CPU only)
     st3 = setup_boring(parse_boring_config(d)).state
     # the tool-frame model's state (conduction on): the same argument types as the workpiece
     # frame's, with the ALE arrays filled; the kernels of its phases (ALE and heat: the

@@ -47,7 +47,7 @@ def test_3d_run_stops_on_a_lost_balance():
         "insert": {"edge_radius_um": 10.0},
         "cut": {"depth_of_cut_mm": 0.06, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                 "cut_length_mm": 0.06},
-        "mesh": {"element_size_um": 20.0, "ahead_mm": 0.04},
+        "mesh": {"element_size_um": 20.0, "frame": "workpiece", "ahead_mm": 0.04},
         "solver": {"n_samples": 40, "energy_error_limit": 1e-9}})
     with pytest.raises(NumericalError, match=_MSG):
         simulate_boring(cfg)

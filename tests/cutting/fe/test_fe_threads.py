@@ -108,7 +108,7 @@ def test_3d_boring_model_gives_the_same_digits_on_any_thread_count():
 
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                  "cut_length_mm": 0.02},
-         "mesh": {"element_size_um": 16.6, "ahead_mm": 0.03},
+         "mesh": {"element_size_um": 16.6, "frame": "workpiece", "ahead_mm": 0.03},
          "solver": {"mass_scaling": 400.0, "n_samples": 10}}
     runs = []
     for adaptive, gov in ((False, None), (True, Alternating())):

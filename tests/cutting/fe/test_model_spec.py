@@ -166,10 +166,12 @@ def test_keys_of_the_chosen_variants_are_accepted():
     assert p[K.P_EROSION] == K.ERODE_NONE
 
 
-def _boring(**sections):
+def _boring(frame: str | None = "workpiece", **sections):
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                  "cut_length_mm": 0.02},
          "mesh": {"element_size_um": 16.6}, "solver": {}, "contact": {}}
+    if frame is not None:
+        d["mesh"]["frame"] = frame
     for sec, kv in sections.items():
         d[sec].update(kv)
     return d
@@ -177,19 +179,37 @@ def _boring(**sections):
 
 def test_the_boring_spec_and_its_slots():
     from robobore.cutting.fe.config.boring3d import load_boring_config, parse_boring_config
-    from robobore.cutting.fe.config.spec import EdgePathLayer, HexElement, build_boring_spec
+    from robobore.cutting.fe.config.spec import (
+        EdgePathLayer,
+        HexElement,
+        ToolFrame3D,
+        build_boring_spec,
+    )
     from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine.state3d import default_prm3
 
-    cfg = load_boring_config(EX / "fe_boring_paper.toml")
-    mat = load_material(cfg.material.name, hardening_strain_limit=cfg.material.strain_limit())
-    s = build_boring_spec(cfg, mat, 37.7)
-    assert s.separation == EdgePathLayer() and s.damage_erosion
-    assert s.element == HexElement(0.05, 0.05) and isinstance(s.thermal, Conduction)
-    assert isinstance(s.friction, SlidingSpeedFriction) and s.hardening == HardeningHold(0.6)
+    # the defaults: the tool frame, the hexahedron's hourglass control, conduction, the
+    # calibrated friction law read at the sliding speed and the hardening hold
+    for cfg in (load_boring_config(EX / "fe_boring_paper.toml"),
+                parse_boring_config(_boring(frame=None))):
+        mat = load_material(cfg.material.name,
+                            hardening_strain_limit=cfg.material.strain_limit())
+        s = build_boring_spec(cfg, mat, 37.7)
+        assert s.tool_frame == ToolFrame3D(ale_interval=10, thin_element_mass_scaling=True)
+        assert s.separation is None and not s.damage_erosion
+        assert s.element == HexElement(0.05, 0.05) and isinstance(s.thermal, Conduction)
+        assert isinstance(s.friction, SlidingSpeedFriction)
+        assert s.hardening == HardeningHold(0.6)
+        p = s.write_prm(default_prm3(), K3, 37.7)
+        assert p[K3.P_GATE] == -1.0 and p[K3.P_EROSION] == K3.ERODE_NONE
+        assert p[K3.P_RZ_EVERY] == 10
+        assert p[K3.P_MUTAB_N] == 6 and p[K3.P_COND_EVERY] == 10
+    assert cfg.solver.mass_scaling == 400.0 and cfg.cut.cut_length_mm == 0.02
+    # the workpiece frame: the erosion layer with damage erosion by default
+    s = build_boring_spec(parse_boring_config(_boring()), mat, 37.7)
+    assert s.tool_frame is None and s.separation == EdgePathLayer() and s.damage_erosion
     p = s.write_prm(default_prm3(), K3, 37.7)
     assert p[K3.P_GATE] == -1.0 and p[K3.P_EROSION] == K3.ERODE_LAYER
-    assert p[K3.P_MUTAB_N] == 6 and p[K3.P_COND_EVERY] == 10
     ns = parse_boring_config(_boring(mesh={"separation": "node_split", "chip_rows": 4},
                                      solver={"separation_gate_um": 1.0}))
     s2 = build_boring_spec(ns, mat, 37.7)
@@ -202,6 +222,11 @@ def test_the_boring_spec_and_its_slots():
     ({"mesh": {"chip_rows": 4}}, "mesh.chip_rows", "no parting line"),
     ({"solver": {"heat_conduction": False}, "contact": {"friction_heat_fraction": 0.3}},
      "contact.friction_heat_fraction", "adiabatic"),
+    # a workpiece key on the default (tool) frame names the frame it belongs to
+    ({"frame": None, "mesh": {"ahead_mm": 0.03}}, "mesh.ahead_mm",
+     'the default: the 3D tool-frame ALE model'),
+    ({"frame": None, "mesh": {"separation": "node_split"}}, "mesh.separation",
+     'belongs to mesh.frame = "workpiece"'),
 ])
 def test_a_boring_key_without_a_place_is_an_error(sections, field, words):
     from robobore.cutting.fe.config.boring3d import parse_boring_config

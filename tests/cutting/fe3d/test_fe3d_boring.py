@@ -1,4 +1,5 @@
-"""3D FE boring model: config validation, feed-mark geometry, a tiny run through the CLI.
+"""3D FE boring model: config validation, feed-mark geometry, a tiny workpiece-frame run
+through the CLI (the tool frame's: tests/cutting/fe3d/test_toolframe3d_boring.py).
 
 The long validation (paper's condition, mesh refinement, comparison with the mechanistic
 model) is in ``benchmarks/bench_fe3d.py``; these tests keep the mesh tiny.
@@ -33,6 +34,7 @@ bore_diameter_mm = 40.0
 cut_length_mm = 0.06
 [mesh]
 element_size_um = 20.0
+frame = "workpiece"
 ahead_mm = 0.04
 [solver]
 n_samples = 40

@@ -170,7 +170,7 @@ def test_frictional_heat_and_contact_with_the_cold_insert():
 def _boring(conduction: bool):
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                  "cut_length_mm": 0.05},
-         "mesh": {"element_size_um": 16.6, "ahead_mm": 0.03},
+         "mesh": {"element_size_um": 16.6, "frame": "workpiece", "ahead_mm": 0.03},
          "solver": {"mass_scaling": 400.0, "n_samples": 20, "heat_conduction": conduction}}
     return setup_boring(parse_boring_config(d))
 

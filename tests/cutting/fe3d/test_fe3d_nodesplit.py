@@ -121,7 +121,8 @@ def test_pairs_part_where_the_insert_passed():
     # the flow of this 16.6 um mesh, and with it which of the swept pairs the edge reaches)
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                  "cut_length_mm": 0.04},
-         "mesh": {"element_size_um": 16.6, "separation": "node_split", "ahead_mm": 0.03},
+         "mesh": {"element_size_um": 16.6, "frame": "workpiece", "separation": "node_split",
+                  "ahead_mm": 0.03},
          "solver": {"mass_scaling": 400.0, "n_samples": 20, "heat_conduction": False}}
     s = setup_boring(parse_boring_config(d))
     st = s.state
@@ -141,7 +142,7 @@ def test_pairs_part_where_the_insert_passed():
 
 def test_bad_split_settings():
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0},
-         "mesh": {"element_size_um": 12.5, "separation": "glue"}}
+         "mesh": {"element_size_um": 12.5, "frame": "workpiece", "separation": "glue"}}
     with pytest.raises(ConfigError, match="separation"):
         parse_boring_config(d)
     d["mesh"]["separation"] = "node_split"

@@ -32,6 +32,13 @@ def _cfg(**mesh) -> dict:
     return d
 
 
+def _workpiece() -> dict:
+    """The paper example on the workpiece frame."""
+    d = load_toml(EX / "fe_boring_paper.toml")
+    d["mesh"]["frame"] = "workpiece"
+    return d
+
+
 @pytest.mark.parametrize("section, key, value", [
     ("mesh", "separation", "node_split"), ("mesh", "separation_height_um", 5.0),
     ("mesh", "chip_rows", 4), ("mesh", "depth_factor", 2.0), ("mesh", "ahead_mm", 0.1),
@@ -49,7 +56,7 @@ def test_tool_frame_refuses_workpiece_keys(section, key, value):
     ("mesh", "edge_element_um", 4.0), ("mesh", "slice_spacing_um", 10.0),
     ("solver", "ale_interval", 5)])
 def test_workpiece_frame_refuses_tool_frame_keys(section, key, value):
-    d = load_toml(EX / "fe_boring_paper.toml")
+    d = _workpiece()
     d.setdefault(section, {})[key] = value
     with pytest.raises(ConfigError, match=f"{section}.{key}"):
         parse_boring_config(d)
@@ -98,7 +105,7 @@ def test_tool_frame_state():
 
 
 def test_workpiece_state_has_empty_ale_arrays():
-    d = load_toml(EX / "fe_boring_paper.toml")
+    d = _workpiece()
     d["mesh"]["element_size_um"] = 16.6
     d["cut"]["cut_length_mm"] = 0.02
     st = setup_boring(parse_boring_config(d)).state
@@ -167,7 +174,7 @@ def test_the_spec_chooses_the_loop():
     # conduction (the default): the loops with the heat pass
     s = setup_boring(parse_boring_config(_cfg(t_min_um=8.0)))
     assert K3.run_chunk3_for(s.spec) is K3.run_chunk3_ale_heat
-    d = load_toml(EX / "fe_boring_paper.toml")
+    d = _workpiece()
     d["mesh"]["element_size_um"] = 16.6
     d["cut"]["cut_length_mm"] = 0.02
     w = setup_boring(parse_boring_config(d))
@@ -205,13 +212,20 @@ def test_cli_refuses_the_gpu_with_the_tool_frame(tmp_path):
     res = CliRunner().invoke(app, ["fe", "boring", str(cfg), "--device", "gpu"])
     assert res.exit_code == 2
     assert "CPU only" in res.output and "--device" in res.output
+    # the default frame: the message names the way to the GPU
+    d = _cfg()
+    del d["mesh"]["frame"]
+    cfg.write_text(dump_toml(d))
+    res = CliRunner().invoke(app, ["fe", "boring", str(cfg), "--device", "gpu"])
+    assert res.exit_code == 2
+    assert "default mesh.frame" in res.output and 'frame = "workpiece"' in res.output
 
 
 def test_contact_normal_damping_as_in_2d():
     """``contact.normal_damping``: default 1 (critical) in the tool frame, 0 in the workpiece
     frame (the 2D engine's defaults); a given value in either."""
     assert setup_boring(parse_boring_config(_cfg(t_min_um=8.0))).state.prm[K3.P_CDAMP] == 1.0
-    d = load_toml(EX / "fe_boring_paper.toml")
+    d = _workpiece()
     d["mesh"]["element_size_um"] = 16.6
     d["cut"]["cut_length_mm"] = 0.02
     assert setup_boring(parse_boring_config(d)).state.prm[K3.P_CDAMP] == 0.0

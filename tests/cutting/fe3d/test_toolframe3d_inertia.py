@@ -101,6 +101,7 @@ def test_renewal_follows_the_element_steps_both_ways():
 
 def test_workpiece_frame_refuses_the_key():
     d = load_toml(EX / "fe_boring_paper.toml")
+    d["mesh"]["frame"] = "workpiece"
     d["solver"]["thin_element_mass_scaling"] = False
     with pytest.raises(ConfigError, match="solver.thin_element_mass_scaling"):
         parse_boring_config(d)

@@ -44,17 +44,20 @@ _ROWS = [
 #: the tool-frame model's status, printed with every tool-frame run (docs/fe3d.md,
 #: "Tool-frame 3D model")
 TOOL_FRAME_STATUS = (
-    'mesh.frame = "tool": the 3D tool-frame ALE model is checked at the paper\'s condition '
-    "only (each force component within 15 % of the mechanistic model calibrated from the "
-    "validated 2D model, 16.6 to 10 um elements; docs/fe3d.md, \"Tool-frame 3D model\").")
+    'the 3D tool-frame ALE model (mesh.frame = "tool", the default) is checked at the '
+    "paper's condition only (each force component within 15 % of the mechanistic model "
+    "calibrated from the validated 2D model, 16.6 to 10 um elements, mass scaling 400, 0.15 mm "
+    "of travel; docs/fe3d.md, \"Tool-frame 3D model\").")
 
-#: the model's validation status, printed with every run (docs/fe3d.md, "Limits")
+#: the workpiece-frame model's status, printed with every workpiece-frame run (docs/fe3d.md,
+#: "Limits of the workpiece frame")
 THRUST_LIMIT = (
-    "the 3D model's radial and feed forces are 22-38 % below the mechanistic model calibrated "
-    "from the validated 2D model at the paper's condition on every mesh from 12.5 to 6.25 um "
-    "(its chip separation deletes material the edge radius should plough; the tangential force "
-    "is within 12 %). Take the radial and feed forces from the mechanistic model or from the "
-    'tool-frame model (mesh.frame = "tool": within 15 % there; docs/fe3d.md, "Limits").')
+    'the workpiece-frame model (mesh.frame = "workpiece") gives radial and feed forces 22-38 % '
+    "below the mechanistic model calibrated from the validated 2D model at the paper's "
+    "condition on every mesh from 12.5 to 6.25 um (its chip separation deletes material the "
+    "edge radius should plough; the tangential force is within 12 %). Take the radial and feed "
+    'forces from the default tool-frame model (within 15 % there) or the mechanistic model '
+    '(docs/fe3d.md, "Limits of the workpiece frame").')
 
 
 def boring_cmd(

@@ -270,8 +270,9 @@ _VARIANT_TEXT = {
     "erosion_layer": 'mesh.separation = "erosion_layer" (no parting line: the layer, its '
                      "position and erosion)",
     "workpiece": 'mesh.frame = "workpiece" (no tool-frame ALE mesh)',
-    "tool3d": 'mesh.frame = "tool" (the 3D tool-frame ALE model: no workpiece block, no '
-              "separation, no damage or time-step erosion)",
+    "tool3d": 'mesh.frame = "tool" (the default: the 3D tool-frame ALE model, no workpiece '
+              "block, no separation, no damage or time-step erosion; the key belongs to "
+              'mesh.frame = "workpiece")',
     "bbar": 'solver.element = "q4_bbar" (no hourglass modes: no hourglass coefficients)',
     "adiabatic": "solver.heat_conduction = false (adiabatic: no conduction interval, no "
                  "thermal contact with the tool)",

@@ -6,10 +6,11 @@ nose.
 model (docs/fe.md): the mesh travels with the insert and the material flows through it --
 in ahead of the edge, round the edge radius (where a workpiece-frame mesh with an erosion
 layer or node splitting deletes or parts the ploughed layer and loses most of the thrust,
-docs/fe3d.md "Limits"), out through the machined surface behind the flank and through the
-chip's top face. Frame: the local frame of :mod:`robobore.cutting.fe.models.boring3d` (x
-along the cutting velocity of the insert, y normal to the bore wall out of the material, z
-along the feed), the insert's tip reference (its lowest point, on the edge) at the origin.
+docs/fe3d.md "Limits of the workpiece frame"), out through the machined surface behind the
+flank and through the chip's top face. Frame: the local frame of
+:mod:`robobore.cutting.fe.models.boring3d` (x along the cutting velocity of the insert, y
+normal to the bore wall out of the material, z along the feed), the insert's tip reference
+(its lowest point, on the edge) at the origin.
 The current edge profile is ``y = drop(z)``, the surface left by the previous revolution
 ``y_top(z) = min(ap, drop(z + f))``; the true chip is the material between them, of local
 (vertical) thickness ``t(z) = y_top(z) - drop(z)`` on the engaged edge

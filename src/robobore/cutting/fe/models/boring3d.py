@@ -130,11 +130,14 @@ def _mean_amp(v: np.ndarray) -> tuple[float, float]:
 
 
 def check_boring_device(cfg: BoringFEConfig, device: str, source: str | None = None) -> None:
-    """ConfigError for the GPU with the tool frame (its ALE pass runs on the CPU only)."""
+    """ConfigError for the GPU with the tool frame (the default frame; its ALE pass runs on
+    the CPU only)."""
     if device == "gpu" and cfg.mesh.frame == "tool":
-        raise ConfigError("the 3D tool-frame model runs on the CPU only", file=source,
-                          field="--device", value=device,
-                          expected='cpu with mesh.frame = "tool"')
+        raise ConfigError("the 3D tool-frame model (the default mesh.frame) runs on the CPU "
+                          "only", file=source, field="--device", value=device,
+                          expected='cpu, or set [mesh] frame = "workpiece" in the config for '
+                          "the GPU (the workpiece-frame model: radial and feed forces 22-38 % "
+                          "low at the paper's condition, docs/fe3d.md)")
 
 
 def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
