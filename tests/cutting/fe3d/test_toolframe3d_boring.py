@@ -73,6 +73,22 @@ def test_tool_frame_range_checks():
         parse_boring_config(d)
 
 
+def test_a_cut_outside_the_tool_frame_mesh_names_the_way_out():
+    """The default frame's mesh needs the chip below the nose's centre in every slice: a deep
+    cut is a ConfigError at setup naming mesh.frame and the workpiece frame, not a fallback."""
+    d = load_toml(EX / "fe_boring_paper.toml")
+    del d["mesh"]["frame"]
+    d["mesh"]["element_size_um"] = 16.6
+    d["cut"]["depth_of_cut_mm"] = 0.1
+    with pytest.raises(ConfigError) as ei:
+        setup_boring(parse_boring_config(d, "deep.toml"), "deep.toml")
+    msg = str(ei.value)
+    assert ei.value.field == "mesh.frame" and "deep.toml" in msg
+    assert "reaches past the nose" in msg and 'frame = "workpiece"' in msg
+    d["mesh"]["frame"] = "workpiece"
+    assert setup_boring(parse_boring_config(d)).spec.tool_frame is None
+
+
 def test_tool_frame_is_cpu_only():
     cfg = parse_boring_config(_cfg())
     with pytest.raises(ConfigError, match="CPU only"):
@@ -154,6 +170,36 @@ def test_tool_frame_summary_has_the_mesh_facts():
     assert r["eroded_damage"] == 0 and r["eroded_distortion"] == 0
     # the pre-shaped chip stands above the pre-bore surface (y = ap)
     assert r["chip_max_height_um"] > 10.0
+
+
+def test_a_radial_deflection_the_mesh_does_not_follow_is_reported():
+    """On a support the insert deflects along the wall normal, which the tool-frame mesh's
+    placement does not follow: the run reports the largest deflection (from the tool's
+    boring-frame history and the bar angle) beside the edge element, and warns above a
+    tenth of it."""
+    from robobore.cutting.fe.cli_boring import RADIAL_DEFLECTION_LIMIT, boring_warnings
+
+    d = _cfg(t_min_um=8.0)
+    d["tool_support"] = {"stiffness_N_per_m": 1.0e4, "damping_N_s_per_m": 0.0,
+                         "mass_kg": 1.0e-7}
+    cfg = parse_boring_config(d)
+    s = setup_boring(cfg)
+    cfg.cut.cut_length_mm = 150 * float(s.state.clock[1]) * s.vc * 1e3
+    res = simulate_boring(cfg)
+    r, h = res.summary, res.history
+    th = h["bar_angle_rad"]
+    uy = -np.cos(th) * h["tool_dX_um"] - np.sin(th) * h["tool_dY_um"]
+    tf = r["toolframe_mesh"]
+    assert tf["edge_element_um"] == pytest.approx(16.6 / 4)
+    assert tf["radial_deflection_max_um"] == pytest.approx(np.max(np.abs(uy)), rel=1e-9)
+    assert tf["radial_deflection_max_um"] > 0.0
+    status = boring_warnings(cfg, {})
+    for frac, warned in ((0.5, False), (2.0, True)):
+        tf["radial_deflection_max_um"] = frac * RADIAL_DEFLECTION_LIMIT * tf["edge_element_um"]
+        w = boring_warnings(cfg, r)
+        assert w[0] == status[0] and len(w) == 1 + warned
+        if warned:
+            assert "radial deflection" in w[1] and "edge element" in w[1]
 
 
 def test_the_tool_frame_loop_is_the_one_step_loop():
