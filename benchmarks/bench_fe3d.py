@@ -62,6 +62,7 @@ def speed(n_elements: int, steps: int, frame: str | None = None) -> dict:
     if parse_boring_config(d).mesh.frame == "tool":
         le = 12.5 * (25548 / n_elements) ** (1 / 2.17)
     else:
+        d["cut"]["cut_length_mm"] = 0.3  # the block of 8,120 hexahedra at 12.5 um
         le = 12.5 * (8120 / n_elements) ** (1 / 3)
     d["mesh"]["element_size_um"] = min(le, 16.6)
     out: dict = {"frame": parse_boring_config(d).mesh.frame}
