@@ -59,13 +59,14 @@ def speed(n_elements: int, steps: int, frame: str | None = None) -> dict:
     # the element size giving about n_elements: the workpiece block has 8,120 hexahedra at
     # 12.5 um (cubic in 1 / size), the tool-frame mesh 25,548 (slices and sections: a power
     # 2.17, from its 13,947 / 25,548 / 41,450 at 16.6 / 12.5 / 10 um)
-    if parse_boring_config(d).mesh.frame == "tool":
+    frame = parse_boring_config(d).mesh.frame  # the example's where not given
+    if frame == "tool":
         le = 12.5 * (25548 / n_elements) ** (1 / 2.17)
     else:
         d["cut"]["cut_length_mm"] = 0.3  # the block of 8,120 hexahedra at 12.5 um
         le = 12.5 * (8120 / n_elements) ** (1 / 3)
     d["mesh"]["element_size_um"] = min(le, 16.6)
-    out: dict = {"frame": parse_boring_config(d).mesh.frame}
+    out: dict = {"frame": frame}
     n_max = numba.get_num_threads()
     for par in (False, True):
         numba.set_num_threads(n_max if par else 1)

@@ -27,16 +27,16 @@ from robobore.io.config import dump_toml, load_toml
 _EX = Path(__file__).parents[3] / "examples"
 
 #: case -> (example file, section and key of the cut length, short cut length [mm], CLI
-#: subcommand, outputs compared[, other keys set: {(section, key): value}])
+#: subcommand, outputs compared, other keys set {(section, key): value})
 CASES = {
     "validation_config": ("fe_orthogonal_toolframe_calibrated.toml", ("cut", "length_mm"), 0.01,
                           "orthogonal", ("cutting_force_N_per_mm", "feed_force_N_per_mm",
-                                         "steps")),
+                                         "steps"), {}),
     "contract": ("fe_orthogonal.toml", ("cut", "length_mm"), 0.01, "orthogonal",
-                 ("cutting_force_N_per_mm", "feed_force_N_per_mm", "steps")),
+                 ("cutting_force_N_per_mm", "feed_force_N_per_mm", "steps"), {}),
     "tool_support": ("fe_orthogonal_tool_support.toml", ("cut", "length_mm"), 0.03,
                      "orthogonal", ("cutting_force_N_per_mm", "feed_force_N_per_mm", "steps",
-                                    "tool_dx_mean_um", "tool_dy_mean_um")),
+                                    "tool_dx_mean_um", "tool_dy_mean_um"), {}),
     "boring_paper": ("fe_boring_paper.toml", ("cut", "cut_length_mm"), 0.02, "boring",
                      ("force_rotating_N", "steps"),
                      {("mesh", "frame"): "workpiece", ("solver", "mass_scaling"): 100.0}),
@@ -73,10 +73,10 @@ EXPECTED: dict[str, dict] = {
 
 
 def run_case(name: str, tmp: Path) -> dict:
-    example, (sec, key), length, sub, keys, *other = CASES[name]
+    example, (sec, key), length, sub, keys, other = CASES[name]
     d = load_toml(_EX / example)
     d[sec][key] = length
-    for (s, k), v in (other[0] if other else {}).items():
+    for (s, k), v in other.items():
         d[s][k] = v
     cfg = tmp / f"{name}.toml"
     cfg.write_text(dump_toml(d))

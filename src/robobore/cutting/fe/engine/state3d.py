@@ -336,6 +336,14 @@ def heat_pass(prm: np.ndarray) -> bool:
     return every >= 1.0
 
 
+#: what to try when a 3D run becomes unstable (the message of NumericalError)
+_HINT = ("a smaller solver.cfl, a larger mesh.element_size_um, less mass scaling or a softer "
+         "contact.penalty_factor")
+_TOOL_FRAME_HINT = (_HINT + "; in the tool frame (the default) a larger mesh.t_min_um, or "
+                    '[mesh] frame = "workpiece" (docs/fe3d.md, "Tool-frame 3D model": where '
+                    "the tool frame is checked)")
+
+
 def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
              progress: Callable[[float], None] | None = None,
              check: Callable[[FEState3], None] | None = None,
@@ -371,14 +379,6 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
                         hint=_TOOL_FRAME_HINT if st.tool_frame else _HINT,
                         progress=progress, check=check, adaptive_threads=adaptive_threads,
                         governor=governor)
-
-
-#: what to try when a 3D run becomes unstable (the message of NumericalError)
-_HINT = ("a smaller solver.cfl, a larger mesh.element_size_um, less mass scaling or a softer "
-         "contact.penalty_factor")
-_TOOL_FRAME_HINT = (_HINT + "; in the tool frame (the default) a larger mesh.t_min_um, or "
-                    '[mesh] frame = "workpiece" (the tool frame is checked at the paper\'s '
-                    "condition; docs/fe3d.md, \"Tool-frame 3D model\")")
 
 
 def box_mesh(nx: int, ny: int, nz: int, lx: float, ly: float, lz: float,

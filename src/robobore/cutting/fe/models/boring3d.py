@@ -252,14 +252,14 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
                 np.sum(st.vol0 * (st.msf - 1.0)) / np.sum(st.vol0))
     else:
         summary["mesh_shape"] = list(setup.mesh.shape)
-    if cfg.tool_support is not None and cfg.mesh.frame == "tool":
-        # the insert's deflection along the wall normal (local y; tool_kinematics_py), which
-        # the tool-frame mesh's placement does not follow, against the edge element
-        uy = -np.cos(thr) * hh[:, K3.H_UX] - np.sin(thr) * hh[:, K3.H_UY]
-        tf = summary["toolframe_mesh"]
-        tf["radial_deflection_max_um"] = float(np.max(np.abs(uy))) * 1e6
-        tf["edge_element_um"] = setup.mesh.sizes.edge * 1e6
     if cfg.tool_support is not None:
+        if cfg.mesh.frame == "tool":
+            # the insert's deflection along the wall normal (local y; tool_kinematics_py),
+            # which the tool-frame mesh's placement does not follow, against the edge element
+            uy = -np.cos(thr) * hh[:, K3.H_UX] - np.sin(thr) * hh[:, K3.H_UY]
+            tf = summary["toolframe_mesh"]
+            tf["radial_deflection_max_um"] = float(np.max(np.abs(uy))) * 1e6
+            tf["edge_element_um"] = setup.mesh.sizes.edge * 1e6
         k = cfg.tool_support.total_stiffness()
         uz = hh[:, K3.H_UZ] * 1e6
         mean_z, amp_z = _mean_amp(uz[win])
