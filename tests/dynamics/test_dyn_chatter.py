@@ -88,7 +88,12 @@ def test_verdict_growing_oscillation_is_chatter():
     assert v.chatter
     assert v.feed_amplitude_growth > 10 and v.radial_amplitude_growth > 10
     assert v.chatter_frequency_Hz == pytest.approx(7.3 * 600 / 60, rel=0.02)
-    assert v.surface_finish == "ok" and v.paper_stable  # smooth surface: paper says stable
+    # the growth per revolution (one insert: per pitch) is 20^(1/40) = 1.0778
+    assert v.floquet_multiplier == pytest.approx(20.0 ** (1 / 40), rel=2e-3)
+    assert v.chatter_decided and v.chatter_cause == "regenerative"
+    # a smooth surface, but the cut chatters: the paper's criterion cannot say "stable"
+    assert v.surface_finish == "ok" and v.paper_stable is False
+    assert v.verdicts()["paper_criterion"] == "vibratory"
 
 
 def test_verdict_steady_oscillation_is_not_chatter():
@@ -151,6 +156,26 @@ def test_verdict_tool_leaves_cut():
     v = classify(_cut(X, NS, z, h, area=area))
     assert v.tool_leaves_cut and 0 < v.tool_left_cut_fraction < 0.02
     assert v.surface_finish is None  # no tolerance given
+    # without a tolerance the paper's criterion is not judged (never "stable" by default)
+    assert v.paper_stable is None and v.verdicts()["paper_criterion"] is None
+    assert any("not judged" in r for r in v.reasons)
+
+
+def test_floquet_multiplier_of_decaying_growing_and_periodic_motion():
+    """The per-pitch growth of |r(t) - r(t - tau)| fitted on the second half: a decay of
+    2 %/pitch and a growth of 0.5 %/pitch on top of a large periodic motion are found within
+    1e-3, with standard errors far below the margin; an exactly periodic motion gives 0."""
+    from robobore.dynamics.chatter import floquet_multiplier
+
+    s, n = 90, 120
+    t = np.arange(n * s)
+    per = 1e-4 * np.column_stack([np.cos(2 * np.pi * t / s), np.sin(2 * np.pi * t / s),
+                                  0.1 * np.cos(4 * np.pi * t / s)])
+    for rate in (0.98, 1.005):
+        v = 1e-6 * rate ** (t / s) * np.sin(2 * np.pi * 0.37 * t / s)
+        rho, se, k = floquet_multiplier(per + np.column_stack([v, 0.3 * v, v]), s)
+        assert rho == pytest.approx(rate, abs=1e-3) and se < 1e-3 and k >= 50
+    assert floquet_multiplier(per, s)[0] == 0.0
 
 
 def test_amplitude_growth_ignores_the_entry_transient_and_beats():

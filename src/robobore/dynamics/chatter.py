@@ -2,20 +2,26 @@
 
 A cut gets separate, named verdicts (:func:`classify`, :class:`ChatterVerdict`):
 
-* ``chatter`` -- self-excited (regenerative) vibration: the vibration GROWS over the
-  revolutions. Two measures must both exceed ``growth_limit`` (default 1): the envelope of
-  the regenerative displacement ``|r(t) - r(t - tau)|`` (``tau`` = insert pitch; a stable
-  process settles on a motion that repeats every pitch, so this decays) over the last delay
-  period divided by the smallest per-delay envelope of the first half of the run
-  (:func:`vibration_growth`: the decay of the entry transient neither hides growth after it
-  nor counts as growth, and vibration that grew and saturated reads as grown), and the same
-  growth of the per-revolution amplitude of that displacement in the feed (Z) or radial (XY)
-  direction (:func:`amplitude_growth`). A run that diverged (tool-point displacement above
-  the divergence limit) is chatter. A cut whose amplitude does not grow is not chatter,
-  however rough. Reported with it: the chatter frequency
-  (largest spectral peak away from the tooth-passing harmonics ``k N n / 60``, in the last
-  ``tail_fraction`` of the run) and the non-harmonic energy fraction of the displacement
-  (:func:`harmonic_analysis`).
+* ``chatter`` -- self-excited (regenerative) vibration: the vibration GROWS from pitch to
+  pitch. The measure is the Floquet multiplier of the simulated cut
+  (:func:`floquet_multiplier`): the growth per insert pitch ``tau`` of the regenerative
+  displacement ``|r(t) - r(t - tau)|`` (a stable cut settles on a motion that repeats every
+  pitch, so this decays as ``rho^k``, ``rho`` the spectral radius of the linearised cut's
+  monodromy matrix, which the semi-discretisation lobes compute), fitted on the per-pitch
+  maxima of the second half of the run, with its standard error. Chatter when the multiplier
+  exceeds 1; the verdict is ``decided`` when ``|ln rho|`` exceeds three standard errors
+  (:data:`DECISION_SIGMAS`), else the run is too short to decide near the limit and says so
+  (``chatter_decided`` false, a reason naming the multiplier; ``simulate`` callers lengthen the
+  run). Where the tool leaves the cut in the last ``tail_fraction`` of the run the cut is
+  nonlinear (the chip is interrupted; the multiplier of the linear cut no longer describes
+  it): chatter is then vibration that grew from the quietest point of the first half and
+  stays (:func:`vibration_growth` and :func:`amplitude_growth` both above ``growth_limit``),
+  and the reason names the nonlinear cause. A run that diverged (tool-point displacement above
+  the divergence limit) is chatter. A cut whose vibration does not grow is not chatter,
+  however rough. Reported with it: the chatter frequency (largest spectral peak away from the
+  tooth-passing harmonics ``k N n / 60``, in the last ``tail_fraction`` of the run; none for a
+  run that diverged, whose record stops before a spectrum means anything) and the
+  non-harmonic energy fraction of the displacement (:func:`harmonic_analysis`).
 * ``surface_finish`` -- ``"ok"`` / ``"rough"``: Ra of the machined profile AFTER removing its
   form (least-squares line: offset and taper, :func:`robobore.dynamics.timedomain.roughness`)
   against the tolerance; ``None`` without a tolerance. Feed marks alone can make a cut rough.
@@ -23,10 +29,16 @@ A cut gets separate, named verdicts (:func:`classify`, :class:`ChatterVerdict`):
   last ``tail_fraction`` of the run (``tool_left_cut_fraction`` > 0): the cut is interrupted,
   the linear models no longer apply.
 * ``paper_stable`` -- the paper's own criterion (its "stable" / "vibratory"): vibratory when
-  Ra (form removed) exceeds the tolerance, or when the run diverged. It is a roughness
-  criterion: it calls a cut vibratory whose feed marks alone exceed the tolerance. The study
-  summaries keep it under the name ``stable``, so that measured data classified the paper's
-  way compare with it.
+  Ra (form removed) exceeds the tolerance, when the cut chatters or when the run diverged;
+  stable when Ra is within the tolerance and the cut does not chatter; ``None`` (not judged)
+  without a tolerance, unless the cut chatters or diverged. It is a roughness criterion: it
+  calls a cut vibratory whose feed marks alone exceed the tolerance. The study summaries keep
+  it under the name ``stable``, so that measured data classified the paper's way compare with
+  it. No verdict says stable while another says chatter or diverged.
+
+Amplitudes below :data:`AMPLITUDE_RESOLUTION_M` (1 nm, below what a displacement sensor or a
+profilometer on a boring cell resolves) are below resolution: :func:`resolved` says so, and
+ratios of such values are not findings.
 """
 
 from __future__ import annotations
@@ -75,6 +87,79 @@ def _ratio(first: float, last: float, X: np.ndarray) -> float:
     if last <= floor:
         return 0.0
     return float(last / max(first, floor)) if max(first, floor) > 0 else math.inf
+
+
+#: Floquet-multiplier fit: per-pitch maxima below this fraction of the largest displacement
+#: are round-off (left out), and a verdict is decided when ``|ln rho|`` exceeds
+#: :data:`DECISION_SIGMAS` standard errors of the fit and :data:`DECISION_FLOOR` absolutely.
+FLOQUET_FLOOR = 1e-7
+DECISION_SIGMAS = 3.0
+DECISION_FLOOR = 1e-4
+#: Linear range of a simulated cut for the multiplier fit: regenerative vibration up to this
+#: fraction of the depth of cut (:func:`floquet_multiplier`).
+LINEAR_FRACTION = 0.1
+#: Amplitudes below this [m] are below resolution (1 nm).
+AMPLITUDE_RESOLUTION_M = 1e-9
+
+
+def resolved(amplitude_m: float) -> bool:
+    """True when ``amplitude_m`` is at or above :data:`AMPLITUDE_RESOLUTION_M`."""
+    return bool(math.isfinite(amplitude_m) and amplitude_m >= AMPLITUDE_RESOLUTION_M)
+
+
+def floquet_multiplier(displacement: np.ndarray, samples_per_delay: int,
+                       tail_fraction: float = 0.5, min_delays: int = 6,
+                       linear_limit_m: float | None = None) -> tuple[float, float, int]:
+    """Growth per delay of the regenerative displacement: ``(rho, se_ln_rho, delays)``.
+
+    ``d(t) = |r(t) - r(t - tau)|`` (``tau`` = ``samples_per_delay`` samples) decays or grows as
+    ``rho^k`` over the delays ``k`` once the other Floquet modes have died out, ``rho`` the
+    largest Floquet multiplier of the linear cut. ``ln`` of the per-delay maxima of ``d`` is
+    fitted by least squares against ``k`` over the last ``tail_fraction`` of the delays (at
+    least ``min_delays``), leaving out maxima at round-off level (below :data:`FLOQUET_FLOOR`
+    of the largest displacement); where the envelope reaches round-off before the tail, over
+    the last ``min_delays`` delays above it. Returns ``rho = exp(slope)``, the standard error
+    of ``ln rho`` and the number of delays fitted; ``(0, 0, 0)`` when ``d`` is at round-off
+    throughout (a motion that repeats every delay); NaN with fewer than ``min_delays + 1``
+    delays in the run.
+
+    ``linear_limit_m``: the linear range of the cut (:func:`classify` passes
+    :data:`LINEAR_FRACTION` of the depth of cut). A growing vibration leaves it (the depth
+    modulation and the chip thickness are no longer small perturbations and its growth slows
+    down); the run is then fitted only up to the first delay whose maximum exceeds the limit
+    (the last ``tail_fraction`` of those delays), so that the estimate is the linear cut's
+    multiplier."""
+    X = np.asarray(displacement, float)
+    s = int(samples_per_delay)
+    n = X.shape[0] // s - 1
+    if n < min_delays + 1:
+        return math.nan, math.nan, 0
+    d = np.linalg.norm(X[s:(n + 1) * s] - X[:n * s], axis=1)
+    pk = d.reshape(n, s).max(axis=1)
+    floor = FLOQUET_FLOOR * float(np.abs(X).max()) if X.size else 0.0
+    if linear_limit_m is not None and linear_limit_m > 0.0:
+        over = np.nonzero(pk > linear_limit_m)[0]
+        if over.size and over[0] >= min_delays + 1:
+            n = int(over[0])
+            pk = pk[:n]
+    valid = np.nonzero(pk > floor)[0]
+    if valid.size < 2:
+        return 0.0, 0.0, 0
+    start = n - max(min_delays, int(round(n * tail_fraction)))
+    use = valid[valid >= start]
+    if use.size < min_delays:
+        use = valid[-min_delays:] if valid.size >= min_delays else valid
+    k = use.astype(float)
+    y = np.log(pk[use])
+    kc = k - k.mean()
+    sxx = float(kc @ kc)
+    if sxx <= 0.0:
+        return math.nan, math.nan, int(use.size)
+    slope = float(kc @ (y - y.mean())) / sxx
+    res = y - y.mean() - slope * kc
+    dof = max(1, use.size - 2)
+    se = math.sqrt(float(res @ res) / dof / sxx)
+    return math.exp(slope), se, int(use.size)
 
 
 def harmonic_analysis(signal: np.ndarray, fs: float, tooth_freq: float,
@@ -132,7 +217,7 @@ class ChatterVerdict:
     chatter: bool
     surface_finish: str | None
     tool_leaves_cut: bool
-    paper_stable: bool
+    paper_stable: bool | None
     vibration_growth: float
     feed_amplitude_growth: float
     radial_amplitude_growth: float
@@ -145,13 +230,18 @@ class ChatterVerdict:
     roughness_ok: bool
     tool_left_cut_fraction: float
     reasons: tuple[str, ...]
+    floquet_multiplier: float = math.nan
+    floquet_multiplier_se: float = math.nan
+    chatter_decided: bool = True
+    chatter_cause: str | None = None
 
     def verdicts(self) -> dict[str, Any]:
         """The named verdicts: ``chatter``, ``surface_finish``, ``tool_leaves_cut``,
-        ``paper_criterion`` ("stable" / "vibratory")."""
+        ``paper_criterion`` ("stable" / "vibratory" / None: not judged)."""
+        paper = None if self.paper_stable is None else (
+            "stable" if self.paper_stable else "vibratory")
         return {"chatter": self.chatter, "surface_finish": self.surface_finish,
-                "tool_leaves_cut": self.tool_leaves_cut,
-                "paper_criterion": "stable" if self.paper_stable else "vibratory"}
+                "tool_leaves_cut": self.tool_leaves_cut, "paper_criterion": paper}
 
     def to_dict(self) -> dict[str, Any]:
         d = dict(self.__dict__)
@@ -184,16 +274,41 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
     amp = max((v for v in ag.values() if math.isfinite(v)), default=math.nan)
     grows = (math.isfinite(g) and g > growth_limit and math.isfinite(amp)
              and amp > growth_limit)
-    chatter = diverged or grows
+    depth = float(ds.attrs.get("depth_m", math.nan))
+    rho, se, _ = floquet_multiplier(X, spd, linear_limit_m=(
+        LINEAR_FRACTION * depth if math.isfinite(depth) and depth > 0 else None))
+    decided = True
+    cause = None
     reasons = []
     if diverged:
+        chatter, cause = True, "diverged"
         reasons.append(f"chatter: vibration diverged (tool-point displacement above "
                        f"{float(ds.attrs['divergence_limit_m']) * 1e3:.3g} mm at "
                        f"t = {float(ds.attrs['diverged_at_s']):.4g} s)")
-    elif grows:
-        reasons.append(f"chatter: vibration grows (regenerative envelope x{g:.3g}, feed "
-                       f"amplitude x{ag['feed']:.3g}, radial x{ag['radial']:.3g}) at "
-                       f"{fpk:.4g} Hz")
+    elif left > 0:
+        chatter = grows
+        if chatter:
+            cause = "tool leaves the cut"
+            reasons.append(f"chatter: vibration grows and the tool leaves the cut (nonlinear: "
+                           f"regenerative envelope x{g:.3g}, feed amplitude "
+                           f"x{ag['feed']:.3g}, radial x{ag['radial']:.3g}) at {fpk:.4g} Hz")
+    elif not math.isfinite(rho):
+        chatter, decided = grows, False
+        reasons.append("undecided: the run is too short for a growth estimate (fewer than 7 "
+                       "insert pitches); lengthen [simulation] revolutions")
+    else:
+        ln = math.log(rho) if rho > 0 else -math.inf
+        decided = abs(ln) > max(DECISION_SIGMAS * se, DECISION_FLOOR)
+        chatter = rho > 1.0
+        if chatter:
+            cause = "regenerative"
+            reasons.append(f"chatter: vibration grows x{rho:.4g} per insert pitch (Floquet "
+                           f"multiplier of the simulated cut, +-{se:.2g} in ln) at "
+                           f"{fpk:.4g} Hz")
+        if not decided:
+            reasons.append(f"undecided: multiplier {rho:.5g} per insert pitch (+-{se:.2g} in "
+                           "ln) is within the fit's uncertainty of 1: the cut is at its "
+                           "stability limit; lengthen [simulation] revolutions to decide")
     if not r_ok:
         reasons.append(f"rough: Ra {ra * 1e6:.3g} um (form removed) above tolerance "
                        f"{ra_tolerance_m * 1e6:.3g} um")
@@ -201,11 +316,19 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
         reasons.append(f"tool leaves the cut in {100 * left:.3g} % of the last "
                        f"{100 * tail_fraction:.3g} % of the run")
     finish = None if not has_tol else ("ok" if r_ok else "rough")
-    paper_stable = r_ok and not diverged
+    if diverged or chatter or not r_ok:
+        paper_stable: bool | None = False
+    else:
+        paper_stable = True if has_tol else None
+    if paper_stable is None:
+        reasons.append("paper's criterion not judged: no Ra tolerance "
+                       "([simulation] ra_tolerance_um)")
+    freq = fpk if (chatter and not diverged and math.isfinite(fpk) and fpk > 0) else None
     return ChatterVerdict(chatter, finish, left > 0, paper_stable, g, ag["feed"], ag["radial"],
-                          ratio, fpk if chatter else None, fpk, ra, rz, slope, r_ok, left,
-                          tuple(reasons))
+                          ratio, freq, fpk, ra, rz, slope, r_ok, left, tuple(reasons),
+                          rho, se, decided, cause)
 
 
 __all__ = ["vibration_growth", "amplitude_growth", "harmonic_analysis", "classify",
-           "ChatterVerdict"]
+           "ChatterVerdict", "floquet_multiplier", "resolved", "FLOQUET_FLOOR",
+           "DECISION_SIGMAS", "DECISION_FLOOR", "AMPLITUDE_RESOLUTION_M", "LINEAR_FRACTION"]

@@ -24,6 +24,16 @@ set by the feed (where the nose meets the previous pass), not by the depth, so i
 stretches with the simulated depth nor enters the depth-modulation stiffness. Those elements
 have ``h0 = w = 0``: they rub (edge force) but carry no chip and no regeneration.
 
+One linearised model at every depth: a boring process remembers how it was built
+(``geometry``: insert, coefficients, feed and options, :class:`BoringGeometry`), and
+:meth:`CuttingProcess.at_depth` rebuilds it from the chip geometry at another depth of cut.
+The time-domain simulation integrates the process built at its own depth; the lobes
+(semi-discretisation, frequency domain) and the mode-coupling limit judge each trial depth
+``a`` with ``process.at_depth(a)``, so a nose-radius insert, whose engaged edge, local
+approach angles and chip thicknesses change with the depth, is judged on the same chip at the
+same depth by every method. A process without ``geometry`` (the single-point contract, whose
+force is linear in the depth) is the same at every depth.
+
 ``n_e`` (chip normal: a tool displacement along it REDUCES the chip), ``shear_e`` [N/m^2] and
 ``edge_e`` [N/m] are basis coordinates; forces are ON THE TOOL; ``mu`` is the overlap factor
 (1: full regeneration). The general contract (``[process]`` of the TOML) is one element with
@@ -32,14 +42,31 @@ have ``h0 = w = 0``: they rub (edge force) but carry no chip and no regeneration
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Any
+
+import math
 
 import numpy as np
 
 from robobore.cutting.forces import CuttingCoefficients
 from robobore.cutting.geometry import BoringInsert, edge_elements
 from robobore.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class BoringGeometry:
+    """What a boring process is built from (:func:`boring_process`'s arguments but the depth),
+    so that :meth:`CuttingProcess.at_depth` can rebuild the process at any depth of cut."""
+
+    insert: BoringInsert
+    coefficients: CuttingCoefficients
+    feed_per_rev_m: float
+    n_elements: int = 24
+    overlap: float = 1.0
+    depth_modulation: bool = True
+    min_chip_thickness_m: float | None = None
+    trailing_edge: bool = True
 
 
 @dataclass(frozen=True)
@@ -60,6 +87,8 @@ class CuttingProcess:
     reference_depth_m: float | None = None
     label: str = ""
     edge_fixed_m: np.ndarray | None = None
+    geometry: BoringGeometry | None = None
+    _at_depth_cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         E = int(np.asarray(self.h0).size)
@@ -77,6 +106,40 @@ class CuttingProcess:
     @property
     def n_elements(self) -> int:
         return int(self.h0.size)
+
+    @property
+    def depth_dependent(self) -> bool:
+        """True when the process changes with the depth of cut beyond the linear scaling of
+        its widths (a boring insert, rebuilt from its chip geometry at each depth)."""
+        return self.geometry is not None
+
+    def at_depth(self, depth_m: float) -> CuttingProcess:
+        """The process linearised at depth of cut ``depth_m`` [m]: rebuilt from the chip
+        geometry (:func:`boring_process` with the same insert, coefficients, feed and options)
+        for a boring process, ``self`` for a process without geometry or at its own depth.
+        Processes are cached per depth (12 significant digits)."""
+        g = self.geometry
+        a = float(depth_m)
+        if g is None or not (math.isfinite(a) and a > 0.0):
+            return self
+        ref = self.reference_depth_m
+        if ref is not None and abs(a - ref) <= 1e-12 * ref:
+            return self
+        key = float(f"{a:.12g}")
+        hit = self._at_depth_cache.get(key)
+        if hit is None:
+            if len(self._at_depth_cache) > 4096:
+                self._at_depth_cache.clear()
+            hit = boring_process(g.insert, g.coefficients, key, g.feed_per_rev_m, g.n_elements,
+                                 g.overlap, g.depth_modulation, g.min_chip_thickness_m,
+                                 g.trailing_edge)
+            self._at_depth_cache[key] = hit
+        return hit
+
+    def fixed(self) -> CuttingProcess:
+        """The same process without its geometry: linearised once, at its reference depth,
+        its widths scaled linearly with any other depth (the model of a straight edge)."""
+        return replace(self, geometry=None, _at_depth_cache={})
 
     def basis(self, theta: np.ndarray) -> np.ndarray:
         """Basis matrices, shape (n, 3, 3): rows are the basis vectors in the boring frame."""
@@ -105,7 +168,7 @@ class CuttingProcess:
         A = np.zeros((th.size, 3, 3))
         for p in range(self.n_inserts):
             B = self.basis(th + 2 * np.pi * p / self.n_inserts)
-            Ap = np.einsum("nki,kl,nlj->nij", B, core, B)
+            Ap = np.swapaxes(B, 1, 2) @ (core @ B)
             if insert_weights is not None:
                 Ap = Ap * insert_weights[:, p, None, None]
             A += Ap
@@ -135,12 +198,13 @@ class CuttingProcess:
             return P
         for p in range(self.n_inserts):
             B = self.basis(th + 2 * np.pi * p / self.n_inserts)
-            P += np.einsum("nki,kl,nlj->nij", B, core, B)
+            P += np.swapaxes(B, 1, 2) @ (core @ B)
         return P
 
     def to_dict(self) -> dict[str, Any]:
         return {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                for k, v in self.__dict__.items()}
+                for k, v in self.__dict__.items()
+                if k not in ("geometry", "_at_depth_cache")}
 
 
 def single_point_process(cutting_coefficient_N_per_m2: float, force_direction: np.ndarray,
@@ -209,7 +273,10 @@ def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dept
         overlap=float(overlap), feed_per_rev_m=feed_per_rev_m, reference_depth_m=depth_m,
         label=f"boring bar, {insert.n_inserts} insert(s), nose {insert.nose_radius_m * 1e3:g} mm, "
               f"kappa_r {insert.approach_angle_deg:g} deg",
-        edge_fixed_m=np.where(trail, el.dS, 0.0))
+        edge_fixed_m=np.where(trail, el.dS, 0.0),
+        geometry=BoringGeometry(insert, coefficients, float(feed_per_rev_m), int(n_elements),
+                                float(overlap), bool(depth_modulation), min_chip_thickness_m,
+                                bool(trailing_edge)))
 
 
 def tooth_period(speed_rpm: float, n_inserts: int) -> float:
@@ -217,4 +284,4 @@ def tooth_period(speed_rpm: float, n_inserts: int) -> float:
     return 60.0 / (n_inserts * speed_rpm)
 
 
-__all__ = ["CuttingProcess", "single_point_process", "boring_process", "tooth_period"]
+__all__ = ["CuttingProcess", "BoringGeometry", "single_point_process", "boring_process", "tooth_period"]

@@ -41,6 +41,11 @@ DEPTH_SCAN_RATIO = 1.25
 #: Monodromy matrices up to this size are solved densely; larger ones by ARPACK (the few
 #: eigenvalues of largest modulus), falling back to the dense solver if ARPACK does not converge.
 DENSE_EIG_MAX = 120
+#: Richardson extrapolation of the spectral radius (:func:`monodromy_spectral_radius`) when
+#: half the steps are at least this many.
+RICHARDSON_MIN_STEPS = 12
+#: Samples per revolution of the steady deflected path (:func:`deflected_depth_weights`).
+DEFLECTION_SAMPLES = 360
 
 
 def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,6 +141,8 @@ def deflected_depth_weights(structure: ToolPointStructure, process: CuttingProce
     without it (or without such edge lengths) only ``r_1`` counts, which does not depend on
     the depth. ``None`` for fixed-direction processes or without depth modulation (no such
     effect)."""
+    if depth_m is not None:
+        process = process.at_depth(depth_m)
     parts = _deflection_parts(structure, process, speed_rpm)
     return None if parts is None else _deflected_weights(parts, process, theta, depth_m)
 
@@ -146,14 +153,13 @@ def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
     each (720, 3) over one revolution; ``None`` when there is no depth modulation."""
     if not process.rotating or not np.any(process.depth_direction):
         return None
-    from robobore.dynamics.timedomain import forced_response
+    from robobore.dynamics.timedomain import nominal_cut_deflection
 
-    Ns = 720
-    rp = forced_response(structure, process, speed_rpm, 1.0, Ns)  # (Ns,3), a = 1 m
-    if np.any(process.edge_fixed_m):
-        r0 = forced_response(structure, process, speed_rpm, 0.0, Ns)  # fixed edge force only
-        return rp - r0, r0
-    return rp, None
+    parts = nominal_cut_deflection(structure, process, speed_rpm, DEFLECTION_SAMPLES)
+    if parts is None:
+        return None
+    r1, r0 = parts
+    return (r1, r0) if np.any(process.edge_fixed_m) else (r1, None)
 
 
 def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
@@ -290,15 +296,42 @@ def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingPro
 
 def _rho(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
          about_deflected, parts=False):
+    """Spectral radius with ``steps`` per delay, extrapolated to zero step (Richardson).
+
+    First-order semi-discretisation converges as the square of the step (Insperger, Stepan &
+    Turi 2008): ``rho(r) = rho* + C / r^2``, so the spectral radius with ``steps`` and with
+    half of them give ``rho* = rho(r) + (rho(r) - rho(r/2)) / 3``. On the example robot at
+    700 r/min (0.9 x its limit) 100 steps give 0.98392, 200 give 0.98414 and 800 give 0.98420;
+    the extrapolation from 100 and 50 steps gives 0.98419."""
     with np.errstate(over="ignore", invalid="ignore"):
+        if process.depth_dependent:
+            at = process.at_depth(depth_m)
+            if at is not process:
+                process, parts = at, False
+        if parts is False and about_deflected:
+            parts = _deflection_parts(structure, process, speed_rpm)
         rho = _monodromy(structure, process, speed_rpm, depth_m, steps,
                          include_process_stiffness, about_deflected, parts)
+        half = steps // 2
+        if math.isfinite(rho) and half >= RICHARDSON_MIN_STEPS:
+            rho_h = _monodromy(structure, process, speed_rpm, depth_m, half,
+                               include_process_stiffness, about_deflected, parts)
+            if math.isfinite(rho_h):
+                rho = max(0.0, rho + (rho - rho_h) / 3.0)
     return rho if math.isfinite(rho) else math.inf
 
 
 def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
                about_deflected=True, parts=False):
-    """``parts``: :func:`_deflection_parts` at this speed (``False``: compute them here)."""
+    """``parts``: :func:`_deflection_parts` at this speed (``False``: compute them here).
+
+    A depth-dependent (boring) process is linearised at ``depth_m`` itself
+    (:meth:`~robobore.dynamics.process.CuttingProcess.at_depth`), the chip the time domain
+    integrates at that depth; ``parts`` are then those of that process."""
+    if process.depth_dependent:
+        at = process.at_depth(depth_m)
+        if at is not process:
+            process, parts = at, False
     m = structure.n_modes
     tau = 60.0 / (process.n_inserts * speed_rpm)
     dt = tau / steps
@@ -334,9 +367,11 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
 
 def auto_steps(structure: ToolPointStructure, process: CuttingProcess, speed_rpm: float,
                per_cycle: int = 20, lo: int = 30, hi: int = 400) -> int:
-    """Semi-discretisation steps per delay: ``per_cycle`` steps per period of the highest mode."""
+    """Semi-discretisation steps per delay: ``per_cycle`` steps per period of the highest mode
+    (even, within ``lo`` .. ``hi``)."""
     tau = 60.0 / (process.n_inserts * speed_rpm)
-    return int(min(hi, max(lo, math.ceil(per_cycle * structure.frequency_Hz.max() * tau))))
+    r = int(min(hi, max(lo, math.ceil(per_cycle * structure.frequency_Hz.max() * tau))))
+    return r + (r % 2)  # even: the Richardson step halves it
 
 
 def depth_scan_grid(depth_hi_m: float = DEPTH_SCAN_HI_M, decades: float = DEPTH_SCAN_DECADES,
@@ -354,9 +389,18 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
                                       include_process_stiffness: bool = True,
                                       about_deflected: bool = True,
                                       decades: float = DEPTH_SCAN_DECADES,
-                                      ratio: float = DEPTH_SCAN_RATIO) -> float:
+                                      ratio: float = DEPTH_SCAN_RATIO,
+                                      guess_m: float | None = None) -> float:
     """Critical depth [m] at one speed: the first depth at which the monodromy spectral radius
     reaches 1.
+
+    ``guess_m`` (the limit at a neighbouring speed, as :func:`lobes_semidiscretization`
+    passes it): continuation instead of the grid scan. The spectral radius at the scan's
+    lowest depth decides whether the cut is unstable there (then the grid scan as below);
+    otherwise the crossing is bracketed from the guess outwards (``1 +- CONTINUATION_STEP``,
+    the bracket doubling until it holds) and narrowed as below. It costs about a fifth of the
+    grid scan and returns the same limit unless an unstable window lies between the scan's
+    lowest depth and the crossing nearest the guess.
 
     The stability indicator ``rho(a) - 1`` is evaluated on the geometric grid of
     :func:`depth_scan_grid` from the bottom up; between the last stable and the first unstable
@@ -368,7 +412,8 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
     cut, e.g. the depth-modulation stiffness). A spectral radius that overflows or is not a
     number counts as unstable. Never raises for a valid structure and process."""
     steps = steps or auto_steps(structure, process, speed_rpm)
-    parts = _deflection_parts(structure, process, speed_rpm) if about_deflected else None
+    parts = (_deflection_parts(structure, process, speed_rpm)
+             if about_deflected and not process.depth_dependent else False)
 
     def rho(b: float) -> float:
         r = _rho(structure, process, speed_rpm, b, steps, include_process_stiffness,
@@ -376,7 +421,45 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
         return r if r == r else math.inf  # NaN counts as unstable
 
     with blas_thread_limit(1):
+        if guess_m is not None and 0.0 < guess_m < depth_hi_m:
+            return _continue(rho, guess_m, depth_hi_m, tol, decades, ratio)
         return _scan(rho, depth_hi_m, tol, decades, ratio)
+
+
+#: First relative step of the continuation bracket (:func:`critical_depth_semidiscretization`).
+CONTINUATION_STEP = 0.03
+
+
+def _continue(rho, guess: float, depth_hi_m: float, tol: float, decades: float,
+              ratio: float) -> float:
+    """Crossing of ``rho = 1`` bracketed outwards from ``guess``, after checking the scan's
+    lowest depth (unstable there: the grid scan)."""
+    lowest = float(depth_scan_grid(depth_hi_m, decades, ratio)[0])
+    if guess <= lowest or rho(lowest) >= 1.0:
+        return _scan(rho, depth_hi_m, tol, decades, ratio)
+    r_g = rho(guess)
+    step = 1.0 + CONTINUATION_STEP
+    if r_g < 1.0:
+        lo, r_lo = guess, r_g
+        while True:
+            hi = min(lo * step, depth_hi_m)
+            r_hi = rho(hi)
+            if r_hi >= 1.0:
+                break
+            if hi >= depth_hi_m:
+                return math.inf
+            lo, r_lo, step = hi, r_hi, step * step
+    else:
+        hi, r_hi = guess, r_g
+        while True:
+            lo = max(hi / step, lowest)
+            r_lo = rho(lo)
+            if r_lo < 1.0:
+                break
+            if lo <= lowest:  # unstable down to the lowest depth: the grid scan decides
+                return _scan(rho, depth_hi_m, tol, decades, ratio)
+            hi, r_hi, step = lo, r_lo, step * step
+    return _narrow(rho, lo, r_lo, hi, r_hi, tol)
 
 
 def _scan(rho, depth_hi_m: float, tol: float, decades: float, ratio: float) -> float:
@@ -400,7 +483,12 @@ def _scan(rho, depth_hi_m: float, tol: float, decades: float, ratio: float) -> f
             r_prev = r1
         if lo is None:
             return math.inf
-    # Illinois false position on f = log rho over x = log a; f(x0) < 0 <= f(x1)
+    return _narrow(rho, lo, r_lo, hi, r_hi, tol)
+
+
+def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> float:
+    """Illinois false position on ``f = log rho`` over ``x = log a`` between a stable ``lo``
+    and an unstable ``hi``, to a relative width ``tol``."""
     x0, x1 = math.log(lo), math.log(hi)
     f0 = math.log(max(r_lo, 1e-300))
     f1 = math.log(r_hi) if math.isfinite(r_hi) else math.inf

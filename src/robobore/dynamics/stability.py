@@ -150,16 +150,19 @@ def lobes_semidiscretization(structure: ToolPointStructure, process: CuttingProc
                              speed_rpm: np.ndarray, steps: int = 0,
                              depth_hi_m: float = DEPTH_SCAN_HI_M,
                              progress=None) -> LobeResult:
-    """Critical depth at each speed (:func:`critical_depth_semidiscretization`).
+    """Critical depth at each speed (:func:`critical_depth_semidiscretization`), each speed's
+    search continued from the previous speed's finite limit (``guess_m``).
 
     ``inf`` at a speed: stable up to ``depth_hi_m`` (reported as unconditionally stable up to
     that depth). ``absolute_limit_m`` is the smallest finite critical depth (``inf`` if none)."""
     speeds = np.asarray(speed_rpm, float)
     out = np.empty(speeds.size)
     with blas_thread_limit(1):
+        prev = None
         for i, n in enumerate(speeds):
             out[i] = critical_depth_semidiscretization(structure, process, float(n),
-                                                       depth_hi_m, steps)
+                                                       depth_hi_m, steps, guess_m=prev)
+            prev = float(out[i]) if 0.0 < out[i] < depth_hi_m else None
             if progress is not None:
                 progress(1)
     fin = out[np.isfinite(out)]

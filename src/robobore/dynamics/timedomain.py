@@ -178,6 +178,12 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, sh
     return n_steps
 
 
+#: Divergence limit of the time domain: this floor [m] plus this factor times the largest
+#: steady forced displacement of the cut (:class:`SimulationSettings`).
+DIVERGENCE_FLOOR_M = 2e-3
+DIVERGENCE_FORCED_FACTOR = 10.0
+
+
 @dataclass(frozen=True)
 class SimulationSettings:
     """Spindle speed [rpm], depth of cut [m], revolutions, samples per revolution (0: auto).
@@ -188,10 +194,13 @@ class SimulationSettings:
     measures the growth of that perturbation; ``"rest"`` starts from zero displacement with the
     nominal chip (the tool is loaded suddenly).
 
-    ``divergence_limit_m``: the run stops when the tool-point displacement exceeds this
-    (default 2 mm, tens of times any depth of cut or feed of boring): the linear cutting model
-    means nothing beyond it (the insert would break or the bar hit the wall). The Dataset is
-    then cut at the last whole revolution and flagged ``diverged``; the cut is vibratory.
+    ``divergence_limit_m``: the run stops when the tool-point displacement exceeds this: the
+    linear cutting model means nothing beyond it (the insert would break or the bar hit the
+    wall). The Dataset is then cut at the last whole revolution and flagged ``diverged``; the
+    cut is vibratory. Default (``None``): :data:`DIVERGENCE_FLOOR_M` (2 mm, tens of times a
+    finishing cut's depth or feed) plus :data:`DIVERGENCE_FORCED_FACTOR` times the largest
+    steady forced displacement of the cut, so that the deflection a deep cut causes by itself
+    is not taken for a divergence.
     """
 
     speed_rpm: float
@@ -200,7 +209,7 @@ class SimulationSettings:
     samples_per_rev: int = 0
     start: str = "periodic"
     perturbation_m: float | None = None
-    divergence_limit_m: float = 2e-3
+    divergence_limit_m: float | None = None
 
     def check(self) -> None:
         if not (math.isfinite(self.speed_rpm) and 1.0 <= self.speed_rpm <= 100000.0):
@@ -215,7 +224,8 @@ class SimulationSettings:
         if self.start not in ("periodic", "rest"):
             raise ConfigError("unknown start", field="start", value=self.start,
                               expected="periodic or rest")
-        if not (math.isfinite(self.divergence_limit_m) and self.divergence_limit_m > 0.0):
+        lim = self.divergence_limit_m
+        if lim is not None and not (math.isfinite(lim) and lim > 0.0):
             raise ConfigError("divergence limit must be positive", field="divergence_limit_m",
                               value=self.divergence_limit_m, expected="a length > 0 in m")
         if self.samples_per_rev and not 8 <= self.samples_per_rev <= 200000:
@@ -264,7 +274,137 @@ def periodic_start(structure: ToolPointStructure, process: CuttingProcess, Ns: i
     return c, om, F
 
 
+@nb.njit(cache=True)
+def _step_map(Phi, Gam, Pm_i, Fm_i, half_dt, A, b):  # pragma: no cover - numba
+    """One step of the nominal-chip map (see :func:`_orbit_kernel`) into ``A`` (2m, 2m) and
+    ``b`` (2m, K)."""
+    m = Phi.shape[0]
+    A[:, :] = 0.0
+    for j in range(m):
+        A[j, j] = Phi[j, 0, 0]
+        A[j, m + j] = Phi[j, 0, 1]
+        A[m + j, j] = Phi[j, 1, 0]
+        A[m + j, m + j] = Phi[j, 1, 1]
+        for k in range(m):
+            A[j, k] += Gam[j, 0] * Pm_i[j, k]
+            A[j, m + k] += Gam[j, 0] * Pm_i[j, k] * half_dt
+            A[m + j, k] += Gam[j, 1] * Pm_i[j, k]
+            A[m + j, m + k] += Gam[j, 1] * Pm_i[j, k] * half_dt
+        for c in range(Fm_i.shape[1]):
+            b[j, c] = Gam[j, 0] * Fm_i[j, c]
+            b[m + j, c] = Gam[j, 1] * Fm_i[j, c]
+
+
+@nb.njit(cache=True)
+def _orbit_kernel(Phi, Gam, Pm, Fm, half_dt, X_out):  # pragma: no cover - numba
+    """Periodic orbits of the discrete map of :func:`_simulate_kernel` on the nominal chip.
+
+    Step ``i``: ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))`` per mode (``Pm``: the
+    depth-modulation stiffness in modal coordinates, (Ns, m, m); ``Fm``: the nominal modal
+    forces, (Ns, m, K), K load cases); the state ``x = (q, q')`` (2m). Composes the Ns steps
+    into ``x_Ns = T x_0 + c``, solves ``x_0 = T x_0 + c`` and writes the orbits' states at the
+    step starts into ``X_out`` (Ns, 2m, K). Returns False when ``I - T`` is singular."""
+    Ns, m, K = Fm.shape
+    n = 2 * m
+    T = np.eye(n)
+    c = np.zeros((n, K))
+    A = np.zeros((n, n))
+    b = np.zeros((n, K))
+    for i in range(Ns):
+        _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
+        T = A @ T
+        c = A @ c + b
+    M = np.eye(n) - T
+    if abs(np.linalg.det(M)) < 1e-300:
+        return False
+    x = np.linalg.solve(M, c)
+    for i in range(Ns):
+        X_out[i] = x
+        _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
+        x = A @ x + b
+    return True
+
+
+def periodic_orbit(structure: ToolPointStructure, process: CuttingProcess, Ns: int,
+                   depth_m: float, speed_rpm: float):
+    """The steady periodic cut of the time-domain map, depth-modulation stiffness included.
+
+    On the nominal chip (every insert cutting ``h0``, the surface one pitch old equal to the
+    present path, so no regeneration) the simulated map is linear with period one revolution:
+    the nominal force plus the depth-modulation stiffness ``P(theta) r``
+    (:meth:`~robobore.dynamics.process.CuttingProcess.process_stiffness`) at the step
+    midpoints, integrated as :func:`simulate` integrates it. Its periodic orbit is solved
+    exactly (the Ns steps composed, ``x_0 = T x_0 + c``). Returns ``(q0, qd0, sr, r_t)`` as
+    :func:`_periodic_state`; ``None`` when the process has no depth modulation (the harmonic
+    solution is then exact) or the orbit does not exist (``I - T`` singular)."""
+    orbits = _orbits(structure, process, Ns, speed_rpm, (depth_m,))
+    if orbits is None:
+        return None
+    X = orbits[:, :, 0]
+    m = structure.n_modes
+    dt = 60.0 / (speed_rpm * Ns)
+    D = structure.directions
+    q_t, qd_t = X[:, :m], X[:, m:]
+    r_mid = (q_t + 0.5 * dt * qd_t) @ D  # what the kernel stores as the surface
+    spp = Ns // int(process.n_inserts)
+    sr = r_mid[np.arange(Ns) % spp]
+    return X[0, :m].copy(), X[0, m:].copy(), np.ascontiguousarray(sr), q_t @ D
+
+
+def _orbits(structure: ToolPointStructure, process: CuttingProcess, Ns: int, speed_rpm: float,
+            depths: tuple[float, ...]) -> np.ndarray | None:
+    """States (Ns, 2m, K) of the nominal-chip orbits at the depths ``depths`` (a depth of 0:
+    the depth-independent edge force alone); None without depth modulation or orbit."""
+    if not process.rotating or not np.any(process.depth_direction):
+        return None
+    dt = 60.0 / (speed_rpm * Ns)
+    Phi, Gam = modal_zoh(structure, dt)
+    theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # the kernel's directions (midpoints)
+    D = structure.directions
+    Pm = np.einsum("jo,noi,ki->njk", D, process.process_stiffness(theta), D)
+    Fm = np.stack([_nominal_force(process, theta, a) @ D.T for a in depths], axis=-1)
+    X = np.empty((Ns, 2 * structure.n_modes, len(depths)))
+    if not _orbit_kernel(Phi, Gam, np.ascontiguousarray(Pm), np.ascontiguousarray(Fm),
+                         0.5 * dt, X):
+        return None
+    return X
+
+
+def nominal_cut_deflection(structure: ToolPointStructure, process: CuttingProcess,
+                           speed_rpm: float, samples_per_rev: int = 720
+                           ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Steady tool-point displacement of the nominal cut, split by what drives it: per unit
+    depth ``r_1`` and the depth-independent part ``r_0`` (the trailing-side edge force), each
+    (samples_per_rev, 3) at bar angles ``2 pi i / samples_per_rev``; the displacement at depth
+    ``a`` is ``a r_1 + r_0``. The orbit of :func:`periodic_orbit` (depth-modulation stiffness
+    included); None for a process without depth modulation."""
+    N = int(process.n_inserts)
+    Ns = int(math.ceil(samples_per_rev / N) * N)
+    X = _orbits(structure, process, Ns, speed_rpm, (1.0, 0.0))
+    if X is None:
+        return None
+    r = np.einsum("nmk,mo->nok", X[:, :structure.n_modes, :], structure.directions)
+    r0 = r[:, :, 1]
+    return r[:, :, 0] - r0, r0
+
+
+def _nominal_force(process: CuttingProcess, theta: np.ndarray, depth_m: float) -> np.ndarray:
+    """Nominal (rigid-tool) force on the tool [N], all inserts, at bar angles ``theta``."""
+    N = int(process.n_inserts)
+    f0 = (np.einsum("e,e,ei->i", process.width_per_depth * depth_m, process.h0, process.shear)
+          + np.einsum("e,ei->i", process.edge_per_depth * depth_m + process.edge_fixed_m,
+                      process.edge))
+    F = np.zeros((theta.size, 3))
+    for p in range(N):
+        B = process.basis(theta + 2 * np.pi * p / N)
+        F += np.einsum("nki,k->ni", B, f0)
+    return F
+
+
 def _periodic_state(structure, process, Ns, depth_m, speed_rpm):
+    orbit = periodic_orbit(structure, process, Ns, depth_m, speed_rpm)
+    if orbit is not None:
+        return orbit
     c, om, _ = periodic_start(structure, process, Ns, depth_m)
     w = om * speed_rpm / 60.0  # (Ns,1) rad/s
     H = structure.modal_frf(np.abs(w[:, 0])).T  # (Ns, m) receptance at |w|
@@ -292,11 +432,15 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
              settings: SimulationSettings, insert_profile=None) -> xr.Dataset:
     """Run the time-domain simulation; see the module docstring for the Dataset contents.
 
+    A boring process is integrated as built at the simulated depth
+    (:meth:`~robobore.dynamics.process.CuttingProcess.at_depth`).
+
     ``insert_profile``: optional :class:`robobore.cutting.geometry.BoringInsert` used to draw
     the machined bore profile along the feed (nose geometry + the tool's radial and axial
     position at each pass). Without it the surface record is the chip-normal displacement.
     """
     settings.check()
+    process = process.at_depth(settings.depth_m)  # the chip geometry at the simulated depth
     N = int(process.n_inserts)
     Ns = settings.samples_per_rev or auto_samples_per_rev(structure, settings.speed_rpm, N)
     Ns = int(math.ceil(Ns / N) * N)
@@ -314,8 +458,9 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     inv_depth = 1.0 / a if np.any(process.depth_direction) else 0.0
     m = structure.n_modes
     spp = Ns // N
+    r_forced = None
     if settings.start == "periodic":
-        q, qd, sr, _ = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
+        q, qd, sr, r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
         pert = settings.perturbation_m
         if pert is None:
             pert = 0.01 * float(np.max(process.h0))
@@ -324,6 +469,11 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
         q = np.zeros(m)
         qd = np.zeros(m)
         sr = np.zeros((Ns, 3))
+    limit = settings.divergence_limit_m
+    if limit is None:
+        if r_forced is None:
+            r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)[3]
+        limit = DIVERGENCE_FLOOR_M + DIVERGENCE_FORCED_FACTOR * float(np.abs(r_forced).max())
     tlast = np.full(Ns, -spp, dtype=np.int64)
     F = np.empty((n_steps, 3))
     X = np.empty((n_steps, 3))
@@ -336,14 +486,14 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
                               process.depth_direction, inv_depth, process.overlap,
                               structure.omega, structure.damping_ratio,
                               1.0 / structure.modal_mass, 0.5 * dt, q, qd, sr, tlast, F, X, acc,
-                              area, float(settings.divergence_limit_m))
+                              area, float(limit))
     diverged = n_done < n_steps
     revs = int(settings.revolutions)
     if diverged:
         revs = n_done // Ns  # keep the whole revolutions before the divergence
         if revs < 1:
             raise NumericalError(
-                f"the tool-point displacement exceeded {settings.divergence_limit_m * 1e3:.3g} mm"
+                f"the tool-point displacement exceeded {limit * 1e3:.3g} mm"
                 f" within the first revolution (t = {n_done * dt:.4g} s): the cut diverges at "
                 "once; check the structure (stiffness, mass) and the cutting coefficients")
         n_steps = revs * Ns
@@ -379,7 +529,7 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
                "feed_per_rev_m": process.feed_per_rev_m, "process": process.label,
                "diverged": int(diverged), "revolutions_requested": int(settings.revolutions),
                "diverged_at_s": n_done * dt if diverged else math.nan,
-               "divergence_limit_m": float(settings.divergence_limit_m),
+               "divergence_limit_m": float(limit),
                "frame": "boring frame: x horizontal, y vertical, z feed (bore axis)"},
     )
     prof_z, prof_r, ra, rz = surface_profile(X, area, Ns, N, process, insert_profile)
@@ -486,6 +636,6 @@ def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, 
     }
 
 
-__all__ = ["simulate", "SimulationSettings", "modal_zoh", "auto_samples_per_rev",
-           "periodic_start", "forced_response",
+__all__ = ["simulate", "SimulationSettings", "DIVERGENCE_FLOOR_M", "DIVERGENCE_FORCED_FACTOR", "modal_zoh", "auto_samples_per_rev",
+           "periodic_start", "forced_response", "periodic_orbit", "nominal_cut_deflection",
            "surface_profile", "roughness", "summarize", "FORM_DEGREE"]

@@ -1,0 +1,175 @@
+"""Lobes against the time domain on random SYNTHETIC boring cuts: the check that holds the
+stability answers of robobore to each other.
+
+A cut (:class:`CrossCheckCut`) is a robot-like three-axis equivalent model, an insert, a feed
+and a speed drawn from documented ranges (:func:`random_cut`; SYNTHETIC ground truth: no
+measurement is involved). :func:`check_cut` computes the semi-discretisation critical depth
+``a_c`` of the cut and simulates it in the time domain at ``0.8 a_c`` and ``1.25 a_c``, at the
+default sampling and at twice it: the lobes and the time domain agree when the first two say
+no chatter and the last two say chatter. ``benchmarks/chatter_agreement.py`` runs the set
+and prints the agreement table; ``tests/dynamics/test_dyn_agreement.py`` holds a sample of
+it.
+
+Ranges (the held-out description of the robots and cuts robobore is judged on): three
+orthogonal units in a random frame, 5-60 Hz, damping ratio 1-6 %, stiffness 0.3-10 N/um;
+spindle speed 150-1500 r/min; feed 0.05-0.5 mm/r; nose radius 0.2-1.2 mm; approach angle
+90 deg; one insert; bore 40 mm; the TC4 coefficients of `material = "TC4"` at the cut's speed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robobore.cutting.forces import CuttingCoefficients, ti64_coefficients
+from robobore.cutting.geometry import BoringInsert
+from robobore.dynamics.process import CuttingProcess, boring_process
+from robobore.dynamics.structure import ToolPointStructure
+
+#: Ranges of :func:`random_cut` (see the module docstring).
+FREQUENCY_HZ = (5.0, 60.0)
+DAMPING_RATIO = (0.01, 0.06)
+STIFFNESS_N_PER_M = (3e5, 1e7)
+SPEED_RPM = (150.0, 1500.0)
+FEED_MM_PER_REV = (0.05, 0.5)
+NOSE_RADIUS_MM = (0.2, 1.2)
+BORE_DIAMETER_M = 0.04
+#: Depth at which a process is first built (its geometry is rebuilt at every trial depth).
+REFERENCE_DEPTH_M = 0.05e-3
+
+
+@dataclass(frozen=True)
+class CrossCheckCut:
+    """One SYNTHETIC cut: the structure, the insert, the feed [m/rev], the speed [r/min] and
+    the coefficients."""
+
+    structure: ToolPointStructure
+    insert: BoringInsert
+    feed_per_rev_m: float
+    speed_rpm: float
+    coefficients: CuttingCoefficients
+    label: str = ""
+
+    def process(self, depth_m: float = REFERENCE_DEPTH_M) -> CuttingProcess:
+        """The boring process of the cut at ``depth_m``."""
+        return boring_process(self.insert, self.coefficients, depth_m, self.feed_per_rev_m)
+
+    def describe(self) -> dict[str, Any]:
+        st = self.structure
+        return {"label": self.label, "speed_rpm": self.speed_rpm,
+                "feed_mm_per_rev": self.feed_per_rev_m * 1e3,
+                "nose_radius_mm": self.insert.nose_radius_m * 1e3,
+                "frequency_Hz": st.frequency_Hz.tolist(),
+                "damping_ratio": st.damping_ratio.tolist(),
+                "stiffness_N_per_um": (st.stiffness_N_per_m * 1e-6).tolist()}
+
+
+def random_structure(rng: np.random.Generator) -> ToolPointStructure:
+    """Three orthogonal units in a random frame, frequencies, damping ratios and stiffnesses
+    drawn in the ranges of the module (stiffness log-uniform)."""
+    q, _ = np.linalg.qr(rng.standard_normal((3, 3)))
+    f = np.sort(rng.uniform(*FREQUENCY_HZ, 3))
+    lo, hi = STIFFNESS_N_PER_M
+    k = 10 ** rng.uniform(math.log10(lo), math.log10(hi), 3)
+    z = rng.uniform(*DAMPING_RATIO, 3)
+    return ToolPointStructure.from_modes([
+        {"frequency_Hz": float(f[i]), "damping_ratio": float(z[i]),
+         "stiffness_N_per_m": float(k[i]), "direction": q[:, i].tolist()} for i in range(3)])
+
+
+def random_cut(rng: np.random.Generator, label: str = "") -> CrossCheckCut:
+    """A SYNTHETIC cut drawn from the module's ranges."""
+    st = random_structure(rng)
+    n = float(rng.uniform(*SPEED_RPM))
+    f = float(rng.uniform(*FEED_MM_PER_REV)) * 1e-3
+    r = float(rng.uniform(*NOSE_RADIUS_MM)) * 1e-3
+    ins = BoringInsert(nose_radius_m=r, approach_angle_deg=90.0)
+    coef = ti64_coefficients(math.pi * BORE_DIAMETER_M * n)
+    return CrossCheckCut(st, ins, f, n, coef, label)
+
+
+@dataclass(frozen=True)
+class CrossCheckResult:
+    """Critical depth [m] and the four time-domain verdicts of one cut (``None``: the limit
+    is 0 or beyond the scan, nothing to simulate)."""
+
+    cut: CrossCheckCut
+    critical_depth_m: float
+    runs: tuple[dict[str, Any], ...]
+
+    @property
+    def applicable(self) -> bool:
+        return 0.0 < self.critical_depth_m < math.inf
+
+    @property
+    def agrees(self) -> bool | None:
+        """Every run's verdict on the side of the limit its depth is on, or stating the
+        nonlinear cause (the tool leaving the cut) that takes it outside the linear lobes;
+        None when there is nothing to check."""
+        if not self.applicable:
+            return None
+        return all(run_agrees(r) for r in self.runs)
+
+    @property
+    def nonlinear(self) -> bool:
+        """Some run leaves the linear model (the tool leaves the cut)."""
+        return any(r["tool_leaves_cut"] for r in self.runs)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**self.cut.describe(),
+                "critical_depth_mm": (self.critical_depth_m * 1e3
+                                      if math.isfinite(self.critical_depth_m) else None),
+                "agrees": self.agrees, "runs": list(self.runs)}
+
+
+def run_agrees(run: dict[str, Any]) -> bool:
+    """A run at ``factor`` x the critical depth agrees when it chatters above the limit and
+    does not below it, or when its verdict states the tool leaving the cut."""
+    return bool(run["tool_leaves_cut"] or run["chatter"] == (run["factor"] > 1.0))
+
+
+def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
+              sampling: tuple[int, ...] = (1, 2), process: CuttingProcess | None = None,
+              revolutions: int | None = None) -> CrossCheckResult:
+    """Semi-discretisation critical depth of ``cut`` and the time-domain verdicts at
+    ``factors`` x that depth, at the default samples per revolution times each of
+    ``sampling``. ``process``: the process whose lobes are checked (default: the cut's,
+    rebuilt at every depth); the time domain always integrates the cut's process at its own
+    depth. ``revolutions``: the run length (default: the time domain's own choice)."""
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
+    from robobore.dynamics.timedomain import SimulationSettings, simulate, auto_samples_per_rev
+
+    pr = cut.process() if process is None else process
+    ac = critical_depth_semidiscretization(cut.structure, pr, cut.speed_rpm)
+    runs: list[dict[str, Any]] = []
+    if 0.0 < ac < math.inf:
+        base = auto_samples_per_rev(cut.structure, cut.speed_rpm, cut.insert.n_inserts)
+        for fac in factors:
+            a = fac * ac
+            if a > 0.05:
+                continue
+            pa = cut.process(a)
+            for s in sampling:
+                kw = {} if revolutions is None else {"revolutions": int(revolutions)}
+                ds = simulate(cut.structure, pa,
+                              SimulationSettings(cut.speed_rpm, a, samples_per_rev=base * s,
+                                                 **kw), cut.insert)
+                v = classify(ds)
+                runs.append({"factor": fac, "sampling": s, "depth_mm": a * 1e3,
+                             "chatter": bool(v.chatter), "decided": bool(v.chatter_decided),
+                             "cause": v.chatter_cause,
+                             "floquet_multiplier": v.floquet_multiplier,
+                             "vibration_growth": v.vibration_growth,
+                             "revolutions": int(ds.attrs["revolutions"]),
+                             "samples_per_rev": int(ds.attrs["samples_per_rev"]),
+                             "tool_leaves_cut": bool(v.tool_leaves_cut)})
+    return CrossCheckResult(cut, ac, tuple(runs))
+
+
+__all__ = ["CrossCheckCut", "CrossCheckResult", "run_agrees", "random_cut", "random_structure", "check_cut",
+           "FREQUENCY_HZ", "DAMPING_RATIO", "STIFFNESS_N_PER_M", "SPEED_RPM", "FEED_MM_PER_REV",
+           "NOSE_RADIUS_MM"]
