@@ -41,6 +41,10 @@ def main() -> None:
         rows.append(d)
         if not res.applicable:
             counts["zero" if res.critical_depth_m == 0.0 else "stable"] += 1
+            ic = res.interrupted_confirmed
+            if ic is not None:
+                counts["interrupted"] = counts.get("interrupted", 0) + 1
+                counts["interrupted_confirmed"] = counts.get("interrupted_confirmed", 0) + ic
             continue
         counts["agree" if res.agrees else "disagree"] += 1
         counts["nonlinear"] = counts.get("nonlinear", 0) + int(res.nonlinear)
@@ -54,6 +58,12 @@ def main() -> None:
                   f"f_n {np.round(cut.structure.frequency_Hz, 1).tolist()} -> {bad}", flush=True)
     dt = time.perf_counter() - t0
     n_app = counts["agree"] + counts["disagree"]
+    strict = sum(1 for r in rows if r["agrees"] is not None
+                 and all(x["chatter"] == (x["factor"] > 1.0) for x in r["runs"]))
+    print(f"verdicts on the side of the limit without the nonlinear exemption: {strict}/{n_app}; "
+          f"limit 0 because the steady cut is interrupted up to the linear limit: "
+          f"{counts.get('interrupted', 0)} (time domain finds the tool leaving the cut below "
+          f"it: {counts.get('interrupted_confirmed', 0)})")
     print(f"lobes: {'fixed at 0.05 mm' if a.fixed else 'rebuilt at each depth'}; "
           f"{a.cuts} cuts (seed {a.seed}), {n_app} with a finite limit: agree "
           f"{counts['agree']}/{n_app}; limit 0: {counts['zero']}, stable to 50 mm: "

@@ -99,6 +99,7 @@ class CrossCheckResult:
     cut: CrossCheckCut
     critical_depth_m: float
     runs: tuple[dict[str, Any], ...]
+    interrupted_below_m: float = 0.0
 
     @property
     def applicable(self) -> bool:
@@ -114,6 +115,13 @@ class CrossCheckResult:
         return all(run_agrees(r) for r in self.runs)
 
     @property
+    def interrupted_confirmed(self) -> bool | None:
+        """For a speed without a chatter-free depth (interrupted up to the linear limit):
+        whether the time domain below that limit finds the tool leaving the cut."""
+        runs = [r for r in self.runs if r.get("interrupted")]
+        return None if not runs else all(r["tool_leaves_cut"] for r in runs)
+
+    @property
     def nonlinear(self) -> bool:
         """Some run leaves the linear model (the tool leaves the cut)."""
         return any(r["tool_leaves_cut"] for r in self.runs)
@@ -122,6 +130,7 @@ class CrossCheckResult:
         return {**self.cut.describe(),
                 "critical_depth_mm": (self.critical_depth_m * 1e3
                                       if math.isfinite(self.critical_depth_m) else None),
+                "interrupted_below_mm": self.interrupted_below_m * 1e3,
                 "agrees": self.agrees, "runs": list(self.runs)}
 
 
@@ -140,12 +149,32 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
     rebuilt at every depth); the time domain always integrates the cut's process at its own
     depth. ``revolutions``: the run length (default: the time domain's own choice)."""
     from robobore.dynamics.chatter import classify
-    from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
+    from robobore.dynamics.semidiscretization import (
+        chatter_free_window,
+        critical_depth_semidiscretization,
+    )
     from robobore.dynamics.timedomain import SimulationSettings, simulate, auto_samples_per_rev
 
     pr = cut.process() if process is None else process
-    ac = critical_depth_semidiscretization(cut.structure, pr, cut.speed_rpm)
+    if process is None:
+        below, ac = chatter_free_window(cut.structure, pr, cut.speed_rpm)
+    else:
+        below, ac = 0.0, critical_depth_semidiscretization(cut.structure, pr, cut.speed_rpm)
     runs: list[dict[str, Any]] = []
+    if ac == 0.0 and below > 0.0 and 0.8 * below <= 0.05:
+        # no chatter-free depth: the steady cut is interrupted up to the linear limit; the
+        # time domain at 0.8 x that limit must find the tool leaving the cut
+        a = 0.8 * below
+        ds = simulate(cut.structure, cut.process(a), SimulationSettings(cut.speed_rpm, a),
+                      cut.insert)
+        v = classify(ds)
+        runs.append({"factor": 0.8, "sampling": 1, "depth_mm": a * 1e3, "interrupted": True,
+                     "chatter": bool(v.chatter), "decided": bool(v.chatter_decided),
+                     "cause": v.chatter_cause, "floquet_multiplier": v.floquet_multiplier,
+                     "vibration_growth": v.vibration_growth,
+                     "revolutions": int(ds.attrs["revolutions"]),
+                     "samples_per_rev": int(ds.attrs["samples_per_rev"]),
+                     "tool_leaves_cut": bool(v.tool_leaves_cut)})
     if 0.0 < ac < math.inf:
         base = auto_samples_per_rev(cut.structure, cut.speed_rpm, cut.insert.n_inserts)
         for fac in factors:
@@ -167,7 +196,7 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
                              "revolutions": int(ds.attrs["revolutions"]),
                              "samples_per_rev": int(ds.attrs["samples_per_rev"]),
                              "tool_leaves_cut": bool(v.tool_leaves_cut)})
-    return CrossCheckResult(cut, ac, tuple(runs))
+    return CrossCheckResult(cut, ac, tuple(runs), below)
 
 
 __all__ = ["CrossCheckCut", "CrossCheckResult", "run_agrees", "random_cut", "random_structure", "check_cut",

@@ -88,7 +88,9 @@ class CuttingProcess:
     label: str = ""
     edge_fixed_m: np.ndarray | None = None
     geometry: BoringGeometry | None = None
-    _at_depth_cache: dict = field(default_factory=dict, repr=False, compare=False)
+    #: derived quantities kept with the process: the processes at other depths
+    #: (:meth:`at_depth`) and the steady deflections of the lobes; not part of its value
+    memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         E = int(np.asarray(self.h0).size)
@@ -126,20 +128,20 @@ class CuttingProcess:
         if ref is not None and abs(a - ref) <= 1e-12 * ref:
             return self
         key = float(f"{a:.12g}")
-        hit = self._at_depth_cache.get(key)
+        hit = self.memo.get(key)
         if hit is None:
-            if len(self._at_depth_cache) > 4096:
-                self._at_depth_cache.clear()
+            if len(self.memo) > 4096:
+                self.memo.clear()
             hit = boring_process(g.insert, g.coefficients, key, g.feed_per_rev_m, g.n_elements,
                                  g.overlap, g.depth_modulation, g.min_chip_thickness_m,
                                  g.trailing_edge)
-            self._at_depth_cache[key] = hit
+            self.memo[key] = hit
         return hit
 
     def fixed(self) -> CuttingProcess:
         """The same process without its geometry: linearised once, at its reference depth,
         its widths scaled linearly with any other depth (the model of a straight edge)."""
-        return replace(self, geometry=None, _at_depth_cache={})
+        return replace(self, geometry=None, memo={})
 
     def basis(self, theta: np.ndarray) -> np.ndarray:
         """Basis matrices, shape (n, 3, 3): rows are the basis vectors in the boring frame."""
@@ -204,7 +206,7 @@ class CuttingProcess:
     def to_dict(self) -> dict[str, Any]:
         return {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                 for k, v in self.__dict__.items()
-                if k not in ("geometry", "_at_depth_cache")}
+                if k not in ("geometry", "memo")}
 
 
 def single_point_process(cutting_coefficient_N_per_m2: float, force_direction: np.ndarray,

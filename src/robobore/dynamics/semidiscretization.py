@@ -153,6 +153,19 @@ def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
     each (720, 3) over one revolution; ``None`` when there is no depth modulation."""
     if not process.rotating or not np.any(process.depth_direction):
         return None
+    cache = process.memo
+    key = ("deflection", float(speed_rpm), id(structure))
+    hit = cache.get(key)
+    if hit is not None and hit[0] is structure:
+        return hit[1]
+    out = _deflection_parts_uncached(structure, process, speed_rpm)
+    if len(cache) > 4096:
+        cache.clear()
+    cache[key] = (structure, out)
+    return out
+
+
+def _deflection_parts_uncached(structure, process, speed_rpm):
     from robobore.dynamics.timedomain import nominal_cut_deflection
 
     parts = nominal_cut_deflection(structure, process, speed_rpm, DEFLECTION_SAMPLES)
@@ -176,6 +189,104 @@ def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
         B = process.basis(th + 2 * np.pi * p / N)  # (n,3,3)
         w[:, p] = 1.0 + np.einsum("k,nki,ni->n", process.depth_direction, B, r)
     return np.clip(w, 0.0, None)
+
+
+def steady_min_depth_ratio(structure: ToolPointStructure, process: CuttingProcess,
+                           speed_rpm: float, depth_m: float) -> float:
+    """Smallest actual/nominal depth ``1 + e_r . r(theta) / a`` of any insert along the steady
+    deflected path of the cut at depth ``depth_m`` (the process built at that depth), before
+    clipping at 0; ``inf`` for a process without depth modulation. At or below 0 the forced
+    vibration takes the insert out of the material once per revolution."""
+    process = process.at_depth(depth_m)
+    parts = _deflection_parts(structure, process, speed_rpm)
+    if parts is None:
+        return math.inf
+    rp, r0 = parts
+    if r0 is not None and depth_m > 0.0:
+        rp = rp + r0 / depth_m
+    ang = 2 * np.pi * np.arange(rp.shape[0]) / rp.shape[0]
+    N = process.n_inserts
+    lo = math.inf
+    for p in range(N):
+        B = process.basis(ang + 2 * np.pi * p / N)
+        lo = min(lo, float(np.min(1.0 + np.einsum("k,nki,ni->n", process.depth_direction, B,
+                                                  rp))))
+    return lo
+
+
+def interrupted_below(structure: ToolPointStructure, process: CuttingProcess,
+                      speed_rpm: float, depth_m: float) -> float:
+    """Depth [m] below which the steady forced vibration takes an insert out of the material,
+    estimated with the steady deflections of the cut at ``depth_m`` (``a r_1 + r_0``, the
+    process built at ``depth_m``; the depth's own geometry changes them little): the largest
+    depth up to ``depth_m`` where the smallest actual/nominal depth ratio
+    ``1 + e_r . (r_1 + r_0 / a)`` is at or below 0. 0 when the cut stays in the material
+    down to vanishing depth (or has no depth modulation); ``depth_m`` itself when it is
+    interrupted there (then at every smaller depth too, the ratio falling with the depth where
+    ``r_0`` pulls the tool out, or staying below 0 where ``r_1`` alone does)."""
+    process = process.at_depth(depth_m)
+    parts = _deflection_parts(structure, process, speed_rpm)
+    if parts is None:
+        return 0.0
+    rp, r0 = parts
+    ang = 2 * np.pi * np.arange(rp.shape[0]) / rp.shape[0]
+    N = process.n_inserts
+    u1 = np.empty((N, rp.shape[0]))
+    u0 = np.zeros((N, rp.shape[0]))
+    for p in range(N):
+        B = process.basis(ang + 2 * np.pi * p / N)
+        u1[p] = np.einsum("k,nki,ni->n", process.depth_direction, B, rp)
+        if r0 is not None:
+            u0[p] = np.einsum("k,nki,ni->n", process.depth_direction, B, r0)
+
+    def gmin(a: float) -> float:
+        return float(np.min(1.0 + u1 + u0 / a))
+
+    if gmin(depth_m) <= 0.0:
+        return float(depth_m)
+    lo = depth_m * 1e-6
+    if gmin(lo) > 0.0:
+        return 0.0
+    hi = float(depth_m)
+    for _ in range(50):  # gmin(lo) <= 0 < gmin(hi)
+        mid = math.sqrt(lo * hi)
+        if gmin(mid) <= 0.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi / lo < 1.0 + 1e-4:
+            break
+    return lo
+
+
+def chatter_free_window(structure: ToolPointStructure, process: CuttingProcess,
+                        speed_rpm: float, guess_m: float | None = None,
+                        **kwargs) -> tuple[float, float]:
+    """``(interrupted_below_m, critical_depth_m)`` at one speed: the linear chatter limit
+    (:func:`critical_depth_semidiscretization`, keyword arguments passed on) and the depth
+    below which the steady forced vibration takes the tool out of the material
+    (:func:`interrupted_below`, evaluated at the limit, or at the top of the scan when the cut
+    is stable up to it). Depths between the two are chatter-free. When the cut is interrupted
+    at the limit itself there is no chatter-free depth at that speed: the critical depth is
+    then reported as 0 (with ``interrupted_below_m`` the linear limit)."""
+    a_c = critical_depth_semidiscretization(structure, process, speed_rpm, guess_m=guess_m,
+                                            **kwargs)
+    if a_c == 0.0:
+        return 0.0, 0.0
+    top = a_c if math.isfinite(a_c) else kwargs.get("depth_hi_m", DEPTH_SCAN_HI_M)
+    below = interrupted_below(structure, process, speed_rpm, float(top) * (1.0 - 1e-3))
+    if below >= float(top) * (1.0 - 1e-3):
+        return float(top), 0.0
+    return below, a_c
+
+
+def steady_cut_leaves(structure: ToolPointStructure, process: CuttingProcess,
+                      speed_rpm: float, depth_m: float) -> bool:
+    """True when the steady forced vibration of the cut at ``depth_m`` takes an insert out of
+    the material (:func:`steady_min_depth_ratio` <= 0): the cut is interrupted once per
+    revolution, outside the linear model, and the time domain finds it vibrating with the
+    tool leaving the cut. The critical-depth search counts such depths as not chatter-free."""
+    return steady_min_depth_ratio(structure, process, speed_rpm, depth_m) <= 0.0
 
 
 def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: np.ndarray,
@@ -410,7 +521,9 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
     to ``depth_hi_m`` is unstable (stable up to that depth) and 0 when the system is unstable
     already at ``depth_hi_m * 1e-3 * 10**-decades`` (an instability that does not need the
     cut, e.g. the depth-modulation stiffness). A spectral radius that overflows or is not a
-    number counts as unstable. Never raises for a valid structure and process."""
+    number counts as unstable. Never raises for a valid structure and process. Where the
+    steady forced vibration takes the tool out of the material below the limit, the linear
+    limit is not the whole answer: :func:`chatter_free_window` gives both ends."""
     steps = steps or auto_steps(structure, process, speed_rpm)
     parts = (_deflection_parts(structure, process, speed_rpm)
              if about_deflected and not process.depth_dependent else False)
@@ -524,4 +637,7 @@ def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> 
 
 __all__ = ["DEPTH_SCAN_HI_M", "DEPTH_SCAN_DECADES", "DEPTH_SCAN_RATIO", "DENSE_EIG_MAX",
            "blas_thread_limit", "depth_scan_grid", "auto_steps", "deflected_depth_weights",
-           "monodromy_spectral_radius", "critical_depth_semidiscretization"]
+           "monodromy_spectral_radius", "critical_depth_semidiscretization",
+           "steady_min_depth_ratio", "steady_cut_leaves", "interrupted_below",
+           "chatter_free_window", "CONTINUATION_STEP",
+           "RICHARDSON_MIN_STEPS", "DEFLECTION_SAMPLES"]

@@ -34,6 +34,7 @@ from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_HI_M,
     auto_steps,
     blas_thread_limit,
+    chatter_free_window,
     critical_depth_semidiscretization,
     deflected_depth_weights,
     depth_scan_grid,
@@ -55,7 +56,10 @@ class LobeResult:
     """Stability lobes: ``speed_rpm`` (n,), ``critical_depth_m`` (n,), ``chatter_frequency_Hz``
     (n,), ``absolute_limit_m`` and its frequency; ``method``; ``depth_scan_max_m``: the top of
     the semi-discretisation depth scan (``inf`` depths mean stable up to it; ``None`` for the
-    frequency domain)."""
+    frequency domain); ``interrupted_below_m`` (n,) (semi-discretisation): the depth below
+    which the steady forced vibration takes the tool out of the material (0: nowhere), so that
+    the chatter-free depths at a speed lie between it and the critical depth
+    (:func:`~robobore.dynamics.semidiscretization.chatter_free_window`)."""
 
     speed_rpm: np.ndarray
     critical_depth_m: np.ndarray
@@ -64,6 +68,7 @@ class LobeResult:
     absolute_limit_frequency_Hz: float
     method: str
     depth_scan_max_m: float | None = None
+    interrupted_below_m: np.ndarray | None = None
 
     @property
     def unconditionally_stable(self) -> bool:
@@ -79,6 +84,9 @@ class LobeResult:
         if self.depth_scan_max_m is not None:
             d["depth_scan_max_mm"] = self.depth_scan_max_m * 1e3
             d["stable_speeds"] = int(np.sum(~np.isfinite(self.critical_depth_m)))
+        if self.interrupted_below_m is not None:
+            d["interrupted_below_mm"] = self.interrupted_below_m * 1e3
+            d["interrupted_speeds"] = int(np.sum(self.interrupted_below_m > 0))
         return d
 
 
@@ -96,11 +104,68 @@ def _refine_min(omega: np.ndarray, b: np.ndarray) -> tuple[float, float]:
     return float(b[i]), float(omega[i])
 
 
+#: Depth grid of the frequency-domain lobes of a depth-dependent process: from
+#: DEPTH_SCAN_HI_M * 10**-FD_DEPTH_DECADES to DEPTH_SCAN_HI_M, neighbours FD_DEPTH_RATIO apart.
+FD_DEPTH_DECADES = 4.0
+FD_DEPTH_RATIO = 1.2
+
+
 def lobes_frequency_domain(structure: ToolPointStructure, process: CuttingProcess,
                            speed_rpm: np.ndarray, omega: np.ndarray | None = None) -> LobeResult:
-    """Zero-order frequency-domain lobes at the given spindle speeds (any number of modes)."""
+    """Zero-order frequency-domain lobes at the given spindle speeds (any number of modes).
+
+    A depth-dependent (boring) process is judged at each depth on its own chip: the
+    revolution-averaged directional matrix of ``process.at_depth(a)`` on a geometric depth
+    grid (:data:`FD_DEPTH_RATIO`), the limit ``L(n; a)`` of each, and at each speed the first
+    depth where ``a >= L(n; a)`` (interpolated linearly in ``log a`` between grid depths);
+    ``inf`` when no grid depth reaches its limit, 0 when the lowest does."""
     speeds = np.asarray(speed_rpm, float)
     w = frequency_grid(structure) if omega is None else np.asarray(omega, float)
+    if process.depth_dependent and process.overlap > 1.0 - 1e-9:
+        return _lobes_frequency_domain_by_depth(structure, process, speeds, w)
+    return _lobes_frequency_domain(structure, process, speeds, w)
+
+
+def _lobes_frequency_domain_by_depth(structure, process, speeds, w) -> LobeResult:
+    n = int(math.ceil(FD_DEPTH_DECADES * math.log(10.0) / math.log(FD_DEPTH_RATIO))) + 1
+    grid = np.geomspace(DEPTH_SCAN_HI_M * 10.0 ** (-FD_DEPTH_DECADES), DEPTH_SCAN_HI_M, n)
+    lim = np.empty((n, speeds.size))
+    frq = np.empty((n, speeds.size))
+    alim = np.empty(n)
+    afrq = np.empty(n)
+    for j, a in enumerate(grid):
+        r = _lobes_frequency_domain(structure, process.at_depth(float(a)), speeds, w)
+        lim[j], frq[j], alim[j], afrq[j] = (r.critical_depth_m, r.chatter_frequency_Hz,
+                                            r.absolute_limit_m, r.absolute_limit_frequency_Hz)
+    out = np.empty(speeds.size)
+    out_f = np.empty(speeds.size)
+    for i in range(speeds.size):
+        out[i], out_f[i] = _first_fixed_point(grid, lim[:, i], frq[:, i])
+    a_abs, f_abs = _first_fixed_point(grid, alim, afrq)
+    return LobeResult(speeds, out, out_f, a_abs, f_abs, "frequency")
+
+
+def _first_fixed_point(grid: np.ndarray, limit: np.ndarray, freq: np.ndarray
+                       ) -> tuple[float, float]:
+    """First depth of ``grid`` where ``a >= limit(a)``, interpolated in ``log a``."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.log(grid) - np.log(np.where(limit > 0, limit, np.nan))
+    g = np.where(np.isnan(g), np.where(limit <= 0, np.inf, -np.inf), g)  # limit 0: unstable
+    hit = np.nonzero(g >= 0.0)[0]
+    if hit.size == 0:
+        return math.inf, math.nan
+    j = int(hit[0])
+    if j == 0:
+        return 0.0, float(freq[0])
+    g0, g1 = g[j - 1], g[j]
+    if not (math.isfinite(g0) and math.isfinite(g1)) or g1 <= g0:
+        return float(grid[j]), float(freq[j])
+    t = -g0 / (g1 - g0)
+    a = math.exp(math.log(grid[j - 1]) + t * (math.log(grid[j]) - math.log(grid[j - 1])))
+    return a, float(freq[j] if t >= 0.5 else freq[j - 1])
+
+
+def _lobes_frequency_domain(structure, process, speeds, w) -> LobeResult:
     A0 = process.mean_directional_matrix()
     lam = oriented_eigenvalues(structure, A0, w)
     mu = process.overlap
@@ -157,18 +222,21 @@ def lobes_semidiscretization(structure: ToolPointStructure, process: CuttingProc
     that depth). ``absolute_limit_m`` is the smallest finite critical depth (``inf`` if none)."""
     speeds = np.asarray(speed_rpm, float)
     out = np.empty(speeds.size)
+    below = np.zeros(speeds.size)
     with blas_thread_limit(1):
         prev = None
         for i, n in enumerate(speeds):
-            out[i] = critical_depth_semidiscretization(structure, process, float(n),
-                                                       depth_hi_m, steps, guess_m=prev)
-            prev = float(out[i]) if 0.0 < out[i] < depth_hi_m else None
+            below[i], out[i] = chatter_free_window(structure, process, float(n), guess_m=prev,
+                                                   depth_hi_m=depth_hi_m, steps=steps)
+            # continue from the linear limit (the interruption does not move it)
+            lin = out[i] if out[i] > 0.0 else below[i]
+            prev = float(lin) if 0.0 < lin < depth_hi_m else None
             if progress is not None:
                 progress(1)
     fin = out[np.isfinite(out)]
     alim = float(fin.min()) if fin.size else math.inf
     return LobeResult(speeds, out, np.full(speeds.size, np.nan), alim, math.nan,
-                      "semi-discretization", depth_hi_m)
+                      "semi-discretization", depth_hi_m, below)
 
 
 # --------------------------------------------------------------------------- mode coupling
@@ -188,7 +256,9 @@ class ModeCoupling:
 
 def mode_coupling(structure: ToolPointStructure, process: CuttingProcess,
                   depth_m: float) -> ModeCoupling:
-    """Tlusty/Pan mode-coupling criterion at depth ``depth_m`` (no regeneration)."""
+    """Tlusty/Pan mode-coupling criterion at depth ``depth_m`` (no regeneration), on the
+    process's chip at that depth (:meth:`~robobore.dynamics.process.CuttingProcess.at_depth`)."""
+    process = process.at_depth(depth_m)
     m = structure.n_modes
     D = structure.directions
     minv = 1.0 / structure.modal_mass
@@ -224,7 +294,7 @@ def mode_coupling_limit(structure: ToolPointStructure, process: CuttingProcess,
         return math.inf
     i = flags.index(True)
     lo, hi = grid[i - 1], grid[i]
-    for _ in range(60):
+    for _ in range(40):
         mid = 0.5 * (lo + hi)
         if bad(mid):
             hi = mid

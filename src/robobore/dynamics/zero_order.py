@@ -51,18 +51,31 @@ def oriented_eigenvalues(structure: ToolPointStructure, A0: np.ndarray,
     sv = np.linalg.svd(A0, compute_uv=False)
     if sv[1] <= 1e-12 * sv[0]:
         return np.trace(M, axis1=1, axis2=2)[None, :]
-    ev = np.linalg.eigvals(M)  # (nw, 3)
+    ev = np.ascontiguousarray(np.linalg.eigvals(M))  # (nw, 3)
     out = np.empty_like(ev)
-    out[0] = ev[0]
-    perms = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
-    for i in range(1, ev.shape[0]):
-        best, cost = None, np.inf
-        for p in perms:
-            c = np.abs(ev[i, list(p)] - out[i - 1]).sum()
-            if c < cost:
-                best, cost = p, c
-        out[i] = ev[i, list(best)]
+    _track_eigenvalues(ev, _PERMS, out)
     return out.T
+
+
+_PERMS = np.array([(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)])
+
+
+@nb.njit(cache=True)
+def _track_eigenvalues(ev, perms, out):  # pragma: no cover - numba
+    """Order the eigenvalues of each frequency (rows of ``ev``, (nw, 3)) by nearest-neighbour
+    matching to the previous frequency's: the permutation of least summed distance."""
+    out[0] = ev[0]
+    for i in range(1, ev.shape[0]):
+        best = 0
+        cost = np.inf
+        for q in range(perms.shape[0]):
+            c = 0.0
+            for k in range(3):
+                c += abs(ev[i, perms[q, k]] - out[i - 1, k])
+            if c < cost:
+                best, cost = q, c
+        for k in range(3):
+            out[i, k] = ev[i, perms[best, k]]
 
 
 def lobe_branches(lam: np.ndarray, overlap: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
