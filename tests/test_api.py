@@ -99,9 +99,16 @@ def test_readme_example_foot_raises_the_lobes_and_the_run_agrees(readme_run):
     assert speeds[0] == 150.0 and speeds[-1] == 1100.0 and speeds.size == 39
     d, df = np.asarray(lb["critical_depth_mm"]), np.asarray(lf["critical_depth_mm"])
     assert np.all(d >= 0) and np.all(df >= 0)
-    # a robot: chatter within a few tenths of a mm at most speeds, never above the scan
-    assert np.mean((d > 0) & np.isfinite(d)) >= 0.8
+    # a robot: chatter within a few tenths of a mm at most speeds, never above the scan;
+    # no chatter-free depth near the forced resonances (425-475 r/min: the 6.9 Hz mode;
+    # 750-800 r/min: twice the spindle frequency at the 24.6 Hz mode; above 975 r/min), where
+    # the steady forced vibration takes the tool out of the cut or the bar's parametric
+    # instability needs no cut (27 of 39 speeds finite)
+    assert np.mean((d > 0) & np.isfinite(d)) >= 0.6
     assert np.median(d) < 1.0
+    below = np.asarray(lb["interrupted_below_mm"])
+    assert below.shape == d.shape and np.all(below >= 0)
+    assert np.all(d[d > 0] > below[d > 0])  # chatter-free window between the two
     # the pressure foot adds stiffness and damping: every axis stiffer, lobes higher
     for a in "xyz":
         assert ns["robot_foot"].stiffness_N_per_m[a] > ns["robot"].stiffness_N_per_m[a]

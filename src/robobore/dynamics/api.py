@@ -12,11 +12,16 @@ the process; a dict config's ``coefficients`` may be the cutting stage's
 (:func:`robobore.dynamics.handoff.with_coefficients`).
 
 The summary's verdicts (:mod:`robobore.dynamics.chatter`): ``chatter`` (the vibration
-grows), ``surface_finish`` ("ok" / "rough": Ra after form removal against
-``ra_tolerance_um``; None without a tolerance), ``tool_leaves_cut``, and ``stable``: the
-paper's criterion (vibratory when Ra exceeds the tolerance or the run diverged), also under
-``verdicts["paper_criterion"]``.
+grows from pitch to pitch: the Floquet multiplier of the simulated cut above 1, or a
+nonlinear cause named in ``chatter_cause``), ``chatter_decided`` (False when the multiplier is
+within its uncertainty of 1 even after the run was lengthened), ``surface_finish`` ("ok" /
+"rough": Ra after form removal against ``ra_tolerance_um``; None without a tolerance),
+``tool_leaves_cut``, and ``stable``: the paper's criterion (vibratory when Ra exceeds the
+tolerance, the cut chatters or the run diverged; None without a tolerance otherwise), also
+under ``verdicts["paper_criterion"]``. ``feed_amplitude_resolved`` is False below the
+documented resolution (1 nm, :data:`robobore.dynamics.chatter.AMPLITUDE_RESOLUTION_M`).
 """
+
 
 from __future__ import annotations
 
@@ -36,6 +41,10 @@ from robobore.dynamics.config import (
 from robobore.dynamics.handoff import with_coefficients, with_equivalent
 from robobore.errors import ConfigError, InputError
 from robobore.io.config import validate_model
+
+#: An undecided run (:attr:`~robobore.dynamics.chatter.ChatterVerdict.chatter_decided`) is
+#: lengthened, doubling its revolutions, up to this factor of the configured revolutions.
+UNDECIDED_MAX_FACTOR = 4
 
 
 def _config(config: str | Path | dict[str, Any] | DynamicsConfig, source: str | None = None,
@@ -78,7 +87,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     ``pressure_MPa`` (boring configs with an ``[equivalent]`` section) replaces the pressure
     foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
     """
-    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.chatter import AMPLITUDE_RESOLUTION_M, classify, resolved
     from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
 
     cfg, raw, src = _config(config, source, equivalent)
@@ -125,16 +134,27 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     st = build_structure(cfg, src)
     coef = build_coefficients(cfg, src) if cfg.is_boring else None
     pr = build_process(cfg, src, depth_m=a * 1e-3 if cfg.is_boring else None, coefficients=coef)
-    try:
-        ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs), int(nspr)),
-                      cfg.insert.to_insert() if cfg.is_boring else None)
-    except ConfigError as exc:  # a settings error (size guard): name the config file
-        if exc.file is None and src is not None:
-            raise ConfigError(exc.message, file=src, field=exc.field, value=exc.value,
-                              expected=exc.expected) from None
-        raise
     tol = cfg.simulation.ra_tolerance_um
-    v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
+    ins = cfg.insert.to_insert() if cfg.is_boring else None
+    extend = revolutions is None and cfg.simulation.extend_undecided
+    ds, v = None, None
+    run_revs = int(revs)
+    while True:
+        try:
+            ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, run_revs, int(nspr)),
+                          ins)
+        except ConfigError as exc:  # a settings error (size guard): name the config file
+            if exc.file is None and src is not None:
+                raise ConfigError(exc.message, file=src, field=exc.field, value=exc.value,
+                                  expected=exc.expected) from None
+            raise
+        v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
+        # near the stability limit the growth per pitch is within its uncertainty of 1:
+        # lengthen the run (up to UNDECIDED_MAX_FACTOR x) before saying so
+        if v.chatter_decided or not extend or run_revs >= UNDECIDED_MAX_FACTOR * int(revs):
+            break
+        run_revs *= 2
+    revs = run_revs
     s = summarize(ds)
     out: dict[str, Any] = {
         "stable": v.paper_stable,
@@ -143,12 +163,18 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         "surface_finish": v.surface_finish,
         "tool_leaves_cut": v.tool_leaves_cut,
         "chatter_frequency_Hz": v.chatter_frequency_Hz,
+        "chatter_decided": v.chatter_decided,
+        "chatter_cause": v.chatter_cause,
+        "floquet_multiplier": v.floquet_multiplier,
+        "floquet_multiplier_se": v.floquet_multiplier_se,
         "vibration_growth": v.vibration_growth,
         "feed_amplitude_growth": v.feed_amplitude_growth,
         "radial_amplitude_growth": v.radial_amplitude_growth,
         "force_mean_N": s["force_mean_N"],
         "force_amplitude_N": s["force_amplitude_N"],
         "feed_amplitude_um": s["feed_amplitude_m"] * 1e6,
+        "feed_amplitude_resolved": resolved(s["feed_amplitude_m"]),
+        "amplitude_resolution_um": AMPLITUDE_RESOLUTION_M * 1e6,
         "nonharmonic_energy_ratio": v.nonharmonic_energy_ratio,
         "roughness_Ra_um": ds.attrs["Ra_m"] * 1e6,
         "roughness_Rz_um": ds.attrs["Rz_m"] * 1e6,
@@ -214,4 +240,4 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     return d
 
 
-__all__ = ["run_boring", "lobes"]
+__all__ = ["run_boring", "lobes", "UNDECIDED_MAX_FACTOR"]

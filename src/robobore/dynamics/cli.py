@@ -106,20 +106,34 @@ def lobes_cmd(
         elif n_stable:
             notes.append(f"stable up to {top:g} mm (the top of the depth scan) at {n_stable} "
                          f"of {speeds.size} speeds")
-        zero = speeds[res.critical_depth_m == 0.0]
+        below = (res.interrupted_below_m if res.interrupted_below_m is not None
+                 else np.zeros(speeds.size))
+        cut0 = res.critical_depth_m == 0.0
+        zero = speeds[cut0 & (below == 0.0)]
         if zero.size:
             notes.append(f"unstable at vanishing depth at {zero.size} speed(s) "
                          f"({zero.min():.0f}-{zero.max():.0f} r/min): an instability that does "
                          "not need the regenerative cut (the rotating bar's depth-modulation "
                          "stiffness, parametric); critical depth 0")
+        inter = speeds[cut0 & (below > 0.0)]
+        if inter.size:
+            notes.append(f"no chatter-free depth at {inter.size} speed(s) "
+                         f"({inter.min():.0f}-{inter.max():.0f} r/min): the steady forced "
+                         "vibration takes the tool out of the material up to the linear limit "
+                         "(interrupted cut, outside the linear model); critical depth 0, the "
+                         "linear limit in interrupted_below_mm")
+        part = speeds[(~cut0) & (below > 0.0)]
+        if part.size:
+            notes.append(f"at {part.size} speed(s) the steady forced vibration takes the tool "
+                         "out of the material below interrupted_below_mm: chatter-free "
+                         "between that depth and the critical depth")
     mc = stability.mode_coupling_limit(st, pr)
     out = res.to_dict()
     out["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
     out["process"] = pr.label
-    if pr.reference_depth_m is not None:
-        notes.append(f"boring process linearised at depth {pr.reference_depth_m * 1e3:g} mm "
-                     "(leading edge stretched with depth; the trailing side of the nose "
-                     "keeps its feed-set length)")
+    if pr.depth_dependent:
+        notes.append("boring process built from its chip geometry at every trial depth (the "
+                     "chip the time domain integrates at that depth)")
     out["notes"] = notes
     if plot is not None:
         curves = stability.lobe_curves(st, pr, 12) if method == "frequency" else None
@@ -236,23 +250,36 @@ def simulate_boring_cmd(
 
     def render(r: dict[str, Any]) -> None:
         fin = {None: "no tolerance", "ok": "ok", "rough": "ROUGH"}[r["surface_finish"]]
-        rows = [("chatter (vibration grows)", "CHATTER" if r["chatter"] else "no"),
+        ch = "CHATTER" if r["chatter"] else "no"
+        if r["chatter_cause"] not in (None, "regenerative"):
+            ch += f" ({r['chatter_cause']})"
+        if not r["chatter_decided"]:
+            ch += " (undecided: at the stability limit)"
+        paper = {None: "not judged (no Ra tolerance)", True: "stable",
+                 False: "VIBRATORY"}[r["stable"]]
+        res_um = r["amplitude_resolution_um"]
+        feed = (r["feed_amplitude_um"] if r["feed_amplitude_resolved"]
+                else f"below {res_um * 1e3:g} nm (resolution)")
+        rows = [("chatter (vibration grows)", ch),
                 ("surface finish (Ra, form removed)", fin),
                 ("tool leaves the cut", "YES" if r["tool_leaves_cut"] else "no"),
-                ("paper's criterion (Ra > tolerance)",
-                 "stable" if r["stable"] else "VIBRATORY"),
-                ("chatter frequency (Hz)", r["chatter_frequency_Hz"]),
+                ("paper's criterion (Ra > tolerance or chatter)", paper),
+                ("chatter frequency (Hz)", r["chatter_frequency_Hz"]
+                 if r["chatter_frequency_Hz"] is not None else "-"),
+                ("growth per insert pitch (Floquet multiplier)",
+                 f"{fmt(r['floquet_multiplier'])} +- {fmt(r['floquet_multiplier_se'])} (ln)"),
                 ("vibration growth (envelope, feed, radial)",
                  f"{fmt(r['vibration_growth'])} / {fmt(r['feed_amplitude_growth'])} / "
                  f"{fmt(r['radial_amplitude_growth'])}"),
                 *[(f"mean force {a} (N)", r["force_mean_N"][a]) for a in "xyz"],
                 *[(f"force amplitude {a} (N)", r["force_amplitude_N"][a]) for a in "xyz"],
-                ("feed amplitude (um)", r["feed_amplitude_um"]),
+                ("feed amplitude (um)", feed),
                 ("Ra / Rz, form removed (um)",
                  f"{fmt(r['roughness_Ra_um'])} / {fmt(r['roughness_Rz_um'])}"),
                 ("Ra with form (um), taper (um/mm)",
                  f"{fmt(r['roughness_Ra_with_form_um'])}, {fmt(r['form_slope_um_per_mm'])}"),
-                ("samples per revolution", r["samples_per_rev"])]
+                ("samples per revolution", r["samples_per_rev"]),
+                ("revolutions simulated", r["revolutions_simulated"])]
         for why in r["reasons"]:
             rows.append(("reason", why))
         for w in r["coefficient_warnings"]:

@@ -285,6 +285,9 @@ class CoefficientsCfg(_Strict):
 class SimulationCfg(_Strict):
     revolutions: int = Field(150, ge=1, le=20000)
     samples_per_rev: int = Field(0, ge=0, le=200000)
+    # a run whose chatter verdict is within the growth estimate's uncertainty is lengthened
+    # (doubling, up to 4 x revolutions) unless revolutions are given as an argument
+    extend_undecided: bool = True
     ra_tolerance_um: float | None = Field(None, gt=0, le=100)
 
     @field_validator("ra_tolerance_um")
