@@ -173,28 +173,43 @@ def test_critical_depth_matches_stability_module(rb, paper_process):
     model = PoseModel(rb, K6, np.array([3000, 3000, 800, 150, 80, 30.0]), tool=TOOL)
     Q = PAPER_Q + np.random.default_rng(2).normal(0, 0.2, (4, 6))
     pm = model.modes(Q)
-    A0 = paper_process.mean_directional_matrix()
+    # the planner's screen linearises the process once, at the cutting depth
+    fixed = paper_process.fixed()
+    A0 = fixed.mean_directional_matrix()
     for lo, hi in ((150.0, 1100.0), (2000.0, 20000.0)):
         b, _, n = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0, lo, hi)
         assert np.all((n >= lo * (1 - 1e-9)) & (n <= hi * (1 + 1e-9)))
         for i in range(Q.shape[0]):
-            L = lobes_frequency_domain(pm.structure(i), paper_process, np.linspace(lo, hi, 4000))
+            L = lobes_frequency_domain(pm.structure(i), fixed, np.linspace(lo, hi, 4000))
             assert b[i] == pytest.approx(L.critical_depth_m.min(), rel=5e-3)
 
 
-def test_feed_amplitude_matches_forced_response(rb, paper_process):
-    from robobore.dynamics.timedomain import forced_response
-    from robobore.plan.scoring import feed_amplitude, nominal_force_basis
+def test_feed_amplitude_is_the_time_domain_s(rb, paper_process):
+    """The planner's feed amplitude (the steady cut's half peak-to-peak Z) is what
+    ``simulate`` reports on the same structure and process at 300 r/min, 0.05 mm where the
+    cut is stable (it starts on that steady cut and settles back to it): within 1 % (measured
+    1e-5) at the postures of three that do not chatter, and the lobes' spectral radius says
+    which do."""
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.semidiscretization import monodromy_spectral_radius
+    from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
+    from robobore.plan.scoring import steady_feed_amplitude
 
     model = PoseModel(rb, K6, np.array([3000, 3000, 800, 150, 80, 30.0]), tool=TOOL)
     Q = PAPER_Q + np.random.default_rng(3).normal(0, 0.2, (3, 6))
     pm = model.modes(Q)
-    fb = nominal_force_basis(paper_process, 0.05e-3)
-    amp = feed_amplitude(pm.frequency_Hz, pm.damping_ratio, pm.u, fb, 300.0, 1)
+    stable = 0
     for i in range(3):
-        r = forced_response(pm.structure(i), paper_process, 300.0, 0.05e-3)
-        ref = 0.5 * (r[:, 2].max() - r[:, 2].min())
-        assert amp[i] == pytest.approx(ref, rel=1e-3)
+        st = pm.structure(i, 1e-3)
+        amp = steady_feed_amplitude(st, paper_process, 0.05e-3, 300.0)
+        ds = simulate(st, paper_process, SimulationSettings(300.0, 0.05e-3, 60))
+        v = classify(ds)
+        rho = monodromy_spectral_radius(st, paper_process, 300.0, 0.05e-3)
+        assert v.chatter == (rho > 1.0)
+        if not v.chatter:
+            stable += 1
+            assert amp == pytest.approx(summarize(ds)["feed_amplitude_m"], rel=0.01)
+    assert stable >= 2
 
 
 def test_modal_frf_vs_direct_solve_with_joint_dampers(rb):

@@ -9,6 +9,7 @@ import typer
 
 from robobore.clitools import JSON_OPTION, emit, fmt, handle_errors, kv_table, progress_bar, stdout
 from robobore.errors import ConfigError
+from robobore.plan.posture import SD_TOP
 
 
 @handle_errors
@@ -78,6 +79,11 @@ def posture_cmd(
             rows.append(("measured posture", "not a candidate (does not hold this bore)"))
         if r.get("synthetic_inputs"):
             rows.append(("inputs", "SYNTHETIC identification results"))
+        rows.append(("critical depth method",
+                     f"semi-discretization for the best {SD_TOP} of a frequency-domain screen "
+                     "and the measured posture (critical_depth_method per candidate)"))
+        for w in r.get("warnings", []):
+            rows.append(("warning", w))
         rows.append(("wall time (s)", r["wall_time_s"]))
         stdout.print(kv_table("posture plan", rows))
         t = Table(title=f"best {top} candidates", header_style="bold")
@@ -99,7 +105,9 @@ def posture_cmd(
             k = c["directional_stiffness_N_per_m"]
             t.add_row(f"{c['tool_axis_rotation_deg']:.1f}", str(c["branch"]),
                       fmt(k["x"] * 1e-6), fmt(k["y"] * 1e-6), fmt(k["z"] * 1e-6),
-                      fmt(c["modes"][0]["frequency_Hz"]), fmt(c["critical_depth_mm"]),
+                      fmt(c["modes"][0]["frequency_Hz"]),
+                      fmt(c["critical_depth_mm"]) + (
+                          "" if c["critical_depth_method"] == "semi-discretization" else " (FD)"),
                       fmt(c["feed_amplitude_um"]))
         stdout.print(t)
 

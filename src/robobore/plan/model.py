@@ -296,6 +296,12 @@ class PoseModel:
             {"directional_stiffness_N_per_m": ks}, {"modes": modes})
 
 
+#: Link inertia scale factors of :func:`calibrate` are bounded to this range.
+SCALE_BOUNDS = (0.25, 4.0)
+#: A calibration frequency residual above this [%] is a warning (:meth:`Calibration.warnings`).
+CALIBRATION_RESIDUAL_WARN_PERCENT = 10.0
+
+
 @dataclass(frozen=True)
 class Calibration:
     """Result of :func:`calibrate`: the calibrated model and how well it matches."""
@@ -313,8 +319,32 @@ class Calibration:
     def frequency_error_percent(self) -> np.ndarray:
         return 100 * (self.model_frequency_Hz / self.identified_frequency_Hz - 1)
 
+    def warnings(self, residual_limit_percent: float = CALIBRATION_RESIDUAL_WARN_PERCENT,
+                 scale_bounds: tuple[float, float] = SCALE_BOUNDS) -> list[str]:
+        """Plain-language warnings on the calibration: a frequency residual above
+        ``residual_limit_percent`` (the model does not reproduce the identified modes) and link
+        scale factors at their bounds (the fit wanted more than the model allows)."""
+        out = []
+        err = np.abs(self.frequency_error_percent)
+        for j, e in enumerate(err):
+            if e > residual_limit_percent:
+                out.append(f"calibration: identified mode {j + 1} "
+                           f"({self.identified_frequency_Hz[j]:.4g} Hz) is matched at "
+                           f"{self.model_frequency_Hz[j]:.4g} Hz ({e:.3g} % off, above "
+                           f"{residual_limit_percent:g} %): the pose-dependent model does not "
+                           "reproduce it; its posture ratings are less certain")
+        lo, hi = scale_bounds
+        at = [i + 1 for i, v in enumerate(self.model.link_scale)
+              if v <= lo * (1 + 1e-6) or v >= hi * (1 - 1e-6)]
+        if at:
+            out.append(f"calibration: link inertia scale factor(s) of link(s) {at} at the bounds "
+                       f"{lo:g} / {hi:g}: the link data or the identified modes are unlikely "
+                       "for this robot (check the robot file, the modes file and the posture)")
+        return out
+
     def to_dict(self) -> dict[str, Any]:
         return {
+            "warnings": self.warnings(),
             "matched_modes": self.matched,
             "model_mode_of_identified": [int(i) + 1 for i in self.model_modes],
             "link_scale": [float(v) for v in self.model.link_scale],
@@ -374,7 +404,7 @@ def fit_proportional_damping(G: np.ndarray, w: np.ndarray, zeta: np.ndarray,
 
 
 def calibrate(model: PoseModel, q_meas_rad: Any, frequency_Hz: Any, damping_ratio: Any, *,
-              scale_bounds: tuple[float, float] = (0.25, 4.0),
+              scale_bounds: tuple[float, float] = SCALE_BOUNDS,
               regularisation: float = 0.05,
               damping_regularisation: float = 0.01) -> Calibration:
     """Fit link scale factors and joint dampers so the modes at ``q_meas`` match (see module

@@ -15,13 +15,17 @@ calibrated pose-dependent model (:mod:`robobore.plan.model`):
    (smallest singular value of the Jacobian with its translational rows divided by the
    robot's reach ``L = sum |a_i| + |d_i|``: dimensionless, 0 at a singularity);
 3. per candidate: directional stiffness in the boring frame, modes, the lowest critical depth
-   over ``[lobes]`` speed range (:mod:`robobore.plan.chatter`), and the feed-direction
-   amplitude of the steady forced response at ``[cutting]`` (half peak-to-peak of Z, the
-   quantity the time-domain simulation reports as ``feed_amplitude``; linear, valid when the
-   cut is stable);
+   over ``[lobes]`` speed range, and the feed-direction amplitude of the steady cut at
+   ``[cutting]`` (half peak-to-peak of Z of the periodic orbit the time-domain simulation
+   starts on and settles to, :func:`robobore.plan.scoring.steady_feed_amplitude`: the same
+   computation, so the same number as ``simulate boring`` on the same structure). The
+   critical depth of every candidate is first screened by the zero-order frequency domain
+   (:mod:`robobore.plan.chatter`); the best :data:`SD_TOP` of the screen and the measured
+   posture are then rated by the semi-discretisation lobes of the stability module (the
+   method of ``robobore lobes``; ``critical_depth_method`` says which a value comes from);
 4. recommendation: the candidate with the largest value of the criterion
-   (``critical_depth`` by default, or ``stiffness_x``/``stiffness_y``/``stiffness_z``/
-   ``stiffness_min``).
+   (``critical_depth`` by default, among the semi-discretisation-rated candidates, or
+   ``stiffness_x``/``stiffness_y``/``stiffness_z``/``stiffness_min``).
 
 Config: see ``examples/plan_paper_bore.toml`` and docs/plan.md.
 
@@ -60,6 +64,16 @@ from robobore.plan.scoring import (
 )
 
 
+#: Semi-discretisation rating of the plan: the best SD_TOP candidates of the frequency-domain
+#: screen (and the measured posture) over SD_SPEEDS speeds of the [lobes] range.
+SD_TOP = 3
+SD_SPEEDS = 30
+#: Modes whose tool-point flexibility is below this share of the largest are left out of the
+#: structures the plan rates (:meth:`robobore.plan.model.PostureModes.structure`): they do not move
+#: the tool point, but a stiff local mode would set the semi-discretisation step.
+PLAN_MODE_SHARE = 1e-3
+
+
 def _same_posture(q1: np.ndarray, q2: np.ndarray, tol: float = 1e-6) -> bool:
     d = np.angle(np.exp(1j * (np.asarray(q1) - np.asarray(q2))))
     return bool(np.max(np.abs(d)) < tol)
@@ -80,7 +94,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     """The posture plan for validated inputs (see :func:`plan_posture`)."""
     from contextlib import nullcontext
 
-    from robobore.dynamics.stability import lobes_frequency_domain
+    from robobore.dynamics.stability import lobes_semidiscretization
     from robobore.plan.model import PoseModel, ToolBody, calibrate
     from robobore.robot.kinematics import fk
 
@@ -122,23 +136,64 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     pf = progress_factory or (lambda d, t: nullcontext(lambda n=1: None))
     with pf("posture candidates", cand.q_rad.shape[0]) as adv:
         ev = evaluate(model, robot, cand, process, A0, cfg, adv)
-    crit = criterion_values(cfg.plan.criterion, ev["stiffness_N_per_m"], ev["critical_depth_m"])
-    best = recommend(crit, cand.q_rad, inp.q_meas_rad)
     meas_idx = None
     for i in np.flatnonzero(np.abs(((cand.rotation_deg - anchor) + 180) % 360 - 180) < 1e-9):
         if _same_posture(cand.q_rad[i], inp.q_meas_rad):
             meas_idx = int(i)
+    # the chatter limit of the lobes' method: the frequency-domain limit screens every
+    # candidate; the best SD_TOP of the screen and the measured posture are rated by the
+    # semi-discretisation lobes (the default of `robobore lobes`) on the same structure and
+    # process, and the recommendation is the best of those
+    speeds = np.linspace(cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm, SD_SPEEDS)
+    method = np.array(["frequency (screening)"] * cand.q_rad.shape[0], dtype=object)
+    crit0 = criterion_values(cfg.plan.criterion, ev["stiffness_N_per_m"],
+                             ev["critical_depth_m"])
+    order = [int(i) for i in np.argsort(-np.where(np.isnan(crit0), -np.inf, crit0),
+                                        kind="stable")[:SD_TOP]]
+    rated = sorted(set(order) | ({meas_idx} if meas_idx is not None else set()))
+    sd_lobes = {}
+    by_structure: dict[tuple, Any] = {}
+
+    def sd(idx: int):
+        # candidates with the same structure (a tool-axis rotation about the flange axis)
+        # share their lobes
+        st = model.modes(cand.q_rad[idx]).structure(0, PLAN_MODE_SHARE)
+        key = (tuple(np.round(st.frequency_Hz, 6)), tuple(np.round(st.damping_ratio, 8)),
+               tuple(np.round(st.stiffness_N_per_m, 0)), tuple(np.round(st.directions, 6).ravel()))
+        if key not in by_structure:
+            by_structure[key] = lobes_semidiscretization(st, process, speeds)
+        return by_structure[key]
+
+    with pf("semi-discretisation lobes", len(rated)) as adv:
+        for idx in rated:
+            L = sd(idx)
+            sd_lobes[idx] = L
+            ev["critical_depth_m"][idx] = float(np.min(L.critical_depth_m))
+            k = int(np.argmin(L.critical_depth_m))
+            ev["critical_speed_rpm"][idx] = float(speeds[k])
+            ev["chatter_frequency_Hz"][idx] = math.nan
+            method[idx] = "semi-discretization"
+            adv(1)
+    ev["critical_depth_method"] = method
+    crit = criterion_values(cfg.plan.criterion, ev["stiffness_N_per_m"], ev["critical_depth_m"])
+    pick = np.array([c if method[i] == "semi-discretization" else -np.inf
+                     for i, c in enumerate(crit)]) if cfg.plan.criterion == "critical_depth" \
+        else crit
+    best = recommend(pick, cand.q_rad, inp.q_meas_rad)
+    if best not in sd_lobes:
+        sd_lobes[best] = sd(best)
+        ev["critical_depth_m"][best] = float(np.min(sd_lobes[best].critical_depth_m))
+        method[best] = "semi-discretization"
     entries = [_entry(i, cand, ev) for i in range(cand.q_rad.shape[0])]
-    # lobes (frequency domain, stability module) at the recommended and measured postures
+    # the semi-discretisation lobes at the recommended and measured postures
     lobes = {}
-    speeds = np.linspace(cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm, 300)
     for name, idx in (("recommended", best), ("measured", meas_idx)):
         if idx is None:
             continue
-        st = model.modes(cand.q_rad[idx]).structure(0)
-        L = lobes_frequency_domain(st, process, speeds)
-        lobes[name] = {"speed_rpm": speeds.tolist(),
+        L = sd_lobes[idx]
+        lobes[name] = {"method": L.method, "speed_rpm": speeds.tolist(),
                        "critical_depth_mm": (L.critical_depth_m * 1e3).tolist(),
+                       "interrupted_below_mm": (L.interrupted_below_m * 1e3).tolist(),
                        "critical_depth_at_speed_mm": float(np.interp(
                            cfg.cutting.speed_rpm, speeds, L.critical_depth_m * 1e3))}
     equivalent = {}
@@ -159,6 +214,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "measured_posture_error": {"position_mm": meas_pos_err * 1e3,
                                    "axis_deg": meas_ax_err},
         "calibration": cal.to_dict(),
+        "warnings": cal.warnings(),
         "bore": {"point_m": inp.bore_point_m.tolist(), "axis": inp.bore_axis.tolist(),
                  "boring_frame_columns": Rb.T.tolist()},
         "tcp_m": inp.tcp_m.tolist(),
@@ -195,6 +251,7 @@ def _entry(i: int, cand: Candidates, ev: dict[str, np.ndarray]) -> dict[str, Any
         "modes": [{"frequency_Hz": float(fr), "damping_ratio": float(z)}
                   for fr, z in zip(ev["frequency_Hz"][i], ev["damping_ratio"][i], strict=True)],
         "critical_depth_mm": None if not math.isfinite(b) else float(b * 1e3),
+        "critical_depth_method": str(ev["critical_depth_method"][i]),
         "chatter_frequency_Hz": float(ev["chatter_frequency_Hz"][i]),
         "feed_amplitude_um": float(ev["feed_amplitude_m"][i] * 1e6),
         "singularity_measure": float(cand.singularity[i]),

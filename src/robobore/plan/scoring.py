@@ -14,28 +14,17 @@ from robobore.plan.config import PlanConfig, PlanInputs
 CRITERIA = ("critical_depth", "stiffness_x", "stiffness_y", "stiffness_z", "stiffness_min")
 
 
-def feed_amplitude(frequency_Hz: np.ndarray, damping_ratio: np.ndarray, u: np.ndarray,
-                   force_basis_N: np.ndarray, speed_rpm: float, n_inserts: int) -> np.ndarray:
-    """Half peak-to-peak feed-direction (Z) tool displacement of the steady forced response
-    [m], (n,), for a rotating bar whose per-insert force is ``(f_t, f_r, f_z)`` in the insert
-    basis. Only the first spindle harmonic reaches X/Y (the bar force is a rotating vector),
-    and only through the cross receptances ``G_zx``, ``G_zy``; ``n_inserts`` equally spaced
-    inserts cancel it (factor ``|sum_p exp(2 pi i p / N)|``)."""
-    ft, fr, _ = force_basis_N
-    W = 2 * np.pi * speed_rpm / 60.0
-    w = 2 * np.pi * frequency_Hz
-    h = 1.0 / (w ** 2 - W ** 2 + 2j * damping_ratio * w * W)  # (n, m)
-    Gzx = np.einsum("nm,nm,nm->n", h, u[:, :, 2], u[:, :, 0])
-    Gzy = np.einsum("nm,nm,nm->n", h, u[:, :, 2], u[:, :, 1])
-    S = abs(np.sum(np.exp(2j * np.pi * np.arange(n_inserts) / n_inserts)))
-    return np.abs(Gzx * (fr + 1j * ft) + Gzy * (ft - 1j * fr)) * S
+def steady_feed_amplitude(structure: Any, process: Any, depth_m: float, speed_rpm: float
+                          ) -> float:
+    """Half peak-to-peak feed-direction (Z) displacement [m] of the steady cut: the periodic
+    orbit the time-domain simulation starts on and settles to when the cut is stable
+    (:func:`robobore.dynamics.timedomain.nominal_cut_deflection`, depth-modulation stiffness
+    included; the process built at ``depth_m``), so the planner and ``simulate boring``
+    report the same amplitude."""
+    from robobore.dynamics.timedomain import forced_response
 
-
-def nominal_force_basis(process: Any, depth_m: float) -> np.ndarray:
-    """Per-insert nominal force (t, r, z) [N] of a boring process at depth ``depth_m``."""
-    return (np.einsum("e,e,ei->i", process.width_per_depth * depth_m, process.h0, process.shear)
-            + np.einsum("e,ei->i", process.edge_per_depth * depth_m + process.edge_fixed_m,
-                        process.edge))
+    z = forced_response(structure, process.at_depth(depth_m), speed_rpm, depth_m)[:, 2]
+    return float(0.5 * (z.max() - z.min()))
 
 
 def build_process(inp: PlanInputs) -> Any:
@@ -70,8 +59,11 @@ CRITERION_UNITS = {"critical_depth": "mm", "stiffness_x": "N/m", "stiffness_y": 
 
 
 def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndarray,
-             cfg: PlanConfig, progress: Any = None) -> dict[str, np.ndarray]:
-    """Stiffness, modes, critical depth and feed amplitude per candidate (chunks of 512)."""
+             cfg: PlanConfig, progress: Any = None, mode_share: float = 1e-3
+             ) -> dict[str, np.ndarray]:
+    """Stiffness, modes, critical depth (frequency-domain screen) and the steady feed
+    amplitude per candidate (chunks of 512); ``mode_share``: the feed amplitude's structure
+    leaves out modes below that share of the tool-point flexibility."""
     from robobore.plan.chatter import critical_depth_range
 
     n = cand.q_rad.shape[0]
@@ -80,7 +72,6 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
            "stiffness_N_per_m": np.empty((n, 3)), "critical_depth_m": np.empty(n),
            "chatter_frequency_Hz": np.empty(n), "critical_speed_rpm": np.empty(n),
            "feed_amplitude_m": np.empty(n)}
-    fb = nominal_force_basis(process, cfg.cutting.depth_mm * 1e-3)
     for s in range(0, n, 512):
         e = min(n, s + 512)
         pm = model.modes(cand.q_rad[s:e])
@@ -93,9 +84,10 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
         out["critical_depth_m"][s:e] = b
         out["chatter_frequency_Hz"][s:e] = fch
         out["critical_speed_rpm"][s:e] = nch
-        out["feed_amplitude_m"][s:e] = feed_amplitude(pm.frequency_Hz, pm.damping_ratio, pm.u,
-                                                      fb, cfg.cutting.speed_rpm,
-                                                      process.n_inserts)
+        for k in range(e - s):
+            out["feed_amplitude_m"][s + k] = steady_feed_amplitude(
+                pm.structure(k, mode_share), process, cfg.cutting.depth_mm * 1e-3,
+                cfg.cutting.speed_rpm)
         if progress is not None:
             progress(e - s)
     return out
@@ -117,5 +109,5 @@ def recommend(crit: np.ndarray, Q: np.ndarray, q_ref: np.ndarray, rel_tol: float
     return int(near[int(np.argmin(move))])
 
 
-__all__ = ["CRITERIA", "CRITERION_UNITS", "feed_amplitude", "nominal_force_basis",
+__all__ = ["CRITERIA", "CRITERION_UNITS", "steady_feed_amplitude",
            "build_process", "criterion_values", "evaluate", "recommend"]
