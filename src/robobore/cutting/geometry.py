@@ -37,6 +37,7 @@ previous pass to the depth-of-cut end).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -308,7 +309,16 @@ def trailing_intersection(insert: BoringInsert, depth_m: float, feed_m: float) -
     """
     _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
     _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
+    # the root without the pre-bore surface is the root with it wherever the previous pass
+    # lies inside the material there (drop(z + f) <= ap): the depth then does not enter
+    z = _trailing_root(insert, float(feed_m), math.inf)
+    if float(insert.drop(np.array([z + feed_m]))[0]) <= depth_m:
+        return z
+    return _trailing_root(insert, float(feed_m), float(depth_m))
 
+
+@functools.lru_cache(maxsize=1024)
+def _trailing_root(insert: BoringInsert, feed_m: float, depth_m: float) -> float:
     def g(z: np.ndarray) -> np.ndarray:
         return _prev_surface_drop(insert, z, feed_m, depth_m) - insert.drop(z)
 

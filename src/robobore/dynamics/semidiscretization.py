@@ -601,12 +601,33 @@ def _scan(rho, depth_hi_m: float, tol: float, decades: float, ratio: float) -> f
 
 def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> float:
     """Illinois false position on ``f = log rho`` over ``x = log a`` between a stable ``lo``
-    and an unstable ``hi``, to a relative width ``tol``."""
+    and an unstable ``hi``, to a relative width ``tol``. Once the secant through the bracket
+    puts the root within ``tol`` of the last point, the next point is placed just past that
+    estimate (by 0.45 ``tol``), so that a good estimate closes the bracket in one evaluation;
+    a bisection step whenever the bracket shrank by less than half."""
     x0, x1 = math.log(lo), math.log(hi)
     f0 = math.log(max(r_lo, 1e-300))
     f1 = math.log(r_hi) if math.isfinite(r_hi) else math.inf
+    t0, t1 = f0, f1  # the true values (f0, f1 are scaled by the Illinois rule)
     side = 0
     width_tol = math.log1p(tol)
+
+    def update(x: float, rx: float) -> float:
+        nonlocal x0, x1, f0, f1, t0, t1, side
+        fx = math.log(rx) if math.isfinite(rx) and rx > 0 else (
+            math.inf if rx >= 1.0 else math.log(1e-300))
+        if rx >= 1.0:
+            x1, f1, t1 = x, fx, fx
+            if side == -1 and math.isfinite(f0):
+                f0 *= 0.5
+            side = -1
+        else:
+            x0, f0, t0 = x, fx, fx
+            if side == 1 and math.isfinite(f1):
+                f1 *= 0.5
+            side = 1
+        return fx
+
     while x1 - x0 > width_tol:
         w = x1 - x0
         if math.isfinite(f1) and f1 > f0:
@@ -614,24 +635,19 @@ def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> 
             x = min(max(x, x0 + 0.01 * w), x1 - 0.01 * w)
         else:
             x = 0.5 * (x0 + x1)
-        rx = rho(math.exp(x))
-        if rx >= 1.0:
-            x1, f1 = x, (math.log(rx) if math.isfinite(rx) else math.inf)
-            if side == -1 and math.isfinite(f0):
-                f0 *= 0.5
-            side = -1
-        else:
-            x0, f0 = x, math.log(max(rx, 1e-300))
-            if side == 1 and math.isfinite(f1):
-                f1 *= 0.5
-            side = 1
+        fx = update(x, rho(math.exp(x)))
+        if x1 - x0 <= width_tol:
+            break
+        if math.isfinite(fx) and math.isfinite(t0) and math.isfinite(t1) and t1 > t0:
+            d = -fx * (x1 - x0) / (t1 - t0)  # secant distance from x to the root
+            if abs(d) < width_tol:
+                step = d + math.copysign(0.45 * width_tol, d if d != 0.0 else -fx)
+                xs = min(max(x + step, x0 + 1e-3 * (x1 - x0)), x1 - 1e-3 * (x1 - x0))
+                update(xs, rho(math.exp(xs)))
+                continue
         if x1 - x0 > 0.5 * w:  # slow progress: bisect once
             xm = 0.5 * (x0 + x1)
-            rm = rho(math.exp(xm))
-            if rm >= 1.0:
-                x1, f1, side = xm, (math.log(rm) if math.isfinite(rm) else math.inf), -1
-            else:
-                x0, f0, side = xm, math.log(max(rm, 1e-300)), 1
+            update(xm, rho(math.exp(xm)))
     return math.exp(0.5 * (x0 + x1))
 
 

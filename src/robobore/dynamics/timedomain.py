@@ -317,7 +317,7 @@ def _orbit_kernel(Phi, Gam, Pm, Fm, half_dt, X_out):  # pragma: no cover - numba
     M = np.eye(n) - T
     if abs(np.linalg.det(M)) < 1e-300:
         return False
-    x = np.linalg.solve(M, c)
+    x = np.ascontiguousarray(np.linalg.solve(M, c))
     for i in range(Ns):
         X_out[i] = x
         _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)

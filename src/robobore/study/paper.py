@@ -266,6 +266,64 @@ def compute_lobes(cfg: PaperConfig, robot_model: dict[str, Any]) -> dict[str, An
     return out
 
 
+#: Rule of the lobes-vs-verdicts check: a condition more than this fraction above the
+#: semi-discretisation limit must chatter, more than this fraction below it must not, unless
+#: its verdict states the tool leaving the cut (nonlinear).
+LOBE_MARGIN = 0.10
+
+
+def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
+                     rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """The swept robot conditions at the base feed against the semi-discretisation limit at
+    their own speed and foot pressure (the lobes of :func:`compute_lobes`, evaluated at the
+    condition's speed): each is ``"above"`` (depth > (1 + LOBE_MARGIN) x limit), ``"below"``
+    (< (1 - LOBE_MARGIN) x limit) or ``"near"``, and consistent when above means chatter and
+    below means no chatter, or its verdict states the tool leaving the cut. Returns the
+    counts and one record per condition; ``inconsistent`` lists the conditions that break
+    the rule."""
+    from robobore.dynamics.api import lobes
+
+    base_f = float(cfg.study.base["feed_mm_per_rev"])
+    cache: dict[tuple[float, float], float] = {}
+    records = []
+    for r in rows:
+        s = r.get("summary")
+        if r["system"] != "robot" or not s or not math.isclose(r["feed_mm_per_rev"], base_f):
+            continue
+        n, p = float(r["speed_rpm"]), float(r["pressure_MPa"])
+        if (n, p) not in cache:
+            dyn = json.loads(json.dumps(robot_model["dynamics"]))
+            if p == 0.0:
+                dyn["equivalent"].pop("pressure_foot", None)
+            else:
+                dyn["equivalent"]["pressure_foot"] = {
+                    **(dyn["equivalent"].get("pressure_foot") or {}), "pressure_MPa": p}
+            dyn["cutting"] = {"speed_rpm": n, "feed_mm_per_rev": base_f,
+                              "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
+            dyn["speed_rpm"] = {"min": n, "max": n, "count": 1}
+            d = lobes(dyn, method="semidiscretization")
+            v = d["critical_depth_mm"][0]
+            cache[(n, p)] = math.inf if v is None else float(v)
+        lim = cache[(n, p)]
+        a = float(r["depth_of_cut_mm"])
+        side = ("above" if a > (1 + LOBE_MARGIN) * lim else
+                "below" if a < (1 - LOBE_MARGIN) * lim else "near")
+        ch = s.get("chatter")
+        leaves = bool(s.get("tool_leaves_cut"))
+        ok = (side == "near" or leaves or (side == "above" and ch is True)
+              or (side == "below" and ch is False))
+        records.append({"key": r["key"], "speed_rpm": n, "pressure_MPa": p, "depth_mm": a,
+                        "critical_depth_mm": None if not math.isfinite(lim) else lim,
+                        "side": side, "chatter": ch, "tool_leaves_cut": leaves,
+                        "consistent": bool(ok)})
+    bad = [x for x in records if not x["consistent"]]
+    return {"rule": f"above (1 + {LOBE_MARGIN:g}) x the semi-discretisation limit: chatter; "
+                    f"below (1 - {LOBE_MARGIN:g}) x: no chatter; unless the tool leaves the cut",
+            "checked": len(records), "consistent": len(records) - len(bad),
+            "nonlinear": sum(1 for x in records if x["tool_leaves_cut"]),
+            "inconsistent": bad, "conditions": records}
+
+
 # ----------------------------------------------------------------------------- outputs
 def results_dataset(rows: list[dict[str, Any]]) -> Any:
     """All conditions and their summaries as one Dataset (dimension ``condition``)."""
@@ -411,6 +469,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
                 for r in rows if r["system"] == "robot" and r["summary"]]
         cmp = compare(table, sims)
     checks = qualitative_checks(rows, cfg)
+    consistency = lobe_consistency(cfg, robot_model, rows)
     lap("comparison", t)
     advance(1)
     t = time.perf_counter()
@@ -449,6 +508,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         "comparison": None if cmp is None else {"groups": cmp.groups,
                                                 "agreement": cmp.agreement},
         "qualitative_checks": checks,
+        "lobe_consistency": consistency,
         "robobore_version": __version__,
         "posture_plan": summary_posture,
     }
@@ -472,4 +532,5 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
 
 __all__ = ["run_paper", "identify_stiffness", "identify_modes", "build_equivalent",
            "load_or_calibrate", "dynamics_model", "study_conditions", "build_plan",
-           "compute_lobes", "results_dataset", "RUNNER", "PAPER_DAMPING_N_S_PER_M"]
+           "compute_lobes", "lobe_consistency", "LOBE_MARGIN", "results_dataset", "RUNNER",
+           "PAPER_DAMPING_N_S_PER_M"]

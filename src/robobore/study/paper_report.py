@@ -364,11 +364,19 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
         plt.close(fig)
     if lobes:
         fig = fig_lobes(lobes, rows, base)
-        rep.add_figure(fig, "Stability lobe diagram of the robot at the base feed, with the "
-                       "swept conditions (speed and depth series) marked by their verdict. "
-                       "The lobes are the linear regenerative limit, comparable with the "
-                       "chatter verdict; rough-only points can lie below the lobes.")
+        cons = summary.get("lobe_consistency") or {}
+        rep.add_figure(fig, "Stability lobe diagram of the robot at the base feed "
+                       "(semi-discretisation on the chip at each depth, the model the time "
+                       "domain integrates), with the swept conditions (speed and depth series) "
+                       "marked by their verdict; rough-only points can lie below the lobes. "
+                       f"Checked condition by condition ({cons.get('rule', '')}): "
+                       f"{cons.get('consistent', 0)} of {cons.get('checked', 0)} consistent, "
+                       f"{cons.get('nonlinear', 0)} with the tool leaving the cut.")
         plt.close(fig)
+        for x in cons.get("inconsistent", []):
+            rep.add_text(f"Lobes and verdict disagree at n {x['speed_rpm']:g} r/min, "
+                         f"P {x['pressure_MPa']:g} MPa, ap {x['depth_mm']:g} mm: {x['side']} "
+                         f"the limit {x['critical_depth_mm']} mm, chatter {x['chatter']}.")
 
     # ---------------------------------------------------------------- comparison
     rep.add_section("Comparison with the measurements")

@@ -18,7 +18,7 @@ time series are decimated to about this many samples per revolution and stored a
 
 The Dataset carries the summary contract of :mod:`robobore.study.summary` as 0-d
 variables (``force_amplitude_{x,y,z}_N``, ``feed_amplitude_um``, ``stable`` (the paper's
-criterion) as int8 0/1), the verdicts by cause (``chatter``, ``surface_finish_ok``,
+criterion) as int8 0/1, absent where it is not judged), the verdicts by cause (``chatter``, ``surface_finish_ok``,
 ``tool_leaves_cut`` as int8 0/1, ``roughness_Ra_um`` after form removal,
 ``feed_amplitude_growth``), the force / displacement / rotational-acceleration histories
 (boring frame), the feed amplitude per revolution, the machined-surface profile, and in the
@@ -110,8 +110,10 @@ def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
         ds[f"force_amplitude_{ax}_N"] = xr.DataArray(float(fa[ax]))
         ds[f"force_mean_{ax}_N"] = xr.DataArray(float(r["force_mean_N"][ax]))
     ds["feed_amplitude_um"] = xr.DataArray(float(r["feed_amplitude_um"]))
-    ds["stable"] = xr.DataArray(np.int8(1 if r["stable"] else 0))
-    ds["stable"].attrs["meaning"] = "the paper's criterion: Ra (form removed) <= tolerance"
+    if r["stable"] is not None:  # absent: not judged (no Ra tolerance, no chatter)
+        ds["stable"] = xr.DataArray(np.int8(1 if r["stable"] else 0))
+        ds["stable"].attrs["meaning"] = ("the paper's criterion: Ra (form removed) <= "
+                                         "tolerance and no chatter")
     ds["chatter"] = xr.DataArray(np.int8(1 if r["chatter"] else 0))
     ds["tool_leaves_cut"] = xr.DataArray(np.int8(1 if r["tool_leaves_cut"] else 0))
     if r["surface_finish"] is not None:
