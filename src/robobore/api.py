@@ -94,8 +94,95 @@ def identify_joint_stiffness(campaign: Any = None, robot: Any = DEFAULT_ROBOT, *
     return _identify(campaign, rb, sigma_m=sigma_m, frame=frame, tcp_m=tcp_m)
 
 
+def _identity_of(obj: Any) -> dict[str, Any] | None:
+    """The identity block (robobore.io.identity) of a result object or its dict form."""
+    from robobore.io.identity import read_identity
+
+    if isinstance(obj, dict):
+        return read_identity(obj, "<argument>")
+    ident = getattr(obj, "identity", None)
+    return ident if isinstance(ident, dict) and ident else None
+
+
+def _robot_arg(robot: Any, joint_stiffness: Any, name: str = "joint_stiffness"):
+    """The robot for ``joint_stiffness``: ``robot`` checked against what the stiffness was
+    identified for, or (``robot=None``) the stiffness's own robot (the default robot when it
+    names none)."""
+    import warnings
+
+    from robobore.io.identity import check_robot
+    from robobore.robot.description import Robot, robot_of_identity
+    from robobore.robot.kinematics import get_robot
+    from robobore.robot.stiffness import JointStiffness
+
+    ident = _identity_of(joint_stiffness)
+    if ident is None:
+        js = getattr(joint_stiffness, "joint", joint_stiffness)
+        rname = js.robot if isinstance(js, JointStiffness) else (
+            joint_stiffness.get("robot") if isinstance(joint_stiffness, dict) else None)
+        ident = {"robot": str(rname)} if rname else None
+    if robot is not None and not isinstance(robot, str | Path | Robot):
+        raise InputError("not a robot", field="robot", value=type(robot).__name__,
+                         expected="a robot library name, a robot TOML path, a Robot or None")
+    if robot is None:
+        if ident is not None and ident.get("robot"):
+            rb = robot_of_identity(ident, f"argument {name}")
+            if rb.name != DEFAULT_ROBOT:  # the answer differs from the default robot's
+                warnings.warn(f"robot {rb.name} taken from {name} (robot=None)", stacklevel=3)
+            return rb
+        return get_robot(DEFAULT_ROBOT)
+    rb = get_robot(robot)
+    check_robot(ident, f"argument {name}", rb.name, rb.description_hash(), "robot=")
+    return rb
+
+
+def _joints_arg(joints_deg: Any, n: int):
+    """``joints_deg`` as n finite angles in rad (InputError naming the argument), with the
+    "radians?" warning of robobore.io.ranges.radians_hint."""
+    import warnings
+
+    import numpy as np
+
+    from robobore.io.ranges import radians_hint
+
+    try:
+        q = np.asarray(joints_deg, float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("not joint angles", field="joints_deg", value=joints_deg,
+                         expected=f"{n} numbers in deg") from None
+    if q.size != n or not np.all(np.isfinite(q)):
+        raise InputError(f"got {q.size} joint angles" if q.size != n else "not finite",
+                         field="joints_deg", value=q.tolist(),
+                         expected=f"{n} finite numbers in deg")
+    hint = radians_hint(q.tolist(), "joints_deg")
+    if hint is not None:
+        warnings.warn(hint, stacklevel=3)
+    return np.radians(q)
+
+
+def _tcp_arg(tcp_m: Any):
+    """``tcp_m`` as 3 numbers in m within the plausible tool-point range (or None)."""
+    import numpy as np
+
+    from robobore.io.ranges import check_value
+
+    if tcp_m is None:
+        return None
+    try:
+        t = np.asarray(tcp_m, float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("not a tool point", field="tcp_m", value=tcp_m,
+                         expected="3 numbers x, y, z in m (flange frame)") from None
+    if t.size != 3:
+        raise InputError(f"got {t.size} values", field="tcp_m", value=t.tolist(),
+                         expected="3 numbers x, y, z in m (flange frame)")
+    for v in t:
+        check_value(float(v), "tcp_m", field="tcp_m")
+    return t.tolist()
+
+
 def stiffness_at_pose(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
-                      robot: Any = DEFAULT_ROBOT, *, frame: Any = "boring",
+                      robot: Any = None, *, frame: Any = "boring",
                       tcp_m: Any = None, wrench_N_Nm: Any = None):
     """Stiffness of the robot at a posture -> ``StiffnessResult``: directional stiffness
     along the ``frame`` axes (``directional_stiffness_N_per_m``), Cartesian 6x6 stiffness,
@@ -103,26 +190,30 @@ def stiffness_at_pose(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
     N, moment N m on the robot at the tool point, world frame), the CCT stiffness under
     load. ``joint_stiffness``: a ``StiffnessIdentification``, ``JointStiffness``, their
     dict form or n values in N m/rad (every joint identified); ``tcp_m`` the tool point in
-    the flange frame [m]."""
-    import numpy as np
+    the flange frame [m]. ``robot``: a library name, robot TOML path or ``Robot``, checked
+    against the robot the stiffness was identified for (another robot: ``ConfigError``
+    naming both); None: the stiffness's own robot (a warning says so when it is not the
+    default robot), else the default."""
+    from robobore.robot.stiffness import joint_stiffness_arg, stiffness_at
 
-    from robobore.robot.stiffness import stiffness_at
-
-    return stiffness_at(robot, np.radians(np.asarray(joints_deg, float)), joint_stiffness,
-                        frame=frame, tcp_m=tcp_m, wrench=wrench_N_Nm)
+    joint_stiffness_arg(joint_stiffness)
+    rb = _robot_arg(robot, joint_stiffness)
+    return stiffness_at(rb, _joints_arg(joints_deg, rb.n_joints), joint_stiffness,
+                        frame=frame, tcp_m=_tcp_arg(tcp_m), wrench=wrench_N_Nm)
 
 
 def directional_stiffness(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
-                          robot: Any = DEFAULT_ROBOT, *, frame: Any = "boring",
+                          robot: Any = None, *, frame: Any = "boring",
                           tcp_m: Any = None) -> dict[str, float | None]:
     """Directional stiffness ``{"x", "y", "z"}`` [N/m] along the ``frame`` axes at a
-    posture; an axis that an unidentified joint moves is None (no made-up value)."""
-    import numpy as np
+    posture; an axis that an unidentified joint moves is None (no made-up value).
+    ``robot`` as in :func:`stiffness_at_pose`."""
+    from robobore.robot.stiffness import directional_stiffness_xyz, joint_stiffness_arg
 
-    from robobore.robot.stiffness import directional_stiffness_xyz
-
-    return directional_stiffness_xyz(robot, np.radians(np.asarray(joints_deg, float)),
-                                     joint_stiffness, frame=frame, tcp_m=tcp_m)
+    joint_stiffness_arg(joint_stiffness)
+    rb = _robot_arg(robot, joint_stiffness)
+    return directional_stiffness_xyz(rb, _joints_arg(joints_deg, rb.n_joints),
+                                     joint_stiffness, frame=frame, tcp_m=_tcp_arg(tcp_m))
 
 
 # ----------------------------------------------------------------------------- modal

@@ -145,8 +145,56 @@ def parse_campaign_text(text: str, source: str = "<campaign>", robot=None) -> Ca
     return camp
 
 
+def truth_path(path: str | Path) -> Path:
+    """The identity file written next to a campaign CSV (``<csv>.truth.json``): robot,
+    robot hash, SYNTHETIC flag and, for a virtual campaign, its ground truth."""
+    return Path(str(path) + ".truth.json")
+
+
+def read_truth(path: str | Path) -> dict | None:
+    """The campaign's identity file (:func:`truth_path`), or None when there is none."""
+    from robobore.io.readers import load_json
+
+    tp = truth_path(path)
+    if not tp.is_file():
+        return None
+    data = load_json(tp, "campaign identity file",
+                     "the JSON object `robobore robot campaign` writes next to its CSV")
+    syn = data.get("synthetic")
+    if not isinstance(syn, bool):
+        raise DataError("missing or not a boolean", file=str(tp), field="synthetic", value=syn,
+                        expected="true (virtual campaign) or false (measured)")
+    for key in ("robot", "robot_hash"):
+        if data.get(key) is not None and not isinstance(data[key], str):
+            raise DataError("not a string", file=str(tp), field=key, value=data[key],
+                            expected="the robot's library name / description hash")
+    return data
+
+
+def _sniff_separator(text: str, source: str) -> str:
+    """The CSV text with its separator: ``;``, tab and ``|`` separated files are read (their
+    decimal separator must be ``.``); anything else is left to the column check."""
+    first = text.lstrip("\ufeff").splitlines()[0] if text.strip() else ""
+    if "," in first:
+        return text
+    for sep in (";", "\t", "|"):
+        if sep in first and "posture" in first:
+            rows = list(csv.reader(io.StringIO(text), delimiter=sep))
+            buf = io.StringIO()
+            csv.writer(buf, lineterminator="\n").writerows(rows)
+            return buf.getvalue()
+    return text
+
+
 def read_campaign(path: str | Path, robot=None) -> Campaign:
-    """Read and validate a campaign CSV file (``robot``: name/Robot to check joint limits)."""
+    """Read and validate a campaign CSV file (``robot``: name/Robot to check joint limits).
+
+    A ``;``, tab or ``|`` separated file is read as well (with ``.`` as the decimal
+    separator). The identity file next to it (:func:`truth_path`), if there is one, goes to
+    ``Campaign.truth``: its ``synthetic`` flag travels into the identification, and a
+    ``robot`` other than ``robot`` is refused, naming both."""
+    import dataclasses
+
     p = Path(path)
     if not p.is_file():
         raise DataError("campaign file not found", file=str(p), expected="an existing CSV file")
@@ -155,7 +203,16 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
     except UnicodeDecodeError as exc:
         raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
                         expected="a UTF-8 CSV file") from None
-    return parse_campaign_text(text, source=str(p), robot=robot)
+    truth = read_truth(p)
+    if truth is not None and robot is not None:
+        from robobore.io.identity import check_robot
+        from robobore.robot.kinematics import get_robot
+
+        rb = get_robot(robot)
+        check_robot({"robot": truth.get("robot"), "robot_hash": truth.get("robot_hash")},
+                    str(p), rb.name, rb.description_hash(), "the robot given")
+    camp = parse_campaign_text(_sniff_separator(text, str(p)), source=str(p), robot=robot)
+    return camp if truth is None else dataclasses.replace(camp, truth=truth)
 
 
 def validate_campaign(c: Campaign, robot=None) -> None:
@@ -270,11 +327,15 @@ def format_campaign(c: Campaign) -> str:
     return buf.getvalue()
 
 
-def write_campaign(c: Campaign, path: str | Path) -> Path:
-    """Write the contract CSV atomically."""
-    from robobore.io.results import atomic_write_text
+def write_campaign(c: Campaign, path: str | Path, identity: dict | None = None) -> Path:
+    """Write the contract CSV atomically; with ``identity`` (robot, robot_hash, synthetic,
+    ...), also its identity file (:func:`truth_path`)."""
+    from robobore.io.results import atomic_write_text, write_json
 
-    return atomic_write_text(path, format_campaign(c))
+    out = atomic_write_text(path, format_campaign(c))
+    if identity is not None:
+        write_json(truth_path(path), identity)
+    return out
 
 
 __all__ = [
@@ -285,4 +346,6 @@ __all__ = [
     "validate_campaign",
     "format_campaign",
     "write_campaign",
+    "truth_path",
+    "read_truth",
 ]

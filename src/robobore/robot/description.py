@@ -122,6 +122,18 @@ class Robot:
     def base(self) -> np.ndarray:
         return np.asarray(self.base_transform, float).reshape(4, 4)
 
+    def description_hash(self) -> str:
+        """16-hex-digit hash of the kinematic description (D-H data, joint limits, base
+        transform; not the name): the ``robot_hash`` of result files
+        (:mod:`robobore.io.identity`)."""
+        from robobore.io.hashing import stable_hash
+
+        return stable_hash({"d_m": self.d_m, "a_m": self.a_m, "alpha_rad": self.alpha_rad,
+                            "theta_offset_rad": self.theta_offset_rad,
+                            "lower_limit_rad": self.lower_limit_rad,
+                            "upper_limit_rad": self.upper_limit_rad,
+                            "base_transform": self.base_transform}, length=16)
+
     def to_dict(self) -> dict[str, Any]:
         """Human-unit dict, the same layout as the library TOML files."""
         return {
@@ -266,6 +278,26 @@ def get_robot(name: str | Path | Robot) -> Robot:
     return load_robot_file(lib[str(name)])
 
 
+def robot_of_identity(ident: dict[str, Any], file: str) -> Robot:
+    """The robot a file's identity names (its robot file if that still holds the same
+    robot, else the library robot of that name), checked against the recorded hash."""
+    from robobore.io.identity import IDENTITY_KEY, check_robot
+
+    rf = ident.get("robot_file")
+    if rf and Path(rf).is_file():
+        rb = get_robot(Path(rf))
+    elif ident.get("robot") in available_robots():
+        rb = get_robot(ident["robot"])
+    else:
+        raise ConfigError(f"{file} was identified for robot {ident.get('robot')}, which is not "
+                          "in the robot library", file=file, field=f"{IDENTITY_KEY}.robot",
+                          value=ident.get("robot"),
+                          expected="--robot NAME or --robot-file PATH of that robot")
+    check_robot(ident, file, rb.name, rb.description_hash(),
+                f"the robot found for it ({rb.file or rb.name})")
+    return rb
+
+
 # --- joint limits ---------------------------------------------------------------------------
 
 
@@ -315,5 +347,6 @@ __all__ = [
     "available_robots",
     "get_robot",
     "load_robot_file",
+    "robot_of_identity",
     "check_joint_limits",
 ]
