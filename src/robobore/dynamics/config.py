@@ -392,14 +392,15 @@ def resolve_model_files(raw: dict[str, Any], path: str | Path,
                               "no model files", src)
     try:
         if ef is not None:
-            em = EquivalentModel.from_dict(_read_json_file(ef, "model equivalent --json", src))
+            em = EquivalentModel.from_dict(_read_json_file(ef, "model equivalent --json", src),
+                                           str(ef))
             files = {"equivalent_file": str(ef)}
         else:
             em = EquivalentModel.from_stiffness_and_modes(
                 _read_json_file(sf, "identify stiffness --json", src),
                 _read_json_file(mf, "identify modes --json", src),
                 None if mcfg.assign is None else dict(zip("xyz", mcfg.assign, strict=True)),
-                damping_N_s_per_m=mcfg.damping_N_s_per_m)
+                damping_N_s_per_m=mcfg.damping_N_s_per_m, names=(str(sf), str(mf)))
             files = {"stiffness_file": str(sf), "modes_file": str(mf)}
     except ConfigError as exc:
         if exc.file is not None:

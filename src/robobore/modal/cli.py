@@ -81,6 +81,12 @@ def modes_cmd(
         None, "--frf-type", help="FRF type of a UFF FRF file if its records do not say."),
     plot: Path | None = typer.Option(None, "--plot", help="Write PNG plots to this folder."),
     out: Path | None = typer.Option(None, "--out", help="Write the result JSON to this file."),
+    robot: str | None = typer.Option(
+        None, "--robot", help="Robot of the hammer test (library name or robot TOML), "
+        "recorded in the result's identity (default: the test's identity file, if any)."),
+    joints_deg: str | None = typer.Option(
+        None, "--joints-deg", help="Posture of the hammer test, q1,..,q6 in deg, recorded in "
+        "the result's identity."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
@@ -148,7 +154,10 @@ def modes_cmd(
         advance(1)
         res = an.result.to_dict()
         res["source"] = str(input_file)
-        res["synthetic"] = bool(example)
+        ident = _test_identity(Path(input_file), robot, joints_deg, band_hz)
+        res["synthetic"] = bool(example or ident["synthetic"])
+        ident["synthetic"] = res["synthetic"]
+        res["identity"] = ident
         if hits is not None:
             res["hits"] = hits.to_dict()
         res["warnings"] = warn_list
@@ -160,6 +169,40 @@ def modes_cmd(
     if out is not None:
         write_json(out, res)
     emit(res, as_json, _render_modes)
+
+
+def _test_identity(path: Path, robot: str | None, joints_deg: str | None,
+                   band_hz: Any) -> dict[str, Any]:
+    """The identity of modes identified from ``path``: the hammer test's identity file
+    (``<file>.truth.json``, written by the virtual hammer test) and the options, checked
+    against each other."""
+    from robobore.io.identity import check_posture, check_robot, make_identity, read_identity
+    from robobore.io.readers import load_json
+
+    tp = Path(str(path) + ".truth.json")
+    ident = None
+    synthetic = None
+    if tp.is_file():
+        data = load_json(tp, "hammer-test identity file",
+                         "the JSON the virtual hammer test writes next to its UFF file")
+        synthetic = bool(data.get("synthetic", False))
+        ident = read_identity(data, str(tp))
+    out = dict(ident) if ident is not None else make_identity("modes")
+    out["kind"] = "modes"
+    out["source"] = str(path)
+    out["synthetic"] = synthetic if synthetic is not None else out.get("synthetic")
+    if robot is not None:
+        from robobore.robot.kinematics import get_robot
+
+        rb = get_robot(robot)
+        check_robot(ident, str(tp), rb.name, rb.description_hash(), "--robot",
+                    verb="is a hammer test of")
+        out.update(robot=rb.name, robot_hash=rb.description_hash(), robot_file=rb.file or None)
+    if joints_deg is not None:
+        q = parse_floats(joints_deg, None, "--joints-deg", "deg")
+        check_posture(ident, str(tp), q, "--joints-deg")
+        out["joints_deg"] = q
+    return out
 
 
 @handle_errors
@@ -226,7 +269,7 @@ def virtual_test_cmd(
                        "SYNTHETIC robobore virtual hammer test")
     truth_path = Path(str(out) + ".truth.json")
     info = {"file": str(out), "truth_file": str(truth_path), "synthetic": True,
-            "settings": settings, "truth": truth.to_dict()}
+            "settings": settings, "truth": truth.to_dict(), "identity": _virtual_identity()}
     write_json(truth_path, info)
     if as_json:
         emit(info, True, lambda r: None)
@@ -238,6 +281,18 @@ def virtual_test_cmd(
             ("hammer inputs", ", ".join(truth.input_names)),
             ("hits per input", settings["n_hits"]), ("noise (fraction of RMS)",
                                                       settings["noise_response"])]))
+
+
+def _virtual_identity() -> dict[str, Any]:
+    """What the virtual hammer test describes: the example robot at the example posture."""
+    from robobore.io.identity import make_identity
+    from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, EXAMPLE_ROBOT, EXAMPLE_TCP_M
+    from robobore.robot.kinematics import get_robot
+
+    rb = get_robot(EXAMPLE_ROBOT)
+    return make_identity("hammer test", robot=rb.name, robot_hash=rb.description_hash(),
+                         joints_deg=EXAMPLE_POSTURE_DEG, tcp_m=EXAMPLE_TCP_M, frame="boring",
+                         synthetic=True, source="robobore virtual hammer test")
 
 
 def _check_hammer_size(n_inputs: int, hits: int, n_outputs: int, sample_rate_hz: float,

@@ -94,6 +94,8 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     model = cal.model
     process = build_process(inp)
     A0 = process.mean_directional_matrix()
+    from robobore.io.identity import make_identity
+
     Rb = boring_frame(inp.bore_axis)
     # measured posture: does it hold this bore? anchor the rotation grid at its angle
     Tm = fk(robot, inp.q_meas_rad, inp.tcp_m)
@@ -173,6 +175,11 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "lobes": lobes,
         "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
+        "identity": make_identity(
+            "plan", robot=robot.name, robot_hash=robot.description_hash(),
+            robot_file=robot.file or None, joints_deg=entries[best]["joints_deg"],
+            tcp_m=inp.tcp_m.tolist(), frame="boring", synthetic=bool(inp.synthetic),
+            source=f),
         "wall_time_s": wall,
     }
     result["_arrays"] = {"cand": cand, "ev": ev, "criterion": crit, "best": best,
