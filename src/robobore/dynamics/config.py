@@ -278,7 +278,9 @@ class CoefficientsCfg(_Strict):
                              "interpolated at the cutting speed")
         if self.material is not None and self.material.upper() not in ("TC4", "TI6AL4V",
                                                                          "TI-6AL-4V"):
-            raise ValueError("unknown material; expected TC4")
+            raise ValueError(f"unknown material {self.material!r}; expected 'TC4' (Ti-6Al-4V, "
+                             "the measured default), or a coefficients file / inline "
+                             "Ktc_N_per_m2 for another material")
         return self
 
 

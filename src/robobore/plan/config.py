@@ -153,7 +153,7 @@ def load_plan_config(path: str | Path) -> PlanInputs:
     f = str(p)
     rname = cfg.robot.name
     rpath = _resolve(p, rname) if rname.endswith(".toml") else None
-    robot = get_robot(str(rpath) if rpath is not None else rname)
+    robot = get_robot(str(rpath) if rpath is not None else rname, file=f, field="robot.name")
     if not robot.links:
         raise ConfigError(
             f"robot '{robot.name}' has no inertial data (mass, centre of mass and inertia per "

@@ -80,6 +80,11 @@ def parse_campaign_text(text: str, source: str = "<campaign>", robot=None) -> Ca
     header = [h.strip() for h in header]
     missing = [c for c in REQUIRED if c not in header]
     if missing:
+        seps = [s for s in (";", "\t", "|", " ") if len(header) == 1 and s in header[0]]
+        if seps:
+            raise DataError(f"the header is one cell separated by {seps[0]!r}, not by commas",
+                            file=source, field=header[0][:40],
+                            expected=f"comma-separated columns {list(REQUIRED)}")
         raise DataError(f"missing column(s) {missing}", file=source, field=missing[0],
                         expected=f"columns {list(REQUIRED)} (+ optional {list(OPTIONAL)})")
     unknown = [c for c in header if c not in REQUIRED and c not in OPTIONAL]
@@ -171,26 +176,11 @@ def read_truth(path: str | Path) -> dict | None:
     return data
 
 
-def _sniff_separator(text: str, source: str) -> str:
-    """The CSV text with its separator: ``;``, tab and ``|`` separated files are read (their
-    decimal separator must be ``.``); anything else is left to the column check."""
-    first = text.lstrip("\ufeff").splitlines()[0] if text.strip() else ""
-    if "," in first:
-        return text
-    for sep in (";", "\t", "|"):
-        if sep in first and "posture" in first:
-            rows = list(csv.reader(io.StringIO(text), delimiter=sep))
-            buf = io.StringIO()
-            csv.writer(buf, lineterminator="\n").writerows(rows)
-            return buf.getvalue()
-    return text
-
-
 def read_campaign(path: str | Path, robot=None) -> Campaign:
     """Read and validate a campaign CSV file (``robot``: name/Robot to check joint limits).
 
-    A ``;``, tab or ``|`` separated file is read as well (with ``.`` as the decimal
-    separator). The identity file next to it (:func:`truth_path`), if there is one, goes to
+    A ``;``, tab or ``|`` separated file is read as well
+    (:func:`robobore.io.readers.comma_separated`). The identity file next to it (:func:`truth_path`), if there is one, goes to
     ``Campaign.truth``: its ``synthetic`` flag travels into the identification, and a
     ``robot`` other than ``robot`` is refused, naming both."""
     import dataclasses
@@ -211,7 +201,9 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
         rb = get_robot(robot)
         check_robot({"robot": truth.get("robot"), "robot_hash": truth.get("robot_hash")},
                     str(p), rb.name, rb.description_hash(), "the robot given")
-    camp = parse_campaign_text(_sniff_separator(text, str(p)), source=str(p), robot=robot)
+    from robobore.io.readers import comma_separated
+
+    camp = parse_campaign_text(comma_separated(text, REQUIRED), source=str(p), robot=robot)
     return camp if truth is None else dataclasses.replace(camp, truth=truth)
 
 

@@ -55,7 +55,7 @@ def _robot(robot: str | None, robot_file: Path | None, default: str | None = DEF
             raise ConfigError("no robot given", field="--robot",
                               expected="a robot library name or --robot-file PATH")
         robot = default
-    return get_robot(robot)
+    return get_robot(robot, field="--robot")
 
 
 def _tcp(tcp: str | None) -> list[float] | None:

@@ -260,18 +260,28 @@ def load_robot_file(path: str | Path) -> Robot:
     return dataclasses.replace(r, file=str(path))
 
 
-def get_robot(name: str | Path | Robot) -> Robot:
-    """A robot by library name, or by the path of a TOML file; unknown names raise ConfigError."""
+def get_robot(name: str | Path | Robot, *, file: str | None = None,
+              field: str = "robot") -> Robot:
+    """A robot by library name, or by the path of a TOML file; unknown names raise ConfigError
+    naming ``file`` (the config that named the robot) and ``field`` (its key or option)."""
     if isinstance(name, Robot):
         return name
+    if not isinstance(name, str | Path):
+        raise ConfigError("not a robot", file=file, field=field, value=type(name).__name__,
+                          expected="a robot library name, a robot TOML path or a Robot")
     p = Path(str(name))
     if p.suffix == ".toml" and p.is_file():
         return load_robot_file(p)
+    if p.suffix == ".toml":
+        raise ConfigError("robot file not found", file=file, field=field, value=str(name),
+                          expected="an existing robot TOML file")
     lib = available_robots()
     if str(name) not in lib:
+        close = [n for n in lib if n.startswith(str(name)) or str(name) in n]
         raise ConfigError(
-            "unknown robot",
-            field="robot",
+            "unknown robot" + (f" (did you mean {close[0]!r}?)" if close else ""),
+            file=file,
+            field=field,
             value=str(name),
             expected=f"one of {sorted(lib)} or the path of a robot TOML file",
         )

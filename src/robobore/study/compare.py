@@ -101,9 +101,13 @@ def _parse_number(cell: str, *, source: str, row: int, col: str, unit: str,
 
 
 def parse_measured_csv(text: str, source: str = "<measured>") -> MeasuredTable:
-    """Parse and validate measured-CSV text (see module doc)."""
+    """Parse and validate measured-CSV text (see module doc); ``;``, tab or ``|``
+    separated text is read too (:func:`robobore.io.readers.comma_separated`)."""
+    from robobore.io.readers import comma_separated
+
     if text.startswith("\ufeff"):
         text = text[1:]
+    text = comma_separated(text, KNOWN_COLUMNS)
     reader = csv.reader(io.StringIO(text))
     header: list[str] | None = None
     header_line = 0
@@ -172,7 +176,10 @@ def _check_header(header: list[str], source: str) -> None:
             raise DataError("empty column name", file=source, row=0, field=f"column {i + 1}",
                             expected="a column name")
         if h not in KNOWN_COLUMNS:
-            raise DataError("unknown column", file=source, field=h,
+            seps = [s for s in (";", "\t", "|", " ") if s in h]
+            hint = (f" (the header is separated by {seps[0]!r}: the file needs ',' between "
+                    "columns)") if seps and len(header) == 1 else ""
+            raise DataError("unknown column" + hint, file=source, field=h,
                             expected=f"one of {', '.join(KNOWN_COLUMNS)}")
         if header.count(h) > 1:
             raise DataError("column appears twice", file=source, field=h,
