@@ -146,3 +146,25 @@ def test_silent_scheduler_fails_in_seconds(tmp_path):
         for c in conns:
             c.close()
         srv.close()
+
+
+def test_95_deg_boring_bar_accepted_and_110_refused(tmp_path):
+    import json
+
+    s = tmp_path / "s.json"
+    r = runner.invoke(app, ["identify", "stiffness", "--example", "--json"])
+    s.write_text(r.stdout)
+    m = tmp_path / "m.json"
+    m.write_text(runner.invoke(app, ["identify", "modes", "--example", "--json"]).stdout)
+    base = (EX / "boring_process.toml").read_text()
+    assert "approach_angle_deg = 90.0" in base
+    f95 = tmp_path / "b95.toml"
+    f95.write_text(base.replace("approach_angle_deg = 90.0", "approach_angle_deg = 95.0"))
+    r = runner.invoke(app, ["lobes", str(f95), "--stiffness-file", str(s), "--modes-file",
+                            str(m), "--method", "frequency", "--json"])
+    assert r.exit_code == 0, r.output
+    assert min(json.loads(r.stdout)["critical_depth_mm"]) > 0
+    f110 = tmp_path / "b110.toml"
+    f110.write_text(base.replace("approach_angle_deg = 90.0", "approach_angle_deg = 110.0"))
+    msg = _err(["lobes", str(f110), "--stiffness-file", str(s), "--modes-file", str(m)])
+    assert str(f110) in msg and "insert.approach_angle_deg" in msg and "107.5" in msg

@@ -196,7 +196,7 @@ def speed_range(cfg: DynamicsConfig) -> tuple[SpeedCfg, str | None]:
 
 class InsertCfg(_Strict):
     nose_radius_mm: float = Field(0.4, gt=0, le=10)
-    approach_angle_deg: float = Field(90.0, gt=0, le=90)
+    approach_angle_deg: float = 90.0  # range: robobore.cutting.geometry.check_approach_angle
     end_edge_angle_deg: float = Field(5.0, gt=0, lt=90)
     rake_deg: float = Field(7.0, ge=-30, le=30)
     inclination_deg: float = Field(0.0, ge=-30, le=30)
@@ -209,10 +209,13 @@ class InsertCfg(_Strict):
     @field_validator("approach_angle_deg")
     @classmethod
     def _kappa(cls, v: float) -> float:
-        if v < 5.0:
-            raise ValueError(f"approach angle {v:g} deg is below 5 deg (looks like radians; "
-                             "expected deg, boring inserts 45 .. 95 deg)")
-        return v
+        from robobore.cutting.geometry import check_approach_angle
+
+        try:
+            return check_approach_angle(v)
+        except ConfigError as exc:
+            raise ValueError(f"{exc.message} (got {v:g} deg); expected {exc.expected}"
+                             ) from None
 
     @field_validator("edge_radius_um")
     @classmethod
