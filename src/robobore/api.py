@@ -63,6 +63,60 @@ def bundled_coefficients_path() -> Path:
     return _data("paper_example", "tc4_fe_coefficients.json")
 
 
+# ----------------------------------------------------------------------------- arguments
+def _path_arg(path: Any, name: str) -> Path | None:
+    """``path`` as a Path (None passes through); anything else an InputError naming it."""
+    if path is None or isinstance(path, Path):
+        return path
+    if isinstance(path, str) and path.strip():
+        return Path(path)
+    raise InputError("not a file path", field=name, value=path if isinstance(path, str)
+                     else type(path).__name__, expected="a str or pathlib.Path (or None)")
+
+
+def _number_arg(value: Any, name: str, unit: str, *, positive: bool = True,
+                allow_none: bool = True) -> float | None:
+    """``value`` as a finite float (> 0 when ``positive``); InputError naming ``name``."""
+    import math
+    import numbers
+
+    if value is None and allow_none:
+        return None
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if ok:
+        v = float(value)
+        ok = math.isfinite(v) and (v > 0 or not positive)
+    if not ok:
+        raise InputError("not a number" if not isinstance(value, numbers.Real) else
+                         "out of range", field=name, value=value,
+                         expected=f"a finite {'positive ' if positive else ''}number in {unit}")
+    return float(value)
+
+
+def _int_arg(value: Any, name: str, lo: int, hi: int, allow_none: bool = True) -> int | None:
+    import numbers
+
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or \
+            not lo <= value <= hi:
+        raise InputError("not an integer in range", field=name, value=value,
+                         expected=f"an integer {lo} .. {hi}")
+    return int(value)
+
+
+def _band_arg(band: Any, name: str = "band_Hz") -> tuple[float, float]:
+    if isinstance(band, str | bytes) or not hasattr(band, "__len__") or len(band) != 2:
+        raise InputError("not a frequency band", field=name, value=band,
+                         expected="(low, high) in Hz, low < high")
+    lo = _number_arg(band[0], f"{name}[0]", "Hz", allow_none=False)
+    hi = _number_arg(band[1], f"{name}[1]", "Hz", allow_none=False)
+    if not lo < hi:  # type: ignore[operator]
+        raise InputError("empty band", field=name, value=list(band),
+                         expected="(low, high) in Hz, low < high")
+    return lo, hi  # type: ignore[return-value]
+
+
 # ----------------------------------------------------------------------------- robot
 def load_campaign(path: str | Path | None = None, robot: Any = DEFAULT_ROBOT):
     """Read a laser-tracker stiffness campaign CSV (None: the bundled SYNTHETIC one),
@@ -70,7 +124,8 @@ def load_campaign(path: str | Path | None = None, robot: Any = DEFAULT_ROBOT):
     from robobore.robot.campaign_io import read_campaign
     from robobore.robot.kinematics import get_robot
 
-    return read_campaign(bundled_campaign_path() if path is None else Path(path),
+    path = _path_arg(path, "path")
+    return read_campaign(bundled_campaign_path() if path is None else path,
                          robot=get_robot(robot))
 
 
@@ -86,6 +141,8 @@ def identify_joint_stiffness(campaign: Any = None, robot: Any = DEFAULT_ROBOT, *
     from robobore.robot.kinematics import get_robot
 
     rb = get_robot(robot)
+    sigma_m = _number_arg(sigma_m, "sigma_m", "m (1-sigma tracker noise per coordinate)")
+    tcp_m = _tcp_arg(tcp_m)
     if campaign is None or isinstance(campaign, str | Path):
         campaign = load_campaign(campaign, rb)
     elif not isinstance(campaign, Campaign):
@@ -196,8 +253,19 @@ def stiffness_at_pose(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
     default robot), else the default."""
     from robobore.robot.stiffness import joint_stiffness_arg, stiffness_at
 
+    import numpy as np
+
     joint_stiffness_arg(joint_stiffness)
     rb = _robot_arg(robot, joint_stiffness)
+    if wrench_N_Nm is not None:
+        try:
+            w = np.asarray(wrench_N_Nm, float).reshape(-1)
+        except (TypeError, ValueError):
+            w = np.zeros(0)
+        if w.size != 6 or not np.all(np.isfinite(w)):
+            raise InputError("not a wrench", field="wrench_N_Nm", value=wrench_N_Nm,
+                             expected="6 finite numbers Fx, Fy, Fz (N), Mx, My, Mz (N m)")
+        wrench_N_Nm = w.tolist()
     return stiffness_at(rb, _joints_arg(joints_deg, rb.n_joints), joint_stiffness,
                         frame=frame, tcp_m=_tcp_arg(tcp_m), wrench=wrench_N_Nm)
 
@@ -222,7 +290,8 @@ def load_hammer_test(path: str | Path | None = None, frf_type: str | None = None
     SYNTHETIC test) -> ``HammerRecords`` (time records) or ``FRFData``."""
     from robobore.modal.io import load_input
 
-    return load_input(bundled_hammer_test_path() if path is None else Path(path), frf_type)
+    path = _path_arg(path, "path")
+    return load_input(bundled_hammer_test_path() if path is None else path, frf_type)
 
 
 def frf(records: Any, *, estimator: str = "H1", exp_window_tau_s: float | None = None):
@@ -255,10 +324,11 @@ def identify_modes(data: Any = None, *, band_Hz: Any = PAPER_BAND_HZ,
     ``n_modes`` best-supported modes (frequency_Hz, damping_ratio, direction, ...)."""
     from robobore.modal.identify import identify_modes as _identify
 
+    lo, hi = _band_arg(band_Hz)
+    n_modes = _int_arg(n_modes, "n_modes", 1, 100)
+    max_order = _int_arg(max_order, "max_order", 1, 1000, allow_none=False)
     data = load_hammer_test() if data is None else data
-    lo, hi = band_Hz
-    return _identify(frf(data), band_Hz=(float(lo), float(hi)), n_modes=n_modes,
-                     max_order=max_order)
+    return _identify(frf(data), band_Hz=(lo, hi), n_modes=n_modes, max_order=max_order)
 
 
 # ----------------------------------------------------------------------------- equivalent
@@ -303,8 +373,9 @@ def cutting_coefficients(cutting_speed_m_per_min: float | None = None,
     set) at a cutting speed [m/min] -> ``CuttingCoefficients`` (SI)."""
     from robobore.cutting.forces import load_coefficients
 
-    return load_coefficients(bundled_coefficients_path() if path is None else Path(path),
-                             cutting_speed_m_per_min)
+    v = _number_arg(cutting_speed_m_per_min, "cutting_speed_m_per_min", "m/min")
+    path = _path_arg(path, "path")
+    return load_coefficients(bundled_coefficients_path() if path is None else path, v)
 
 
 # ----------------------------------------------------------------------------- dynamics
