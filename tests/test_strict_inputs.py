@@ -168,3 +168,24 @@ def test_95_deg_boring_bar_accepted_and_110_refused(tmp_path):
     f110.write_text(base.replace("approach_angle_deg = 90.0", "approach_angle_deg = 110.0"))
     msg = _err(["lobes", str(f110), "--stiffness-file", str(s), "--modes-file", str(m)])
     assert str(f110) in msg and "insert.approach_angle_deg" in msg and "107.5" in msg
+
+
+@pytest.mark.parametrize(("call", "arg"), [
+    (lambda api: api.identify_modes(band_Hz="3-60"), "band_Hz"),
+    (lambda api: api.identify_modes(n_modes="5"), "n_modes"),
+    (lambda api: api.load_campaign(5), "path"),
+    (lambda api: api.identify_joint_stiffness(sigma_m="10"), "sigma_m"),
+    (lambda api: api.cutting_coefficients("fast"), "cutting_speed_m_per_min"),
+    (lambda api: api.load_hammer_test(7), "path"),
+    (lambda api: api.stiffness_at_pose([3e6, 4e6, 2.5e6, 5e5, 4.5e5, 3e5],
+                                       wrench_N_Nm=[1, 2]), "wrench_N_Nm"),
+    (lambda api: api.stiffness_at_pose([3e6, 4e6, 2.5e6, 5e5, 4.5e5, 3e5],
+                                       tcp_m=[0, 0, 300]), "tcp_m"),
+])
+def test_api_arguments_of_the_wrong_type_are_named(call, arg):
+    from robobore import api
+    from robobore.errors import InputError
+
+    with pytest.raises(InputError) as ei:
+        call(api)
+    assert ei.value.field == arg
