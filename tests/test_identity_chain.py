@@ -166,3 +166,25 @@ def test_horizontal_boring_frame_unchanged():
     R = boring_frame(np.array([1.0, 0, 0]))
     assert np.allclose(R[:, 0], np.cross([0, 0, 1.0], [1.0, 0, 0]))
     assert np.allclose(R[:, 1], [0, 0, 1.0])
+
+
+def test_plan_warns_on_a_calibration_that_does_not_fit(tmp_path):
+    """Joint stiffnesses x 1000 (N m/rad given as N mm/rad): the model calibrated at the
+    measured posture misses the identified modes by about 2,240 % rms; said, not silent."""
+    import re as _re
+
+    from robobore.plan.posture import CALIBRATION_WARN_PERCENT, plan_posture
+
+    shutil.copytree(EX / "plan_paper_bore", tmp_path / "plan_paper_bore")
+    s = tmp_path / "plan_paper_bore" / "joint_stiffness.json"
+    d = json.loads(s.read_text())
+    d["joint_stiffness_Nm_per_rad"] = [k * 1000 for k in d["joint_stiffness_Nm_per_rad"]]
+    s.write_text(json.dumps(d))
+    cfg = (EX / "plan_paper_bore.toml").read_text().replace(
+        '"../src/robobore', f'"{REPO}/src/robobore').replace("rotation_step_deg = 1.0",
+                                                            "rotation_step_deg = 10.0")
+    cfg = _re.sub(r"(?s)\[workspace\].*", "", cfg)
+    (tmp_path / "p.toml").write_text(cfg)
+    r = plan_posture(tmp_path / "p.toml")
+    assert r["calibration"]["rms_frequency_residual_percent"] > CALIBRATION_WARN_PERCENT
+    assert r["warnings"] and "joint_stiffness.json" in r["warnings"][0]

@@ -95,6 +95,8 @@ def test_json_contract(paper_result):
     r = public(paper_result)
     json.dumps(r)  # serialisable as is
     assert {"recommended", "candidates", "criterion", "wall_time_s"} <= set(r)
+    assert r["warnings"] == []  # the bundled inputs belong together (calibration 29 % rms)
+    assert r["identity"]["robot"] == "irb6600-175-2.55" and r["identity"]["synthetic"]
     for c in [r["recommended"], *r["candidates"][:5]]:
         assert len(c["joints_deg"]) == 6
         assert isinstance(c["tool_axis_rotation_deg"], float)

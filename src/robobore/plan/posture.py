@@ -59,6 +59,11 @@ from robobore.plan.scoring import (
     recommend,
 )
 
+#: an rms frequency residual of the calibration above this (%) is reported: the stiffness,
+#: the modes and the posture do not describe one robot (the bundled example: 29 %; joint
+#: stiffnesses x 1000: about 2,240 %)
+CALIBRATION_WARN_PERCENT = 100.0
+
 
 def _same_posture(q1: np.ndarray, q2: np.ndarray, tol: float = 1e-6) -> bool:
     d = np.angle(np.exp(1j * (np.asarray(q1) - np.asarray(q2))))
@@ -92,6 +97,15 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
                        tcp_m=tuple(inp.tcp_m), robot_file=robot.file or None)
     cal = calibrate(model0, inp.q_meas_rad, inp.modes_f_Hz, inp.modes_zeta)
     model = cal.model
+    warn = []
+    rms_cal = float(np.sqrt(np.mean(cal.frequency_error_percent ** 2)))
+    if not rms_cal <= CALIBRATION_WARN_PERCENT:
+        warn.append(
+            f"the model calibrated at the measured posture misses the identified modes by "
+            f"{rms_cal:.4g} % rms (more than {CALIBRATION_WARN_PERCENT:g} %): the joint "
+            f"stiffnesses ({inp.stiffness_file}), the modes ({inp.modes_file}) and the posture "
+            "may not belong together (another robot, a unit slip such as N m/rad x 1000, "
+            "rad/s as Hz); the plan's figures are not reliable")
     process = build_process(inp)
     A0 = process.mean_directional_matrix()
     from robobore.io.identity import make_identity
@@ -175,6 +189,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "lobes": lobes,
         "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
+        "warnings": warn,
         "identity": make_identity(
             "plan", robot=robot.name, robot_hash=robot.description_hash(),
             robot_file=robot.file or None, joints_deg=entries[best]["joints_deg"],
