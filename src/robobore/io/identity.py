@@ -34,12 +34,14 @@ IDENTITY_KEY = "identity"
 POSTURE_TOL_DEG = 0.5
 #: two tool points further apart than this (m) are different tool points
 TCP_TOL_M = 1e-3
-_KEYS = ("kind", "robot", "robot_hash", "robot_file", "joints_deg", "tcp_m", "frame", "synthetic", "source")
+_KEYS = ("kind", "robot", "robot_hash", "robot_file", "joints_deg", "tcp_m", "frame",
+         "synthetic", "source")
 
 
 def make_identity(kind: str, *, robot: str | None = None, robot_hash: str | None = None,
-                  robot_file: str | None = None, joints_deg: Any = None, tcp_m: Any = None, frame: str | None = None,
-                  synthetic: bool | None = None, source: str | None = None) -> dict[str, Any]:
+                  robot_file: str | None = None, joints_deg: Any = None, tcp_m: Any = None,
+                  frame: str | None = None, synthetic: bool | None = None,
+                  source: str | None = None) -> dict[str, Any]:
     """The identity block of a result file (module docstring); ``None`` where unknown."""
     return {
         "kind": kind,

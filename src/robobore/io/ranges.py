@@ -486,7 +486,8 @@ def range_table() -> list[dict[str, str]]:
     return rows
 
 
-__all__ = ["radians_hint", "Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning", "check_value",
+__all__ = ["radians_hint", "Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning",
+           "check_value",
            "check_array",
            "check_tree", "quantity_of", "option_name", "enabled", "set_enabled", "provenance",
            "range_table",

@@ -11,6 +11,7 @@ and the cause.
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -55,7 +56,8 @@ def load_json(path: str | Path, what: str = "JSON file", expected: str = "a JSON
     return data
 
 
-_DECIMAL_COMMA = None
+#: a cell holding a number with a decimal comma (``0,15``, ``-1,5e-3``)
+_DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d+,\d*([eE][-+]?\d+)?\s*$")
 
 
 def comma_separated(text: str, columns: Any) -> str:
@@ -68,11 +70,7 @@ def comma_separated(text: str, columns: Any) -> str:
     returned unchanged (the column check then names what is missing)."""
     import csv
     import io
-    import re
 
-    global _DECIMAL_COMMA
-    if _DECIMAL_COMMA is None:
-        _DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d+,\d*([eE][-+]?\d+)?\s*$")
     header = next((ln for ln in text.lstrip("\ufeff").splitlines()
                    if ln.strip() and not ln.lstrip().startswith("#")), "")
     if "," in header:

@@ -180,9 +180,10 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
     """Read and validate a campaign CSV file (``robot``: name/Robot to check joint limits).
 
     A ``;``, tab or ``|`` separated file is read as well
-    (:func:`robobore.io.readers.comma_separated`). The identity file next to it (:func:`truth_path`), if there is one, goes to
-    ``Campaign.truth``: its ``synthetic`` flag travels into the identification, and a
-    ``robot`` other than ``robot`` is refused, naming both."""
+    (:func:`robobore.io.readers.comma_separated`). The identity file next to it
+    (:func:`truth_path`), if there is one, goes to ``Campaign.truth``: its ``synthetic``
+    flag travels into the identification, and a ``robot`` other than ``robot`` is refused,
+    naming both."""
     import dataclasses
 
     p = Path(path)
