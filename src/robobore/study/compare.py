@@ -219,6 +219,8 @@ class Comparison:
     quantities: tuple[str, ...] = field(default_factory=tuple)
     system: str | None = None  # the simulated system compared (e.g. "robot")
     systems: tuple[str, ...] = field(default_factory=tuple)  # systems in the results store
+    #: likely unit slips: a measured column off the simulation by a power of ten in most rows
+    warnings: tuple[str, ...] = field(default_factory=tuple)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -226,6 +228,7 @@ class Comparison:
             "quantities": list(self.quantities), "group_source": self.group_source,
             "groups": self.groups, "agreement": self.agreement, "conditions": list(self.rows),
             "unmatched_measured": list(self.unmatched_measured), "undefined": list(self.undefined),
+            "warnings": list(self.warnings),
         }
 
     def table_rows(self) -> list[dict[str, Any]]:
@@ -332,6 +335,7 @@ def compare(measured: MeasuredTable,
         groups[g] = {**_stats(allv),
                      "n_conditions": sum(1 for r in rows if r["group"] == g),
                      "per_quantity": {q: _stats(v) for q, v in qs.items()}}
+    warn = _unit_slip_warnings(rows, measured.source)
     n_cmp = sum(confusion.values())
     agreement = {"n": n_cmp, "agree": confusion["both_stable"] + confusion["both_vibratory"],
                  "rate": None if n_cmp == 0 else
@@ -341,8 +345,36 @@ def compare(measured: MeasuredTable,
         rows=tuple(rows), groups=groups, agreement=agreement,
         group_source="measured" if use_measured_flag else "simulated",
         unmatched_measured=tuple(unmatched), undefined=tuple(undefined),
-        quantities=measured.quantities,
+        quantities=measured.quantities, warnings=tuple(warn),
     )
+
+
+#: a measured column whose median |log10(simulated / measured)| reaches this (two decades)
+#: over at least :data:`UNIT_SLIP_MIN_ROWS` rows is reported as a likely unit slip
+UNIT_SLIP_DECADES = 2.0
+UNIT_SLIP_MIN_ROWS = 3
+
+
+def _unit_slip_warnings(rows: list[dict[str, Any]], source: str) -> list[str]:
+    import math
+    import statistics
+
+    out = []
+    by_q: dict[str, list[float]] = {}
+    for r in rows:
+        for q, e in r["quantities"].items():
+            mv, sv = e["measured"], e["simulated"]
+            if mv and sv and mv > 0 and sv > 0:
+                by_q.setdefault(q, []).append(math.log10(sv / mv))
+    for q, lr in by_q.items():
+        if len(lr) >= UNIT_SLIP_MIN_ROWS:
+            med = statistics.median(lr)
+            if abs(med) >= UNIT_SLIP_DECADES:
+                out.append(f"{source}, column '{q}': the simulation is {10 ** med:.3g} times "
+                           f"the measurement (median over {len(lr)} rows): a unit slip in the "
+                           "measured column (mm for um, N for kN, ...)? The relative errors "
+                           "of this column are not meaningful")
+    return out
 
 
 #: label of results whose store does not name the simulated system (``robobore sweep``)
