@@ -188,3 +188,31 @@ def test_plan_warns_on_a_calibration_that_does_not_fit(tmp_path):
     r = plan_posture(tmp_path / "p.toml")
     assert r["calibration"]["rms_frequency_residual_percent"] > CALIBRATION_WARN_PERCENT
     assert r["warnings"] and "joint_stiffness.json" in r["warnings"][0]
+
+
+def test_plan_posture_in_radians(tmp_path):
+    """The measured posture given in radians: refused where the modes file records its
+    posture, warned where it does not."""
+    import re as _re
+
+    from robobore.plan.config import load_plan_config
+    from robobore.plan.posture import plan_posture
+
+    shutil.copytree(EX / "plan_paper_bore", tmp_path / "plan_paper_bore")
+    q_rad = [round(math.radians(v), 4) for v in (-48.38, 54.82, 6.86, -54.16, 107.43, -21.95)]
+    cfg = (EX / "plan_paper_bore.toml").read_text().replace(
+        '"../src/robobore', f'"{REPO}/src/robobore').replace("rotation_step_deg = 1.0",
+                                                            "rotation_step_deg = 10.0")
+    cfg = _re.sub(r"(?m)^posture_deg = .*$", f"posture_deg = {q_rad}", cfg)
+    cfg = _re.sub(r"(?s)\[workspace\].*", "", cfg)
+    (tmp_path / "p.toml").write_text(cfg)
+    mfile = tmp_path / "plan_paper_bore" / "modes.json"
+    d = json.loads(mfile.read_text())
+    if d.get("identity", {}).get("joints_deg") or d.get("posture_deg"):
+        with pytest.raises(ConfigError, match="posture"):
+            load_plan_config(tmp_path / "p.toml")
+    d.pop("identity", None)
+    d.pop("posture_deg", None)
+    mfile.write_text(json.dumps(d))
+    r = plan_posture(tmp_path / "p.toml")
+    assert any("radians?" in w for w in r["warnings"])

@@ -199,7 +199,13 @@ def _test_identity(path: Path, robot: str | None, joints_deg: str | None,
                     verb="is a hammer test of")
         out.update(robot=rb.name, robot_hash=rb.description_hash(), robot_file=rb.file or None)
     if joints_deg is not None:
+        from robobore.clitools import stderr
+        from robobore.io.ranges import radians_hint
+
         q = parse_floats(joints_deg, None, "--joints-deg", "deg")
+        hint = radians_hint(q, "--joints-deg")
+        if hint is not None:
+            stderr.print(f"[yellow]warning:[/] {hint}", soft_wrap=True, highlight=False)
         check_posture(ident, str(tp), q, "--joints-deg")
         out["joints_deg"] = q
     return out
@@ -330,6 +336,12 @@ def _virtual_truth(robot: str | None, robot_file: Path | None, joint_stiffness: 
           get_robot(robot or "irb6600-175-2.55", field="--robot"))
     q = (list(EXAMPLE_POSTURE_DEG) if joints_deg is None
          else parse_floats(joints_deg, rb.n_joints, "--joints-deg", "deg"))
+    from robobore.clitools import stderr
+    from robobore.io.ranges import radians_hint
+
+    hint = radians_hint(q, "--joints-deg")
+    if hint is not None:
+        stderr.print(f"[yellow]warning:[/] {hint}", soft_wrap=True, highlight=False)
     import numpy as np
 
     from robobore.errors import ConfigError, InputError

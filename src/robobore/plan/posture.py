@@ -97,7 +97,11 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
                        tcp_m=tuple(inp.tcp_m), robot_file=robot.file or None)
     cal = calibrate(model0, inp.q_meas_rad, inp.modes_f_Hz, inp.modes_zeta)
     model = cal.model
-    warn = []
+    from robobore.io.ranges import radians_hint
+
+    hint = radians_hint(np.degrees(inp.q_meas_rad).tolist(),
+                        f"{f}: the measured posture (identification.posture_deg)")
+    warn = [] if hint is None else [hint]
     rms_cal = float(np.sqrt(np.mean(cal.frequency_error_percent ** 2)))
     if not rms_cal <= CALIBRATION_WARN_PERCENT:
         warn.append(
