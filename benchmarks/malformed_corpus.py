@@ -4,8 +4,12 @@ whose commands run FE simulations or the whole paper study, through their parse 
     python benchmarks/malformed_corpus.py [--out /tmp/corpus] [--timeout 60] [--workers 2]
                                           [--only TEXT]
 
-The cases come from two generators: this module corrupts every bundled example input (the
-list below), and ``benchmarks/malformed_corpus_more.py`` adds the output paths (files where
+The cases come from three generators: this module corrupts every bundled example input (the
+list below), ``benchmarks/malformed_corpus_identity.py`` adds the paths that join files
+(identity mix-ups of robot, posture, tool point and frame, unit slips in identification and
+model files, the planner, FE validation's measured file, the Python API, ``sweep
+--scheduler`` with a silent server, CSV separators), and
+``benchmarks/malformed_corpus_more.py`` adds the output paths (files where
 folders are expected, folders that cannot be created), huge requests (size guards),
 encodings and corrupt files on each reader, partial failures (exit code) and durability
 (a sweep killed at random points and resumed, a zero-byte result recomputed). ``fe`` and
@@ -522,6 +526,7 @@ def build_corpus(workdir: Path) -> list[Case]:
                                                            else args[3:]),
                           opt_files, _cli(*args, "--json"), True, (name,)))
     cases += more_cases(workdir / "fixtures")
+    cases += identity_cases(workdir / "fixtures_identity")
     return cases
 
 
@@ -538,6 +543,13 @@ def _kind_of(desc: str, argv: list[str]) -> str:
         return "durability / resume"
     if head == "slip":
         return "process TOML (simulate boring)"
+    kinds = {"id": "identity (robot, posture, tool point, frame)",
+             "unit": "unit slips in identification / model files",
+             "plan": "planner (plan posture)", "fe": "FE validation (measured file)",
+             "api": "Python API", "sweep": "sweep (--scheduler, runner)",
+             "csv": "CSV separators, CSV as UFF"}
+    if head in kinds:
+        return kinds[head]
     r = rest.lower()
     for words, kind in ((("--scheduler", "--frf-type"), "command-line options"),
                         (("npz",), "NPZ FRF (identify modes)"),
@@ -561,6 +573,19 @@ def more_cases(fixtures: Path) -> list[Case]:
     out = []
     for desc, argv, pattern, mode in more.build(fixtures):
         argv = [str(a) for a in argv]
+        cmd = argv if mode == "script" else _cli(*argv)
+        out.append(Case(_kind_of(desc, argv), desc, {}, cmd, mode != "script", (),
+                        pattern=pattern, mode=mode))
+    return out
+
+
+def identity_cases(fixtures: Path) -> list[Case]:
+    """The cases of benchmarks/malformed_corpus_identity.py as :class:`Case` objects."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import malformed_corpus_identity as ident
+
+    out = []
+    for desc, argv, pattern, mode in ident.build(fixtures):
         cmd = argv if mode == "script" else _cli(*argv)
         out.append(Case(_kind_of(desc, argv), desc, {}, cmd, mode != "script", (),
                         pattern=pattern, mode=mode))

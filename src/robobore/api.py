@@ -63,6 +63,60 @@ def bundled_coefficients_path() -> Path:
     return _data("paper_example", "tc4_fe_coefficients.json")
 
 
+# ----------------------------------------------------------------------------- arguments
+def _path_arg(path: Any, name: str) -> Path | None:
+    """``path`` as a Path (None passes through); anything else an InputError naming it."""
+    if path is None or isinstance(path, Path):
+        return path
+    if isinstance(path, str) and path.strip():
+        return Path(path)
+    raise InputError("not a file path", field=name, value=path if isinstance(path, str)
+                     else type(path).__name__, expected="a str or pathlib.Path (or None)")
+
+
+def _number_arg(value: Any, name: str, unit: str, *, positive: bool = True,
+                allow_none: bool = True) -> float | None:
+    """``value`` as a finite float (> 0 when ``positive``); InputError naming ``name``."""
+    import math
+    import numbers
+
+    if value is None and allow_none:
+        return None
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if ok:
+        v = float(value)
+        ok = math.isfinite(v) and (v > 0 or not positive)
+    if not ok:
+        raise InputError("not a number" if not isinstance(value, numbers.Real) else
+                         "out of range", field=name, value=value,
+                         expected=f"a finite {'positive ' if positive else ''}number in {unit}")
+    return float(value)
+
+
+def _int_arg(value: Any, name: str, lo: int, hi: int, allow_none: bool = True) -> int | None:
+    import numbers
+
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or \
+            not lo <= value <= hi:
+        raise InputError("not an integer in range", field=name, value=value,
+                         expected=f"an integer {lo} .. {hi}")
+    return int(value)
+
+
+def _band_arg(band: Any, name: str = "band_Hz") -> tuple[float, float]:
+    if isinstance(band, str | bytes) or not hasattr(band, "__len__") or len(band) != 2:
+        raise InputError("not a frequency band", field=name, value=band,
+                         expected="(low, high) in Hz, low < high")
+    lo = _number_arg(band[0], f"{name}[0]", "Hz", allow_none=False)
+    hi = _number_arg(band[1], f"{name}[1]", "Hz", allow_none=False)
+    if not lo < hi:  # type: ignore[operator]
+        raise InputError("empty band", field=name, value=list(band),
+                         expected="(low, high) in Hz, low < high")
+    return lo, hi  # type: ignore[return-value]
+
+
 # ----------------------------------------------------------------------------- robot
 def load_campaign(path: str | Path | None = None, robot: Any = DEFAULT_ROBOT):
     """Read a laser-tracker stiffness campaign CSV (None: the bundled SYNTHETIC one),
@@ -70,7 +124,8 @@ def load_campaign(path: str | Path | None = None, robot: Any = DEFAULT_ROBOT):
     from robobore.robot.campaign_io import read_campaign
     from robobore.robot.kinematics import get_robot
 
-    return read_campaign(bundled_campaign_path() if path is None else Path(path),
+    path = _path_arg(path, "path")
+    return read_campaign(bundled_campaign_path() if path is None else path,
                          robot=get_robot(robot))
 
 
@@ -86,6 +141,8 @@ def identify_joint_stiffness(campaign: Any = None, robot: Any = DEFAULT_ROBOT, *
     from robobore.robot.kinematics import get_robot
 
     rb = get_robot(robot)
+    sigma_m = _number_arg(sigma_m, "sigma_m", "m (1-sigma tracker noise per coordinate)")
+    tcp_m = _tcp_arg(tcp_m)
     if campaign is None or isinstance(campaign, str | Path):
         campaign = load_campaign(campaign, rb)
     elif not isinstance(campaign, Campaign):
@@ -94,8 +151,95 @@ def identify_joint_stiffness(campaign: Any = None, robot: Any = DEFAULT_ROBOT, *
     return _identify(campaign, rb, sigma_m=sigma_m, frame=frame, tcp_m=tcp_m)
 
 
+def _identity_of(obj: Any) -> dict[str, Any] | None:
+    """The identity block (robobore.io.identity) of a result object or its dict form."""
+    from robobore.io.identity import read_identity
+
+    if isinstance(obj, dict):
+        return read_identity(obj, "<argument>")
+    ident = getattr(obj, "identity", None)
+    return ident if isinstance(ident, dict) and ident else None
+
+
+def _robot_arg(robot: Any, joint_stiffness: Any, name: str = "joint_stiffness"):
+    """The robot for ``joint_stiffness``: ``robot`` checked against what the stiffness was
+    identified for, or (``robot=None``) the stiffness's own robot (the default robot when it
+    names none)."""
+    import warnings
+
+    from robobore.io.identity import check_robot
+    from robobore.robot.description import Robot, robot_of_identity
+    from robobore.robot.kinematics import get_robot
+    from robobore.robot.stiffness import JointStiffness
+
+    ident = _identity_of(joint_stiffness)
+    if ident is None:
+        js = getattr(joint_stiffness, "joint", joint_stiffness)
+        rname = js.robot if isinstance(js, JointStiffness) else (
+            joint_stiffness.get("robot") if isinstance(joint_stiffness, dict) else None)
+        ident = {"robot": str(rname)} if rname else None
+    if robot is not None and not isinstance(robot, str | Path | Robot):
+        raise InputError("not a robot", field="robot", value=type(robot).__name__,
+                         expected="a robot library name, a robot TOML path, a Robot or None")
+    if robot is None:
+        if ident is not None and ident.get("robot"):
+            rb = robot_of_identity(ident, f"argument {name}")
+            if rb.name != DEFAULT_ROBOT:  # the answer differs from the default robot's
+                warnings.warn(f"robot {rb.name} taken from {name} (robot=None)", stacklevel=3)
+            return rb
+        return get_robot(DEFAULT_ROBOT)
+    rb = get_robot(robot)
+    check_robot(ident, f"argument {name}", rb.name, rb.description_hash(), "robot=")
+    return rb
+
+
+def _joints_arg(joints_deg: Any, n: int):
+    """``joints_deg`` as n finite angles in rad (InputError naming the argument), with the
+    "radians?" warning of robobore.io.ranges.radians_hint."""
+    import warnings
+
+    import numpy as np
+
+    from robobore.io.ranges import radians_hint
+
+    try:
+        q = np.asarray(joints_deg, float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("not joint angles", field="joints_deg", value=joints_deg,
+                         expected=f"{n} numbers in deg") from None
+    if q.size != n or not np.all(np.isfinite(q)):
+        raise InputError(f"got {q.size} joint angles" if q.size != n else "not finite",
+                         field="joints_deg", value=q.tolist(),
+                         expected=f"{n} finite numbers in deg")
+    hint = radians_hint(q.tolist(), "joints_deg")
+    if hint is not None:
+        warnings.warn(hint, stacklevel=3)
+    return np.radians(q)
+
+
+def _tcp_arg(tcp_m: Any):
+    """``tcp_m`` as 3 numbers in m within the plausible tool-point range (or None)."""
+    import numpy as np
+
+    from robobore.io.ranges import check_value
+
+    if tcp_m is None:
+        return None
+    try:
+        t = np.asarray(tcp_m, float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("not a tool point", field="tcp_m", value=tcp_m,
+                         expected="3 numbers x, y, z in m (flange frame)") from None
+    if t.size != 3:
+        raise InputError(f"got {t.size} values", field="tcp_m", value=t.tolist(),
+                         expected="3 numbers x, y, z in m (flange frame)")
+    for v in t:
+        check_value(float(v), "tcp_m", field="tcp_m")
+    return t.tolist()
+
+
 def stiffness_at_pose(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
-                      robot: Any = DEFAULT_ROBOT, *, frame: Any = "boring",
+                      robot: Any = None, *, frame: Any = "boring",
                       tcp_m: Any = None, wrench_N_Nm: Any = None):
     """Stiffness of the robot at a posture -> ``StiffnessResult``: directional stiffness
     along the ``frame`` axes (``directional_stiffness_N_per_m``), Cartesian 6x6 stiffness,
@@ -103,26 +247,41 @@ def stiffness_at_pose(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
     N, moment N m on the robot at the tool point, world frame), the CCT stiffness under
     load. ``joint_stiffness``: a ``StiffnessIdentification``, ``JointStiffness``, their
     dict form or n values in N m/rad (every joint identified); ``tcp_m`` the tool point in
-    the flange frame [m]."""
+    the flange frame [m]. ``robot``: a library name, robot TOML path or ``Robot``, checked
+    against the robot the stiffness was identified for (another robot: ``ConfigError``
+    naming both); None: the stiffness's own robot (a warning says so when it is not the
+    default robot), else the default."""
+    from robobore.robot.stiffness import joint_stiffness_arg, stiffness_at
+
     import numpy as np
 
-    from robobore.robot.stiffness import stiffness_at
-
-    return stiffness_at(robot, np.radians(np.asarray(joints_deg, float)), joint_stiffness,
-                        frame=frame, tcp_m=tcp_m, wrench=wrench_N_Nm)
+    joint_stiffness_arg(joint_stiffness)
+    rb = _robot_arg(robot, joint_stiffness)
+    if wrench_N_Nm is not None:
+        try:
+            w = np.asarray(wrench_N_Nm, float).reshape(-1)
+        except (TypeError, ValueError):
+            w = np.zeros(0)
+        if w.size != 6 or not np.all(np.isfinite(w)):
+            raise InputError("not a wrench", field="wrench_N_Nm", value=wrench_N_Nm,
+                             expected="6 finite numbers Fx, Fy, Fz (N), Mx, My, Mz (N m)")
+        wrench_N_Nm = w.tolist()
+    return stiffness_at(rb, _joints_arg(joints_deg, rb.n_joints), joint_stiffness,
+                        frame=frame, tcp_m=_tcp_arg(tcp_m), wrench=wrench_N_Nm)
 
 
 def directional_stiffness(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
-                          robot: Any = DEFAULT_ROBOT, *, frame: Any = "boring",
+                          robot: Any = None, *, frame: Any = "boring",
                           tcp_m: Any = None) -> dict[str, float | None]:
     """Directional stiffness ``{"x", "y", "z"}`` [N/m] along the ``frame`` axes at a
-    posture; an axis that an unidentified joint moves is None (no made-up value)."""
-    import numpy as np
+    posture; an axis that an unidentified joint moves is None (no made-up value).
+    ``robot`` as in :func:`stiffness_at_pose`."""
+    from robobore.robot.stiffness import directional_stiffness_xyz, joint_stiffness_arg
 
-    from robobore.robot.stiffness import directional_stiffness_xyz
-
-    return directional_stiffness_xyz(robot, np.radians(np.asarray(joints_deg, float)),
-                                     joint_stiffness, frame=frame, tcp_m=tcp_m)
+    joint_stiffness_arg(joint_stiffness)
+    rb = _robot_arg(robot, joint_stiffness)
+    return directional_stiffness_xyz(rb, _joints_arg(joints_deg, rb.n_joints),
+                                     joint_stiffness, frame=frame, tcp_m=_tcp_arg(tcp_m))
 
 
 # ----------------------------------------------------------------------------- modal
@@ -131,7 +290,8 @@ def load_hammer_test(path: str | Path | None = None, frf_type: str | None = None
     SYNTHETIC test) -> ``HammerRecords`` (time records) or ``FRFData``."""
     from robobore.modal.io import load_input
 
-    return load_input(bundled_hammer_test_path() if path is None else Path(path), frf_type)
+    path = _path_arg(path, "path")
+    return load_input(bundled_hammer_test_path() if path is None else path, frf_type)
 
 
 def frf(records: Any, *, estimator: str = "H1", exp_window_tau_s: float | None = None):
@@ -164,10 +324,11 @@ def identify_modes(data: Any = None, *, band_Hz: Any = PAPER_BAND_HZ,
     ``n_modes`` best-supported modes (frequency_Hz, damping_ratio, direction, ...)."""
     from robobore.modal.identify import identify_modes as _identify
 
+    lo, hi = _band_arg(band_Hz)
+    n_modes = _int_arg(n_modes, "n_modes", 1, 100)
+    max_order = _int_arg(max_order, "max_order", 1, 1000, allow_none=False)
     data = load_hammer_test() if data is None else data
-    lo, hi = band_Hz
-    return _identify(frf(data), band_Hz=(float(lo), float(hi)), n_modes=n_modes,
-                     max_order=max_order)
+    return _identify(frf(data), band_Hz=(lo, hi), n_modes=n_modes, max_order=max_order)
 
 
 # ----------------------------------------------------------------------------- equivalent
@@ -212,8 +373,9 @@ def cutting_coefficients(cutting_speed_m_per_min: float | None = None,
     set) at a cutting speed [m/min] -> ``CuttingCoefficients`` (SI)."""
     from robobore.cutting.forces import load_coefficients
 
-    return load_coefficients(bundled_coefficients_path() if path is None else Path(path),
-                             cutting_speed_m_per_min)
+    v = _number_arg(cutting_speed_m_per_min, "cutting_speed_m_per_min", "m/min")
+    path = _path_arg(path, "path")
+    return load_coefficients(bundled_coefficients_path() if path is None else path, v)
 
 
 # ----------------------------------------------------------------------------- dynamics

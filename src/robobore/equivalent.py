@@ -250,6 +250,8 @@ class EquivalentModel:
                                                      (0.0, 0.0, 1.0))
     foot: PressureFoot | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    #: what the model describes (robot, posture, tool point, SYNTHETIC; robobore.io.identity)
+    identity: dict[str, Any] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -316,17 +318,32 @@ class EquivalentModel:
         assignment: dict[str, int] | None = None,
         damping_N_s_per_m: float | None = None,
         foot: PressureFoot | None = None,
+        names: tuple[str, str] = ("the stiffness", "the modes"),
     ) -> EquivalentModel:
         """Build from the robot-stiffness and modal stages' results or their JSON contracts
         (see module docstring; an object and its dict form give the same model).
+
+        Their identities (:mod:`robobore.io.identity`) must agree: stiffness and modes of
+        different robots, postures, tool points or frames are a ``ConfigError`` naming both
+        (``names``: how to call them, e.g. their files); the model records the merged
+        identity (SYNTHETIC when either input is), and a note where an input has none.
 
         If ``stiffness`` carries a full ``"stiffness_matrix_N_per_m"`` (3x3, boring frame),
         the units act along its principal directions (:func:`principal_frame`, equal-mass
         assumption of the paper) with the principal stiffnesses, and mode directions are
         compared with those principal axes.
         """
+        from robobore.io.identity import check_pair, merged, read_identity, unchecked_note
+
+        id_s = getattr(stiffness, "identity", None) or None
         stiffness = _stiffness_contract(stiffness)
         modes = _modes_contract(modes)
+        if id_s is None:
+            id_s = read_identity(stiffness, names[0])
+        id_m = read_identity(modes, names[1])
+        check_pair(id_s, names[0], id_m, names[1])
+        id_notes = tuple(unchecked_note(nm) for nm, idn in zip(names, (id_s, id_m),
+                                                               strict=True) if idn is None)
         R = None
         if isinstance(stiffness, dict) and "stiffness_matrix_N_per_m" in stiffness:
             kp, R = principal_frame(np.asarray(stiffness["stiffness_matrix_N_per_m"], float))
@@ -370,8 +387,12 @@ class EquivalentModel:
                                         for a in AXES),)
         if R is not None:
             notes = notes + ("units along the principal directions of the stiffness matrix",)
-        return cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
-                         damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot, notes=notes)
+        em = cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
+                       damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot,
+                       notes=notes + id_notes)
+        import dataclasses
+
+        return dataclasses.replace(em, identity=merged(id_s, id_m, kind="equivalent model"))
 
     # ------------------------------------------------------------------ derived
     def unit(self, axis: str) -> DirectionUnit:
@@ -418,11 +439,14 @@ class EquivalentModel:
                 "mass_kg": self.mass_kg, "damping_N_s_per_m": self.damping_N_s_per_m,
                 "frame": [list(r) for r in self.frame],
                 "foot": None if self.foot is None else self.foot.to_dict(),
-                "notes": list(self.notes)}
+                "notes": list(self.notes),
+                "identity": dict(self.identity) if self.identity else None}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> EquivalentModel:
-        """Inverse of :meth:`to_dict` (the foot is already included in k, f, zeta)."""
+    def from_dict(cls, d: dict[str, Any], source: str = "<equivalent model>"
+                  ) -> EquivalentModel:
+        """Inverse of :meth:`to_dict` (the foot is already included in k, f, zeta); zero
+        damping and a ``mass_kg`` that does not fit ``k / (2 pi f)^2`` are refused."""
         for key in ("stiffness_N_per_m", "frequency_Hz", "damping_ratio"):
             if key not in d:
                 raise ConfigError("missing key", field=key, expected="a dict over x, y, z")
@@ -432,10 +456,30 @@ class EquivalentModel:
              for a in AXES}
         z = {a: _nonneg(f"damping_ratio.{a}", _xyz(d, "damping_ratio").get(a), "(ratio)")
              for a in AXES}
+        for a in AXES:
+            if z[a] == 0.0:
+                raise ConfigError("zero damping", field=f"damping_ratio.{a}", value=0.0,
+                                  expected="a damping ratio > 0 (a real structure dissipates; "
+                                           "robots: 0.01 .. 0.2)")
+        given_m = d.get("mass_kg")
+        if isinstance(given_m, dict):
+            for a in AXES:
+                mk = given_m.get(a)
+                if mk is None:
+                    continue
+                m_a = _positive(f"mass_kg.{a}", mk, "kg")
+                m_kf = k[a] / (2 * math.pi * f[a]) ** 2
+                if abs(m_a - m_kf) > 1e-3 * m_kf:
+                    raise ConfigError("mass does not fit k / (2 pi f)^2", field=f"mass_kg.{a}",
+                                      value=mk, expected=f"{m_kf:.6g} kg from stiffness_N_per_m."
+                                      f"{a} and frequency_Hz.{a} (frequency in rad/s?)")
+        from robobore.io.identity import read_identity
+
+        ident = read_identity(d, source) or {}
         frame = d.get("frame", np.eye(3).tolist())
         foot = None if d.get("foot") is None else PressureFoot.from_dict(d["foot"])
         return cls(k, f, z, tuple(tuple(float(v) for v in r) for r in frame), foot,
-                   tuple(d.get("notes", ())))
+                   tuple(d.get("notes", ())), ident)
 
 
 def _mode_direction(md: dict[str, Any], signed: bool = False) -> np.ndarray | None:

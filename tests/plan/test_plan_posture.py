@@ -103,6 +103,8 @@ def test_json_contract(paper_result):
     r = public(paper_result)
     json.dumps(r)  # serialisable as is
     assert {"recommended", "candidates", "criterion", "wall_time_s"} <= set(r)
+    assert r["warnings"] == []  # the bundled inputs belong together (calibration 29 % rms)
+    assert r["identity"]["robot"] == "irb6600-175-2.55" and r["identity"]["synthetic"]
     for c in [r["recommended"], *r["candidates"][:5]]:
         assert len(c["joints_deg"]) == 6
         assert isinstance(c["tool_axis_rotation_deg"], float)
@@ -210,6 +212,14 @@ def test_modes_without_posture(ident, tmp_path):
     cfg = write_config(tmp_path, ident)
     text = re.sub(r"(?m)^posture_deg =.*$", "", cfg.read_text())
     cfg.write_text(text)
+    mfile = tmp_path / "id" / "modes.json"
+    d = json.loads(mfile.read_text())
+    assert d["identity"]["joints_deg"] is not None  # the hammer test's posture travels ...
+    from robobore.plan.config import load_plan_config
+
+    assert np.allclose(np.degrees(load_plan_config(cfg).q_meas_rad), d["identity"]["joints_deg"])
+    d.pop("identity")  # ... a modes file without it needs identification.posture_deg
+    mfile.write_text(json.dumps(d))
     msg = _err(cfg)
     assert str(cfg) in msg and "identification.posture_deg" in msg and "modes.json" in msg
 

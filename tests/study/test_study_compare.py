@@ -343,3 +343,18 @@ def test_unlabelled_duplicates_name_the_choices(tmp_path):
     csv.write_text(f"{HEAD},force_amplitude_x_N\n300,0.15,0.05,0,100\n")
     with pytest.raises(DataError, match="more than one model or posture"):
         compare_results(csv, tmp_path / "s")
+
+
+def test_a_unit_slip_in_a_measured_column_is_warned():
+    """Feed amplitudes given in mm in the um column: every relative error near 1e5 %; the
+    comparison says which column looks slipped (and no warning on the right units)."""
+    rows = [(0.05, 10.0), (0.1, 20.0), (0.2, 50.0), (0.3, 80.0)]
+    sims = [_sim(300, 0.15, ap, 0, feed_amplitude_um=a * 1.1, stable=True) for ap, a in rows]
+    good = f"{HEAD},feed_amplitude_um\n" + "".join(f"300,0.15,{ap},0,{a}\n" for ap, a in rows)
+    assert compare(parse_measured_csv(good), sims).warnings == ()
+    slip = f"{HEAD},feed_amplitude_um\n" + "".join(f"300,0.15,{ap},0,{a / 1000}\n"
+                                                   for ap, a in rows)
+    c = compare(parse_measured_csv(slip, "m.csv"), sims)
+    assert len(c.warnings) == 1 and "m.csv" in c.warnings[0]
+    assert "feed_amplitude_um" in c.warnings[0] and "unit slip" in c.warnings[0]
+    assert c.to_dict()["warnings"] == list(c.warnings)

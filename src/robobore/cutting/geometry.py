@@ -11,7 +11,9 @@ parametrised by arc length ``s`` from the tip (``s > 0`` on the leading/major si
 
 * nose arc (``-r kappa' <= s <= r kappa``): local approach angle ``psi = s / r``,
   ``zeta = r sin psi``, ``drop = r (1 - cos psi)``;
-* major (lead) edge beyond it, at the approach angle ``kappa`` to the feed axis;
+* major (lead) edge beyond it, at the approach angle ``kappa`` to the feed axis (up to
+  :data:`APPROACH_ANGLE_MAX_DEG`; above 90 deg the edge is undercut: it runs back against
+  the feed as it goes outwards, as on 93 .. 107.5 deg boring bars and copying tools);
 * minor (end) edge on the trailing side at the end-cutting-edge angle ``kappa'``.
 
 Chip of a steady pass with feed ``f`` per revolution (per insert) and radial depth ``ap``
@@ -20,7 +22,15 @@ previous pass (shifted by ``-f``) and the pre-bore surface. Its exact area is
 ``A = integral_0^ap min(f, w(d)) dd`` where ``w(d)`` is the width of the profile at drop
 ``d``; hence ``A = ap f - A_scallop`` where ``A_scallop`` is the cusp area the nose leaves
 on the bore (``~ f^3 / (12 r)`` when the feed is inside the nose). ``A = ap f`` is the
-textbook value when the scallop is negligible.
+textbook value when the scallop is negligible. For an undercut edge (``kappa > 90 deg``) the
+profile is not a function of ``zeta`` (the major edge runs back behind the nose's axial
+extreme ``zeta = r``), so the area and the scallop are computed by radial levels: at drop
+``d`` the tool spans ``[a(d), b(d)]`` (trailing and leading edge), each pass removes
+``min(f, w(d))`` with ``w = b - a``, and a gap ``f - w(d)`` stays where the tool is narrower
+than the feed (the cusp between the minor edge and the previous pass's major edge).
+:meth:`BoringInsert.drop` is then the profile's lower envelope (the nose arc up to ``zeta =
+r``), used for the trailing-side contact; it is exact while the cusp stays within the nose
+(``f`` below about ``r``).
 
 Edge elements: the leading edge from the tip to the pre-bore surface is cut into ``n``
 elements of equal arc length ``dS = db``; each element takes the chip slices at the radial
@@ -47,6 +57,27 @@ import numpy as np
 from robobore.errors import ConfigError
 
 
+#: The approach angles (kappa_r, deg) the geometry and force model accept: from
+#: :data:`APPROACH_ANGLE_MIN_DEG` (below it the value looks like radians) to
+#: :data:`APPROACH_ANGLE_MAX_DEG` (the most undercut standard boring bars, e.g. 107.5 deg
+#: with a 35 deg V insert). One definition for every command (:func:`check_approach_angle`).
+APPROACH_ANGLE_MIN_DEG = 5.0
+APPROACH_ANGLE_MAX_DEG = 107.5
+
+
+def check_approach_angle(value: float, field: str = "insert.approach_angle_deg",
+                         file: str | None = None) -> float:
+    """``value`` (deg) if it is a plausible approach angle, else a ConfigError naming it."""
+    v = float(value)
+    if not (math.isfinite(v) and APPROACH_ANGLE_MIN_DEG <= v <= APPROACH_ANGLE_MAX_DEG):
+        hint = " (looks like radians)" if math.isfinite(v) and 0 < v < APPROACH_ANGLE_MIN_DEG \
+            else ""
+        raise ConfigError(f"approach angle out of range{hint}", file=file, field=field,
+                          value=value, expected=f"{APPROACH_ANGLE_MIN_DEG:g} .. "
+                          f"{APPROACH_ANGLE_MAX_DEG:g} deg (boring bars 45 .. 107.5 deg)")
+    return v
+
+
 def _check(name: str, value: float, lo: float, hi: float, unit: str, lo_open: bool = False) -> None:
     ok = math.isfinite(value) and (value > lo if lo_open else value >= lo) and value <= hi
     if not ok:
@@ -60,7 +91,9 @@ class BoringInsert:
     """Boring insert geometry (SI: metres, angles in degrees as named).
 
     ``approach_angle_deg`` (kappa_r) is the angle between the major cutting edge and the feed
-    axis (90 deg: edge perpendicular to the bore axis); the lead angle is 90 - kappa_r.
+    axis (90 deg: edge perpendicular to the bore axis; up to 107.5 deg, undercut); the lead
+    angle is 90 - kappa_r. The insert's included angle ``180 - kappa_r - end_edge_angle`` must
+    be positive.
     ``end_edge_angle_deg`` is the minor (end) cutting edge angle. ``rake_deg`` is the normal
     rake, ``inclination_deg`` the cutting-edge inclination, ``clearance_deg`` the relief angle,
     ``edge_radius_m`` the cutting-edge (hone) radius, ``n_inserts`` the number of inserts on
@@ -78,8 +111,13 @@ class BoringInsert:
 
     def __post_init__(self) -> None:
         _check("insert.nose_radius_m", self.nose_radius_m, 0.0, 0.01, "m", lo_open=True)
-        _check("insert.approach_angle_deg", self.approach_angle_deg, 0.0, 90.0, "deg", True)
+        check_approach_angle(self.approach_angle_deg)
         _check("insert.end_edge_angle_deg", self.end_edge_angle_deg, 0.0, 89.0, "deg", True)
+        if self.approach_angle_deg + self.end_edge_angle_deg >= 180.0:
+            raise ConfigError("no insert: approach angle + end-edge angle >= 180 deg",
+                              field="insert.end_edge_angle_deg", value=self.end_edge_angle_deg,
+                              expected=f"< {180.0 - self.approach_angle_deg:g} deg (a positive "
+                              "included angle)")
         _check("insert.rake_deg", self.rake_deg, -30.0, 30.0, "deg")
         _check("insert.inclination_deg", self.inclination_deg, -30.0, 30.0, "deg")
         _check("insert.clearance_deg", self.clearance_deg, 0.0, 30.0, "deg")
@@ -97,16 +135,24 @@ class BoringInsert:
     def kappa_end(self) -> float:
         return math.radians(self.end_edge_angle_deg)
 
+    @property
+    def zeta_max(self) -> float:
+        """Axial extent of the profile ahead of the tip [m]: where the nose arc meets the
+        major edge (``r sin kappa``), or the arc's extreme ``r`` for ``kappa >= 90 deg``."""
+        r, k = self.nose_radius_m, self.kappa
+        return r if k >= math.pi / 2 - 1e-12 else r * math.sin(k)
+
     def drop(self, zeta: np.ndarray) -> np.ndarray:
-        """Radial drop of the edge profile below the tip [m] at axial offsets ``zeta`` [m]."""
+        """Radial drop of the profile's lower envelope below the tip [m] at axial offsets
+        ``zeta`` [m] (the surface a pass leaves; inf ahead of the tool for kappa >= 90 deg)."""
         z = np.asarray(zeta, float)
         r, k, ke = self.nose_radius_m, self.kappa, self.kappa_end
-        s_maj, s_min = r * math.sin(k), r * math.sin(ke)
+        s_maj, s_min = self.zeta_max, r * math.sin(ke)
         out = np.empty_like(z)
         arc = (z >= -s_min) & (z <= s_maj)
         out[arc] = r - np.sqrt(np.maximum(r * r - z[arc] ** 2, 0.0))
         lead = z > s_maj
-        if math.isclose(k, math.pi / 2):
+        if k >= math.pi / 2 - 1e-12:
             out[lead] = np.inf
         else:
             out[lead] = r * (1 - math.cos(k)) + (z[lead] - s_maj) * math.tan(k)
@@ -227,9 +273,13 @@ def chip_area(insert: BoringInsert, depth_m: float, feed_m: float, n_grid: int =
     """
     _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
     _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
-    z_hi = lead_end(insert, depth_m)
+    if insert.kappa > math.pi / 2:
+        return _level_area(insert, depth_m, feed_m, n_grid)
     r = insert.nose_radius_m
-    s_maj, s_min = r * math.sin(insert.kappa), r * math.sin(insert.kappa_end)
+    s_maj, s_min = insert.zeta_max, r * math.sin(insert.kappa_end)
+    # front of the envelope: an undercut edge deeper than r lies behind the arc's extreme
+    undercut = insert.kappa > math.pi / 2 and depth_m >= r
+    z_hi = s_maj if undercut else lead_end(insert, depth_m)
     # piecewise over the profile's corners (the integrand jumps at s_maj - f when kappa = 90)
     cuts = [-feed_m, z_hi]
     for b in (-s_min, s_maj, -s_min - feed_m, s_maj - feed_m, 0.0, -feed_m / 2):
@@ -245,15 +295,42 @@ def chip_area(insert: BoringInsert, depth_m: float, feed_m: float, n_grid: int =
     return total
 
 
+def _level_area(insert: BoringInsert, depth_m: float, feed_m: float, n_grid: int) -> float:
+    """``integral_0^ap min(f, w(d)) dd`` [m^2], piecewise between the profile's corners and
+    the level where ``w(d) = f`` (``w`` grows with ``d`` for a positive included angle)."""
+    r = insert.nose_radius_m
+    cuts = {0.0, depth_m}
+    for b in (r * (1 - math.cos(insert.kappa)), r * (1 - math.cos(insert.kappa_end))):
+        if 0.0 < b < depth_m:
+            cuts.add(b)
+    if _width_at_drop(insert, np.array([depth_m]))[0] > feed_m:
+        dc = float(_bisect(lambda d: feed_m - _width_at_drop(insert, d), np.zeros(1),
+                           np.full(1, depth_m), iters=80)[0])
+        if 0.0 < dc < depth_m:
+            cuts.add(dc)
+    cuts_l = sorted(cuts)
+    n_seg = max(200, n_grid // len(cuts_l))
+    total = 0.0
+    for a, b in zip(cuts_l[:-1], cuts_l[1:], strict=True):
+        d = np.linspace(a, b, n_seg)
+        total += float(np.trapezoid(np.minimum(feed_m, _width_at_drop(insert, d)), d))
+    return total
+
+
 def scallop_area(insert: BoringInsert, feed_m: float, n_grid: int = 20001) -> float:
     """Area [m^2] of one cusp left on the bore by the nose (per feed period)."""
+    if insert.kappa > math.pi / 2:  # by radial levels: the gaps f - w(d) where w < f
+        d_hi = float(_bisect(lambda d: feed_m - _width_at_drop(insert, d), np.zeros(1),
+                             np.full(1, 0.05), iters=80)[0])
+        return d_hi * feed_m - _level_area(insert, d_hi, feed_m, n_grid)
     z = np.linspace(-feed_m, 0.0, n_grid)
     g = np.minimum(insert.drop(z), insert.drop(z + feed_m))
     return float(np.trapezoid(g, z))
 
 
 def lead_end(insert: BoringInsert, depth: float) -> float:
-    """zeta [m] where the leading edge reaches the pre-bore surface (drop = ap)."""
+    """zeta [m] where the leading edge reaches the pre-bore surface (drop = ap); for an
+    undercut edge (kappa > 90 deg) this lies behind the arc's extreme ``r``."""
     r, k = insert.nose_radius_m, insert.kappa
     d_arc = r * (1 - math.cos(k))
     if depth <= d_arc:
@@ -287,7 +364,7 @@ def _width_at_drop(insert: BoringInsert, d: np.ndarray) -> np.ndarray:
     """Width ``w(d) = b(d) - a(d)`` [m] of the tool profile at drop ``d`` [m]."""
     d = np.asarray(d, float)
     r, k, ke = insert.nose_radius_m, insert.kappa, insert.kappa_end
-    circ = np.sqrt(np.clip(r * r - (r - np.minimum(d, r)) ** 2, 0.0, None))
+    circ = np.sqrt(np.clip(r * r - (r - np.minimum(d, 2 * r)) ** 2, 0.0, None))
     d_lead, d_trail = r * (1 - math.cos(k)), r * (1 - math.cos(ke))
     if math.isclose(k, math.pi / 2):
         b = np.where(d <= d_lead, circ, r)
@@ -416,4 +493,5 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
 
 
 __all__ = ["BoringInsert", "EdgeElements", "chip_area", "scallop_area", "edge_elements", "lead_end",
-           "trailing_intersection"]
+           "trailing_intersection", "check_approach_angle", "APPROACH_ANGLE_MIN_DEG",
+           "APPROACH_ANGLE_MAX_DEG"]

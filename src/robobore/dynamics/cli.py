@@ -360,9 +360,10 @@ def equivalent_cmd(
                             piston_area_m2=math.pi * (foot_piston_diameter_mm * 1e-3 / 2) ** 2,
                             normal_stiffness_N_per_m=foot_normal_stiffness_N_per_m)
     try:
-        em = EquivalentModel.from_stiffness_and_modes(stiff, modes, assignment,
-                                                      damping_N_s_per_m=damping_N_s_per_m,
-                                                      foot=foot)
+        em = EquivalentModel.from_stiffness_and_modes(
+            stiff, modes, assignment, damping_N_s_per_m=damping_N_s_per_m, foot=foot,
+            names=(str(stiffness_file or "--stiffness-N-per-m"),
+                   str(modes_file or "--frequencies-Hz")))
     except ConfigError as exc:  # name the JSON file the bad key came from
         src = modes_file if (exc.field or "").startswith("modes") else stiffness_file
         if exc.file is not None or src is None:

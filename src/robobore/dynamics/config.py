@@ -196,7 +196,7 @@ def speed_range(cfg: DynamicsConfig) -> tuple[SpeedCfg, str | None]:
 
 class InsertCfg(_Strict):
     nose_radius_mm: float = Field(0.4, gt=0, le=10)
-    approach_angle_deg: float = Field(90.0, gt=0, le=90)
+    approach_angle_deg: float = 90.0  # range: robobore.cutting.geometry.check_approach_angle
     end_edge_angle_deg: float = Field(5.0, gt=0, lt=90)
     rake_deg: float = Field(7.0, ge=-30, le=30)
     inclination_deg: float = Field(0.0, ge=-30, le=30)
@@ -209,10 +209,13 @@ class InsertCfg(_Strict):
     @field_validator("approach_angle_deg")
     @classmethod
     def _kappa(cls, v: float) -> float:
-        if v < 5.0:
-            raise ValueError(f"approach angle {v:g} deg is below 5 deg (looks like radians; "
-                             "expected deg, boring inserts 45 .. 95 deg)")
-        return v
+        from robobore.cutting.geometry import check_approach_angle
+
+        try:
+            return check_approach_angle(v)
+        except ConfigError as exc:
+            raise ValueError(f"{exc.message} (got {v:g} deg); expected {exc.expected}"
+                             ) from None
 
     @field_validator("edge_radius_um")
     @classmethod
@@ -278,7 +281,9 @@ class CoefficientsCfg(_Strict):
                              "interpolated at the cutting speed")
         if self.material is not None and self.material.upper() not in ("TC4", "TI6AL4V",
                                                                          "TI-6AL-4V"):
-            raise ValueError("unknown material; expected TC4")
+            raise ValueError(f"unknown material {self.material!r}; expected 'TC4' (Ti-6Al-4V, "
+                             "the measured default), or a coefficients file / inline "
+                             "Ktc_N_per_m2 for another material")
         return self
 
 
@@ -395,14 +400,15 @@ def resolve_model_files(raw: dict[str, Any], path: str | Path,
                               "no model files", src)
     try:
         if ef is not None:
-            em = EquivalentModel.from_dict(_read_json_file(ef, "model equivalent --json", src))
+            em = EquivalentModel.from_dict(_read_json_file(ef, "model equivalent --json", src),
+                                           str(ef))
             files = {"equivalent_file": str(ef)}
         else:
             em = EquivalentModel.from_stiffness_and_modes(
                 _read_json_file(sf, "identify stiffness --json", src),
                 _read_json_file(mf, "identify modes --json", src),
                 None if mcfg.assign is None else dict(zip("xyz", mcfg.assign, strict=True)),
-                damping_N_s_per_m=mcfg.damping_N_s_per_m)
+                damping_N_s_per_m=mcfg.damping_N_s_per_m, names=(str(sf), str(mf)))
             files = {"stiffness_file": str(sf), "modes_file": str(mf)}
     except ConfigError as exc:
         if exc.file is not None:

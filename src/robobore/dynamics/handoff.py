@@ -15,7 +15,8 @@ from robobore.errors import ConfigError, InputError
 
 #: the keys of :meth:`robobore.equivalent.EquivalentModel.to_dict` (``model equivalent --json``)
 EQUIVALENT_KEYS = frozenset({"stiffness_N_per_m", "frequency_Hz", "damping_ratio", "mass_kg",
-                              "damping_N_s_per_m", "frame", "foot", "notes"})
+                              "damping_N_s_per_m", "frame", "foot", "notes",
+                              "identity"})
 
 
 def equivalent_arg(equivalent: Any, name: str = "equivalent"):

@@ -453,6 +453,24 @@ def _walk(node: Any, path: str, file: str | None, kind: type[InputError],
     check_value(node, path, file=file, field=path, allowed=ok, kind=kind)
 
 
+def radians_hint(joints_deg: Any, where: str) -> str | None:
+    """A warning when joint angles given in deg look like radians: every value within
+    +-pi and at least two of them non-zero (a real posture in deg almost always has a joint
+    beyond 3.2 deg); None when they look like degrees."""
+    import math
+
+    try:
+        q = [float(v) for v in joints_deg]
+    except (TypeError, ValueError):
+        return None
+    nonzero = [v for v in q if abs(v) > 1e-9]
+    if len(nonzero) >= 2 and all(abs(v) <= math.pi + 1e-9 for v in q):
+        return (f"{where}: every joint angle is within +-pi "
+                f"({', '.join(f'{v:g}' for v in q)}): radians? The values are read as deg "
+                f"(in deg: {', '.join(f'{math.degrees(v):.4g}' for v in q)})")
+    return None
+
+
 def provenance() -> dict[str, Any] | None:
     """What to record in a config's provenance when the checks are off (else None)."""
     return None if enabled() else {"disabled": "--no-range-check"}
@@ -468,7 +486,8 @@ def range_table() -> list[dict[str, str]]:
     return rows
 
 
-__all__ = ["Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning", "check_value",
+__all__ = ["radians_hint", "Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning",
+           "check_value",
            "check_array",
            "check_tree", "quantity_of", "option_name", "enabled", "set_enabled", "provenance",
            "range_table",

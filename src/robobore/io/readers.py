@@ -11,6 +11,7 @@ and the cause.
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -55,4 +56,36 @@ def load_json(path: str | Path, what: str = "JSON file", expected: str = "a JSON
     return data
 
 
-__all__ = ["read_text", "load_json"]
+#: a cell holding a number with a decimal comma (``0,15``, ``-1,5e-3``)
+_DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d+,\d*([eE][-+]?\d+)?\s*$")
+
+
+def comma_separated(text: str, columns: Any) -> str:
+    """CSV text with ``,`` separators from a file separated by ``;``, a tab or ``|``.
+
+    The separator is taken from the first line that is neither blank nor a ``#`` comment
+    (the header): when it holds no comma but splits on one of those separators into at
+    least one of ``columns``, the file is re-written with commas; in a ``;`` or tab
+    separated file a decimal comma (``0,15``) is read as a decimal point. Any other text is
+    returned unchanged (the column check then names what is missing)."""
+    import csv
+    import io
+
+    header = next((ln for ln in text.lstrip("\ufeff").splitlines()
+                   if ln.strip() and not ln.lstrip().startswith("#")), "")
+    if "," in header:
+        return text
+    cols = set(columns)
+    for sep in (";", "\t", "|"):
+        if sep in header and cols & {c.strip() for c in header.split(sep)}:
+            rows = list(csv.reader(io.StringIO(text), delimiter=sep))
+            if sep != "|":
+                rows = [[c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c for c in r]
+                        for r in rows]
+            buf = io.StringIO()
+            csv.writer(buf, lineterminator="\n").writerows(rows)
+            return buf.getvalue()
+    return text
+
+
+__all__ = ["read_text", "load_json", "comma_separated"]

@@ -81,6 +81,12 @@ def modes_cmd(
         None, "--frf-type", help="FRF type of a UFF FRF file if its records do not say."),
     plot: Path | None = typer.Option(None, "--plot", help="Write PNG plots to this folder."),
     out: Path | None = typer.Option(None, "--out", help="Write the result JSON to this file."),
+    robot: str | None = typer.Option(
+        None, "--robot", help="Robot of the hammer test (library name or robot TOML), "
+        "recorded in the result's identity (default: the test's identity file, if any)."),
+    joints_deg: str | None = typer.Option(
+        None, "--joints-deg", help="Posture of the hammer test, q1,..,q6 in deg, recorded in "
+        "the result's identity."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Identify modes (frequency, damping, MPC, shapes) from a hammer test automatically."""
@@ -148,7 +154,10 @@ def modes_cmd(
         advance(1)
         res = an.result.to_dict()
         res["source"] = str(input_file)
-        res["synthetic"] = bool(example)
+        ident = _test_identity(Path(input_file), robot, joints_deg, band_hz)
+        res["synthetic"] = bool(example or ident["synthetic"])
+        ident["synthetic"] = res["synthetic"]
+        res["identity"] = ident
         if hits is not None:
             res["hits"] = hits.to_dict()
         res["warnings"] = warn_list
@@ -160,6 +169,46 @@ def modes_cmd(
     if out is not None:
         write_json(out, res)
     emit(res, as_json, _render_modes)
+
+
+def _test_identity(path: Path, robot: str | None, joints_deg: str | None,
+                   band_hz: Any) -> dict[str, Any]:
+    """The identity of modes identified from ``path``: the hammer test's identity file
+    (``<file>.truth.json``, written by the virtual hammer test) and the options, checked
+    against each other."""
+    from robobore.io.identity import check_posture, check_robot, make_identity, read_identity
+    from robobore.io.readers import load_json
+
+    tp = Path(str(path) + ".truth.json")
+    ident = None
+    synthetic = None
+    if tp.is_file():
+        data = load_json(tp, "hammer-test identity file",
+                         "the JSON the virtual hammer test writes next to its UFF file")
+        synthetic = bool(data.get("synthetic", False))
+        ident = read_identity(data, str(tp))
+    out = dict(ident) if ident is not None else make_identity("modes")
+    out["kind"] = "modes"
+    out["source"] = str(path)
+    out["synthetic"] = synthetic if synthetic is not None else out.get("synthetic")
+    if robot is not None:
+        from robobore.robot.kinematics import get_robot
+
+        rb = get_robot(robot)
+        check_robot(ident, str(tp), rb.name, rb.description_hash(), "--robot",
+                    verb="is a hammer test of")
+        out.update(robot=rb.name, robot_hash=rb.description_hash(), robot_file=rb.file or None)
+    if joints_deg is not None:
+        from robobore.clitools import stderr
+        from robobore.io.ranges import radians_hint
+
+        q = parse_floats(joints_deg, None, "--joints-deg", "deg")
+        hint = radians_hint(q, "--joints-deg")
+        if hint is not None:
+            stderr.print(f"[yellow]warning:[/] {hint}", soft_wrap=True, highlight=False)
+        check_posture(ident, str(tp), q, "--joints-deg")
+        out["joints_deg"] = q
+    return out
 
 
 @handle_errors
@@ -178,9 +227,22 @@ def virtual_test_cmd(
     double_hit: list[str] = typer.Option([], "--double-hit",
                                          help="Make hit I,H (1-based) a double hit."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
+    robot: str | None = typer.Option(
+        None, "--robot", help="Robot of the virtual test (library name or robot TOML); "
+        "default: the example's IRB 6600."),
+    robot_file: Path | None = typer.Option(None, "--robot-file", help="A robot TOML file."),
+    joint_stiffness: str | None = typer.Option(
+        None, "--joint-stiffness-Nm-per-rad", help="TRUE k1..k6 (N m/rad) of that robot; "
+        "default: the virtual campaign's ground truth."),
+    joints_deg: str | None = typer.Option(
+        None, "--joints-deg", help="Posture of the test, q1..q6 in deg; default: the "
+        "example's (the paper's boring posture)."),
+    tcp_m: str | None = typer.Option(None, "--tcp-m", help="Tool point in the flange frame "
+                                     "'x,y,z' in m (default: flange)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
-    """Write a SYNTHETIC impact-hammer test of the robot boring truth model."""
+    """Write a SYNTHETIC impact-hammer test of the robot boring truth model (the example
+    robot, or the robot, joint stiffness, posture and tool point given)."""
     from robobore.clitools import kv_table, stdout
     from robobore.errors import ConfigError
     from robobore.io.outputs import check_output_file
@@ -196,7 +258,13 @@ def virtual_test_cmd(
 
     check_output_file(out, "OUT", "the UFF file")
     check_output_file(Path(str(out) + ".truth.json"), "OUT", "the ground-truth JSON")
-    truth = robot_boring_truth()
+    own = [n for n, v in (("--robot", robot), ("--robot-file", robot_file),
+                          ("--joint-stiffness-Nm-per-rad", joint_stiffness),
+                          ("--joints-deg", joints_deg), ("--tcp-m", tcp_m)) if v is not None]
+    if example and own:
+        raise ConfigError("the bundled example has its own robot and posture", field=own[0],
+                          expected="--example alone, or the options without --example")
+    truth, ident = _virtual_truth(robot, robot_file, joint_stiffness, joints_deg, tcp_m)
     if example:
         make_example(out)
         settings: dict[str, Any] = dict(EXAMPLE_SETTINGS)
@@ -226,7 +294,7 @@ def virtual_test_cmd(
                        "SYNTHETIC robobore virtual hammer test")
     truth_path = Path(str(out) + ".truth.json")
     info = {"file": str(out), "truth_file": str(truth_path), "synthetic": True,
-            "settings": settings, "truth": truth.to_dict()}
+            "settings": settings, "truth": truth.to_dict(), "identity": ident}
     write_json(truth_path, info)
     if as_json:
         emit(info, True, lambda r: None)
@@ -238,6 +306,60 @@ def virtual_test_cmd(
             ("hammer inputs", ", ".join(truth.input_names)),
             ("hits per input", settings["n_hits"]), ("noise (fraction of RMS)",
                                                       settings["noise_response"])]))
+
+
+def _virtual_identity(rb: Any = None, q_deg: Any = None, tcp: Any = None) -> dict[str, Any]:
+    """What the virtual hammer test describes: its robot at its posture (default: the
+    example robot at the example posture)."""
+    from robobore.io.identity import make_identity
+    from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, EXAMPLE_ROBOT, EXAMPLE_TCP_M
+    from robobore.robot.kinematics import get_robot
+
+    rb = get_robot(EXAMPLE_ROBOT) if rb is None else rb
+    return make_identity("hammer test", robot=rb.name, robot_hash=rb.description_hash(),
+                         robot_file=(rb.file or None) if rb.name != EXAMPLE_ROBOT else None,
+                         joints_deg=EXAMPLE_POSTURE_DEG if q_deg is None else q_deg,
+                         tcp_m=EXAMPLE_TCP_M if tcp is None else tcp, frame="boring",
+                         synthetic=True, source="robobore virtual hammer test")
+
+
+def _virtual_truth(robot: str | None, robot_file: Path | None, joint_stiffness: str | None,
+                   joints_deg: str | None, tcp_m: str | None):
+    """The truth model and identity of a virtual hammer test (options checked here)."""
+    from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, EXAMPLE_TCP_M, robot_boring_truth
+    from robobore.robot.kinematics import check_joint_limits, get_robot, load_robot_file
+
+    if robot is None and robot_file is None and joint_stiffness is None and \
+            joints_deg is None and tcp_m is None:
+        return robot_boring_truth(), _virtual_identity()
+    rb = (load_robot_file(robot_file) if robot_file is not None else
+          get_robot(robot or "irb6600-175-2.55", field="--robot"))
+    q = (list(EXAMPLE_POSTURE_DEG) if joints_deg is None
+         else parse_floats(joints_deg, rb.n_joints, "--joints-deg", "deg"))
+    from robobore.clitools import stderr
+    from robobore.io.ranges import radians_hint
+
+    hint = radians_hint(q, "--joints-deg")
+    if hint is not None:
+        stderr.print(f"[yellow]warning:[/] {hint}", soft_wrap=True, highlight=False)
+    import numpy as np
+
+    from robobore.errors import ConfigError, InputError
+
+    try:
+        check_joint_limits(rb, np.radians(q))
+    except InputError as exc:
+        raise ConfigError(exc.message, field=f"--joints-deg ({exc.field})", value=exc.value,
+                          expected=exc.expected) from None
+    k = None if joint_stiffness is None else parse_floats(
+        joint_stiffness, rb.n_joints, "--joint-stiffness-Nm-per-rad", "N m/rad")
+    if k is not None and any(not v > 0 for v in k):
+        raise ConfigError("joint stiffnesses must be positive",
+                          field="--joint-stiffness-Nm-per-rad", value=joint_stiffness,
+                          expected=f"{rb.n_joints} positive values in N m/rad")
+    tcp = list(EXAMPLE_TCP_M) if tcp_m is None else parse_floats(tcp_m, 3, "--tcp-m", "m")
+    truth = robot_boring_truth(k, q, rb, tcp)
+    return truth, _virtual_identity(rb, q, tcp)
 
 
 def _check_hammer_size(n_inputs: int, hits: int, n_outputs: int, sample_rate_hz: float,

@@ -71,6 +71,19 @@ def _uff_sets(path: Path, need: int = 58) -> list[dict[str, Any]]:
             tail = fh.read().rstrip()
     except OSError as exc:
         raise DataError(f"cannot read: {exc.strerror or exc}", file=str(p)) from None
+    try:
+        with p.open("rb") as fh:
+            head = fh.read(512)
+    except OSError as exc:
+        raise DataError(f"cannot read: {exc.strerror or exc}", file=str(p)) from None
+    first = next((ln.strip() for ln in head.splitlines() if ln.strip()), b"")
+    if first != b"-1":  # every universal file starts with a "    -1" delimiter line
+        kind = ("a CSV / text table" if any(c in first for c in (b",", b";", b"\t"))
+                else "not a universal file")
+        raise DataError(f"{kind}: its first line is {first[:60].decode('latin-1')!r}, not "
+                        "the UFF delimiter '-1'", file=str(p),
+                        expected="a UFF file (dataset 58 records, each between '    -1' "
+                                 "lines) or an NPZ FRF file")
     if not tail.endswith(b"-1"):
         raise DataError("truncated or not a universal file: it does not end with the "
                         "dataset delimiter '-1'", file=str(p),

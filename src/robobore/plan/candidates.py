@@ -21,8 +21,9 @@ AXIS_TOL_DEG = 0.05
 
 
 def boring_frame(axis: np.ndarray) -> np.ndarray:
-    """Columns X (horizontal, vertical x Z), Y = Z x X, Z = the bore axis (a non-vertical unit
-    vector); the robot stage's ``"boring"`` frame of a tool whose z axis is the bore axis."""
+    """Columns X (horizontal, vertical x Z), Y = Z x X, Z = the bore axis (a unit vector; a
+    vertical one takes X from the base x axis, :func:`robobore.robot.stiffness.process_frame`);
+    the robot stage's ``"boring"`` frame of a tool whose z axis is the bore axis."""
     from robobore.robot.stiffness import process_frame
 
     z = np.asarray(axis, float) / np.linalg.norm(axis)

@@ -46,6 +46,10 @@ def posture_cmd(
             ws = workspace_map(result, adv)
         result["workspace"] = ws
     pub = public(result)
+    for w in pub.get("warnings", []):
+        from robobore.clitools import stderr
+
+        stderr.print(f"[yellow]warning:[/] {w}", soft_wrap=True, highlight=False)
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         write_netcdf(results_dataset(result), out / "posture_plan.nc", config=inp.raw)

@@ -70,7 +70,7 @@ class LobesCfg(_Strict):
 
 
 class PlanCfg(_Strict):
-    rotation_step_deg: float = Field(1.0, gt=0, le=180)
+    rotation_step_deg: float = Field(1.0, ge=0.01, le=180)  # 36,000 rotations at most
     criterion: Literal["critical_depth", "stiffness_x", "stiffness_y", "stiffness_z",
                        "stiffness_min"] = "critical_depth"
     singularity_margin: float = Field(0.02, ge=0, le=1)
@@ -79,7 +79,7 @@ class PlanCfg(_Strict):
 class WorkspaceCfg(_Strict):
     dx_m: list[float] = Field(min_length=1)
     dy_m: list[float] = Field(min_length=1)
-    rotation_step_deg: float = Field(10.0, gt=0, le=180)
+    rotation_step_deg: float = Field(10.0, ge=0.01, le=180)
 
 
 class PlanConfig(_Strict):
@@ -153,7 +153,7 @@ def load_plan_config(path: str | Path) -> PlanInputs:
     f = str(p)
     rname = cfg.robot.name
     rpath = _resolve(p, rname) if rname.endswith(".toml") else None
-    robot = get_robot(str(rpath) if rpath is not None else rname)
+    robot = get_robot(str(rpath) if rpath is not None else rname, file=f, field="robot.name")
     if not robot.links:
         raise ConfigError(
             f"robot '{robot.name}' has no inertial data (mass, centre of mass and inertia per "
@@ -179,10 +179,6 @@ def load_plan_config(path: str | Path) -> PlanInputs:
                                    "of mass, flange frame")
     point = _vec3(cfg.bore.point_m, f, "bore.point_m", "m")
     axis = check_unit_vector(cfg.bore.axis, "bore.axis", file=f)
-    if abs(axis[2]) > 1 - 1e-9:
-        raise ConfigError("a vertical bore axis leaves the boring frame's X undefined", file=f,
-                          field="bore.axis", value=cfg.bore.axis,
-                          expected="a non-vertical unit vector (base frame)")
     if cfg.part is not None:
         o = _vec3(cfg.part.origin_m, f, "part.origin_m", "m")
         y = math.radians(cfg.part.yaw_deg)
@@ -231,8 +227,24 @@ def load_plan_config(path: str | Path) -> PlanInputs:
         raise DataError("mode frequencies must be > 0 Hz and damping ratios >= 0",
                         file=str(mfile), field="modes", value=fz.tolist(),
                         expected="frequency_Hz > 0, damping_ratio >= 0")
+    # what the files describe (robobore.io.identity): one robot, the config's
+    from robobore.io.identity import check_pair, check_robot, read_identity
+
+    id_s = read_identity(sdata, str(sfile))
+    id_m = read_identity(mdata, str(mfile))
+    named = isinstance(raw.get("robot"), dict) and "name" in raw["robot"]
+    for ident, fl in ((id_s, sfile), (id_m, mfile)):
+        check_robot(ident, str(fl), robot.name, robot.description_hash(),
+                    f"robot.name in {f}" if named else f"the default robot of {f} (robot.name)",
+                    verb="was identified for" if fl == sfile else "is a hammer test of")
+    if id_s is not None and id_m is not None:
+        check_pair({"robot": id_s.get("robot"), "robot_hash": id_s.get("robot_hash")},
+                   str(sfile), {"robot": id_m.get("robot"), "robot_hash": id_m.get("robot_hash")},
+                   str(mfile))
     # the posture at which the modes were measured
     file_posture = mdata.get("posture_deg")
+    if file_posture is None and id_m is not None:
+        file_posture = id_m.get("joints_deg")
     cfg_posture = cfg.identification.posture_deg
     if cfg_posture is None and file_posture is None:
         raise ConfigError(

@@ -63,6 +63,11 @@ from robobore.plan.scoring import (
     recommend,
 )
 
+#: an rms frequency residual of the calibration above this (%) is reported: the stiffness,
+#: the modes and the posture do not describe one robot (the bundled example: 29 %; mode
+#: frequencies in rad/s given as Hz: 64 %; joint stiffnesses x 1000: about 2,240 %)
+CALIBRATION_WARN_PERCENT = 50.0
+
 
 #: Semi-discretisation rating of the plan: the best SD_TOP candidates of the frequency-domain
 #: screen (and the measured posture) over SD_SPEEDS speeds of the [lobes] range.
@@ -106,8 +111,23 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
                        tcp_m=tuple(inp.tcp_m), robot_file=robot.file or None)
     cal = calibrate(model0, inp.q_meas_rad, inp.modes_f_Hz, inp.modes_zeta)
     model = cal.model
+    from robobore.io.ranges import radians_hint
+
+    hint = radians_hint(np.degrees(inp.q_meas_rad).tolist(),
+                        f"{f}: the measured posture (identification.posture_deg)")
+    warn = [] if hint is None else [hint]
+    rms_cal = float(np.sqrt(np.mean(cal.frequency_error_percent ** 2)))
+    if not rms_cal <= CALIBRATION_WARN_PERCENT:
+        warn.append(
+            f"the model calibrated at the measured posture misses the identified modes by "
+            f"{rms_cal:.4g} % rms (more than {CALIBRATION_WARN_PERCENT:g} %): the joint "
+            f"stiffnesses ({inp.stiffness_file}), the modes ({inp.modes_file}) and the posture "
+            "may not belong together (another robot, a unit slip such as N m/rad x 1000, "
+            "rad/s as Hz); the plan's figures are not reliable")
     process = build_process(inp)
     A0 = process.mean_directional_matrix()
+    from robobore.io.identity import make_identity
+
     Rb = boring_frame(inp.bore_axis)
     # measured posture: does it hold this bore? anchor the rotation grid at its angle
     Tm = fk(robot, inp.q_meas_rad, inp.tcp_m)
@@ -229,6 +249,12 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "lobes": lobes,
         "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
+        "warnings": warn,
+        "identity": make_identity(
+            "plan", robot=robot.name, robot_hash=robot.description_hash(),
+            robot_file=robot.file or None, joints_deg=entries[best]["joints_deg"],
+            tcp_m=inp.tcp_m.tolist(), frame="boring", synthetic=bool(inp.synthetic),
+            source=f),
         "wall_time_s": wall,
     }
     result["_arrays"] = {"cand": cand, "ev": ev, "criterion": crit, "best": best,

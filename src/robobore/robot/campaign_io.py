@@ -80,6 +80,11 @@ def parse_campaign_text(text: str, source: str = "<campaign>", robot=None) -> Ca
     header = [h.strip() for h in header]
     missing = [c for c in REQUIRED if c not in header]
     if missing:
+        seps = [s for s in (";", "\t", "|", " ") if len(header) == 1 and s in header[0]]
+        if seps:
+            raise DataError(f"the header is one cell separated by {seps[0]!r}, not by commas",
+                            file=source, field=header[0][:40],
+                            expected=f"comma-separated columns {list(REQUIRED)}")
         raise DataError(f"missing column(s) {missing}", file=source, field=missing[0],
                         expected=f"columns {list(REQUIRED)} (+ optional {list(OPTIONAL)})")
     unknown = [c for c in header if c not in REQUIRED and c not in OPTIONAL]
@@ -145,8 +150,42 @@ def parse_campaign_text(text: str, source: str = "<campaign>", robot=None) -> Ca
     return camp
 
 
+def truth_path(path: str | Path) -> Path:
+    """The identity file written next to a campaign CSV (``<csv>.truth.json``): robot,
+    robot hash, SYNTHETIC flag and, for a virtual campaign, its ground truth."""
+    return Path(str(path) + ".truth.json")
+
+
+def read_truth(path: str | Path) -> dict | None:
+    """The campaign's identity file (:func:`truth_path`), or None when there is none."""
+    from robobore.io.readers import load_json
+
+    tp = truth_path(path)
+    if not tp.is_file():
+        return None
+    data = load_json(tp, "campaign identity file",
+                     "the JSON object `robobore robot campaign` writes next to its CSV")
+    syn = data.get("synthetic")
+    if not isinstance(syn, bool):
+        raise DataError("missing or not a boolean", file=str(tp), field="synthetic", value=syn,
+                        expected="true (virtual campaign) or false (measured)")
+    for key in ("robot", "robot_hash"):
+        if data.get(key) is not None and not isinstance(data[key], str):
+            raise DataError("not a string", file=str(tp), field=key, value=data[key],
+                            expected="the robot's library name / description hash")
+    return data
+
+
 def read_campaign(path: str | Path, robot=None) -> Campaign:
-    """Read and validate a campaign CSV file (``robot``: name/Robot to check joint limits)."""
+    """Read and validate a campaign CSV file (``robot``: name/Robot to check joint limits).
+
+    A ``;``, tab or ``|`` separated file is read as well
+    (:func:`robobore.io.readers.comma_separated`). The identity file next to it
+    (:func:`truth_path`), if there is one, goes to ``Campaign.truth``: its ``synthetic``
+    flag travels into the identification, and a ``robot`` other than ``robot`` is refused,
+    naming both."""
+    import dataclasses
+
     p = Path(path)
     if not p.is_file():
         raise DataError("campaign file not found", file=str(p), expected="an existing CSV file")
@@ -155,7 +194,18 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
     except UnicodeDecodeError as exc:
         raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
                         expected="a UTF-8 CSV file") from None
-    return parse_campaign_text(text, source=str(p), robot=robot)
+    truth = read_truth(p)
+    if truth is not None and robot is not None:
+        from robobore.io.identity import check_robot
+        from robobore.robot.kinematics import get_robot
+
+        rb = get_robot(robot)
+        check_robot({"robot": truth.get("robot"), "robot_hash": truth.get("robot_hash")},
+                    str(p), rb.name, rb.description_hash(), "the robot given")
+    from robobore.io.readers import comma_separated
+
+    camp = parse_campaign_text(comma_separated(text, REQUIRED), source=str(p), robot=robot)
+    return camp if truth is None else dataclasses.replace(camp, truth=truth)
 
 
 def validate_campaign(c: Campaign, robot=None) -> None:
@@ -270,11 +320,15 @@ def format_campaign(c: Campaign) -> str:
     return buf.getvalue()
 
 
-def write_campaign(c: Campaign, path: str | Path) -> Path:
-    """Write the contract CSV atomically."""
-    from robobore.io.results import atomic_write_text
+def write_campaign(c: Campaign, path: str | Path, identity: dict | None = None) -> Path:
+    """Write the contract CSV atomically; with ``identity`` (robot, robot_hash, synthetic,
+    ...), also its identity file (:func:`truth_path`)."""
+    from robobore.io.results import atomic_write_text, write_json
 
-    return atomic_write_text(path, format_campaign(c))
+    out = atomic_write_text(path, format_campaign(c))
+    if identity is not None:
+        write_json(truth_path(path), identity)
+    return out
 
 
 __all__ = [
@@ -285,4 +339,6 @@ __all__ = [
     "validate_campaign",
     "format_campaign",
     "write_campaign",
+    "truth_path",
+    "read_truth",
 ]

@@ -21,6 +21,7 @@ from robobore.clitools import (
     handle_errors,
     kv_table,
     parse_floats,
+    stderr,
     stdout,
 )
 
@@ -54,7 +55,7 @@ def _robot(robot: str | None, robot_file: Path | None, default: str | None = DEF
             raise ConfigError("no robot given", field="--robot",
                               expected="a robot library name or --robot-file PATH")
         robot = default
-    return get_robot(robot)
+    return get_robot(robot, field="--robot")
 
 
 def _tcp(tcp: str | None) -> list[float] | None:
@@ -76,12 +77,19 @@ def _frame(frame: str, frame_rotation: str | None) -> Any:
     return frame
 
 
-def _q(robot, joints_deg: str):
+def _q(robot, joints_deg: str, warn: list[str] | None = None):
     import numpy as np
 
+    from robobore.io.ranges import radians_hint
     from robobore.robot.kinematics import check_joint_limits
 
-    q = np.radians(parse_floats(joints_deg, robot.n_joints, "--joints-deg", "deg"))
+    vals = parse_floats(joints_deg, robot.n_joints, "--joints-deg", "deg")
+    hint = radians_hint(vals, "--joints-deg")
+    if hint is not None:
+        stderr.print(f"[yellow]warning:[/] {hint}", soft_wrap=True, highlight=False)
+        if warn is not None:
+            warn.append(hint)
+    q = np.radians(vals)
     try:
         check_joint_limits(robot, q)
     except Exception as exc:  # re-label with the CLI option
@@ -143,7 +151,8 @@ def fk_cmd(
     from robobore.robot.stiffness import process_frame
 
     rb = _robot(robot, robot_file)
-    q = _q(rb, joints_deg)
+    notes: list[str] = []
+    q = _q(rb, joints_deg, notes)
     T, J = fk_jacobian(rb, q, _tcp(tcp_m))
     res = {
         "robot": rb.name,
@@ -153,6 +162,7 @@ def fk_cmd(
         "rotation": T[:3, :3].tolist(),
         "jacobian": J.tolist(),
         "jacobian_condition": float(np.linalg.cond(J)),
+        "notes": notes,
     }
     try:
         res["R_world_boring"] = process_frame(T[:3, :3], "boring").tolist()
@@ -178,6 +188,35 @@ def fk_cmd(
 # --- robot stiffness ------------------------------------------------------------------------
 
 
+def _stiffness_file_robot(file: Path | None, robot: str | None, robot_file: Path | None,
+                          notes: list[str]):
+    """The robot of ``robot stiffness``: the options' robot, checked against the joint
+    stiffness file's identity, or (no robot option) the file's own robot, said in a note."""
+    from robobore.io.identity import check_robot, read_identity, unchecked_note
+    from robobore.io.readers import load_json
+    from robobore.robot.description import robot_of_identity
+
+    if file is None:
+        return _robot(robot, robot_file)
+    data = load_json(Path(file), "joint stiffness file",
+                     "a JSON object from `robobore identify stiffness --json`")
+    ident = read_identity(data, str(file))
+    if ident is None:
+        notes.append(unchecked_note(str(file)))
+        if data.get("robot") and robot is None and robot_file is None:
+            ident = {"robot": str(data["robot"])}
+    if robot is not None or robot_file is not None:
+        rb = _robot(robot, robot_file)
+        check_robot(ident, str(file), rb.name, rb.description_hash(),
+                    "--robot-file" if robot_file is not None else "--robot")
+        return rb
+    if ident is not None and ident.get("robot"):
+        rb = robot_of_identity(ident, str(file))
+        notes.append(f"robot {rb.name} taken from {file} (no --robot given)")
+        return rb
+    return _robot(None, None)
+
+
 def _joint_stiffness(text: str | None, file: Path | None, n: int):
     from robobore.errors import ConfigError, InputError
     from robobore.robot.stiffness import JointStiffness
@@ -193,6 +232,11 @@ def _joint_stiffness(text: str | None, file: Path | None, n: int):
         except InputError as exc:
             raise ConfigError(exc.message, file=str(p), field=exc.field, value=exc.value,
                               expected=exc.expected) from None
+        if len(js.k_Nm_per_rad) != n:
+            raise ConfigError(f"got {len(js.k_Nm_per_rad)} joint stiffnesses", file=str(p),
+                              field="joint_stiffness_Nm_per_rad",
+                              value=list(js.k_Nm_per_rad),
+                              expected=f"{n} values in N m/rad (one per joint of the robot)")
         return js
     if text is None:
         raise ConfigError("no joint stiffness given", field="--joint-stiffness-Nm-per-rad",
@@ -236,13 +280,16 @@ def stiffness_cmd(
     from robobore.robot.stiffness import stiffness_at
 
     check_output_dir(plot, "--plot", "the PNG plots")
-    rb = _robot(robot, robot_file)
-    q = _q(rb, joints_deg)
+    notes: list[str] = []
+    rb = _stiffness_file_robot(joint_stiffness_file, robot, robot_file, notes)
+    for n_ in notes:
+        stderr.print(f"[yellow]note:[/] {n_}", soft_wrap=True, highlight=False)
+    q = _q(rb, joints_deg, notes)
     k = _joint_stiffness(joint_stiffness, joint_stiffness_file, rb.n_joints)
     W = None if wrench is None else parse_floats(wrench, 6, "--wrench-N-Nm", "N and N m")
     res = stiffness_at(rb, q, k, frame=_frame(frame, frame_rotation), tcp_m=_tcp(tcp_m),
                        wrench=W).to_dict()
-    res = {"robot": rb.name, "joints_deg": np.degrees(q).tolist(), **res}
+    res = {"robot": rb.name, "joints_deg": np.degrees(q).tolist(), **res, "notes": notes}
     if plot is not None:
         res["plots"] = _plot_stiffness(res, Path(plot))
 
@@ -367,9 +414,17 @@ def campaign_cmd(
         kw["load_levels_N"] = tuple(parse_floats(load_levels_N, None, "--load-levels-N", "N"))
         spec = cm.CampaignSpec(**kw)
     camp = cm.simulate_campaign(spec)
-    write_campaign(camp, out)
+    from robobore.robot.campaign_io import truth_path
+
+    check_output_file(truth_path(out), "OUT", "the campaign's identity file")
+    write_campaign(camp, out, identity={
+        "file": str(out), "synthetic": True, "robot": rb.name,
+        "robot_hash": rb.description_hash(), "robot_file": rb.file or None,
+        "true_joint_stiffness_Nm_per_rad": list(spec.joint_stiffness_Nm_per_rad),
+        "spec": spec.to_dict()})
     res = {
         "file": str(out),
+        "identity_file": str(truth_path(out)),
         "synthetic": True,
         "rows": camp.n_rows,
         "postures": len(camp.postures()),
@@ -446,6 +501,7 @@ def identify_stiffness_cmd(
                                    frame=_frame(frame, None), tcp_m=_tcp(tcp_m))
     d = res.to_dict()
     d["synthetic"] = bool(example or res.synthetic)
+    d["identity"]["synthetic"] = d["synthetic"]
     if example:
         d["example"] = "bundled SYNTHETIC campaign (virtual experiment, documented ground truth)"
     if plot is not None:

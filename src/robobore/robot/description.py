@@ -122,6 +122,18 @@ class Robot:
     def base(self) -> np.ndarray:
         return np.asarray(self.base_transform, float).reshape(4, 4)
 
+    def description_hash(self) -> str:
+        """16-hex-digit hash of the kinematic description (D-H data, joint limits, base
+        transform; not the name): the ``robot_hash`` of result files
+        (:mod:`robobore.io.identity`)."""
+        from robobore.io.hashing import stable_hash
+
+        return stable_hash({"d_m": self.d_m, "a_m": self.a_m, "alpha_rad": self.alpha_rad,
+                            "theta_offset_rad": self.theta_offset_rad,
+                            "lower_limit_rad": self.lower_limit_rad,
+                            "upper_limit_rad": self.upper_limit_rad,
+                            "base_transform": self.base_transform}, length=16)
+
     def to_dict(self) -> dict[str, Any]:
         """Human-unit dict, the same layout as the library TOML files."""
         return {
@@ -248,22 +260,52 @@ def load_robot_file(path: str | Path) -> Robot:
     return dataclasses.replace(r, file=str(path))
 
 
-def get_robot(name: str | Path | Robot) -> Robot:
-    """A robot by library name, or by the path of a TOML file; unknown names raise ConfigError."""
+def get_robot(name: str | Path | Robot, *, file: str | None = None,
+              field: str = "robot") -> Robot:
+    """A robot by library name, or by the path of a TOML file; unknown names raise ConfigError
+    naming ``file`` (the config that named the robot) and ``field`` (its key or option)."""
     if isinstance(name, Robot):
         return name
+    if not isinstance(name, str | Path):
+        raise ConfigError("not a robot", file=file, field=field, value=type(name).__name__,
+                          expected="a robot library name, a robot TOML path or a Robot")
     p = Path(str(name))
     if p.suffix == ".toml" and p.is_file():
         return load_robot_file(p)
+    if p.suffix == ".toml":
+        raise ConfigError("robot file not found", file=file, field=field, value=str(name),
+                          expected="an existing robot TOML file")
     lib = available_robots()
     if str(name) not in lib:
+        close = [n for n in lib if n.startswith(str(name)) or str(name) in n]
         raise ConfigError(
-            "unknown robot",
-            field="robot",
+            "unknown robot" + (f" (did you mean {close[0]!r}?)" if close else ""),
+            file=file,
+            field=field,
             value=str(name),
             expected=f"one of {sorted(lib)} or the path of a robot TOML file",
         )
     return load_robot_file(lib[str(name)])
+
+
+def robot_of_identity(ident: dict[str, Any], file: str) -> Robot:
+    """The robot a file's identity names (its robot file if that still holds the same
+    robot, else the library robot of that name), checked against the recorded hash."""
+    from robobore.io.identity import IDENTITY_KEY, check_robot
+
+    rf = ident.get("robot_file")
+    if rf and Path(rf).is_file():
+        rb = get_robot(Path(rf))
+    elif ident.get("robot") in available_robots():
+        rb = get_robot(ident["robot"])
+    else:
+        raise ConfigError(f"{file} was identified for robot {ident.get('robot')}, which is not "
+                          "in the robot library", file=file, field=f"{IDENTITY_KEY}.robot",
+                          value=ident.get("robot"),
+                          expected="--robot NAME or --robot-file PATH of that robot")
+    check_robot(ident, file, rb.name, rb.description_hash(),
+                f"the robot found for it ({rb.file or rb.name})")
+    return rb
 
 
 # --- joint limits ---------------------------------------------------------------------------
@@ -315,5 +357,6 @@ __all__ = [
     "available_robots",
     "get_robot",
     "load_robot_file",
+    "robot_of_identity",
     "check_joint_limits",
 ]

@@ -48,6 +48,10 @@ STRUCTURAL_ZERO = 1e-8  # column norm relative to the largest: "no excitation"
 #: chi-square (6 dof) 99.9 % quantile: a measurement whose whitened residual exceeds it is
 #: flagged ``suspect`` (a reflector knocked in its nest, a wrong force reading ...).
 SUSPECT_CHI2_6DOF = 22.458
+#: level of the whole-fit residual test: a fit whose weighted residual exceeds the
+#: chi-square quantile of this level for the stated tracker noise is reported (a wrong
+#: robot, tool point or reflector file explains it better than noise does)
+RESIDUAL_TEST_LEVEL = 0.999
 
 
 def kabsch(P0: np.ndarray, P1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -280,6 +284,10 @@ class StiffnessIdentification:
     source: str = ""
     synthetic: bool = False
     notes: tuple[str, ...] = ()
+    #: the chi-square test of the weighted residual against the stated tracker noise
+    residual_test: dict[str, Any] = field(default_factory=dict)
+    #: what the result describes (:mod:`robobore.io.identity`)
+    identity: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         j = self.joint.to_dict()
@@ -310,7 +318,9 @@ class StiffnessIdentification:
             "residual_rms_translation_m": self.residual_rms_translation_m,
             "residual_rms_rotation_rad": self.residual_rms_rotation_rad,
             "residuals": list(self.residuals),
+            "residual_test": dict(self.residual_test),
             "notes": list(self.notes),
+            "identity": dict(self.identity),
         })
         return out
 
@@ -431,6 +441,18 @@ def identify_joint_stiffness(
         except InputError:  # boring frame undefined for a vertical feed axis
             by_frame[fr] = None
     directional["directional_stiffness_by_frame_N_per_m"] = by_frame
+    test = residual_test(campaign, sol.chi2_dof[0], sol.dof, sigma_m)
+    notes = [f"posture {lab!r} has no loaded step: it was not used" for lab in
+             d.unused_postures]
+    if not test["passed"]:
+        notes.append(test["message"])
+    from robobore.io.identity import make_identity
+
+    ident = make_identity(
+        "joint stiffness", robot=robot.name, robot_hash=robot.description_hash(),
+        robot_file=robot.file or None,
+        joints_deg=np.degrees(d.q_rad[0]).tolist(), tcp_m=directional["directional_tcp_m"],
+        frame=directional["directional_frame"], synthetic=synthetic, source=campaign.source)
     return StiffnessIdentification(
         joint=js,
         compliance_rad_per_Nm=_opt(c, ok),
@@ -450,9 +472,42 @@ def identify_joint_stiffness(
         directional=directional,
         source=campaign.source,
         synthetic=synthetic,
-        notes=tuple(f"posture {lab!r} has no loaded step: it was not used" for lab in
-                    d.unused_postures),
+        notes=tuple(notes),
+        residual_test=test,
+        identity=ident,
     )
+
+
+def residual_test(campaign: Campaign, s2: float, dof: int, sigma_m: float | None
+                  ) -> dict[str, Any]:
+    """Chi-square test of the weighted residual against the stated tracker noise.
+
+    ``s2`` is the weighted residual variance: chi^2/dof when ``sigma_m`` (the known noise)
+    is given, else the estimated per-coordinate noise variance [m^2]. Without ``sigma_m``
+    the reference is the documented default tracker model
+    (:class:`robobore.robot.campaign.TrackerNoise`: AT901 class, half of the MPE
+    15 um + 6 um/m, from its default position), RMS over the campaign's reflector
+    positions. The fit passes when ``chi^2 = dof * s^2 / sigma^2`` is below the chi-square
+    quantile at ``RESIDUAL_TEST_LEVEL`` with ``dof`` degrees of freedom."""
+    from robobore.robot.campaign import TrackerNoise
+
+    if sigma_m is not None:
+        sigma, how, chi2 = float(sigma_m), "the given tracker noise", float(s2) * dof
+    else:
+        sigma = float(np.sqrt(np.mean(TrackerNoise().sigma(campaign.xyz_m) ** 2)))
+        how = "the default tracker model (AT901 class, half of 15 um + 6 um/m)"
+        chi2 = float(s2) * dof / sigma ** 2
+    limit = float(stats.chi2.ppf(RESIDUAL_TEST_LEVEL, dof))
+    est = math.sqrt(chi2 / dof) * sigma
+    passed = bool(chi2 <= limit)
+    msg = "" if passed else (
+        f"{campaign.source}: the fit's residual (noise {est * 1e6:.3g} um per coordinate) "
+        f"exceeds what {how} of {sigma * 1e6:.3g} um explains (chi-square {chi2:.4g} > "
+        f"{limit:.4g}, the {RESIDUAL_TEST_LEVEL:.1%} quantile with {dof} dof): a wrong "
+        "robot, tool point or reflector file? (a noisier tracker: give --sigma-um)")
+    return {"sigma_reference_m": sigma, "sigma_reference": how, "chi2": chi2, "dof": dof,
+            "chi2_limit": limit, "level": RESIDUAL_TEST_LEVEL,
+            "noise_equivalent_m": est, "passed": passed, "message": msg}
 
 
 def directional_with_interval(
@@ -509,5 +564,6 @@ __all__ = [
     "identify_joint_stiffness",
     "identify_batch",
     "directional_with_interval",
+    "residual_test",
     "StiffnessIdentification",
 ]

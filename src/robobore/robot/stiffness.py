@@ -42,6 +42,9 @@ from robobore.errors import ConfigError, IdentificationError, InputError, Numeri
 from robobore.robot.kinematics import Robot, fk_jacobian, get_robot, jacobian_derivative
 
 FRAMES = ("tool", "base", "boring")
+#: a feed axis within this angle of the vertical (deg) is a vertical bore: the boring
+#: frame's X is then the base x axis projected onto the plane normal to the feed axis
+VERTICAL_TOL_DEG = 1.0
 
 
 def joint_stiffness_arg(k: Any, name: str = "joint_stiffness") -> Any:
@@ -169,6 +172,9 @@ def process_frame(
 
     ``frame``: "tool" (the flange/tool orientation), "base" (identity), "boring" (Z = tool z
     = feed, X = normalise(vertical x Z) horizontal, Y = Z x X), or a 3x3 rotation matrix.
+    A feed axis within :data:`VERTICAL_TOL_DEG` of the vertical (a vertical bore, up or
+    down) leaves "horizontal" undefined: X is then the robot base's x axis projected onto
+    the plane normal to Z (Y = Z x X).
     """
     if isinstance(frame, str):
         if frame == "base":
@@ -177,12 +183,13 @@ def process_frame(
             return np.asarray(R_world_tool, float).copy()
         if frame == "boring":
             z = np.asarray(R_world_tool, float)[:, 2]
-            x = np.cross(np.asarray(vertical, float), z)
+            v = np.asarray(vertical, float)
+            x = np.cross(v, z)
             nx = np.linalg.norm(x)
-            if nx < 1e-6:
-                raise InputError("the boring frame needs a non-vertical feed axis (tool z)",
-                                 field="frame", value="boring",
-                                 expected="'tool' or 'base' when the bore axis is vertical")
+            if nx < math.sin(math.radians(VERTICAL_TOL_DEG)) * np.linalg.norm(v):
+                ex = np.array([1.0, 0.0, 0.0])
+                x = ex - (ex @ z) * z
+                nx = np.linalg.norm(x)
             x /= nx
             return np.column_stack([x, np.cross(z, x), z])
         raise ConfigError("unknown frame", field="frame", value=frame,

@@ -177,6 +177,8 @@ def _render_compare(res: dict[str, Any]) -> None:
                   _pct(s["max_rel_error"]), _pct(s["mean_rel_error"]))
     stdout.print(g)
     a = res["agreement"]
+    for w in res.get("warnings", []):
+        stdout.print(f"[yellow]warning:[/] {w}")
     if len(res.get("systems_in_store", [])) > 1:
         stdout.print(f"[dim]note: compared the {res['system']} results; the store also holds "
                      + ", ".join(x for x in res["systems_in_store"] if x != res["system"])

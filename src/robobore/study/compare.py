@@ -101,9 +101,13 @@ def _parse_number(cell: str, *, source: str, row: int, col: str, unit: str,
 
 
 def parse_measured_csv(text: str, source: str = "<measured>") -> MeasuredTable:
-    """Parse and validate measured-CSV text (see module doc)."""
+    """Parse and validate measured-CSV text (see module doc); ``;``, tab or ``|``
+    separated text is read too (:func:`robobore.io.readers.comma_separated`)."""
+    from robobore.io.readers import comma_separated
+
     if text.startswith("\ufeff"):
         text = text[1:]
+    text = comma_separated(text, KNOWN_COLUMNS)
     reader = csv.reader(io.StringIO(text))
     header: list[str] | None = None
     header_line = 0
@@ -172,7 +176,10 @@ def _check_header(header: list[str], source: str) -> None:
             raise DataError("empty column name", file=source, row=0, field=f"column {i + 1}",
                             expected="a column name")
         if h not in KNOWN_COLUMNS:
-            raise DataError("unknown column", file=source, field=h,
+            seps = [s for s in (";", "\t", "|", " ") if s in h]
+            hint = (f" (the header is separated by {seps[0]!r}: the file needs ',' between "
+                    "columns)") if seps and len(header) == 1 else ""
+            raise DataError("unknown column" + hint, file=source, field=h,
                             expected=f"one of {', '.join(KNOWN_COLUMNS)}")
         if header.count(h) > 1:
             raise DataError("column appears twice", file=source, field=h,
@@ -212,6 +219,8 @@ class Comparison:
     quantities: tuple[str, ...] = field(default_factory=tuple)
     system: str | None = None  # the simulated system compared (e.g. "robot")
     systems: tuple[str, ...] = field(default_factory=tuple)  # systems in the results store
+    #: likely unit slips: a measured column off the simulation by a power of ten in most rows
+    warnings: tuple[str, ...] = field(default_factory=tuple)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -219,6 +228,7 @@ class Comparison:
             "quantities": list(self.quantities), "group_source": self.group_source,
             "groups": self.groups, "agreement": self.agreement, "conditions": list(self.rows),
             "unmatched_measured": list(self.unmatched_measured), "undefined": list(self.undefined),
+            "warnings": list(self.warnings),
         }
 
     def table_rows(self) -> list[dict[str, Any]]:
@@ -325,6 +335,7 @@ def compare(measured: MeasuredTable,
         groups[g] = {**_stats(allv),
                      "n_conditions": sum(1 for r in rows if r["group"] == g),
                      "per_quantity": {q: _stats(v) for q, v in qs.items()}}
+    warn = _unit_slip_warnings(rows, measured.source)
     n_cmp = sum(confusion.values())
     agreement = {"n": n_cmp, "agree": confusion["both_stable"] + confusion["both_vibratory"],
                  "rate": None if n_cmp == 0 else
@@ -334,8 +345,36 @@ def compare(measured: MeasuredTable,
         rows=tuple(rows), groups=groups, agreement=agreement,
         group_source="measured" if use_measured_flag else "simulated",
         unmatched_measured=tuple(unmatched), undefined=tuple(undefined),
-        quantities=measured.quantities,
+        quantities=measured.quantities, warnings=tuple(warn),
     )
+
+
+#: a measured column whose median |log10(simulated / measured)| reaches this (two decades)
+#: over at least :data:`UNIT_SLIP_MIN_ROWS` rows is reported as a likely unit slip
+UNIT_SLIP_DECADES = 2.0
+UNIT_SLIP_MIN_ROWS = 3
+
+
+def _unit_slip_warnings(rows: list[dict[str, Any]], source: str) -> list[str]:
+    import math
+    import statistics
+
+    out = []
+    by_q: dict[str, list[float]] = {}
+    for r in rows:
+        for q, e in r["quantities"].items():
+            mv, sv = e["measured"], e["simulated"]
+            if mv and sv and mv > 0 and sv > 0:
+                by_q.setdefault(q, []).append(math.log10(sv / mv))
+    for q, lr in by_q.items():
+        if len(lr) >= UNIT_SLIP_MIN_ROWS:
+            med = statistics.median(lr)
+            if abs(med) >= UNIT_SLIP_DECADES:
+                out.append(f"{source}, column '{q}': the simulation is {10 ** med:.3g} times "
+                           f"the measurement (median over {len(lr)} rows): a unit slip in the "
+                           "measured column (mm for um, N for kN, ...)? The relative errors "
+                           "of this column are not meaningful")
+    return out
 
 
 #: label of results whose store does not name the simulated system (``robobore sweep``)

@@ -56,21 +56,23 @@ RUNNERS: dict[str, str] = {
 }
 
 
-def resolve_runner(spec: str) -> Runner:
-    """The runner function for a registered name or a ``"module:function"`` path."""
+def resolve_runner(spec: str, file: str | None = None) -> Runner:
+    """The runner function for a registered name or a ``"module:function"`` path
+    (``file``: the sweep config, named in the errors)."""
     target = RUNNERS.get(spec, spec)
     if ":" not in target:
-        raise ConfigError("unknown runner", field="sweep.runner", value=spec,
+        raise ConfigError("unknown runner", file=file, field="sweep.runner", value=spec,
                           expected=f"one of {sorted(RUNNERS)} or 'package.module:function'")
     mod_name, _, attr = target.partition(":")
     try:
         mod = importlib.import_module(mod_name)
         fn = getattr(mod, attr)
     except (ImportError, AttributeError) as exc:
-        raise ConfigError(f"cannot import runner ({exc})", field="sweep.runner", value=spec,
+        raise ConfigError(f"cannot import runner ({exc})", file=file, field="sweep.runner",
+                          value=spec,
                           expected="an importable 'package.module:function'") from None
     if not callable(fn):
-        raise ConfigError("runner is not callable", field="sweep.runner", value=spec,
+        raise ConfigError("runner is not callable", file=file, field="sweep.runner", value=spec,
                           expected="a function runner(condition, context) -> xarray.Dataset")
     return fn
 
@@ -239,7 +241,8 @@ def run_sweep(
     """
     if not isinstance(store, ResultsStore):
         store = ResultsStore(store)
-    fn = runner if runner is not None else resolve_runner(plan.runner)
+    fn = runner if runner is not None else resolve_runner(plan.runner,
+                                                          getattr(plan, "source", None))
     with store.lock():
         return _run_locked(plan, store, fn, scheduler=scheduler, workers=workers,
                            processes=processes, progress=progress, index_every_s=index_every_s,
@@ -312,6 +315,33 @@ def _forget_failed_client(exc: BaseException) -> None:
         tb = tb.tb_next
 
 
+def _client_within(client_cls: Any, scheduler: str, timeout_s: float) -> Any:
+    """``Client(scheduler)`` or TimeoutError after ``timeout_s``: Dask's own connect
+    timeout does not bound the handshake, so a server that accepts the connection and never
+    answers would hang the sweep; the client is built in a daemon thread and abandoned when
+    it does not finish in time."""
+    import threading
+
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            box["client"] = client_cls(scheduler, timeout=f"{timeout_s}s",
+                                       set_as_default=False)
+        except BaseException as exc:  # noqa: BLE001 - re-raised in the caller's thread
+            box["error"] = exc
+
+    t = threading.Thread(target=target, name="robobore-dask-connect", daemon=True)
+    t.start()
+    t.join(timeout_s + 1.0)
+    if t.is_alive():
+        raise TimeoutError(f"no Dask handshake within {timeout_s:g} s (the server accepts "
+                           "connections but does not answer)")
+    if "error" in box:
+        raise box["error"]
+    return box["client"]
+
+
 def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: str | None,
               workers: int, processes: bool, connect_timeout_s: float) -> None:
     from distributed import Client, LocalCluster, as_completed
@@ -321,8 +351,7 @@ def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: s
     try:
         if scheduler is not None:
             try:
-                client = Client(scheduler, timeout=f"{connect_timeout_s}s",
-                                set_as_default=False)
+                client = _client_within(Client, scheduler, connect_timeout_s)
             except (OSError, TimeoutError) as exc:
                 _forget_failed_client(exc)
                 raise RoboboreError(
@@ -391,7 +420,7 @@ def plan_from_file(path: str | Path) -> SweepPlan:
 
     cfg, conds = load_sweep_config(path)
     plan = replace(SweepPlan.from_config(cfg, conds), source=str(path))
-    resolve_runner(plan.runner)
+    resolve_runner(plan.runner, str(path))
     return plan
 
 

@@ -78,6 +78,11 @@ def test_reader_points_and_missing_quantities(tmp_path):
     ({"measured": {"Fz": {"60": {"30": 1.0}}}}, "measured.Fz", "unknown measured quantity"),
     ({"measured": {"Fc": {"60": {"30": 1e9}}}}, "measured.Fc.60.30", "finite number"),
     ({"units": {"Fc": "N"}, "measured": {"Fc": {"60": {"30": 100.0}}}}, "units.Fc", "unit"),
+    # kN per mm of width is not N per mm ("n per mm" inside it); an inverted chip ratio
+    ({"units": {"Fc": "kN per mm of width"}, "measured": {"Fc": {"60": {"30": 0.118}}}},
+     "units.Fc", "kN: multiply"),
+    ({"measured": {"Fc": {"60": {"30": 118.0}}, "chip_ratio": {"60": {"30": 0.55}}}},
+     "measured.chip_ratio.60.30", "looks like the inverse"),
     ({"Fc": {}}, "measured", "no 'measured'"),
     ({"measured": {}}, "measured", "no measured point"),
     # Fc and Ff at different speeds: a speed missing under one of them

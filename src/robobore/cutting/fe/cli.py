@@ -185,7 +185,17 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
     parse_config(base, str(config))  # the base config's own errors first
     meas = read_measured(measured)
     pts = None if points is None else parse_points(points)
+    default_out = out is None
     out = Path(f"fe_validate_{Path(config).stem}") if out is None else out
+    from robobore.io.outputs import check_output_dir
+
+    check_output_dir(out, "--out", "the per-point results (resumable store)")
+    check_output_dir(plot, "--plot", "the validation picture")
+    if default_out:  # said before the work: the store lands in the working folder
+        from robobore.clitools import stderr
+
+        stderr.print(f"[yellow]note:[/] per-point results (resumable) go to "
+                     f"{out.resolve()} (no --out given)", soft_wrap=True, highlight=False)
     with fraction_progress("FE validation", enabled=not as_json) as prog:
         result = run_validation(base, meas, source=str(config), points=pts, out_dir=out,
                                 device=device, progress=prog)

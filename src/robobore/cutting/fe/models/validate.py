@@ -31,6 +31,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -48,7 +49,12 @@ QUANTITIES = {
 }
 #: plausible ranges of the measured values (per mm of width; a chip thicker than 10 h or
 #: forces of 1e5 N/mm are unit slips)
-_RANGES = {"Fc": (0.0, 1e5), "Ff": (-1e5, 1e5), "chip_ratio": (0.2, 10.0)}
+#: (a continuous chip is thicker than the uncut chip: a ratio below 1 is the inverse,
+#: uncut / chip thickness)
+_RANGES = {"Fc": (0.0, 1e5), "Ff": (-1e5, 1e5), "chip_ratio": (1.0, 10.0)}
+#: the force unit the file may state: N per mm of width, spelt "N/mm", "N per mm", with or
+#: without "of width" (case and spaces free); anything else (kN/mm, N/m, lbf/in) is refused
+_FORCE_UNIT = re.compile(r"^n\s*(/|per)\s*mm(\s*(of\s*)?width)?$")
 #: plausible chip thickness [um] and cutting speed [m/min] of a measured point
 _H_RANGE, _VC_RANGE = (0.1, 2000.0), (0.01, 2000.0)
 
@@ -95,9 +101,11 @@ def read_measured(path: str | Path) -> list[MeasuredPoint]:
     for q in ("Fc", "Ff"):
         u = units.get(q)
         if u is not None and not (isinstance(u, str) and
-                                  ("n per mm" in u.lower() or "n/mm" in u.lower())):
-            raise DataError("force unit not supported", file=f, field=f"units.{q}", value=u,
-                            expected="N per mm of width (N/mm)")
+                                  _FORCE_UNIT.match(" ".join(u.lower().split()))):
+            hint = (" (kN: multiply the values by 1000)" if isinstance(u, str)
+                    and u.strip().lower().startswith("kn") else "")
+            raise DataError("force unit not supported" + hint, file=f, field=f"units.{q}",
+                            value=u, expected="N per mm of width (N/mm)")
     meas = data["measured"]
     unknown = sorted(set(meas) - set(QUANTITIES))
     if unknown:
@@ -123,6 +131,12 @@ def read_measured(path: str | Path) -> list[MeasuredPoint]:
                 vc = _num(vk, f, fv, "cutting speed in m/min", *_VC_RANGE)
                 lo, hi = _RANGES[q]
                 unit = QUANTITIES[q][2]
+                if q == "chip_ratio" and isinstance(val, int | float) and 0 < val < lo:
+                    raise DataError("chip ratio below 1: the chip is thicker than the uncut "
+                                    "chip, so this looks like the inverse (uncut / chip "
+                                    "thickness)", file=f, field=fv, value=val,
+                                    expected=f"chip thickness / uncut chip thickness, "
+                                    f"{lo:g}..{hi:g} (Ti-6Al-4V: 1.1 .. 3)")
                 if isinstance(val, bool) or not isinstance(val, int | float) or \
                         not math.isfinite(val) or not lo <= val <= hi:
                     raise DataError(f"{q} must be a finite number", file=f, field=fv,

@@ -1,0 +1,71 @@
+"""A second robot of the user's own, given as TOML (examples/robots/kr240-r2900.toml, a
+KUKA KR 240 R2900-like arm), through the whole chain: virtual campaign, identification,
+virtual hammer test, modal identification, equivalent model, lobes and the planner, with
+no identity mix-up and no warning; SYNTHETIC carried to the end."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from robobore.cli import app
+
+runner = CliRunner()
+REPO = Path(__file__).resolve().parents[1]
+EX = REPO / "examples"
+KUKA = EX / "robots" / "kr240-r2900.toml"
+Q = "20,20,10,0,-30,0"
+POSTURES = ("20,20,10,0,-30,0; 0,40,-10,0,30,0; -30,10,20,20,40,10; 45,30,-20,-30,-20,30; "
+            "10,50,-30,40,50,-20; -60,0,30,0,60,0")
+
+
+def _run(args, out: Path | None = None):
+    r = runner.invoke(app, [str(a) for a in args])
+    assert r.exit_code == 0, r.output
+    assert "warning:" not in r.output.lower(), r.output  # no warning line (stderr)
+    if out is not None:
+        out.write_text(r.stdout)
+        return json.loads(r.stdout)
+    return None
+
+
+def test_kuka_like_robot_whole_chain(tmp_path):
+    camp, s, uff, m = (tmp_path / n for n in ("kc.csv", "ks.json", "kh.uff", "km.json"))
+    _run(["robot", "campaign", camp, "--robot-file", KUKA, "--postures-deg", POSTURES])
+    sd = _run(["identify", "stiffness", camp, "--robot-file", KUKA, "--json"], s)
+    assert sd["residual_test"]["passed"] and sd["identity"]["synthetic"] is True
+    _run(["identify", "virtual-hammer-test", uff, "--robot-file", KUKA, "--joints-deg", Q])
+    md = _run(["identify", "modes", uff, "--band-hz", "3", "60", "--json"], m)
+    assert md["identity"]["robot"] == "kr240-r2900" and md["synthetic"] is True
+    eq = _run(["model", "equivalent", "--stiffness-file", s, "--modes-file", m, "--json"],
+              tmp_path / "keq.json")
+    assert eq["identity"]["robot"] == "kr240-r2900" and eq["identity"]["synthetic"] is True
+    assert not any("could not be checked" in n for n in eq["notes"])
+    # the hammer test's static stiffness is the campaign robot's: the equivalent model's k_z
+    # is the directional stiffness of robot stiffness at the test posture (same robot, file)
+    rs = _run(["robot", "stiffness", f"--joints-deg={Q}", "--joint-stiffness-file", s,
+               "--json"], tmp_path / "rs.json")
+    assert rs["robot"] == "kr240-r2900"
+    assert abs(eq["stiffness_N_per_m"]["z"] / rs["directional_stiffness_N_per_m"]["z"] - 1) < 1e-6
+    lob = _run(["lobes", EX / "boring_process.toml", "--equivalent-file",
+                tmp_path / "keq.json", "--method", "frequency", "--json"], tmp_path / "l.json")
+    assert min(lob["critical_depth_mm"]) > 0
+    fk = _run(["robot", "fk", "--robot-file", KUKA, f"--joints-deg={Q}", "--json"],
+              tmp_path / "fk.json")
+    t = (EX / "plan_paper_bore.toml").read_text()
+    t = t.replace('name = "irb6600-175-2.55"', f'name = "{KUKA}"')
+    t = t.replace('"plan_paper_bore/joint_stiffness.json"', f'"{s}"')
+    t = t.replace('"plan_paper_bore/modes.json"', f'"{m}"')
+    t = re.sub(r"(?m)^posture_deg = .*$", "", t)  # the modes file records it
+    t = re.sub(r"(?m)^point_m = .*$", f"point_m = {fk['position_m']}", t)
+    t = re.sub(r"(?m)^axis = \[-0.99.*$", f"axis = {[r[2] for r in fk['rotation']]}", t)
+    t = t.replace('"../src/robobore', f'"{REPO}/src/robobore')
+    t = t.replace("rotation_step_deg = 1.0", "rotation_step_deg = 10.0")
+    (tmp_path / "kplan.toml").write_text(re.sub(r"(?s)\[workspace\].*", "", t))
+    plan = _run(["plan", "posture", tmp_path / "kplan.toml", "--json"], tmp_path / "p.json")
+    assert plan["robot"] == "kr240-r2900" and plan["warnings"] == []
+    assert plan["measured"] is not None and plan["identity"]["synthetic"] is True
+    assert plan["recommended"]["critical_depth_mm"] > 0
