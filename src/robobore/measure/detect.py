@@ -14,13 +14,17 @@ signal's level and units:
    periodic with the spindle: lines at the rotation harmonics ``k n / 60`` (the insert-passing
    harmonics ``k N n / 60`` are among them). Those bands are excluded, after the spindle
    frequency is found on the record's averaged spectrum (long windows): given
-   (``speed_rpm``), it is refined within +-:data:`SPEED_TOLERANCE`; not given, it is the
+   (``speed_rpm``), it is refined within +-:data:`SPEED_TOLERANCE` on the lines among its
+   first ten harmonics (none there: no harmonic is in the record, none is excluded); not
+   given, it is the
    harmonic comb that explains the most spectral lines beyond chance (each line weighted by
    its prominence; a comb of spacing ``f0`` matches a line by chance with probability
-   ``2 tol / f0``, which is subtracted, so sub-harmonic combs do not win), searched up to
-   :data:`MAX_SPINDLE_HZ`, with at least two lines among its first ten harmonics and at least
-   two lines that are not harmonics of the record's strongest line (a saturated chatter
-   vibration has harmonics of its own; they do not make a spindle). Fixed lines that do
+   ``2 tol / f0``, which is subtracted; of the combs within 80 % of the best score the
+   highest fundamental wins, since a sub-multiple matches the same lines), searched up to
+   :data:`MAX_SPINDLE_HZ`, with at least two lines among its first ten harmonics, and, for a
+   comb below the record's strongest line, at least two lines that are not harmonics of that
+   line (a saturated chatter vibration has harmonics of its own; a sub-multiple of it does not
+   make a spindle). Fixed lines that do
    not move with the speed are excluded too: mains (50 and 60 Hz families, each detected by
    its fundamental line, then every multiple present as a line weaker than the fundamental:
    mains distortion decays with the order) and any lines given.
@@ -73,6 +77,8 @@ LOW_HARMONICS = 10
 LOW_HARMONIC_LINES = 2
 #: Highest spindle frequency looked for when the speed is not given [Hz] (30 000 r/min).
 MAX_SPINDLE_HZ = 500.0
+#: A comb within this fraction of the best comb's score and of a higher fundamental wins.
+COMB_SHARE = 0.8
 #: Mains families looked for as fixed lines [Hz].
 MAINS_HZ = (50.0, 60.0)
 #: Shortest default window [s] (2 Hz resolution: a resonance hump of 1 % damping at 500 Hz
@@ -269,11 +275,11 @@ def find_spindle(f: np.ndarray, P: np.ndarray, speed_rpm: float | None, f_lo: fl
         for g in grid:
             lw = low(g)
             s, m = comb_score(g, freqs[lw], w[lw], tol[lw])
-            if m.sum() >= LOW_HARMONIC_LINES and (s > best_s + 1e-9 or (
+            if m.sum() >= 1 and (s > best_s + 1e-9 or (
                     abs(s - best_s) <= 1e-9 and abs(g - nom) < abs(best - nom))):
                 best, best_s = g, s
         if best is None:
-            return nom, "given", 0
+            return nom, "given; no harmonic lines in the record (none excluded)", 0
         lw = low(best)
         _, m = comb_score(best, freqs[lw], w[lw], tol[lw])
         f0 = _refine_f0(best, freqs[lw], w[lw], m)
@@ -292,7 +298,7 @@ def find_spindle(f: np.ndarray, P: np.ndarray, speed_rpm: float | None, f_lo: fl
     cands = [fl / k for fl in top for k in range(1, LOW_HARMONICS + 1)]
     cands += [abs(a - b) for i, a in enumerate(top) for b in top[i + 1:]]
     fmin = max(3.0 * df, f_lo, 0.5)
-    best_s, best_f, best_m = -math.inf, None, None
+    found = []
     for c in cands:
         if not fmin <= c <= min(f_hi / 3.0, MAX_SPINDLE_HZ):
             continue
@@ -302,10 +308,16 @@ def find_spindle(f: np.ndarray, P: np.ndarray, speed_rpm: float | None, f_lo: fl
         s2, m2 = comb_score(c2, freqs, w, tol)
         if s2 >= s:
             s, m, c = s2, m2, c2
-        if not ok(c, m) or int(np.sum(m & ~family)) < LOW_HARMONIC_LINES:
-            continue
-        if s > best_s + 1e-9 or (abs(s - best_s) <= 1e-9 and best_f is not None and c > best_f):
-            best_s, best_f, best_m = s, c, m
+        own = int(np.sum(m & ~family)) >= LOW_HARMONIC_LINES or abs(c - fs_) <= tol[strongest]
+        if ok(c, m) and own:
+            found.append((s, c, m))
+    best_s, best_f, best_m = -math.inf, None, None
+    if found:
+        top_s = max(v[0] for v in found)
+        # a sub-multiple of the spindle frequency matches its lines too: the highest
+        # fundamental whose comb explains nearly as much wins (the octave-error rule)
+        best_s, best_f, best_m = max((v for v in found if v[0] >= COMB_SHARE * top_s),
+                                     key=lambda v: v[1])
     if best_f is None or best_m.sum() < 3 or best_s < 1.5:
         return None, "not found (no harmonic comb with its low harmonics)", 0
     return float(best_f), "estimated from the record's harmonic comb", int(best_m.sum())
@@ -413,7 +425,10 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     avgL = PLn.mean(axis=(0, 1))
     f_hi = 0.95 * 0.5 * fs
     lines = fixed_lines(fL, avgL, tuple(s.mains_Hz), tuple(s.fixed_lines_Hz))
-    f0, f0_src, _ = find_spindle(fL, avgL, s.speed_rpm, float(fL[lowL]), f_hi, lines)
+    f0, f0_src, n_matched = find_spindle(fL, avgL, s.speed_rpm, float(fL[lowL]), f_hi, lines)
+    # harmonics are excluded where the record shows them; a given speed whose harmonics are
+    # not in the record leaves nothing to exclude (and its +-1.5 % would misplace the bands)
+    f_mask = f0 if n_matched > 0 else None
     if progress is not None:
         progress(0.3)
     # --- windows
@@ -428,7 +443,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     f, t0, P = window_spectra(x, fs, nwin, max(1, nwin // 2))
     df = f[1] - f[0]
     f_lo = max(4.0 * df, 0.5 * f0 if f0 else 0.0)
-    excl = exclusion_mask(f, f0, lines, f_lo)
+    excl = exclusion_mask(f, f_mask, lines, f_lo)
     allowed = np.ones(f.size, dtype=bool)
     if s.modes_Hz:
         reach = 1.5 * f0 if f0 else 0.0
