@@ -184,6 +184,53 @@ def measure_cut_cmd(
     emit(out, as_json, render)
 
 
+@handle_errors
+def measure_synthetic_cmd(
+    out: Path = typer.Argument(..., help="Record to write: .csv (vibration: time_s + acc; "
+                                         "force: DynoWare-style ASCII) ."),
+    kind: str = typer.Option("vibration", "--kind", help="vibration (a tool-holder "
+                             "accelerometer record of the time-domain simulation, labelled by "
+                             "its verdict) or force (a dynamometer record of a boring cut)."),
+    seed: int = typer.Option(0, "--seed", help="Random seed (the record's ground truth)."),
+    duration_s: float = typer.Option(3.0, "--duration-s", help="Length [s] of the cut "
+                                     "(0.5 .. 60; a force record adds 1 s of air before and "
+                                     "after)."),
+    as_json: bool = JSON_OPTION,
+) -> None:
+    """Write a SYNTHETIC record with its ground truth (to try `detect chatter` and
+    `measure cut`)."""
+    from robobore.io.outputs import check_output_file
+
+    check_output_file(out, "OUT", "the record")
+    if not 0.5 <= duration_s <= 60.0:
+        raise ConfigError("duration out of range", field="--duration-s", value=duration_s,
+                          expected="0.5 .. 60 s")
+    if kind == "vibration":
+        from robobore.measure.records import write_record_csv
+        from robobore.measure.synthetic import simulated_record
+
+        rec = simulated_record(seed, duration_s=duration_s)
+        write_record_csv(rec, out)
+    elif kind == "force":
+        from robobore.measure.cut import synthetic_force_record, write_dynoware_ascii
+
+        rec = synthetic_force_record(duration_s=duration_s + 2.0, seed=seed)  # + 1 s of air
+        # before and after the cut
+        write_dynoware_ascii(rec, out)
+    else:
+        raise ConfigError("unknown kind", field="--kind", value=kind,
+                          expected="vibration or force")
+    res = {"file": str(out), "kind": rec.kind, "truth": rec.truth, "record": rec.to_dict()}
+
+    def render(r: dict[str, Any]) -> None:
+        rows = [("file", r["file"]), ("kind", r["kind"])]
+        rows += [(f"truth: {k}", v) for k, v in r["truth"].items()
+                 if not isinstance(v, dict)]
+        stdout.print(kv_table("SYNTHETIC record", rows))
+
+    emit(res, as_json, render)
+
+
 def register(groups: dict[str, typer.Typer]) -> None:
     """Add ``detect chatter`` and ``measure cut``."""
     groups.setdefault("detect", typer.Typer(help="Detect events in measured records.",
@@ -193,3 +240,4 @@ def register(groups: dict[str, typer.Typer]) -> None:
                                              rich_markup_mode=None))
     groups["detect"].command("chatter")(detect_chatter_cmd)
     groups["measure"].command("cut")(measure_cut_cmd)
+    groups["measure"].command("synthetic")(measure_synthetic_cmd)

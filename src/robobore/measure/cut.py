@@ -201,6 +201,27 @@ def read_cut_record(path: str | Path, sample_rate_Hz: float | None = None) -> Re
     return _from_table(header, data, src, hl, sample_rate_Hz, False)
 
 
+def _cutting_span(F: np.ndarray, fs: float) -> tuple[int, int]:
+    """Samples of the cutting part before the speed is known: the longest run where the
+    resultant force, averaged over 0.1 s, is at least half its 90th percentile."""
+    mag = np.linalg.norm(F, axis=0)
+    w = max(1, int(0.1 * fs))
+    env = np.convolve(mag, np.ones(w) / w, mode="same")
+    on = env >= 0.5 * np.percentile(env, 90)
+    best, cur, start, bstart = 0, 0, 0, 0
+    for i, v in enumerate(on):
+        if v:
+            if cur == 0:
+                start = i
+            cur += 1
+            if cur > best:
+                best, bstart = cur, start
+        else:
+            cur = 0
+    a, b = bstart + w, bstart + best - w
+    return (a, b) if b - a >= 256 else (0, F.shape[1])
+
+
 def _cutting_revolutions(F: np.ndarray, spr: float, nrev: int) -> tuple[int, int]:
     """First and last+1 revolution of the cutting part (module docstring)."""
     mags = np.array([np.linalg.norm(F[:, int(round(i * spr)):int(round((i + 1) * spr))],
@@ -243,15 +264,17 @@ def cut_quantities(record: Record, speed_rpm: float | None = None,
     src_speed = "given"
     if speed_rpm is None:
         use = fi or di
-        nl = int(min(record.n_samples, max(256, round(min(4.0, record.duration_s / 2) * fs))))
-        f, _, P = window_spectra(record.signals[use], fs, nl, nl // 2)
-        Pn = P / (P[:, :, 4:].sum(axis=2, keepdims=True) + 1e-300)
+        i0, i1 = _cutting_span(record.signals[fi], fs) if fi else (0, record.n_samples)
+        seg = record.signals[use, i0:i1]
+        nl = int(min(seg.shape[1], max(256, round(min(4.0, seg.shape[1] / fs / 2) * fs))))
+        f, _, P = window_spectra(seg, fs, nl, nl // 2)
+        Pn = P / (P[:, :, 2:].sum(axis=2, keepdims=True) + 1e-300)
         avg = Pn.mean(axis=(0, 1))
-        f0, _, _ = find_spindle(f, avg, None, float(f[4]), 0.45 * fs)
+        f0, _, _ = find_spindle(f, avg, None, float(f[2]), 0.45 * fs)
         src_speed = "estimated from the record's harmonic comb"
         if f0 is None and fi:
             # the forces of a rotating bar turn once per revolution: the strongest line
-            lines, prom = spectral_lines(f, avg, 4)
+            lines, prom = spectral_lines(f, avg, 2)
             if lines.size:
                 f0 = float(lines[int(np.argmax(prom))])
                 src_speed = "estimated from the strongest force line (once per revolution)"

@@ -418,9 +418,12 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     fs = record.sample_rate_Hz
     n = record.n_samples
     # --- the spindle and the fixed lines on long windows (fine resolution)
-    nlong = int(min(n, max(256, round(min(2.0, record.duration_s / 4) * fs))))
+    long_s = min(2.0, record.duration_s / 4)
+    if s.speed_rpm is not None:  # at least 8 revolutions (the first harmonics resolved)
+        long_s = max(long_s, min(record.duration_s, 8.0 * 60.0 / s.speed_rpm))
+    nlong = int(min(n, max(256, round(long_s * fs))))
     fL, _, PL = window_spectra(x, fs, nlong, max(1, nlong // 2))
-    lowL = max(4, int(0.001 * fL.size))
+    lowL = 2
     PLn = PL / (PL[:, :, lowL:].sum(axis=2, keepdims=True) + 1e-300)
     avgL = PLn.mean(axis=(0, 1))
     f_hi = 0.95 * 0.5 * fs
