@@ -17,9 +17,9 @@ of the per-revolution means, less its first and last revolution; the whole recor
 displacement-only record):
 
 * ``force_mean_N`` per axis: the mean force;
-* ``force_amplitude_N`` per axis: the paper's "average amplitude of the cutting force" (Yang
-  et al., Figs. 7 and 10: the forces of a stable cut are near-sinusoidal over a revolution of
-  the bar): the half peak-to-peak of the force in each revolution, averaged over the
+* ``force_amplitude_N`` per axis: the paper's "average amplitude of the cutting force" (its
+  Figs. 7 and 10: the forces of a stable cut are near-sinusoidal over a revolution of the
+  bar): the half peak-to-peak of the force in each revolution, averaged over the
   revolutions; ``force_amplitude_overall_N``: the half peak-to-peak over the whole cutting
   part (:func:`robobore.dynamics.timedomain.summarize`'s definition for simulated runs; the
   two coincide for a steady periodic cut);
