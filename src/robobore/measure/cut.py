@@ -169,26 +169,27 @@ def read_cut_record(path: str | Path, sample_rate_Hz: float | None = None) -> Re
     if ext not in (".csv", ".txt", ".asc", ".dat"):
         raise DataError("unknown record format", file=src, value=ext,
                         expected=".csv, .txt, .asc, .dat (DynoWare ASCII) or .npz")
-    from robobore.measure.records import guard_size
-
-    guard_size(p, 4.5, "a force record")
-    try:
-        text = p.read_text(encoding="utf-8-sig", errors="strict")
-    except UnicodeDecodeError:
-        text = p.read_text(encoding="latin-1")  # DynoWare writes ANSI text
-    lines = text.splitlines()
-    hi = _dynoware_header(lines)
+    head: list[str] = []
+    enc = "utf-8-sig"
+    for enc in ("utf-8-sig", "latin-1"):  # DynoWare writes ANSI text
+        try:
+            with p.open("r", encoding=enc, newline="") as fh:
+                head = [fh.readline().rstrip("\r\n") for _ in range(200)]
+            break
+        except UnicodeDecodeError:
+            continue
+    hi = _dynoware_header(head)
     if hi is not None:
-        hdr_line = lines[hi]
+        hdr_line = head[hi]
         delim = "\t" if "\t" in hdr_line else (";" if ";" in hdr_line else ",")
-        header = [c.strip() for c in hdr_line.split(delim) if c.strip()]
-        body = [ln.replace(",", ".") if delim != "," else ln for ln in lines[hi + 1:]]
+        header = [c.strip() for c in hdr_line.split(delim)]
+        while header and header[-1] == "":
+            header.pop()
         meta = {}
-        for ln in lines[:hi]:
+        for ln in head[:hi]:
             kv = re.split(r":\s*|\t", ln, maxsplit=1)
             if len(kv) == 2 and kv[0].strip():
                 meta[kv[0].strip()] = kv[1].strip()
-        data = parse_rows([b.strip(delim) for b in body], header, src, hi + 1, delim)
         rate = None
         for k, v in meta.items():
             if "sampling rate" in k.lower():
@@ -196,6 +197,16 @@ def read_cut_record(path: str | Path, sample_rate_Hz: float | None = None) -> Re
                     rate = float(v.split()[0].replace(",", "."))
                 except (ValueError, IndexError):
                     rate = None
+        if delim == ";" or enc != "utf-8-sig":  # decimal commas or ANSI: parsed as text
+            from robobore.measure.records import guard_size
+
+            guard_size(p, 6.0, "a force record")
+            lines = p.read_text(encoding=enc).splitlines()
+            body = [ln.replace(",", ".").strip(delim) for ln in lines[hi + 1:]]
+            data = parse_rows(body, header, src, hi + 1, delim)
+        else:
+            _, data, _ = read_csv_table(p, "a DynoWare export", skip_lines=hi, delimiter=delim,
+                                        header=header)
         return _from_table(header, data, src, hi + 1, rate if rate else sample_rate_Hz, True)
     header, data, hl = read_csv_table(p, "a force/displacement record")
     return _from_table(header, data, src, hl, sample_rate_Hz, False)

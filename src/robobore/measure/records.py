@@ -40,8 +40,6 @@ MIN_SAMPLES = 64
 UNIFORM_TOLERANCE = 0.01
 #: Names of the time column of a CSV record (matched case-insensitively).
 TIME_COLUMNS = ("time_s", "time [s]", "t_s", "time")
-#: Bytes of memory per parsed CSV cell (float64 + parser overhead), for the size guard.
-CSV_BYTES_PER_CELL = 24.0
 
 
 @dataclass(frozen=True)
@@ -189,31 +187,89 @@ def split_unit(column: str) -> tuple[str, str]:
     return column.strip(), ""
 
 
-def read_csv_table(path: Path, what: str = "a record CSV") -> tuple[list[str], np.ndarray, int]:
+def read_csv_table(path: Path, what: str = "a record CSV", skip_lines: int = 0,
+                   delimiter: str | None = None, header: list[str] | None = None
+                   ) -> tuple[list[str], np.ndarray, int]:
     """Header and numeric rows of a CSV ``(header, data (n_rows, n_cols), header_line)``;
-    ``#`` comments and blank lines skipped. Bad cells are reported with row and column."""
-    guard_size(path, CSV_BYTES_PER_CELL / 8.0 * 1.5, what)
+    ``#`` comments and blank lines skipped. Bad cells are reported with row and column.
+
+    The samples are parsed from the open file (never the whole text in memory); before that
+    the number of rows is estimated from the file size and the length of the first lines, and
+    a table that would not fit in memory is refused with its estimate. ``skip_lines``: lines
+    before the header (a header block); ``delimiter`` and ``header``: given by a caller that
+    has read the header itself (the header line is then line ``skip_lines + 1``)."""
+    src = str(path)
+    size = path.stat().st_size
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        fh = path.open("r", encoding="utf-8-sig", newline="")
+        with fh:
+            for _ in range(skip_lines):
+                fh.readline()
+            line_no = skip_lines
+            if header is None:
+                while True:
+                    ln = fh.readline()
+                    if not ln:
+                        raise DataError("no header line", file=src,
+                                        expected=f"{what} with a header")
+                    line_no += 1
+                    st = ln.strip()
+                    if st and not st.startswith("#"):
+                        break
+                delim = ";" if ln.count(";") > ln.count(",") else ","
+                if delim == "," and "," not in ln and "\t" in ln:
+                    delim = "\t"
+                header = [h.strip() for h in ln.split(delim)]
+            else:
+                fh.readline()
+                line_no += 1
+                delim = delimiter or ","
+            header_line = line_no
+            start = fh.tell()
+            probe = [fh.readline() for _ in range(200)]
+            probe = [x for x in probe if x]
+            per_line = max(1.0, sum(len(x.encode()) for x in probe) / max(1, len(probe)))
+            rows_est = size / per_line
+            from robobore.io.memory import check_memory
+
+            check_memory(rows_est * len(header) * 8.0 * 3.0,
+                         f"reading {what} (about {rows_est:.3g} rows x {len(header)} columns, "
+                         f"{size / 2**20:.4g} MiB on disk)",
+                         "the record's length (split it into shorter files)", file=src)
+            fh.seek(start)
+            try:
+                data = np.loadtxt(fh, delimiter=None if delim == " " else delim,
+                                  comments="#", dtype=float, ndmin=2)
+            except ValueError:
+                data = None
+            if data is None or data.shape[1] != len(header) or data.shape[0] == 0:
+                fh.seek(start)
+                _locate_bad_row(fh, header, src, delim)
+                raise DataError("no data rows", file=src, expected="one row per sample")
     except UnicodeDecodeError as exc:
-        raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(path),
+        raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=src,
                         expected=f"{what} in UTF-8") from None
-    lines = text.splitlines()
-    hdr_i = None
-    for i, ln in enumerate(lines):
-        s = ln.strip()
-        if s and not s.startswith("#"):
-            hdr_i = i
-            break
-    if hdr_i is None:
-        raise DataError("no header line", file=str(path), expected=f"{what} with a header")
-    delim = ";" if lines[hdr_i].count(";") > lines[hdr_i].count(",") else ","
-    if delim == "," and "," not in lines[hdr_i] and "\t" in lines[hdr_i]:
-        delim = "\t"
-    header = [h.strip() for h in lines[hdr_i].split(delim)]
-    body = [ln for ln in lines[hdr_i + 1:]]
-    data = parse_rows(body, header, str(path), hdr_i + 1, delim)
-    return header, data, hdr_i + 1
+    return header, data, header_line
+
+
+def _locate_bad_row(lines: Any, header: list[str], source: str, delim: str | None) -> None:
+    """Raise the error of the first bad data row of ``lines`` (an iterable of text lines);
+    rows are counted from 1 after the header, blank and comment lines included."""
+    n = 0
+    for ln in lines:
+        n += 1
+        if not ln.strip() or ln.lstrip().startswith("#"):
+            continue
+        cells = ln.rstrip("\r\n").split(delim) if delim else ln.split()
+        if len(cells) != len(header):
+            raise DataError(f"row has {len(cells)} cells, the header has {len(header)}",
+                            file=source, row=n, expected=f"{len(header)} cells")
+        for h, c in zip(header, cells, strict=True):
+            try:
+                float(c)
+            except ValueError:
+                raise DataError("not a number", file=source, row=n, field=h,
+                                value=c.strip(), expected="a number") from None
 
 
 def parse_rows(body: list[str], header: list[str], source: str, header_line: int,
@@ -228,23 +284,7 @@ def parse_rows(body: list[str], header: list[str], source: str, header_line: int
     except ValueError:
         data = None
     if data is None or data.shape[1] != len(header):
-        # locate the first bad row (slow path, errors only)
-        n = 0
-        for ln in body:
-            if not ln.strip() or ln.lstrip().startswith("#"):
-                n += 1
-                continue
-            n += 1
-            cells = ln.split(delim) if delim else ln.split()
-            if len(cells) != len(header):
-                raise DataError(f"row has {len(cells)} cells, the header has {len(header)}",
-                                file=source, row=n, expected=f"{len(header)} cells")
-            for h, c in zip(header, cells, strict=True):
-                try:
-                    float(c)
-                except ValueError:
-                    raise DataError("not a number", file=source, row=n, field=h,
-                                    value=c.strip(), expected="a number") from None
+        _locate_bad_row(body, header, source, delim)
         raise DataError("unreadable rows", file=source, expected="numbers in every cell")
     return data
 
