@@ -111,6 +111,7 @@ def detect_chatter_cmd(
                  r["nonharmonic_energy_share"]),
                 ("chatter peak energy share (median)", r["chatter_energy_share"]),
                 ("peak above floor (dB)", r["peak_prominence_dB"]),
+                ("chatter line growth in the record (dB)", r["chatter_growth_dB"]),
                 ("fixed lines excluded (Hz)", ", ".join(fmt(v) for v in r["fixed_lines_Hz"])
                  or "none"),
                 ("nearest mode (Hz)", r["nearest_mode_Hz"]),

@@ -60,8 +60,11 @@ from robobore.measure.records import Record
 
 #: Share of a window's energy that the chatter peak (above the local floor) must hold.
 SHARE_LIMIT = 0.2
-#: How far the chatter peak must stand above the local spectral floor [dB].
-PROMINENCE_DB = 15.0
+#: How far the chatter peak must stand above the local spectral floor [dB]. A resonance
+#: driven by broadband cutting noise peaks a few dB above its own hump (the periodogram of a
+#: noise band fluctuates exponentially from bin to bin); on the SYNTHETIC records of
+#: robobore.measure.synthetic such humps reach 18.4 dB, chatter lines 34 dB and more.
+PROMINENCE_DB = 20.0
 #: Consecutive chattering windows (at one frequency) that make the record chatter.
 PERSIST_WINDOWS = 3
 #: Relative tolerance of a given spindle speed (the speed found is refined within it).
@@ -146,6 +149,7 @@ class ChatterDetection:
     nonharmonic_energy_share: float
     chatter_energy_share: float
     peak_prominence_dB: float
+    chatter_growth_dB: float | None
     nearest_mode_Hz: float | None
     fixed_lines_Hz: tuple[float, ...]
     window_s: float
@@ -158,8 +162,10 @@ class ChatterDetection:
     def to_dict(self) -> dict[str, Any]:
         """JSON contract: ``chatter``, ``chatter_frequency_Hz``, ``onset_s``, ``windows``
         (each ``t0_s``, ``t1_s``, ``chatter``, ``peak_Hz``, ``peak_share``,
-        ``nonharmonic_share``, ``prominence_dB``), the spindle frequency used and where it
-        came from, the energy shares, the fixed lines excluded, the record and settings."""
+        ``nonharmonic_share``, ``prominence_dB``; with chatter ``chatter_line_dB``: the
+        chatter line's power relative to its largest), ``chatter_growth_dB`` (that largest
+        over the first window's), the spindle frequency used and where it came from, the
+        energy shares, the fixed lines excluded, the record and settings."""
         d = {k: v for k, v in self.__dict__.items() if k != "spectrogram"}
         d["windows"] = list(self.windows)
         d["reasons"] = list(self.reasons)
@@ -476,15 +482,17 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
         if run_len >= need and best is None:
             best = run_start
     chatter = best is not None
-    windows = tuple({"t0_s": float(record.t0_s + t0[i]),
+    wins = [{"t0_s": float(record.t0_s + t0[i]),
                      "t1_s": float(record.t0_s + t0[i] + nwin / fs),
                      "chatter": bool(flag[i]), "peak_Hz": float(pk_hz[i]),
                      "peak_share": float(share[i]), "nonharmonic_share": float(nonh[i]),
                      "prominence_dB": float(prom[i]),
-                     "channel": record.channels[int(best_ch[i])]} for i in range(nw))
+                     "channel": record.channels[int(best_ch[i])]} for i in range(nw)]
     reasons = []
     fc = None
     onset = None
+    line_db = None
+    growth_db = None
     ch_idx = int(np.bincount(best_ch).argmax())
     if chatter:
         # the developed chatter: the chattering windows of the record's last third (else
@@ -500,6 +508,12 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
         k = int(np.flatnonzero(near)[np.argmax(avg[near])])
         fc = float((k + _parabolic(np.log(avg + 1e-300), k)) * df)
         onset = float(record.t0_s + t0[best])
+        # the line's power per window (the same bins, raw: a ratio in time is level-free)
+        bw = int(max(2, round(0.005 * fc / df)))
+        kb = int(round(fc / df))
+        line = P[ch_idx][:, max(0, kb - bw):kb + bw + 1].sum(axis=1) + 1e-300
+        line_db = 10 * np.log10(line / line.max())
+        growth_db = float(10 * np.log10(line.max() / line[0]))
         reasons.append(f"chatter: a line at {fc:.5g} Hz away from the spindle harmonics holds "
                        f"{100 * float(np.median(share[use])):.3g} % of the energy "
                        f"({float(np.median(prom[use])):.3g} dB above the floor) in "
@@ -510,6 +524,10 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
                        f"{100 * s.share_limit:.3g} % of the energy {s.prominence_dB:g} dB above "
                        f"the floor in {need} consecutive windows ({nflag} of {nw} windows "
                        "flagged)")
+    if line_db is not None:
+        for i, w in enumerate(wins):
+            w["chatter_line_dB"] = float(line_db[i])
+    windows = tuple(wins)
     if f0 is None:
         reasons.append("spindle harmonics not found: only fixed lines excluded")
     use_w = [i for i in range(nw) if flag[i]] if chatter else list(range(nw))
@@ -524,7 +542,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
         nonharmonic_energy_share=float(np.mean(nonh)),
         chatter_energy_share=float(np.median(share[use_w])) if use_w else 0.0,
         peak_prominence_dB=float(np.median(prom[use_w])) if use_w else 0.0,
-        nearest_mode_Hz=mode, fixed_lines_Hz=tuple(sorted(round(v, 4) for v in lines)),
+        chatter_growth_dB=growth_db, nearest_mode_Hz=mode, fixed_lines_Hz=tuple(sorted(round(v, 4) for v in lines)),
         window_s=nwin / fs, windows=windows, reasons=tuple(reasons),
         record=record.to_dict(),
         settings={"share_limit": s.share_limit, "prominence_dB": s.prominence_dB,
