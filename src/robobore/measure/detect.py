@@ -191,12 +191,16 @@ def window_spectra(x: np.ndarray, fs: float, nwin: int, hop: int
     n = x.shape[1]
     nwin = int(min(nwin, n))
     starts = np.arange(0, n - nwin + 1, max(1, int(hop)))
-    view = np.lib.stride_tricks.sliding_window_view(x, nwin, axis=1)[:, starts, :]
+    view = np.lib.stride_tricks.sliding_window_view(x, nwin, axis=1)
     w = np.hanning(nwin)
-    seg = view - view.mean(axis=2, keepdims=True)
-    spec = fft.rfft(seg * w, axis=2, workers=1)
-    P = spec.real ** 2 + spec.imag ** 2
     f = np.fft.rfftfreq(nwin, 1.0 / fs)
+    P = np.empty((x.shape[0], starts.size, f.size))
+    chunk = max(1, int(2**22 // max(1, nwin * x.shape[0])))  # ~32 MiB of samples at a time
+    for c0 in range(0, starts.size, chunk):
+        seg = view[:, starts[c0:c0 + chunk], :]
+        seg = (seg - seg.mean(axis=2, keepdims=True)) * w
+        spec = fft.rfft(seg, axis=2, workers=1)
+        P[:, c0:c0 + chunk] = spec.real ** 2 + spec.imag ** 2
     return f, starts / fs, P
 
 
@@ -420,6 +424,13 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     """
     s = settings or DetectSettings()
     s.check(record)
+    from robobore.io.memory import check_memory
+
+    # the spectra of the 50 %-overlapping windows and their normalised copies: about four
+    # times the record in float64
+    check_memory(4.0 * 8.0 * record.signals.size, f"chatter detection on {record.n_channels} "
+                 f"x {record.n_samples} samples", "the record's length (split it into shorter "
+                 "files)", file=record.source)
     x = record.signals
     fs = record.sample_rate_Hz
     n = record.n_samples
