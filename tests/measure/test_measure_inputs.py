@@ -114,3 +114,16 @@ def test_cut_record_too_short(tmp_path):
     with pytest.raises(DataError) as e:
         cut_quantities(rec, 100.0)
     assert "3 revolutions" in str(e.value)
+
+
+def test_missing_sample_is_non_uniform(tmp_path):
+    t = np.delete(np.arange(400) / 1000.0, 150)
+    with pytest.raises(DataError) as e:
+        read_record(_csv(tmp_path, t, np.zeros(t.size)))
+    assert "uniformly" in str(e.value) and e.value.row is not None
+
+
+def test_float32_time_rounding_is_accepted(tmp_path):
+    t = (29.0 + np.arange(2000) / 10000.0).astype(np.float32).astype(float)
+    rec = read_record(_csv(tmp_path, t, np.sin(np.arange(2000.0))))
+    assert rec.sample_rate_Hz == pytest.approx(10000.0, rel=1e-3)

@@ -15,7 +15,8 @@ A :class:`Record` holds ``signals`` of shape ``(n_channels, n_samples)`` sampled
 * **WAV**: the channels of the file at its sample rate (integer PCM scaled to +-1).
 
 Every reader checks the record before it is used: a time column that decreases or is not
-uniform (a step more than 1 % off the mean step, or a missing sample), non-finite samples,
+uniform (a step more than 20 % off the median step, or a time more than a quarter step off
+the uniform grid: a missing sample), non-finite samples,
 fewer than :data:`MIN_SAMPLES` samples, or a file whose parsed size would not fit in memory
 (estimated from the file size before reading) are refused with a
 :class:`~robobore.errors.DataError` naming the file, the row or column, the value and what
@@ -36,8 +37,12 @@ from robobore.errors import DataError
 
 #: Fewest samples a record may have (a spectrum needs a few periods of anything).
 MIN_SAMPLES = 64
-#: Largest relative deviation of one time step from the mean step.
-UNIFORM_TOLERANCE = 0.01
+#: Largest relative deviation of one time step from the median step (rounding of the
+#: written times, float32 clocks: 2 % at 30 s and 10 kHz) ...
+STEP_TOLERANCE = 0.2
+#: ... and of a time from the uniform grid, in steps (a missing or repeated sample shifts the
+#: grid by one step).
+GRID_TOLERANCE = 0.25
 #: Names of the time column of a CSV record (matched case-insensitively).
 TIME_COLUMNS = ("time_s", "time [s]", "t_s", "time")
 
@@ -146,14 +151,20 @@ def sample_rate_from_time(t: np.ndarray, source: str, column: str = "time_s",
                         value=float(t[i]), expected=f"a time after {t[i - 1]!r} s "
                         "(samples in time order, each once)")
     dt = (t[-1] - t[0]) / (t.size - 1)
-    dev = np.abs(d - dt) / dt
-    if dev.max() > UNIFORM_TOLERANCE:
-        i = int(np.argmax(dev)) + 1
+    med = float(np.median(d))
+    step_bad = np.abs(d - med) > STEP_TOLERANCE * med
+    grid_bad = np.abs(t - (t[0] + dt * np.arange(t.size))) > GRID_TOLERANCE * dt
+    if step_bad.any() or grid_bad.any():
+        i1 = int(np.argmax(step_bad)) + 1 if step_bad.any() else t.size
+        i2 = int(np.argmax(grid_bad)) if grid_bad.any() else t.size
+        i = max(1, min(i1, i2))
         raise DataError("time is not uniformly sampled", file=source, row=i + first_row,
                         field=column, value=float(t[i]),
-                        expected=f"steps of {dt:.6g} s within {100 * UNIFORM_TOLERANCE:g} % "
-                        f"(step here {d[i - 1]:.6g} s; resample the record or give each "
-                        "uniform part as its own file)")
+                        expected=f"steps of {med:.6g} s (each within "
+                        f"{100 * STEP_TOLERANCE:g} %, every time within "
+                        f"{100 * GRID_TOLERANCE:g} % of a step of the uniform grid; step here "
+                        f"{d[i - 1]:.6g} s; resample the record or give each uniform part "
+                        "as its own file)")
     return 1.0 / dt, float(t[0])
 
 
@@ -467,4 +478,4 @@ def write_record_csv(record: Record, path: str | Path, digits: int = 9) -> Path:
 
 __all__ = ["Record", "make_record", "read_record", "read_csv_table", "parse_rows",
            "sample_rate_from_time", "check_samples", "split_unit", "guard_size",
-           "write_record_csv", "MIN_SAMPLES", "UNIFORM_TOLERANCE", "TIME_COLUMNS"]
+           "write_record_csv", "MIN_SAMPLES", "STEP_TOLERANCE", "GRID_TOLERANCE", "TIME_COLUMNS"]
