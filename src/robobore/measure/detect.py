@@ -21,13 +21,16 @@ signal's level and units:
    its prominence; a comb of spacing ``f0`` matches a line by chance with probability
    ``2 tol / f0``, which is subtracted; of the combs within 80 % of the best score the
    highest fundamental wins, since a sub-multiple matches the same lines), searched up to
-   :data:`MAX_SPINDLE_HZ`, with at least two lines among its first ten harmonics, and, for a
+   :data:`MAX_SPINDLE_HZ`, with lines at two or more of its first ten harmonics and at three
+   or more harmonics in all (a cluster of lines round one frequency counts once), and, for a
    comb below the record's strongest line, at least two lines that are not harmonics of that
    line (a saturated chatter vibration has harmonics of its own; a sub-multiple of it does not
-   make a spindle). Fixed lines that do
-   not move with the speed are excluded too: mains (50 and 60 Hz families, each detected by
-   its fundamental line, then every multiple present as a line weaker than the fundamental:
-   mains distortion decays with the order) and any lines given.
+   make a spindle). In each window only the harmonics it shows as lines are excluded, as
+   wide as their skirts (:func:`line_extent`), the spindle frequency re-refined in the window
+   (:func:`window_harmonic_bands`). Fixed lines that do not move with the speed are excluded
+   too: mains (50 and 60 Hz families, each detected by its fundamental line, then every
+   multiple present as a line weaker than the fundamental: mains distortion decays with the
+   order) and any lines given.
 3. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
    modes when modes are given) and its energy above the local spectral floor (the median of
    the remaining spectrum within +-5 % of its frequency) as a share of the window's energy.
@@ -43,8 +46,8 @@ signal's level and units:
 
 Limits: a chatter line that falls on a spindle harmonic or a mains multiple (within the
 band widths) cannot be told from it and is missed; a spindle speed that drifts by more than
-+-0.3 % within the record widens the harmonics past their bands; a lightly damped mode driven
-by broadband noise looks like a line.
++-0.5 % from the record's mean widens the harmonics past their bands; a lightly damped mode
+driven by broadband noise looks like a line.
 """
 
 from __future__ import annotations
@@ -73,6 +76,12 @@ SPEED_TOLERANCE = 0.015
 #: :data:`LINE_REL_WIDTH` times the line frequency.
 LINE_BINS = 2.0
 LINE_REL_WIDTH = 0.001
+#: How far the spindle frequency may wander from the record's within one window.
+WINDOW_SPEED_TOLERANCE = 0.005
+#: A window's own spindle frequency is taken when it matches this many more lines.
+WINDOW_REALIGN_LINES = 3
+#: Widest half-width of an excluded line, as a fraction of its frequency.
+MAX_LINE_REL_WIDTH = 0.005
 #: A spectral line stands this far above the local floor [dB].
 LINE_DB = 10.0
 #: A spindle comb matches this many lines among its first LOW_HARMONICS harmonics.
@@ -272,8 +281,8 @@ def find_spindle(f: np.ndarray, P: np.ndarray, speed_rpm: float | None, f_lo: fl
     tol = _line_tol(freqs, df)
 
     def ok(c: float, m: np.ndarray) -> bool:
-        k = np.round(freqs[m] / c)
-        return int(np.sum(k <= LOW_HARMONICS)) >= LOW_HARMONIC_LINES
+        k = np.round(freqs[m] / c)  # distinct harmonics: a cluster of lines is one
+        return len(set(k[k <= LOW_HARMONICS].tolist())) >= LOW_HARMONIC_LINES
 
     def low(c: float) -> np.ndarray:
         return freqs <= (LOW_HARMONICS + 0.5) * c
@@ -328,7 +337,7 @@ def find_spindle(f: np.ndarray, P: np.ndarray, speed_rpm: float | None, f_lo: fl
         # fundamental whose comb explains nearly as much wins (the octave-error rule)
         best_s, best_f, best_m = max((v for v in found if v[0] >= COMB_SHARE * top_s),
                                      key=lambda v: v[1])
-    if best_f is None or best_m.sum() < 3 or best_s < 1.5:
+    if best_f is None or len(set(np.round(freqs[best_m] / best_f).tolist())) < 3 or best_s < 1.5:
         return None, "not found (no harmonic comb with its low harmonics)", 0
     return float(best_f), "estimated from the record's harmonic comb", int(best_m.sum())
 
@@ -364,40 +373,102 @@ def fixed_lines(f: np.ndarray, P: np.ndarray, mains: tuple[float, ...],
     return out
 
 
-def exclusion_mask(f: np.ndarray, f0: float | None, lines: list[float], f_lo: float
+def line_extent(f: np.ndarray, P: np.ndarray, center: float) -> float:
+    """Half-width [Hz] of the line at ``center`` in a spectrum: how far its skirts descend
+    while :data:`LINE_DB` above the local floor on either side (a spindle whose speed wanders
+    widens its harmonics; a rise is the next line), at most :data:`MAX_LINE_REL_WIDTH` of the
+    frequency plus a bin."""
+    df = f[1] - f[0]
+    fl = _floor(P, 25) + 1e-300
+    above = P >= fl * 10 ** (LINE_DB / 10)
+    k = int(np.clip(round(center / df), 0, f.size - 1))
+    cap = int(np.ceil(MAX_LINE_REL_WIDTH * center / df)) + 1
+    lo = k  # down the line's skirts while above the floor; a rise is another line
+    while lo > 0 and k - lo < cap and above[lo - 1] and P[lo - 1] <= P[lo]:
+        lo -= 1
+    hi = k
+    while hi < f.size - 1 and hi - k < cap and above[hi + 1] and P[hi + 1] <= P[hi]:
+        hi += 1
+    return float(max(k - lo, hi - k) * df + df)
+
+
+def harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
+                   exclude: list[float]) -> list[tuple[float, float]]:
+    """``(centre, half-width)`` [Hz] of the harmonics of ``f0`` that the averaged spectrum
+    shows as lines (:func:`line_extent`); harmonics absent from the record leave nothing to
+    exclude. ``exclude``: fixed lines, not taken for harmonics."""
+    df = f[1] - f[0]
+    freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
+    tol = _line_tol(freqs, df)
+    k = np.round(freqs / f0)
+    on = (k >= 1) & (np.abs(freqs - k * f0) <= tol)
+    for ln in exclude:
+        on &= np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)
+    return [(float(c), line_extent(f, P, float(c))) for c in freqs[on]]
+
+
+def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
+                          exclude: list[float]) -> list[tuple[float, float]]:
+    """:func:`harmonic_bands` of one window, the spindle frequency re-refined in it within
+    +-:data:`WINDOW_SPEED_TOLERANCE` of the record's ``f0`` (a speed that wanders over the
+    record is nearly constant over one window) when that aligns at least
+    :data:`WINDOW_REALIGN_LINES` more of the window's lines with the harmonics."""
+    df = f[1] - f[0]
+    freqs, prom = spectral_lines(f, P, max(1, int(f_lo / df)))
+    if freqs.size == 0:
+        return []
+    for ln in exclude:
+        keep = np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)
+        freqs, prom = freqs[keep], prom[keep]
+    w = np.minimum(np.log10(np.maximum(prom, 1.0)), 3.0)
+    tol = _line_tol(freqs, df)
+    fi = f0
+    _, m0 = comb_score(f0, freqs, w, tol)
+    grid = f0 * (1 + np.linspace(-WINDOW_SPEED_TOLERANCE, WINDOW_SPEED_TOLERANCE, 81))
+    counts = [int(comb_score(g, freqs, w, tol)[1].sum()) for g in grid]
+    j = max(range(grid.size), key=lambda i: (counts[i], -abs(grid[i] - f0)))
+    # the speed moved when several harmonics realign, not when one line (a chatter line
+    # near a harmonic) does
+    if counts[j] >= int(m0.sum()) + WINDOW_REALIGN_LINES:
+        _, mj = comb_score(grid[j], freqs, w, tol)
+        f2 = _refine_f0(grid[j], freqs, w, mj)
+        fi = f2 if abs(f2 / f0 - 1) <= WINDOW_SPEED_TOLERANCE else grid[j]
+    _, m = comb_score(fi, freqs, w, tol)
+    return [(float(c), line_extent(f, P, float(c))) for c in freqs[m]]
+
+
+def exclusion_mask(f: np.ndarray, bands: list[tuple[float, float]], f_lo: float
                    ) -> np.ndarray:
-    """True where a frequency bin is excluded: below ``f_lo``, near a harmonic of ``f0``
-    or near a fixed line."""
+    """True where a frequency bin is excluded: below ``f_lo``, within a band ``(centre,
+    half-width)`` (widened to :data:`LINE_BINS` bins and :data:`LINE_REL_WIDTH` of the
+    frequency at least), or in the anti-alias roll-off (the top 5 % below Nyquist)."""
     df = f[1] - f[0]
     mask = f < f_lo
-    if f0 is not None:
-        k = np.maximum(np.round(f / f0), 1.0)
-        hw = np.maximum(LINE_BINS * df, LINE_REL_WIDTH * k * f0)
-        mask |= np.abs(f - k * f0) <= hw
-    for ln in lines:
-        mask |= np.abs(f - ln) <= max(LINE_BINS * df, LINE_REL_WIDTH * ln)
-    mask[-max(1, int(0.05 * f.size)):] = True  # the anti-alias roll-off near Nyquist
+    for c, hw in bands:
+        mask |= np.abs(f - c) <= max(hw, LINE_BINS * df, LINE_REL_WIDTH * c)
+    mask[-max(1, int(0.05 * f.size)):] = True
     return mask
 
 
 # ----------------------------------------------------------------------------- windows
 def _window_measures(f: np.ndarray, P: np.ndarray, excl: np.ndarray, allowed: np.ndarray,
                      f_lo: float) -> dict[str, np.ndarray]:
-    """Per window (P: (n_win, n_f)): nonharmonic share, peak bin, peak share, prominence."""
+    """Per window (P, excl: (n_win, n_f)): nonharmonic share, peak bin, peak share,
+    prominence."""
     df = f[1] - f[0]
     band = f >= f_lo
     tot = P[:, band].sum(axis=1) + 1e-300
-    keep = ~excl
-    nonh = P[:, keep & band].sum(axis=1) / tot
-    cand = keep & allowed
+    keeps = ~excl  # (n_win, n_f)
+    nonh = (P * (keeps & band)).sum(axis=1) / tot
     nw = P.shape[0]
     pk = np.zeros(nw, dtype=int)
     share = np.zeros(nw)
     prom = np.zeros(nw)
-    if not cand.any():
-        return {"nonharmonic": nonh, "peak": pk, "share": share, "prominence": prom}
-    idx = np.flatnonzero(cand)
     for i in range(nw):
+        keep = keeps[i]
+        idx = np.flatnonzero(keep & allowed)
+        if idx.size == 0:
+            continue
         row = P[i]
         k = int(idx[np.argmax(row[idx])])
         pk[i] = k
@@ -448,7 +519,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     f0, f0_src, n_matched = find_spindle(fL, avgL, s.speed_rpm, float(fL[lowL]), f_hi, lines)
     # harmonics are excluded where the record shows them; a given speed whose harmonics are
     # not in the record leaves nothing to exclude (and its +-1.5 % would misplace the bands)
-    f_mask = f0 if n_matched > 0 else None
+    fixed_bands = [(ln, line_extent(fL, avgL, ln)) for ln in lines]
     if progress is not None:
         progress(0.3)
     # --- windows
@@ -463,7 +534,12 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     f, t0, P = window_spectra(x, fs, nwin, max(1, nwin // 2))
     df = f[1] - f[0]
     f_lo = max(4.0 * df, 0.5 * f0 if f0 else 0.0)
-    excl = exclusion_mask(f, f_mask, lines, f_lo)
+    Pall = P / (P[:, :, f >= f_lo].sum(axis=2, keepdims=True) + 1e-300)
+    Pall = Pall.mean(axis=0)  # (n_win, n_f): the channels' normalised spectra
+    excl = np.empty((t0.size, f.size), dtype=bool)
+    for i in range(t0.size):
+        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines) if n_matched > 0 else [])
+        excl[i] = exclusion_mask(f, wb + fixed_bands, f_lo)
     allowed = np.ones(f.size, dtype=bool)
     if s.modes_Hz:
         reach = 1.5 * f0 if f0 else 0.0
@@ -515,7 +591,9 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
         ch_idx = int(np.bincount(best_ch[use]).argmax())
         Pn = P[ch_idx, use] / (P[ch_idx, use][:, f >= f_lo].sum(axis=1, keepdims=True) + 1e-300)
         avg = Pn.mean(axis=0)
-        near = (~excl) & (np.abs(f - ref) <= max(3 * df, 0.02 * ref))
+        near = (np.mean(excl[use], axis=0) < 0.5) & (np.abs(f - ref) <= max(3 * df, 0.02 * ref))
+        if not near.any():
+            near = np.abs(f - ref) <= max(3 * df, 0.02 * ref)
         k = int(np.flatnonzero(near)[np.argmax(avg[near])])
         fc = float((k + _parabolic(np.log(avg + 1e-300), k)) * df)
         onset = float(record.t0_s + t0[best])
@@ -566,5 +644,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
 
 
 __all__ = ["DetectSettings", "ChatterDetection", "detect_chatter", "window_spectra",
-           "spectral_lines", "find_spindle", "fixed_lines", "exclusion_mask", "comb_score",
+           "spectral_lines", "find_spindle", "fixed_lines", "harmonic_bands",
+           "window_harmonic_bands", "line_extent",
+           "exclusion_mask", "comb_score",
            "SHARE_LIMIT", "PROMINENCE_DB", "PERSIST_WINDOWS", "SPEED_TOLERANCE", "MAINS_HZ"]
