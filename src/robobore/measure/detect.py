@@ -29,8 +29,8 @@ signal's level and units:
    wide as their skirts (:func:`line_extent`), the spindle frequency re-refined in the window
    (:func:`window_harmonic_bands`). Fixed lines that do not move with the speed are excluded
    too: mains (50 and 60 Hz families, each detected by its fundamental line, then every
-   multiple present as a line weaker than the fundamental: mains distortion decays with the
-   order) and any lines given.
+   multiple up to the 20th present as a line weaker than the fundamental: mains distortion
+   decays with the order) and any lines given.
 3. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
    modes when modes are given) and its energy above the local spectral floor (the median of
    the remaining spectrum within +-5 % of its frequency) as a share of the window's energy.
@@ -91,6 +91,9 @@ LOW_HARMONIC_LINES = 2
 MAX_SPINDLE_HZ = 500.0
 #: A comb within this fraction of the best comb's score and of a higher fundamental wins.
 COMB_SHARE = 0.8
+#: Highest multiple of a mains fundamental taken for a fixed line (pickup harmonics fade with
+#: the order; a line at a higher multiple is more likely the process's own).
+MAINS_MAX_ORDER = 20
 #: Mains families looked for as fixed lines [Hz].
 MAINS_HZ = (50.0, 60.0)
 #: Shortest default window [s] (2 Hz resolution: a resonance hump of 1 % damping at 500 Hz
@@ -356,7 +359,7 @@ def fixed_lines(f: np.ndarray, P: np.ndarray, mains: tuple[float, ...],
         kmax = int(f[-1] / m)
         present: list[float] = []
         p1 = 0.0
-        for k in range(1, min(kmax, 40) + 1):
+        for k in range(1, min(kmax, MAINS_MAX_ORDER) + 1):
             tol = max(2.0 * df, LINE_REL_WIDTH * k * m)
             sel = np.abs(freqs - k * m) <= tol
             if not sel.any():
