@@ -47,3 +47,18 @@ def test_measure_cut_json(tmp_path):
     assert {"force_mean_N", "force_amplitude_N", "force_amplitude_overall_N", "per_revolution",
             "chatter", "chatter_frequency_Hz", "cutting_time_s", "speed_rpm"} <= set(q)
     assert len(q["plots"]) == 2
+
+
+def test_detect_chatter_with_modes_file(tmp_path):
+    rec = simulated_record(0, duration_s=2.0)  # chatters near its mode
+    p = write_record_csv(rec, tmp_path / "acc.csv")
+    m = tmp_path / "m.json"
+    m.write_text(json.dumps({"modes": [{"frequency_Hz": rec.truth["mode_Hz"]}]}))
+    r = runner.invoke(app, ["detect", "chatter", str(p), "--modes-file", str(m), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["chatter"] is rec.truth["chatter"] is True
+    assert d["nearest_mode_Hz"] == rec.truth["mode_Hz"]
+    m.write_text(json.dumps({"modes": [{"frequency_Hz": "abc"}]}))
+    r = runner.invoke(app, ["detect", "chatter", str(p), "--modes-file", str(m)])
+    assert r.exit_code == 2 and "frequency_Hz" in r.output
