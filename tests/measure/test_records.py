@@ -72,8 +72,8 @@ def test_dynoware_semicolon_decimal_comma(tmp_path):
     fx = 100 * np.cos(2 * np.pi * 5 * t)
     lines = ["File:;test.dwd", "Sampling rate [Hz]:;2000", "",
              "Time [s];Fx [N];Fy [N];Fz [N]"]
-    lines += [f"{a:.4f};{b:.3f};{-b:.3f};{30.0:.3f}".replace(".", ",") for a, b in zip(t, fx,
-                                                                                        strict=True)]
+    lines += [f"{a:.4f};{b:.3f};{-b:.3f};{30.0:.3f}".replace(".", ",")
+              for a, b in zip(t, fx, strict=True)]
     p = tmp_path / "d.txt"
     p.write_text("\n".join(lines) + "\n", encoding="latin-1")
     rec = read_cut_record(p)
