@@ -46,3 +46,17 @@ def test_units_converted_and_feed_amplitude(tmp_path):
     assert len(q["per_revolution"]) >= 15
     assert {"force_mean_x_N", "force_amplitude_z_N", "force_rms_y_N", "amplitude_z_um"} <= set(
         q["per_revolution"][0])
+
+
+def test_chatter_in_the_forces_is_reported():
+    from robobore.measure.records import make_record
+
+    rec = synthetic_force_record(noise_N=0.5, feed_amplitude_um=None, duration_s=8.0)
+    t = np.arange(rec.n_samples) / rec.sample_rate_Hz
+    on = (t >= 1.0) & (t < 7.0)
+    x = rec.signals.copy()
+    # a vibration of 100 N at 187.3 Hz in X and Y: 36 % of the energy beside the rotating
+    # 134 N; at 60 N (17 %) it stays under the share limit of 20 %
+    x[:2] += 100.0 * np.sin(2 * np.pi * 187.3 * t) * on
+    q = cut_quantities(make_record(x, rec.sample_rate_Hz, rec.channels, rec.units), 300.0)
+    assert q["chatter"] and q["chatter_frequency_Hz"] == pytest.approx(187.3, rel=2e-3)
