@@ -90,3 +90,11 @@ def test_forced_vibration_of_a_wandering_spindle_is_stable():
     rec = make_record(_forced_with_drift(0.002, chatter_amp=20.0), FS, ["acc"])
     d = detect_chatter(rec)
     assert d.chatter and d.chatter_frequency_Hz == pytest.approx(1234.5, rel=2e-3)
+
+
+def test_a_ramp_channel_and_a_drift_are_not_chatter():
+    x = _signal(0.0)
+    t = np.arange(x.size) / FS
+    rec = make_record(np.vstack([x + 5.0 * t, np.arange(x.size, dtype=float)]), FS,
+                      ["acc", "sample_index"])
+    assert not detect_chatter(rec, DetectSettings(speed_rpm=1500.0)).chatter

@@ -196,7 +196,7 @@ def window_spectra(x: np.ndarray, fs: float, nwin: int, hop: int
     """Hann power spectra of overlapping windows.
 
     ``x``: (n_channels, n_samples). Returns ``(f (n_f,), t0 (n_win,), P (n_channels, n_win,
-    n_f))``; each window is de-meaned first.
+    n_f))``; each window's mean and linear trend are removed first.
     """
     from scipy import fft
 
@@ -208,9 +208,12 @@ def window_spectra(x: np.ndarray, fs: float, nwin: int, hop: int
     f = np.fft.rfftfreq(nwin, 1.0 / fs)
     P = np.empty((x.shape[0], starts.size, f.size))
     chunk = max(1, int(2**22 // max(1, nwin * x.shape[0])))  # ~32 MiB of samples at a time
+    c = np.arange(nwin) - 0.5 * (nwin - 1)
+    c2 = float(np.sum(c * c))
     for c0 in range(0, starts.size, chunk):
         seg = view[:, starts[c0:c0 + chunk], :]
-        seg = (seg - seg.mean(axis=2, keepdims=True)) * w
+        slope = (seg @ c)[..., None] / c2  # linear trend (drift, a ramp) removed
+        seg = (seg - seg.mean(axis=2, keepdims=True) - slope * c) * w
         spec = fft.rfft(seg, axis=2, workers=1)
         P[:, c0:c0 + chunk] = spec.real ** 2 + spec.imag ** 2
     return f, starts / fs, P
