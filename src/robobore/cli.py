@@ -48,6 +48,7 @@ STAGE_CLIS = [
     "robobore.cutting.fe.cli",
     "robobore.study.cli",
     "robobore.plan.cli",
+    "robobore.measure.cli",
 ]
 
 

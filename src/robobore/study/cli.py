@@ -197,7 +197,9 @@ def _render_compare(res: dict[str, Any]) -> None:
 
 
 def compare_cmd(
-    measured: Path = typer.Argument(..., help="Measured CSV (see docs/study.md for columns)."),
+    measured: Path = typer.Argument(..., help="Measured CSV, or a manifest of record files "
+                                              "(force_file, displacement_file columns) measured "
+                                              "as by 'measure cut' (docs/study.md)."),
     results: Path = typer.Argument(..., help="Results store folder written by 'robobore sweep',"
                                              " or the output folder of 'robobore paper'."),
     report: Path | None = typer.Option(None, "--report", help="Also write an HTML report here."),
@@ -211,7 +213,10 @@ def compare_cmd(
     from robobore.study.compare import compare_results
 
     check_output_file(report, "--report", "the HTML report")
-    cmp = compare_results(measured, results, system)
+    from robobore.clitools import stage_progress
+
+    with stage_progress(not as_json) as progress:
+        cmp = compare_results(measured, results, system, progress=progress)
     res = cmp.to_dict()
     res["measured"] = str(measured)
     res["results"] = str(results)

@@ -17,6 +17,16 @@ Measured CSV contract (one row per condition, header first)::
   :class:`robobore.errors.DataError` naming the file, the row (data rows counted from 1 after
   the header; blank lines count) and the column. Lines starting with ``#`` are comments.
 
+Manifest of raw records (a CSV with a ``force_file`` and/or ``displacement_file`` column):
+one row per condition, the condition columns (and optional ``posture``, ``stable``, and
+``n_inserts``) plus the record files, paths relative to the manifest's folder (an empty
+cell: not measured). The measured side is computed from the records by
+:func:`robobore.measure.cut.cut_quantities` (``robobore measure cut``): the force
+amplitudes ``force_amplitude_{x,y,z}_N`` (per-revolution half peak-to-peak, averaged) from
+the force file and ``feed_amplitude_um`` from the displacement file (else from a ``z``
+channel of the force file), at the row's ``speed_rpm``. Quantity columns are not allowed in a
+manifest (they are computed); a missing record file is refused naming the row and column.
+
 Relative error of a quantity: ``|simulated - measured| / |measured|`` (a fraction; the
 paper quotes it in %). A measured value of 0 has no relative error: that pair is listed in
 ``undefined`` with the reason, never silently dropped. Conditions are split into stable and
@@ -79,9 +89,15 @@ class MeasuredTable:
     has_posture: bool
     rows: tuple[MeasuredRow, ...]
 
+    #: For a manifest: per row, the record files and what was computed from them.
+    records: tuple[dict[str, Any], ...] = ()
+
     def to_dict(self) -> dict[str, Any]:
-        return {"source": self.source, "columns": list(self.columns),
-                "quantities": list(self.quantities), "rows": [r.to_dict() for r in self.rows]}
+        d = {"source": self.source, "columns": list(self.columns),
+             "quantities": list(self.quantities), "rows": [r.to_dict() for r in self.rows]}
+        if self.records:
+            d["records"] = list(self.records)
+        return d
 
 
 def _parse_number(cell: str, *, source: str, row: int, col: str, unit: str,
@@ -193,8 +209,10 @@ def _check_header(header: list[str], source: str) -> None:
                         expected=f"at least one of {', '.join(SUMMARY_QUANTITIES)}")
 
 
-def read_measured_csv(path: str | Path) -> MeasuredTable:
-    """Read and validate a measured CSV file (see module doc)."""
+def read_measured_csv(path: str | Path, progress=None) -> MeasuredTable:
+    """Read and validate a measured CSV file, or a manifest of record files whose measured
+    side is computed from the records (see module doc; ``progress(done, total)`` per row of
+    a manifest)."""
     p = Path(path)
     if not p.is_file():
         raise DataError("file not found", file=str(p), expected="a measured-results CSV file")
@@ -203,7 +221,130 @@ def read_measured_csv(path: str | Path) -> MeasuredTable:
     except UnicodeDecodeError as exc:
         raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(p),
                         expected="a UTF-8 CSV file") from None
+    if _is_manifest(text):
+        return parse_manifest_csv(text, source=str(p), base=p.parent, progress=progress)
     return parse_measured_csv(text, source=str(p))
+
+
+#: Record-file columns of a manifest.
+RECORD_COLUMNS = ("force_file", "displacement_file")
+MANIFEST_COLUMNS = (*CONDITION_FIELDS, "posture", "stable", "n_inserts", *RECORD_COLUMNS)
+
+
+def _is_manifest(text: str) -> bool:
+    for cells in csv.reader(io.StringIO(text.lstrip("\ufeff"))):
+        if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
+            continue
+        return any(c.strip() in RECORD_COLUMNS for c in cells)
+    return False
+
+
+def parse_manifest_csv(text: str, source: str = "<manifest>", base: str | Path = ".",
+                       progress=None) -> MeasuredTable:
+    """A manifest (module doc) -> the measured table, its quantities computed from the
+    record files (paths relative to ``base``)."""
+    from robobore.measure.cut import cut_quantities, read_cut_record
+
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    lines = [(i + 1, c) for i, c in enumerate(csv.reader(io.StringIO(text)))
+             if c and not all(not x.strip() for x in c) and not c[0].lstrip().startswith("#")]
+    header_line, header = lines[0][0], [h.strip() for h in lines[0][1]]
+    for h in header:
+        if h not in MANIFEST_COLUMNS:
+            extra = (" (a manifest's quantities are computed from its record files)"
+                     if h in SUMMARY_QUANTITIES else "")
+            raise DataError("unknown manifest column" + extra, file=source, field=h,
+                            expected=f"one of {', '.join(MANIFEST_COLUMNS)}")
+        if header.count(h) > 1:
+            raise DataError("column appears twice", file=source, field=h,
+                            expected="each column once")
+    for col in CONDITION_FIELDS:
+        if col not in header:
+            raise DataError("missing column", file=source, field=col,
+                            expected=f"columns {', '.join(CONDITION_FIELDS)}")
+    rows: list[MeasuredRow] = []
+    recs: list[dict[str, Any]] = []
+    seen: dict[tuple[Any, ...], int] = {}
+    found: set[str] = set()
+    body = lines[1:]
+    for n_done, (line, cells) in enumerate(body):
+        row = line - header_line
+        if len(cells) != len(header):
+            raise DataError(f"row has {len(cells)} cells, the header has {len(header)}",
+                            file=source, row=row, expected=f"{len(header)} comma-separated cells")
+        rec = {h: c.strip() for h, c in zip(header, cells, strict=True)}
+        cond: dict[str, Any] = {}
+        for col in CONDITION_FIELDS:
+            unit, allow_zero = _COND_UNITS[col]
+            if rec[col] == "":
+                raise DataError("empty cell", file=source, row=row, field=col,
+                                expected=f"a number in {unit}")
+            cond[col] = _parse_number(rec[col], source=source, row=row, col=col, unit=unit,
+                                      allow_zero=allow_zero)
+        if "posture" in rec:
+            cond["posture"] = rec["posture"] or DEFAULT_POSTURE
+        n_ins = 1
+        if rec.get("n_inserts", ""):
+            try:
+                n_ins = int(rec["n_inserts"])
+            except ValueError:
+                n_ins = 0
+            if not 1 <= n_ins <= 100:
+                raise DataError("not a number of inserts", file=source, row=row,
+                                field="n_inserts", value=rec["n_inserts"],
+                                expected="an integer 1 .. 100")
+        values: dict[str, Any] = {}
+        info: dict[str, Any] = {"row": row}
+        for col in RECORD_COLUMNS:
+            name = rec.get(col, "")
+            if not name:
+                continue
+            path = Path(base) / name
+            if not path.is_file():
+                raise DataError("record file not found", file=source, row=row, field=col,
+                                value=name, expected="a record file, relative to the manifest")
+            q = cut_quantities(read_cut_record(path), cond["speed_rpm"], n_ins)
+            info[col] = {"file": str(path), "chatter": q["chatter"],
+                         "chatter_frequency_Hz": q["chatter_frequency_Hz"],
+                         "cutting_time_s": q["cutting_time_s"]}
+            if col == "force_file":
+                for ax, v in q.get("force_amplitude_N", {}).items():
+                    values[f"force_amplitude_{ax}_N"] = v
+                if q.get("feed_amplitude_um") is not None and "feed_amplitude_um" not in values:
+                    values["feed_amplitude_um"] = q["feed_amplitude_um"]
+            elif q.get("feed_amplitude_um") is not None:
+                values["feed_amplitude_um"] = q["feed_amplitude_um"]
+            else:
+                raise DataError("no feed-direction (z) displacement in the record", file=source,
+                                row=row, field=col, value=name,
+                                expected="a z displacement column (z_um, z [mm], ...)")
+        if "stable" in rec and rec["stable"] != "":
+            b = parse_bool(rec["stable"])
+            if b is None:
+                raise DataError("not a boolean", file=source, row=row, field="stable",
+                                value=rec["stable"], expected="true or false")
+            values["stable"] = b
+        key = _match_key(cond, "posture" in rec)
+        if key in seen:
+            raise DataError(f"the same condition as row {seen[key]}", file=source, row=row,
+                            field=",".join(CONDITION_FIELDS),
+                            expected="each condition once (one record set per condition)")
+        seen[key] = row
+        found.update(values)
+        rows.append(MeasuredRow(row=row, condition=cond, values=values))
+        recs.append(info)
+        if progress is not None:
+            progress(n_done + 1, len(body))
+    if not rows:
+        raise DataError("no data rows", file=source, expected="at least one measured condition")
+    if not found:
+        raise DataError("no record file in any row", file=source,
+                        field=", ".join(RECORD_COLUMNS), expected="record files to measure")
+    quantities = tuple(q for q in SUMMARY_QUANTITIES if q in found)
+    return MeasuredTable(source=source, columns=tuple(header), quantities=quantities,
+                         has_posture="posture" in header, rows=tuple(rows),
+                         records=tuple(recs))
 
 
 @dataclass(frozen=True)
@@ -221,6 +362,7 @@ class Comparison:
     systems: tuple[str, ...] = field(default_factory=tuple)  # systems in the results store
     #: likely unit slips: a measured column off the simulation by a power of ten in most rows
     warnings: tuple[str, ...] = field(default_factory=tuple)
+    records: tuple[dict[str, Any], ...] = field(default_factory=tuple)  # a manifest's records
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -229,6 +371,7 @@ class Comparison:
             "groups": self.groups, "agreement": self.agreement, "conditions": list(self.rows),
             "unmatched_measured": list(self.unmatched_measured), "undefined": list(self.undefined),
             "warnings": list(self.warnings),
+            **({"measured_records": list(self.records)} if self.records else {}),
         }
 
     def table_rows(self) -> list[dict[str, Any]]:
@@ -412,16 +555,18 @@ def resolve_store_dir(results_dir: str | Path) -> Path:
 
 
 def compare_results(measured_csv: str | Path, results_dir: str | Path,
-                    system: str | None = None) -> Comparison:
+                    system: str | None = None, progress=None) -> Comparison:
     """Compare a measured CSV with the finished conditions of a results store.
 
     ``results_dir``: a store (``robobore sweep``) or the output folder of ``robobore paper``
     (its ``sweep`` store). A store may hold several simulated systems (the paper's robot and
     machine tool, told apart by :func:`result_system`); ``system`` chooses one, and by
-    default the robot is compared when the store holds it next to others."""
+    default the robot is compared when the store holds it next to others. A manifest's
+    records are measured first (``progress(task, done, total)`` per record row)."""
     from robobore.study.store import ResultsStore
 
-    table = read_measured_csv(measured_csv)
+    table = read_measured_csv(measured_csv, None if progress is None else (
+        lambda done, total: progress("measuring records", done, total)))
     store_dir = resolve_store_dir(results_dir)
     store = ResultsStore.open_existing(store_dir)
     by_system: dict[str, list[tuple[dict[str, Any], dict[str, Any]]]] = {}
@@ -448,7 +593,7 @@ def compare_results(measured_csv: str | Path, results_dir: str | Path,
     cmp = compare(table, by_system[chosen])
     from dataclasses import replace
 
-    return replace(cmp, system=chosen, systems=systems)
+    return replace(cmp, system=chosen, systems=systems, records=table.records)
 
 
 __all__ = [
@@ -457,7 +602,9 @@ __all__ = [
     "MeasuredTable",
     "Comparison",
     "parse_measured_csv",
+    "parse_manifest_csv",
     "read_measured_csv",
+    "RECORD_COLUMNS",
     "compare",
     "compare_results",
     "result_system",

@@ -1,0 +1,1 @@
+"""Measured cutting records in: readers, the paper's quantities, chatter detection."""
