@@ -157,17 +157,19 @@ def cmif(frf_data: Any):
 
 
 def identify_modes(data: Any = None, *, band_Hz: Any = PAPER_BAND_HZ,
-                   n_modes: int | None = 5, max_order: int = 40):
+                   n_modes: int | None = 5, select: str = "dominant", max_order: int = 40):
     """Automatic modal identification (CMIF, poly-reference LSCF over orders 1..max_order,
     stabilisation, pole selection, LSFD) of hammer records, FRFs or None (the bundled
     test) in ``band_Hz`` -> ``ModalAnalysis``; ``.result`` (``ModalResult``) holds the
-    ``n_modes`` best-supported modes (frequency_Hz, damping_ratio, direction, ...)."""
+    ``n_modes`` modes chosen by ``select`` (``dominant``: the largest shares of the
+    driving-point compliance; ``lowest``; ``stable``) with frequency_Hz, damping_ratio,
+    direction, share, ..."""
     from robobore.modal.identify import identify_modes as _identify
 
     data = load_hammer_test() if data is None else data
     lo, hi = band_Hz
     return _identify(frf(data), band_Hz=(float(lo), float(hi)), n_modes=n_modes,
-                     max_order=max_order)
+                     select=select, max_order=max_order)
 
 
 # ----------------------------------------------------------------------------- equivalent

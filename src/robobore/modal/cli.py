@@ -36,14 +36,21 @@ def _render_modes(res: dict[str, Any]) -> None:
               header_style="bold")
     # dominant input: hammer input with the largest residues; m_eff: effective modal mass
     # at that input's driving point; orders: pLSCF orders where the mode is stable
-    for c in ("#", "f (Hz)", "zeta (%)", "MPC", "input", "m_eff (kg)", "orders", "CMIF"):
+    # share: the mode's share of the rank point's modal peak compliance
+    for c in ("#", "f (Hz)", "zeta (%)", "MPC", "input", "m_eff (kg)", "orders", "CMIF",
+              "share (%)"):
         t.add_column(c, justify="right")
     for k, m in enumerate(res["modes"]):
         mass = m.get("modal_mass_kg", {}).get(m["dominant_input"])
+        sh = m.get("share")
         t.add_row(str(k + 1), f"{m['frequency_Hz']:.4f}", f"{100 * m['damping_ratio']:.3f}",
                   f"{m['mpc']:.7f}", m["dominant_input"], fmt(mass), str(m["cluster_size"]),
-                  fmt(m["cmif_support"]))
+                  fmt(m["cmif_support"]), "-" if sh is None else f"{100 * sh:.1f}")
     stdout.print(t)
+    sel = res["stabilisation"].get("selection")
+    if sel:
+        stdout.print(f"selection: {sel['select']} (rank point: {sel['rank_point']}; physical "
+                     f"modes stable over >= {sel['orders_needed']} orders)")
     st = res["stabilisation"]
     stdout.print(f"poles: {st['n_poles']} over orders {st['orders'][0]}-{st['orders'][1]}; "
                  f"status counts {st['status_counts']}; CMIF peaks (Hz): "
@@ -69,6 +76,12 @@ def modes_cmd(
     band_hz: tuple[float, float] | None = typer.Option(
         None, "--band-hz", help="Analysis band LO HI in Hz (default: all lines)."),
     modes: int | None = typer.Option(None, "--modes", help="Number of modes to keep."),
+    select: str = typer.Option(
+        "dominant", "--select",
+        help="Which N modes --modes keeps: dominant (largest share of the driving-point "
+             "compliance), lowest (lowest well-supported), stable (best-supported)."),
+    point: str | None = typer.Option(
+        None, "--point", help="Output whose FRFs rank the modes (default: driving points)."),
     approx_hz: str | None = typer.Option(
         None, "--approx-hz", help="Approximate mode frequencies, comma-separated, Hz."),
     max_order: int = typer.Option(40, "--max-order", help="Highest pLSCF model order."),
@@ -106,6 +119,11 @@ def modes_cmd(
     for v in band_hz or ():  # plausible ranges (robobore.io.ranges)
         check_option(v, "--band-hz", "band_Hz")
     check_count(modes, "--modes", 1, 100)
+    from robobore.modal.identify import SELECT_MODES
+
+    if select not in SELECT_MODES:
+        raise ConfigError("unknown mode selection", field="--select", value=select,
+                          expected="one of " + ", ".join(SELECT_MODES))
     if max_order > 1000:  # (below 1: identify_modes says why)
         raise ConfigError("max order too high", field="--max-order", value=max_order,
                           expected="an integer 1 .. 1000 (the stabilisation diagram's orders)")
@@ -137,7 +155,7 @@ def modes_cmd(
                               expected="no window option for FRF input")
         try:
             an = identify_modes(data, band_Hz=band_hz, n_modes=modes, approx_Hz=approx,
-                                max_order=max_order)
+                                select=select, point=point, max_order=max_order)
         except (IdentificationError, NumericalError) as exc:  # say which data it was
             raise type(exc)(f"{input_file}: {exc}") from None
         except InputError as exc:  # a band the data cannot give: name the data file
