@@ -37,15 +37,22 @@ def _render_modes(res: dict[str, Any]) -> None:
     # dominant input: hammer input with the largest residues; m_eff: effective modal mass
     # at that input's driving point; orders: pLSCF orders where the mode is stable
     # share: the mode's share of the rank point's modal peak compliance
-    for c in ("#", "f (Hz)", "zeta (%)", "MPC", "input", "m_eff (kg)", "orders", "CMIF",
-              "share (%)"):
-        t.add_column(c, justify="right")
+    # f and zeta with the half-width of their 95 % interval (jackknife over hits; time
+    # records only); 1-MPC: 0 for a real mode; the orders that support each mode and its
+    # CMIF support are in the JSON
+    for c in ("#", "f (Hz)", "zeta (%)", "1-MPC", "input", "m_eff kg", "share %"):
+        t.add_column(c, justify="right", min_width={"f (Hz)": 15, "zeta (%)": 11}.get(c))
     for k, m in enumerate(res["modes"]):
         mass = m.get("modal_mass_kg", {}).get(m["dominant_input"])
         sh = m.get("share")
-        t.add_row(str(k + 1), f"{m['frequency_Hz']:.4f}", f"{100 * m['damping_ratio']:.3f}",
-                  f"{m['mpc']:.7f}", m["dominant_input"], fmt(mass), str(m["cluster_size"]),
-                  fmt(m["cmif_support"]), "-" if sh is None else f"{100 * sh:.1f}")
+        u = m.get("uncertainty")
+        fs = f"{m['frequency_Hz']:.4f}"
+        zs = f"{100 * m['damping_ratio']:.3f}"
+        if u:
+            fs += f"±{(u['frequency_ci95_Hz'][1] - u['frequency_ci95_Hz'][0]) / 2:.4f}"
+            zs += f"±{50 * (u['damping_ci95'][1] - u['damping_ci95'][0]):.3f}"
+        t.add_row(str(k + 1), fs, zs, f"{1 - m['mpc']:.1e}", m["dominant_input"], fmt(mass),
+                  "-" if sh is None else f"{100 * sh:.1f}")
     stdout.print(t)
     sel = res["stabilisation"].get("selection")
     if sel:
@@ -85,6 +92,9 @@ def modes_cmd(
     approx_hz: str | None = typer.Option(
         None, "--approx-hz", help="Approximate mode frequencies, comma-separated, Hz."),
     max_order: int = typer.Option(40, "--max-order", help="Highest pLSCF model order."),
+    uncertainty: bool = typer.Option(
+        True, "--uncertainty/--no-uncertainty",
+        help="95 % intervals of f, zeta and shapes by the jackknife over hits (time records)."),
     estimator: str = typer.Option("H1", "--estimator", help="FRF estimator: H1, H2, Hv."),
     exp_window_tau_s: float | None = typer.Option(
         None, "--exp-window-tau-s", help="Exponential window time constant, s (corrected)."),
@@ -148,14 +158,15 @@ def modes_cmd(
                 est = estimate_frf(data, estimator=estimator, exp_window_tau_s=exp_window_tau_s,
                                    drop_flagged=drop_flagged)
             warn_list += [str(w.message) for w in caught]
-            data, hits = est.frf, est
+            data, hits = est, est
         elif exp_window_tau_s is not None:
             raise ConfigError("--exp-window-tau-s applies to time records only",
                               field="--exp-window-tau-s", value=exp_window_tau_s,
                               expected="no window option for FRF input")
         try:
             an = identify_modes(data, band_Hz=band_hz, n_modes=modes, approx_Hz=approx,
-                                select=select, point=point, max_order=max_order)
+                                select=select, point=point, max_order=max_order,
+                                uncertainty=uncertainty)
         except (IdentificationError, NumericalError) as exc:  # say which data it was
             raise type(exc)(f"{input_file}: {exc}") from None
         except InputError as exc:  # a band the data cannot give: name the data file

@@ -15,6 +15,7 @@ stiffness ``k = m w_n^2`` (N/m): see :meth:`Mode.driving_point_mass_kg`.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -48,6 +49,14 @@ def _cplx_list(a: np.ndarray) -> Any:
                         otypes=[object])(np.asarray(a)).tolist()
 
 
+def _uncertainty_of(d: Any) -> Any:
+    if not d:
+        return None
+    from robobore.modal.uncertainty import ModeUncertainty
+
+    return ModeUncertainty.from_dict(d)
+
+
 def _opt_float(v: Any) -> float | None:
     return None if v is None else float(v)
 
@@ -78,6 +87,8 @@ class Mode:
     or out-of-phase residues give no entry). share: the mode's share of the rank point's
     modal peak compliance (see :func:`identify_modes`), share_point: that FRF
     (``output/input``), peak_compliance_m_per_N: the mode's own receptance peak there.
+    uncertainty: standard deviations and 95 % intervals of frequency, damping and shape
+    (:class:`~robobore.modal.uncertainty.ModeUncertainty`; None for FRF input).
     """
 
     frequency_Hz: float
@@ -95,6 +106,7 @@ class Mode:
     share: float | None = None
     share_point: str | None = None
     peak_compliance_m_per_N: float | None = None
+    uncertainty: Any = None  # ModeUncertainty (robobore.modal.uncertainty) or None
 
     @property
     def pole(self) -> complex:
@@ -124,6 +136,8 @@ class Mode:
                 "modal_mass_kg": dict(self.modal_mass_kg),
                 "share": self.share, "share_point": self.share_point,
                 "peak_compliance_m_per_N": self.peak_compliance_m_per_N,
+                "uncertainty": (None if self.uncertainty is None
+                                else self.uncertainty.to_dict()),
                 "modal_stiffness_N_per_m": {k: v * (2 * np.pi * self.frequency_Hz) ** 2
                                             for k, v in self.modal_mass_kg.items()},
                 "mode_shape": _cplx_list(self.mode_shape),
@@ -141,7 +155,8 @@ class Mode:
                    {str(k): float(v) for k, v in (d.get("modal_mass_kg") or {}).items()
                     if v is not None},
                    _opt_float(d.get("share")), d.get("share_point"),
-                   _opt_float(d.get("peak_compliance_m_per_N")))
+                   _opt_float(d.get("peak_compliance_m_per_N")),
+                   _uncertainty_of(d.get("uncertainty")))
 
 
 @dataclass(frozen=True)
@@ -254,6 +269,7 @@ def mode_shares(fit: LSFDResult, poles: np.ndarray, pairs: list[tuple[int, int]]
 def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
                    n_modes: int | None = None, approx_Hz: list[float] | None = None,
                    select: str = "dominant", point: str | None = None,
+                   uncertainty: bool = True,
                    max_order: int = 40, min_order: int = 1, freq_tol: float = 0.01,
                    damp_tol: float = 0.05, mac_tol: float = 0.98,
                    min_fraction: float = 0.3) -> ModalAnalysis:
@@ -272,9 +288,12 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
         near each of these frequencies (Hz); neither: every physical mode.
     point: output name whose FRFs rank the modes (default: the driving points from the
         DOFs, else all FRFs).
+    uncertainty: with an FRFEstimate (time records), the 95 % intervals of every mode by the
+        jackknife over hits (:mod:`robobore.modal.uncertainty`); FRFs alone carry none.
     max_order: highest pLSCF order (``max_order * n_inputs`` poles).
     freq_tol, damp_tol, mac_tol: stabilisation criteria.
     """
+    est = data if isinstance(data, FRFEstimate) and data.per_hit is not None else None
     data = _frf_arg(data)
     if approx_Hz is not None and n_modes is not None:
         raise InputError("give either a number of modes or approximate frequencies",
@@ -355,7 +374,8 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
     summary["selected"] = [{"frequency_Hz": s.frequency_Hz, "damping_ratio": s.damping_ratio,
                             "orders_stable": s.cluster_size,
                             "frequency_spread": s.frequency_spread,
-                            "damping_spread": s.damping_spread} for s in sel]
+                            "damping_spread": s.damping_spread,
+                            "orders": list(s.orders)} for s in sel]
     summary["physical_modes"] = [
         {"frequency_Hz": c.frequency_Hz, "damping_ratio": c.damping_ratio,
          "orders_stable": c.cluster_size, "share": float(share[i]),
@@ -365,12 +385,25 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
                             "orders_needed": need,
                             "rank_point": point or ("driving points" if best else "all FRFs")}
     summary["cmif_peaks_Hz"] = cm.peaks_Hz.tolist()
+    timings = {"cmif": t1 - t0, "plscf": t2 - t1, "stabilisation_selection": t3 - t2,
+               "lsfd": t4 - t3}
     result = ModalResult(tuple(modes), d.output_names, d.input_names, d.frf_type,
                          res.band_Hz, max_order, summary, fit.fit_percent,
-                         data.exp_window_tau_s, data.source,
-                         {"cmif": t1 - t0, "plscf": t2 - t1, "stabilisation_selection": t3 - t2,
-                          "lsfd": t4 - t3})
-    return ModalAnalysis(result, d, cm, res, diag, fit)
+                         data.exp_window_tau_s, data.source, timings)
+    an = ModalAnalysis(result, d, cm, res, diag, fit)
+    if uncertainty and est is not None:
+        from robobore.modal.uncertainty import jackknife_over_hits
+
+        unc, info = jackknife_over_hits(est, an)
+        summary["uncertainty"] = info
+        timings["uncertainty"] = info["time_s"]
+        result = dataclasses.replace(result, modes=tuple(
+            dataclasses.replace(m, uncertainty=u) for m, u in zip(modes, unc, strict=True)))
+        an = dataclasses.replace(an, result=result)
+    elif uncertainty:
+        summary["uncertainty"] = {"method": None, "reason": "FRF input: no per-hit spectra "
+                                  "(identify from time records for the jackknife over hits)"}
+    return an
 
 
 __all__ = ["Mode", "ModalResult", "ModalAnalysis", "identify_modes", "mode_shares", "rank_pairs",

@@ -132,6 +132,7 @@ class SelectedPole:
     cluster_size: int
     frequency_spread: float  # relative std of the cluster's frequencies
     damping_spread: float  # relative std of the cluster's damping ratios
+    orders: tuple[int, ...] = ()  # the orders that support the cluster
 
 
 def _cluster(feat: np.ndarray) -> np.ndarray:
@@ -197,7 +198,8 @@ def pole_clusters(diagram: StabilisationDiagram, *, cluster_freq_tol: float = 0.
         wn = 2 * np.pi * fm
         lam = complex(-zm * wn, wn * np.sqrt(max(0.0, 1 - zm**2)))
         return SelectedPole(lam, diagram.participation[k].copy(), fm, zm, int(n_ord),
-                            float(np.std(fd) / fm), float(np.std(zd) / zm))
+                            float(np.std(fd) / fm), float(np.std(zd) / zm),
+                            tuple(int(v) for v in np.unique(diagram.order[mem])))
 
     out = [make(mem) for mem in merged]
     out.sort(key=lambda c: -c.cluster_size)
