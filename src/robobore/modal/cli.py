@@ -148,7 +148,12 @@ def modes_cmd(
     approx = parse_floats(approx_hz, None, "--approx-hz", "Hz") if approx_hz else None
     warn_list: list[str] = []
     with progress_bar("modal analysis", 3, enabled=not as_json) as advance:
-        data = load_input(input_file, frf_type)
+        from robobore.modal.io import UFFWarning
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", UFFWarning)
+            data = load_input(input_file, frf_type)
+        warn_list += [str(w.message) for w in caught if issubclass(w.category, UFFWarning)]
         advance(1)
         hits = None
         if not isinstance(data, FRFData):
