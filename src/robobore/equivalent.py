@@ -98,6 +98,90 @@ def _nonneg(name: str, value: Any, unit: str) -> float:
     return check_value(v, name, kind=ConfigError)  # plausible range of the unit
 
 
+class EquivalentWarning(UserWarning):
+    """The stiffness and the modes of an equivalent model do not agree (different robots or
+    postures suspected)."""
+
+
+#: a direction's static stiffness and its mode's modal stiffness further apart than this
+#: factor draw a warning: a mode of the same robot carries part of the direction's
+#: compliance, so its modal stiffness exceeds the static one by 1/share (1.1 at the bundled
+#: test's coupled tool point), not by 2
+STIFFNESS_MISMATCH_FACTOR = 2.0
+
+
+def _posture_of(d: Any) -> list[float] | None:
+    if not isinstance(d, dict):
+        return None
+    for key in ("joints_deg", "posture_deg", "directional_posture_deg"):
+        v = d.get(key)
+        if isinstance(v, list | tuple) and v and all(isinstance(x, int | float) for x in v):
+            return [float(x) for x in v]
+    return None
+
+
+def _robot_of(d: Any) -> str | None:
+    if not isinstance(d, dict) or not d.get("robot"):
+        return None
+    r = str(d["robot"]).strip()
+    return r[:-5].rsplit("/", 1)[-1] if r.endswith(".toml") else r
+
+
+def check_same_robot(stiffness: Any, modes: Any) -> None:
+    """Refuse a stiffness and modes that name different robots or postures (ConfigError);
+    files that do not name them pass."""
+    rs, rm = _robot_of(stiffness), _robot_of(modes)
+    if rs and rm and rs != rm:
+        raise ConfigError("the stiffness and the modes are of different robots",
+                          field="robot", value=f"stiffness: {rs}, modes: {rm}",
+                          expected="the stiffness and the hammer test of one robot")
+    qs, qm = _posture_of(stiffness), _posture_of(modes)
+    if qs and qm and (len(qs) != len(qm) or max(abs(a - b) for a, b in
+                                                 zip(qs, qm, strict=False)) > 0.01):
+        raise ConfigError("the stiffness and the modes are of different postures",
+                          field="joints_deg", value=f"stiffness: {qs}, modes: {qm}",
+                          expected="the stiffness and the hammer test at one posture "
+                                   "(within 0.01 deg)")
+
+
+def _mode_stiffness(md: dict[str, Any], axis: str) -> float | None:
+    """The modal stiffness (N/m) of a mode at the driving point of ``axis``, if given."""
+    ks = md.get("modal_stiffness_N_per_m")
+    if not isinstance(ks, dict):
+        return None
+    for name, v in ks.items():
+        n = str(name).strip().lower()
+        if (n == axis or (len(n) >= 2 and n[-1] == axis and n[-2] in "_-+ .")) and \
+                isinstance(v, int | float) and v > 0 and math.isfinite(v):
+            return float(v)
+    return None
+
+
+def stiffness_mismatch_notes(ks: dict[str, Any], assigned: dict[str, dict[str, Any]]
+                             ) -> tuple[str, ...]:
+    """Warnings (also issued as :class:`EquivalentWarning`) for the directions whose static
+    stiffness and the modal stiffness of the mode assigned to them differ by more than
+    :data:`STIFFNESS_MISMATCH_FACTOR`."""
+    import warnings
+
+    out = []
+    for a in AXES:
+        k, km = ks.get(a), _mode_stiffness(assigned[a], a)
+        if k is None or km is None or not k > 0:
+            continue
+        r = km / float(k)
+        if r > STIFFNESS_MISMATCH_FACTOR or r < 1.0 / STIFFNESS_MISMATCH_FACTOR:
+            msg = (f"WARNING: {a}: static stiffness {float(k):.4g} N/m, the modal stiffness of "
+                   f"its mode {km:.4g} N/m (x{r:.3g}, beyond a factor "
+                   f"{STIFFNESS_MISMATCH_FACTOR:g}): the mode carries little of the "
+                   "direction's compliance (a coupled tool point) or the stiffness and the "
+                   "hammer test are of different robots or postures; the unit's mass k/w^2 "
+                   "does not represent the mode")
+            warnings.warn(msg, EquivalentWarning, stacklevel=3)
+            out.append(msg)
+    return tuple(out)
+
+
 def _stiffness_contract(stiffness: Any) -> Any:
     """The robot-stiffness JSON contract of ``stiffness`` (module docstring); a dict other
     than the ``{"x", "y", "z"}`` table is returned as it is."""
@@ -363,6 +447,7 @@ class EquivalentModel:
                 if d is not None:
                     md["direction"] = list(np.abs(R.T @ d))
                     md.pop("shape", None)
+        check_same_robot(stiffness, modes)
         chosen, how = assign_modes(ml, assignment)
         fn = {a: float(ml[chosen[a]]["frequency_Hz"]) for a in AXES}
         zr = {a: float(ml[chosen[a]].get("damping_ratio", 0.0)) for a in AXES}
@@ -370,6 +455,8 @@ class EquivalentModel:
                                         for a in AXES),)
         if R is not None:
             notes = notes + ("units along the principal directions of the stiffness matrix",)
+        if R is None:
+            notes = notes + stiffness_mismatch_notes(ks, {a: ml[chosen[a]] for a in AXES})
         return cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
                          damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot, notes=notes)
 
@@ -521,4 +608,5 @@ def principal_frame(stiffness_matrix: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 __all__ = ["EquivalentModel", "PressureFoot", "DirectionUnit", "assign_modes",
-           "principal_frame", "AXES"]
+           "principal_frame", "AXES", "EquivalentWarning", "check_same_robot",
+           "stiffness_mismatch_notes", "STIFFNESS_MISMATCH_FACTOR"]

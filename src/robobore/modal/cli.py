@@ -156,6 +156,7 @@ def modes_cmd(
         warn_list += [str(w.message) for w in caught if issubclass(w.category, UFFWarning)]
         advance(1)
         hits = None
+        load_meta = data
         if not isinstance(data, FRFData):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", DoubleHitWarning)
@@ -185,6 +186,10 @@ def modes_cmd(
         res["synthetic"] = bool(example)
         if hits is not None:
             res["hits"] = hits.to_dict()
+        from robobore.modal.virtual_robot import parse_header
+
+        meta = getattr(load_meta, "meta", None) or {}
+        res.update(parse_header(meta.get("header")))
         res["warnings"] = warn_list
         if plot is not None:
             from robobore.modal.plots import plot_all
@@ -206,15 +211,31 @@ def virtual_test_cmd(
     hits: int = typer.Option(5, "--hits", help="Hits per hammer direction."),
     directions: str = typer.Option("x,y,z", "--directions",
                                    help="Hammer directions at the tool point (subset of x,y,z)."),
-    sample_rate_hz: float = typer.Option(256.0, "--sample-rate-hz", help="Sampling rate, Hz."),
+    sample_rate_hz: float | None = typer.Option(
+        None, "--sample-rate-hz",
+        help="Sampling rate, Hz (default 256; with --robot a power of 2 >= 5x the top mode)."),
     duration_s: float = typer.Option(6.0, "--duration-s", help="Record length, s."),
     tip: str = typer.Option("soft", "--tip", help="Hammer tip: soft, medium, hard."),
     double_hit: list[str] = typer.Option([], "--double-hit",
                                          help="Make hit I,H (1-based) a double hit."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
+    robot: str | None = typer.Option(
+        None, "--robot", help="Test this library robot's multibody model (with --joints-deg)."),
+    robot_file: Path | None = typer.Option(
+        None, "--robot-file", help="Robot TOML file (D-H and [[links]] inertias) instead."),
+    joints_deg: str | None = typer.Option(None, "--joints-deg", help="Posture q1,...,qn in deg."),
+    joint_stiffness_file: Path | None = typer.Option(
+        None, "--joint-stiffness-file",
+        help="JSON with joint_stiffness_Nm_per_rad (`robobore identify stiffness --json`)."),
+    joint_stiffness: str | None = typer.Option(
+        None, "--joint-stiffness-Nm-per-rad", help="k1,...,kn in N m/rad (instead of a file)."),
+    tcp_m: str = typer.Option("0,0,0", "--tcp-m", help="Tool point in the flange frame, m."),
+    damping_ratio: float = typer.Option(
+        0.03, "--damping-ratio", help="Modal damping ratio of every mode (ASSUMED) with --robot."),
     as_json: bool = JSON_OPTION,
 ) -> None:
-    """Write a SYNTHETIC impact-hammer test of the robot boring truth model."""
+    """Write a SYNTHETIC impact-hammer test: the bundled robot boring truth, or any robot's
+    pose-dependent multibody model (--robot/--robot-file, --joints-deg, joint stiffness)."""
     from robobore.clitools import kv_table, stdout
     from robobore.errors import ConfigError
     from robobore.io.outputs import check_output_file
@@ -230,7 +251,20 @@ def virtual_test_cmd(
 
     check_output_file(out, "OUT", "the UFF file")
     check_output_file(Path(str(out) + ".truth.json"), "OUT", "the ground-truth JSON")
-    truth = robot_boring_truth()
+    robot_info = None
+    header = None
+    if robot is not None or robot_file is not None or joints_deg is not None:
+        truth, robot_info = _robot_truth(robot, robot_file, joints_deg, joint_stiffness_file,
+                                         joint_stiffness, tcp_m, damping_ratio, example)
+        from robobore.modal.virtual_robot import header_text, sample_rate_for
+
+        header = header_text(robot_info)
+        if sample_rate_hz is None:
+            sample_rate_hz = sample_rate_for(truth)
+    else:
+        truth = robot_boring_truth()
+    if sample_rate_hz is None:
+        sample_rate_hz = 256.0
     if example:
         make_example(out)
         settings: dict[str, Any] = dict(EXAMPLE_SETTINGS)
@@ -256,11 +290,18 @@ def virtual_test_cmd(
                     "tip": tip, "noise_force": noise, "noise_response": noise, "seed": seed,
                     "double_hits": dh}
         rec = simulate_hammer_test(truth, **settings)
-        write_uff_time(rec, out, [EXAMPLE_INPUT_DOFS[r] for r in rows], EXAMPLE_OUTPUT_DOFS,
-                       "SYNTHETIC robobore virtual hammer test")
+        out_dofs = (EXAMPLE_OUTPUT_DOFS if robot_info is None else
+                    [(1, 1), (1, 2), (1, 3), (2, 1), (2, 2), (2, 3)])
+        write_uff_time(rec, out, [EXAMPLE_INPUT_DOFS[r] for r in rows], out_dofs,
+                       "SYNTHETIC robobore virtual hammer test", header=header)
     truth_path = Path(str(out) + ".truth.json")
     info = {"file": str(out), "truth_file": str(truth_path), "synthetic": True,
             "settings": settings, "truth": truth.to_dict()}
+    if robot_info is not None:
+        from robobore.modal.virtual_robot import static_stiffness
+
+        info["robot"] = robot_info
+        info["static_stiffness_N_per_m"] = static_stiffness(truth.with_inputs(rows))
     write_json(truth_path, info)
     if as_json:
         emit(info, True, lambda r: None)
@@ -271,7 +312,75 @@ def virtual_test_cmd(
             ("damping ratios", ", ".join(f"{z:g}" for z in truth.damping_ratios)),
             ("hammer inputs", ", ".join(truth.input_names)),
             ("hits per input", settings["n_hits"]), ("noise (fraction of RMS)",
-                                                      settings["noise_response"])]))
+                                                      settings["noise_response"])]
+            + ([("robot", robot_info["robot"]),
+                ("posture (deg)", ", ".join(f"{v:g}" for v in robot_info["joints_deg"])),
+                ("robot directional stiffness (N/um)", ", ".join(
+                    f"{a} {v / 1e6:.4g}" for a, v in
+                    robot_info["directional_stiffness_N_per_m"].items())),
+                ("test static stiffness (N/um)", ", ".join(
+                    f"{a} {v / 1e6:.4g}" for a, v in info["static_stiffness_N_per_m"].items())),
+                ("sample rate (Hz)", settings["sample_rate_Hz"])]
+               if robot_info is not None else [])))
+
+
+def _robot_truth(robot: str | None, robot_file: Path | None, joints_deg: str | None,
+                 stiffness_file: Path | None, stiffness: str | None, tcp_m: str,
+                 damping_ratio: float, example: bool) -> tuple[Any, dict[str, Any]]:
+    """The modal truth of a user's robot from the CLI options (ConfigError naming the option
+    when one is missing or bad)."""
+    from robobore.errors import ConfigError, IdentificationError, InputError
+    from robobore.modal.virtual_robot import robot_truth
+    from robobore.robot.kinematics import get_robot
+
+    if example:
+        raise ConfigError("--example regenerates the bundled test", field="--robot",
+                          value=robot or robot_file, expected="either --example or --robot")
+    if (robot is None) == (robot_file is None):
+        raise ConfigError("give exactly one robot", field="--robot/--robot-file",
+                          value=(robot, robot_file),
+                          expected="--robot NAME (robobore robot list) or --robot-file F.toml")
+    if robot_file is not None and not Path(robot_file).is_file():
+        raise ConfigError("robot file not found", file=str(robot_file), field="--robot-file",
+                          expected="a robot TOML file")
+    rb = get_robot(robot if robot is not None else str(robot_file))
+    if joints_deg is None:
+        raise ConfigError("no posture given", field="--joints-deg",
+                          expected=f"{rb.n_joints} comma-separated joint angles in deg")
+    q = parse_floats(joints_deg, rb.n_joints, "--joints-deg", "deg")
+    if (stiffness_file is None) == (stiffness is None):
+        raise ConfigError("give exactly one joint stiffness", field="--joint-stiffness-file",
+                          expected="--joint-stiffness-file s.json or "
+                                   "--joint-stiffness-Nm-per-rad k1,...,kn")
+    if stiffness_file is not None:
+        from robobore.io.readers import load_json
+        from robobore.robot.stiffness import JointStiffness
+
+        data = load_json(Path(stiffness_file), "joint stiffness file",
+                         "a JSON object from `robobore identify stiffness --json`")
+        try:
+            k = list(JointStiffness.from_dict(data).as_array())
+        except (InputError, IdentificationError) as exc:
+            msg = getattr(exc, "message", str(exc))
+            raise ConfigError(msg, file=str(stiffness_file),
+                              field=getattr(exc, "field", None) or "joint_stiffness_Nm_per_rad",
+                              expected=f"{rb.n_joints} joint stiffnesses in N m/rad") from None
+        named = str(data.get("robot", "") or "")
+        if named and named not in (rb.name, str(robot_file)):
+            raise ConfigError("the joint stiffness file is of another robot",
+                              file=str(stiffness_file), field="robot", value=named,
+                              expected=f"the stiffness of {rb.name}")
+    else:
+        k = parse_floats(stiffness, rb.n_joints, "--joint-stiffness-Nm-per-rad", "N m/rad")
+    if len(k) != rb.n_joints:
+        raise ConfigError("one joint stiffness per joint", field="joint_stiffness_Nm_per_rad",
+                          value=len(k), expected=f"{rb.n_joints} values in N m/rad")
+    tcp = parse_floats(tcp_m, 3, "--tcp-m", "m")
+    try:
+        return robot_truth(rb, q, k, tcp_m=tcp, damping_ratio=damping_ratio)
+    except InputError as exc:
+        raise ConfigError(exc.message, field=exc.field, value=exc.value,
+                          expected=exc.expected) from None
 
 
 def _check_hammer_size(n_inputs: int, hits: int, n_outputs: int, sample_rate_hz: float,

@@ -497,19 +497,30 @@ def _write_sets(path: str | Path, sets: list[dict[str, Any]]) -> Path:
     return dest
 
 
+def header_set(model_name: str = "", description: str = "", program: str = "robobore"
+               ) -> dict[str, Any]:
+    """A UFF 151 header dataset (80-character fields)."""
+    return {"type": 151, "model_name": model_name[:80], "description": description[:80],
+            "db_app": "robobore", "date_db_created": "NONE", "time_db_created": "NONE",
+            "version_db1": 0, "version_db2": 0, "file_type": 0, "date_db_saved": "NONE",
+            "time_db_saved": "NONE", "program": program[:80], "date_file_written": "NONE",
+            "time_file_written": "NONE"}
+
+
 def write_uff_time(records: HammerRecords, path: str | Path,
                    input_dofs: list[tuple[int, int]] | None = None,
                    output_dofs: list[tuple[int, int]] | None = None,
-                   description: str = "") -> Path:
+                   description: str = "", header: dict[str, str] | None = None) -> Path:
     """Write time records as UFF 58 (binary 58b, float64: pyuff writes binary data in
-    double precision only) + 164 (SI units)."""
+    double precision only) + 164 (SI units); ``header``: 151 fields (model_name,
+    description, program) written first."""
     out_d = output_dofs or default_dofs(records.output_names)
     in_d = input_dofs or default_dofs(records.input_names)
     dt = 1.0 / records.sample_rate_Hz
     x = np.arange(records.n_samples) * dt
     odt = 4
     spec = SPEC_BY_QUANTITY[records.response_quantity]
-    sets: list[dict[str, Any]] = [_units_set()]
+    sets: list[dict[str, Any]] = ([header_set(**header)] if header else []) + [_units_set()]
     desc = (description or "robobore hammer test")[:80]
 
     def rec(data: np.ndarray, name: str, rsp: tuple[int, int], ref: tuple[int, int],
@@ -651,5 +662,5 @@ def load_input(path: str | Path, frf_type: str | None = None) -> HammerRecords |
     return read_uff(p, frf_type)
 
 
-__all__ = ["read_uff", "read_uff_modes", "write_uff_time", "write_uff_frf", "load_npz",
+__all__ = ["read_uff", "read_uff_modes", "header_set", "write_uff_time", "write_uff_frf", "load_npz",
            "save_npz", "load_input", "default_dofs", "UFFWarning", "UFF_READS"]
