@@ -4,7 +4,7 @@ the equivalent model's checks that the stiffness and the modes are of one robot.
 Acceptance: the test's static driving-point stiffness within 10 % of the robot's directional
 stiffness at the same posture, for the IRB 6600 and for a second robot given as a TOML
 (``tests/modal/data/synthetic-6r-mid.toml``, SYNTHETIC); measured exactly for the truth
-(1e-9) and within 0.1 % from the modes identified from the simulated test.
+(1e-9) and within 0.03 % from the modes identified from the simulated test.
 """
 
 from __future__ import annotations
