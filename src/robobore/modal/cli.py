@@ -78,6 +78,11 @@ def _render_modes(res: dict[str, Any]) -> None:
 def modes_cmd(
     input_file: Path | None = typer.Argument(
         None, help="UFF file (58 time records or FRFs, 164 units) or NPZ FRF file."),
+    operational: Path | None = typer.Option(
+        None, "--operational",
+        help="Output-only record (NPZ data/sample_rate_Hz, or UFF 58 responses): SSI-COV."),
+    spindle_rpm: float | None = typer.Option(
+        None, "--spindle-rpm", help="Spindle speed of a cutting record (harmonics excluded)."),
     example: bool = typer.Option(False, "--example",
                                  help="Use the bundled SYNTHETIC robot hammer test."),
     band_hz: tuple[float, float] | None = typer.Option(
@@ -121,6 +126,17 @@ def modes_cmd(
     from robobore.modal.identify import identify_modes
     from robobore.modal.io import load_input
 
+    if operational is not None:
+        if example or input_file is not None:
+            raise ConfigError("--operational takes the record instead of INPUT/--example",
+                              field="--operational", value=operational,
+                              expected="--operational FILE alone")
+        return _operational(operational, band_hz, modes, spindle_rpm, max_order, uncertainty,
+                            plot, out, as_json)
+    if spindle_rpm is not None:
+        raise ConfigError("--spindle-rpm applies to --operational records",
+                          field="--spindle-rpm", value=spindle_rpm,
+                          expected="--operational FILE with it")
     if example == (input_file is not None):
         raise ConfigError("give either INPUT or --example", field="INPUT", value=input_file,
                           expected="a UFF/NPZ file path or the --example flag")
@@ -199,6 +215,83 @@ def modes_cmd(
     if out is not None:
         write_json(out, res)
     emit(res, as_json, _render_modes)
+
+
+def _operational(path: Path, band_hz: tuple[float, float] | None, modes: int | None,
+                 spindle_rpm: float | None, max_order: int, uncertainty: bool,
+                 plot: Path | None, out: Path | None, as_json: bool) -> None:
+    """``identify modes --operational FILE``: SSI-COV of an output-only record."""
+    from robobore.errors import ConfigError, IdentificationError, InputError
+    from robobore.io.outputs import check_output_dir, check_output_file
+    from robobore.io.results import write_json
+    from robobore.modal.oma import identify_operational, load_operational
+
+    check_output_dir(plot, "--plot", "the PNG plots")
+    check_output_file(out, "--out", "the result JSON")
+    if band_hz is None:
+        raise ConfigError("an operational record needs its band", field="--band-hz",
+                          expected="--band-hz LO HI in Hz (LO sets the shortest record: ten "
+                                   "periods)")
+    for v in band_hz:
+        check_option(v, "--band-hz", "band_Hz")
+    check_count(modes, "--modes", 1, 100)
+    check_option(spindle_rpm, "--spindle-rpm")
+    if not 1 <= max_order <= 200:
+        raise ConfigError("max order out of range", field="--max-order", value=max_order,
+                          expected="an integer 1 .. 200 (modes; 2x that many states)")
+    with progress_bar("operational modal analysis", 2, enabled=not as_json) as advance:
+        rec = load_operational(path)
+        advance(1)
+        try:
+            r = identify_operational(rec, band_hz, n_modes=modes, spindle_rpm=spindle_rpm,
+                                     max_order=max_order, uncertainty=uncertainty)
+        except (IdentificationError, InputError) as exc:
+            if isinstance(exc, InputError) and exc.file is None:
+                raise type(exc)(exc.message, file=str(path), field=exc.field,
+                                value=exc.value, expected=exc.expected) from None
+            if isinstance(exc, IdentificationError):
+                raise type(exc)(f"{path}: {exc}") from None
+            raise
+        res = r.to_dict()
+        res["source"] = str(path)
+        res["record"] = {"channels": len(rec.channel_names), "sample_rate_Hz":
+                         rec.sample_rate_Hz, "duration_s": rec.duration_s}
+        if plot is not None:
+            from robobore.modal.plots import plot_operational
+
+            res["plots"] = [str(plot_operational(r, Path(plot) / "stabilisation_oma.png"))]
+        advance(1)
+    if out is not None:
+        write_json(out, res)
+    emit(res, as_json, _render_operational)
+
+
+def _render_operational(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    from robobore.clitools import stdout
+
+    rec = res["record"]
+    t = Table(title=f"Operational modes (SSI-COV, {res['source']}, {rec['channels']} "
+              f"channels, {rec['duration_s']:.4g} s, band {res['band_Hz'][0]:.4g}-"
+              f"{res['band_Hz'][1]:.4g} Hz)", header_style="bold")
+    for c in ("#", "f (Hz)", "zeta (%)", "orders", "share %"):
+        t.add_column(c, justify="right", min_width={"f (Hz)": 15, "zeta (%)": 11}.get(c))
+    for k, m in enumerate(res["modes"]):
+        u = m.get("uncertainty")
+        fs = f"{m['frequency_Hz']:.4f}"
+        zs = f"{100 * m['damping_ratio']:.3f}"
+        if u:
+            fs += f"±{(u['frequency_ci95_Hz'][1] - u['frequency_ci95_Hz'][0]) / 2:.4f}"
+            zs += f"±{50 * (u['damping_ci95'][1] - u['damping_ci95'][0]):.3f}"
+        t.add_row(str(k + 1), fs, zs, str(m["orders_stable"]), f"{100 * m['share']:.1f}")
+    stdout.print(t)
+    h = res.get("harmonics_excluded") or []
+    if h:
+        stdout.print("rotation harmonics excluded (Hz): "
+                     + ", ".join(f"{x['frequency_Hz']:.3g}" for x in h))
+    for p in res.get("plots", []):
+        stdout.print(f"plot: {p}")
 
 
 @handle_errors

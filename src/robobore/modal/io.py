@@ -252,6 +252,22 @@ def read_uff(path: str | Path, frf_type: str | None = None) -> HammerRecords | F
     return _read_frf(p, [s for s in s58 if int(s["func_type"]) == 4], lf, ff, frf_type, coh)
 
 
+def read_uff_records(path: str | Path) -> list[dict[str, Any]]:
+    """The dataset 58 records of a UFF file, each checked (:func:`read_uff`'s record checks)
+    and in SI units (responses by the 164 length factor and their unit exponents)."""
+    p = str(path)
+    sets = _uff_sets(Path(path), need=58)
+    lf, ff = _unit_factors(sets)
+    out = []
+    for k, r in enumerate(s for s in sets if int(s.get("type", 0)) == 58):
+        _check_record(p, k, r)
+        r = dict(r)
+        force = int(r.get("ordinate_spec_data_type", 0)) == SPEC_FORCE
+        r["data"] = np.asarray(r["data"]) / _factor(r, lf, ff, (0, 1) if force else (1, 0))
+        out.append(r)
+    return out
+
+
 def read_uff_modes(path: str | Path) -> list[dict[str, Any]]:
     """Mode shapes of UFF dataset 55 (normal modes, analysis type 2; complex eigenvalues,
     type 3): per mode ``{mode, frequency_Hz, damping_ratio (viscous; complex modes from the
@@ -662,5 +678,5 @@ def load_input(path: str | Path, frf_type: str | None = None) -> HammerRecords |
     return read_uff(p, frf_type)
 
 
-__all__ = ["read_uff", "read_uff_modes", "header_set", "write_uff_time", "write_uff_frf", "load_npz",
+__all__ = ["read_uff", "read_uff_modes", "read_uff_records", "header_set", "write_uff_time", "write_uff_frf", "load_npz",
            "save_npz", "load_input", "default_dofs", "UFFWarning", "UFF_READS"]

@@ -59,7 +59,7 @@ class ModeUncertainty:
     frequency_ci_Hz: tuple[float, float]
     damping_ci: tuple[float, float]
     dof: float
-    shape_mac_min: float
+    shape_mac_min: float | None
     shape_std: tuple[float, ...]
     n_replicates: int
     method: str = "jackknife over hits"
@@ -75,7 +75,8 @@ class ModeUncertainty:
     def from_dict(cls, d: dict[str, Any]) -> ModeUncertainty:
         return cls(float(d["frequency_std_Hz"]), float(d["damping_std"]),
                    tuple(d["frequency_ci95_Hz"]), tuple(d["damping_ci95"]), float(d["dof"]),
-                   float(d["shape_mac_min"]), tuple(float(v) for v in d["shape_std"]),
+                   None if d.get("shape_mac_min") is None else float(d["shape_mac_min"]),
+                   tuple(float(v) for v in d["shape_std"]),
                    int(d["n_replicates"]), str(d.get("method", "jackknife over hits")))
 
 
