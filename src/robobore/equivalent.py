@@ -334,6 +334,10 @@ class EquivalentModel:
                                                      (0.0, 0.0, 1.0))
     foot: PressureFoot | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    #: 95 % ranges per axis propagated from the modes' intervals (empty when the modes carry
+    #: none): ``{axis: {"frequency_Hz": [lo, hi], "damping_ratio": [..], "mass_kg": [..],
+    #: "damping_N_s_per_m": [..]}}``
+    uncertainty: dict[str, dict[str, list[float]]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -457,8 +461,30 @@ class EquivalentModel:
             notes = notes + ("units along the principal directions of the stiffness matrix",)
         if R is None:
             notes = notes + stiffness_mismatch_notes(ks, {a: ml[chosen[a]] for a in AXES})
-        return cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
-                         damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot, notes=notes)
+        kk = {a: ks.get(a) for a in AXES}
+        em = cls.build(kk, fn, damping_ratio=zr, damping_N_s_per_m=damping_N_s_per_m, frame=R,
+                       foot=foot, notes=notes)
+        unc = {a: ml[chosen[a]].get("uncertainty") for a in AXES}
+        if all(isinstance(u, dict) and "frequency_ci95_Hz" in u for u in unc.values()):
+            from dataclasses import replace as _replace
+
+            ends = []
+            for side in (0, 1):  # the model at the intervals' low and high ends
+                fs_ = {a: max(float(unc[a]["frequency_ci95_Hz"][side]), 1e-9) for a in AXES}
+                zs_ = {a: max(float(unc[a]["damping_ci95"][side]), 0.0) for a in AXES}
+                ends.append(cls.build(kk, fs_, damping_ratio=zs_,
+                                      damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot))
+            rng = {}
+            for a in AXES:
+                vals = {"frequency_Hz": [e.frequency_Hz[a] for e in ends],
+                        "damping_ratio": [e.damping_ratio[a] for e in ends],
+                        "mass_kg": [e.mass_kg[a] for e in ends],
+                        "damping_N_s_per_m": [e.damping_N_s_per_m[a] for e in ends]}
+                rng[a] = {k: [float(min(v)), float(max(v))] for k, v in vals.items()}
+            em = _replace(em, uncertainty=rng, notes=em.notes + (
+                "95 % ranges of f, zeta, m and c from the modes' intervals (stiffness taken "
+                "as exact)",))
+        return em
 
     # ------------------------------------------------------------------ derived
     def unit(self, axis: str) -> DirectionUnit:
@@ -505,7 +531,8 @@ class EquivalentModel:
                 "mass_kg": self.mass_kg, "damping_N_s_per_m": self.damping_N_s_per_m,
                 "frame": [list(r) for r in self.frame],
                 "foot": None if self.foot is None else self.foot.to_dict(),
-                "notes": list(self.notes)}
+                "notes": list(self.notes)} | (
+                    {"uncertainty": self.uncertainty} if self.uncertainty else {})
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> EquivalentModel:
@@ -522,7 +549,7 @@ class EquivalentModel:
         frame = d.get("frame", np.eye(3).tolist())
         foot = None if d.get("foot") is None else PressureFoot.from_dict(d["foot"])
         return cls(k, f, z, tuple(tuple(float(v) for v in r) for r in frame), foot,
-                   tuple(d.get("notes", ())))
+                   tuple(d.get("notes", ())), dict(d.get("uncertainty") or {}))
 
 
 def _mode_direction(md: dict[str, Any], signed: bool = False) -> np.ndarray | None:

@@ -84,3 +84,27 @@ def test_combine_hits_reproduces_the_average_and_refuses_empty_inputs():
 
     with pytest.raises(InputError, match="every input needs a hit"):
         combine_hits(est, np.zeros((1, 5)))
+
+
+def test_intervals_propagate_to_the_equivalent_model():
+    from robobore.equivalent import EquivalentModel
+    from robobore.modal.virtual import robot_boring_truth
+
+    truth = robot_boring_truth()
+    rec = simulate_hammer_test(truth, n_hits=5, sample_rate_Hz=256.0, duration_s=6.0,
+                               noise_force=0.02, noise_response=0.02, seed=4)
+    res = identify_modes(estimate_frf(rec), band_Hz=(3.0, 60.0)).result
+    ks = {"x": 1.588e6, "y": 1.306e6, "z": 1.143e6}
+    em = EquivalentModel.from_stiffness_and_modes(ks, res)
+    for a in "xyz":
+        u = em.uncertainty[a]
+        assert u["frequency_Hz"][0] < em.frequency_Hz[a] < u["frequency_Hz"][1]
+        assert u["mass_kg"][0] < em.mass_kg[a] < u["mass_kg"][1]  # m = k / w^2
+        assert u["damping_N_s_per_m"][0] < em.damping_N_s_per_m[a] < \
+            u["damping_N_s_per_m"][1]
+    back = EquivalentModel.from_dict(em.to_dict())
+    assert back.uncertainty == em.uncertainty
+    # FRF input: no intervals, and the contract is unchanged
+    plain = EquivalentModel.from_stiffness_and_modes(
+        ks, identify_modes(estimate_frf(rec).frf, band_Hz=(3.0, 60.0)).result)
+    assert plain.uncertainty == {} and "uncertainty" not in plain.to_dict()
