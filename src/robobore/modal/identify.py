@@ -227,6 +227,8 @@ def _frf_arg(data: Any) -> FRFData:
 
 
 SELECT_MODES = ("dominant", "lowest", "stable")
+#: the clustering's frequency width (stabilization.pole_clusters' cluster_freq_tol)
+DEDUPE_FREQ_TOL = 0.005
 
 
 def rank_pairs(data: FRFData, point: str | None = None) -> tuple[list[tuple[int, int]], bool]:
@@ -323,6 +325,15 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
         sel = select_poles(diag, approx_Hz=approx_Hz, min_fraction=min_fraction)
         pool = physical + [c for c in sel if all(c.pole != p.pole for p in physical)]
     else:
+        # one cluster per mode: a mode whose damping scatters over the orders can leave two
+        # clusters at one frequency, whose LSFD columns are nearly collinear (large residues
+        # of opposite sign); within 2 cluster widths in frequency the better-supported stays
+        uniq: list[SelectedPole] = []
+        for c in physical:  # best-supported first
+            if all(abs(c.frequency_Hz / u.frequency_Hz - 1) >= 2 * DEDUPE_FREQ_TOL
+                   for u in uniq):
+                uniq.append(c)
+        physical = uniq
         pool = physical + [c for c in clusters if c.cluster_size < need][
             : max(0, n_modes - len(physical))]
         if len(pool) < n_modes:
