@@ -89,3 +89,25 @@ def test_share_round_trips_in_json():
     back = ModalResult.from_dict(res.to_dict())
     assert [m.share for m in back.modes] == [m.share for m in res.modes]
     assert back.modes[0].share_point == res.modes[0].share_point
+
+
+@pytest.mark.parametrize("dofs", ["none", "opposite sign"])
+def test_rank_point_without_matching_dofs_is_the_most_compliant_output(dofs):
+    """Measured FRFs (5 % complex noise on the SYNTHETIC tool point) without driving-point
+    DOFs: the modes are ranked at the tip (the most compliant output) or at the DOF whose
+    direction sign differs, and the three tip-dominant modes come back."""
+    from robobore.modal.frf import FRFData
+
+    truth = tool_point_truth()
+    f = np.arange(0.0, 5000.0, 2.0)
+    H = truth.frf(f, "receptance")
+    rng = np.random.default_rng(3)
+    H = H + 0.05 * np.abs(H).mean(axis=2, keepdims=True) * (
+        rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)) / np.sqrt(2)
+    kw = {} if dofs == "none" else {"output_dofs": tuple((k + 1, 3) for k in range(5)),
+                                    "input_dofs": ((1, -3),)}
+    d = FRFData(f, H, "receptance", None, truth.output_names, truth.input_names, **kw)
+    res = identify_modes(d, band_Hz=BAND, n_modes=3).result
+    np.testing.assert_allclose(res.frequencies_Hz, truth.frequencies_Hz[:3], rtol=0.02)
+    rp = res.stabilisation["selection"]["rank_point"]
+    assert ("tip" in rp) if dofs == "none" else ("sign ignored" in rp)

@@ -231,20 +231,32 @@ SELECT_MODES = ("dominant", "lowest", "stable")
 DEDUPE_FREQ_TOL = 0.005
 
 
-def rank_pairs(data: FRFData, point: str | None = None) -> tuple[list[tuple[int, int]], bool]:
-    """The FRFs ``(output, input)`` a mode's share is measured at, and whether a mode's share
-    is its largest over them (True: a user point or the driving points) or its share of the
-    sum over all FRFs (False: no driving point known)."""
+def rank_pairs(data: FRFData, point: str | None = None
+               ) -> tuple[list[tuple[int, int]], bool, str]:
+    """The FRFs ``(output, input)`` a mode's share is measured at, whether a mode's share is
+    its largest over them (always, here) and how they were chosen: ``point`` (an output name:
+    its FRFs to every input), else the driving points from the DOFs (same node and
+    direction, or the same node and opposite direction sign), else the most compliant output
+    (largest mean |H| over the band and the inputs: under a hammer at the tool, the tool
+    point)."""
     if point is not None:
         if point not in data.output_names:
             raise InputError("unknown rank point", field="point", value=point,
                              expected="one of the outputs: " + ", ".join(data.output_names))
         o = data.output_names.index(point)
-        return [(o, j) for j in range(data.n_inputs)], True
+        return [(o, j) for j in range(data.n_inputs)], True, point
     dp = data.driving_points()
     if dp:
-        return dp, True
-    return [(o, j) for o in range(data.n_outputs) for j in range(data.n_inputs)], False
+        return dp, True, "driving points"
+    if data.output_dofs and data.input_dofs:
+        ab = [(n, abs(d)) for n, d in data.output_dofs]
+        dp = [(ab.index((n, abs(d))), j) for j, (n, d) in enumerate(data.input_dofs)
+              if (n, abs(d)) in ab]
+        if dp:
+            return dp, True, "driving points (direction sign ignored)"
+    o = int(np.argmax(np.mean(np.abs(data.frf), axis=(1, 2))))
+    return ([(o, j) for j in range(data.n_inputs)], True,
+            f"most compliant output ({data.output_names[o]})")
 
 
 def mode_shares(fit: LSFDResult, poles: np.ndarray, pairs: list[tuple[int, int]],
@@ -312,7 +324,7 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
     d = data.band(lo, hi)
     if d.frequency_Hz[0] == 0:
         d = d.band(float(d.frequency_Hz[1]), None)
-    pairs, best = rank_pairs(d, point)
+    pairs, best, rank_label = rank_pairs(d, point)
     cm = cmif(d)
     t1 = time.perf_counter()
     res = plscf(d, None, max_order=max_order, min_order=min_order)
@@ -394,7 +406,7 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
     summary["selection"] = {"select": select if n_modes is not None else
                             ("approx_Hz" if approx_Hz else "all"),
                             "orders_needed": need,
-                            "rank_point": point or ("driving points" if best else "all FRFs")}
+                            "rank_point": rank_label}
     summary["cmif_peaks_Hz"] = cm.peaks_Hz.tolist()
     timings = {"cmif": t1 - t0, "plscf": t2 - t1, "stabilisation_selection": t3 - t2,
                "lsfd": t4 - t3}
