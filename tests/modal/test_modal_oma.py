@@ -115,3 +115,30 @@ def test_cli_operational(tmp_path):
     assert (tmp_path / "plots" / "stabilisation_oma.png").is_file()
     r = runner.invoke(app, ["identify", "modes", "--operational", str(p)])
     assert r.exit_code == 2 and "--band-hz" in r.output
+
+
+def test_operational_uff_records(tmp_path):
+    """UFF 58 response records (no force channel) in mm/s^2 with a 164 length factor."""
+    import pyuff
+
+    rec = simulate_operational(robot_boring_truth(), 200.0, 256.0, seed=5)
+    dt = 1.0 / rec.sample_rate_Hz
+    sets = [{"type": 164, "units_code": 1, "units_description": "mm", "temp_mode": 2,
+             "length": 1000.0, "force": 1.0, "temp": 1.0, "temp_offset": 273.15}]
+    for k, name in enumerate(rec.channel_names):
+        sets.append(dict(type=58, binary=1, id1="SYNTHETIC", id2=name, id3="NONE",
+                         id4="NONE", id5="NONE", func_type=1, ver_num=0, load_case_id=1,
+                         rsp_ent_name=name[:10], rsp_node=k + 1, rsp_dir=1,
+                         ref_ent_name="NONE", ref_node=0, ref_dir=0, ord_data_type=4,
+                         num_pts=rec.data.shape[1], abscissa_spacing=1, abscissa_min=0.0,
+                         abscissa_inc=dt, abscissa_spec_data_type=17,
+                         ordinate_spec_data_type=12, orddenom_spec_data_type=0,
+                         z_axis_spec_data_type=0, data=1000.0 * rec.data[k],
+                         x=np.arange(rec.data.shape[1]) * dt))
+    p = tmp_path / "amb.uff"
+    pyuff.UFF(str(p)).write_sets(sets, mode="add")
+    from robobore.modal.oma import load_operational
+
+    back = load_operational(p)
+    np.testing.assert_allclose(back.data, rec.data, rtol=1e-12)
+    assert back.channel_names == rec.channel_names and back.sample_rate_Hz == 256.0
