@@ -336,7 +336,8 @@ class EquivalentModel:
     notes: tuple[str, ...] = field(default_factory=tuple)
     #: 95 % ranges per axis propagated from the modes' intervals (empty when the modes carry
     #: none): ``{axis: {"frequency_Hz": [lo, hi], "damping_ratio": [..], "mass_kg": [..],
-    #: "damping_N_s_per_m": [..]}}``
+    #: "damping_N_s_per_m": [..]}}``; not part of :meth:`to_dict` (the dict form is the
+    #: stability stage's contract, whose keys are fixed)
     uncertainty: dict[str, dict[str, list[float]]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ construction
@@ -531,8 +532,7 @@ class EquivalentModel:
                 "mass_kg": self.mass_kg, "damping_N_s_per_m": self.damping_N_s_per_m,
                 "frame": [list(r) for r in self.frame],
                 "foot": None if self.foot is None else self.foot.to_dict(),
-                "notes": list(self.notes)} | (
-                    {"uncertainty": self.uncertainty} if self.uncertainty else {})
+                "notes": list(self.notes)}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> EquivalentModel:
@@ -549,7 +549,7 @@ class EquivalentModel:
         frame = d.get("frame", np.eye(3).tolist())
         foot = None if d.get("foot") is None else PressureFoot.from_dict(d["foot"])
         return cls(k, f, z, tuple(tuple(float(v) for v in r) for r in frame), foot,
-                   tuple(d.get("notes", ())), dict(d.get("uncertainty") or {}))
+                   tuple(d.get("notes", ())))
 
 
 def _mode_direction(md: dict[str, Any], signed: bool = False) -> np.ndarray | None:

@@ -87,8 +87,8 @@ class Mode:
     or out-of-phase residues give no entry). share: the mode's share of the rank point's
     modal peak compliance (see :func:`identify_modes`), share_point: that FRF
     (``output/input``), peak_compliance_m_per_N: the mode's own receptance peak there.
-    uncertainty: standard deviations and 95 % intervals of frequency, damping and shape
-    (:class:`~robobore.modal.uncertainty.ModeUncertainty`; None for FRF input).
+    uncertainty: standard deviations and 95 % intervals of frequency, damping (and, from
+    hits, shape) (:class:`~robobore.modal.uncertainty.ModeUncertainty`).
     """
 
     frequency_Hz: float
@@ -302,8 +302,9 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
         near each of these frequencies (Hz); neither: every physical mode.
     point: output name whose FRFs rank the modes (default: the driving points from the
         DOFs, else all FRFs).
-    uncertainty: with an FRFEstimate (time records), the 95 % intervals of every mode by the
-        jackknife over hits (:mod:`robobore.modal.uncertainty`); FRFs alone carry none.
+    uncertainty: 95 % intervals of every mode (:mod:`robobore.modal.uncertainty`): with an
+        FRFEstimate (time records) by the jackknife over hits, with FRFs alone by a wild
+        bootstrap of the residuals of the fit with every physical mode.
     max_order: highest pLSCF order (``max_order * n_inputs`` poles).
     freq_tol, damp_tol, mac_tol: stabilisation criteria.
     """
@@ -424,8 +425,14 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
             dataclasses.replace(m, uncertainty=u) for m, u in zip(modes, unc, strict=True)))
         an = dataclasses.replace(an, result=result)
     elif uncertainty:
-        summary["uncertainty"] = {"method": None, "reason": "FRF input: no per-hit spectra "
-                                  "(identify from time records for the jackknife over hits)"}
+        from robobore.modal.uncertainty import bootstrap_residuals
+
+        unc, info = bootstrap_residuals(d, pool_fit.synthesised, an)
+        summary["uncertainty"] = info
+        timings["uncertainty"] = info["time_s"]
+        result = dataclasses.replace(result, modes=tuple(
+            dataclasses.replace(m, uncertainty=u) for m, u in zip(modes, unc, strict=True)))
+        an = dataclasses.replace(an, result=result)
     return an
 
 
