@@ -372,22 +372,25 @@ def identify_modes(data: FRFData, *, band_Hz: tuple[float, float] | None = None,
             order = np.argsort([-c.cluster_size for c in pool], kind="stable")
         sel = sorted((pool[i] for i in order[:n_modes]), key=lambda c: c.frequency_Hz)
     t3 = time.perf_counter()
-    fit = pool_fit if len(sel) == len(pool) else fit_of(sel)
+    # shapes and residues of the selected modes from the fit with every physical mode: the
+    # modes left out of the selection are still in the data (lower/upper residuals do not
+    # take in-band modes)
+    fit = pool_fit
     t4 = time.perf_counter()
     c1 = cm.values[0]
     modes = []
-    for k, s in enumerate(sel):
+    for s in sel:
         i = next(i for i, c in enumerate(pool) if c.pole == s.pole)
         o_j = pairs[where[i]] if where[i] >= 0 else None
-        R = fit.residues[:, :, k]
+        R = fit.residues[:, :, i]
         w_in = np.linalg.norm(R, axis=0)
         w_in = w_in / (w_in.sum() or 1.0)
         dom = d.input_names[int(np.argmax(w_in))]
         mode = Mode(s.frequency_Hz, s.damping_ratio, 0.0, np.zeros(0), s.participation, R, dom)
         masses = {d.input_names[j]: mode.driving_point_mass_kg(o, j)
                   for o, j in d.driving_points()}
-        modes.append(Mode(s.frequency_Hz, s.damping_ratio, mpc(fit.mode_shapes[:, k]),
-                          normalise_shape(fit.mode_shapes[:, k]), s.participation, R,
+        modes.append(Mode(s.frequency_Hz, s.damping_ratio, mpc(fit.mode_shapes[:, i]),
+                          normalise_shape(fit.mode_shapes[:, i]), s.participation, R,
                           dom, _axis_of(dom), tuple(float(v) for v in w_in), s.cluster_size,
                           float(cm.at(s.frequency_Hz)[0] / c1.max()),
                           {k: v for k, v in masses.items() if np.isfinite(v)},
