@@ -317,18 +317,21 @@ def cmif(frf_data: Any):
 
 
 def identify_modes(data: Any = None, *, band_Hz: Any = PAPER_BAND_HZ,
-                   n_modes: int | None = 5, max_order: int = 40):
+                   n_modes: int | None = 5, select: str = "dominant", max_order: int = 40):
     """Automatic modal identification (CMIF, poly-reference LSCF over orders 1..max_order,
     stabilisation, pole selection, LSFD) of hammer records, FRFs or None (the bundled
     test) in ``band_Hz`` -> ``ModalAnalysis``; ``.result`` (``ModalResult``) holds the
-    ``n_modes`` best-supported modes (frequency_Hz, damping_ratio, direction, ...)."""
+    ``n_modes`` modes chosen by ``select`` (``dominant``: the largest shares of the
+    driving-point compliance; ``lowest``; ``stable``) with frequency_Hz, damping_ratio,
+    direction, share, ..."""
     from robobore.modal.identify import identify_modes as _identify
 
     lo, hi = _band_arg(band_Hz)
     n_modes = _int_arg(n_modes, "n_modes", 1, 100)
     max_order = _int_arg(max_order, "max_order", 1, 1000, allow_none=False)
     data = load_hammer_test() if data is None else data
-    return _identify(frf(data), band_Hz=(lo, hi), n_modes=n_modes, max_order=max_order)
+    return _identify(frf(data), band_Hz=(lo, hi), n_modes=n_modes, select=select,
+                     max_order=max_order)
 
 
 # ----------------------------------------------------------------------------- equivalent

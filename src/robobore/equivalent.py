@@ -98,6 +98,90 @@ def _nonneg(name: str, value: Any, unit: str) -> float:
     return check_value(v, name, kind=ConfigError)  # plausible range of the unit
 
 
+class EquivalentWarning(UserWarning):
+    """The stiffness and the modes of an equivalent model do not agree (different robots or
+    postures suspected)."""
+
+
+#: a direction's static stiffness and its mode's modal stiffness further apart than this
+#: factor draw a warning: a mode of the same robot carries part of the direction's
+#: compliance, so its modal stiffness exceeds the static one by 1/share (1.1 at the bundled
+#: test's coupled tool point), not by 2
+STIFFNESS_MISMATCH_FACTOR = 2.0
+
+
+def _posture_of(d: Any) -> list[float] | None:
+    if not isinstance(d, dict):
+        return None
+    for key in ("joints_deg", "posture_deg", "directional_posture_deg"):
+        v = d.get(key)
+        if isinstance(v, list | tuple) and v and all(isinstance(x, int | float) for x in v):
+            return [float(x) for x in v]
+    return None
+
+
+def _robot_of(d: Any) -> str | None:
+    if not isinstance(d, dict) or not d.get("robot"):
+        return None
+    r = str(d["robot"]).strip()
+    return r[:-5].rsplit("/", 1)[-1] if r.endswith(".toml") else r
+
+
+def check_same_robot(stiffness: Any, modes: Any) -> None:
+    """Refuse a stiffness and modes that name different robots or postures (ConfigError);
+    files that do not name them pass."""
+    rs, rm = _robot_of(stiffness), _robot_of(modes)
+    if rs and rm and rs != rm:
+        raise ConfigError("the stiffness and the modes are of different robots",
+                          field="robot", value=f"stiffness: {rs}, modes: {rm}",
+                          expected="the stiffness and the hammer test of one robot")
+    qs, qm = _posture_of(stiffness), _posture_of(modes)
+    if qs and qm and (len(qs) != len(qm) or max(abs(a - b) for a, b in
+                                                 zip(qs, qm, strict=False)) > 0.01):
+        raise ConfigError("the stiffness and the modes are of different postures",
+                          field="joints_deg", value=f"stiffness: {qs}, modes: {qm}",
+                          expected="the stiffness and the hammer test at one posture "
+                                   "(within 0.01 deg)")
+
+
+def _mode_stiffness(md: dict[str, Any], axis: str) -> float | None:
+    """The modal stiffness (N/m) of a mode at the driving point of ``axis``, if given."""
+    ks = md.get("modal_stiffness_N_per_m")
+    if not isinstance(ks, dict):
+        return None
+    for name, v in ks.items():
+        n = str(name).strip().lower()
+        if (n == axis or (len(n) >= 2 and n[-1] == axis and n[-2] in "_-+ .")) and \
+                isinstance(v, int | float) and v > 0 and math.isfinite(v):
+            return float(v)
+    return None
+
+
+def stiffness_mismatch_notes(ks: dict[str, Any], assigned: dict[str, dict[str, Any]]
+                             ) -> tuple[str, ...]:
+    """Warnings (also issued as :class:`EquivalentWarning`) for the directions whose static
+    stiffness and the modal stiffness of the mode assigned to them differ by more than
+    :data:`STIFFNESS_MISMATCH_FACTOR`."""
+    import warnings
+
+    out = []
+    for a in AXES:
+        k, km = ks.get(a), _mode_stiffness(assigned[a], a)
+        if k is None or km is None or not k > 0:
+            continue
+        r = km / float(k)
+        if r > STIFFNESS_MISMATCH_FACTOR or r < 1.0 / STIFFNESS_MISMATCH_FACTOR:
+            msg = (f"WARNING: {a}: static stiffness {float(k):.4g} N/m, the modal stiffness of "
+                   f"its mode {km:.4g} N/m (x{r:.3g}, beyond a factor "
+                   f"{STIFFNESS_MISMATCH_FACTOR:g}): the mode carries little of the "
+                   "direction's compliance (a coupled tool point) or the stiffness and the "
+                   "hammer test are of different robots or postures; the unit's mass k/w^2 "
+                   "does not represent the mode")
+            warnings.warn(msg, EquivalentWarning, stacklevel=3)
+            out.append(msg)
+    return tuple(out)
+
+
 def _stiffness_contract(stiffness: Any) -> Any:
     """The robot-stiffness JSON contract of ``stiffness`` (module docstring); a dict other
     than the ``{"x", "y", "z"}`` table is returned as it is."""
@@ -252,6 +336,11 @@ class EquivalentModel:
     notes: tuple[str, ...] = field(default_factory=tuple)
     #: what the model describes (robot, posture, tool point, SYNTHETIC; robobore.io.identity)
     identity: dict[str, Any] = field(default_factory=dict)
+    #: 95 % ranges per axis propagated from the modes' intervals (empty when the modes carry
+    #: none): ``{axis: {"frequency_Hz": [lo, hi], "damping_ratio": [..], "mass_kg": [..],
+    #: "damping_N_s_per_m": [..]}}``; not part of :meth:`to_dict` (the dict form is the
+    #: stability stage's contract, whose keys are fixed)
+    uncertainty: dict[str, dict[str, list[float]]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -380,6 +469,7 @@ class EquivalentModel:
                 if d is not None:
                     md["direction"] = list(np.abs(R.T @ d))
                     md.pop("shape", None)
+        check_same_robot(stiffness, modes)
         chosen, how = assign_modes(ml, assignment)
         fn = {a: float(ml[chosen[a]]["frequency_Hz"]) for a in AXES}
         zr = {a: float(ml[chosen[a]].get("damping_ratio", 0.0)) for a in AXES}
@@ -387,12 +477,35 @@ class EquivalentModel:
                                         for a in AXES),)
         if R is not None:
             notes = notes + ("units along the principal directions of the stiffness matrix",)
-        em = cls.build({a: ks.get(a) for a in AXES}, fn, damping_ratio=zr,
-                       damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot,
-                       notes=notes + id_notes)
+        if R is None:
+            notes = notes + stiffness_mismatch_notes(ks, {a: ml[chosen[a]] for a in AXES})
+        kk = {a: ks.get(a) for a in AXES}
+        em = cls.build(kk, fn, damping_ratio=zr, damping_N_s_per_m=damping_N_s_per_m, frame=R,
+                       foot=foot, notes=notes + id_notes)
         import dataclasses
 
-        return dataclasses.replace(em, identity=merged(id_s, id_m, kind="equivalent model"))
+        em = dataclasses.replace(em, identity=merged(id_s, id_m, kind="equivalent model"))
+        unc = {a: ml[chosen[a]].get("uncertainty") for a in AXES}
+        if all(isinstance(u, dict) and "frequency_ci95_Hz" in u for u in unc.values()):
+            from dataclasses import replace as _replace
+
+            ends = []
+            for side in (0, 1):  # the model at the intervals' low and high ends
+                fs_ = {a: max(float(unc[a]["frequency_ci95_Hz"][side]), 1e-9) for a in AXES}
+                zs_ = {a: max(float(unc[a]["damping_ci95"][side]), 0.0) for a in AXES}
+                ends.append(cls.build(kk, fs_, damping_ratio=zs_,
+                                      damping_N_s_per_m=damping_N_s_per_m, frame=R, foot=foot))
+            rng = {}
+            for a in AXES:
+                vals = {"frequency_Hz": [e.frequency_Hz[a] for e in ends],
+                        "damping_ratio": [e.damping_ratio[a] for e in ends],
+                        "mass_kg": [e.mass_kg[a] for e in ends],
+                        "damping_N_s_per_m": [e.damping_N_s_per_m[a] for e in ends]}
+                rng[a] = {k: [float(min(v)), float(max(v))] for k, v in vals.items()}
+            em = _replace(em, uncertainty=rng, notes=em.notes + (
+                "95 % ranges of f, zeta, m and c from the modes' intervals (stiffness taken "
+                "as exact)",))
+        return em
 
     # ------------------------------------------------------------------ derived
     def unit(self, axis: str) -> DirectionUnit:
@@ -565,4 +678,5 @@ def principal_frame(stiffness_matrix: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 __all__ = ["EquivalentModel", "PressureFoot", "DirectionUnit", "assign_modes",
-           "principal_frame", "AXES"]
+           "principal_frame", "AXES", "EquivalentWarning", "check_same_robot",
+           "stiffness_mismatch_notes", "STIFFNESS_MISMATCH_FACTOR"]

@@ -36,14 +36,28 @@ def _render_modes(res: dict[str, Any]) -> None:
               header_style="bold")
     # dominant input: hammer input with the largest residues; m_eff: effective modal mass
     # at that input's driving point; orders: pLSCF orders where the mode is stable
-    for c in ("#", "f (Hz)", "zeta (%)", "MPC", "input", "m_eff (kg)", "orders", "CMIF"):
-        t.add_column(c, justify="right")
+    # share: the mode's share of the rank point's modal peak compliance
+    # f and zeta with the half-width of their 95 % interval (jackknife over hits; time
+    # records only); 1-MPC: 0 for a real mode; the orders that support each mode and its
+    # CMIF support are in the JSON
+    for c in ("#", "f (Hz)", "zeta (%)", "1-MPC", "input", "m_eff kg", "share %"):
+        t.add_column(c, justify="right", min_width={"f (Hz)": 15, "zeta (%)": 11}.get(c))
     for k, m in enumerate(res["modes"]):
         mass = m.get("modal_mass_kg", {}).get(m["dominant_input"])
-        t.add_row(str(k + 1), f"{m['frequency_Hz']:.4f}", f"{100 * m['damping_ratio']:.3f}",
-                  f"{m['mpc']:.7f}", m["dominant_input"], fmt(mass), str(m["cluster_size"]),
-                  fmt(m["cmif_support"]))
+        sh = m.get("share")
+        u = m.get("uncertainty")
+        fs = f"{m['frequency_Hz']:.4f}"
+        zs = f"{100 * m['damping_ratio']:.3f}"
+        if u:
+            fs += f"±{(u['frequency_ci95_Hz'][1] - u['frequency_ci95_Hz'][0]) / 2:.4f}"
+            zs += f"±{50 * (u['damping_ci95'][1] - u['damping_ci95'][0]):.3f}"
+        t.add_row(str(k + 1), fs, zs, f"{1 - m['mpc']:.1e}", m["dominant_input"], fmt(mass),
+                  "-" if sh is None else f"{100 * sh:.1f}")
     stdout.print(t)
+    sel = res["stabilisation"].get("selection")
+    if sel:
+        stdout.print(f"selection: {sel['select']} (rank point: {sel['rank_point']}; physical "
+                     f"modes stable over >= {sel['orders_needed']} orders)")
     st = res["stabilisation"]
     stdout.print(f"poles: {st['n_poles']} over orders {st['orders'][0]}-{st['orders'][1]}; "
                  f"status counts {st['status_counts']}; CMIF peaks (Hz): "
@@ -64,14 +78,28 @@ def _render_modes(res: dict[str, Any]) -> None:
 def modes_cmd(
     input_file: Path | None = typer.Argument(
         None, help="UFF file (58 time records or FRFs, 164 units) or NPZ FRF file."),
+    operational: Path | None = typer.Option(
+        None, "--operational",
+        help="Output-only record (NPZ data/sample_rate_Hz, or UFF 58 responses): SSI-COV."),
+    spindle_rpm: float | None = typer.Option(
+        None, "--spindle-rpm", help="Spindle speed of a cutting record (harmonics excluded)."),
     example: bool = typer.Option(False, "--example",
                                  help="Use the bundled SYNTHETIC robot hammer test."),
     band_hz: tuple[float, float] | None = typer.Option(
         None, "--band-hz", help="Analysis band LO HI in Hz (default: all lines)."),
     modes: int | None = typer.Option(None, "--modes", help="Number of modes to keep."),
+    select: str = typer.Option(
+        "dominant", "--select",
+        help="Which N modes --modes keeps: dominant (largest share of the driving-point "
+             "compliance), lowest (lowest well-supported), stable (best-supported)."),
+    point: str | None = typer.Option(
+        None, "--point", help="Output whose FRFs rank the modes (default: driving points)."),
     approx_hz: str | None = typer.Option(
         None, "--approx-hz", help="Approximate mode frequencies, comma-separated, Hz."),
     max_order: int = typer.Option(40, "--max-order", help="Highest pLSCF model order."),
+    uncertainty: bool = typer.Option(
+        True, "--uncertainty/--no-uncertainty",
+        help="95 % intervals of f, zeta and shapes by the jackknife over hits (time records)."),
     estimator: str = typer.Option("H1", "--estimator", help="FRF estimator: H1, H2, Hv."),
     exp_window_tau_s: float | None = typer.Option(
         None, "--exp-window-tau-s", help="Exponential window time constant, s (corrected)."),
@@ -104,6 +132,17 @@ def modes_cmd(
     from robobore.modal.identify import identify_modes
     from robobore.modal.io import load_input
 
+    if operational is not None:
+        if example or input_file is not None:
+            raise ConfigError("--operational takes the record instead of INPUT/--example",
+                              field="--operational", value=operational,
+                              expected="--operational FILE alone")
+        return _operational(operational, band_hz, modes, spindle_rpm, max_order, uncertainty,
+                            plot, out, as_json)
+    if spindle_rpm is not None:
+        raise ConfigError("--spindle-rpm applies to --operational records",
+                          field="--spindle-rpm", value=spindle_rpm,
+                          expected="--operational FILE with it")
     if example == (input_file is not None):
         raise ConfigError("give either INPUT or --example", field="INPUT", value=input_file,
                           expected="a UFF/NPZ file path or the --example flag")
@@ -112,6 +151,11 @@ def modes_cmd(
     for v in band_hz or ():  # plausible ranges (robobore.io.ranges)
         check_option(v, "--band-hz", "band_Hz")
     check_count(modes, "--modes", 1, 100)
+    from robobore.modal.identify import SELECT_MODES
+
+    if select not in SELECT_MODES:
+        raise ConfigError("unknown mode selection", field="--select", value=select,
+                          expected="one of " + ", ".join(SELECT_MODES))
     if max_order > 1000:  # (below 1: identify_modes says why)
         raise ConfigError("max order too high", field="--max-order", value=max_order,
                           expected="an integer 1 .. 1000 (the stabilisation diagram's orders)")
@@ -126,9 +170,15 @@ def modes_cmd(
     approx = parse_floats(approx_hz, None, "--approx-hz", "Hz") if approx_hz else None
     warn_list: list[str] = []
     with progress_bar("modal analysis", 3, enabled=not as_json) as advance:
-        data = load_input(input_file, frf_type)
+        from robobore.modal.io import UFFWarning
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", UFFWarning)
+            data = load_input(input_file, frf_type)
+        warn_list += [str(w.message) for w in caught if issubclass(w.category, UFFWarning)]
         advance(1)
         hits = None
+        load_meta = data
         if not isinstance(data, FRFData):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", DoubleHitWarning)
@@ -136,14 +186,15 @@ def modes_cmd(
                 est = estimate_frf(data, estimator=estimator, exp_window_tau_s=exp_window_tau_s,
                                    drop_flagged=drop_flagged)
             warn_list += [str(w.message) for w in caught]
-            data, hits = est.frf, est
+            data, hits = est, est
         elif exp_window_tau_s is not None:
             raise ConfigError("--exp-window-tau-s applies to time records only",
                               field="--exp-window-tau-s", value=exp_window_tau_s,
                               expected="no window option for FRF input")
         try:
             an = identify_modes(data, band_Hz=band_hz, n_modes=modes, approx_Hz=approx,
-                                max_order=max_order)
+                                select=select, point=point, max_order=max_order,
+                                uncertainty=uncertainty)
         except (IdentificationError, NumericalError) as exc:  # say which data it was
             raise type(exc)(f"{input_file}: {exc}") from None
         except InputError as exc:  # a band the data cannot give: name the data file
@@ -160,6 +211,10 @@ def modes_cmd(
         res["identity"] = ident
         if hits is not None:
             res["hits"] = hits.to_dict()
+        from robobore.modal.virtual_robot import parse_header
+
+        meta = getattr(load_meta, "meta", None) or {}
+        res.update(parse_header(meta.get("header")))
         res["warnings"] = warn_list
         if plot is not None:
             from robobore.modal.plots import plot_all
@@ -211,6 +266,83 @@ def _test_identity(path: Path, robot: str | None, joints_deg: str | None,
     return out
 
 
+def _operational(path: Path, band_hz: tuple[float, float] | None, modes: int | None,
+                 spindle_rpm: float | None, max_order: int, uncertainty: bool,
+                 plot: Path | None, out: Path | None, as_json: bool) -> None:
+    """``identify modes --operational FILE``: SSI-COV of an output-only record."""
+    from robobore.errors import ConfigError, IdentificationError, InputError
+    from robobore.io.outputs import check_output_dir, check_output_file
+    from robobore.io.results import write_json
+    from robobore.modal.oma import identify_operational, load_operational
+
+    check_output_dir(plot, "--plot", "the PNG plots")
+    check_output_file(out, "--out", "the result JSON")
+    if band_hz is None:
+        raise ConfigError("an operational record needs its band", field="--band-hz",
+                          expected="--band-hz LO HI in Hz (LO sets the shortest record: ten "
+                                   "periods)")
+    for v in band_hz:
+        check_option(v, "--band-hz", "band_Hz")
+    check_count(modes, "--modes", 1, 100)
+    check_option(spindle_rpm, "--spindle-rpm")
+    if not 1 <= max_order <= 200:
+        raise ConfigError("max order out of range", field="--max-order", value=max_order,
+                          expected="an integer 1 .. 200 (modes; 2x that many states)")
+    with progress_bar("operational modal analysis", 2, enabled=not as_json) as advance:
+        rec = load_operational(path)
+        advance(1)
+        try:
+            r = identify_operational(rec, band_hz, n_modes=modes, spindle_rpm=spindle_rpm,
+                                     max_order=max_order, uncertainty=uncertainty)
+        except (IdentificationError, InputError) as exc:
+            if isinstance(exc, InputError) and exc.file is None:
+                raise type(exc)(exc.message, file=str(path), field=exc.field,
+                                value=exc.value, expected=exc.expected) from None
+            if isinstance(exc, IdentificationError):
+                raise type(exc)(f"{path}: {exc}") from None
+            raise
+        res = r.to_dict()
+        res["source"] = str(path)
+        res["record"] = {"channels": len(rec.channel_names), "sample_rate_Hz":
+                         rec.sample_rate_Hz, "duration_s": rec.duration_s}
+        if plot is not None:
+            from robobore.modal.plots import plot_operational
+
+            res["plots"] = [str(plot_operational(r, Path(plot) / "stabilisation_oma.png"))]
+        advance(1)
+    if out is not None:
+        write_json(out, res)
+    emit(res, as_json, _render_operational)
+
+
+def _render_operational(res: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    from robobore.clitools import stdout
+
+    rec = res["record"]
+    t = Table(title=f"Operational modes (SSI-COV, {res['source']}, {rec['channels']} "
+              f"channels, {rec['duration_s']:.4g} s, band {res['band_Hz'][0]:.4g}-"
+              f"{res['band_Hz'][1]:.4g} Hz)", header_style="bold")
+    for c in ("#", "f (Hz)", "zeta (%)", "orders", "share %"):
+        t.add_column(c, justify="right", min_width={"f (Hz)": 15, "zeta (%)": 11}.get(c))
+    for k, m in enumerate(res["modes"]):
+        u = m.get("uncertainty")
+        fs = f"{m['frequency_Hz']:.4f}"
+        zs = f"{100 * m['damping_ratio']:.3f}"
+        if u:
+            fs += f"±{(u['frequency_ci95_Hz'][1] - u['frequency_ci95_Hz'][0]) / 2:.4f}"
+            zs += f"±{50 * (u['damping_ci95'][1] - u['damping_ci95'][0]):.3f}"
+        t.add_row(str(k + 1), fs, zs, str(m["orders_stable"]), f"{100 * m['share']:.1f}")
+    stdout.print(t)
+    h = res.get("harmonics_excluded") or []
+    if h:
+        stdout.print("rotation harmonics excluded (Hz): "
+                     + ", ".join(f"{x['frequency_Hz']:.3g}" for x in h))
+    for p in res.get("plots", []):
+        stdout.print(f"plot: {p}")
+
+
 @handle_errors
 def virtual_test_cmd(
     out: Path = typer.Argument(..., help="Output UFF file (time records, UFF 58 + 164)."),
@@ -221,28 +353,34 @@ def virtual_test_cmd(
     hits: int = typer.Option(5, "--hits", help="Hits per hammer direction."),
     directions: str = typer.Option("x,y,z", "--directions",
                                    help="Hammer directions at the tool point (subset of x,y,z)."),
-    sample_rate_hz: float = typer.Option(256.0, "--sample-rate-hz", help="Sampling rate, Hz."),
+    sample_rate_hz: float | None = typer.Option(
+        None, "--sample-rate-hz",
+        help="Sampling rate, Hz (default 256; with --robot a power of 2 >= 5x the top mode)."),
     duration_s: float = typer.Option(6.0, "--duration-s", help="Record length, s."),
     tip: str = typer.Option("soft", "--tip", help="Hammer tip: soft, medium, hard."),
     double_hit: list[str] = typer.Option([], "--double-hit",
                                          help="Make hit I,H (1-based) a double hit."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
     robot: str | None = typer.Option(
-        None, "--robot", help="Robot of the virtual test (library name or robot TOML); "
-        "default: the example's IRB 6600."),
-    robot_file: Path | None = typer.Option(None, "--robot-file", help="A robot TOML file."),
+        None, "--robot", help="Test this library robot's multibody model (with --joints-deg)."),
+    robot_file: Path | None = typer.Option(
+        None, "--robot-file", help="Robot TOML file (D-H and [[links]] inertias) instead."),
+    joints_deg: str | None = typer.Option(None, "--joints-deg", help="Posture q1,...,qn in deg."),
+    joint_stiffness_file: Path | None = typer.Option(
+        None, "--joint-stiffness-file",
+        help="JSON with joint_stiffness_Nm_per_rad (`robobore identify stiffness --json`)."),
     joint_stiffness: str | None = typer.Option(
-        None, "--joint-stiffness-Nm-per-rad", help="TRUE k1..k6 (N m/rad) of that robot; "
-        "default: the virtual campaign's ground truth."),
-    joints_deg: str | None = typer.Option(
-        None, "--joints-deg", help="Posture of the test, q1..q6 in deg; default: the "
-        "example's (the paper's boring posture)."),
+        None, "--joint-stiffness-Nm-per-rad", help="k1,...,kn in N m/rad (instead of a file)."),
     tcp_m: str | None = typer.Option(None, "--tcp-m", help="Tool point in the flange frame "
                                      "'x,y,z' in m (default: flange)."),
+    damping_ratio: float = typer.Option(
+        0.03, "--damping-ratio", help="Modal damping ratio of every mode (ASSUMED) with --robot."),
     as_json: bool = JSON_OPTION,
 ) -> None:
-    """Write a SYNTHETIC impact-hammer test of the robot boring truth model (the example
-    robot, or the robot, joint stiffness, posture and tool point given)."""
+    """Write a SYNTHETIC impact-hammer test: the bundled robot boring truth; any robot's
+    pose-dependent multibody model (--robot/--robot-file, --joints-deg and a joint stiffness);
+    or, without a joint stiffness, the example's five modes on that robot's compliance at that
+    posture (its ground-truth joint stiffness)."""
     from robobore.clitools import kv_table, stdout
     from robobore.errors import ConfigError
     from robobore.io.outputs import check_output_file
@@ -258,13 +396,33 @@ def virtual_test_cmd(
 
     check_output_file(out, "OUT", "the UFF file")
     check_output_file(Path(str(out) + ".truth.json"), "OUT", "the ground-truth JSON")
-    own = [n for n, v in (("--robot", robot), ("--robot-file", robot_file),
-                          ("--joint-stiffness-Nm-per-rad", joint_stiffness),
-                          ("--joints-deg", joints_deg), ("--tcp-m", tcp_m)) if v is not None]
-    if example and own:
-        raise ConfigError("the bundled example has its own robot and posture", field=own[0],
-                          expected="--example alone, or the options without --example")
-    truth, ident = _virtual_truth(robot, robot_file, joint_stiffness, joints_deg, tcp_m)
+    robot_info = None
+    header = None
+    if joint_stiffness_file is not None or (
+            joint_stiffness is not None and (robot is not None or robot_file is not None)):
+        # the robot's own multibody model at the posture
+        truth, robot_info = _robot_truth(robot, robot_file, joints_deg, joint_stiffness_file,
+                                         joint_stiffness, tcp_m or "0,0,0", damping_ratio,
+                                         example)
+        from robobore.modal.virtual_robot import header_text, sample_rate_for
+
+        rb_ = get_robot_for_identity(robot, robot_file)
+        ident = _virtual_identity(rb_, robot_info["joints_deg"],
+                                  parse_floats(tcp_m or "0,0,0", 3, "--tcp-m", "m"))
+        header = header_text(robot_info)
+        if sample_rate_hz is None:
+            sample_rate_hz = sample_rate_for(truth)
+    else:
+        own = [n for n, v in (("--robot", robot), ("--robot-file", robot_file),
+                              ("--joint-stiffness-Nm-per-rad", joint_stiffness),
+                              ("--joints-deg", joints_deg), ("--tcp-m", tcp_m))
+               if v is not None]
+        if example and own:
+            raise ConfigError("the bundled example has its own robot and posture", field=own[0],
+                              expected="--example alone, or the options without --example")
+        truth, ident = _virtual_truth(robot, robot_file, joint_stiffness, joints_deg, tcp_m)
+    if sample_rate_hz is None:
+        sample_rate_hz = 256.0
     if example:
         make_example(out)
         settings: dict[str, Any] = dict(EXAMPLE_SETTINGS)
@@ -290,11 +448,18 @@ def virtual_test_cmd(
                     "tip": tip, "noise_force": noise, "noise_response": noise, "seed": seed,
                     "double_hits": dh}
         rec = simulate_hammer_test(truth, **settings)
-        write_uff_time(rec, out, [EXAMPLE_INPUT_DOFS[r] for r in rows], EXAMPLE_OUTPUT_DOFS,
-                       "SYNTHETIC robobore virtual hammer test")
+        out_dofs = (EXAMPLE_OUTPUT_DOFS if robot_info is None else
+                    [(1, 1), (1, 2), (1, 3), (2, 1), (2, 2), (2, 3)])
+        write_uff_time(rec, out, [EXAMPLE_INPUT_DOFS[r] for r in rows], out_dofs,
+                       "SYNTHETIC robobore virtual hammer test", header=header)
     truth_path = Path(str(out) + ".truth.json")
     info = {"file": str(out), "truth_file": str(truth_path), "synthetic": True,
             "settings": settings, "truth": truth.to_dict(), "identity": ident}
+    if robot_info is not None:
+        from robobore.modal.virtual_robot import static_stiffness
+
+        info["robot"] = robot_info
+        info["static_stiffness_N_per_m"] = static_stiffness(truth.with_inputs(rows))
     write_json(truth_path, info)
     if as_json:
         emit(info, True, lambda r: None)
@@ -305,7 +470,83 @@ def virtual_test_cmd(
             ("damping ratios", ", ".join(f"{z:g}" for z in truth.damping_ratios)),
             ("hammer inputs", ", ".join(truth.input_names)),
             ("hits per input", settings["n_hits"]), ("noise (fraction of RMS)",
-                                                      settings["noise_response"])]))
+                                                      settings["noise_response"])]
+            + ([("robot", robot_info["robot"]),
+                ("posture (deg)", ", ".join(f"{v:g}" for v in robot_info["joints_deg"])),
+                ("robot directional stiffness (N/um)", ", ".join(
+                    f"{a} {v / 1e6:.4g}" for a, v in
+                    robot_info["directional_stiffness_N_per_m"].items())),
+                ("test static stiffness (N/um)", ", ".join(
+                    f"{a} {v / 1e6:.4g}" for a, v in info["static_stiffness_N_per_m"].items())),
+                ("sample rate (Hz)", settings["sample_rate_Hz"])]
+               if robot_info is not None else [])))
+
+
+def _robot_truth(robot: str | None, robot_file: Path | None, joints_deg: str | None,
+                 stiffness_file: Path | None, stiffness: str | None, tcp_m: str,
+                 damping_ratio: float, example: bool) -> tuple[Any, dict[str, Any]]:
+    """The modal truth of a user's robot from the CLI options (ConfigError naming the option
+    when one is missing or bad)."""
+    from robobore.errors import ConfigError, IdentificationError, InputError
+    from robobore.modal.virtual_robot import robot_truth
+    from robobore.robot.kinematics import get_robot
+
+    if example:
+        raise ConfigError("--example regenerates the bundled test", field="--robot",
+                          value=robot or robot_file, expected="either --example or --robot")
+    if (robot is None) == (robot_file is None):
+        raise ConfigError("give exactly one robot", field="--robot/--robot-file",
+                          value=(robot, robot_file),
+                          expected="--robot NAME (robobore robot list) or --robot-file F.toml")
+    if robot_file is not None and not Path(robot_file).is_file():
+        raise ConfigError("robot file not found", file=str(robot_file), field="--robot-file",
+                          expected="a robot TOML file")
+    rb = get_robot(robot if robot is not None else str(robot_file))
+    if joints_deg is None:
+        raise ConfigError("no posture given", field="--joints-deg",
+                          expected=f"{rb.n_joints} comma-separated joint angles in deg")
+    q = parse_floats(joints_deg, rb.n_joints, "--joints-deg", "deg")
+    if (stiffness_file is None) == (stiffness is None):
+        raise ConfigError("give exactly one joint stiffness", field="--joint-stiffness-file",
+                          expected="--joint-stiffness-file s.json or "
+                                   "--joint-stiffness-Nm-per-rad k1,...,kn")
+    if stiffness_file is not None:
+        from robobore.io.readers import load_json
+        from robobore.robot.stiffness import JointStiffness
+
+        data = load_json(Path(stiffness_file), "joint stiffness file",
+                         "a JSON object from `robobore identify stiffness --json`")
+        try:
+            k = list(JointStiffness.from_dict(data).as_array())
+        except (InputError, IdentificationError) as exc:
+            msg = getattr(exc, "message", str(exc))
+            raise ConfigError(msg, file=str(stiffness_file),
+                              field=getattr(exc, "field", None) or "joint_stiffness_Nm_per_rad",
+                              expected=f"{rb.n_joints} joint stiffnesses in N m/rad") from None
+        named = str(data.get("robot", "") or "")
+        if named and named not in (rb.name, str(robot_file)):
+            raise ConfigError("the joint stiffness file is of another robot",
+                              file=str(stiffness_file), field="robot", value=named,
+                              expected=f"the stiffness of {rb.name}")
+    else:
+        k = parse_floats(stiffness, rb.n_joints, "--joint-stiffness-Nm-per-rad", "N m/rad")
+    if len(k) != rb.n_joints:
+        raise ConfigError("one joint stiffness per joint", field="joint_stiffness_Nm_per_rad",
+                          value=len(k), expected=f"{rb.n_joints} values in N m/rad")
+    tcp = parse_floats(tcp_m, 3, "--tcp-m", "m")
+    try:
+        return robot_truth(rb, q, k, tcp_m=tcp, damping_ratio=damping_ratio)
+    except InputError as exc:
+        raise ConfigError(exc.message, field=exc.field, value=exc.value,
+                          expected=exc.expected) from None
+
+
+def get_robot_for_identity(robot: str | None, robot_file: Path | None) -> Any:
+    """The robot named by ``--robot`` or ``--robot-file``."""
+    from robobore.robot.kinematics import get_robot, load_robot_file
+
+    return load_robot_file(robot_file) if robot_file is not None else get_robot(
+        robot or "irb6600-175-2.55", field="--robot")
 
 
 def _virtual_identity(rb: Any = None, q_deg: Any = None, tcp: Any = None) -> dict[str, Any]:

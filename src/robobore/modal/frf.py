@@ -34,6 +34,7 @@ its public names are importable from here too.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import dataclass, field
 from typing import Any
@@ -279,6 +280,10 @@ class FRFEstimate:
     hits: tuple[HitCheck, ...]
     n_averages: np.ndarray  # (n_inputs,) hits used per input
     decay_ratio: np.ndarray | None = None  # (n_inputs,) median over hits, record_decay_ratio
+    #: per-hit spectra for resampling the hits (:func:`combine_hits`): ``sff (ni, nh, nf)``,
+    #: ``sfa (no, ni, nh, nf)``, ``saa (no, ni, nh, nf)`` on all DFT lines, ``used (ni, nh)``
+    per_hit: dict[str, Any] | None = field(default=None, repr=False, compare=False)
+    estimator: str = "H1"
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"hits": [h.to_dict() for h in self.hits],
@@ -344,11 +349,12 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
     fs = records.sample_rate_Hz
     ni, nh, no, n = records.n_inputs, records.n_hits, records.n_outputs, records.n_samples
     nf = n // 2 + 1
-    sff = np.zeros((ni, nf))
-    sfa = np.zeros((no, ni, nf), complex)
-    saa = np.zeros((no, ni, nf))
+    sff = np.zeros((ni, nh, nf))
+    sfa = np.zeros((no, ni, nh, nf), complex)
+    saa = np.zeros((no, ni, nh, nf))
     checks: list[HitCheck] = []
     used = np.zeros(ni, int)
+    use = np.zeros((ni, nh), bool)
     decay = np.zeros(ni)
     ratios: list[float] = []
     for i in range(ni):
@@ -378,10 +384,11 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
                 we = exponential_window(n, fs, exp_window_tau_s, np.argmax(np.abs(f)) / fs)
             F = np.fft.rfft(f * wf * we)
             A = np.fft.rfft(r * we[None, :], axis=-1)
-            sff[i] += np.abs(F) ** 2
-            sfa[:, i] += np.conj(F)[None, :] * A
-            saa[:, i] += np.abs(A) ** 2
+            sff[i, h] = np.abs(F) ** 2
+            sfa[:, i, h] = np.conj(F)[None, :] * A
+            saa[:, i, h] = np.abs(A) ** 2
             used[i] += 1
+            use[i, h] = True
             ratios.append(record_decay_ratio(r, int(np.argmax(np.abs(f)))))
         decay[i] = float(np.median(ratios)) if ratios else 0.0
         ratios.clear()
@@ -395,20 +402,12 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
             raise DataError("no valid hit left for an input", file=records.source,
                             field=f"input {records.input_names[i]}",
                             expected="at least one hit that is not dropped")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        h1 = sfa / sff[None]
-        h2 = saa / np.conj(sfa)
-        coh = np.abs(sfa) ** 2 / (sff[None] * saa)
-    if est == "H1":
-        h = h1
-    elif est == "H2":
-        h = h2
-    else:
-        h = np.sqrt(np.abs(h1) * np.abs(h2)) * np.exp(1j * np.angle(h1))
+    h, coh = _combine(sff.sum(axis=1), sfa.sum(axis=2), saa.sum(axis=2), est)
+    sff_all = sff.sum(axis=1)
     freq = np.fft.rfftfreq(n, 1.0 / fs)
     # lines where the force has no energy (e.g. exactly at a zero of the pulse spectrum)
     # cannot be estimated: report them instead of returning NaN
-    good = np.isfinite(h).all(axis=(0, 1)) & (sff.min(axis=0) > 0)
+    good = np.isfinite(h).all(axis=(0, 1)) & (sff_all.min(axis=0) > 0)
     if not good.all():
         k = int(np.flatnonzero(~good)[0])
         if good.sum() < 8:
@@ -422,12 +421,50 @@ def estimate_frf(records: HammerRecords, *, estimator: str = "H1",
                    exp_window_tau_s, records.source,
                    tuple(records.meta.get("output_dofs", ())),
                    tuple(records.meta.get("input_dofs", ())))
-    return FRFEstimate(data, tuple(checks), used, decay)
+    per_hit = {"sff": sff[:, :, good], "sfa": sfa[:, :, :, good], "saa": saa[:, :, :, good],
+               "used": use}
+    return FRFEstimate(data, tuple(checks), used, decay, per_hit, est)
+
+
+def _combine(sff: np.ndarray, sfa: np.ndarray, saa: np.ndarray, est: str
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """FRF (H1/H2/HV) and coherence from summed spectra ``(ni, nf)``, ``(no, ni, nf)``."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h1 = sfa / sff[None]
+        h2 = saa / np.conj(sfa)
+        coh = np.abs(sfa) ** 2 / (sff[None] * saa)
+    if est == "H1":
+        h = h1
+    elif est == "H2":
+        h = h2
+    else:
+        h = np.sqrt(np.abs(h1) * np.abs(h2)) * np.exp(1j * np.angle(h1))
+    return h, coh
+
+
+def combine_hits(est: FRFEstimate, weights: np.ndarray) -> FRFData:
+    """The FRFs of ``est`` re-averaged with per-hit ``weights (n_inputs, n_hits)`` (0 leaves a
+    hit out, 2 counts it twice): the resampling step of the bootstrap/jackknife over hits."""
+    ph = est.per_hit
+    if ph is None:
+        raise InputError("the FRF estimate holds no per-hit spectra", field="per_hit",
+                         expected="an FRFEstimate of estimate_frf")
+    w = np.asarray(weights, float) * ph["used"]
+    if np.any(w.sum(axis=1) <= 0):
+        raise InputError("every input needs a hit", field="weights", value=w.sum(axis=1),
+                         expected="a positive weight for at least one used hit per input")
+    sff = np.einsum("ih,ihf->if", w, ph["sff"])
+    sfa = np.einsum("ih,oihf->oif", w, ph["sfa"])
+    saa = np.einsum("ih,oihf->oif", w, ph["saa"])
+    h, coh = _combine(sff, sfa, saa, est.estimator)
+    coh = np.nan_to_num(np.clip(coh, 0.0, 1.0), nan=0.0)
+    return dataclasses.replace(est.frf, frf=h, coherence=coh)
 
 
 __all__ = [
     "FRF_TYPES", "FRF_UNITS", "FRFData", "HammerRecords", "HitCheck", "FRFEstimate",
     "DoubleHitWarning", "LeakageWarning", "record_decay_ratio", "estimate_frf", "convert_frf",
+    "combine_hits",
     "check_hit", "force_window",
     "exponential_window", "check_frequencies", "check_frf_array", "check_frf_type",
 ]

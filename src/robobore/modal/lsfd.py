@@ -102,6 +102,18 @@ def lsfd(data: FRFData, poles: np.ndarray, participation: np.ndarray,
     return LSFDResult(psi, residues, lr, ur, f, syn, fit)
 
 
+def modal_peak_compliance(residues: np.ndarray, poles: np.ndarray) -> np.ndarray:
+    """``|H_m(j w_d,m)|`` (m/N): the receptance of each mode's own term
+    ``R/(jw - lambda) + conj(R)/(jw - conj(lambda))`` at its damped frequency, per FRF;
+    residues ``(n_o, n_i, n_m)`` receptance residues, poles ``(n_m,)`` rad/s -> ``(n_o, n_i,
+    n_m)``. For a lightly damped real mode this is the modal peak ``phi_o phi_j / (2 zeta
+    w_n^2)``."""
+    lam = np.asarray(poles, complex).ravel()
+    jw = 1j * np.abs(lam.imag)
+    term = residues / (jw - lam) + np.conj(residues) / (jw - np.conj(lam))
+    return np.abs(term)
+
+
 def mpc(shape: np.ndarray) -> float:
     """Modal phase collinearity (Pappa, Elliott & Schenk 1993), 1 for a real (normal) mode.
 
@@ -131,4 +143,4 @@ def normalise_shape(shape: np.ndarray) -> np.ndarray:
     return v / v[k].real if v[k].real != 0 else v / np.abs(v[k])
 
 
-__all__ = ["LSFDResult", "lsfd", "mpc", "normalise_shape"]
+__all__ = ["LSFDResult", "lsfd", "mpc", "normalise_shape", "modal_peak_compliance"]

@@ -123,3 +123,29 @@ def plot_all(an: ModalAnalysis, folder: str | Path) -> list[Path]:
 
 
 __all__ = ["plot_frf_fit", "plot_cmif", "plot_stabilisation", "plot_all"]
+
+
+def plot_operational(result, path: str | Path) -> Path:
+    """Stabilisation diagram of an output-only (SSI-COV) identification: every pole by
+    order and status, the selected modes and the excluded rotation harmonics."""
+    plt = _plt()
+    dg = result.diagram
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for k, (mk, col, lab) in _MARKERS.items():
+        m = dg.status == k
+        if np.any(m):
+            ax.scatter(dg.frequency_Hz[m], dg.order[m], marker=mk, s=14, c=col, label=lab,
+                       linewidths=0.8)
+    for i, md in enumerate(result.modes):
+        ax.axvline(md.frequency_Hz, color="tab:red", lw=0.8,
+                   label="selected" if i == 0 else None)
+    for i, h in enumerate(result.harmonics):
+        ax.axvline(h["frequency_Hz"], color="0.4", lw=0.8, ls=":",
+                   label="rotation harmonic (excluded)" if i == 0 else None)
+    ax.set_xlim(*result.band_Hz)
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("model order (modes)")
+    ax.set_title("SSI-COV stabilisation diagram (output-only)")
+    ax.legend(fontsize=7, loc="upper right")
+    return _save(fig, Path(path))
+

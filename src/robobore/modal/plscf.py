@@ -266,7 +266,8 @@ def correct_poles_for_window(poles: np.ndarray, tau_s: float | None) -> np.ndarr
 
 
 def plscf(data: FRFData, band_Hz: tuple[float, float] | None = None, max_order: int = 40,
-          min_order: int = 1, weighting: str | np.ndarray | None = None) -> PLSCFResult:
+          min_order: int = 1, weighting: str | np.ndarray | None = None,
+          orders: Any = None) -> PLSCFResult:
     """Run pLSCF over the orders ``min_order..max_order``.
 
     Parameters
@@ -276,11 +277,18 @@ def plscf(data: FRFData, band_Hz: tuple[float, float] | None = None, max_order: 
     max_order: highest polynomial order ``p`` (each order gives ``p * n_inputs`` poles).
     weighting: None/``"output"`` (one constant per output, equalising outputs), ``"unit"``,
         or an array ``(n_outputs, n_f_band)``.
+    orders: solve only these orders (``max_order``/``min_order`` are then taken from them).
 
     Returns
     -------
     PLSCFResult; poles are corrected for an exponential window (``data.exp_window_tau_s``).
     """
+    if orders is not None:
+        orders = np.unique(np.asarray(orders, int))
+        if orders.size == 0 or orders[0] < 1:
+            raise InputError("orders must be positive integers", field="orders",
+                             value=orders.tolist(), expected="integers >= 1")
+        max_order, min_order = int(orders[-1]), int(orders[0])
     if not (isinstance(max_order, int | np.integer) and max_order >= 1):
         raise InputError("max order must be a positive integer", field="max_order",
                          value=max_order, expected="an integer >= 1")
@@ -309,8 +317,8 @@ def plscf(data: FRFData, band_Hz: tuple[float, float] | None = None, max_order: 
         r, s, t = normal_equation_lags(f, d.frf / scale, max_order, f_hi, w)
         R, S, T = _blocks(r, s, t, max_order)
         proportional = bool(np.all(w == w[:, :1]))  # constant weight per output
-        sets = solve_orders(R, S, T, np.arange(min_order, max_order + 1), l, Ts,
-                            proportional)
+        todo = np.arange(min_order, max_order + 1) if orders is None else orders
+        sets = solve_orders(R, S, T, todo, l, Ts, proportional)
     tau = data.exp_window_tau_s
     shift = 0.0 if tau is None else 1.0 / tau
     if shift:
@@ -319,5 +327,100 @@ def plscf(data: FRFData, band_Hz: tuple[float, float] | None = None, max_order: 
     return PLSCFResult(tuple(sets), (float(f[0]), f_hi), l, Ts, shift)
 
 
+def poles_near(data: FRFData, poles0: np.ndarray, orders: Any,
+               band_Hz: tuple[float, float] | None = None,
+               weighting: str | np.ndarray | None = None, iterations: int = 30,
+               single_thread: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """The pLSCF poles nearest ``poles0 (n_m,)`` (rad/s, window-corrected like
+    :func:`plscf`'s) at each of ``orders``, without the companion eigenvalue problem: Newton
+    iteration on ``det D(z) = 0`` from ``z0 = exp(lambda0 Ts)``, step
+    ``1 / tr(D(z)^-1 D'(z))`` (all poles at once); the same normal equations and
+    denominators as :func:`plscf`. ``single_thread``: limit BLAS to one thread here (the
+    caller may do it once around many calls).
+
+    Returns poles ``(n_orders, n_m)`` (NaN where Newton did not converge) and participation
+    vectors ``(n_orders, n_m, n_inputs)`` (left null vectors of ``D(z)``, unit norm)."""
+    from contextlib import nullcontext
+
+    orders = np.unique(np.asarray(orders, int))
+    lo, hi = band_Hz if band_Hz is not None else (float(data.frequency_Hz[0]),
+                                                  float(data.frequency_Hz[-1]))
+    d = data.band(lo, hi)
+    f = d.frequency_Hz
+    if f[0] == 0:
+        d = d.band(f[1], f[-1])
+        f = d.frequency_Hz
+    no, l, nf = d.frf.shape
+    p = int(orders[-1])
+    f_hi = float(f[-1])
+    Ts = 1.0 / (2.0 * f_hi)
+    w = _weights(d.frf, weighting)
+    scale = np.max(np.abs(d.frf)) or 1.0
+    tau = data.exp_window_tau_s
+    shift = 0.0 if tau is None else 1.0 / tau
+    lam0 = np.asarray(poles0, complex).ravel() - shift
+    nm = lam0.size
+    out = np.full((orders.size, nm), np.nan + 0j)
+    part = np.zeros((orders.size, nm, l), complex)
+    with single_thread_blas() if single_thread else nullcontext():
+        r, s_, t = normal_equation_lags(f, d.frf / scale, p, f_hi, w)
+        R, S, T = _blocks(r, s_, t, p)
+        proportional = bool(np.all(w == w[:, :1]))
+        for io, n in enumerate(int(v) for v in orders):
+            M = _reduced_matrix(R, S, T, n, l, proportional)
+            ar, _ = _companion(M, n, l)
+            full = np.concatenate([ar, np.eye(l)[None]], axis=0)  # alpha_0..alpha_n
+            dfull = full[1:] * np.arange(1, n + 1)[:, None, None]  # r alpha_r
+            z = np.exp(lam0 * Ts)
+            done = np.zeros(nm, bool)
+            bad = np.zeros(nm, bool)
+            for _ in range(iterations):
+                act = ~(done | bad)
+                if not act.any():
+                    break
+                pw = z[act, None] ** np.arange(n + 1)[None, :]  # (na, n+1)
+                D = np.einsum("kr,rab->kab", pw, full)
+                Dp = np.einsum("kr,rab->kab", pw[:, :n], dfull)
+                with np.errstate(all="ignore"):
+                    try:
+                        tr = np.trace(np.linalg.solve(D, Dp), axis1=1, axis2=2)
+                    except np.linalg.LinAlgError:  # a singular D: that z is a root
+                        tr = np.array([_trace_or_root(Dk, Dpk) for Dk, Dpk in zip(D, Dp,
+                                                                                 strict=True)])
+                    step = np.where(np.isfinite(tr) & (tr != 0), 1.0 / tr, 0.0)
+                ia = np.flatnonzero(act)
+                zn = z[ia] - step
+                root = ~np.isfinite(tr)  # singular D
+                ok = np.isfinite(zn) & (np.abs(zn) > 0) & (np.abs(zn) < 2)
+                bad[ia[~ok & ~root]] = True
+                z[ia[ok]] = zn[ok]
+                conv = (np.abs(step) < 1e-13 * np.maximum(1.0, np.abs(zn))) & ok
+                done[ia[conv | root]] = True
+            good = done & ~bad
+            with np.errstate(all="ignore"):
+                lam = np.log(z) / Ts
+            lam = np.where(lam.imag < 0, np.conj(lam), lam)
+            zg = np.where(lam.imag < 0, np.conj(z), z)
+            out[io, good] = lam[good] + shift
+            if l == 1:
+                part[io, good] = 1.0
+            elif good.any():
+                pw = zg[good, None] ** np.arange(n + 1)[None, :]
+                DT = np.einsum("kr,rab->kba", pw, full)
+                _, _, Vh = np.linalg.svd(DT)
+                v = Vh[:, -1, :].conj()
+                part[io, good] = v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True),
+                                                1e-300)
+    return out, part
+
+
+def _trace_or_root(D: np.ndarray, Dp: np.ndarray) -> complex:
+    """``tr(D^-1 D')``, or inf when ``D`` is singular (``z`` is a root)."""
+    try:
+        return complex(np.trace(np.linalg.solve(D, Dp)))
+    except np.linalg.LinAlgError:
+        return complex(np.inf)
+
+
 __all__ = ["PoleSet", "PLSCFResult", "plscf", "normal_equation_lags", "solve_orders",
-           "correct_poles_for_window"]
+           "correct_poles_for_window", "poles_near"]

@@ -132,6 +132,7 @@ class SelectedPole:
     cluster_size: int
     frequency_spread: float  # relative std of the cluster's frequencies
     damping_spread: float  # relative std of the cluster's damping ratios
+    orders: tuple[int, ...] = ()  # the orders that support the cluster
 
 
 def _cluster(feat: np.ndarray) -> np.ndarray:
@@ -144,15 +145,11 @@ def _cluster(feat: np.ndarray) -> np.ndarray:
     return fcluster(Z, t=1.0, criterion="distance") - 1
 
 
-def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
-                 approx_Hz: list[float] | None = None, min_fraction: float = 0.3,
-                 cluster_freq_tol: float = 0.005, cluster_damp_tol: float = 0.3,
-                 max_damping: float = 0.3, edge_fraction: float = 0.01,
-                 search_tol: float = 0.1, min_status: int = 4) -> list[SelectedPole]:
-    """Pick the physical poles automatically (see module docstring); sorted by frequency."""
-    if n_modes is not None and n_modes < 1:
-        raise InputError("number of modes must be >= 1", field="modes", value=n_modes,
-                         expected="an integer >= 1")
+def pole_clusters(diagram: StabilisationDiagram, *, cluster_freq_tol: float = 0.005,
+                  cluster_damp_tol: float = 0.3, max_damping: float = 0.3,
+                  edge_fraction: float = 0.01, min_status: int = 4) -> list[SelectedPole]:
+    """Every cluster of fully stable in-band poles as a :class:`SelectedPole`, best-supported
+    (most orders) first; raises IdentificationError when the band holds no stable pole."""
     lo, hi = diagram.band_Hz
     width = hi - lo
     m = ((diagram.status >= min_status) & (diagram.damping_ratio > 0)
@@ -167,7 +164,6 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
     z = diagram.damping_ratio[idx]
     feat = np.column_stack([np.log(f) / cluster_freq_tol, np.log(z) / cluster_damp_tol])
     labels = _cluster(feat)
-    n_orders = diagram.orders.size
     # complete linkage may split one mode's poles in two when they spread over slightly
     # more than one diameter: merge clusters whose medians are within one diameter
     groups = [idx[labels == c] for c in np.unique(labels)]
@@ -184,16 +180,9 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
                 break
         else:
             merged.append(g)
-    clusters = []
-    for mem in merged:
-        n_ord = np.unique(diagram.order[mem]).size  # orders supporting this cluster
-        fm = float(np.median(diagram.frequency_Hz[mem]))
-        zm = float(np.median(diagram.damping_ratio[mem]))
-        clusters.append((n_ord, fm, zm, mem))
-    clusters.sort(key=lambda c: -c[0])
 
-    def make(c: tuple[int, float, float, np.ndarray]) -> SelectedPole:
-        n_ord, _, _, mem = c
+    def make(mem: np.ndarray) -> SelectedPole:
+        n_ord = np.unique(diagram.order[mem]).size  # orders supporting this cluster
         fd = diagram.frequency_Hz[mem]
         zd = diagram.damping_ratio[mem]
         # estimate from the upper half of the cluster's orders: low orders bias close and
@@ -209,20 +198,46 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
         wn = 2 * np.pi * fm
         lam = complex(-zm * wn, wn * np.sqrt(max(0.0, 1 - zm**2)))
         return SelectedPole(lam, diagram.participation[k].copy(), fm, zm, int(n_ord),
-                            float(np.std(fd) / fm), float(np.std(zd) / zm))
+                            float(np.std(fd) / fm), float(np.std(zd) / zm),
+                            tuple(int(v) for v in np.unique(diagram.order[mem])))
 
-    need = max(2, int(np.ceil(min_fraction * n_orders)))
+    out = [make(mem) for mem in merged]
+    out.sort(key=lambda c: -c.cluster_size)
+    return out
+
+
+def support_needed(diagram: StabilisationDiagram, min_fraction: float = 0.3) -> int:
+    """Orders a cluster must be stable over to count as a physical mode."""
+    return max(2, int(np.ceil(min_fraction * diagram.orders.size)))
+
+
+def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
+                 approx_Hz: list[float] | None = None, min_fraction: float = 0.3,
+                 cluster_freq_tol: float = 0.005, cluster_damp_tol: float = 0.3,
+                 max_damping: float = 0.3, edge_fraction: float = 0.01,
+                 search_tol: float = 0.1, min_status: int = 4) -> list[SelectedPole]:
+    """Pick the physical poles automatically (see module docstring); sorted by frequency.
+
+    ``n_modes`` keeps the best-supported clusters (the contribution ranking is
+    :func:`robobore.modal.identify.identify_modes`' ``select``)."""
+    if n_modes is not None and n_modes < 1:
+        raise InputError("number of modes must be >= 1", field="modes", value=n_modes,
+                         expected="an integer >= 1")
+    clusters = pole_clusters(diagram, cluster_freq_tol=cluster_freq_tol,
+                             cluster_damp_tol=cluster_damp_tol, max_damping=max_damping,
+                             edge_fraction=edge_fraction, min_status=min_status)
+    need = support_needed(diagram, min_fraction)
     if approx_Hz:
         chosen = []
         for fa in approx_Hz:
-            cand = [c for c in clusters if abs(c[1] - fa) <= search_tol * fa]
+            cand = [c for c in clusters if abs(c.frequency_Hz - fa) <= search_tol * fa]
             if not cand:
                 raise IdentificationError(
                     f"no stable pole cluster within {100 * search_tol:g} % of {fa:g} Hz")
             # the nearest well-supported cluster; if none is, the best-supported one
-            strong = [c for c in cand if c[0] >= need]
-            best = (min(strong, key=lambda c: abs(c[1] - fa)) if strong
-                    else max(cand, key=lambda c: (c[0], -abs(c[1] - fa))))
+            strong = [c for c in cand if c.cluster_size >= need]
+            best = (min(strong, key=lambda c: abs(c.frequency_Hz - fa)) if strong
+                    else max(cand, key=lambda c: (c.cluster_size, -abs(c.frequency_Hz - fa))))
             chosen.append(best)
     elif n_modes is not None:
         chosen = clusters[:n_modes]
@@ -231,7 +246,7 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
                 f"asked for {n_modes} modes but the diagram has only {len(chosen)} stable "
                 "pole clusters: raise --max-order or check the band")
     else:
-        chosen = [c for c in clusters if c[0] >= need]
+        chosen = [c for c in clusters if c.cluster_size >= need]
         if not chosen:
             raise IdentificationError(
                 f"no pole is stable over {need} orders: raise --max-order or check the data")
@@ -242,9 +257,10 @@ def select_poles(diagram: StabilisationDiagram, *, n_modes: int | None = None,
         if id(c) in seen:
             continue
         seen.add(id(c))
-        out.append(make(c))
+        out.append(c)
     return sorted(out, key=lambda s: s.frequency_Hz)
 
 
-__all__ = ["StabilisationDiagram", "SelectedPole", "stabilisation", "select_poles", "mac",
+__all__ = ["StabilisationDiagram", "SelectedPole", "stabilisation", "select_poles",
+           "pole_clusters", "support_needed", "mac",
            "mac_matrix", "STATUS_LABELS"]
