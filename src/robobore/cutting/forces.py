@@ -71,6 +71,22 @@ class CuttingCoefficients:
     #: the cutting speed [m/min] a speed-dependent set was evaluated at (None: one set for
     #: every speed)
     speed_m_per_min: float | None = field(default=None, compare=False)
+    #: the uncut chip thicknesses [m] the set was fitted over (None: not known)
+    chip_thickness_range_m: tuple[float, float] | None = field(default=None, compare=False)
+
+    def domain_warnings(self, chip_thickness_m: Any) -> list[str]:
+        """The set's warnings plus one when the nominal chip thickness of a cut (the largest
+        ``h0`` of its elements) exceeds the fitted range: the linear law extrapolated beyond
+        its thickest test. Thinner chips are what the edge term of the law is for (towards
+        the nose tip every boring chip thins to zero), so they are not flagged."""
+        out = list(self.warnings)
+        rng = self.chip_thickness_range_m
+        h = np.asarray(chip_thickness_m, float)
+        if rng is not None and h.size and float(h.max()) > rng[1] * (1 + 1e-9):
+            out.append(f"cutting coefficients fitted over chip thicknesses "
+                       f"{rng[0] * 1e6:g}-{rng[1] * 1e6:g} um, used up to "
+                       f"{float(h.max()) * 1e6:.3g} um (the linear force law extrapolated)")
+        return out
 
     def __post_init__(self) -> None:
         for name in _KEYS:
@@ -342,8 +358,15 @@ def ti64_coefficients(cutting_speed_m_per_min: float | None = 30.0) -> CuttingCo
     prov = ("TC4: least-squares fit Fc = Kte + Ktc h, Ff = Kfe + Kfc h of measured orthogonal "
             "forces (Ducobu et al., CIRP 2022; rake 15 deg, edge radius 20 um), "
             f"interpolated at vc = {vq:.3g} m/min" + note)
+    warn = (f"cutting speed {vc:.3g} m/min outside the measured {v[0]:g}-{v[-1]:g} m/min of "
+            f"the TC4 coefficients: held at the {vq:g} m/min fit",) if note else ()
     return CuttingCoefficients(Ktc=vals["Ktc"], Krc=0.0, Kfc=vals["Kfc"], Kte=vals["Kte"],
-                               Kre=0.0, Kfe=vals["Kfe"], provenance=prov, speed_m_per_min=vq)
+                               Kre=0.0, Kfe=vals["Kfe"], provenance=prov, speed_m_per_min=vq,
+                               warnings=warn, chip_thickness_range_m=TI64_CHIP_THICKNESS_M)
+
+
+#: Uncut chip thicknesses [m] of the measured TC4 data the default coefficients are fitted to.
+TI64_CHIP_THICKNESS_M = (40e-6, 80e-6)
 
 
 @dataclass(frozen=True)

@@ -190,8 +190,9 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         "model": "robobore.dynamics time-domain boring (regenerative, mechanistic forces)",
         # the set used at this condition's cutting speed (speed-dependent coefficients)
         "coefficients_provenance": None if coef is None else coef.provenance,
-        "coefficient_warnings": [] if coef is None else list(coef.warnings),
+        "coefficient_warnings": [] if coef is None else coef.domain_warnings(pr.h0),
     }
+    out["warnings"] = list(out["coefficient_warnings"])
     if return_dataset:
         out["dataset"] = ds
         out["config"] = raw
@@ -231,6 +232,7 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     d["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
     if default_note is not None:
         d["speed_note"] = default_note
+    d["warnings"] = [] if coef is None else coef.domain_warnings(pr.h0)
     if coef is not None:
         from robobore.dynamics.config import lobe_coefficient_note
 

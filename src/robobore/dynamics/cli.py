@@ -135,6 +135,7 @@ def lobes_cmd(
         notes.append("boring process built from its chip geometry at every trial depth (the "
                      "chip the time domain integrates at that depth)")
     out["notes"] = notes
+    out["warnings"] = [] if coef is None else coef.domain_warnings(pr.h0)
     if plot is not None:
         curves = stability.lobe_curves(st, pr, 12) if method == "frequency" else None
         out["plot"] = str(stability_plot(res, plot, curves, pr.label))
@@ -154,6 +155,8 @@ def lobes_cmd(
                 ("mode-coupling limit (mm)", r["mode_coupling_limit_mm"])]
         if "plot" in r:
             rows.append(("plot", r["plot"]))
+        for w in r["warnings"]:
+            rows.append(("warning (coefficients)", w))
         stdout.print(kv_table("stability lobes", rows))
         for n in notes:
             stdout.print(f"[dim]note: {n}[/]")
