@@ -125,8 +125,6 @@ def test_factor_two_warning():
 @pytest.mark.parametrize("args,words", [
     (["--robot", "irb6600-175-2.55", "--joint-stiffness-Nm-per-rad", "1,2,3,4,5,6"],
      "no posture given"),
-    (["--robot", "irb6600-175-2.55", "--joints-deg=0,0,0,0,30,0"],
-     "give exactly one joint stiffness"),
     (["--robot", "nosuchrobot", "--joints-deg=0,0,0,0,30,0",
       "--joint-stiffness-Nm-per-rad", "1,2,3,4,5,6"], "unknown robot"),
     (["--robot", "irb6600-175-2.55", "--joints-deg=0,0,0",

@@ -242,4 +242,26 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     return d
 
 
-__all__ = ["run_boring", "lobes", "UNDECIDED_MAX_FACTOR"]
+def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, speed_rpm: float,
+                      equivalent: Any = None) -> dict[str, Any]:
+    """The semi-discretisation answer of :func:`lobes` at one speed: ``critical_depth_mm``
+    (None: stable up to the scan top; 0: no chatter-free depth) and
+    ``interrupted_below_mm`` (:func:`robobore.dynamics.semidiscretization.chatter_free_window`)
+    of the config's robot and process."""
+    from robobore.dynamics.semidiscretization import chatter_free_window
+
+    cfg, _, src = _config(config, equivalent=equivalent)
+    if not (isinstance(speed_rpm, int | float) and math.isfinite(speed_rpm)
+            and 1.0 <= speed_rpm <= 100000.0):
+        raise ConfigError("spindle speed out of range", file=src, field="speed_rpm",
+                          value=speed_rpm, expected="1 .. 100000 r/min")
+    st = build_structure(cfg, src)
+    coef = build_coefficients(cfg, src) if cfg.is_boring else None
+    pr = build_process(cfg, src, coefficients=coef)
+    below, a = chatter_free_window(st, pr, float(speed_rpm))
+    return {"speed_rpm": float(speed_rpm),
+            "critical_depth_mm": a * 1e3 if math.isfinite(a) else None,
+            "interrupted_below_mm": below * 1e3}
+
+
+__all__ = ["run_boring", "lobes", "critical_depth_at", "UNDECIDED_MAX_FACTOR"]

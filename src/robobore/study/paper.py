@@ -282,7 +282,7 @@ def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
     below means no chatter, or its verdict states the tool leaving the cut. Returns the
     counts and one record per condition; ``inconsistent`` lists the conditions that break
     the rule."""
-    from robobore.dynamics.api import lobes
+    from robobore.dynamics.api import critical_depth_at
 
     base_f = float(cfg.study.base["feed_mm_per_rev"])
     cache: dict[tuple[float, float], float] = {}
@@ -301,9 +301,7 @@ def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
                     **(dyn["equivalent"].get("pressure_foot") or {}), "pressure_MPa": p}
             dyn["cutting"] = {"speed_rpm": n, "feed_mm_per_rev": base_f,
                               "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
-            dyn["speed_rpm"] = {"min": n, "max": n, "count": 1}
-            d = lobes(dyn, method="semidiscretization")
-            v = d["critical_depth_mm"][0]
+            v = critical_depth_at(dyn, n)["critical_depth_mm"]
             cache[(n, p)] = math.inf if v is None else float(v)
         lim = cache[(n, p)]
         a = float(r["depth_of_cut_mm"])
