@@ -39,6 +39,13 @@ def plot_rotation_map(result: dict[str, Any], ax: Any) -> None:
                 label="measured posture")
     ax.set_xlabel("tool-axis rotation ψ [deg] (flange x from boring X)")
     ax.set_ylabel(CRITERION_LABEL[result["criterion"]])
+    ax.ticklabel_format(axis="y", useOffset=False)
+    fin = crit[np.isfinite(crit)]
+    if fin.size and np.ptp(fin) <= 1e-6 * max(abs(float(fin.max())), 1e-300):
+        ax.text(0.5, 0.5, "the criterion does not vary over the candidates\n"
+                f"({fin.max():.4g} everywhere: e.g. a tool axis along the flange axis, where "
+                "the rotation only turns joint 6)", transform=ax.transAxes, ha="center",
+                va="center", fontsize=8, bbox=dict(fc="white", ec="0.6"))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
 
@@ -89,7 +96,10 @@ def plot_posture_plan(result: dict[str, Any], out_dir: str | Path,
     if result.get("lobes"):
         fig, ax = plt.subplots(figsize=(7, 4))
         for name, L in result["lobes"].items():
-            ax.plot(L["speed_rpm"], L["critical_depth_mm"], label=f"{name} posture")
+            d = np.asarray(L["critical_depth_mm"], float)
+            pos = d[np.isfinite(d) & (d > 0)]
+            floor = 0.5 * float(pos.min()) if pos.size else 1e-3
+            ax.plot(L["speed_rpm"], np.where(d > 0, d, floor), label=f"{name} posture")
         ax.axhline(result["cutting"]["depth_mm"], color="k", lw=0.8, ls="--",
                    label="depth of cut")
         ax.set_xlabel("spindle speed [r/min]")
@@ -97,7 +107,8 @@ def plot_posture_plan(result: dict[str, Any], out_dir: str | Path,
         ax.set_yscale("log")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-        ax.set_title("stability lobes (frequency domain)" + syn, fontsize=9)
+        ax.set_title("stability lobes (semi-discretisation; 0: no chatter-free depth, drawn "
+                     "at the axis floor)" + syn, fontsize=9)
         fig.tight_layout()
         p = out / "posture_lobes.png"
         fig.savefig(p, dpi=130)

@@ -79,6 +79,17 @@ SD_SPEEDS = 30
 PLAN_MODE_SHARE = 1e-3
 
 
+def _flat_map_warning(crit: np.ndarray, name: str) -> list[str]:
+    """A sentence when the criterion does not vary over the candidates (the map is flat)."""
+    fin = crit[np.isfinite(crit)]
+    if fin.size > 1 and np.ptp(fin) <= 1e-6 * max(abs(float(fin.max())), 1e-300):
+        return [f"the {name} criterion does not vary over the {fin.size} candidates "
+                f"({float(fin.max()):.4g}): the posture choice does not matter for it here "
+                "(e.g. a tool axis along the flange axis, where the rotation only turns "
+                "joint 6)"]
+    return []
+
+
 def _same_posture(q1: np.ndarray, q2: np.ndarray, tol: float = 1e-6) -> bool:
     d = np.angle(np.exp(1j * (np.asarray(q1) - np.asarray(q2))))
     return bool(np.max(np.abs(d)) < tol)
@@ -234,7 +245,6 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "measured_posture_error": {"position_mm": meas_pos_err * 1e3,
                                    "axis_deg": meas_ax_err},
         "calibration": cal.to_dict(),
-        "warnings": cal.warnings(),
         "bore": {"point_m": inp.bore_point_m.tolist(), "axis": inp.bore_axis.tolist(),
                  "boring_frame_columns": Rb.T.tolist()},
         "tcp_m": inp.tcp_m.tolist(),
@@ -249,7 +259,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "lobes": lobes,
         "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
-        "warnings": warn,
+        "warnings": warn + cal.warnings() + _flat_map_warning(crit0, cfg.plan.criterion),
         "identity": make_identity(
             "plan", robot=robot.name, robot_hash=robot.description_hash(),
             robot_file=robot.file or None, joints_deg=entries[best]["joints_deg"],

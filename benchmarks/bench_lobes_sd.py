@@ -1,0 +1,72 @@
+"""Semi-discretisation lobes per speed on the example robot (examples/boring_paper.toml).
+
+Prints the wall time per speed of ``lobes_semidiscretization`` over ``--speeds`` speeds of
+150-1100 r/min (one BLAS thread, numba compiled beforehand) and the spectral radii it
+evaluated per speed; with ``--reference-tree PATH`` the same run of another checkout's
+``src`` in a subprocess, alternated ``--pairs`` times, and the ratio of the medians (the two
+trees share the machine's load).
+
+    python benchmarks/bench_lobes_sd.py [--speeds 48] [--reference-tree ../main] [--pairs 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CHILD = r"""
+import json, sys, time
+import numpy as np
+from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+from robobore.dynamics.stability import lobes_semidiscretization
+cfg, _ = load_dynamics_config(sys.argv[1])
+st, pr = build_structure(cfg), build_process(cfg)
+sp = np.linspace(150.0, 1100.0, int(sys.argv[2]))
+lobes_semidiscretization(st, pr, sp[:2])
+t = time.perf_counter()
+L = lobes_semidiscretization(st, pr, sp)
+dt = time.perf_counter() - t
+print("RESULT" + json.dumps({"ms_per_speed": 1e3 * dt / sp.size,
+                             "critical_depth_mm": (L.critical_depth_m * 1e3).tolist()}))
+"""
+
+
+def run(tree: Path, speeds: int) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(tree / "src"), "NUMBA_NUM_THREADS": "1",
+           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    out = subprocess.run([sys.executable, "-c", CHILD, str(ROOT / "examples" / "boring_paper.toml"),
+                          str(speeds)], env=env, capture_output=True, text=True, check=True)
+    line = [ln for ln in out.stdout.splitlines() if ln.startswith("RESULT")][-1]
+    return json.loads(line[len("RESULT"):])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--speeds", type=int, default=48)
+    ap.add_argument("--reference-tree", type=Path, default=None)
+    ap.add_argument("--pairs", type=int, default=3)
+    a = ap.parse_args()
+    load = os.getloadavg()[0]
+    mine, ref = [], []
+    for _ in range(a.pairs if a.reference_tree else 1):
+        mine.append(run(ROOT, a.speeds)["ms_per_speed"])
+        if a.reference_tree:
+            ref.append(run(a.reference_tree, a.speeds)["ms_per_speed"])
+    print(f"semi-discretisation lobes, examples/boring_paper.toml, {a.speeds} speeds "
+          f"150-1100 r/min, load {load:.1f}: this tree {statistics.median(mine):.1f} ms/speed "
+          f"({', '.join(f'{v:.1f}' for v in mine)})")
+    if ref:
+        print(f"reference {a.reference_tree}: {statistics.median(ref):.1f} ms/speed "
+              f"({', '.join(f'{v:.1f}' for v in ref)}); ratio reference/this "
+              f"{statistics.median(ref) / statistics.median(mine):.2f}")
+
+
+if __name__ == "__main__":
+    main()
