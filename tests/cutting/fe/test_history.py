@@ -34,7 +34,7 @@ def test_both_layouts_follow_the_history_column_order():
 
 def test_an_engine_description_must_name_every_slot():
     with pytest.raises(ValueError, match="NDIM"):
-        H.bind_end_step(lambda f: f, {"NDIM": 2}, None, None)
+        H.make_end_step(lambda f: f, {"NDIM": 2}, None, None)
 
 
 def _state2(n_hist=3, sample_dt=1.0, t_end=10.0):

@@ -19,9 +19,9 @@ neighbours); moves limited to ``max_move`` of the local size. The class of a nod
 in-plane neighbours (global indices) are ``acls`` (n, 7) of
 :attr:`robobore.cutting.fe.mesh.toolframe3d.ToolFrameMesh3D.acls`; ``aflt`` (n, 6) the 2D
 meaning, per slice in the slice's plane (:func:`toolframe3d_ale_data`). The per-node passes
-are the 2D scalar functions themselves, run on the 3D x, y arrays: ``tf_place_py`` rebound
-(:func:`robobore.material.johnson_cook.rebind`) to leave out its 2D "off tool" step, which
-:func:`off_insert_py` replaces with the 3D insert's: a surface node whose placed point lies
+are the 2D scalar functions themselves, run on the 3D x, y arrays: ``tf_place_py`` made again
+(:func:`robobore.cutting.fe.ale.rezone.make_tf_place` given :func:`keep_py`) to leave out its
+2D "off tool" step, which :func:`off_insert_py` replaces with the 3D insert's: a surface node whose placed point lies
 deeper in the insert than its old point (or in it at all when the old point was outside)
 is pushed back along the in-plane part ``(nx, ny)`` of the insert's outward normal by
 ``(g_t - g_1) / (nx^2 + ny^2)`` -- the first-order in-plane move that restores the gap
@@ -45,8 +45,8 @@ deflection of the insert in y moves the insert, not the places.
 
 The passes are scalar functions of one node (``*_py`` originals, ``njit`` versions without
 the suffix), each reading only what the previous pass wrote and allocating nothing, run from
-``prange`` loops on the CPU; a GPU kernel can compile the same source (rebinding
-``tf_place_py``'s ``_limit``, ``off_insert_py``'s ``insert_gap3``).
+``prange`` loops on the CPU; a GPU kernel can compile the same source (with device
+versions of ``make_tf_place``'s ``limit`` and of ``off_insert_py``'s ``insert_gap3``).
 """
 
 from __future__ import annotations
@@ -85,7 +85,6 @@ from robobore.cutting.fe.hex.layout3d import (
     P_TOOL,
 )
 from robobore.cutting.fe.hex.scalar3d import insert_gap3
-from robobore.material.johnson_cook import rebind
 
 __all__ = ["OFF_NMIN2", "keep_py", "off_insert_py", "off_insert", "tf_place_plane_py",
            "tf_place_plane", "place3_py", "place3", "tf_face3_py", "tf_face3",
@@ -104,9 +103,10 @@ def keep_py(px, py, qx, qy, tg):
 _keep = njit(cache=True, inline="always")(keep_py)
 
 #: :func:`robobore.cutting.fe.ale.rezone.tf_place_py` without its 2D "off tool" step (the
-#: same source, ``_off_tool`` rebound to :func:`keep_py`): rigid nodes, surface chains and
-#: chain ends on the outflow lines, in the plane of the node
-tf_place_plane_py = rebind(RZ.tf_place_py, _off_tool=_keep)
+#: same source, :func:`robobore.cutting.fe.ale.rezone.make_tf_place` given :func:`keep_py` for
+#: ``off_tool``): rigid nodes, surface chains and chain ends on the outflow lines, in the plane
+#: of the node
+tf_place_plane_py = RZ.make_tf_place(RZ.limit, _keep)
 tf_place_plane = njit(inline="always")(tf_place_plane_py)
 
 

@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.ale.rezone3d import rezone3d
-from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
+from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
 from robobore.cutting.fe.engine.kernels import (
     E_ERODED,
     E_EXT,
@@ -65,7 +65,7 @@ from robobore.cutting.fe.engine.kernels import (
     STATUS_NONFINITE,
     STATUS_OK,
 )
-from robobore.cutting.fe.engine.step_loop import bind_chunk_loop
+from robobore.cutting.fe.engine.step_loop import make_chunk_loop
 from robobore.cutting.fe.hex.element import hex_element
 from robobore.cutting.fe.hex.layout3d import (
     ERODE_LAYER,
@@ -229,12 +229,10 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
                  pairs)
 
 
-#: the energy totals (:func:`robobore.cutting.fe.engine.history.energy_totals_py` in 3D) of the
-#: state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
-#: ``en`` (2D engine's indices) [J]
-sum_energies3_py = jc.rebind(energy_totals_py, NDIM=3)
-# its own name (see history.bind_end_step)
-sum_energies3_py.__name__ = sum_energies3_py.__qualname__ = "sum_energies3_py"
+#: the energy totals (:func:`robobore.cutting.fe.engine.history.make_energy_totals` in 3D) of
+#: the state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
+#: into ``en`` (2D engine's indices) [J], under its own name (see history.make_end_step)
+sum_energies3_py = make_energy_totals(3, "sum_energies3_py")
 _energy_totals3 = njit(sum_energies3_py)
 
 
@@ -264,8 +262,8 @@ def tool_columns3_py(tool):
 ENGINE3 = {"NDIM": 3, "N_SPLIT": 0, "N_TOOL_COLUMNS": 2, "T_FORCE": T_FX, "T_DISP": T_UX,
            "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
            "COUNT_STOPPED_STEP": 1}
-#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`)
-_end_step3 = bind_end_step(njit, ENGINE3, njit(tool_columns3_py), _energy_totals3)
+#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.make_end_step`)
+_end_step3 = make_end_step(njit, ENGINE3, njit(tool_columns3_py), _energy_totals3)
 
 
 @njit(cache=True)
@@ -411,7 +409,7 @@ def _no_heat3(s, step, t, dt):
 
 def _bind3(name, remesh, elements, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases
-    return bind_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
+    return make_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
                            energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
                            nodes=_nodes3, tool_step=_tool_step3, remesh=remesh,
                            elements=elements, heat=heat, end_step=_end_step3,
@@ -437,7 +435,7 @@ def run_chunk3(n_steps, *arrays):
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
     STATUS_DONE at ``prm[P_TEND]``, or an instability status (each step ends with
-    :func:`robobore.cutting.fe.engine.history.end_step_py`). Returns the steps taken; the
+    :func:`robobore.cutting.fe.engine.history.make_end_step`). Returns the steps taken; the
     energy totals are summed after a chunk that ran to its end.
     """
     return _loop3(n_steps, *arrays)

@@ -5,8 +5,9 @@ of the CPU engine (:func:`kernels.quad_element_py`, :func:`kernels.quad_node_py`
 :func:`kernels.tool_kinematics_py`, :func:`kernels.tool_step_py`,
 :func:`kernels.quad_centroid_py`, :func:`kernels.quad_conduct_py`,
 :func:`kernels.sum_energies_py`) and the shared material/contact/support functions
-(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), re-bound
-to device versions with :func:`robobore.material.johnson_cook.rebind` and compiled with
+(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), made
+with device versions of their callees by their factories
+(:mod:`robobore.cutting.fe.engine.gpu.device2d`) and compiled with
 ``numba.cuda.jit(device=True)``; the CPU engine calls the ``njit`` versions of the same
 functions from its ``prange`` loops.
 

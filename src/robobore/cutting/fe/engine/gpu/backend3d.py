@@ -3,9 +3,8 @@
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
 (:func:`hex.element.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
 and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
-:mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
-:func:`robobore.material.johnson_cook.rebind` and compiled with
-``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
+:mod:`robobore.cutting.fe.physics.tool_contact`), made with device versions of their callees
+by their factories and compiled with ``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
 force total (one block, in the CPU's fixed lane order, so a run is reproducible bit for
 bit), the tool (one thread), elements (stable step by atomic min), and the step end (one
 thread: time, status, time-averaged histories); every ``solver.conduction_interval`` steps

@@ -313,7 +313,7 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red, es):
-        # the step end (one thread): history.end_step_py on the step's reductions
+        # the step end (one thread): history.make_end_step's end_step on the step's reductions
         nc = red[R_NC]
         red[R_NC] = 0.0  # the force total is rewritten by k_contact_sum every step
         end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], 0.0, nc,

@@ -68,9 +68,9 @@ def jc_device_functions(dev):
 
     th = dev(jc.homologous_temperature_py)
     athermal = dev(jc.jc_athermal_py)
-    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
-    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
-    ret = dev(jc.rebind(jc.jc_return_py, jc_athermal=athermal, homologous_temperature=th))
+    fail = dev(jc.make_jc_failure_strain(homologous_temperature=th))
+    dmg = dev(jc.make_jc_damage_increment(jc_failure_strain=fail))
+    ret = dev(jc.make_jc_return(jc_athermal=athermal, homologous_temperature=th))
     return dmg, ret
 
 
