@@ -2,7 +2,7 @@
 (:data:`robobore.cutting.fe.engine.layout.PRM_FIELDS`,
 :data:`robobore.cutting.fe.hex.layout3d.PRM_FIELDS`): every ``P_*`` constant a kernel reads
 is the first slot of its declared field, the fields tile ``0 .. N_PRM - 1`` without gap or
-overlap, the modules that import the constants agree with the declaration, and the literal
+overlap, modules that import the constants agree with the declaration, and the literal
 block of constants in each layout module is the one its table renders (a table edited
 without ``python -m robobore.cutting.fe.engine.prm_layout`` fails here).
 """
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import chunk_loop as CL
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine import layout as L
 from robobore.cutting.fe.engine.prm_layout import (
@@ -31,7 +31,7 @@ from robobore.cutting.fe.hex import layout3d as L3
 from robobore.cutting.fe.hex import scalar3d as S3
 
 
-@pytest.mark.parametrize("layout, users", [(L, (K,)), (L3, (K3, S3))])
+@pytest.mark.parametrize("layout, users", [(L, (CL,)), (L3, (K3, S3))])
 def test_fields_tile_the_vector_and_bind_the_constants(layout, users):
     rows = describe(layout.PRM_FIELDS)
     nxt = 0

@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-
 #: most points of a friction table read at the sliding speed (its ``P_MUTAB_*`` slots)
 MU_TABLE_MAX = 8
 

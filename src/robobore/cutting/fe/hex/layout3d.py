@@ -1,6 +1,7 @@
-"""Index layout of the 3D engine's parameter vector ``prm`` (module constants ``P_*``, the
-first slot of each field of the one declaration :data:`PRM_FIELDS`, written out below it as
-literal constants by :mod:`robobore.cutting.fe.engine.prm_layout`; ``N_PRM`` its length) and the damage-erosion codes ``ERODE_*``; read by the hexahedron
+"""Index layout of the 3D engine's parameter vector ``prm`` (module constants ``P_*``, the first
+slot of each field of the one declaration :data:`PRM_FIELDS`, written out below it as literal
+constants by :mod:`robobore.cutting.fe.engine.prm_layout`; ``N_PRM`` its length) and the
+damage-erosion codes ``ERODE_*``; read by the hexahedron
 (:mod:`robobore.cutting.fe.hex.element`), the scalar node and tool functions
 (:mod:`robobore.cutting.fe.hex.scalar3d`) and the 3D loops on both devices.
 """

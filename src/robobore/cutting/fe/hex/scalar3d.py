@@ -137,17 +137,17 @@ def make_insert_gap3(tool_gap, edge_section):
     def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
         """Signed distance of a point to the boring insert and the insert's outward normal.
 
-        ``(px, py, pz)`` [m] is the point relative to the insert's tip reference (the lowest point
-        of the nose, on the cutting edge) in the local frame (x cutting direction, y out of the
-        workpiece, z feed). The edge profile in the y-z plane is the nose arc of radius ``rn``
-        (centre at y = rn, z = 0) spanning local approach angles -kend..kappa, continued by the
-        major edge (approach angle ``kappa`` to the feed axis) and the minor (end) edge (angle
-        ``kend``). In every normal section of the edge the insert is the 2D wedge of the 2D
-        engine (:func:`tool_contact.tool_gap_py`: normal rake ``rake``, clearance ``clr``, edge
-        radius ``re`` [rad, m]); the wedge apex runs along the profile offset by ``re`` into the
-        tool. The inclination enters as ``x -> x - tani * s`` with ``s`` the arc length along the
-        edge from the tip (small-angle model). Exact for points in a normal section; near the surface
-        (where contact acts) the error is second order in the distance.
+        ``(px, py, pz)`` [m] is the point relative to the insert's tip reference (the lowest
+        point of the nose, on the cutting edge) in the local frame (x cutting direction, y out
+        of the workpiece, z feed). The edge profile in the y-z plane is the nose arc of radius
+        ``rn`` (centre at y = rn, z = 0) spanning local approach angles -kend..kappa, continued
+        by the major edge (approach angle ``kappa`` to the feed axis) and the minor (end) edge
+        (angle ``kend``). In every normal section of the edge the insert is the 2D wedge of the
+        2D engine (:func:`tool_contact.tool_gap_py`: normal rake ``rake``, clearance ``clr``,
+        edge radius ``re`` [rad, m]); the wedge apex runs along the profile offset by ``re``
+        into the tool. The inclination enters as ``x -> x - tani * s`` with ``s`` the arc length
+        along the edge from the tip (small-angle model). Exact for points in a normal section;
+        near the surface (where contact acts) the error is second order in the distance.
 
         Returns ``(gap, nx, ny, nz)``: gap > 0 outside, < 0 penetration depth [m]; unit normal.
         """
@@ -242,13 +242,13 @@ def make_hex_node(insert_gap3, contact_force3, friction_at3):
         ``fixed[n]`` bit mask (1 x, 2 y, 4 z): that velocity component is held (prescribed).
         ``(cx, cy, cz)`` tool tip reference, ``(tvx, tvy, tvz)`` tool velocity (local frame).
 
-        Friction (the 2D engine's rule, :func:`kernels.quad_node_py`): the constant
+        Friction (the 2D engine's rule, :func:`quad.node_contact.quad_node_py`): the constant
         ``prm[P_MU]``, or with a table (``prm[P_MUTAB_N]`` > 0) the table at the node's sliding
         speed relative to the insert (the tangential part of its relative velocity), low-pass
         filtered with the time constant ``prm[P_SLIP_TAU]`` and kept in ``cf[n, 3]`` [m/s]
         (:func:`friction_at3_py`).
 
-        Node splitting (the 2D engine's rule, :func:`kernels.node_update`): ``pairs[n]`` =
+        Node splitting (the 2D engine's rule, :func:`quad.node_contact.node_update`): ``pairs[n]`` =
         (twin, tied); a node with ``twin >= 0`` and ``tied`` moves with its twin as one node --
         forces and masses of both copies summed in a fixed order (lower id first) so that both
         stay bitwise identical, the contact force computed once with the pair's mass and booked

@@ -1,7 +1,7 @@
 """Heat conduction of the 3D engine: the 2D engine's thermal model on hexahedra.
 
-The same model as the 2D engine (:func:`robobore.cutting.fe.engine.kernels.conduct`,
-:func:`~robobore.cutting.fe.engine.kernels.tool_heat`), written for hexahedra in the same
+The same model as the 2D engine (:func:`robobore.cutting.fe.physics.thermal2d.conduct`,
+:func:`~robobore.cutting.fe.physics.thermal2d.tool_heat`), written for hexahedra in the same
 device-ready style (``_py`` scalar functions, bound to ``njit`` here and to
 ``numba.cuda.jit(device=True)`` in :mod:`robobore.cutting.fe.engine.gpu.backend3d`):
 
@@ -24,7 +24,7 @@ device-ready style (``_py`` scalar functions, bound to ``njit`` here and to
   proportion to their volumes.
 * **Node splitting**: a face on the parting surface joins two elements that share no nodes
   (its nodes are doubled); heat crosses it while all four of its nodes are still tied, as in
-  2D (:func:`robobore.cutting.fe.engine.kernels.parting_edge_py`).
+  2D (:func:`robobore.cutting.fe.physics.thermal2d.parting_edge_py`).
 
 Heat capacities use the initial volume ``V0`` and the material's true density (mass scaling
 scales the inertia, not the heat capacity); plastic flow is isochoric, so ``V`` stays within
