@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+from robobore.cutting.fe.ale import remap
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.engine.gpu.shared import jc_device_functions
 from robobore.cutting.fe.physics import thermal2d
@@ -48,10 +49,10 @@ def device_functions2(dev) -> SimpleNamespace:
     tsweep = dev(RZ.tf_sweep_py)
     tscopy = dev(RZ.tf_sweep_copy_py)
     tinter = dev(RZ.make_tf_interior(limit=lim))
-    rflux = dev(RZ.make_rz_flux(swept=dev(RZ.swept_py)))
-    rvel = dev(RZ.rz_velocity_py)
-    rwrite = dev(RZ.rz_write_py)
-    rmass = dev(RZ.rz_node_mass_py)
+    rflux = dev(remap.make_rz_flux(swept=dev(remap.swept_py)))
+    rvel = dev(remap.rz_velocity_py)
+    rwrite = dev(remap.rz_write_py)
+    rmass = dev(remap.rz_node_mass_py)
     SWEEPS = RZ.TF_SWEEPS
     cf = dev(make_contact_force(normal_force=dev(normal_force_py)))
     sup = dev(tool_support_step_py)
