@@ -28,7 +28,7 @@ def test_both_layouts_follow_the_history_column_order():
     assert (scalar3d.H_FZ, scalar3d.H_UZ) == (scalar3d.H_FX + 2, scalar3d.H_UX + 2)
     assert (scalar3d.H_TIPX, scalar3d.H_THETA) == (c3["tool"], c3["tool"] + 1)
     assert scalar3d.N_HIST == c3["n_hist"]
-    for mod, c in ((layout, c2), (layout3d, c3)):
+    for mod, c in ((layout, c2), (scalar3d, c3)):
         e0 = c["energy"]
         assert (mod.H_EKIN, mod.H_EINT, mod.H_EPL, mod.H_EHG, mod.H_EFRIC, mod.H_EEXT,
                 mod.H_EERO) == tuple(e0 + j for j in (H.HE_KIN, H.HE_INT, H.HE_PL, H.HE_HG,
