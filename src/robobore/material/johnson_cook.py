@@ -75,7 +75,7 @@ def jc_flow_stress_py(eps_p, eps_rate, T, a, b, n, c, m, eps0, Troom, Tmelt, ehm
 
 def make_jc_failure_strain(homologous_temperature):
     """:func:`jc_failure_strain_py` with its callees ``homologous_temperature`` given (the
-    CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def jc_failure_strain_py(triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt):
         """Johnson-Cook (1985) equivalent plastic strain at failure.
@@ -97,7 +97,7 @@ def make_jc_failure_strain(homologous_temperature):
 
 def make_jc_damage_increment(jc_failure_strain):
     """:func:`jc_damage_increment_py` with its callees ``jc_failure_strain`` given (the
-    CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def jc_damage_increment_py(deps_p, triax, eps_rate, T, d1, d2, d3, d4, d5, eps0, Troom, Tmelt):
         """Damage increment dD = d(eps_p) / eps_f (Johnson-Cook 1985, linear accumulation)."""
@@ -111,7 +111,7 @@ def make_jc_damage_increment(jc_failure_strain):
 
 def make_jc_return(jc_athermal, homologous_temperature):
     """:func:`jc_return_py` with its callees ``jc_athermal``, ``homologous_temperature``
-    given (the CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    given (the CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def jc_return_py(q, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt, ehmax):
         """Scalar Johnson-Cook return mapping: plastic strain increment and flow stress.
@@ -196,7 +196,7 @@ def make_jc_return(jc_athermal, homologous_temperature):
 
 def make_radial_return(jc_return):
     """:func:`radial_return_py` with its callees ``jc_return`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def radial_return_py(sxx, syy, szz, sxy, eps_p, T, dt, G, a, b, n, c, m, eps0, Troom, Tmelt,
                          ehmax):

@@ -37,7 +37,7 @@ swept = njit(cache=True)(swept_py)
 
 def make_rz_flux(swept):
     """:func:`rz_flux_py` with its callees ``swept`` given (the CPU's compiled functions
-    here, a GPU engine's device functions in its port)"""
+    here, a GPU engine's device functions in its port)."""
 
     def rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
                    eps_p, temp, dmg, qhx, qhy, area0, t_room):

@@ -71,7 +71,7 @@ def limit_py(px, py, tx, ty, lim):
 
 def make_off_tool(tool_gap):
     """:func:`off_tool_py` with its callees ``tool_gap`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def off_tool_py(px, py, qx, qy, tg):
         """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
@@ -99,7 +99,7 @@ off_tool = njit(cache=False, inline="always")(off_tool_py)
 
 def make_tf_place(limit, off_tool):
     """:func:`tf_place_py` with its callees ``limit``, ``off_tool`` given (the CPU's
-    compiled functions here, a GPU engine's device functions in its port)"""
+    compiled functions here, a GPU engine's device functions in its port)."""
 
     def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
         """first pass, node ``n``: the new place of a rigid node, a surface-chain
@@ -212,7 +212,7 @@ def tf_sweep_copy_py(n, acls, aflt, scratch):
 
 def make_tf_interior(limit):
     """:func:`tf_interior_py` with its callees ``limit`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
         """last pass, interior node ``n``: its place in the tool frame plus the

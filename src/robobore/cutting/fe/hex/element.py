@@ -69,7 +69,7 @@ from robobore.material.johnson_cook import N as JN
 
 def make_hex_element(jc_return, jc_damage_increment):
     """:func:`hex_element_py` with its callees ``jc_return``, ``jc_damage_increment`` given
-    (the CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    (the CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def hex_element_py(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
                        ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):

@@ -132,7 +132,7 @@ edge_section = njit(cache=True, inline="always")(edge_section_py)
 
 def make_insert_gap3(tool_gap, edge_section):
     """:func:`insert_gap3_py` with its callees ``tool_gap``, ``edge_section`` given (the
-    CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def insert_gap3_py(px, py, pz, rn, kappa, kend, rake, clr, re, tani):
         """Signed distance of a point to the boring insert and the insert's outward normal.
@@ -164,7 +164,7 @@ def make_insert_gap3(tool_gap, edge_section):
 
 def make_contact_force3(normal_force):
     """:func:`contact_force3_py` with its callees ``normal_force`` given (the CPU's
-    compiled functions here, a GPU engine's device functions in its port)"""
+    compiled functions here, a GPU engine's device functions in its port)."""
 
     def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_max, pen_factor,
                           dt, damping, fox, foy, foz):
@@ -404,7 +404,7 @@ tool_kinematics = njit(cache=True)(tool_kinematics_py)
 
 def make_tool_step(tool_kinematics, tool_support_step):
     """:func:`tool_step_py` with its callees ``tool_kinematics``, ``tool_support_step``
-    given (the CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    given (the CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def tool_step_py(tool, prm, fwx, fwy, fwz, dt):
         """Advance the tool one step given the contact force ON THE WORKPIECE (local) [N].

@@ -72,7 +72,7 @@ def hex_face_corner_py(f, j):
 
 def make_face_area3(hex_face_corner):
     """:func:`face_area3_py` with its callees ``hex_face_corner`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def face_area3_py(e, f, conn, x, y, z):
         """Area of face ``f`` of hexahedron ``e`` [m^2]: half the norm of the cross product of its
@@ -97,7 +97,7 @@ def make_face_area3(hex_face_corner):
 
 def make_face_tied3(hex_face_corner):
     """:func:`face_tied3_py` with its callees ``hex_face_corner`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def face_tied3_py(e, f, conn, pairs):
         """True while every node of face ``f`` of element ``e`` is shared or still tied to its
@@ -128,7 +128,7 @@ def hex_centroid3_py(e, conn, x, y, z, tbuf):
 
 def make_hex_conduct3(face_tied3, face_area3):
     """:func:`hex_conduct3_py` with its callees ``face_tied3``, ``face_area3`` given (the
-    CPU's compiled functions here, a GPU engine's device functions in its port)"""
+    CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
     def hex_conduct3_py(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th):
         """New temperature of hexahedron ``e`` into ``tbuf[e, 3]`` (second pass of conduction).
@@ -168,7 +168,7 @@ def make_hex_conduct3(face_tied3, face_area3):
 
 def make_face_free3(face_tied3):
     """:func:`face_free3_py` with its callees ``face_tied3`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def face_free3_py(e, f, conn, alive, enbr, pairs):
         """True where face ``f`` of live element ``e`` is a free surface (no live neighbour

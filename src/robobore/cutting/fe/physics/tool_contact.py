@@ -57,7 +57,7 @@ def tool_face_py(dx, dy, nrx, nry, nfx, nfy):
 
 def make_tool_gap(tool_face):
     """:func:`tool_gap_py` with its callees ``tool_face`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
         """Signed gap of point (px, py) to the rigid tool and the tool's outward normal.
@@ -102,7 +102,7 @@ def normal_force_py(gap, vn, mass, pen_factor, dt, damping):
 
 def make_contact_force(normal_force):
     """:func:`contact_force_py` with its callees ``normal_force`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
                          damping, fox, foy):

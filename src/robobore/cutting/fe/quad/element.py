@@ -70,7 +70,7 @@ def quad_retire_py(e, fex, fey, dte):
 
 def make_quad_distorted(quad_retire):
     """:func:`quad_distorted_py` with its callees ``quad_retire`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def quad_distorted_py(e, alive, fex, fey, dte, area0, A, cmin, dlim):
         """True (and the element retired) when quad ``e`` is inverted (``alive`` = -2: an error
@@ -112,7 +112,7 @@ def quad_step_py(rho_s, a0, A, K, G, bsum, trd, bv1, bv2):
 
 def make_damage_erosion(tool_gap):
     """:func:`damage_erosion_py` with its callees ``tool_gap`` given (the CPU's compiled
-    functions here, a GPU engine's device functions in its port)"""
+    functions here, a GPU engine's device functions in its port)."""
 
     def damage_erosion_py(e, conn, x, y, alive, layer, dmg, prm, erosion):
         """Erode quad ``e`` of the separation layer once its Johnson-Cook damage reached 1

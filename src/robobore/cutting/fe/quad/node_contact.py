@@ -263,7 +263,7 @@ def contact_total(cfx, cfy):
 
 def make_contact_split_node(tool_face):
     """:func:`contact_split_node_py` with its callees ``tool_face`` given (the CPU's
-    compiled functions here, a GPU engine's device functions in its port)"""
+    compiled functions here, a GPU engine's device functions in its port)."""
 
     def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o):
         """Node ``i``'s contact force on the tool added to its face's pair in ``out[o:o + 6]``

@@ -41,7 +41,7 @@ def tool_kinematics_py(tool, prm):
 
 def make_tool_step(tool_support_step):
     """:func:`tool_step_py` with its callees ``tool_support_step`` given (the CPU's
-    compiled functions here, a GPU engine's device functions in its port)"""
+    compiled functions here, a GPU engine's device functions in its port)."""
 
     def tool_step_py(tool, prm, fwx, fwy, dt):
         """Advance the tool over one step under the contact force (fwx, fwy) on the workpiece.
