@@ -95,8 +95,8 @@ def small3d(n_samples: int = 4000):
     histories every 2 ns."""
     import math
 
-    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine.state3d import box_mesh, default_prm3, make_state3
+    from robobore.cutting.fe.hex import layout3d
     from robobore.material import load_material
 
     le = 20e-6
@@ -105,29 +105,31 @@ def small3d(n_samples: int = 4000):
     fixed[idx[:, 0, :].ravel()] = 7
     fixed[idx[-1, :, :].ravel()] = 7
     p = default_prm3()
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN], p[K3.P_KAPPA], p[K3.P_KEND] = 0.4e-3, math.pi / 2, math.radians(5)
-    p[K3.P_RAKE], p[K3.P_CLR], p[K3.P_RE] = math.radians(7), math.radians(7), 10e-6
-    p[K3.P_MU], p[K3.P_TAU] = 0.3, 576e6
-    p[K3.P_MS] = 100.0
-    p[K3.P_VC], p[K3.P_VF], p[K3.P_RADIUS] = 5.0, 1e-3, 0.02
-    p[K3.P_SUPPORT] = 1.0
-    p[K3.P_KX] = p[K3.P_KY] = p[K3.P_KZ] = 1e7
-    p[K3.P_CX] = p[K3.P_CY] = p[K3.P_CZ] = 50.0
-    p[K3.P_MX] = p[K3.P_MY] = p[K3.P_MZ] = 1e-3
-    p[K3.P_EROSION] = K3.ERODE_LAYER
-    p[K3.P_SAMPLE_DT] = 2e-9
+    p[layout3d.P_TOOL] = 1.0
+    p[layout3d.P_RN], p[layout3d.P_KAPPA], p[layout3d.P_KEND] = 0.4e-3, math.pi / 2, math.radians(5)
+    p[layout3d.P_RAKE], p[layout3d.P_CLR] = math.radians(7), math.radians(7)
+    p[layout3d.P_RE] = 10e-6
+    p[layout3d.P_MU], p[layout3d.P_TAU] = 0.3, 576e6
+    p[layout3d.P_MS] = 100.0
+    p[layout3d.P_VC], p[layout3d.P_VF], p[layout3d.P_RADIUS] = 5.0, 1e-3, 0.02
+    p[layout3d.P_SUPPORT] = 1.0
+    p[layout3d.P_KX] = p[layout3d.P_KY] = p[layout3d.P_KZ] = 1e7
+    p[layout3d.P_CX] = p[layout3d.P_CY] = p[layout3d.P_CZ] = 50.0
+    p[layout3d.P_MX] = p[layout3d.P_MY] = p[layout3d.P_MZ] = 1e-3
+    p[layout3d.P_EROSION] = layout3d.ERODE_LAYER
+    p[layout3d.P_SAMPLE_DT] = 2e-9
     # every element in the erosion layer: damage erodes anywhere in the box
     return make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, n_samples=n_samples,
                        layer=np.ones(len(conn), np.bool_), tool_tip=(-12e-6, -1.2 * le, 0.0))
 
 
 def _diff3(a, b) -> dict:
-    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.hex import scalar3d
 
     out = {k: _rel(getattr(a, k), getattr(b, k))
            for k in ("x", "vx", "vy", "vz", "sd", "pres", "eps_p", "temp", "tool")}
-    out["forces"] = _rel(a.tool[K3.T_FX:K3.T_FZ + 1], b.tool[K3.T_FX:K3.T_FZ + 1])
+    fx, fz = scalar3d.T_FX, scalar3d.T_FZ
+    out["forces"] = _rel(a.tool[fx:fz + 1], b.tool[fx:fz + 1])
     out["same_alive"] = bool(np.array_equal(a.alive, b.alive))
     return out
 
@@ -274,11 +276,11 @@ def _ortho_cfg(le: float | None, length_mm: float | None, config: str | None = N
 
 
 def _diff2(a, b) -> dict:
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout
 
     out = {k: _rel(getattr(a, k), getattr(b, k))
            for k in ("x", "y", "vx", "vy", "sdx", "pres", "eps_p", "temp", "tool")}
-    out["forces"] = _rel(a.tool[K.T_FX:K.T_FY + 1], b.tool[K.T_FX:K.T_FY + 1])
+    out["forces"] = _rel(a.tool[layout.T_FX:layout.T_FY + 1], b.tool[layout.T_FX:layout.T_FY + 1])
     out["same_alive"] = bool(np.array_equal(a.alive, b.alive))
     return out
 

@@ -39,7 +39,9 @@ def main() -> None:
     a = ap.parse_args()
 
     from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.state3d import advance3
+    from robobore.cutting.fe.hex import scalar3d
     from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
     from robobore.io.config import load_toml
 
@@ -65,9 +67,9 @@ def main() -> None:
                  step=K3.run_chunk3_for(setup.spec))
         msf = st.msf if st.msf.shape[0] else np.ones(ne)
         de = st.dte * np.sqrt(msf)
-        cx, cy, cz, *_ = K3.tool_kinematics(st.tool, st.prm)
+        cx, cy, cz, *_ = scalar3d.tool_kinematics(st.tool, st.prm)
         xyz = np.stack([st.x, st.y, st.z], 1)
-        row = {"travel_um": travel, "steps": int(st.ist[K3.I_STEP]), "dt_s": float(st.clock[1]),
+        row = {"travel_um": travel, "steps": int(st.ist[layout.I_STEP]), "dt_s": float(st.clock[1]),
                "median_element_step_s": float(np.median(de)), "wall_s": time.perf_counter() - t0,
                "limiting": []}
         print(f"{row['wall_s']:7.1f} s  travel {travel:6.2f} um  step {row['steps']}  "

@@ -74,13 +74,14 @@ def main() -> int:
     disp.get_current_device = lambda: types.SimpleNamespace(compute_capability=cc)
 
     from robobore.cutting.fe.config.orthogonal import load_fe_config
-    from robobore.cutting.fe.engine import kernels as K
-    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.chunk_loop import Phases
     from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
     from robobore.cutting.fe.engine.gpu import backend3d as gpu
+    from robobore.cutting.fe.hex import layout3d
     from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
     from robobore.cutting.fe.models.orthogonal import setup_orthogonal
+    from robobore.cutting.fe.quad import node_contact
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
@@ -96,7 +97,7 @@ def main() -> int:
     k2 = gpu2d._kernels(st2.phases)
 
     def chunk_arrays(nn: int) -> list:
-        n = (nn + K.N_SUM_LANES - 1) // K.N_SUM_LANES
+        n = (nn + node_contact.N_SUM_LANES - 1) // node_contact.N_SUM_LANES
         return [np.zeros(n, np.int32), np.zeros(n, np.int64)]
 
     # k_run(n_steps, state (the arrays, then the scalar settings), red, cflag, clist)
@@ -104,7 +105,7 @@ def main() -> int:
     }
     # the 3D persistent kernel with and without the heat phase
     run3 = [1, gpu.RunState3(*[np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS],
-                             int(st3.prm[K3.P_EROSION])),
+                             int(st3.prm[layout3d.P_EROSION])),
             np.zeros(gpu.N_RED)] + chunk_arrays(st3.x.shape[0])
     for conduction in (True, False):
         name = f"3D k_run ({'conduction' if conduction else 'adiabatic'})"
@@ -112,7 +113,8 @@ def main() -> int:
     # the 2D persistent kernel of each GPU model choice (the tool frame and conduction, each
     # on or off), compiled for the tool-frame state's argument types
     run2 = [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS],
-                              int(st2.prm[K.P_EROSION]), 1, 1, int(st2.prm[K.P_RZ_EVERY])),
+                              int(st2.prm[layout.P_EROSION]), 1, 1,
+                              int(st2.prm[layout.P_RZ_EVERY])),
             np.zeros(gpu2d.N_RED)] + chunk_arrays(st2.x.shape[0])
     for tool_frame in (True, False):
         for conduction in (True, False):

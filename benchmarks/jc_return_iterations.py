@@ -29,7 +29,7 @@ from robobore.material.library import load_material
 
 
 class _Counter:
-    """``abs`` for the rebound solve: the solve calls it once per Newton iteration (its
+    """``abs`` for the instrumented solve: the solve calls it once per Newton iteration (its
     convergence test), so the calls count the iterations."""
 
     def __init__(self) -> None:
@@ -40,21 +40,25 @@ class _Counter:
         return abs(v)
 
 
-#: ``math`` for the rebound solve with the previous start: ``exp`` answers infinity, so the
+#: ``math`` for the instrumented solve with the previous start: ``exp`` answers infinity, so the
 #: rate bound never undercuts the perfectly plastic increment
 _NO_RATE_BOUND = types.SimpleNamespace(log=math.log, exp=lambda x: math.inf)
 
 
 def _solve(q, ep0, T, dt, G, k, start):
-    """The package's own ``jc_return_py``, run as Python with its globals rebound
-    (``jc.rebind``): ``abs`` counts the iterations, and for ``start = "perfectly_plastic"``
-    ``math.exp`` answers infinity. Returns (d, iterations)."""
+    """The package's own return mapping (``jc.make_jc_return`` given the plain-Python callees),
+    run as Python with two of its globals swapped for instrumentation (this script only):
+    ``abs`` counts the iterations, and for ``start = "perfectly_plastic"`` ``math.exp``
+    answers infinity. Returns (d, iterations)."""
     count = _Counter()
-    names = {"abs": count, "homologous_temperature": jc.homologous_temperature_py,
-             "jc_athermal": jc.jc_athermal_py}
+    ret = jc.make_jc_return(jc_athermal=jc.jc_athermal_py,
+                            homologous_temperature=jc.homologous_temperature_py)
+    g = dict(ret.__globals__, abs=count)
     if start == "perfectly_plastic":
-        names["math"] = _NO_RATE_BOUND
-    d, _ = jc.rebind(jc.jc_return_py, **names)(q, ep0, T, dt, G, *k)
+        g["math"] = _NO_RATE_BOUND
+    counted = types.FunctionType(ret.__code__, g, ret.__name__, ret.__defaults__,
+                                 ret.__closure__)
+    d, _ = counted(q, ep0, T, dt, G, *k)
     return d, count.n
 
 

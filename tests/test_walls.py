@@ -8,6 +8,11 @@
   where ``m`` is a robobore module bound by an import).
 - No import cycle between robobore's modules, following the imports at module level and
   those inside functions (``python tests/test_walls.py`` prints both counts).
+- Layer order (:data:`LAYERS`, drawn in docs/ARCHITECTURE.md, "Layers"): a module imports
+  only modules of its own stage and of stages in lower layers, at module level and inside
+  functions (``TYPE_CHECKING`` imports, annotations only, are left out). ``errors`` and ``io``
+  import no stage; the command-line modules and ``api`` form the top layer. A module in no
+  stage of the table fails, so that a new package is placed in it.
 
 Every failure names ``file:line`` of the offending import or attribute. ``EXEMPT`` lists the
 packages not yet held to the private-name and cycle rules, by name, so that each can be
@@ -29,6 +34,32 @@ ROOT_PACKAGE = "robobore"
 EXEMPT: tuple[str, ...] = ()
 
 CLI_LAYER = ("robobore.cli", "robobore.clitools")
+
+#: the layers of the package, lowest first: (layer, stages), each stage (name, the dotted
+#: module prefixes it holds). A module belongs to the stage of its longest matching prefix
+#: (the root ``robobore`` only as itself); the command-line modules (:func:`is_cli_module`)
+#: belong to the top layer wherever they sit. A module may import its own stage's modules and
+#: those of the stages of lower layers, never a stage of its own layer or above.
+LAYERS: tuple[tuple[str, tuple[tuple[str, tuple[str, ...]], ...]], ...] = (
+    ("errors", (("errors", ("robobore.errors",)),)),
+    ("foundation", (("io", ("robobore.io", "robobore")),)),
+    ("models", (("robot", ("robobore.robot",)),
+                ("material", ("robobore.material",)),
+                ("cutting.geometry", ("robobore.cutting.geometry", "robobore.cutting")))),
+    ("identification", (("modal", ("robobore.modal",)),
+                        ("cutting.forces", ("robobore.cutting.forces",)))),
+    ("equivalent and FE", (("equivalent", ("robobore.equivalent",)),
+                           ("cutting.fe", ("robobore.cutting.fe",)))),
+    ("process", (("dynamics", ("robobore.dynamics",)),
+                 ("cutting.calibration", ("robobore.cutting.calibrate",
+                                          "robobore.cutting.calibration_config",
+                                          "robobore.cutting.calibration_runs")))),
+    ("planning", (("plan", ("robobore.plan",)),)),
+    ("measurement", (("measure", ("robobore.measure",)),)),
+    ("study", (("study", ("robobore.study",)),)),
+    ("interface", (("api", ("robobore.api",)),
+                   ("cli", ("robobore.cli", "robobore.clitools", "robobore.__main__")))),
+)
 
 
 @dataclass(frozen=True)
@@ -260,6 +291,39 @@ def cycle_violations(files: dict[str, Path] | None = None, function_level: bool 
             if not (exempt and all(_exempt(m) for m in c))]
 
 
+def stage_of(mod: str) -> tuple[int, str] | None:
+    """(layer index, stage name) of a module by :data:`LAYERS`; None for a module in no
+    stage."""
+    if is_cli_module(mod):
+        return len(LAYERS) - 1, "cli"
+    best: tuple[int, int, str] | None = None  # (prefix length, layer, stage)
+    for i, (_layer, stages) in enumerate(LAYERS):
+        for name, prefixes in stages:
+            for pre in prefixes:
+                hit = mod == pre or (pre != ROOT_PACKAGE and mod.startswith(pre + "."))
+                if hit and (best is None or len(pre) > best[0]):
+                    best = (len(pre), i, name)
+    return None if best is None else (best[1], best[2])
+
+
+def layer_violations(files: dict[str, Path] | None = None) -> list[str]:
+    """Imports against the layer order of :data:`LAYERS` (module and function level; not
+    ``TYPE_CHECKING``), and modules in no stage, each naming ``file:line``."""
+    files = files if files is not None else module_files()
+    bad = [f"{_rel(p)}: {m} is in no stage of tests/test_walls.py LAYERS (place it there and "
+           "in docs/ARCHITECTURE.md)" for m, p in files.items() if stage_of(m) is None]
+    for imp in imports(files):
+        if imp.type_checking:
+            continue
+        a, b = stage_of(imp.module), stage_of(imp.target)
+        if a is None or b is None or a[1] == b[1] or b[0] < a[0]:
+            continue
+        where = "the same layer" if a[0] == b[0] else "a higher layer"
+        bad.append(f"{imp.where}: {imp.module} ({a[1]}, layer {LAYERS[a[0]][0]}) imports "
+                   f"{imp.target} ({b[1]}, {where}: {LAYERS[b[0]][0]})")
+    return sorted(set(bad))
+
+
 def module_sizes(files: dict[str, Path] | None = None) -> dict[str, int]:
     files = files if files is not None else module_files()
     return {m: len(p.read_text(encoding="utf-8").splitlines()) for m, p in files.items()}
@@ -284,6 +348,58 @@ def test_no_import_cycle():
     hidden in a function is still two modules that need each other)."""
     bad = cycle_violations(function_level=True)
     assert not bad, "import cycles:\n" + "\n".join(bad)
+
+
+def test_layer_order():
+    """Each module imports only its own stage and lower layers (errors and io: no stage)."""
+    bad = layer_violations()
+    assert not bad, "imports against the layer order (LAYERS, docs/ARCHITECTURE.md):\n" + \
+        "\n".join(bad)
+
+
+def test_the_layer_table_is_the_one_the_architecture_draws():
+    """docs/ARCHITECTURE.md's "Layers" table lists the stages of :data:`LAYERS` layer by
+    layer, lowest first."""
+    doc = (SRC.parent / "docs" / "ARCHITECTURE.md").read_text(encoding="utf-8")
+    section = doc.split("## Layers", 1)[1].split("\n## ", 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith("| ") and "---" not in line]
+    drawn = [tuple(s.strip(" `") for s in row.split("|")[2].split(",")) for row in rows[1:]]
+    assert drawn == [tuple(name for name, _p in stages) for _layer, stages in LAYERS]
+
+
+def test_the_layer_check_sees_a_planted_upward_import(tmp_path):
+    """io importing a stage, a stage importing a higher one (in a function too), two stages of
+    one layer importing each other and a package in no stage are each reported; a downward
+    import, an import of the own stage, a ``TYPE_CHECKING`` import and a stage's CLI importing
+    a higher stage are not."""
+    pkg = tmp_path / ROOT_PACKAGE
+    for sub in ("io", "robot", "material", "dynamics", "plan", "newstage"):
+        (pkg / sub).mkdir(parents=True)
+        (pkg / sub / "__init__.py").write_text("")
+    (pkg / "__init__.py").write_text("")
+    (pkg / "errors.py").write_text("")
+    (pkg / "io" / "memory.py").write_text("from robobore.errors import x\n"
+                                          "from robobore.robot import kin\n")
+    (pkg / "robot" / "kin.py").write_text(
+        "import robobore.io.memory\nfrom robobore.robot import other\n"
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import robobore.plan.p\n\n\n"
+        "def f():\n    from robobore.dynamics import d\n    import robobore.material.jc\n")
+    (pkg / "robot" / "other.py").write_text("")
+    (pkg / "robot" / "cli.py").write_text("import robobore.plan.p\n")
+    (pkg / "material" / "jc.py").write_text("")
+    (pkg / "dynamics" / "d.py").write_text("import robobore.robot.kin\n")
+    (pkg / "plan" / "p.py").write_text("import robobore.dynamics.d\n")
+    (pkg / "newstage" / "n.py").write_text("")
+    bad = layer_violations(module_files(tmp_path))
+    assert len(bad) == 5, bad
+    text = "\n".join(bad)
+    assert "io/memory.py:2: robobore.io.memory (io, layer foundation) imports robobore.robot.kin" \
+        in text
+    assert "robot/kin.py:9: robobore.robot.kin (robot, layer models) imports " \
+        "robobore.dynamics.d (dynamics, a higher layer: process)" in text
+    assert "robot/kin.py:10:" in text and "the same layer" in text
+    assert sum("robobore.newstage" in b and "no stage" in b for b in bad) == 2
+    assert "robot/cli.py" not in text and "plan/p.py" not in text and "kin.py:5" not in text
 
 
 def test_the_scanners_see_a_planted_violation(tmp_path):
@@ -333,6 +449,10 @@ def main() -> None:
               f"{len(out)} outside {_exempt_text()}")
         for c in cyc:
             print("  " + cycle_report(g, c).replace("\n", "\n  "))
+    lay = layer_violations(files)
+    print(f"imports against the layer order: {len(lay)}")
+    for b in lay:
+        print("  " + b)
     sizes = module_sizes(files)
     big = sorted(((n, m) for m, n in sizes.items() if n > 600), reverse=True)
     print(f"modules over 600 lines: {len(big)}")

@@ -21,10 +21,12 @@ import pytest
 from conftest import elastic_tc4, strip_mesh
 
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
+from robobore.cutting.fe.quad import bbar
+from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
@@ -37,8 +39,8 @@ QUAD = np.array([[0.0, 0.0], [11e-6, 1e-6], [12e-6, 9e-6], [-1e-6, 10e-6]])
 
 def _bbar_prm():
     prm = default_prm()
-    prm[K.P_BV1] = 0.0
-    prm[K.P_BV2] = 0.0
+    prm[layout.P_BV1] = 0.0
+    prm[layout.P_BV2] = 0.0
     return prm
 
 
@@ -55,10 +57,10 @@ def _kernel_stiffness(mat: Material, nodes=QUAD) -> np.ndarray:
         (st.vx if j % 2 == 0 else st.vy)[j // 2] = v
         st.x += dt * st.vx
         st.y += dt * st.vy
-        K.element_update_bbar(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
+        bbar.element_update_bbar(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
                               st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg,
                               st.gps, st.area0, st.ie, st.fex, st.fey, st.dte, st.plast,
-                              st.rate, st.mat, st.prm, dt, K.ERODE_NONE)
+                              st.rate, st.mat, st.prm, dt, layout.ERODE_NONE)
         f = np.column_stack([st.fex[0], st.fey[0]]).ravel()
         Kmat[:, j] = f / (v * dt)
     return Kmat
@@ -127,15 +129,15 @@ def test_only_rigid_body_modes_have_zero_energy():
     cols = []
     for j in range(8):
         prm = default_prm()
-        prm[K.P_HGS] = prm[K.P_HGV] = prm[K.P_BV1] = prm[K.P_BV2] = 0.0
+        prm[layout.P_HGS] = prm[layout.P_HGV] = prm[layout.P_BV1] = prm[layout.P_BV2] = 0.0
         st = make_state(QUAD, conn, np.zeros(4, bool), mat, prm=prm)
         (st.vx if j % 2 == 0 else st.vy)[j // 2] = 1e-3
         st.x += 1e-12 * st.vx
         st.y += 1e-12 * st.vy
-        K.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
+        q_element.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
                          st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg, st.qhx,
                          st.qhy, st.area0, st.ie, st.hge, st.fex, st.fey, st.dte, st.plast,
-                         st.rate, st.mat, st.prm, 1e-12, K.ERODE_NONE)
+                         st.rate, st.mat, st.prm, 1e-12, layout.ERODE_NONE)
         cols.append(np.column_stack([st.fex[0], st.fey[0]]).ravel() / 1e-15)
     K1 = np.array(cols).T
     ev1 = np.linalg.eigvalsh(0.5 * (K1 + K1.T))
@@ -174,10 +176,10 @@ def test_homogeneous_flow_follows_the_flow_curve(kind):
         t0 = st.temp[0]
         st.x += dt * vx
         st.y += dt * vy
-        K.element_update_bbar(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
+        bbar.element_update_bbar(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
                               st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg,
                               st.gps, st.area0, st.ie, st.fex, st.fey, st.dte, st.plast,
-                              st.rate, st.mat, st.prm, dt, K.ERODE_NONE)
+                              st.rate, st.mat, st.prm, dt, layout.ERODE_NONE)
         s = st.gps[0]
         q = np.sqrt(1.5 * (s[:, 0] ** 2 + s[:, 1] ** 2 + s[:, 2] ** 2 + 2 * s[:, 3] ** 2))
         out.append((q.min(), q.max(), st.eps_p[0], st.rate[0], t0, st.pres[0]))
@@ -201,8 +203,8 @@ def test_elastic_bar_period_and_energy_bbar():
     nodes, conn = strip_mesh(nx, 1, length, thick)
     fixed = nodes[:, 0] < 1e-15
     prm = _bbar_prm()
-    prm[K.P_HGV] = prm[K.P_HGS] = 0.0
-    prm[K.P_SAMPLE_DT] = 2e-8
+    prm[layout.P_HGV] = prm[layout.P_HGS] = 0.0
+    prm[layout.P_SAMPLE_DT] = 2e-8
     mat = elastic_tc4()
     st = make_state(nodes, conn, fixed, mat, prm=prm, n_samples=20000, phases=BBAR)
     st.vx[:] = v0 * np.sin(0.5 * math.pi * st.x / length)
@@ -216,10 +218,10 @@ def test_elastic_bar_period_and_energy_bbar():
         advance(st, (k + 1) * 1.5 * T / 60, chunk_steps=10**7)
         xs.append(st.x[tip] - st.x0[tip])
         ts.append(st.time)
-    h = st.hist[np.isfinite(st.hist[:, K.H_T])]
-    energies = h[:, K.H_EKIN] + h[:, K.H_EINT] + h[:, K.H_EHG]
+    h = st.hist[np.isfinite(st.hist[:, layout.H_T])]
+    energies = h[:, layout.H_EKIN] + h[:, layout.H_EINT] + h[:, layout.H_EHG]
     assert np.max(np.abs(energies - ke0)) / ke0 < 5e-3
-    assert np.all(h[:, K.H_EHG] == 0.0)
+    assert np.all(h[:, layout.H_EHG] == 0.0)
     xs, ts = np.array(xs), np.array(ts)
     i = np.argmax(xs < 0)
     t_zero = ts[i - 1] + (ts[i] - ts[i - 1]) * xs[i - 1] / (xs[i - 1] - xs[i])

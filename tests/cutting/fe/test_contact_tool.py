@@ -16,7 +16,7 @@ from conftest import elastic_tc4, strip_mesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.physics import tool_contact as P
@@ -134,28 +134,28 @@ def test_rake_face_contact_patch():
     fixed = nodes[:, 0] < 1e-15
     mat = elastic_tc4()
     prm = default_prm()
-    prm[K.P_NRX], prm[K.P_NRY] = -1.0, 0.0
-    prm[K.P_NFX], prm[K.P_NFY] = math.sin(CLR), -math.cos(CLR)
-    prm[K.P_R] = 2e-6
-    prm[K.P_MU] = 0.2
-    prm[K.P_VC] = 0.05
-    prm[K.P_SAMPLE_DT] = 1e-7
+    prm[layout.P_NRX], prm[layout.P_NRY] = -1.0, 0.0
+    prm[layout.P_NFX], prm[layout.P_NFY] = math.sin(CLR), -math.cos(CLR)
+    prm[layout.P_R] = 2e-6
+    prm[layout.P_MU] = 0.2
+    prm[layout.P_VC] = 0.05
+    prm[layout.P_SAMPLE_DT] = 1e-7
     gap0 = 0.1e-6
     st = make_state(nodes, conn, fixed, mat, prm=prm, n_samples=100,
                     tool_center=(L + 2e-6 + gap0, -1e-6))
     delta = 0.2e-6
     t_end = (gap0 + delta) / 0.05
     advance(st, t_end)
-    cx, cy = st.tool[K.T_GX], st.tool[K.T_GY]
-    gaps = np.array([P.tool_gap(st.x[i], st.y[i], cx, cy, *prm[K.P_NRX:K.P_NFY + 1],
-                                prm[K.P_R])[0] for i in range(len(st.x))])
+    cx, cy = st.tool[layout.T_GX], st.tool[layout.T_GY]
+    gaps = np.array([P.tool_gap(st.x[i], st.y[i], cx, cy, *prm[layout.P_NRX:layout.P_NFY + 1],
+                                prm[layout.P_R])[0] for i in range(len(st.x))])
     assert -gaps.min() < 0.02 * le
     contact = gaps < 0
     assert contact.sum() == 11  # the whole right face
     e1 = mat.E / (1 - mat.nu**2)
     # the face moved by delta minus the penetration
     f_static = e1 * H * (delta + np.mean(gaps[contact])) / L
-    f_tool = st.tool[K.T_FX]  # force on the tool at the last step [N/m]
+    f_tool = st.tool[layout.T_FX]  # force on the tool at the last step [N/m]
     assert f_tool == pytest.approx(f_static, rel=0.10)
 
 
@@ -195,18 +195,18 @@ def test_tool_support_in_solver_loop():
     prm = default_prm()
     m, k, zeta = 0.2, 5.0e6, 0.05
     c = 2 * zeta * math.sqrt(k * m)
-    prm[K.P_SUPPORT] = 1.0
-    prm[K.P_KX] = prm[K.P_KY] = k
-    prm[K.P_CX] = prm[K.P_CY] = c
-    prm[K.P_MX] = prm[K.P_MY] = m
-    prm[K.P_SAMPLE_DT] = 5e-6
-    prm[K.P_MS] = 1e6  # big steps: the workpiece is idle here
+    prm[layout.P_SUPPORT] = 1.0
+    prm[layout.P_KX] = prm[layout.P_KY] = k
+    prm[layout.P_CX] = prm[layout.P_CY] = c
+    prm[layout.P_MX] = prm[layout.P_MY] = m
+    prm[layout.P_SAMPLE_DT] = 5e-6
+    prm[layout.P_MS] = 1e6  # big steps: the workpiece is idle here
     st = make_state(nodes, conn, nodes[:, 1] < 1e-15, mat, prm=prm, n_samples=3000,
                     tool_center=(1.0, 1.0))
-    st.tool[K.T_UX] = 1e-6
-    st.tool[K.T_UY] = 1e-6
+    st.tool[layout.T_UX] = 1e-6
+    st.tool[layout.T_UY] = 1e-6
     advance(st, 0.012, chunk_steps=10**6)
-    h = st.hist[np.isfinite(st.hist[:, K.H_T])]
+    h = st.hist[np.isfinite(st.hist[:, layout.H_T])]
     # samples are averages over the interval: compare with the sampled interval mid-times
-    _check_oscillation(h[:, K.H_T] - 2.5e-6, h[:, K.H_UX], math.sqrt(k / m), zeta)
-    np.testing.assert_allclose(h[:, K.H_UY], h[:, K.H_UX], rtol=1e-9, atol=1e-15)
+    _check_oscillation(h[:, layout.H_T] - 2.5e-6, h[:, layout.H_UX], math.sqrt(k / m), zeta)
+    np.testing.assert_allclose(h[:, layout.H_UY], h[:, layout.H_UX], rtol=1e-9, atol=1e-15)

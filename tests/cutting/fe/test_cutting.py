@@ -104,8 +104,8 @@ def test_tool_vibration_changes_forces(rigid, supported):
 
 
 def test_force_by_face_sums_to_the_total(rigid):
-    """The rake / edge / flank split (kernels.contact_split) adds up to the tool force in
-    every sample (same per-node forces, summed in another order: 1e-9 relative)."""
+    """The rake / edge / flank split (quad.node_contact.contact_split) adds up to the tool force
+    in every sample (same per-node forces, summed in another order: 1e-9 relative)."""
     h = rigid.history
     for comp in ("cutting", "feed"):
         parts = sum(h[f"{face}_{comp}_force_N_per_mm"] for face in ("rake", "edge", "flank"))
@@ -122,7 +122,7 @@ def test_force_by_face_sums_to_the_total(rigid):
 def test_contact_split_classifies_by_face():
     """Nodes placed on the rake face, the edge arc and the flank of a tool with rake 15 deg,
     clearance 2 deg, r = 20 um at the origin: each force lands in its face's slot."""
-    from robobore.cutting.fe.engine.kernels import contact_split
+    from robobore.cutting.fe.quad.node_contact import contact_split
 
     r = 20e-6
     rake, clr = math.radians(15.0), math.radians(2.0)

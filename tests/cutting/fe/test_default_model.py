@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.config.orthogonal import FRICTION_TABLE_MU, load_fe_config, parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml
@@ -86,8 +86,8 @@ def test_a_priori_is_one_switch_away():
     np.testing.assert_allclose(cfg.contact.table()[1], FRICTION_TABLE_MU)
     p = setup_orthogonal(cfg).state
     assert p.mat[jc.EPS_HMAX] == math.inf
-    assert p.prm[K.P_MUTAB_N] == 0  # one coefficient for the run: the table at vc
-    assert p.prm[K.P_MU] == pytest.approx(0.18)
+    assert p.prm[layout.P_MUTAB_N] == 0  # one coefficient for the run: the table at vc
+    assert p.prm[layout.P_MU] == pytest.approx(0.18)
     # the same model otherwise: tool frame, conduction, the same mass scaling
     assert cfg.mesh.frame == "tool" and cfg.solver.heat_conduction
     assert cfg.solver.mass_scaling == 100.0

@@ -147,7 +147,7 @@ def test_chip_ratio_uses_the_parting_line_as_the_underside():
     it, not from the lowest surviving node of each column (which lies inside the chip)."""
     from types import SimpleNamespace
 
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.models.output import measure_chip
 
     h, sep, s = 60e-6, 5e-6, 2.5
@@ -160,8 +160,8 @@ def test_chip_ratio_uses_the_parting_line_as_the_underside():
     chip_nodes &= ~((m.twin >= 0) & ~m.upper)  # the work's copies stay put
     y = y0.copy()
     y[chip_nodes] = y_p + (y0[chip_nodes] - y_p) * s
-    tool = np.zeros(K.N_TOOL)
-    tool[K.T_GX], tool[K.T_GY] = cx, -h + 20e-6
+    tool = np.zeros(layout.N_TOOL)
+    tool[layout.T_GX], tool[layout.T_GY] = cx, -h + 20e-6
     st = SimpleNamespace(x=x0.copy(), y=y, x0=x0, y0=y0, tool=tool,
                          ndead=np.zeros(x0.size, bool))
     want = (0.0 - y_p) * s / h
@@ -189,7 +189,7 @@ def test_chip_ratio_from_the_chip_speed():
     varies across the chip is averaged with the nodal masses."""
     from types import SimpleNamespace
 
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.models.output import chip_ratio_from_velocity
 
     h, vc, r_true = 60e-6, 0.5, 1.37
@@ -211,8 +211,8 @@ def test_chip_ratio_from_the_chip_speed():
     q = rng.uniform(0.0, 2.0 * h, inside.size)
     x[inside] = cx + s_al * tr[0] + q * nr[0]
     y[inside] = cy + s_al * tr[1] + q * nr[1]
-    tool = np.zeros(K.N_TOOL)
-    tool[K.T_GX], tool[K.T_GY] = cx, cy
+    tool = np.zeros(layout.N_TOOL)
+    tool[layout.T_GX], tool[layout.T_GY] = cx, cy
     vchip = vc / r_true
     vx[inside] = -vc + vchip * tr[0]
     vy[inside] = vchip * tr[1]

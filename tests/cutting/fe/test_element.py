@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 from conftest import elastic_tc4, strip_mesh
 
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
+from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import NumericalError
 from robobore.material import load_material
 
@@ -31,10 +32,10 @@ def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, si
     nodes = np.array([[0, 0], [size, 0], [size, size], [0, size]], float)
     conn = np.array([[0, 1, 2, 3]])
     prm = default_prm()
-    prm[K.P_HGS] = 0.0
-    prm[K.P_HGV] = 0.0
-    prm[K.P_BV1] = 0.0
-    prm[K.P_BV2] = 0.0
+    prm[layout.P_HGS] = 0.0
+    prm[layout.P_HGV] = 0.0
+    prm[layout.P_BV1] = 0.0
+    prm[layout.P_BV2] = 0.0
     st = make_state(nodes, conn, np.zeros(4, bool), mat, prm=prm)
     out = []
     for _ in range(n_steps):
@@ -43,10 +44,10 @@ def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, si
         st.vy[:] = vy
         st.x += dt * vx
         st.y += dt * vy
-        K.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx, st.sdy,
-                         st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy,
-                         st.area0, st.ie, st.hge, st.fex, st.fey, st.dte, st.plast, st.rate,
-                         st.mat, st.prm, dt, K.ERODE_NONE)
+        q_element.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
+                                 st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg,
+                                 st.qhx, st.qhy, st.area0, st.ie, st.hge, st.fex, st.fey, st.dte,
+                                 st.plast, st.rate, st.mat, st.prm, dt, layout.ERODE_NONE)
         q = math.sqrt(1.5 * (st.sdx[0] ** 2 + st.sdy[0] ** 2 + st.sdz[0] ** 2
                              + 2 * st.sdxy[0] ** 2))
         out.append((total_strain_measure(st), q, st.eps_p[0], st.rate[0], st.temp[0],
@@ -123,10 +124,10 @@ def _bar(nx=200, ny=1, length=2e-3, thickness=1e-5, v0=0.5):
     nodes, conn = strip_mesh(nx, ny, length, thickness)
     fixed = nodes[:, 0] < 1e-15
     prm = default_prm()
-    prm[K.P_HGV] = 0.0
-    prm[K.P_BV1] = 0.0
-    prm[K.P_BV2] = 0.0
-    prm[K.P_SAMPLE_DT] = 2e-8
+    prm[layout.P_HGV] = 0.0
+    prm[layout.P_BV1] = 0.0
+    prm[layout.P_BV2] = 0.0
+    prm[layout.P_SAMPLE_DT] = 2e-8
     mat = elastic_tc4()
     st = make_state(nodes, conn, fixed, mat, prm=prm, n_samples=20000)
     st.vx[:] = v0 * np.sin(0.5 * math.pi * st.x / length)
@@ -148,8 +149,8 @@ def test_elastic_bar_period_and_energy():
         advance(st, (k + 1) * 1.5 * T / n_chunks, chunk_steps=10**7)
         xs.append(st.x[tip] - st.x0[tip])
         ts.append(st.time)
-    h = st.hist[np.isfinite(st.hist[:, K.H_T])]
-    energies = h[:, K.H_EKIN] + h[:, K.H_EINT] + h[:, K.H_EHG]
+    h = st.hist[np.isfinite(st.hist[:, layout.H_T])]
+    energies = h[:, layout.H_EKIN] + h[:, layout.H_EINT] + h[:, layout.H_EHG]
     # energy conserved to 0.5 % (central difference, no viscosity)
     assert np.max(np.abs(energies - ke0)) / ke0 < 5e-3
     # period from the first zero crossing of the tip displacement after its maximum (T/2)
@@ -162,7 +163,7 @@ def test_elastic_bar_period_and_energy():
 
 def test_instability_is_reported_not_nan():
     st, mat, L = _bar(nx=20, length=2e-4)
-    st.prm[K.P_CFL] = 3.0  # far above the stable step
+    st.prm[layout.P_CFL] = 3.0  # far above the stable step
     st.clock[1] *= 3.0 / 0.8
     with pytest.raises(NumericalError, match="step .* time"):
         advance(st, 1e-5, chunk_steps=500)
@@ -178,8 +179,8 @@ def test_heat_conduction_matches_erfc_and_conserves_heat():
     nx, lx, ly = 160, 8e-4, 5e-6
     nodes, conn = strip_mesh(nx, 1, lx, ly)
     prm = default_prm()
-    prm[K.P_MS] = 1e6  # large mechanical step; the thermal mass is never scaled
-    prm[K.P_COND_EVERY] = 1
+    prm[layout.P_MS] = 1e6  # large mechanical step; the thermal mass is never scaled
+    prm[layout.P_COND_EVERY] = 1
     st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm,
                     phases=Phases(conduction=True))
     xc = st.x[conn].mean(axis=1)
@@ -194,7 +195,7 @@ def test_heat_conduction_matches_erfc_and_conserves_heat():
     assert np.max(np.abs(st.temp - exact)) < 0.02 * dT
     assert np.sum(st.temp * st.area0) == pytest.approx(heat0, rel=1e-12)
     # and without conduction (the adiabatic loop) nothing moves
-    prm[K.P_COND_EVERY] = 0
+    prm[layout.P_COND_EVERY] = 0
     st2 = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm)
     st2.temp[:] = np.where(xc < x0, t0k + dT, t0k)
     advance(st2, t_end, chunk_steps=10**6)

@@ -28,14 +28,14 @@ EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
 #: shared by the simulator scripts: histories every 5 steps over the compared steps
 PRELUDE = textwrap.dedent("""
     import numpy as np
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout as L
 
     def sample_every_5_steps(st, rows):
         dt = float(st.clock[1])
-        st.prm[K.P_SAMPLE_DT] = 5 * dt
-        k0 = int(st.clock[0] / st.prm[K.P_SAMPLE_DT])
-        st.ist[K.I_SAMPLE] = k0
-        st.hist = np.full((k0 + rows, K.N_HIST), np.nan)
+        st.prm[L.P_SAMPLE_DT] = 5 * dt
+        k0 = int(st.clock[0] / st.prm[L.P_SAMPLE_DT])
+        st.ist[L.I_SAMPLE] = k0
+        st.hist = np.full((k0 + rows, L.N_HIST), np.nan)
         st.hacc[:] = 0.0
         st.clock[2] = 0.0
         return dt, k0
@@ -46,7 +46,7 @@ SCRIPT = PRELUDE + textwrap.dedent("""
     import numpy as np
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout as L
     from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
     from robobore.cutting.fe.engine.chunk_driver import advance
@@ -88,13 +88,13 @@ SCRIPT = PRELUDE + textwrap.dedent("""
            "contact_nodes": int(np.sum((a.cfx != 0) | (a.cfy != 0))),
            "plastic_growth": float(np.max(a.eps_p - st.eps_p)),
            "released": int(np.sum(st.tied[pairs] == 0)), "tied": int(tied.size),
-           "support_um": float(abs(a.tool[K.T_UX]) * 1e6),
+           "support_um": float(abs(a.tool[L.T_UX]) * 1e6),
            "temp_cond": rel(a.temp, st.temp),
            "tied_bitwise": bool(np.array_equal(b.x[tied], b.x[b.twin[tied]])
                                 and np.array_equal(b.y[tied], b.y[b.twin[tied]])),
            "same_tied": bool(np.array_equal(a.tied, b.tied)),
            "same_alive": bool(np.array_equal(a.alive, b.alive)),
-           "samples": int(a.ist[K.I_SAMPLE] - k0),
+           "samples": int(a.ist[L.I_SAMPLE] - k0),
            "friction_heat_J_per_m": float(np.sum(a.fheat - st.fheat)),
            "parting_edges": int(st.ppair.shape[0])}
     for k in ("x", "y", "vx", "vy", "sdx", "sdy", "sdxy", "pres", "eps_p", "temp", "dmg",
@@ -102,7 +102,7 @@ SCRIPT = PRELUDE + textwrap.dedent("""
               "fheat"):
         out[k] = rel(getattr(a, k), getattr(b, k))
     out["hist"] = rel(a.hist, b.hist)  # with the force split by tool face (H_FX_RAKE ...)
-    out["split_rake"] = float(np.nanmax(np.abs(a.hist[k0:, K.H_FX_RAKE])))
+    out["split_rake"] = float(np.nanmax(np.abs(a.hist[k0:, L.H_FX_RAKE])))
     out["en"] = rel(a.en, b.en)
     out["clock"] = rel(a.clock, b.clock)
     print("RESULT" + json.dumps(out))
@@ -114,7 +114,7 @@ SCRIPT = PRELUDE + textwrap.dedent("""
 SCRIPT_TF = PRELUDE + textwrap.dedent("""
     import copy, json, sys, tomllib
     import numpy as np
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout as L
     from robobore.cutting.fe.config.orthogonal import parse_config
     from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
     from robobore.cutting.fe.engine.chunk_driver import advance
@@ -142,12 +142,12 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
         return float(np.max(np.abs(u - v)) / max(np.max(np.abs(u)), 1e-300))
 
     out = {"n_elements": int(st.conn.shape[0]),
-           "ale_passes": sum(1 for i in range(int(st.ist[K.I_STEP]), int(a.ist[K.I_STEP]))
-                             if i % int(st.prm[K.P_RZ_EVERY]) == 0),
+           "ale_passes": sum(1 for i in range(int(st.ist[L.I_STEP]), int(a.ist[L.I_STEP]))
+                             if i % int(st.prm[L.P_RZ_EVERY]) == 0),
            "mesh_moved_m": float(np.max(np.abs(a.aflt[:, 4:6] - st.aflt[:, 4:6]))),
            "area0_changed": float(np.max(np.abs(a.area0 - st.area0))),
            "mass_changed": float(np.max(np.abs(a.mass - st.mass))),
-           "split_rake": float(np.nanmax(np.abs(a.hist[k0:, K.H_FX_RAKE]))),
+           "split_rake": float(np.nanmax(np.abs(a.hist[k0:, L.H_FX_RAKE]))),
            "temp_changed": float(np.max(np.abs(a.temp - st.temp)))}
     for path in ("persistent", "launch_per_kernel"):
         b = copy.deepcopy(st)
@@ -215,11 +215,11 @@ def test_cuda_kernels_match_cpu_engine_in_simulator(tmp_path, path):
     contact node's sliding speed): the CUDA
     kernels run in numba's simulator give the same bits as the CPU engine: both devices
     run the same scalar functions, sum the contact force in the same fixed order
-    (``kernels.contact_total``), and use atomics only for exact operations (a count, a min,
-    a max) -- both the persistent kernel (the default) and one launch per kernel and step.
+    (``quad.node_contact.contact_total``), and use atomics only for exact operations (a count,
+    a min, a max) -- both the persistent kernel (the default) and one launch per kernel and step.
 
     The CPU engine is compiled afresh in the subprocess (its own NUMBA_CACHE_DIR): the
-    machine code numba makes for ``kernels.element_update`` depends on what else the process
+    machine code numba makes for ``quad.element.element_update`` depends on what else the process
     compiled before it (with a cache filled by other tests the same element can give a result
     2e-13 apart after 40 steps; swapping that function's cache files flips the comparison),
     so bit-identity holds for a given compilation, not across them."""

@@ -14,19 +14,20 @@ import pytest
 from conftest import elastic_tc4, strip_mesh
 
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.physics import tool_contact as P
+from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
 
 
 def _prm(v_m_s, mu):
     p = default_prm()
-    p[K.P_MU] = 0.123
-    p[K.P_MUTAB_N] = len(v_m_s)
-    p[K.P_MUTAB_V:K.P_MUTAB_V + len(v_m_s)] = v_m_s
-    p[K.P_MUTAB_MU:K.P_MUTAB_MU + len(mu)] = mu
+    p[layout.P_MU] = 0.123
+    p[layout.P_MUTAB_N] = len(v_m_s)
+    p[layout.P_MUTAB_V:layout.P_MUTAB_V + len(v_m_s)] = v_m_s
+    p[layout.P_MUTAB_MU:layout.P_MUTAB_MU + len(mu)] = mu
     return p
 
 
@@ -34,12 +35,12 @@ def test_friction_at_is_the_piecewise_linear_table():
     p = _prm([0.1, 0.5, 1.0], [0.4, 0.2, 0.25])
     for speed, want in [(0.0, 0.4), (0.1, 0.4), (0.3, 0.3), (0.5, 0.2), (0.75, 0.225),
                         (1.0, 0.25), (7.0, 0.25)]:
-        assert K.friction_at(p, speed) == pytest.approx(want, rel=1e-14)
-        assert K.friction_at_py(p, speed) == pytest.approx(want, rel=1e-14)
-        assert K.friction_at(p, speed) == pytest.approx(
+        assert node_contact.friction_at(p, speed) == pytest.approx(want, rel=1e-14)
+        assert node_contact.friction_at_py(p, speed) == pytest.approx(want, rel=1e-14)
+        assert node_contact.friction_at(p, speed) == pytest.approx(
             float(np.interp(speed, [0.1, 0.5, 1.0], [0.4, 0.2, 0.25])), rel=1e-14)
-    p[K.P_MUTAB_N] = 0  # no table: the constant coefficient
-    assert K.friction_at(p, 0.3) == 0.123
+    p[layout.P_MUTAB_N] = 0  # no table: the constant coefficient
+    assert node_contact.friction_at(p, 0.3) == 0.123
 
 
 def _cfg(**contact):
@@ -89,18 +90,18 @@ def _sliding_block(vc, table_v_m_s, table_mu, tau=None):
     L, H = 200e-6, 40e-6
     nodes, conn = strip_mesh(20, 4, L, H)
     prm = _prm(table_v_m_s, table_mu)
-    prm[K.P_MS] = 100.0  # quasi-static: the friction's shear wave moves the nodes little
-    prm[K.P_R] = 2e-6
-    prm[K.P_NRX], prm[K.P_NRY] = -1.0, 0.0
-    prm[K.P_NFX], prm[K.P_NFY] = 0.0, -1.0
-    prm[K.P_VC] = vc
-    prm[K.P_CDAMP] = 1.0  # critically damped contact: the 1 nm overlap settles, no chatter
+    prm[layout.P_MS] = 100.0  # quasi-static: the friction's shear wave moves the nodes little
+    prm[layout.P_R] = 2e-6
+    prm[layout.P_NRX], prm[layout.P_NRY] = -1.0, 0.0
+    prm[layout.P_NFX], prm[layout.P_NFY] = 0.0, -1.0
+    prm[layout.P_VC] = vc
+    prm[layout.P_CDAMP] = 1.0  # critically damped contact: the 1 nm overlap settles, no chatter
     # sliding-speed filter: 0.2 um of the 5 um travel
-    prm[K.P_SLIP_TAU] = 0.2e-6 / vc if tau is None else tau
+    prm[layout.P_SLIP_TAU] = 0.2e-6 / vc if tau is None else tau
     st = make_state(nodes, conn, nodes[:, 1] < 1e-15, elastic_tc4(), prm=prm,
                     tool_center=(-10e-6, H + 2e-6 - 1e-9))
     advance(st, 5e-6 / vc)  # 5 um of sliding
-    cx, cy = st.tool[K.T_GX], st.tool[K.T_GY]
+    cx, cy = st.tool[layout.T_GX], st.tool[layout.T_GY]
     out = []
     for n in np.flatnonzero(np.hypot(st.cfx, st.cfy) > 0):
         _, gnx, gny = P.tool_gap(st.x[n], st.y[n], cx, cy, -1.0, 0.0, 0.0, -1.0, 2e-6)
@@ -129,7 +130,7 @@ def test_the_engine_slides_against_the_table_at_the_sliding_speed():
 
 
 def test_the_3d_slab_reads_the_table_at_the_sliding_speed():
-    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.hex import layout3d
     from robobore.cutting.fe.models.slab3d import setup_slab3
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},
@@ -140,10 +141,10 @@ def test_the_3d_slab_reads_the_table_at_the_sliding_speed():
                                  "frame": "workpiece"}})
     p = setup_slab3(cfg).state.prm
     v, mu = cfg.contact.table()
-    assert p[K3.P_MUTAB_N] == v.size
-    np.testing.assert_array_equal(p[K3.P_MUTAB_V:K3.P_MUTAB_V + v.size], v / 60.0)
-    np.testing.assert_array_equal(p[K3.P_MUTAB_MU:K3.P_MUTAB_MU + v.size], mu)
-    assert p[K3.P_SLIP_TAU] == pytest.approx(cfg.contact.sliding_filter_um * 1e-6 / 0.5)
+    assert p[layout3d.P_MUTAB_N] == v.size
+    np.testing.assert_array_equal(p[layout3d.P_MUTAB_V:layout3d.P_MUTAB_V + v.size], v / 60.0)
+    np.testing.assert_array_equal(p[layout3d.P_MUTAB_MU:layout3d.P_MUTAB_MU + v.size], mu)
+    assert p[layout3d.P_SLIP_TAU] == pytest.approx(cfg.contact.sliding_filter_um * 1e-6 / 0.5)
 
 
 def test_no_filter_time_constant_reads_the_raw_speed():

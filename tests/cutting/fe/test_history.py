@@ -10,22 +10,25 @@ import pytest
 
 from robobore.cutting.fe.engine import chunk_loop as CL
 from robobore.cutting.fe.engine import history as H
-from robobore.cutting.fe.engine import kernels as K
 from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
+from robobore.cutting.fe.hex import layout3d, scalar3d
 
 
 def test_both_layouts_follow_the_history_column_order():
     c2 = H.columns(2, 6, 1)
-    assert (K.H_T, K.H_FX, K.H_UX, K.H_NCONT, K.H_FX_RAKE) == (H.H_T, c2["force"], c2["disp"],
-                                                                c2["ncont"], c2["split"])
-    assert (K.H_FY, K.H_UY, K.H_FY_FLANK) == (K.H_FX + 1, K.H_UX + 1, K.H_FX_RAKE + 5)
-    assert K.H_TIP_X == c2["tool"] and K.N_HIST == c2["n_hist"]
+    assert (layout.H_T, layout.H_FX, layout.H_UX, layout.H_NCONT, layout.H_FX_RAKE) == (
+        H.H_T, c2["force"], c2["disp"], c2["ncont"], c2["split"])
+    assert (layout.H_FY, layout.H_UY, layout.H_FY_FLANK) == (
+        layout.H_FX + 1, layout.H_UX + 1, layout.H_FX_RAKE + 5)
+    assert layout.H_TIP_X == c2["tool"] and layout.N_HIST == c2["n_hist"]
     c3 = H.columns(3, 0, 2)
-    assert (K3.H_T, K3.H_FX, K3.H_UX, K3.H_NCONT) == (H.H_T, c3["force"], c3["disp"],
-                                                      c3["ncont"])
-    assert (K3.H_FZ, K3.H_UZ) == (K3.H_FX + 2, K3.H_UX + 2)
-    assert (K3.H_TIPX, K3.H_THETA) == (c3["tool"], c3["tool"] + 1) and K3.N_HIST == c3["n_hist"]
-    for mod, c in ((K, c2), (K3, c3)):
+    assert (scalar3d.H_T, scalar3d.H_FX, scalar3d.H_UX, scalar3d.H_NCONT) == (
+        H.H_T, c3["force"], c3["disp"], c3["ncont"])
+    assert (scalar3d.H_FZ, scalar3d.H_UZ) == (scalar3d.H_FX + 2, scalar3d.H_UX + 2)
+    assert (scalar3d.H_TIPX, scalar3d.H_THETA) == (c3["tool"], c3["tool"] + 1)
+    assert scalar3d.N_HIST == c3["n_hist"]
+    for mod, c in ((layout, c2), (scalar3d, c3)):
         e0 = c["energy"]
         assert (mod.H_EKIN, mod.H_EINT, mod.H_EPL, mod.H_EHG, mod.H_EFRIC, mod.H_EEXT,
                 mod.H_EERO) == tuple(e0 + j for j in (H.HE_KIN, H.HE_INT, H.HE_PL, H.HE_HG,
@@ -34,23 +37,23 @@ def test_both_layouts_follow_the_history_column_order():
 
 def test_an_engine_description_must_name_every_slot():
     with pytest.raises(ValueError, match="NDIM"):
-        H.bind_end_step(lambda f: f, {"NDIM": 2}, None, None)
+        H.make_end_step(lambda f: f, {"NDIM": 2}, None, None)
 
 
 def _state2(n_hist=3, sample_dt=1.0, t_end=10.0):
     """A 2D engine's small arrays: one node, one element, the tool at rest."""
-    prm = np.zeros(K.N_PRM)
-    prm[K.P_CFL] = 0.5
-    prm[K.P_DTMIN] = 1e-3
-    prm[K.P_SAMPLE_DT] = sample_dt
-    prm[K.P_TEND] = t_end
-    tool = np.zeros(K.N_TOOL)
+    prm = np.zeros(layout.N_PRM)
+    prm[layout.P_CFL] = 0.5
+    prm[layout.P_DTMIN] = 1e-3
+    prm[layout.P_SAMPLE_DT] = sample_dt
+    prm[layout.P_TEND] = t_end
+    tool = np.zeros(layout.N_TOOL)
     es = (np.array([2.0]), np.array([3.0]), np.array([4.0]), np.array([3.0]), np.array([5.0]),
           np.array([1.0]), np.array([0.5]), np.array([1], np.int8), np.array([0.25]),
           np.array([0.125]), np.array([0.0]), np.array([0.0]))
-    return dict(ist=np.zeros(K.N_IST, np.int64), clock=np.zeros(3), prm=prm, tool=tool,
-                en=np.zeros(K.N_EN), hacc=np.zeros(K.N_HIST),
-                hist=np.full((n_hist, K.N_HIST), np.nan), es=es)
+    return dict(ist=np.zeros(layout.N_IST, np.int64), clock=np.zeros(3), prm=prm, tool=tool,
+                en=np.zeros(layout.N_EN), hacc=np.zeros(layout.N_HIST),
+                hist=np.full((n_hist, layout.N_HIST), np.nan), es=es)
 
 
 def _end(s, dt, fx=0.0, ncont=0, split=None, bad=-1, dtmin=1.0):
@@ -65,21 +68,21 @@ def test_a_sample_holds_the_time_averages_the_tool_tip_and_the_energies():
     tool = s["tool"]
     split = np.arange(6.0)
     # two steps in the first sample interval (0.4 s, then 0.6 s) with different forces
-    tool[K.T_FX], tool[K.T_UY], tool[K.T_GX], tool[K.T_UX] = 10.0, 1.0, 7.0, 0.5
+    tool[layout.T_FX], tool[layout.T_UY], tool[layout.T_GX], tool[layout.T_UX] = 10.0, 1.0, 7.0, 0.5
     assert _end(s, 0.4, ncont=3, split=split)
-    tool[K.T_FX] = 20.0
-    s["en"][K.E_EXT] = 9.0
+    tool[layout.T_FX] = 20.0
+    s["en"][layout.E_EXT] = 9.0
     assert _end(s, 0.6, ncont=1, split=2.0 * split)
     h = s["hist"][0]
-    assert h[K.H_T] == 1.0 and s["ist"][K.I_SAMPLE] == 1 and s["ist"][K.I_STEP] == 2
-    assert h[K.H_FX] == (0.4 * 10.0 + 0.6 * 20.0) / 1.0
-    assert h[K.H_UY] == 1.0 and h[K.H_UX] == 0.5 and h[K.H_FY] == 0.0
-    assert h[K.H_NCONT] == (0.4 * 3 + 0.6 * 1) / 1.0
-    assert np.allclose(h[K.H_FX_RAKE:K.H_FX_RAKE + 6], 1.6 * split, rtol=1e-15)
-    assert h[K.H_TIP_X] == 7.5
-    assert h[K.H_EKIN] == 0.5 * 2.0 * (3.0 * 3.0 + 4.0 * 4.0)
-    assert (h[K.H_EINT], h[K.H_EPL], h[K.H_EHG]) == (5.0, 1.0, 0.5)
-    assert h[K.H_EFRIC] == 0.25 + 0.125 and h[K.H_EEXT] == 9.0 and h[K.H_EERO] == 0.0
+    assert h[layout.H_T] == 1.0 and s["ist"][layout.I_SAMPLE] == 1 and s["ist"][layout.I_STEP] == 2
+    assert h[layout.H_FX] == (0.4 * 10.0 + 0.6 * 20.0) / 1.0
+    assert h[layout.H_UY] == 1.0 and h[layout.H_UX] == 0.5 and h[layout.H_FY] == 0.0
+    assert h[layout.H_NCONT] == (0.4 * 3 + 0.6 * 1) / 1.0
+    assert np.allclose(h[layout.H_FX_RAKE:layout.H_FX_RAKE + 6], 1.6 * split, rtol=1e-15)
+    assert h[layout.H_TIP_X] == 7.5
+    assert h[layout.H_EKIN] == 0.5 * 2.0 * (3.0 * 3.0 + 4.0 * 4.0)
+    assert (h[layout.H_EINT], h[layout.H_EPL], h[layout.H_EHG]) == (5.0, 1.0, 0.5)
+    assert h[layout.H_EFRIC] == 0.25 + 0.125 and h[layout.H_EEXT] == 9.0 and h[layout.H_EERO] == 0.0
     assert np.all(s["hacc"] == 0.0) and s["clock"][2] == 0.0
     assert s["clock"][0] == 1.0 and s["clock"][1] == 0.5  # the next step: cfl * dtmin
     assert np.all(np.isnan(s["hist"][1]))
@@ -88,35 +91,36 @@ def test_a_sample_holds_the_time_averages_the_tool_tip_and_the_energies():
 def test_the_run_stops_at_its_end_time_with_the_energy_totals():
     s = _state2(t_end=0.5)
     assert not _end(s, 0.5)
-    assert s["ist"][K.I_STATUS] == K.STATUS_DONE and s["en"][K.E_INT] == 5.0
+    assert s["ist"][layout.I_STATUS] == layout.STATUS_DONE and s["en"][layout.E_INT] == 5.0
 
 
 @pytest.mark.parametrize("kw, status", [
-    ({"fx": math.nan}, K.STATUS_NONFINITE),
-    ({"dtmin": 1e-3}, K.STATUS_DT_COLLAPSE),
-    ({"bad": 4}, K.STATUS_INVERTED),
-    ({"dtmin": 1e30}, K.STATUS_NO_ELEMENTS),
+    ({"fx": math.nan}, layout.STATUS_NONFINITE),
+    ({"dtmin": 1e-3}, layout.STATUS_DT_COLLAPSE),
+    ({"bad": 4}, layout.STATUS_INVERTED),
+    ({"dtmin": 1e30}, layout.STATUS_NO_ELEMENTS),
 ])
 def test_a_stopped_step_sets_its_status(kw, status):
     s = _state2()
     assert not _end(s, 0.1, **kw)
-    assert s["ist"][K.I_STATUS] == status
-    counted = status in (K.STATUS_NONFINITE, K.STATUS_DT_COLLAPSE)
+    assert s["ist"][layout.I_STATUS] == status
+    counted = status in (layout.STATUS_NONFINITE, layout.STATUS_DT_COLLAPSE)
     # the 2D engine does not count a step stopped by an inverted element or an empty mesh
-    assert s["ist"][K.I_STEP] == int(counted) and s["clock"][0] == (0.1 if counted else 0.0)
-    if status == K.STATUS_INVERTED:
-        assert s["ist"][K.I_BADELEM] == 4
+    assert s["ist"][layout.I_STEP] == int(counted) and s["clock"][0] == (0.1 if counted else 0.0)
+    if status == layout.STATUS_INVERTED:
+        assert s["ist"][layout.I_BADELEM] == 4
     assert np.all(np.isnan(s["hist"]))
 
 
 def test_the_3d_engine_counts_a_step_stopped_by_an_inverted_element():
-    prm = np.zeros(K3.N_PRM)
-    prm[K3.P_CFL], prm[K3.P_SAMPLE_DT], prm[K3.P_TEND] = 0.5, 1.0, 10.0
-    ist, clock = np.zeros(K3.N_IST, np.int64), np.zeros(3)
-    hist = np.full((2, K3.N_HIST), np.nan)
+    prm = np.zeros(layout3d.N_PRM)
+    prm[layout3d.P_CFL], prm[layout3d.P_SAMPLE_DT], prm[layout3d.P_TEND] = 0.5, 1.0, 10.0
+    ist, clock = np.zeros(layout.N_IST, np.int64), np.zeros(3)
+    hist = np.full((2, scalar3d.N_HIST), np.nan)
     es = tuple(np.zeros(1) for _ in range(7)) + (np.ones(1, np.int8),) + tuple(
         np.zeros(1) for _ in range(4))
     ok = K3._end_step3(0.1, 2, 1.0, 0.0, 0.0, 0.0, 0, np.zeros(1), ist, clock, prm,
-                       np.zeros(K3.N_TOOL), np.zeros(K3.N_EN), np.zeros(K3.N_HIST), hist, es)
-    assert not ok and ist[K3.I_STATUS] == K3.STATUS_INVERTED and ist[K3.I_BADELEM] == 2
-    assert ist[K3.I_STEP] == 1 and clock[0] == 0.1
+                       np.zeros(scalar3d.N_TOOL), np.zeros(layout.N_EN),
+                       np.zeros(scalar3d.N_HIST), hist, es)
+    assert not ok and ist[layout.I_STATUS] == layout.STATUS_INVERTED and ist[layout.I_BADELEM] == 2
+    assert ist[layout.I_STEP] == 1 and clock[0] == 0.1

@@ -28,7 +28,7 @@ from robobore.cutting.fe.config.spec import (
     build_spec,
 )
 from robobore.cutting.fe.engine import chunk_loop as CL
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state2d import default_prm
 from robobore.errors import ConfigError
 from robobore.material import load_material
@@ -101,23 +101,23 @@ def test_the_spec_chooses_the_compiled_step():
 
 
 def test_the_spec_writes_the_model_slots():
-    tool = _spec(load_fe_config(EX / "fe_orthogonal.toml")).write_prm(default_prm(), K, 30.0)
-    assert tool[K.P_EROSION] == K.ERODE_NONE and tool[K.P_GATE] == -1.0
-    assert tool[K.P_DT_ERODE] == 0.0 and tool[K.P_RZ_EVERY] == 10
-    assert tool[K.P_MUTAB_N] == 6
-    assert tool[K.P_MUTAB_V + 5] == pytest.approx(40.0 / 60.0)
-    assert tool[K.P_SLIP_TAU] == pytest.approx(1e-6 / 0.5) and tool[K.P_COND_EVERY] == 10
+    tool = _spec(load_fe_config(EX / "fe_orthogonal.toml")).write_prm(default_prm(), layout, 30.0)
+    assert tool[layout.P_EROSION] == layout.ERODE_NONE and tool[layout.P_GATE] == -1.0
+    assert tool[layout.P_DT_ERODE] == 0.0 and tool[layout.P_RZ_EVERY] == 10
+    assert tool[layout.P_MUTAB_N] == 6
+    assert tool[layout.P_MUTAB_V + 5] == pytest.approx(40.0 / 60.0)
+    assert tool[layout.P_SLIP_TAU] == pytest.approx(1e-6 / 0.5) and tool[layout.P_COND_EVERY] == 10
     ns = _spec(parse_config(_base(mesh={"separation": "node_split"},
                                   solver={"heat_conduction": False},
                                   contact={"friction": 0.3})))
-    p = ns.write_prm(default_prm(), K, 30.0)
-    assert p[K.P_GATE] == 0.0 and p[K.P_RZ_EVERY] == 0 and p[K.P_COND_EVERY] == 0
-    assert p[K.P_DT_ERODE] == -0.3 and p[K.P_MUTAB_N] == 0 and p[K.P_MU] == 0.3
+    p = ns.write_prm(default_prm(), layout, 30.0)
+    assert p[layout.P_GATE] == 0.0 and p[layout.P_RZ_EVERY] == 0 and p[layout.P_COND_EVERY] == 0
+    assert p[layout.P_DT_ERODE] == -0.3 and p[layout.P_MUTAB_N] == 0 and p[layout.P_MU] == 0.3
     el = _spec(parse_config(_base(solver={"separation_gate_um": 2.0, "element": "q4_bbar"})))
-    p = el.write_prm(default_prm(), K, 30.0)
-    assert p[K.P_GATE] == pytest.approx(2e-6) and p[K.P_EROSION] == K.ERODE_LAYER
+    p = el.write_prm(default_prm(), layout, 30.0)
+    assert p[layout.P_GATE] == pytest.approx(2e-6) and p[layout.P_EROSION] == layout.ERODE_LAYER
     none = _spec(parse_config(_base(solver={"erosion": "none"})))
-    assert none.write_prm(default_prm(), K, 30.0)[K.P_EROSION] == K.ERODE_NONE
+    assert none.write_prm(default_prm(), layout, 30.0)[layout.P_EROSION] == layout.ERODE_NONE
 
 
 @pytest.mark.parametrize("frame, sections, field, words", [
@@ -162,8 +162,8 @@ def test_keys_of_the_chosen_variants_are_accepted():
                                "conduction_interval": 5},
                        contact={"tool_temperature_K": 400.0}))
     p = _spec(parse_config(_base(solver={"erosion": "none"}))).write_prm(
-        np.zeros(K.N_PRM), K, 30.0)
-    assert p[K.P_EROSION] == K.ERODE_NONE
+        np.zeros(layout.N_PRM), layout, 30.0)
+    assert p[layout.P_EROSION] == layout.ERODE_NONE
 
 
 def _boring(frame: str | None = "workpiece", **sections):
@@ -185,8 +185,8 @@ def test_the_boring_spec_and_its_slots():
         ToolFrame3D,
         build_boring_spec,
     )
-    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine.state3d import default_prm3
+    from robobore.cutting.fe.hex import layout3d
 
     # the defaults: the tool frame, the hexahedron's hourglass control, conduction, the
     # calibrated friction law read at the sliding speed and the hardening hold
@@ -200,21 +200,21 @@ def test_the_boring_spec_and_its_slots():
         assert s.element == HexElement(0.05, 0.05) and isinstance(s.thermal, Conduction)
         assert isinstance(s.friction, SlidingSpeedFriction)
         assert s.hardening == HardeningHold(0.6)
-        p = s.write_prm(default_prm3(), K3, 37.7)
-        assert p[K3.P_GATE] == -1.0 and p[K3.P_EROSION] == K3.ERODE_NONE
-        assert p[K3.P_RZ_EVERY] == 10
-        assert p[K3.P_MUTAB_N] == 6 and p[K3.P_COND_EVERY] == 10
+        p = s.write_prm(default_prm3(), layout3d, 37.7)
+        assert p[layout3d.P_GATE] == -1.0 and p[layout3d.P_EROSION] == layout3d.ERODE_NONE
+        assert p[layout3d.P_RZ_EVERY] == 10
+        assert p[layout3d.P_MUTAB_N] == 6 and p[layout3d.P_COND_EVERY] == 10
     assert cfg.solver.mass_scaling == 400.0 and cfg.cut.cut_length_mm == 0.02
     # the workpiece frame: the erosion layer with damage erosion by default
     s = build_boring_spec(parse_boring_config(_boring()), mat, 37.7)
     assert s.tool_frame is None and s.separation == EdgePathLayer() and s.damage_erosion
-    p = s.write_prm(default_prm3(), K3, 37.7)
-    assert p[K3.P_GATE] == -1.0 and p[K3.P_EROSION] == K3.ERODE_LAYER
+    p = s.write_prm(default_prm3(), layout3d, 37.7)
+    assert p[layout3d.P_GATE] == -1.0 and p[layout3d.P_EROSION] == layout3d.ERODE_LAYER
     ns = parse_boring_config(_boring(mesh={"separation": "node_split", "chip_rows": 4},
                                      solver={"separation_gate_um": 1.0}))
     s2 = build_boring_spec(ns, mat, 37.7)
     assert s2.separation == NodeSplit(height_um=5.0, gate_um=1.0)
-    assert s2.write_prm(default_prm3(), K3, 37.7)[K3.P_GATE] == pytest.approx(1e-6)
+    assert s2.write_prm(default_prm3(), layout3d, 37.7)[layout3d.P_GATE] == pytest.approx(1e-6)
 
 
 @pytest.mark.parametrize("sections, field, words", [

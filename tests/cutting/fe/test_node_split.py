@@ -16,7 +16,7 @@ import pytest
 from conftest import elastic_tc4, strip_mesh
 
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.mesh.orthogonal import build_mesh
@@ -118,7 +118,7 @@ def test_pairs_release_at_the_tool_edge():
     pairs = np.where(st.twin >= 0)[0]
     assert np.all(st.tied[pairs] == 1)
     advance(st, s.t_end)
-    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
+    cx = st.tool[layout.T_GX] + st.tool[layout.T_UX]
     released = pairs[st.tied[pairs] == 0]
     # released: exactly the pairs the edge has reached (originally ahead of the edge
     # centre's start, behind its present position + a few elements), and they moved apart

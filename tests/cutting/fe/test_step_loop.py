@@ -4,6 +4,7 @@ state's ``kernel_args()`` (the arrays the host driver hands the loop)."""
 
 from __future__ import annotations
 
+import types
 from pathlib import Path
 
 import numpy as np
@@ -45,11 +46,21 @@ def test_the_loop_state_names_the_kernel_arguments_in_order(build, names):
         assert getattr(st, name) is arr, name
 
 
+def loop_code():
+    """The code of the loop :func:`step_loop.make_chunk_loop` returns (a closure: one code
+    object for every engine and choice)."""
+    return next(c for c in SL.make_chunk_loop.__code__.co_consts
+                if isinstance(c, types.CodeType) and c.co_name == "chunk_loop")
+
+
 def test_both_engines_run_the_one_loop():
     loops = [CL._loop_q4r, CL._loop_q4r_heat, CL._loop_bbar, CL._loop_bbar_heat, CL._loop_ale,
              CL._loop_ale_heat, K3._loop3]
     for loop in loops:
-        assert loop.py_func.__code__ is SL.chunk_loop_py.__code__
+        assert loop.py_func.__code__ is loop_code()
+    # each under its own name, its phases closed over (no module global rebound)
+    assert len({loop.py_func.__qualname__ for loop in loops}) == len(loops)
+    assert all(loop.py_func.__closure__ for loop in loops)
 
 
 def test_a_compiled_pass_without_its_interval_is_refused():

@@ -15,12 +15,13 @@ import pytest
 from conftest import strip_mesh
 
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.state2d import default_prm, make_state, parting_edges
 from robobore.cutting.fe.mesh.orthogonal import _split_nodes
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal
+from robobore.cutting.fe.physics import thermal2d
 from robobore.errors import ConfigError
 from robobore.material import load_material
 
@@ -40,8 +41,8 @@ def _split_column(ny: int = 160, lx: float = 5e-6, ly: float = 8e-4):
 
 def _step_state(nodes, conn, twin, y0, t0k, dT):
     prm = default_prm()
-    prm[K.P_MS] = 1e6  # large mechanical step; the thermal mass is never scaled
-    prm[K.P_COND_EVERY] = 1
+    prm[layout.P_MS] = 1e6  # large mechanical step; the thermal mass is never scaled
+    prm[layout.P_COND_EVERY] = 1
     st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=prm, twin=twin,
                     phases=Phases(conduction=True))
     yc = st.y[conn].mean(axis=1)
@@ -94,7 +95,7 @@ def _block(nx=4, ny=2, lx=40e-6, ly=20e-6, temp=800.0):
     st = make_state(nodes, conn, np.zeros(nodes.shape[0], bool), TC4, prm=default_prm())
     st.temp[:] = temp
     # centroids and areas, as conduct() leaves them for the thermal contact
-    K.conduct(st.conn, st.x, st.y, st.alive, st.enbr, st.temp, st.tbuf, 0.0, RCP, 0.0)
+    thermal2d.conduct(st.conn, st.x, st.y, st.alive, st.enbr, st.temp, st.tbuf, 0.0, RCP, 0.0)
     return st
 
 
@@ -103,7 +104,7 @@ def _heat(st):
 
 
 def _tool_heat(st, hc, eta, t_tool, dt):
-    K.tool_heat(st.conn, st.x, st.y, st.ptr, st.nel, st.ncorner, st.alive, st.enbr, st.cfx,
+    thermal2d.tool_heat(st.conn, st.x, st.y, st.ptr, st.nel, st.ncorner, st.alive, st.enbr, st.cfx,
                 st.cfy, st.fric, st.fheat, st.temp, st.tbuf, st.tcq, RCP, hc, eta, t_tool, dt)
 
 
@@ -170,10 +171,10 @@ def test_config_keys_reach_the_kernel_and_are_checked():
     su = setup_orthogonal(_short_cut_cfg(thermal_conductance_W_per_m2K=2e5,
                                          friction_heat_fraction=0.7, tool_temperature_K=400.0))
     p = su.state.prm
-    assert (p[K.P_HC], p[K.P_FHEAT], p[K.P_TTOOL]) == (2e5, 0.7, 400.0)
+    assert (p[layout.P_HC], p[layout.P_FHEAT], p[layout.P_TTOOL]) == (2e5, 0.7, 400.0)
     assert su.state.ppair.shape[0] > 0
     su = setup_orthogonal(_short_cut_cfg())
-    assert su.state.prm[K.P_TTOOL] == TC4.T_room
+    assert su.state.prm[layout.P_TTOOL] == TC4.T_room
     for key, value in (("friction_heat_fraction", 1.5), ("thermal_conductance_W_per_m2K", -1.0),
                        ("tool_temperature_K", 0.0)):
         with pytest.raises(ConfigError) as ei:

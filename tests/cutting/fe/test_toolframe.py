@@ -26,7 +26,7 @@ from robobore.cutting.fe.ale.rezone import (
 )
 from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 from robobore.cutting.fe.config.orthogonal import parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.physics.tool_contact import tool_gap_py
 from robobore.errors import ConfigError
@@ -82,9 +82,9 @@ def _tool_frame_state(h=60e-6):
 
 
 def _pass(st, off):
-    rho_s = st.mat[15] * st.prm[K.P_MS]
-    tg = (st.prm[K.P_ALE_X0] + off, st.prm[K.P_TCY], st.prm[K.P_NRX], st.prm[K.P_NRY],
-          st.prm[K.P_NFX], st.prm[K.P_NFY], st.prm[K.P_R])
+    rho_s = st.mat[15] * st.prm[layout.P_MS]
+    tg = (st.prm[layout.P_ALE_X0] + off, st.prm[layout.P_TCY], st.prm[layout.P_NRX],
+          st.prm[layout.P_NRY], st.prm[layout.P_NFX], st.prm[layout.P_NFY], st.prm[layout.P_R])
     return rezone(st.x, st.y, st.vx, st.vy, st.mass, st.conn, st.alive, st.ptr, st.nel,
                   st.enbr, st.snodes, st.xn, st.yn, st.buf, st.sdx, st.sdy, st.sdz, st.sdxy,
                   st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy, st.area0, rho_s, 0.2,
@@ -203,8 +203,8 @@ def test_example_config_builds():
     cfg = load_fe_config(Path(__file__).parents[3] / "examples" / "fe_orthogonal_toolframe.toml")
     su = setup_orthogonal(cfg)
     p = su.state.prm
-    assert int(p[K.P_RZ_EVERY]) == 10 and p[K.P_RZ_MAXMOVE] == 0.2
-    assert p[K.P_CDAMP] == 1.0 and int(p[K.P_EROSION]) == K.ERODE_NONE
+    assert int(p[layout.P_RZ_EVERY]) == 10 and p[layout.P_RZ_MAXMOVE] == 0.2
+    assert p[layout.P_CDAMP] == 1.0 and int(p[layout.P_EROSION]) == layout.ERODE_NONE
     assert su.t_contact == 0.0 and su.t_end == pytest.approx(0.3e-3 / 0.5)
     assert su.state.snodes.size == int((su.mesh.acls[:, 0] != TF_RIGID).sum())
     # a longer chip (mesh.chip_length_um) adds elements up the rake

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.config.orthogonal import FRICTION_TABLE_MU, load_fe_config, parse_config
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 from robobore.cutting.fe.models.validate import point_config
 from robobore.material import johnson_cook as jc
@@ -55,12 +55,12 @@ def test_calibrated_example_lands_in_the_engine():
     p = su.state.prm
     assert su.state.mat[jc.EPS_HMAX] == 0.6
     # the table is 1.5 x Rech et al. 2013, read per node at its sliding speed, no cap
-    n = int(p[K.P_MUTAB_N])
+    n = int(p[layout.P_MUTAB_N])
     assert n == FRICTION_TABLE_MU.size
-    np.testing.assert_allclose(p[K.P_MUTAB_MU:K.P_MUTAB_MU + n], 1.5 * FRICTION_TABLE_MU,
+    np.testing.assert_allclose(p[layout.P_MUTAB_MU:layout.P_MUTAB_MU + n], 1.5 * FRICTION_TABLE_MU,
                                rtol=1e-12)
-    assert p[K.P_SLIP_TAU] > 0.0
-    assert p[K.P_TAU] == pytest.approx(5000e6)
+    assert p[layout.P_SLIP_TAU] > 0.0
+    assert p[layout.P_TAU] == pytest.approx(5000e6)
     assert cfg.solver.heat_conduction and cfg.mesh.frame == "tool"
 
 

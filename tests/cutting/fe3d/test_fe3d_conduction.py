@@ -10,7 +10,6 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
@@ -18,6 +17,7 @@ from robobore.cutting.fe.engine.state3d import (
     make_state3,
     split_node_layer,
 )
+from robobore.cutting.fe.hex import layout3d
 from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
 from robobore.cutting.fe.physics.thermal3d import (
     conduct3,
@@ -183,11 +183,11 @@ def test_boring_run_conducts_heat_out_of_the_shear_zone():
     for cond in (False, True):
         s = _boring(cond)
         st = s.state
-        assert bool(st.prm[K3.P_COND_EVERY] > 0) is cond
+        assert bool(st.prm[layout3d.P_COND_EVERY] > 0) is cond
         advance3(st, s.t_end)
         t_room = TC4.T_room
         runs[cond] = (float(st.temp.max()), int(np.sum(st.temp > t_room + 1.0)),
-                      energy_error(st.en), float(st.prm[K3.P_COND_T]), st.time,
+                      energy_error(st.en), float(st.prm[layout3d.P_COND_T]), st.time,
                       float(st.clock[1]))
     (pk_a, warm_a, err_a, *_), (pk_c, warm_c, err_c, tc, t, dt) = runs[False], runs[True]
     assert pk_c < pk_a

@@ -16,8 +16,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import advance3, box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.physics.tool_contact import contact_force_py, tool_gap_py
 from robobore.material import Material, load_material
 
@@ -26,41 +26,41 @@ RN, KAP, KEND, RAKE, CLR, RE = 0.4e-3, math.radians(90), math.radians(5), math.r
 
 
 def gap(p):
-    return K3.insert_gap3_py(p[0], p[1], p[2], RN, KAP, KEND, RAKE, CLR, RE, 0.0)
+    return scalar3d.insert_gap3_py(p[0], p[1], p[2], RN, KAP, KEND, RAKE, CLR, RE, 0.0)
 
 
 def test_contact_force3_hand_calculation():
     """Normal penalty F = pf m / dt^2 (-g); sliding capped by mu Fn, opposite to sliding;
     a 2D-plane case equals the 2D law."""
     m, dt, pf, mu = 2e-9, 1e-8, 0.1, 0.3
-    fx, fy, fz, fn, ft, *_ = K3.contact_force3_py(-1e-7, 0, 1, 0, 5.0, 0.0, 0.0, m, 1.0, mu,
+    fx, fy, fz, fn, ft, *_ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 5.0, 0.0, 0.0, m, 1.0, mu,
                                                   1e30, pf, dt, 0.0, 0.0, 0.0, 0.0)
     assert fn == pytest.approx(pf * m / dt**2 * 1e-7)
     assert fy == pytest.approx(fn)
     assert ft == pytest.approx(mu * fn)  # m v / dt = 1 N > mu Fn = 0.06 N
     assert fx == pytest.approx(-mu * fn) and fz == 0.0
     # stick: small sliding velocity -> the force that stops it in one step
-    *_, ft2, tx, ty, tz, _ = K3.contact_force3_py(-1e-7, 0, 1, 0, 0.0, 0.0, 1e-3, m, 1.0, mu,
+    *_, ft2, tx, ty, tz, _ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 0.0, 0.0, 1e-3, m, 1.0, mu,
                                                   1e30, pf, dt, 0.0, 0.0, 0.0, 0.0)
     assert ft2 == pytest.approx(m * 1e-3 / dt) and tz == pytest.approx(1.0)
     # shear cap
-    *_, ft3, _, _, _, _ = K3.contact_force3_py(-1e-7, 0, 1, 0, 5.0, 0.0, 0.0, m, 1e-12, mu,
+    *_, ft3, _, _, _, _ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 5.0, 0.0, 0.0, m, 1e-12, mu,
                                                1e9, pf, dt, 0.0, 0.0, 0.0, 0.0)
     assert ft3 == pytest.approx(1e9 * 1e-12)
     # 2D equivalence in the x-y plane
     f2 = contact_force_py(-1e-7, 0.6, 0.8, 0.3, -0.2, m, 1.0, mu, 1e30, pf, dt, 0.0, 0.0, 0.0)
-    f3 = K3.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt,
+    f3 = scalar3d.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt,
                               0.0, 0.0, 0.0, 0.0)
     assert f3[0] == pytest.approx(f2[0]) and f3[1] == pytest.approx(f2[1]) and f3[2] == 0.0
     # return mapping on the trial velocity, as in 2D: the element forces' tangential part
     # enters the stick force (static friction balances a push below mu Fn)
     fn = pf * m / dt**2 * 1e-7
     push = (0.0, 0.4 * mu * fn, 0.3 * mu * fn)  # y is normal: only z is tangential
-    *_, ft4, tx, ty, tz, _ = K3.contact_force3_py(-1e-7, 0, 1, 0, 0.0, 0.0, 0.0, m, 1.0, mu,
+    *_, ft4, tx, ty, tz, _ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 0.0, 0.0, 0.0, m, 1.0, mu,
                                                   1e30, pf, dt, 0.0, *push)
     assert ft4 == pytest.approx(0.3 * mu * fn) and tz == pytest.approx(1.0)
     g2 = contact_force_py(-1e-7, 0.6, 0.8, 0.3, -0.2, m, 1.0, mu, 1e30, pf, dt, 0.0, 0.5, -0.7)
-    g3 = K3.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt,
+    g3 = scalar3d.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt,
                               0.0, 0.5, -0.7, 0.0)
     assert g3[0] == pytest.approx(g2[0]) and g3[1] == pytest.approx(g2[1])
 
@@ -76,21 +76,21 @@ def test_contact_force3_damping_is_the_2d_law():
     for vr in ((0.3, -0.2), (-0.05, -0.01), (0.0, 10.0)):
         f2 = contact_force_py(-1e-8, 0.6, 0.8, vr[0], vr[1], m, 1.0, mu, 1e30, pf, dt, z,
                               0.5, -0.7)
-        f3 = K3.contact_force3_py(-1e-8, 0.6, 0.8, 0.0, vr[0], vr[1], 0.0, m, 1.0, mu, 1e30, pf,
-                                  dt, z, 0.5, -0.7, 0.0)
+        f3 = scalar3d.contact_force3_py(-1e-8, 0.6, 0.8, 0.0, vr[0], vr[1], 0.0, m, 1.0, mu,
+                                        1e30, pf, dt, z, 0.5, -0.7, 0.0)
         assert f3[0] == pytest.approx(f2[0], rel=1e-12) and f3[1] == pytest.approx(f2[1],
                                                                                    rel=1e-12)
         assert f3[3] == pytest.approx(f2[2], rel=1e-12) and f3[8] == pytest.approx(f2[4],
                                                                                    rel=1e-12)
         assert f3[3] >= 0.0
     # approaching along -y at 0.01 m/s (and sliding in z): fd = c * 0.01 exactly
-    f = K3.contact_force3_py(-1e-8, 0.0, 1.0, 0.0, 0.0, -0.01, 0.2, m, 1.0, mu, 1e30, pf, dt, z,
-                             0.0, 0.0, 0.0)
+    f = scalar3d.contact_force3_py(-1e-8, 0.0, 1.0, 0.0, 0.0, -0.01, 0.2, m, 1.0, mu, 1e30, pf,
+                                   dt, z, 0.0, 0.0, 0.0)
     assert f[8] == pytest.approx(c * 0.01, rel=1e-12)
     assert f[3] == pytest.approx(k * 1e-8 + c * 0.01, rel=1e-12)
     # leaving at 10 m/s: no adhesion
-    f = K3.contact_force3_py(-1e-8, 0.0, 1.0, 0.0, 0.0, 10.0, 0.0, m, 1.0, mu, 1e30, pf, dt, z,
-                             0.0, 0.0, 0.0)
+    f = scalar3d.contact_force3_py(-1e-8, 0.0, 1.0, 0.0, 0.0, 10.0, 0.0, m, 1.0, mu, 1e30, pf,
+                                   dt, z, 0.0, 0.0, 0.0)
     assert f[3] == 0.0 and f[8] == pytest.approx(-k * 1e-8)
 
 
@@ -142,12 +142,12 @@ def test_rigid_insert_contact_patch_without_penetration():
     bottom = idx[:, 0, :].ravel()
     fixed[bottom] = 7
     p = default_prm3()
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN], p[K3.P_KAPPA], p[K3.P_KEND] = RN, KAP, KEND
-    p[K3.P_RAKE], p[K3.P_CLR], p[K3.P_RE] = RAKE, CLR, RE
-    p[K3.P_MU] = 0.3
-    p[K3.P_MS] = 100.0
-    p[K3.P_SAMPLE_DT] = 1e-7
+    p[layout3d.P_TOOL] = 1.0
+    p[layout3d.P_RN], p[layout3d.P_KAPPA], p[layout3d.P_KEND] = RN, KAP, KEND
+    p[layout3d.P_RAKE], p[layout3d.P_CLR], p[layout3d.P_RE] = RAKE, CLR, RE
+    p[layout3d.P_MU] = 0.3
+    p[layout3d.P_MS] = 100.0
+    p[layout3d.P_SAMPLE_DT] = 1e-7
     s = make_state3(nodes, conn, fixed, mat, prm=p, n_samples=400, tool_tip=(0.0, 0.0, 0.0))
     s.vy[bottom] = 0.05
     worst = 0.0
@@ -157,5 +157,5 @@ def test_rigid_insert_contact_patch_without_penetration():
         worst = max(worst, float(-g.min()))
     assert np.abs(s.cf[:, :3]).sum() > 0, "block never reached the insert"
     assert worst < 0.02 * le
-    fy = s.hist[np.isfinite(s.hist[:, K3.H_T]), K3.H_FY]
+    fy = s.hist[np.isfinite(s.hist[:, scalar3d.H_T]), scalar3d.H_FY]
     assert fy[-1] > 0  # the insert is pushed up (out of the material)

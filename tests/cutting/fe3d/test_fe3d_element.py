@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
@@ -21,6 +22,7 @@ from robobore.cutting.fe.engine.state3d import (
     hex_volumes,
     make_state3,
 )
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.errors import NumericalError
 from robobore.material import Material, load_material
 from robobore.material import johnson_cook as jc
@@ -40,7 +42,7 @@ def _distorted_cube(rng):
 def _one_update(st, dt=1e-30):
     K3.element_update3(st.conn, st.x, st.y, st.z, st.vx, st.vy, st.vz, st.alive, st.layer,
                        st.sd, st.pres, st.eps_p, st.temp, st.dmg, st.qh, st.vol0, st.ie, st.hge,
-                       st.fe, st.dte, st.plast, st.rate, st.mat, st.prm, dt, K3.ERODE_NONE)
+                       st.fe, st.dte, st.plast, st.rate, st.mat, st.prm, dt, layout3d.ERODE_NONE)
 
 
 def test_volume_derivative_matches_numerical():
@@ -101,10 +103,10 @@ def _tension_state(rate, mat):
     L = 1e-3
     nodes, conn, _ = box_mesh(1, 1, 1, L, L, L)
     fixed = np.zeros(8, np.int64)
-    fixed[nodes[:, 0] == 0] |= K3.FIX_X
-    fixed[nodes[:, 1] == 0] |= K3.FIX_Y
-    fixed[nodes[:, 2] == 0] |= K3.FIX_Z
-    fixed[nodes[:, 0] == L] |= K3.FIX_X
+    fixed[nodes[:, 0] == 0] |= scalar3d.FIX_X
+    fixed[nodes[:, 1] == 0] |= scalar3d.FIX_Y
+    fixed[nodes[:, 2] == 0] |= scalar3d.FIX_Z
+    fixed[nodes[:, 0] == L] |= scalar3d.FIX_X
     st = make_state3(nodes, conn, fixed, mat)
     st.vx[:] = rate * nodes[:, 0]
     return st, nodes, L
@@ -163,7 +165,7 @@ def test_simple_shear_follows_johnson_cook():
 def _confined_bar(n=60, L=6e-3):
     h = L / n
     nodes, conn, _ = box_mesh(n, 1, 1, L, h, h)
-    fixed = np.full(len(nodes), K3.FIX_Y | K3.FIX_Z, np.int64)
+    fixed = np.full(len(nodes), scalar3d.FIX_Y | scalar3d.FIX_Z, np.int64)
     return nodes, conn, fixed, L
 
 
@@ -172,7 +174,7 @@ def test_dilatational_wave_speed_in_confined_bar():
     reaches x = L/2 at t = (L/2)/c_d, c_d = sqrt((K + 4G/3)/rho). Tolerance 3 %."""
     mat = elastic_tc4()
     nodes, conn, fixed, L = _confined_bar()
-    fixed[nodes[:, 0] == 0] |= K3.FIX_X
+    fixed[nodes[:, 0] == 0] |= scalar3d.FIX_X
     st = make_state3(nodes, conn, fixed, mat)
     v0 = 0.1
     st.vx[nodes[:, 0] == 0] = v0
@@ -205,9 +207,9 @@ def test_elastic_energy_conservation():
     ie_max = 0.0
     for frac in (0.25, 0.5, 0.75, 1.0):
         advance3(st, frac * period)
-        tot = st.en[K3.E_KIN] + st.en[K3.E_INT] + st.en[K3.E_HG]
+        tot = st.en[layout.E_KIN] + st.en[layout.E_INT] + st.en[layout.E_HG]
         assert tot == pytest.approx(e0, rel=0.01)
-        ie_max = max(ie_max, st.en[K3.E_INT])
+        ie_max = max(ie_max, st.en[layout.E_INT])
     assert ie_max > 0.3 * e0  # the energy really went through the elements
 
 
@@ -217,7 +219,7 @@ def test_unstable_run_stops_with_clear_message():
     nodes, conn, _, L = _confined_bar(n=10, L=2e-3)
     st = make_state3(nodes, conn, np.zeros(len(nodes), np.int64), mat)
     st.vx[:] = 0.2 * np.sin(math.pi * nodes[:, 0] / L)
-    st.prm[K3.P_CFL] = 5.0
+    st.prm[layout3d.P_CFL] = 5.0
     st.clock[1] *= 5.0 / 0.8
     with pytest.raises(NumericalError, match="unstable at step"):
         advance3(st, 1.0, chunk_steps=200)
@@ -232,7 +234,7 @@ def test_bad_mesh_rejected():
                     elastic_tc4())
     with pytest.raises(ConfigError, match="mesh must be"):
         make_state3(nodes[:, :2], conn, np.zeros(8, np.int64), elastic_tc4())
-    assert default_prm3().shape == (K3.N_PRM,)
+    assert default_prm3().shape == (layout3d.N_PRM,)
 
 
 @pytest.mark.parametrize("hgs, hgv", [(0.05, 0.0), (0.0, 0.05)])
@@ -243,8 +245,9 @@ def test_hourglass_resistance_matches_2d_quad_in_plane_strain(hgs, hgv):
     means the same in both engines. Tolerance 1e-9 relative (same formulas, rounding only).
     Before the scaling was aligned the cube resisted 3x (stiffness) and 2x (viscous) more, and
     a plane-strain slab cut by the 3D engine gave 1.5x the 2D cutting force."""
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.state2d import default_prm, make_state
+    from robobore.cutting.fe.quad import element as q_element
 
     a = 10e-6
     v0 = 0.1
@@ -252,7 +255,8 @@ def test_hourglass_resistance_matches_2d_quad_in_plane_strain(hgs, hgv):
     mat = elastic_tc4()
     nodes, conn, _ = box_mesh(1, 1, 1, a, a, a)
     p3 = default_prm3()
-    p3[K3.P_HGS], p3[K3.P_HGV], p3[K3.P_BV1], p3[K3.P_BV2] = hgs, hgv, 0.0, 0.0
+    p3[layout3d.P_HGS], p3[layout3d.P_HGV] = hgs, hgv
+    p3[layout3d.P_BV1], p3[layout3d.P_BV2] = 0.0, 0.0
     st = make_state3(nodes, conn, np.zeros(8, np.int64), mat, prm=p3)
     xi = np.sign(st.x - 0.5 * a)
     eta = np.sign(st.y - 0.5 * a)
@@ -263,13 +267,13 @@ def test_hourglass_resistance_matches_2d_quad_in_plane_strain(hgs, hgv):
         f3[conn[0, k]] = st.fe[0, 3 * k]
     nodes2 = np.array([[0, 0], [a, 0], [a, a], [0, a]], float)
     p2 = default_prm()
-    p2[K.P_HGS], p2[K.P_HGV], p2[K.P_BV1], p2[K.P_BV2] = hgs, hgv, 0.0, 0.0
+    p2[layout.P_HGS], p2[layout.P_HGV], p2[layout.P_BV1], p2[layout.P_BV2] = hgs, hgv, 0.0, 0.0
     s2 = make_state(nodes2, np.array([[0, 1, 2, 3]]), np.zeros(4, bool), mat, prm=p2)
     s2.vx[:] = v0 * np.sign(s2.x - 0.5 * a) * np.sign(s2.y - 0.5 * a)
-    K.element_update(s2.conn, s2.x, s2.y, s2.vx, s2.vy, s2.alive, s2.layer, s2.sdx, s2.sdy,
+    q_element.element_update(s2.conn, s2.x, s2.y, s2.vx, s2.vy, s2.alive, s2.layer, s2.sdx, s2.sdy,
                      s2.sdz, s2.sdxy, s2.pres, s2.eps_p, s2.temp, s2.dmg, s2.qhx, s2.qhy,
                      s2.area0, s2.ie, s2.hge, s2.fex, s2.fey, s2.dte, s2.plast, s2.rate,
-                     s2.mat, s2.prm, dt, K.ERODE_NONE)
+                     s2.mat, s2.prm, dt, layout.ERODE_NONE)
     for k in range(4):
         # the cube's two nodes above the quad's node k (z = 0 and z = a), per unit thickness
         sel = (np.abs(st.x - nodes2[k, 0]) < 1e-12) & (np.abs(st.y - nodes2[k, 1]) < 1e-12)

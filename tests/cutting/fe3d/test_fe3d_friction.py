@@ -14,11 +14,12 @@ import pytest
 
 from robobore.cutting.fe.config.engine_settings import apply_friction_settings
 from robobore.cutting.fe.config.orthogonal import ContactSection
-from robobore.cutting.fe.engine import kernels as K2
-from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state2d import default_prm
 from robobore.cutting.fe.engine.state3d import box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.models.boring3d import parse_boring_config
+from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
 from robobore.material import load_material
 from robobore.material.friction import friction_law
@@ -51,8 +52,8 @@ def test_boring_config_defaults_to_the_validated_law():
     assert a.contact.shear_limit_MPa == 576.0 and a.material.strain_limit() == math.inf
     # a constant: no table slots
     k = parse_boring_config(_base(contact={"friction": 0.3}))
-    p = apply_friction_settings(default_prm3(), k.contact, 37.7, K3)
-    assert p[K3.P_MU] == 0.3 and p[K3.P_MUTAB_N] == 0.0
+    p = apply_friction_settings(default_prm3(), k.contact, 37.7, layout3d)
+    assert p[layout3d.P_MU] == 0.3 and p[layout3d.P_MUTAB_N] == 0.0
 
 
 @pytest.mark.parametrize("contact, match", [
@@ -73,15 +74,15 @@ def test_table_lookup_is_the_2d_engines():
     returns what the 2D one does: the law's coefficients at its velocities, linear between,
     constant beyond the ends."""
     c = ContactSection()
-    p3 = apply_friction_settings(default_prm3(), c, 37.7, K3)
-    p2 = apply_friction_settings(default_prm(), c, 37.7, K2)
-    assert p3[K3.P_MUTAB_N] == p2[K2.P_MUTAB_N] == len(LAW.mu)
-    assert p3[K3.P_SLIP_TAU] == p2[K2.P_SLIP_TAU] == pytest.approx(1e-6 / (37.7 / 60.0))
+    p3 = apply_friction_settings(default_prm3(), c, 37.7, layout3d)
+    p2 = apply_friction_settings(default_prm(), c, 37.7, layout)
+    assert p3[layout3d.P_MUTAB_N] == p2[layout.P_MUTAB_N] == len(LAW.mu)
+    assert p3[layout3d.P_SLIP_TAU] == p2[layout.P_SLIP_TAU] == pytest.approx(1e-6 / (37.7 / 60.0))
     for v_m_min, mu in zip(LAW.velocity_m_per_min, LAW.mu, strict=True):
-        assert K3.friction_at3(p3, v_m_min / 60.0) == pytest.approx(mu, abs=1e-15)
+        assert scalar3d.friction_at3(p3, v_m_min / 60.0) == pytest.approx(mu, abs=1e-15)
     for v in (0.0, 0.1, 8.75 / 60.0, 0.4, 5.0):
-        assert K3.friction_at3(p3, v) == K2.friction_at_py(p2, v)
-    assert K3.friction_at3(p3, 8.75 / 60.0) == pytest.approx(0.5 * (0.33 + 0.315))
+        assert scalar3d.friction_at3(p3, v) == node_contact.friction_at_py(p2, v)
+    assert scalar3d.friction_at3(p3, 8.75 / 60.0) == pytest.approx(0.5 * (0.33 + 0.315))
 
 
 def _node_on_rake(speed: float, slip_tau_steps: float):
@@ -89,27 +90,27 @@ def _node_on_rake(speed: float, slip_tau_steps: float):
     node update. Returns (Coulomb ratio of its contact force, its filtered speed, dt)."""
     le = 20e-6
     nodes, conn, _ = box_mesh(1, 1, 1, le, le, le, origin=(-2 * le, -2 * le, -le / 2))
-    p = apply_friction_settings(default_prm3(), ContactSection(), 37.7, K3)
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN], p[K3.P_KAPPA], p[K3.P_KEND] = RN, KAP, KEND
-    p[K3.P_RAKE], p[K3.P_CLR], p[K3.P_RE] = RAKE, CLR, RE
+    p = apply_friction_settings(default_prm3(), ContactSection(), 37.7, layout3d)
+    p[layout3d.P_TOOL] = 1.0
+    p[layout3d.P_RN], p[layout3d.P_KAPPA], p[layout3d.P_KEND] = RN, KAP, KEND
+    p[layout3d.P_RAKE], p[layout3d.P_CLR], p[layout3d.P_RE] = RAKE, CLR, RE
     s = make_state3(nodes, conn, np.zeros(len(nodes), np.int64), load_material("TC4"), prm=p,
                     tool_tip=(0.0, 0.0, 0.0))
     dt = float(s.clock[1])
-    s.prm[K3.P_SLIP_TAU] = slip_tau_steps * dt
+    s.prm[layout3d.P_SLIP_TAU] = slip_tau_steps * dt
     y = 30e-6
     lo, hi = 10e-6, 20e-6  # the rake face crosses y = 30 um between these x
     for _ in range(200):
         mid = 0.5 * (lo + hi)
-        if K3.insert_gap3_py(mid, y, 0.0, RN, KAP, KEND, RAKE, CLR, RE, 0.0)[0] < -1e-10:
+        if scalar3d.insert_gap3_py(mid, y, 0.0, RN, KAP, KEND, RAKE, CLR, RE, 0.0)[0] < -1e-10:
             lo = mid
         else:
             hi = mid
-    g, nx, ny, nz = K3.insert_gap3_py(lo, y, 0.0, RN, KAP, KEND, RAKE, CLR, RE, 0.0)
+    g, nx, ny, nz = scalar3d.insert_gap3_py(lo, y, 0.0, RN, KAP, KEND, RAKE, CLR, RE, 0.0)
     assert -2e-10 < g < 0.0 and nz == 0.0
     s.x[0], s.y[0], s.z[0] = lo, y, 0.0
     s.vx[0], s.vy[0] = -ny * speed, nx * speed  # up the rake face (tangent)
-    K3.hex_node(0, s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.ptr, s.nel, s.ncorner,
+    scalar3d.hex_node(0, s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.ptr, s.nel, s.ncorner,
                 s.alive, s.vol0, s.fe, s.cf, s.fric, s.pen, s.ndead, s.ero_ke, s.nwork, s.prm,
                 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, dt, s.pairs)
     f = s.cf[0, :3]
@@ -136,5 +137,5 @@ def test_sliding_speed_is_low_pass_filtered():
     v = 30.0 / 60.0
     ratio, vs, _ = _node_on_rake(v, slip_tau_steps=4.0)
     assert vs == pytest.approx(0.25 * v, rel=1e-12)
-    p = apply_friction_settings(default_prm(), ContactSection(), 37.7, K2)
-    assert ratio == pytest.approx(K2.friction_at_py(p, 0.25 * v), rel=1e-9)
+    p = apply_friction_settings(default_prm(), ContactSection(), 37.7, layout)
+    assert ratio == pytest.approx(node_contact.friction_at_py(p, 0.25 * v), rel=1e-9)

@@ -27,7 +27,9 @@ SCRIPT = textwrap.dedent("""
     import numpy as np
     from numba import cuda
     assert cuda.simulator_is_being_used() if hasattr(cuda, "simulator_is_being_used") else True
-    from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine import layout as L2
+    from robobore.cutting.fe.hex import layout3d as L3
+    from robobore.cutting.fe.hex import scalar3d as S3
     from robobore.cutting.fe.engine.gpu.backend3d import advance3_gpu
     from robobore.cutting.fe.engine.state3d import advance3
 
@@ -47,9 +49,9 @@ SCRIPT = textwrap.dedent("""
         )
         from robobore.material import load_material
         s = bench.small3d(n_samples=40)
-        apply_friction_settings(s.prm, ContactSection(), s.prm[K3.P_VC] * 60.0, K3)
+        apply_friction_settings(s.prm, ContactSection(), s.prm[L3.P_VC] * 60.0, L3)
         apply_thermal_settings(s.prm, SolverSection(conduction_interval=3), ContactSection(),
-                               load_material("TC4"), K3)
+                               load_material("TC4"), L3)
         return s
 
     a = build()
@@ -62,19 +64,19 @@ SCRIPT = textwrap.dedent("""
     def rel(u, v):
         return float(np.max(np.abs(u - v)) / max(np.max(np.abs(u)), 1e-300))
     out = {"steps": [na, nb], "contact": float(np.abs(a.cf[:, :3]).sum()),
-           "table": float(a.prm[K3.P_MUTAB_N]), "slide": float(np.max(a.cf[:, 3])),
+           "table": float(a.prm[L3.P_MUTAB_N]), "slide": float(np.max(a.cf[:, 3])),
            "vslip": rel(a.cf[:, 3], b.cf[:, 3]),
            "x": rel(a.x, b.x), "vx": rel(a.vx, b.vx), "vy": rel(a.vy, b.vy),
            "sd": rel(a.sd, b.sd), "pres": rel(a.pres, b.pres), "eps_p": rel(a.eps_p, b.eps_p),
            # temperature rise above room temperature (mat[TROOM])
            "temp": rel(a.temp - a.mat[6], b.temp - b.mat[6]),
            "heated": float(np.max(a.temp) - a.mat[6]),
-           "cond_t": [float(a.prm[K3.P_COND_T]), float(b.prm[K3.P_COND_T])],
+           "cond_t": [float(a.prm[L3.P_COND_T]), float(b.prm[L3.P_COND_T])],
            "theat": rel(a.theat, b.theat),
-           "tool": rel(a.tool, b.tool), "ext": rel(a.en[K3.E_EXT:K3.E_EXT + 1],
-                                                  b.en[K3.E_EXT:K3.E_EXT + 1]),
-           "hist_f": rel(np.nan_to_num(a.hist[:, K3.H_FX:K3.H_FZ + 1]),
-                         np.nan_to_num(b.hist[:, K3.H_FX:K3.H_FZ + 1])),
+           "tool": rel(a.tool, b.tool), "ext": rel(a.en[L2.E_EXT:L2.E_EXT + 1],
+                                                  b.en[L2.E_EXT:L2.E_EXT + 1]),
+           "hist_f": rel(np.nan_to_num(a.hist[:, S3.H_FX:S3.H_FZ + 1]),
+                         np.nan_to_num(b.hist[:, S3.H_FX:S3.H_FZ + 1])),
            "profile": sorted(prof) if prof is not None else None}
     print("RESULT" + json.dumps(out))
 """)

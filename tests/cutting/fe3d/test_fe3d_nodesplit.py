@@ -13,8 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state3d import advance3, box_mesh, default_prm3, make_state3
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.models.boring3d import (
     build_boring_mesh,
     parse_boring_config,
@@ -29,7 +30,7 @@ INS = BoringInsert(nose_radius_m=0.4e-3, edge_radius_m=20e-6)
 
 
 def _section_s(ins, y, z):
-    return K3.edge_section(y, z, ins.nose_radius_m, math.radians(ins.approach_angle_deg),
+    return scalar3d.edge_section(y, z, ins.nose_radius_m, math.radians(ins.approach_angle_deg),
                            math.radians(ins.end_edge_angle_deg), ins.edge_radius_m)[0]
 
 
@@ -86,7 +87,7 @@ def _block(split: bool):
         twin[line] = new
         twin[new] = line
     p = default_prm3()
-    p[K3.P_GATE] = 0.0
+    p[layout3d.P_GATE] = 0.0
     st = make_state3(nodes, conn, fixed, load_material("TC4"), prm=p, twin=twin)
     # a shearing, stretching initial velocity: plastic flow through the parting surface
     st.vx[:] = 60.0 * st.y / (4 * le)
@@ -105,7 +106,7 @@ def test_tied_split_mesh_moves_as_the_unsplit_mesh(tie):
     t_end = 300 * float(a.clock[1])
     advance3(a, t_end)
     advance3(b, t_end)
-    assert int(a.ist[K3.I_STEP]) == int(b.ist[K3.I_STEP])
+    assert int(a.ist[layout.I_STEP]) == int(b.ist[layout.I_STEP])
     assert np.abs(a.eps_p).max() > 0.0
     # the pair's mass is summed in another order than the unsplit node's: rounding only
     close = np.allclose(b.x[:n], a.x, rtol=0, atol=1e-14) and np.allclose(
@@ -130,7 +131,7 @@ def test_pairs_part_where_the_insert_passed():
     k = np.flatnonzero(st.twin >= 0)
     x0, z0 = s.mesh.nodes[k, 0], s.mesh.nodes[k, 2]
     y0 = s.mesh.nodes[k, 1]
-    tip = st.tool[K3.T_GX]
+    tip = st.tool[scalar3d.T_GX]
     # pairs the edge swept (parting surface above the edge path) have parted; pairs ahead
     # of the insert, or below its path (the lowered thin chip ends), are still tied
     swept = (x0 < tip - 20e-6) & (y0 >= s.insert.drop(z0))

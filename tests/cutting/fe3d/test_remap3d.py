@@ -309,14 +309,14 @@ def test_runs_on_the_engine_state_and_keeps_its_lumped_masses():
     # the pass takes the arrays of FEState3 as they are (face neighbours: the state's
     # enbr); its lumped masses are the engine's (make_state3) for the remapped vol0
     from robobore.cutting.fe.ale.remap3d import N_RZ3, remap3d
-    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine.state3d import make_state3
+    from robobore.cutting.fe.hex import layout3d
     from robobore.material import load_material
 
     nodes, conn, _, inner = _box()
     mat = load_material("TC4")
     st = make_state3(nodes, conn, np.zeros(nodes.shape[0], np.int64), mat)
-    rho_s = mat.rho * st.prm[K3.P_MS]
+    rho_s = mat.rho * st.prm[layout3d.P_MS]
     rng = np.random.default_rng(4)
     st.vx[:] = rng.normal(size=st.vx.size)
     st.sd[:] = rng.normal(size=st.sd.shape) * 1e8

@@ -14,6 +14,7 @@ from robobore.cutting.fe.ale.remap3d import VEL_TAYLOR
 from robobore.cutting.fe.config.spec import ToolFrame
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import advance3, energy_error
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.mesh.toolframe3d import FK_SIDE
 from robobore.cutting.fe.models.boring3d import (
     parse_boring_config,
@@ -110,14 +111,14 @@ def test_tool_frame_state():
     side = np.zeros(n, bool)
     side[m.node_slice == 0] = True
     side[m.node_slice == m.z_slices.size - 1] = True
-    assert np.all(st.fixed[side] & K3.FIX_Z)
+    assert np.all(st.fixed[side] & scalar3d.FIX_Z)
     assert np.all(st.fixed[~side & ~m.rigid] == 0)
     assert np.any(m.fkind == FK_SIDE)
     p = st.prm
-    assert p[K3.P_RZ_EVERY] == 10 and p[K3.P_RZ_MAXMOVE] == ToolFrame.MAX_MOVE
-    assert p[K3.P_RZ_VEL] == VEL_TAYLOR
-    assert p[K3.P_EROSION] == K3.ERODE_NONE and p[K3.P_DT_ERODE] == 0.0
-    assert p[K3.P_ALE_X0] == 0.0 and p[K3.P_ALE_Z0] == 0.0 and p[K3.P_VC] > 0.0
+    assert p[layout3d.P_RZ_EVERY] == 10 and p[layout3d.P_RZ_MAXMOVE] == ToolFrame.MAX_MOVE
+    assert p[layout3d.P_RZ_VEL] == VEL_TAYLOR
+    assert p[layout3d.P_EROSION] == layout3d.ERODE_NONE and p[layout3d.P_DT_ERODE] == 0.0
+    assert p[layout3d.P_ALE_X0] == 0.0 and p[layout3d.P_ALE_Z0] == 0.0 and p[layout3d.P_VC] > 0.0
 
 
 def test_workpiece_state_has_empty_ale_arrays():
@@ -127,7 +128,7 @@ def test_workpiece_state_has_empty_ale_arrays():
     st = setup_boring(parse_boring_config(d)).state
     assert not st.tool_frame
     assert st.x0.shape == (0,) and st.acls.shape == (0, 7) and st.bflag.shape == (0, 6)
-    assert st.prm[K3.P_RZ_EVERY] == 0
+    assert st.prm[layout3d.P_RZ_EVERY] == 0
 
 
 def test_tool_frame_short_run():
@@ -140,7 +141,7 @@ def test_tool_frame_short_run():
     dt = float(st.clock[1])
     steps = advance3(st, 200.5 * dt, chunk_steps=50, adaptive_threads=False)
     assert 150 <= steps <= 260
-    travel = st.tool[K3.T_GX]
+    travel = st.tool[scalar3d.T_GX]
     assert travel == pytest.approx(st.time * s.vc, rel=1e-9)
     # last pass at a multiple of ale_interval: every node within a few steps' travel of
     # its place (rigid nodes on it)
@@ -148,7 +149,7 @@ def test_tool_frame_short_run():
     assert np.max(np.abs(lag[s.mesh.rigid])) < 11 * dt * s.vc
     assert np.all(st.alive == 1)
     assert np.all(np.isfinite(st.sd))
-    assert -st.tool[K3.T_FX] > 0.0
+    assert -st.tool[scalar3d.T_FX] > 0.0
     assert energy_error(st.en) < 0.05
 
 
@@ -203,15 +204,19 @@ def test_a_radial_deflection_the_mesh_does_not_follow_is_reported():
 
 
 def test_the_tool_frame_loop_is_the_one_step_loop():
+    import types
+
     from robobore.cutting.fe.engine import step_loop as SL
 
-    assert K3._loop3_ale.py_func.__code__ is SL.chunk_loop_py.__code__
+    code = next(c for c in SL.make_chunk_loop.__code__.co_consts
+                if isinstance(c, types.CodeType) and c.co_name == "chunk_loop")
+    assert K3._loop3_ale.py_func.__code__ is code
     assert K3._loop3_ale.__qualname__ != K3._loop3.__qualname__
 
 
 def test_a_tool_frame_state_needs_its_interval():
     s = setup_boring(parse_boring_config(_cfg(t_min_um=8.0)))
-    s.state.prm[K3.P_RZ_EVERY] = 0
+    s.state.prm[layout3d.P_RZ_EVERY] = 0
     with pytest.raises(ConfigError, match="P_RZ_EVERY"):
         advance3(s.state, 1e-9)
 
@@ -242,7 +247,7 @@ def test_the_spec_chooses_the_loop():
     dt["solver"]["heat_conduction"] = False
     assert K3.run_chunk3_for(setup_boring(parse_boring_config(dt)).spec) is K3.run_chunk3_ale
     # an interval below one step is neither adiabatic nor a heat pass
-    w.state.prm[K3.P_COND_EVERY] = 0.5
+    w.state.prm[layout3d.P_COND_EVERY] = 0.5
     with pytest.raises(ConfigError, match="P_COND_EVERY"):
         advance3(w.state, 1e-9)
 
@@ -270,13 +275,13 @@ def test_cli_refuses_the_gpu_with_the_tool_frame(tmp_path):
 def test_contact_normal_damping_as_in_2d():
     """``contact.normal_damping``: default 1 (critical) in the tool frame, 0 in the workpiece
     frame (the 2D engine's defaults); a given value in either."""
-    assert setup_boring(parse_boring_config(_cfg(t_min_um=8.0))).state.prm[K3.P_CDAMP] == 1.0
+    assert setup_boring(parse_boring_config(_cfg(t_min_um=8.0))).state.prm[layout3d.P_CDAMP] == 1.0
     d = _workpiece()
     d["mesh"]["element_size_um"] = 16.6
     d["cut"]["cut_length_mm"] = 0.02
-    assert setup_boring(parse_boring_config(d)).state.prm[K3.P_CDAMP] == 0.0
+    assert setup_boring(parse_boring_config(d)).state.prm[layout3d.P_CDAMP] == 0.0
     d["contact"] = {**d.get("contact", {}), "normal_damping": 0.4}
-    assert setup_boring(parse_boring_config(d)).state.prm[K3.P_CDAMP] == 0.4
+    assert setup_boring(parse_boring_config(d)).state.prm[layout3d.P_CDAMP] == 0.4
     t = _cfg(t_min_um=8.0)
     t["contact"] = {**t.get("contact", {}), "normal_damping": 0.0}
-    assert setup_boring(parse_boring_config(t)).state.prm[K3.P_CDAMP] == 0.0
+    assert setup_boring(parse_boring_config(t)).state.prm[layout3d.P_CDAMP] == 0.0

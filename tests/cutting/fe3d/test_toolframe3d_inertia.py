@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state3d import advance3, element_steps3
+from robobore.cutting.fe.hex import layout3d
 from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
 from robobore.cutting.fe.models.toolframe3d import thin_element_factors, tip_section_step
 from robobore.errors import ConfigError
@@ -29,7 +31,7 @@ def _cfg(**solver) -> dict:
 
 
 def _lumped(st, msf):
-    rho_s = st.mat[RHO] * st.prm[K3.P_MS]
+    rho_s = st.mat[RHO] * st.prm[layout3d.P_MS]
     m = np.zeros_like(st.mass)
     np.add.at(m, st.conn.ravel(), np.repeat(st.vol0 * rho_s * msf / 8.0, 8))
     return m
@@ -58,7 +60,7 @@ def test_factors_only_on_elements_slower_than_the_tip_section(setups):
     assert np.any(msf > 2.0)  # the thin ends do set the step without them
     assert np.array_equal(msf, thin_element_factors(off.state, mesh))
     # the initial step: the tip section's (the factors off: the thin ends')
-    assert st.clock[1] == pytest.approx(st.prm[K3.P_CFL] * dt_tip, rel=1e-12)
+    assert st.clock[1] == pytest.approx(st.prm[layout3d.P_CFL] * dt_tip, rel=1e-12)
     assert off.state.clock[1] < 0.5 * st.clock[1]
     assert off.state.msf.shape == (0,)
     # lumped masses carry the factors; the material's mass is the same
@@ -70,14 +72,14 @@ def test_masses_carry_the_renewed_factors_through_the_ale_pass(setups):
     on, off = setups
     st = on.state
     dt_tip = tip_section_step(off.state, on.mesh)
-    assert st.prm[K3.P_MSF_DT] == dt_tip
-    assert off.state.prm[K3.P_MSF_DT] == 0.0
-    st.prm[K3.P_RZ_EVERY] = 5
+    assert st.prm[layout3d.P_MSF_DT] == dt_tip
+    assert off.state.prm[layout3d.P_MSF_DT] == 0.0
+    st.prm[layout3d.P_RZ_EVERY] = 5
     # a stale factor on the most thinned element: the next pass renews it from its step
     e = int(np.argmax(st.msf))
     st.msf[e] = 1.0
     advance3(st, t_end=40 * st.clock[1], chunk_steps=20, adaptive_threads=False)
-    assert int(st.ist[K3.I_STEP]) >= 20
+    assert int(st.ist[layout.I_STEP]) >= 20
     assert st.msf[e] > 2.0
     assert np.allclose(st.mass, _lumped(st, st.msf), rtol=1e-12, atol=0)
     # every element at about the tip section's step (the running steps lie a few per cent

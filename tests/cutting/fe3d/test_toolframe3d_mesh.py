@@ -239,10 +239,11 @@ def test_counts_without_building_the_mesh(mesh):
 
 
 def test_memory_estimate_of_a_tool_frame_config(monkeypatch):
-    """io.memory.fe3d_elements of a tool-frame boring config is its mesh's hexahedron count;
-    a size whose lower bound alone does not fit is refused without building a section."""
+    """cutting.fe.mesh.memory.fe3d_elements of a tool-frame boring config is its mesh's
+    hexahedron count; a size whose lower bound alone does not fit is refused without building
+    a section."""
+    import robobore.cutting.fe.mesh.memory as memory
     import robobore.cutting.fe.mesh.toolframe3d_layout as layout
-    import robobore.io.memory as memory
     from robobore.cutting.fe.models.boring3d import parse_boring_config
     from robobore.errors import ConfigError
     from robobore.io.config import load_toml

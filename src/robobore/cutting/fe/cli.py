@@ -134,7 +134,7 @@ def _plot_forces(res, path: Path) -> Path:
     fig, ax = plt.subplots(figsize=(7, 4), dpi=120)
     ax.plot(h["cut_length_mm"], h["cutting_force_N_per_mm"], label="Fc")
     ax.plot(h["cut_length_mm"], h["feed_force_N_per_mm"], label="Ff")
-    from robobore.cutting.fe.engine.kernels import FACES
+    from robobore.cutting.fe.engine.layout import FACES
 
     for face, style in zip(FACES, (":", "--", "-."), strict=True):
         if f"{face}_cutting_force_N_per_mm" in h:  # CPU runs: the split by tool face

@@ -32,86 +32,92 @@ def swept_py(ax0, ay0, bx0, by0, ax1, ay1, bx1, by1):
     return -0.5 * s
 
 
-_swept = njit(cache=True)(swept_py)
+swept = njit(cache=True)(swept_py)
 
 
-def rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-               eps_p, temp, dmg, qhx, qhy, area0, t_room):
-    """Donor-cell remap of element ``e`` (old geometry ``x``, ``y`` -> new ``xn``, ``yn``):
-    its new intensive fields and reference area into ``buf[e]`` (see :func:`rezone`).
-    Reads the old state only, so all elements can run at once."""
-    for f in range(N_RZ_FIELDS):
-        buf[e, f] = 0.0
-    if alive[e] != 1:
-        return
-    i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-    a_old = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
-    # the area after the pass that the fluxes account for: the old area plus the areas
-    # swept by the edges shared with live elements (an edge on the outline or next to
-    # an eroded element carries no flux, so a boundary node that slides along a
-    # curved surface neither creates nor destroys mass)
-    a_new = a_old
-    c0 = sdx[e] * a_old
-    c1 = sdy[e] * a_old
-    c2 = sdz[e] * a_old
-    c3 = sdxy[e] * a_old
-    c4 = pres[e] * a_old
-    c5 = eps_p[e] * a_old
-    c6 = temp[e] * a_old
-    c7 = dmg[e] * a_old
-    c8 = qhx[e] * a_old
-    c9 = qhy[e] * a_old
-    c10 = area0[e]
-    for kk in range(4):
-        a = conn[e, kk]
-        b = conn[e, (kk + 1) % 4]
-        sw = _swept(x[a], y[a], x[b], y[b], xn[a], yn[a], xn[b], yn[b])
-        if sw == 0.0:
-            continue
-        nb = np.int64(enbr[e, kk])
-        u = nb
-        if nb < 0:
-            # an outline edge carries a flux only where bflag opens it
-            if bflag.shape[0] == 0 or bflag[e, kk] == BF_CLOSED:
+def make_rz_flux(swept):
+    """:func:`rz_flux_py` with its callees ``swept`` given (the CPU's compiled functions
+    here, a GPU engine's device functions in its port)."""
+
+    def rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
+                   eps_p, temp, dmg, qhx, qhy, area0, t_room):
+        """Donor-cell remap of element ``e`` (old geometry ``x``, ``y`` -> new ``xn``, ``yn``):
+        its new intensive fields and reference area into ``buf[e]`` (see :func:`rezone`).
+        Reads the old state only, so all elements can run at once."""
+        for f in range(N_RZ_FIELDS):
+            buf[e, f] = 0.0
+        if alive[e] != 1:
+            return
+        i1, i2, i3, i4 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
+        a_old = 0.5 * ((x[i3] - x[i1]) * (y[i4] - y[i2]) + (x[i2] - x[i4]) * (y[i3] - y[i1]))
+        # the area after the pass that the fluxes account for: the old area plus the areas
+        # swept by the edges shared with live elements (an edge on the outline or next to
+        # an eroded element carries no flux, so a boundary node that slides along a
+        # curved surface neither creates nor destroys mass)
+        a_new = a_old
+        c0 = sdx[e] * a_old
+        c1 = sdy[e] * a_old
+        c2 = sdz[e] * a_old
+        c3 = sdxy[e] * a_old
+        c4 = pres[e] * a_old
+        c5 = eps_p[e] * a_old
+        c6 = temp[e] * a_old
+        c7 = dmg[e] * a_old
+        c8 = qhx[e] * a_old
+        c9 = qhy[e] * a_old
+        c10 = area0[e]
+        for kk in range(4):
+            a = conn[e, kk]
+            b = conn[e, (kk + 1) % 4]
+            sw = swept(x[a], y[a], x[b], y[b], xn[a], yn[a], xn[b], yn[b])
+            if sw == 0.0:
                 continue
-            a_new += sw
-            if sw > 0.0 and bflag[e, kk] == BF_VIRGIN:
-                c6 += sw * t_room  # virgin: no stress, strain, damage; A0 = A
-                c10 += sw
+            nb = np.int64(enbr[e, kk])
+            u = nb
+            if nb < 0:
+                # an outline edge carries a flux only where bflag opens it
+                if bflag.shape[0] == 0 or bflag[e, kk] == BF_CLOSED:
+                    continue
+                a_new += sw
+                if sw > 0.0 and bflag[e, kk] == BF_VIRGIN:
+                    c6 += sw * t_room  # virgin: no stress, strain, damage; A0 = A
+                    c10 += sw
+                    continue
+                u = np.int64(e)  # outflow (or backflow through an open face): own state
+            elif alive[nb] != 1:
                 continue
-            u = np.int64(e)  # outflow (or backflow through an open face): own state
-        elif alive[nb] != 1:
-            continue
-        else:
-            a_new += sw
-            if sw <= 0.0:
-                u = np.int64(e)
-        iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
-        au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
-                    + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
-        c0 += sw * sdx[u]
-        c1 += sw * sdy[u]
-        c2 += sw * sdz[u]
-        c3 += sw * sdxy[u]
-        c4 += sw * pres[u]
-        c5 += sw * eps_p[u]
-        c6 += sw * temp[u]
-        c7 += sw * dmg[u]
-        c8 += sw * qhx[u]
-        c9 += sw * qhy[u]
-        c10 += sw * area0[u] / au
-    inv = 1.0 / a_new
-    buf[e, 0] = c0 * inv
-    buf[e, 1] = c1 * inv
-    buf[e, 2] = c2 * inv
-    buf[e, 3] = c3 * inv
-    buf[e, 4] = c4 * inv
-    buf[e, 5] = c5 * inv
-    buf[e, 6] = c6 * inv
-    buf[e, 7] = c7 * inv
-    buf[e, 8] = c8 * inv
-    buf[e, 9] = c9 * inv
-    buf[e, 10] = c10
+            else:
+                a_new += sw
+                if sw <= 0.0:
+                    u = np.int64(e)
+            iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
+            au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
+                        + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
+            c0 += sw * sdx[u]
+            c1 += sw * sdy[u]
+            c2 += sw * sdz[u]
+            c3 += sw * sdxy[u]
+            c4 += sw * pres[u]
+            c5 += sw * eps_p[u]
+            c6 += sw * temp[u]
+            c7 += sw * dmg[u]
+            c8 += sw * qhx[u]
+            c9 += sw * qhy[u]
+            c10 += sw * area0[u] / au
+        inv = 1.0 / a_new
+        buf[e, 0] = c0 * inv
+        buf[e, 1] = c1 * inv
+        buf[e, 2] = c2 * inv
+        buf[e, 3] = c3 * inv
+        buf[e, 4] = c4 * inv
+        buf[e, 5] = c5 * inv
+        buf[e, 6] = c6 * inv
+        buf[e, 7] = c7 * inv
+        buf[e, 8] = c8 * inv
+        buf[e, 9] = c9 * inv
+        buf[e, 10] = c10
+
+    return rz_flux_py
 
 
 def rz_velocity_py(n, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf):
@@ -178,7 +184,9 @@ def rz_node_mass_py(n, ptr, nel, area0, rho_s, mass):
     mass[n] = m
 
 
-rz_flux = njit(cache=True, inline="always")(rz_flux_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+rz_flux_py = make_rz_flux(swept)
+rz_flux = njit(cache=False, inline="always")(rz_flux_py)
 rz_velocity = njit(cache=True, inline="always")(rz_velocity_py)
 rz_write = njit(cache=True, inline="always")(rz_write_py)
 rz_node_mass = njit(cache=True, inline="always")(rz_node_mass_py)

@@ -69,93 +69,107 @@ def limit_py(px, py, tx, ty, lim):
     return tx, ty
 
 
-def off_tool_py(px, py, qx, qy, tg):
-    """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
-    ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
-    slides along a chord wrapped round the edge adds no penalty energy."""
-    g0, _a, _b = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
-    g1, n1x, n1y = tool_gap(qx, qy, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
-    gt = min(g0, 0.0)
-    if g1 < gt:
-        return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
-    return qx, qy
+def make_off_tool(tool_gap):
+    """:func:`off_tool_py` with its callees ``tool_gap`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def off_tool_py(px, py, qx, qy, tg):
+        """``(qx, qy)`` put back along the tool normal if it lies deeper in the tool than
+        ``(px, py)`` did (or in it at all when ``(px, py)`` was outside): a surface node that
+        slides along a chord wrapped round the edge adds no penalty energy."""
+        g0, _a, _b = tool_gap(px, py, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+        g1, n1x, n1y = tool_gap(qx, qy, tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6])
+        gt = min(g0, 0.0)
+        if g1 < gt:
+            return qx + (gt - g1) * n1x, qy + (gt - g1) * n1y
+        return qx, qy
+
+    return off_tool_py
 
 
-_limit = njit(cache=True, inline="always")(limit_py)
-_off_tool = njit(cache=True, inline="always")(off_tool_py)
+limit = njit(cache=True, inline="always")(limit_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+off_tool_py = make_off_tool(tool_gap)
+off_tool = njit(cache=False, inline="always")(off_tool_py)
 
 
 # -- the tool-frame and remap passes as scalar functions (one node or element each), called
 # -- by the CPU's prange loops below and by the GPU kernels
 # (robobore.cutting.fe.engine.gpu.backend2d)
 
-def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
-    """first pass, node ``n``: the new place of a rigid node, a surface-chain
-    node or a chain end on an outflow line into ``xn[n]``, ``yn[n]`` (other classes: left
-    as they are). Reads the old positions only."""
-    c = acls[n, 0]
-    px = x[n]
-    py = y[n]
-    qx = x0[n] + off
-    qy = y0[n]
-    if c == TF_RIGID:
-        xn[n] = qx
-        yn[n] = qy
-    elif c == TF_CHAIN:
-        a = acls[n, 1]
-        b = acls[n, 2]
-        tx = px
-        ty = py
-        best = (qx - px) ** 2 + (qy - py) ** 2
-        la = math.sqrt((x[a] - px) ** 2 + (y[a] - py) ** 2)
-        lb = math.sqrt((x[b] - px) ** 2 + (y[b] - py) ** 2)
-        for k in range(2):
-            m = a if k == 0 else b
-            ex = x[m] - px
-            ey = y[m] - py
-            l2 = ex * ex + ey * ey
-            if l2 <= 0.0:
-                continue
-            t = ((qx - px) * ex + (qy - py) * ey) / l2
-            if t <= 0.0:
-                continue
-            t = min(t, 1.0)
-            sx = px + t * ex
-            sy = py + t * ey
-            d = (qx - sx) ** 2 + (qy - sy) ** 2
-            if d < best:
-                best = d
-                tx = sx
-                ty = sy
-        tx, ty = _limit(px, py, tx, ty, max_move * min(la, lb))
-        tx, ty = _off_tool(px, py, tx, ty, tg)
-        xn[n] = tx
-        yn[n] = ty
-    elif c == TF_LINE:
-        # where the surface (its last segment, extended) crosses the line through the
-        # node's tool-frame place along aflt[n, 1:3], at most aflt[n, 0] from that place
-        a = acls[n, 1]
-        ex = px - x[a]
-        ey = py - y[a]
-        dx = aflt[n, 1]
-        dy = aflt[n, 2]
-        cr = ex * dy - ey * dx
-        le = math.sqrt(ex * ex + ey * ey)
-        if abs(cr) > 0.05 * le:
-            t = ((qx - x[a]) * dy - (qy - y[a]) * dx) / cr
-            tx = x[a] + t * ex
-            ty = y[a] + t * ey
-            s = (tx - qx) * dx + (ty - qy) * dy
-        else:  # surface nearly along the line: project onto it
-            s = (px - qx) * dx + (py - qy) * dy
-        # at most aflt[n, 0] along the line from the node's place
-        s = max(-aflt[n, 0], min(aflt[n, 0], s))
-        tx = qx + s * dx
-        ty = qy + s * dy
-        tx, ty = _limit(px, py, tx, ty, max_move * le)
-        tx, ty = _off_tool(px, py, tx, ty, tg)
-        xn[n] = tx
-        yn[n] = ty
+def make_tf_place(limit, off_tool):
+    """:func:`tf_place_py` with its callees ``limit``, ``off_tool`` given (the CPU's
+    compiled functions here, a GPU engine's device functions in its port)."""
+
+    def tf_place_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg):
+        """first pass, node ``n``: the new place of a rigid node, a surface-chain
+        node or a chain end on an outflow line into ``xn[n]``, ``yn[n]`` (other classes: left
+        as they are). Reads the old positions only."""
+        c = acls[n, 0]
+        px = x[n]
+        py = y[n]
+        qx = x0[n] + off
+        qy = y0[n]
+        if c == TF_RIGID:
+            xn[n] = qx
+            yn[n] = qy
+        elif c == TF_CHAIN:
+            a = acls[n, 1]
+            b = acls[n, 2]
+            tx = px
+            ty = py
+            best = (qx - px) ** 2 + (qy - py) ** 2
+            la = math.sqrt((x[a] - px) ** 2 + (y[a] - py) ** 2)
+            lb = math.sqrt((x[b] - px) ** 2 + (y[b] - py) ** 2)
+            for k in range(2):
+                m = a if k == 0 else b
+                ex = x[m] - px
+                ey = y[m] - py
+                l2 = ex * ex + ey * ey
+                if l2 <= 0.0:
+                    continue
+                t = ((qx - px) * ex + (qy - py) * ey) / l2
+                if t <= 0.0:
+                    continue
+                t = min(t, 1.0)
+                sx = px + t * ex
+                sy = py + t * ey
+                d = (qx - sx) ** 2 + (qy - sy) ** 2
+                if d < best:
+                    best = d
+                    tx = sx
+                    ty = sy
+            tx, ty = limit(px, py, tx, ty, max_move * min(la, lb))
+            tx, ty = off_tool(px, py, tx, ty, tg)
+            xn[n] = tx
+            yn[n] = ty
+        elif c == TF_LINE:
+            # where the surface (its last segment, extended) crosses the line through the
+            # node's tool-frame place along aflt[n, 1:3], at most aflt[n, 0] from that place
+            a = acls[n, 1]
+            ex = px - x[a]
+            ey = py - y[a]
+            dx = aflt[n, 1]
+            dy = aflt[n, 2]
+            cr = ex * dy - ey * dx
+            le = math.sqrt(ex * ex + ey * ey)
+            if abs(cr) > 0.05 * le:
+                t = ((qx - x[a]) * dy - (qy - y[a]) * dx) / cr
+                tx = x[a] + t * ex
+                ty = y[a] + t * ey
+                s = (tx - qx) * dx + (ty - qy) * dy
+            else:  # surface nearly along the line: project onto it
+                s = (px - qx) * dx + (py - qy) * dy
+            # at most aflt[n, 0] along the line from the node's place
+            s = max(-aflt[n, 0], min(aflt[n, 0], s))
+            tx = qx + s * dx
+            ty = qy + s * dy
+            tx, ty = limit(px, py, tx, ty, max_move * le)
+            tx, ty = off_tool(px, py, tx, ty, tg)
+            xn[n] = tx
+            yn[n] = ty
+
+    return tf_place_py
 
 
 def tf_face_py(n, xn, yn, x0, y0, acls, aflt, off):
@@ -196,21 +210,31 @@ def tf_sweep_copy_py(n, acls, aflt, scratch):
         aflt[n, 5] = scratch[n, 1]
 
 
-def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
-    """last pass, interior node ``n``: its place in the tool frame plus the
-    interpolated mesh displacement, the move limited to ``max_move`` of its local size."""
-    if acls[n, 0] == TF_INTERIOR:
-        tx, ty = _limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
-                        max_move * aflt[n, 3])
-        xn[n] = tx
-        yn[n] = ty
+def make_tf_interior(limit):
+    """:func:`tf_interior_py` with its callees ``limit`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def tf_interior_py(n, x, y, xn, yn, x0, y0, acls, aflt, off, max_move):
+        """last pass, interior node ``n``: its place in the tool frame plus the
+        interpolated mesh displacement, the move limited to ``max_move`` of its local size."""
+        if acls[n, 0] == TF_INTERIOR:
+            tx, ty = limit(x[n], y[n], x0[n] + off + aflt[n, 4], y0[n] + aflt[n, 5],
+                            max_move * aflt[n, 3])
+            xn[n] = tx
+            yn[n] = ty
+
+    return tf_interior_py
 
 
-tf_place = njit(cache=True, inline="always")(tf_place_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+tf_place_py = make_tf_place(limit, off_tool)
+tf_place = njit(cache=False, inline="always")(tf_place_py)
 tf_face = njit(cache=True, inline="always")(tf_face_py)
 tf_sweep = njit(cache=True, inline="always")(tf_sweep_py)
 tf_sweep_copy = njit(cache=True, inline="always")(tf_sweep_copy_py)
-tf_interior = njit(cache=True, inline="always")(tf_interior_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+tf_interior_py = make_tf_interior(limit)
+tf_interior = njit(cache=False, inline="always")(tf_interior_py)
 
 
 @njit(parallel=True, cache=True)
@@ -300,7 +324,12 @@ __all__ = [
     "TF_FACE",
     "TF_SWEEPS",
     "limit_py",
+    "limit",
+    "make_off_tool",
     "off_tool_py",
+    "off_tool",
+    "make_tf_place",
+    "make_tf_interior",
     "tf_place_py",
     "tf_face_py",
     "tf_sweep_py",

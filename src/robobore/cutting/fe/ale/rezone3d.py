@@ -4,33 +4,32 @@ swept-volume donor-cell remap (:func:`rezone3d`), the 3D counterpart of
 :mod:`robobore.cutting.fe.mesh.toolframe3d`.
 
 **Placement** (:func:`toolframe3d_targets`). Every node keeps its slice: its new z is its
-plane's, ``z0 + off_z`` (``z0`` its z at the start, ``off_z`` the insert's z travel since
-then), so the mesh is Eulerian along z and the material's out-of-plane flow -- the chip's side
-flow -- crosses the z-faces in the remap. In its plane each node is placed by the 2D
-tool-frame passes of :mod:`robobore.cutting.fe.ale.rezone`, applied to the nodes' (x, y)
-with the node's place ``(x0 + off_x, y0)`` (``x0, y0`` its place at the start, ``off_x``
-the insert's x travel since then): rigid nodes (inflow face, bottom) to their place,
-surface-chain nodes sliding along their surface polyline (its in-plane projection) towards
-it, chain ends along their outflow line, outflow-face nodes spread between their ends
-(keeping their offset off the chord of a face the slice's plane bends,
-:func:`tf_face3_py`), interior nodes to their place plus a mesh displacement interpolated
-from the boundary's (``TF_SWEEPS`` Jacobi sweeps over the node's four in-plane edge
-neighbours); moves limited to ``max_move`` of the local size. The class of a node and its
-in-plane neighbours (global indices) are ``acls`` (n, 7) of
+plane's, ``z0 + off_z`` (``z0`` its z at the start, ``off_z`` the insert's z travel since then),
+so the mesh is Eulerian along z and the material's out-of-plane flow -- the chip's side flow --
+crosses the z-faces in the remap. In its plane each node is placed by the 2D tool-frame passes
+of :mod:`robobore.cutting.fe.ale.rezone`, applied to the nodes' (x, y) with the node's place
+``(x0 + off_x, y0)`` (``x0, y0`` its place at the start, ``off_x`` the insert's x travel since
+then): rigid nodes (inflow face, bottom) to their place, surface-chain nodes sliding along their
+surface polyline (its in-plane projection) towards it, chain ends along their outflow line,
+outflow-face nodes spread between their ends (keeping their offset off the chord of a face the
+slice's plane bends, :func:`tf_face3_py`), interior nodes to their place plus a mesh
+displacement interpolated from the boundary's (``TF_SWEEPS`` Jacobi sweeps over the node's four
+in-plane edge neighbours); moves limited to ``max_move`` of the local size. The class of a node
+and its in-plane neighbours (global indices) are ``acls`` (n, 7) of
 :attr:`robobore.cutting.fe.mesh.toolframe3d.ToolFrameMesh3D.acls`; ``aflt`` (n, 6) the 2D
-meaning, per slice in the slice's plane (:func:`toolframe3d_ale_data`). The per-node passes
-are the 2D scalar functions themselves, run on the 3D x, y arrays: ``tf_place_py`` rebound
-(:func:`robobore.material.johnson_cook.rebind`) to leave out its 2D "off tool" step, which
-:func:`off_insert_py` replaces with the 3D insert's: a surface node whose placed point lies
-deeper in the insert than its old point (or in it at all when the old point was outside)
-is pushed back along the in-plane part ``(nx, ny)`` of the insert's outward normal by
-``(g_t - g_1) / (nx^2 + ny^2)`` -- the first-order in-plane move that restores the gap
-``g_t = min(g_old, 0)`` -- with ``nx^2 + ny^2`` held at least :data:`OFF_NMIN2` (an insert
-normal nearly along z, which a slice of the nose never sees, moves a node at most twice the
-gap deficit). The insert's signed distance is
-:func:`robobore.cutting.fe.hex.scalar3d.insert_gap3` with the engine's parameter vector
-``prm`` (slots ``P_RN, P_KAPPA, P_KEND, P_RAKE, P_CLR, P_RE, P_TANI``; none when
-``prm[P_TOOL] <= 0.5``) relative to the insert tip's current position ``(cx, cy, cz)``.
+meaning, per slice in the slice's plane (:func:`toolframe3d_ale_data`). The per-node passes are
+the 2D scalar functions themselves, run on the 3D x, y arrays: ``tf_place_py`` made again
+(:func:`robobore.cutting.fe.ale.rezone.make_tf_place` given :func:`keep_py`) to leave out its 2D
+"off tool" step, which :func:`off_insert_py` replaces with the 3D insert's: a surface node whose
+placed point lies deeper in the insert than its old point (or in it at all when the old point
+was outside) is pushed back along the in-plane part ``(nx, ny)`` of the insert's outward normal
+by ``(g_t - g_1) / (nx^2 + ny^2)`` -- the first-order in-plane move that restores the gap ``g_t
+= min(g_old, 0)`` -- with ``nx^2 + ny^2`` held at least :data:`OFF_NMIN2` (an insert normal
+nearly along z, which a slice of the nose never sees, moves a node at most twice the gap
+deficit). The insert's signed distance is :func:`robobore.cutting.fe.hex.scalar3d.insert_gap3`
+with the engine's parameter vector ``prm`` (slots ``P_RN, P_KAPPA, P_KEND, P_RAKE, P_CLR, P_RE,
+P_TANI``; none when ``prm[P_TOOL] <= 0.5``) relative to the insert tip's current position ``(cx,
+cy, cz)``.
 
 **Remap.** Then :func:`robobore.cutting.fe.ale.remap3d.remap3d` transports the element
 state, the reference volumes, the nodal velocities and the lumped masses from the old
@@ -45,8 +44,8 @@ deflection of the insert in y moves the insert, not the places.
 
 The passes are scalar functions of one node (``*_py`` originals, ``njit`` versions without
 the suffix), each reading only what the previous pass wrote and allocating nothing, run from
-``prange`` loops on the CPU; a GPU kernel can compile the same source (rebinding
-``tf_place_py``'s ``_limit``, ``off_insert_py``'s ``insert_gap3``).
+``prange`` loops on the CPU; a GPU kernel can compile the same source (with device
+versions of ``make_tf_place``'s ``limit`` and of ``off_insert_py``'s ``insert_gap3``).
 """
 
 from __future__ import annotations
@@ -85,7 +84,6 @@ from robobore.cutting.fe.hex.layout3d import (
     P_TOOL,
 )
 from robobore.cutting.fe.hex.scalar3d import insert_gap3
-from robobore.material.johnson_cook import rebind
 
 __all__ = ["OFF_NMIN2", "keep_py", "off_insert_py", "off_insert", "tf_place_plane_py",
            "tf_place_plane", "place3_py", "place3", "tf_face3_py", "tf_face3",
@@ -104,9 +102,10 @@ def keep_py(px, py, qx, qy, tg):
 _keep = njit(cache=True, inline="always")(keep_py)
 
 #: :func:`robobore.cutting.fe.ale.rezone.tf_place_py` without its 2D "off tool" step (the
-#: same source, ``_off_tool`` rebound to :func:`keep_py`): rigid nodes, surface chains and
-#: chain ends on the outflow lines, in the plane of the node
-tf_place_plane_py = rebind(RZ.tf_place_py, _off_tool=_keep)
+#: same source, :func:`robobore.cutting.fe.ale.rezone.make_tf_place` given :func:`keep_py` for
+#: ``off_tool``): rigid nodes, surface chains and chain ends on the outflow lines, in the plane
+#: of the node
+tf_place_plane_py = RZ.make_tf_place(RZ.limit, _keep)
 tf_place_plane = njit(inline="always")(tf_place_plane_py)
 
 

@@ -64,7 +64,7 @@ from robobore.cutting.fe.ale.rezone import (
     TF_LINE,
     TF_RIGID,
 )
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.mesh.orthogonal import MeshSizes
 from robobore.cutting.fe.models.output import ChipGeometry, point_polyline_distance, shear_angle_deg
 
@@ -372,8 +372,8 @@ def measure_chip_toolframe(st, mesh: ToolFrameMesh, h: float, rake: float,
     (ChipGeometry, velocity ratio, number of face nodes).
     """
     x, y = st.x, st.y
-    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
-    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    cx = st.tool[layout.T_GX] + st.tool[layout.T_UX]
+    cy = st.tool[layout.T_GY] + st.tool[layout.T_UY]
     trx, try_ = math.sin(rake), math.cos(rake)
     top = mesh.chip_top_nodes
     under = mesh.chip_under_nodes
@@ -389,8 +389,8 @@ def measure_chip_toolframe(st, mesh: ToolFrameMesh, h: float, rake: float,
         geo = ChipGeometry(math.nan, h, math.nan, math.nan, int(sel.size))
     face = mesh.outflow_nodes
     fx, fy = x[face], y[face]
-    tvx = -vc + st.tool[K.T_VUX]
-    tvy = st.tool[K.T_VUY]
+    tvx = -vc + st.tool[layout.T_VUX]
+    tvy = st.tool[layout.T_VUY]
     speed = np.hypot(st.vx[face] - tvx, st.vy[face] - tvy)
     seg = np.hypot(np.diff(fx), np.diff(fy))
     w = np.zeros(face.size)

@@ -230,7 +230,7 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
                           expected=f">= 20 x cut.cut_length_mm = "
                           f"{20 * cfg.cut.cut_length_mm:g} mm")
     from robobore.cutting.fe.config.spec import build_boring_spec
-    from robobore.io.memory import check_fe3d
+    from robobore.cutting.fe.mesh.memory import check_fe3d
 
     # the model choices: a key the chosen variants have no place for is an error at load
     vc_m_per_min = math.pi * cfg.cut.bore_diameter_mm * 1e-3 * cfg.cut.speed_rpm

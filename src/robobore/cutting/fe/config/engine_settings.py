@@ -23,11 +23,11 @@ from robobore.cutting.fe.config.spec import (
 from robobore.material import Material
 
 
-def apply_numerics(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
+def apply_numerics(p: np.ndarray, s: Any, layout: Any) -> np.ndarray:
     """Write the time integration and element numerics of a ``[solver]`` section (2D or 3D)
     that every model variant uses into ``p`` (returned): CFL fraction, mass scaling, bulk
     viscosity, distortion limit."""
-    k = kernels
+    k = layout
     p[k.P_CFL] = s.cfl
     p[k.P_MS] = s.mass_scaling
     p[k.P_BV1] = s.bulk_viscosity_linear
@@ -37,19 +37,19 @@ def apply_numerics(p: np.ndarray, s: Any, kernels: Any) -> np.ndarray:
 
 
 def apply_thermal_settings(p: np.ndarray, solver: Any, contact: Any, material: Material,
-                           kernels: Any) -> np.ndarray:
+                           layout: Any) -> np.ndarray:
     """Write the heat conduction (``solver.heat_conduction``, ``conduction_interval``) and the
     thermal contact with the tool (``contact.thermal_conductance_W_per_m2K``,
     ``friction_heat_fraction``, ``tool_temperature_K``; None: the material's room
     temperature) into ``p`` (returned) through the spec's thermal model."""
-    return write_thermal(p, thermal_spec(solver, contact, material), kernels)
+    return write_thermal(p, thermal_spec(solver, contact, material), layout)
 
 
 def apply_friction_settings(p: np.ndarray, contact: Any, vc_m_per_min: float,
-                            kernels: Any) -> np.ndarray:
+                            layout: Any) -> np.ndarray:
     """Write the friction of a ``[contact]`` section at the cutting speed ``vc_m_per_min``
     into ``p`` (returned) through the spec's friction model: ``P_MU`` the constant or the
     table at the cutting speed; with ``friction_velocity = "sliding"`` the table in the
     ``P_MUTAB_*`` slots (velocities in m/s), read by every contact node at its own sliding
     speed filtered over the time the tool takes to travel ``sliding_filter_um``."""
-    return write_friction(p, friction_spec(contact, vc_m_per_min), kernels, vc_m_per_min)
+    return write_friction(p, friction_spec(contact, vc_m_per_min), layout, vc_m_per_min)

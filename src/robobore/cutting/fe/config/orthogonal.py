@@ -494,7 +494,7 @@ def parse_config(data: dict[str, Any], source: str | None = None) -> FEConfig:
     """Validate a config dict (as read from TOML); a material file named in it is resolved
     against the config file's folder (robobore.io.paths)."""
     from robobore.cutting.fe.config.spec import build_spec
-    from robobore.io.memory import check_fe2d
+    from robobore.cutting.fe.mesh.memory import check_fe2d
     from robobore.material.library import load_material, resolve_material_name
 
     cfg = validate_model(FEConfig, data, source=source or "<config>")

@@ -177,13 +177,14 @@ class ModelSpec:
     thermal: Adiabatic | Conduction
     hardening: PlainHardening | HardeningHold
 
-    def write_prm(self, p: np.ndarray, kernels: Any, vc_m_per_min: float) -> np.ndarray:
+    def write_prm(self, p: np.ndarray, layout: Any, vc_m_per_min: float) -> np.ndarray:
         """Write the model-choice slots of an engine's parameter vector ``p`` (returned):
-        frame, separation, element, erosion, friction and thermal slots. ``kernels`` is the
-        engine's kernel module (its ``P_*`` indices and ``ERODE_*`` codes). The element type,
+        frame, separation, element, erosion, friction and thermal slots. ``layout`` is the
+        engine's layout module (its ``P_*`` indices and ``ERODE_*`` codes:
+        :mod:`robobore.cutting.fe.engine.layout`). The element type,
         the frame and the thermal model also choose the compiled step
         (:func:`robobore.cutting.fe.engine.chunk_loop.step_for`)."""
-        k = kernels
+        k = layout
         fr = self.frame
         if isinstance(fr, ToolFrame):
             element: OnePointQuad | BBarQuad = fr.element
@@ -207,17 +208,17 @@ class ModelSpec:
         if isinstance(element, OnePointQuad):
             p[k.P_HGV] = element.hourglass_viscous
             p[k.P_HGS] = element.hourglass_stiffness
-        write_friction(p, self.friction, kernels, vc_m_per_min)
-        write_thermal(p, self.thermal, kernels)
+        write_friction(p, self.friction, layout, vc_m_per_min)
+        write_thermal(p, self.thermal, layout)
         return p
 
 
 def write_friction(p: np.ndarray, friction: CoulombFriction | SlidingSpeedFriction,
-                   kernels: Any, vc_m_per_min: float) -> np.ndarray:
+                   layout: Any, vc_m_per_min: float) -> np.ndarray:
     """The friction slots of either engine's parameter vector (``P_MU``, ``P_TAU``; for the
     sliding-speed table ``P_MUTAB_*`` with velocities in m/s and ``P_SLIP_TAU``, the filter's
     time constant: the time the tool takes to travel ``filter_um``)."""
-    k = kernels
+    k = layout
     if isinstance(friction, SlidingSpeedFriction):
         tv = np.asarray(friction.velocity_m_per_min, float)
         p[k.P_MU] = friction.nominal_mu
@@ -231,10 +232,10 @@ def write_friction(p: np.ndarray, friction: CoulombFriction | SlidingSpeedFricti
     return p
 
 
-def write_thermal(p: np.ndarray, thermal: Adiabatic | Conduction, kernels: Any) -> np.ndarray:
+def write_thermal(p: np.ndarray, thermal: Adiabatic | Conduction, layout: Any) -> np.ndarray:
     """The heat slots of either engine's parameter vector (``P_COND_EVERY``: 0 adiabatic;
     ``P_HC``, ``P_FHEAT``, ``P_TTOOL``, read by the conduction passes only)."""
-    k = kernels
+    k = layout
     if isinstance(thermal, Conduction):
         p[k.P_COND_EVERY] = thermal.interval
         p[k.P_HC] = thermal.conductance_W_per_m2K
@@ -442,11 +443,12 @@ class BoringSpec:
     hardening: PlainHardening | HardeningHold
     tool_frame: ToolFrame3D | None = None
 
-    def write_prm(self, p: np.ndarray, kernels: Any, vc_m_per_min: float) -> np.ndarray:
+    def write_prm(self, p: np.ndarray, layout: Any, vc_m_per_min: float) -> np.ndarray:
         """Write the model-choice slots of the 3D parameter vector ``p`` (returned);
-        ``kernels`` the 3D kernel module. The frame also chooses the compiled step
+        ``layout`` the 3D layout module (:mod:`robobore.cutting.fe.hex.layout3d`). The frame
+        also chooses the compiled step
         (:func:`robobore.cutting.fe.engine.kernels3d.run_chunk3_for`)."""
-        k = kernels
+        k = layout
         p[k.P_HGV] = self.element.hourglass_viscous
         p[k.P_HGS] = self.element.hourglass_stiffness
         tf = self.tool_frame
@@ -464,8 +466,8 @@ class BoringSpec:
             p[k.P_EROSION] = k.ERODE_LAYER if self.damage_erosion else k.ERODE_NONE
             sep = self.separation
             p[k.P_GATE] = sep.gate_um * 1e-6 if isinstance(sep, NodeSplit) else -1.0
-        write_friction(p, self.friction, kernels, vc_m_per_min)
-        write_thermal(p, self.thermal, kernels)
+        write_friction(p, self.friction, layout, vc_m_per_min)
+        write_thermal(p, self.thermal, layout)
         return p
 
 

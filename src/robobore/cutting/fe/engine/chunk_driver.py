@@ -15,7 +15,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import chunk_loop, layout
 from robobore.cutting.fe.engine.state2d import (
     FEState,
 )
@@ -45,7 +45,7 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
     numba's thread count is restored on return.
     """
     st.prm[p_tend] = t_end
-    st.ist[K.I_STATUS] = K.STATUS_OK
+    st.ist[layout.I_STATUS] = layout.STATUS_OK
     total = 0
     t_start = st.time
     gov = (governor or ThreadGovernor()) if adaptive_threads else None
@@ -61,14 +61,14 @@ def drive_chunks(st: Any, t_end: float, run_chunk: Callable[..., int], p_tend: i
                 taken = run_chunk(steps, *st.kernel_args())
                 gov.record(threads, int(taken), time.perf_counter() - t0)
             total += int(taken)
-            status = int(st.ist[K.I_STATUS])
+            status = int(st.ist[layout.I_STATUS])
             if status in STATUS_TEXT:
                 raise instability_error(st, label, hint)
             if progress is not None:
                 progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
             if check is not None:
                 check(st)
-            if status == K.STATUS_DONE or st.time >= t_end:
+            if status == layout.STATUS_DONE or st.time >= t_end:
                 return total
     finally:
         numba.set_num_threads(threads_before)
@@ -91,14 +91,14 @@ def advance(st: FEState, t_end: float, *, chunk_steps: int = 2000,
     ``governor``: see :func:`drive_chunks`.
     """
     # the intervals the compiled ALE and heat phases divide the step number by
-    for on, slot, name in ((st.phases.tool_frame, K.P_RZ_EVERY, "P_RZ_EVERY"),
-                           (st.phases.conduction, K.P_COND_EVERY, "P_COND_EVERY")):
+    for on, slot, name in ((st.phases.tool_frame, layout.P_RZ_EVERY, "P_RZ_EVERY"),
+                           (st.phases.conduction, layout.P_COND_EVERY, "P_COND_EVERY")):
         if on and st.prm[slot] < 1:
             raise ConfigError(f"{st.phases} needs an interval of at least one step",
                               field=f"prm[{name}]", value=float(st.prm[slot]),
                               expected=">= 1")
-    run = K.run_chunk_for(st.phases) if step is None else step
-    return drive_chunks(st, t_end, run, K.P_TEND, chunk_steps=chunk_steps,
+    run = chunk_loop.run_chunk_for(st.phases) if step is None else step
+    return drive_chunks(st, t_end, run, layout.P_TEND, chunk_steps=chunk_steps,
                         label="simulation",
                         hint="a smaller solver.cfl, a larger mesh.element_size_um or less "
                         "mass scaling", progress=progress, check=check,
@@ -111,9 +111,10 @@ def energy_error(en: np.ndarray) -> float:
     Internal includes elastic, plastic and bulk-viscous work (and the internal energy of
     eroded elements); contact is frictional dissipation plus the current penalty energy.
     """
-    parts = en[K.E_KIN] + en[K.E_INT] + en[K.E_HG] + en[K.E_FRIC] + en[K.E_EROKE]
-    scale = max(abs(en[K.E_EXT]), abs(parts), 1e-300)
-    return float(abs(en[K.E_EXT] - parts) / scale)
+    parts = (en[layout.E_KIN] + en[layout.E_INT] + en[layout.E_HG] + en[layout.E_FRIC]
+             + en[layout.E_EROKE])
+    scale = max(abs(en[layout.E_EXT]), abs(parts), 1e-300)
+    return float(abs(en[layout.E_EXT] - parts) / scale)
 
 
 def energy_check(t_contact: float, t_end: float, limit: float) -> Callable[[Any], None]:
@@ -128,7 +129,7 @@ def energy_check(t_contact: float, t_end: float, limit: float) -> Callable[[Any]
             err = energy_error(s.en)
             if err > limit:
                 raise NumericalError(
-                    f"energy balance lost at step {int(s.ist[K.I_STEP])}, time {s.time:.6g} s:"
+                    f"energy balance lost at step {int(s.ist[layout.I_STEP])}, time {s.time:.6g} s:"
                     f" error {err:.3g} > solver.energy_error_limit {limit}")
 
     return check

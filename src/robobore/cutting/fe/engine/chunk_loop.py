@@ -35,7 +35,7 @@ from typing import Any, Literal
 from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
-from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
+from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
 from robobore.cutting.fe.engine.layout import (
     P_ALE_X0,
     P_CFL,
@@ -60,7 +60,7 @@ from robobore.cutting.fe.engine.layout import (
     T_GX,
     T_UX,
 )
-from robobore.cutting.fe.engine.step_loop import bind_chunk_loop, no_remesh_py
+from robobore.cutting.fe.engine.step_loop import make_chunk_loop, no_remesh_py
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
     parting_conduct,
@@ -84,12 +84,10 @@ from robobore.cutting.fe.quad.tool_motion import (
 )
 from robobore.material import johnson_cook as jc
 
-#: the energy totals (:func:`robobore.cutting.fe.engine.history.energy_totals_py` in 2D) of the
-#: state arrays ``es`` = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
-#: ``en`` [J/m] (serial, a fixed order)
-sum_energies_py = jc.rebind(energy_totals_py, NDIM=2)
-# its own name (see history.bind_end_step)
-sum_energies_py.__name__ = sum_energies_py.__qualname__ = "sum_energies_py"
+#: the energy totals (:func:`robobore.cutting.fe.engine.history.make_energy_totals` in 2D) of
+#: the state arrays ``es`` = (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
+#: into ``en`` [J/m] (serial, a fixed order), under its own name (see history.make_end_step)
+sum_energies_py = make_energy_totals(2, "sum_energies_py")
 
 
 def tool_columns_py(tool):
@@ -106,10 +104,10 @@ ENGINE2 = {"NDIM": 2, "N_SPLIT": 6, "N_TOOL_COLUMNS": 1, "T_FORCE": T_FX, "T_DIS
            "COUNT_STOPPED_STEP": 0}
 _energy_totals = njit(sum_energies_py)
 _njit_inline = partial(njit, inline="always")
-#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`),
+#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.make_end_step`),
 #: inlined into the loop: as a call it costs about 0.5 % of a step of the 2D contract config
 #: (one thread, paired with the same loop inlined; ``benchmarks/bench_fe_before_after.py``)
-_end_step = bind_end_step(_njit_inline, ENGINE2, njit(tool_columns_py), _energy_totals)
+_end_step = make_end_step(_njit_inline, ENGINE2, njit(tool_columns_py), _energy_totals)
 
 
 @njit(inline="always")
@@ -216,7 +214,7 @@ _no_remesh = njit(inline="always")(no_remesh_py)
 
 def _bind(name, elements, remesh, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 2D phases
-    return bind_chunk_loop(name=name, state=ChunkState, n_split=ENGINE2["N_SPLIT"],
+    return make_chunk_loop(name=name, state=ChunkState, n_split=ENGINE2["N_SPLIT"],
                            energy_arrays=_energy_arrays, kinematics=tool_kinematics,
                            nodes=_nodes, tool_step=_tool_step, remesh=remesh,
                            elements=elements, heat=heat, end_step=_end_step,
@@ -246,7 +244,7 @@ def phases_of(spec: Any) -> Phases:
                   conduction=isinstance(spec.thermal, Conduction))
 
 
-# one loop per choice, each under its own name (step_loop.bind_chunk_loop)
+# one loop per choice, each under its own name (step_loop.make_chunk_loop)
 _loop_q4r = _bind("loop2_q4r", _elements_q4r, _no_remesh, _no_heat)
 _loop_q4r_heat = _bind("loop2_q4r_heat", _elements_q4r, _no_remesh, _heat)
 _loop_bbar = _bind("loop2_bbar", _elements_bbar, _no_remesh, _no_heat)
@@ -308,7 +306,7 @@ def run_chunk_for(phases: Phases):
     ``FEState.kernel_args()`` (:data:`CHUNK_ARGS`) -- node update and contact, tool, the
     tool-frame ALE pass (tool frame only), the chosen element, conduction with the
     parting-line edges and the thermal contact (conduction only) -- each step ending with
-    :func:`robobore.cutting.fe.engine.history.end_step_py` (stop checks, time-averaged
+    the end of step of :mod:`robobore.cutting.fe.engine.history` (stop checks, time-averaged
     histories, samples): stops early with ``ist[I_STATUS]`` = STATUS_DONE at ``prm[P_TEND]``
     or an instability status. Returns the number of steps taken. ValueError for a choice
     with no loop (the tool frame with the B-bar element)."""

@@ -19,12 +19,12 @@ phases and the chunk loops :func:`run_chunk3` (the step loop of
   proportional penalty, viscous normal damping, Coulomb friction, shear-stress cap) with a
   tangential *vector*;
 * :func:`friction_at3_py` -- the 2D engine's friction table lookup
-  (:func:`robobore.cutting.fe.engine.kernels.friction_at_py`, the same code re-bound to the 3D
+  (:func:`robobore.cutting.fe.quad.node_contact.friction_at_py`, the same code re-bound to the 3D
   parameter slots);
 * :func:`hex_node_py` -- gather, contact and central-difference update of one node.
 
 Energy indices, status codes and the energy-balance definition are the 2D engine's
-(:mod:`robobore.cutting.fe.engine.kernels`), so
+(:mod:`robobore.cutting.fe.engine.layout`), so
 :func:`robobore.cutting.fe.engine.chunk_driver.energy_error` applies to both.
 
 Frames: the kernels work in the *local* frame of the insert at the start of the run
@@ -42,171 +42,46 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.ale.rezone3d import rezone3d
-from robobore.cutting.fe.engine.history import bind_end_step, energy_totals_py
-from robobore.cutting.fe.engine.kernels import (
-    E_ERODED,
-    E_EXT,
-    E_FRIC,
-    E_HG,
-    E_INT,
-    E_KIN,
-    E_PLAST,
-    I_BADELEM,
-    I_SAMPLE,
-    I_STATUS,
-    I_STEP,
-    N_EN,
-    N_IST,
-    N_SUM_LANES,
-    STATUS_DONE,
-    STATUS_DT_COLLAPSE,
-    STATUS_INVERTED,
-    STATUS_NO_ELEMENTS,
-    STATUS_NONFINITE,
-    STATUS_OK,
-)
-from robobore.cutting.fe.engine.step_loop import bind_chunk_loop
+from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
+from robobore.cutting.fe.engine.step_loop import make_chunk_loop
 from robobore.cutting.fe.hex.element import hex_element
 from robobore.cutting.fe.hex.layout3d import (
-    ERODE_LAYER,
-    ERODE_NONE,
-    N_PRM,
     P_ALE_X0,
     P_ALE_Z0,
-    P_BV1,
-    P_BV2,
-    P_CDAMP,
     P_CFL,
-    P_CLR,
-    P_COND_EVERY,
     P_COND_T,
-    P_CX,
-    P_CY,
-    P_CZ,
-    P_DIST,
-    P_DT_ERODE,
     P_DTMIN,
     P_EROSION,
     P_FHEAT,
-    P_GATE,
     P_HC,
-    P_HGS,
-    P_HGV,
-    P_KAPPA,
-    P_KEND,
-    P_KX,
-    P_KY,
-    P_KZ,
     P_MS,
     P_MSF_DT,
-    P_MU,
-    P_MUTAB_MU,
-    P_MUTAB_N,
-    P_MUTAB_V,
-    P_MX,
-    P_MY,
-    P_MZ,
-    P_PEN,
-    P_RADIUS,
-    P_RAKE,
-    P_RE,
-    P_RN,
     P_RZ_EVERY,
     P_RZ_MAXMOVE,
     P_RZ_VEL,
     P_SAMPLE_DT,
-    P_SLIP_TAU,
-    P_SUPPORT,
-    P_TANI,
-    P_TAU,
     P_TEND,
-    P_THETA0,
-    P_TOOL,
     P_TTOOL,
-    P_VC,
-    P_VF,
 )
 from robobore.cutting.fe.hex.scalar3d import (
-    FIX_X,
-    FIX_Y,
-    FIX_Z,
-    H_EERO,
-    H_EEXT,
-    H_EFRIC,
-    H_EHG,
-    H_EINT,
-    H_EKIN,
-    H_EPL,
-    H_FX,
-    H_FY,
-    H_FZ,
-    H_NCONT,
-    H_T,
-    H_THETA,
-    H_TIPX,
-    H_UX,
-    H_UY,
-    H_UZ,
-    N_HIST,
-    N_TOOL,
     T_FX,
-    T_FY,
-    T_FZ,
     T_GX,
-    T_GY,
-    T_GZ,
     T_THETA,
     T_UX,
-    T_UY,
-    T_UZ,
-    T_VX,
-    T_VY,
-    T_VZ,
-    contact_force3,
-    contact_force3_py,
-    edge_section,
-    edge_section_py,
-    friction_at3,
-    friction_at3_py,
     hex_node,
-    hex_node_py,
-    insert_gap3,
-    insert_gap3_py,
     is_conduction_step,
-    is_conduction_step_py,
     lane_sum3,
-    lane_sum3_py,
     tool_kinematics,
-    tool_kinematics_py,
     tool_step,
-    tool_step_py,
 )
 from robobore.cutting.fe.physics.thermal3d import conduct3, tool_heat3
+from robobore.cutting.fe.quad.node_contact import N_SUM_LANES
 from robobore.material import johnson_cook as jc
 
 __all__ = [
-    "N_PRM", "P_CFL", "P_MS", "P_HGV", "P_HGS", "P_BV1", "P_BV2", "P_DIST", "P_DT_ERODE",
-    "P_DTMIN", "P_MU", "P_MUTAB_N", "P_MUTAB_V", "P_MUTAB_MU", "P_SLIP_TAU", "P_TAU", "P_PEN",
-    "P_CDAMP",
-    "P_RN", "P_KAPPA", "P_KEND", "P_RAKE", "P_CLR", "P_RE", "P_TANI", "P_TOOL", "P_VC", "P_VF",
-    "P_RADIUS", "P_SUPPORT", "P_KX", "P_KY", "P_KZ", "P_CX", "P_CY", "P_CZ", "P_MX", "P_MY",
-    "P_MZ", "P_THETA0", "P_SAMPLE_DT", "P_TEND", "P_EROSION", "ERODE_NONE", "ERODE_LAYER",
-    "N_EN", "N_IST", "STATUS_OK", "P_COND_EVERY", "P_COND_T", "P_HC", "P_FHEAT",
-    "P_TTOOL", "is_conduction_step_py", "conduction_pass3", "insert_gap3_py", "insert_gap3",
-    "contact_force3_py", "contact_force3", "hex_node_py", "hex_node", "element_update3",
-    "node_update3", "run_chunk3", "FIX_X", "FIX_Y", "FIX_Z", "T_GX", "T_GY", "T_GZ", "T_UX",
-    "T_UY", "T_UZ", "T_VX", "T_VY", "T_VZ", "T_FX", "T_FY", "T_FZ", "T_THETA", "N_TOOL", "H_T",
-    "H_FX", "H_FY", "H_FZ", "H_UX", "H_UY", "H_UZ", "H_TIPX", "H_THETA", "H_EKIN", "H_EINT",
-    "H_EPL", "H_EHG", "H_EFRIC", "H_EEXT", "H_EERO", "H_NCONT", "N_HIST", "edge_section_py",
-    "edge_section", "friction_at3_py", "friction_at3", "tool_kinematics_py", "tool_kinematics",
-    "tool_step_py", "tool_step", "lane_sum3_py", "lane_sum3", "is_conduction_step", "E_ERODED",
-    "E_EXT", "E_FRIC", "E_HG", "E_INT", "E_KIN", "E_PLAST", "I_BADELEM", "I_SAMPLE",
-    "I_STATUS", "I_STEP", "N_SUM_LANES", "P_GATE", "STATUS_DONE", "STATUS_DT_COLLAPSE",
-    "STATUS_INVERTED", "STATUS_NONFINITE", "STATUS_NO_ELEMENTS", "sum_energies3",
+    "conduction_pass3", "element_update3", "node_update3", "run_chunk3", "sum_energies3",
     "contact_total3", "run_chunk3_ale", "run_chunk3_heat", "run_chunk3_ale_heat", "RUN_CHUNK3",
-    "run_chunk3_for", "P_RZ_EVERY", "P_RZ_MAXMOVE",
-    "P_RZ_VEL", "P_ALE_X0", "P_ALE_Z0", "P_MSF_DT", "renew_inertia_factors_py",
-    "renew_inertia_factors",
+    "run_chunk3_for", "renew_inertia_factors_py", "renew_inertia_factors",
 ]
 
 
@@ -229,12 +104,10 @@ def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol
                  pairs)
 
 
-#: the energy totals (:func:`robobore.cutting.fe.engine.history.energy_totals_py` in 3D) of the
-#: state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork) into
-#: ``en`` (2D engine's indices) [J]
-sum_energies3_py = jc.rebind(energy_totals_py, NDIM=3)
-# its own name (see history.bind_end_step)
-sum_energies3_py.__name__ = sum_energies3_py.__qualname__ = "sum_energies3_py"
+#: the energy totals (:func:`robobore.cutting.fe.engine.history.make_energy_totals` in 3D) of
+#: the state arrays ``es`` = (mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork)
+#: into ``en`` (2D engine's indices) [J], under its own name (see history.make_end_step)
+sum_energies3_py = make_energy_totals(3, "sum_energies3_py")
 _energy_totals3 = njit(sum_energies3_py)
 
 
@@ -264,14 +137,14 @@ def tool_columns3_py(tool):
 ENGINE3 = {"NDIM": 3, "N_SPLIT": 0, "N_TOOL_COLUMNS": 2, "T_FORCE": T_FX, "T_DISP": T_UX,
            "P_CFL": P_CFL, "P_DTMIN": P_DTMIN, "P_SAMPLE_DT": P_SAMPLE_DT, "P_TEND": P_TEND,
            "COUNT_STOPPED_STEP": 1}
-#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.end_step_py`)
-_end_step3 = bind_end_step(njit, ENGINE3, njit(tool_columns3_py), _energy_totals3)
+#: the end of a step on the CPU (:func:`robobore.cutting.fe.engine.history.make_end_step`)
+_end_step3 = make_end_step(njit, ENGINE3, njit(tool_columns3_py), _energy_totals3)
 
 
 @njit(cache=True)
 def contact_total3(cf):
     """Total contact force on the workpiece [N] and number of contact nodes, summed in the
-    fixed lane order of :func:`robobore.cutting.fe.engine.kernels.contact_total` (the GPU engine
+    fixed lane order of :func:`robobore.cutting.fe.quad.node_contact.contact_total` (the GPU engine
     sums the same way, so a GPU run is reproducible bit for bit)."""
     fx = 0.0
     fy = 0.0
@@ -411,7 +284,7 @@ def _no_heat3(s, step, t, dt):
 
 def _bind3(name, remesh, elements, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases
-    return bind_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
+    return make_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
                            energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
                            nodes=_nodes3, tool_step=_tool_step3, remesh=remesh,
                            elements=elements, heat=heat, end_step=_end_step3,
@@ -437,7 +310,7 @@ def run_chunk3(n_steps, *arrays):
 
     ``clock`` = [t, dt, t_acc] as in the 2D engine. Stops early with ``ist[I_STATUS]`` =
     STATUS_DONE at ``prm[P_TEND]``, or an instability status (each step ends with
-    :func:`robobore.cutting.fe.engine.history.end_step_py`). Returns the steps taken; the
+    :func:`robobore.cutting.fe.engine.history.make_end_step`). Returns the steps taken; the
     energy totals are summed after a chunk that ran to its end.
     """
     return _loop3(n_steps, *arrays)

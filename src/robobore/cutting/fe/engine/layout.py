@@ -1,7 +1,8 @@
 """Index layout of the 2D engine's small state arrays (module constants).
 
 ``prm`` float64 parameters (``P_*``: the first slot of each field of the one declaration
-:data:`PRM_FIELDS`, bound as module constants at import), ``tool`` float64 tool state
+:data:`PRM_FIELDS`, written out below it as literal constants by
+:mod:`robobore.cutting.fe.engine.prm_layout`), ``tool`` float64 tool state
 (``T_*``), ``en`` float64 energy accumulators (``E_*``), ``ist`` int64 counters/status
 (``I_*``, ``STATUS_*``), ``hist`` (n_samples, N_HIST) histories (``H_*``, the column order of
 :mod:`robobore.cutting.fe.engine.history`); per-Gauss-point state of the B-bar element
@@ -10,14 +11,12 @@
 
 from __future__ import annotations
 
-from robobore.cutting.fe.engine.prm_layout import prm_slots
-
 #: most points of a friction table read at the sliding speed (its ``P_MUTAB_*`` slots)
 MU_TABLE_MAX = 8
 
 #: the parameter vector ``prm`` of the 2D engine: (name, slots, meaning) in slot order; the
-#: module constant of each name is its first slot, ``N_PRM`` the length
-#: (:func:`robobore.cutting.fe.engine.prm_layout.prm_slots`, bound just below)
+#: module constant of each name is its first slot, ``N_PRM`` the length (the block just
+#: below, written by :func:`robobore.cutting.fe.engine.prm_layout.render`)
 PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     # time integration and element numerics
     ("P_CFL", 1, "fraction of the stable time step"),
@@ -75,7 +74,102 @@ PRM_FIELDS: tuple[tuple[str, int, str], ...] = (
     ("P_MUTAB_MU", MU_TABLE_MAX, "friction table coefficients"),
     ("P_SLIP_TAU", 1, "time constant of the filter on the sliding speed [s]"),
 )
-globals().update(prm_slots(PRM_FIELDS))
+# --- generated from PRM_FIELDS by robobore.cutting.fe.engine.prm_layout: do not edit ---
+#: fraction of the stable time step
+P_CFL = 0
+#: mass scaling: density factor of the inertial mass
+P_MS = 1
+#: Flanagan-Belytschko hourglass coefficient, viscous
+P_HGV = 2
+#: Flanagan-Belytschko hourglass coefficient, stiffness
+P_HGS = 3
+#: bulk viscosity, linear
+P_BV1 = 4
+#: bulk viscosity, quadratic
+P_BV2 = 5
+#: distortion erosion limit (area ratio, corner Jacobian); 0: off
+P_DIST = 6
+#: Coulomb coefficient (constant, or the table at the cutting speed)
+P_MU = 7
+#: cap on the contact shear stress [Pa]
+P_TAU = 8
+#: penalty factor: normal stiffness = factor * nodal mass / dt^2
+P_PEN = 9
+#: edge radius [m]
+P_R = 10
+#: rake face normal, x
+P_NRX = 11
+#: rake face normal, y
+P_NRY = 12
+#: flank face normal, x
+P_NFX = 13
+#: flank face normal, y
+P_NFY = 14
+#: cutting speed [m/s] (the guide point moves at -vc along x)
+P_VC = 15
+#: support stiffness x [N/m per m of width]
+P_KX = 16
+#: support stiffness y [N/m per m of width]
+P_KY = 17
+#: support damping x [N s/m per m of width]
+P_CX = 18
+#: support damping y [N s/m per m of width]
+P_CY = 19
+#: support mass x [kg per m of width]
+P_MX = 20
+#: support mass y [kg per m of width]
+P_MY = 21
+#: width of cut [m]
+P_WIDTH = 22
+#: history sample interval [s]
+P_SAMPLE_DT = 23
+#: smallest time step before the run stops [s]
+P_DTMIN = 24
+#: end time [s]
+P_TEND = 25
+#: damage erosion: ERODE_NONE or ERODE_LAYER
+P_EROSION = 26
+#: tool on its support springs (1) or rigid (0)
+P_SUPPORT = 27
+#: steps between tool-frame ALE passes (0: none, the workpiece frame)
+P_RZ_EVERY = 28
+#: largest node move of an ALE pass, fraction of the local size
+P_RZ_MAXMOVE = 29
+#: time-step erosion: the smallest element step [s] (given as minus the fraction of the initial
+#: one until the first step); 0: off
+P_DT_ERODE = 30
+#: separation gate [m]: a layer element erodes, a tied pair parts, only within this distance of
+#: the tool surface; < 0: no gate
+P_GATE = 31
+#: tool edge centre x [m] (set every step)
+P_TCX = 32
+#: tool edge centre y [m] (set every step)
+P_TCY = 33
+#: steps between heat-conduction passes (0: adiabatic)
+P_COND_EVERY = 34
+#: time accumulated since the last conduction pass [s]
+P_COND_ACC = 35
+#: tool interface conductance [W/(m^2 K)] (conduction runs)
+P_HC = 36
+#: fraction of the frictional dissipation that heats the workpiece
+P_FHEAT = 37
+#: tool heat-sink temperature [K]
+P_TTOOL = 38
+#: tool-frame ALE: the tool edge centre's x at the start [m]
+P_ALE_X0 = 39
+#: viscous contact damping, fraction of the penalty spring's critical
+P_CDAMP = 40
+#: friction table points (0: the constant P_MU)
+P_MUTAB_N = 41
+#: friction table velocities [m/s], increasing (slots 42 .. 49)
+P_MUTAB_V = 42
+#: friction table coefficients (slots 50 .. 57)
+P_MUTAB_MU = 50
+#: time constant of the filter on the sliding speed [s]
+P_SLIP_TAU = 58
+#: the length of ``prm``
+N_PRM = 59
+# --- end of the generated block ---
 #: per-Gauss-point state of the B-bar element: deviatoric stress xx, yy, zz, xy, plastic strain
 G_SX, G_SY, G_SZ, G_SXY, G_EPS = 0, 1, 2, 3, 4
 N_GPS = 5

@@ -14,8 +14,9 @@ import numpy as np
 
 from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
 from robobore.cutting.fe.ale.stencils import edge_neighbours
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
+from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import ConfigError
 from robobore.material import Material
 
@@ -180,24 +181,24 @@ class FEState:
 
 def default_prm() -> np.ndarray:
     """Parameter vector with neutral values (no tool contact, no support, no erosion)."""
-    p = np.zeros(K.N_PRM)
-    p[K.P_CFL] = 0.8
-    p[K.P_MS] = 1.0
-    p[K.P_HGV] = 0.05
-    p[K.P_HGS] = 0.05
-    p[K.P_BV1] = 0.06
-    p[K.P_BV2] = 1.2
-    p[K.P_DIST] = 0.0
-    p[K.P_PEN] = 0.1
-    p[K.P_TAU] = 1e30
-    p[K.P_R] = 0.0
+    p = np.zeros(layout.N_PRM)
+    p[layout.P_CFL] = 0.8
+    p[layout.P_MS] = 1.0
+    p[layout.P_HGV] = 0.05
+    p[layout.P_HGS] = 0.05
+    p[layout.P_BV1] = 0.06
+    p[layout.P_BV2] = 1.2
+    p[layout.P_DIST] = 0.0
+    p[layout.P_PEN] = 0.1
+    p[layout.P_TAU] = 1e30
+    p[layout.P_R] = 0.0
     # tool far away: rake normal (-1, 0), flank normal (0, -1)
-    p[K.P_NRX], p[K.P_NRY], p[K.P_NFX], p[K.P_NFY] = -1.0, 0.0, 0.0, -1.0
-    p[K.P_WIDTH] = 1.0
-    p[K.P_SAMPLE_DT] = 1e30
-    p[K.P_TEND] = 1e30
-    p[K.P_EROSION] = K.ERODE_NONE
-    p[K.P_GATE] = -1.0
+    p[layout.P_NRX], p[layout.P_NRY], p[layout.P_NFX], p[layout.P_NFY] = -1.0, 0.0, 0.0, -1.0
+    p[layout.P_WIDTH] = 1.0
+    p[layout.P_SAMPLE_DT] = 1e30
+    p[layout.P_TEND] = 1e30
+    p[layout.P_EROSION] = layout.ERODE_NONE
+    p[layout.P_GATE] = -1.0
     return p
 
 
@@ -230,7 +231,7 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         raise ConfigError("mesh has an element with non-positive area (nodes must be "
                           "counter-clockwise)", field="conn", value=bad)
     mass = np.zeros(n)
-    np.add.at(mass, conn.ravel(), np.repeat(area * material.rho * prm[K.P_MS] / 4.0, 4))
+    np.add.at(mass, conn.ravel(), np.repeat(area * material.rho * prm[layout.P_MS] / 4.0, 4))
     counts = np.bincount(conn.ravel(), minlength=n)
     ptr = np.zeros(n + 1, dtype=np.int64)
     ptr[1:] = np.cumsum(counts)
@@ -242,8 +243,8 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
     nel[:] = order // 4
     nco[:] = order % 4
     del fill
-    tool = np.zeros(K.N_TOOL)
-    tool[K.T_GX], tool[K.T_GY] = tool_center
+    tool = np.zeros(layout.N_TOOL)
+    tool[layout.T_GX], tool[layout.T_GY] = tool_center
     z = np.zeros
     phases = Phases() if phases is None else phases
     st = FEState(
@@ -255,15 +256,15 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
         area0=area.copy(), ie=z(ne), hge=z(ne), fex=z((ne, 4)), fey=z((ne, 4)),
         dte=z(ne), plast=z(ne), rate=z(ne), cfx=z(n), cfy=z(n), fric=z(n), pen=z(n),
         ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
-        en=z(K.N_EN), ist=np.zeros(K.N_IST, np.int64), clock=z(3), hacc=z(K.N_HIST),
-        hist=np.full((max(1, n_samples), K.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
+        en=z(layout.N_EN), ist=np.zeros(layout.N_IST, np.int64), clock=z(3), hacc=z(layout.N_HIST),
+        hist=np.full((max(1, n_samples), layout.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
         enbr=edge_neighbours(conn), snodes=np.zeros(0, np.int64), xn=z(n), yn=z(n),
         buf=z((ne, N_RZ_FIELDS)),
         twin=(-np.ones(n, np.int64) if twin is None else np.asarray(twin, np.int64)),
         tied=(np.zeros(n, np.int64) if twin is None
               else (np.asarray(twin) >= 0).astype(np.int64)),
         tbuf=z((ne, 4)),
-        gps=z((ne if phases.element == "bbar" else 0, 4, K.N_GPS)),
+        gps=z((ne if phases.element == "bbar" else 0, 4, layout.N_GPS)),
         fheat=z(n), tcq=z((n, 2)), ppair=parting_edges(conn, twin), vbuf=z((n, 2)),
         acls=np.zeros((0, 7), np.int64), aflt=z((0, 6)), bflag=np.zeros((0, 4), np.int64),
         vslip=z(n), phases=phases)
@@ -299,16 +300,16 @@ def parting_edges(conn: np.ndarray, twin: np.ndarray | None) -> np.ndarray:
 
 def init_forces(st: FEState) -> float:
     """Element forces and stable step of the current configuration (no stress update)."""
-    K.element_update(st.conn, st.x, st.y, st.vx * 0.0, st.vy * 0.0, st.alive, st.layer,
+    q_element.element_update(st.conn, st.x, st.y, st.vx * 0.0, st.vy * 0.0, st.alive, st.layer,
                      st.sdx.copy(), st.sdy.copy(), st.sdz.copy(), st.sdxy.copy(),
                      st.pres.copy(), st.eps_p.copy(), st.temp.copy(), st.dmg.copy(),
                      st.qhx.copy(), st.qhy.copy(), st.area0, st.ie.copy(), st.hge.copy(),
                      st.fex, st.fey, st.dte, st.plast.copy(), st.rate.copy(), st.mat, st.prm,
-                     1e-30, K.ERODE_NONE)
-    dt = st.prm[K.P_CFL] * float(np.min(st.dte))
+                     1e-30, layout.ERODE_NONE)
+    dt = st.prm[layout.P_CFL] * float(np.min(st.dte))
     st.clock[1] = dt
-    if st.prm[K.P_DTMIN] <= 0:
-        st.prm[K.P_DTMIN] = 1e-3 * dt
-    if st.prm[K.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
-        st.prm[K.P_DT_ERODE] = -st.prm[K.P_DT_ERODE] * float(np.min(st.dte))
+    if st.prm[layout.P_DTMIN] <= 0:
+        st.prm[layout.P_DTMIN] = 1e-3 * dt
+    if st.prm[layout.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
+        st.prm[layout.P_DT_ERODE] = -st.prm[layout.P_DT_ERODE] * float(np.min(st.dte))
     return dt

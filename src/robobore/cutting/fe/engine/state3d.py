@@ -17,8 +17,10 @@ import numpy as np
 
 from robobore.cutting.fe.ale.remap3d import N_RZ3
 from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import drive_chunks, energy_error
 from robobore.cutting.fe.engine.threads import ThreadGovernor
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
 from robobore.errors import ConfigError
 from robobore.material import Material
@@ -78,7 +80,7 @@ class FEState3:
     hacc: np.ndarray
     hist: np.ndarray
     #: node splitting, (n, 2) int64: partner node (-1: none) and whether the pair is still
-    #: tied (one array: see :func:`kernels3d.hex_node_py`)
+    #: tied (one array: see :func:`hex.scalar3d.hex_node_py`)
     pairs: np.ndarray
     #: heat conduction (:mod:`robobore.cutting.fe.physics.thermal3d`): the element across each face
     #: (e, 6) int64 (-1 none, -(nb + 2) across a parting face); scratch (e, 4): centroid,
@@ -159,7 +161,7 @@ class FEState3:
                               value=f"shape {msf.shape}, min {float(np.min(msf, initial=1))}",
                               expected=f"({self.vol0.shape[0]},), >= 1")
         self.msf = msf
-        rho_s = self.mat[MAT_RHO] * self.prm[K3.P_MS]
+        rho_s = self.mat[MAT_RHO] * self.prm[layout3d.P_MS]
         mass = np.zeros_like(self.mass)
         np.add.at(mass, self.conn.ravel(),
                   np.repeat(self.vol0 * rho_s * msf / 8.0, 8))
@@ -191,23 +193,23 @@ class FEState3:
 
 def default_prm3() -> np.ndarray:
     """Parameter vector with neutral values (no insert, no support, no erosion)."""
-    p = np.zeros(K3.N_PRM)
-    p[K3.P_CFL] = 0.8
-    p[K3.P_MS] = 1.0
-    p[K3.P_HGV] = 0.05
-    p[K3.P_HGS] = 0.05
-    p[K3.P_BV1] = 0.06
-    p[K3.P_BV2] = 1.2
-    p[K3.P_PEN] = 0.1
-    p[K3.P_TAU] = 1e30
-    p[K3.P_SAMPLE_DT] = 1e30
-    p[K3.P_TEND] = 1e30
-    p[K3.P_EROSION] = K3.ERODE_NONE
-    p[K3.P_GATE] = -1.0
-    p[K3.P_KAPPA] = np.pi / 2
-    p[K3.P_KEND] = np.radians(5.0)
-    p[K3.P_RN] = 1e-3
-    p[K3.P_COND_EVERY] = 0  # adiabatic
+    p = np.zeros(layout3d.N_PRM)
+    p[layout3d.P_CFL] = 0.8
+    p[layout3d.P_MS] = 1.0
+    p[layout3d.P_HGV] = 0.05
+    p[layout3d.P_HGS] = 0.05
+    p[layout3d.P_BV1] = 0.06
+    p[layout3d.P_BV2] = 1.2
+    p[layout3d.P_PEN] = 0.1
+    p[layout3d.P_TAU] = 1e30
+    p[layout3d.P_SAMPLE_DT] = 1e30
+    p[layout3d.P_TEND] = 1e30
+    p[layout3d.P_EROSION] = layout3d.ERODE_NONE
+    p[layout3d.P_GATE] = -1.0
+    p[layout3d.P_KAPPA] = np.pi / 2
+    p[layout3d.P_KEND] = np.radians(5.0)
+    p[layout3d.P_RN] = 1e-3
+    p[layout3d.P_COND_EVERY] = 0  # adiabatic
     return p
 
 
@@ -257,7 +259,7 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         raise ConfigError("mesh has a hexahedron with non-positive volume (node order must "
                           "be the VTK order)", field="conn", value=bad)
     mass = np.zeros(n)
-    np.add.at(mass, conn.ravel(), np.repeat(vol * material.rho * prm[K3.P_MS] / 8.0, 8))
+    np.add.at(mass, conn.ravel(), np.repeat(vol * material.rho * prm[layout3d.P_MS] / 8.0, 8))
     counts = np.bincount(conn.ravel(), minlength=n)
     ptr = np.zeros(n + 1, dtype=np.int64)
     ptr[1:] = np.cumsum(counts)
@@ -274,11 +276,11 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         raise ConfigError(f"mesh is not a valid hexahedral mesh: {exc}", field="conn",
                           value=f"{ne} elements", expected="each face shared by at most two "
                           "hexahedra") from None
-    tool = z(K3.N_TOOL)
-    tool[K3.T_GX], tool[K3.T_GY], tool[K3.T_GZ] = tool_tip
-    tool[K3.T_THETA] = prm[K3.P_THETA0]
-    if prm[K3.P_TTOOL] <= 0.0:
-        prm[K3.P_TTOOL] = material.T_room
+    tool = z(scalar3d.N_TOOL)
+    tool[scalar3d.T_GX], tool[scalar3d.T_GY], tool[scalar3d.T_GZ] = tool_tip
+    tool[scalar3d.T_THETA] = prm[layout3d.P_THETA0]
+    if prm[layout3d.P_TTOOL] <= 0.0:
+        prm[layout3d.P_TTOOL] = material.T_room
     st = FEState3(
         x=nodes[:, 0].copy(), y=nodes[:, 1].copy(), z=nodes[:, 2].copy(), vx=z(n), vy=z(n),
         vz=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.int64).copy(), ptr=ptr,
@@ -289,9 +291,9 @@ def make_state3(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material
         temp=np.full(ne, material.T_room), dmg=z(ne), qh=z((ne, 12)), vol0=vol, ie=z(ne),
         hge=z(ne), fe=z((ne, 24)), dte=z(ne), plast=z(ne), rate=z(ne), cf=z((n, 4)),
         fric=z(n), pen=z(n), ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n),
-        mat=material.to_array(), prm=prm, tool=tool, en=z(K3.N_EN),
-        ist=np.zeros(K3.N_IST, np.int64), clock=z(3), hacc=z(K3.N_HIST),
-        hist=np.full((max(1, n_samples), K3.N_HIST), np.nan),
+        mat=material.to_array(), prm=prm, tool=tool, en=z(layout.N_EN),
+        ist=np.zeros(layout.N_IST, np.int64), clock=z(3), hacc=z(scalar3d.N_HIST),
+        hist=np.full((max(1, n_samples), scalar3d.N_HIST), np.nan),
         pairs=np.ascontiguousarray(np.stack([tw, (tw >= 0).astype(np.int64)], axis=1)),
         enbr=enbr, tbuf=z((ne, 4)),
         theat=z((n, 3)))
@@ -308,7 +310,7 @@ def element_steps3(st: FEState3) -> np.ndarray:
                        st.alive.copy(), st.layer, st.sd.copy(), st.pres.copy(), st.eps_p.copy(),
                        st.temp.copy(), st.dmg.copy(), st.qh.copy(), st.vol0, st.ie.copy(),
                        st.hge.copy(), np.zeros_like(st.fe), dte, st.plast.copy(),
-                       st.rate.copy(), st.mat, st.prm, 1e-30, K3.ERODE_NONE)
+                       st.rate.copy(), st.mat, st.prm, 1e-30, layout3d.ERODE_NONE)
     return dte
 
 
@@ -317,19 +319,19 @@ def init_forces3(st: FEState3) -> float:
     dte = element_steps3(st)
     if st.msf.shape[0] > 0:
         dte = dte * np.sqrt(st.msf)
-    dt = st.prm[K3.P_CFL] * float(np.min(dte))
+    dt = st.prm[layout3d.P_CFL] * float(np.min(dte))
     st.clock[1] = dt
-    if st.prm[K3.P_DTMIN] <= 0:
-        st.prm[K3.P_DTMIN] = 1e-3 * dt
-    if st.prm[K3.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
-        st.prm[K3.P_DT_ERODE] = -st.prm[K3.P_DT_ERODE] * float(np.min(dte))
+    if st.prm[layout3d.P_DTMIN] <= 0:
+        st.prm[layout3d.P_DTMIN] = 1e-3 * dt
+    if st.prm[layout3d.P_DT_ERODE] < 0:  # given as a fraction of the initial step: make absolute
+        st.prm[layout3d.P_DT_ERODE] = -st.prm[layout3d.P_DT_ERODE] * float(np.min(dte))
     return dt
 
 
 def heat_pass(prm: np.ndarray) -> bool:
     """Whether a 3D state's parameter vector asks for the heat pass (``prm[P_COND_EVERY]``
     >= 1 steps) or none (0: adiabatic); ConfigError for an interval between."""
-    every = float(prm[K3.P_COND_EVERY])
+    every = float(prm[layout3d.P_COND_EVERY])
     if every != 0.0 and every < 1.0:
         raise ConfigError("the heat pass needs an interval of at least one step (0: adiabatic)",
                           field="prm[P_COND_EVERY]", value=every, expected="0 or >= 1")
@@ -362,9 +364,9 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
     ``adaptive_threads``, ``governor``: see
     :func:`~robobore.cutting.fe.engine.chunk_driver.drive_chunks`.
     """
-    if st.tool_frame and st.prm[K3.P_RZ_EVERY] < 1:
+    if st.tool_frame and st.prm[layout3d.P_RZ_EVERY] < 1:
         raise ConfigError("the tool-frame ALE pass needs an interval of at least one step",
-                          field="prm[P_RZ_EVERY]", value=float(st.prm[K3.P_RZ_EVERY]),
+                          field="prm[P_RZ_EVERY]", value=float(st.prm[layout3d.P_RZ_EVERY]),
                           expected=">= 1")
     choice = (bool(st.tool_frame), heat_pass(st.prm))
     run = K3.RUN_CHUNK3[choice] if step is None else step
@@ -374,7 +376,7 @@ def advance3(st: FEState3, t_end: float, *, chunk_steps: int = 500,
                           expected=f"{K3.RUN_CHUNK3[choice].__name__} for a state "
                           f"{'with' if choice[0] else 'without'} the tool-frame arrays and "
                           f"{'with' if choice[1] else 'without'} a heat-pass interval")
-    return drive_chunks(st, t_end, run, K3.P_TEND, chunk_steps=chunk_steps,
+    return drive_chunks(st, t_end, run, layout3d.P_TEND, chunk_steps=chunk_steps,
                         label="3D simulation",
                         hint=_TOOL_FRAME_HINT if st.tool_frame else _HINT,
                         progress=progress, check=check, adaptive_threads=adaptive_threads,

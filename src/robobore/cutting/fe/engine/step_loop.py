@@ -1,10 +1,12 @@
 """The time-step loop of both CPU engines (numba): one loop for 2D and 3D.
 
-:func:`bind_chunk_loop` builds an engine's chunk loop ``loop(n_steps, *arrays)`` -- the state
-arrays in the order of the state's ``kernel_args()`` -- from :func:`chunk_loop_py` and the
-engine's phases, numba functions that take the state as a namedtuple ``s`` of those arrays
-(``s.x``, ``s.prm``, ...). It advances up to ``n_steps`` central-difference steps and returns
-the number taken. One step (``clock`` = [t, dt, t_acc]):
+:func:`make_chunk_loop` builds an engine's chunk loop ``loop(n_steps, *arrays)`` -- the state
+arrays in the order of the state's ``kernel_args()`` -- from the engine's phases, numba
+functions that take the state as a namedtuple ``s`` of those arrays (``s.x``, ``s.prm``, ...):
+a factory that receives the phases as arguments and returns the compiled loop, a closure over
+them, so that every callee of the loop is a name in its source. The loop advances up to
+``n_steps`` central-difference steps and returns the number taken. One step (``clock`` =
+[t, dt, t_acc]):
 
 1. ``nodes(s, kinematics(s.tool, s.prm), dt, split)`` -> ``(fx, fy, fz, ncont)``: the node
    update with the tool contact, the contact-force total in the fixed lane order shared with
@@ -15,8 +17,9 @@ the number taken. One step (``clock`` = [t, dt, t_acc]):
 4. ``elements(s, dt)`` -> ``(dtmin, bad)``: the element update, the smallest stable step [s]
    and an inverted element (-1: none);
 5. ``heat(s, step, t, dt)``: the conduction pass at the steps that have one;
-6. the end of step of :mod:`robobore.cutting.fe.engine.history` (``end_step``, bound to the
-   engine): stop checks, histories, samples; a stop ends the chunk.
+6. the end of step of :mod:`robobore.cutting.fe.engine.history` (``end_step``, made for the
+   engine by :func:`~robobore.cutting.fe.engine.history.make_end_step`): stop checks,
+   histories, samples; a stop ends the chunk.
 
 With ``totals_at_chunk_end`` the energy totals are summed after a chunk that ran to its end
 (3D: the host's energy check reads them).
@@ -39,40 +42,8 @@ import numpy as np
 from numba import njit
 
 from robobore.cutting.fe.engine.layout import E_EXT, I_STEP
-from robobore.material.johnson_cook import rebind
 
-__all__ = ["chunk_loop_py", "bind_chunk_loop"]
-
-# the names that describe an engine, bound by :func:`bind_chunk_loop` (the plain function
-# does not run unbound)
-State = N_SPLIT = TOTALS_AT_CHUNK_END = None
-energy_arrays = kinematics = nodes = tool_step = remesh = elements = heat = None
-end_step = energy_totals = None
-
-
-def chunk_loop_py(n_steps, *a):
-    """The loop of the module docstring (its engine names bound by :func:`bind_chunk_loop`)."""
-    s = State(*a)
-    ist, clock, tool, prm, en = s.ist, s.clock, s.tool, s.prm, s.en
-    split = np.zeros(N_SPLIT)
-    es = energy_arrays(s)
-    taken = 0
-    for _s in range(n_steps):
-        step = ist[I_STEP]
-        t = clock[0]
-        dt = clock[1]
-        fx, fy, fz, ncont = nodes(s, kinematics(tool, prm), dt, split)
-        en[E_EXT] += tool_step(s, fx, fy, fz, dt)
-        remesh(s, step)
-        dtmin, bad = elements(s, dt)
-        heat(s, step, t, dt)
-        taken += 1
-        if not end_step(dt, bad, dtmin, fx, fy, fz, ncont, split, ist, clock,
-                        prm, tool, en, s.hacc, s.hist, es):
-            return taken
-    if TOTALS_AT_CHUNK_END:
-        energy_totals(es, en)
-    return taken
+__all__ = ["make_chunk_loop", "no_remesh_py"]
 
 
 def no_remesh_py(s, step):
@@ -80,27 +51,52 @@ def no_remesh_py(s, step):
     return None
 
 
-def bind_chunk_loop(*, name: str, state, n_split: int, energy_arrays, kinematics, nodes,
+_no_remesh = njit(inline="always")(no_remesh_py)
+
+
+def make_chunk_loop(*, name: str, state, n_split: int, energy_arrays, kinematics, nodes,
                     tool_step, elements, heat, end_step, energy_totals, remesh=None,
                     totals_at_chunk_end: bool = False):
-    """:func:`chunk_loop_py` bound to one engine and compiled with ``numba.njit``.
+    """The chunk loop of the module docstring for one engine, compiled with ``numba.njit``
+    (not cached: the engines call it from their own cached functions).
 
-    ``name``: the bound loop's own ``__qualname__``, distinct for each binding: numba names
-    a compiled function's machine code by its qualified name, a per-process counter and its
-    argument types, so two bindings of one name with the same argument types, each compiled
+    ``name``: the loop's own ``__qualname__``, distinct for each engine and choice: numba
+    names a compiled function's machine code by its qualified name, a per-process counter and
+    its argument types, so two loops of one name with the same argument types, each compiled
     in another process and both loaded from numba's cache into one, could resolve to one
     machine code; ``state``: the namedtuple class of the state arrays (the order of
-    ``kernel_args()``);
-    ``n_split``: the length of the force-by-face buffer (the engine's ``N_SPLIT``);
-    ``energy_arrays(s)``: the arrays of ``energy_totals(es, en)``; ``end_step``: the engine's
-    :func:`robobore.cutting.fe.engine.history.bind_end_step`; the phases as in the module
-    docstring, each already compiled with ``njit(inline="always")``.
+    ``kernel_args()``); ``n_split``: the length of the force-by-face buffer (the engine's
+    ``N_SPLIT``); ``energy_arrays(s)``: the arrays of ``energy_totals(es, en)``;
+    ``end_step``: the engine's
+    :func:`robobore.cutting.fe.engine.history.make_end_step`; ``remesh``: None for none
+    (:func:`no_remesh_py`); ``totals_at_chunk_end``: sum the energy totals after a chunk that
+    ran to its end; the phases as in the module docstring, each already compiled with
+    ``njit(inline="always")``.
     """
-    loop = rebind(
-        chunk_loop_py, State=state, N_SPLIT=n_split, energy_arrays=energy_arrays,
-        kinematics=kinematics, nodes=nodes, tool_step=tool_step,
-        remesh=njit(inline="always")(no_remesh_py) if remesh is None else remesh, elements=elements,
-        heat=heat, end_step=end_step, energy_totals=energy_totals,
-        TOTALS_AT_CHUNK_END=totals_at_chunk_end)
-    loop.__name__ = loop.__qualname__ = name
-    return njit(loop)
+    remesh = _no_remesh if remesh is None else remesh
+
+    def chunk_loop(n_steps, *a):
+        s = state(*a)
+        ist, clock, tool, prm, en = s.ist, s.clock, s.tool, s.prm, s.en
+        split = np.zeros(n_split)
+        es = energy_arrays(s)
+        taken = 0
+        for _s in range(n_steps):
+            step = ist[I_STEP]
+            t = clock[0]
+            dt = clock[1]
+            fx, fy, fz, ncont = nodes(s, kinematics(tool, prm), dt, split)
+            en[E_EXT] += tool_step(s, fx, fy, fz, dt)
+            remesh(s, step)
+            dtmin, bad = elements(s, dt)
+            heat(s, step, t, dt)
+            taken += 1
+            if not end_step(dt, bad, dtmin, fx, fy, fz, ncont, split, ist, clock,
+                            prm, tool, en, s.hacc, s.hist, es):
+                return taken
+        if totals_at_chunk_end:
+            energy_totals(es, en)
+        return taken
+
+    chunk_loop.__name__ = chunk_loop.__qualname__ = name
+    return njit(chunk_loop)

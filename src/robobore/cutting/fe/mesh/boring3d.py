@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import hex_conn, split_node_layer
+from robobore.cutting.fe.hex import scalar3d
 from robobore.cutting.geometry import BoringInsert, lead_end
 
 __all__ = ["BoringMesh", "parting_surface", "build_boring_mesh"]
@@ -41,7 +41,7 @@ def parting_surface(insert: BoringInsert, zs: np.ndarray, height: float,
 
     The offset is along the profile normal (in each normal section of the edge, the 2D
     engine's parting line ``height`` above the edge's lowest point): the points whose
-    :func:`kernels3d.edge_section` distance is ``re - height``. Solved by bisection in y on
+    :func:`hex.scalar3d.edge_section` distance is ``re - height``. Solved by bisection in y on
     [y_low, nose radius] at each z of ``zs``.
     """
     rn, re = insert.nose_radius_m, insert.edge_radius_m
@@ -53,7 +53,7 @@ def parting_surface(insert: BoringInsert, zs: np.ndarray, height: float,
         lo, hi = y_low, rn * (1.0 - 1e-9)
         for _ in range(80):
             mid = 0.5 * (lo + hi)
-            if K3.edge_section(mid, float(z), rn, kap, kend, re)[0] > target:
+            if scalar3d.edge_section(mid, float(z), rn, kap, kend, re)[0] > target:
                 lo = mid
             else:
                 hi = mid

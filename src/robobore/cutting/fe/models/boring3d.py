@@ -14,7 +14,7 @@ compares it with the mechanistic model):
   ``drop`` the insert's edge profile (:meth:`robobore.cutting.geometry.BoringInsert.drop`),
   so the material above the current edge profile ``drop(z)`` is exactly the boring chip of
   the mechanistic model (area ``ap f - scallop``). The new bore surface is y = 0.
-* **Insert** -- rigid, analytic signed distance (:func:`kernels3d.insert_gap3_py`): nose
+* **Insert** -- rigid, analytic signed distance (:func:`hex.scalar3d.insert_gap3_py`): nose
   radius, approach and end-edge angles, normal rake, clearance, edge radius, inclination.
   It moves along +x at the cutting speed ``vc = pi D n`` and along +z at the feed speed
   ``f n``; the bar angle advances as ``theta = theta0 + vc t / R``.
@@ -49,6 +49,7 @@ from robobore.cutting.fe.config.boring3d import (
 )
 from robobore.cutting.fe.config.spec import build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import energy_check
 from robobore.cutting.fe.engine.state3d import (
     FEState3,
@@ -56,6 +57,7 @@ from robobore.cutting.fe.engine.state3d import (
     energy_error,
     make_state3,
 )
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
 from robobore.cutting.fe.models.boring_setup import BoringSetup, boring_prm, check_support_step
 from robobore.cutting.geometry import chip_area
@@ -97,7 +99,7 @@ def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
     x0 = -(ins.edge_radius_m + gap0)
     t_contact = gap0 / vc
     t_end = (L + ins.edge_radius_m + gap0) / vc
-    p[K3.P_SAMPLE_DT] = t_end / s.n_samples
+    p[layout3d.P_SAMPLE_DT] = t_end / s.n_samples
     st = make_state3(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, n_samples=s.n_samples,
                      tool_tip=(x0, 0.0, 0.0), layer=mesh.layer, twin=mesh.twin)
     check_support_step(cfg, st, source)
@@ -120,7 +122,7 @@ def _mean_sliding_speed(st: FEState3) -> float | None:
     """Mean filtered sliding speed [m/s] of the nodes in contact at the end of the run (None
     without a friction table read at the sliding speed, or without contact)."""
     inc = np.any(st.cf[:, :3] != 0.0, axis=1)
-    if st.prm[K3.P_MUTAB_N] <= 0.0 or not inc.any():
+    if st.prm[layout3d.P_MUTAB_N] <= 0.0 or not inc.any():
         return None
     return float(np.mean(st.cf[inc, 3]))
 
@@ -173,25 +175,25 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         raise ConfigError("unknown device", field="--device", value=device,
                           expected="cpu or gpu")
     wall = time.perf_counter() - t0
-    hh = st.hist[np.isfinite(st.hist[:, K3.H_T])]
-    t = hh[:, K3.H_T]
+    hh = st.hist[np.isfinite(st.hist[:, scalar3d.H_T])]
+    t = hh[:, scalar3d.H_T]
     L = cfg.cut.cut_length_mm * 1e-3
     t0w = setup.t_end - cfg.solver.steady_window_fraction * L / setup.vc
     win = t >= t0w
     if not win.any():
         win = np.ones_like(t, bool)
-    Ft = -hh[:, K3.H_FX]
-    Fr = -hh[:, K3.H_FY]
-    Fz = hh[:, K3.H_FZ]
+    Ft = -hh[:, scalar3d.H_FX]
+    Fr = -hh[:, scalar3d.H_FY]
+    Fz = hh[:, scalar3d.H_FZ]
     ft_m, fr_m, fz_m = float(np.mean(Ft[win])), float(np.mean(Fr[win])), float(np.mean(Fz[win]))
     th = np.linspace(0.0, 2 * np.pi, 360, endpoint=False)
     FB = rotating_to_boring(ft_m, fr_m, fz_m, th)
-    thr = hh[:, K3.H_THETA]
+    thr = hh[:, scalar3d.H_THETA]
     FBt = rotating_to_boring(1.0, 0.0, 0.0, thr) * Ft + rotating_to_boring(0.0, 1.0, 0.0, thr) \
         * Fr + rotating_to_boring(0.0, 0.0, 1.0, thr) * Fz
     en = st.en
     n_el = st.n_elements
-    cut_mm = (hh[:, K3.H_TIPX] - setup.x_cut_start) * 1e3
+    cut_mm = (hh[:, scalar3d.H_TIPX] - setup.x_cut_start) * 1e3
     alive = st.alive == 1
     # the pre-bore surface's highest point: the workpiece block's top; ap in the tool frame
     # (whose initial mesh carries the pre-shaped chip above it)
@@ -214,11 +216,11 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         "chip_max_height_um": float((np.max(st.y[~st.ndead]) - ytop_max) * 1e6),
         "peak_temperature_K": float(np.max(st.temp[alive])) if alive.any() else math.nan,
         "energy_error": energy_error(en),
-        "energy_J": {"external": float(en[K3.E_EXT]), "kinetic": float(en[K3.E_KIN]),
-                     "internal": float(en[K3.E_INT]), "plastic": float(en[K3.E_PLAST]),
-                     "hourglass": float(en[K3.E_HG]), "contact": float(en[K3.E_FRIC]),
-                     "eroded": float(en[K3.E_ERODED])},
-        "hourglass_fraction": float(en[K3.E_HG] / max(en[K3.E_INT], 1e-300)),
+        "energy_J": {"external": float(en[layout.E_EXT]), "kinetic": float(en[layout.E_KIN]),
+                     "internal": float(en[layout.E_INT]), "plastic": float(en[layout.E_PLAST]),
+                     "hourglass": float(en[layout.E_HG]), "contact": float(en[layout.E_FRIC]),
+                     "eroded": float(en[layout.E_ERODED])},
+        "hourglass_fraction": float(en[layout.E_HG] / max(en[layout.E_INT], 1e-300)),
         "feed_amplitude_um": None,
         "wall_time_s": wall,
         "element_updates_per_s": n_el * steps / max(wall, 1e-12),
@@ -229,7 +231,7 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         "frame": cfg.mesh.frame,
         "element_size_um": cfg.mesh.element_size_um,
         "cutting_speed_m_per_min": setup.vc * 60.0,
-        "friction_coefficient": float(st.prm[K3.P_MU]),
+        "friction_coefficient": float(st.prm[layout3d.P_MU]),
         "friction_law": cfg.friction_law(),
         "sliding_speed_mean_m_per_s": _mean_sliding_speed(st),
         "separation": cfg.mesh.separation if cfg.mesh.frame == "workpiece" else None,
@@ -256,29 +258,29 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
         if cfg.mesh.frame == "tool":
             # the insert's deflection along the wall normal (local y; tool_kinematics_py),
             # which the tool-frame mesh's placement does not follow, against the edge element
-            uy = -np.cos(thr) * hh[:, K3.H_UX] - np.sin(thr) * hh[:, K3.H_UY]
+            uy = -np.cos(thr) * hh[:, scalar3d.H_UX] - np.sin(thr) * hh[:, scalar3d.H_UY]
             tf = summary["toolframe_mesh"]
             tf["radial_deflection_max_um"] = float(np.max(np.abs(uy))) * 1e6
             tf["edge_element_um"] = setup.mesh.sizes.edge * 1e6
         k = cfg.tool_support.total_stiffness()
-        uz = hh[:, K3.H_UZ] * 1e6
+        uz = hh[:, scalar3d.H_UZ] * 1e6
         mean_z, amp_z = _mean_amp(uz[win])
         summary.update({
             "feed_amplitude_um": amp_z,
             "tool_dz_mean_um": mean_z,
             "tool_dz_static_um": fz_m / k[2] * 1e6 if k[2] > 0 else math.nan,
-            "tool_dx_mean_um": float(np.mean(hh[win, K3.H_UX]) * 1e6),
-            "tool_dy_mean_um": float(np.mean(hh[win, K3.H_UY]) * 1e6),
+            "tool_dx_mean_um": float(np.mean(hh[win, scalar3d.H_UX]) * 1e6),
+            "tool_dy_mean_um": float(np.mean(hh[win, scalar3d.H_UY]) * 1e6),
         })
     history = {
         "time_s": t, "cut_length_mm": cut_mm, "bar_angle_rad": thr,
         "force_tangential_N": Ft, "force_radial_N": Fr, "force_feed_N": Fz,
         "force_X_N": FBt[0], "force_Y_N": FBt[1], "force_Z_N": FBt[2],
-        "tool_dX_um": hh[:, K3.H_UX] * 1e6, "tool_dY_um": hh[:, K3.H_UY] * 1e6,
-        "tool_dZ_um": hh[:, K3.H_UZ] * 1e6, "contact_nodes": hh[:, K3.H_NCONT],
-        "energy_external_J": hh[:, K3.H_EEXT], "energy_kinetic_J": hh[:, K3.H_EKIN],
-        "energy_internal_J": hh[:, K3.H_EINT], "energy_hourglass_J": hh[:, K3.H_EHG],
-        "energy_contact_J": hh[:, K3.H_EFRIC],
+        "tool_dX_um": hh[:, scalar3d.H_UX] * 1e6, "tool_dY_um": hh[:, scalar3d.H_UY] * 1e6,
+        "tool_dZ_um": hh[:, scalar3d.H_UZ] * 1e6, "contact_nodes": hh[:, scalar3d.H_NCONT],
+        "energy_external_J": hh[:, scalar3d.H_EEXT], "energy_kinetic_J": hh[:, scalar3d.H_EKIN],
+        "energy_internal_J": hh[:, scalar3d.H_EINT], "energy_hourglass_J": hh[:, scalar3d.H_EHG],
+        "energy_contact_J": hh[:, scalar3d.H_EFRIC],
     }
     return BoringFEResult(summary=summary, history=history, setup=setup)
 

@@ -14,8 +14,8 @@ import numpy as np
 from robobore.cutting.fe.config.boring3d import BoringFEConfig
 from robobore.cutting.fe.config.engine_settings import apply_numerics
 from robobore.cutting.fe.config.spec import BoringSpec
-from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import FEState3, default_prm3
+from robobore.cutting.fe.hex import layout3d
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
 from robobore.material import Material
@@ -50,27 +50,27 @@ def boring_prm(cfg: BoringFEConfig, spec: BoringSpec, ins: BoringInsert, vc: flo
     s = cfg.solver
     R = 0.5 * cfg.cut.bore_diameter_mm * 1e-3
     n_rps = cfg.cut.speed_rpm / 60.0
-    p = spec.write_prm(apply_numerics(default_prm3(), s, K3), K3, vc * 60.0)
-    p[K3.P_PEN] = cfg.contact.penalty_factor
-    p[K3.P_CDAMP] = cfg.contact.damping_for(spec.tool_frame is not None)
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN] = ins.nose_radius_m
-    p[K3.P_KAPPA] = math.radians(ins.approach_angle_deg)
-    p[K3.P_KEND] = math.radians(ins.end_edge_angle_deg)
-    p[K3.P_RAKE] = math.radians(ins.rake_deg)
-    p[K3.P_CLR] = math.radians(ins.clearance_deg)
-    p[K3.P_RE] = ins.edge_radius_m
-    p[K3.P_TANI] = math.tan(math.radians(ins.inclination_deg))
-    p[K3.P_VC] = vc
-    p[K3.P_VF] = f * n_rps
-    p[K3.P_RADIUS] = R
+    p = spec.write_prm(apply_numerics(default_prm3(), s, layout3d), layout3d, vc * 60.0)
+    p[layout3d.P_PEN] = cfg.contact.penalty_factor
+    p[layout3d.P_CDAMP] = cfg.contact.damping_for(spec.tool_frame is not None)
+    p[layout3d.P_TOOL] = 1.0
+    p[layout3d.P_RN] = ins.nose_radius_m
+    p[layout3d.P_KAPPA] = math.radians(ins.approach_angle_deg)
+    p[layout3d.P_KEND] = math.radians(ins.end_edge_angle_deg)
+    p[layout3d.P_RAKE] = math.radians(ins.rake_deg)
+    p[layout3d.P_CLR] = math.radians(ins.clearance_deg)
+    p[layout3d.P_RE] = ins.edge_radius_m
+    p[layout3d.P_TANI] = math.tan(math.radians(ins.inclination_deg))
+    p[layout3d.P_VC] = vc
+    p[layout3d.P_VF] = f * n_rps
+    p[layout3d.P_RADIUS] = R
     ts = cfg.tool_support
     if ts is not None:
-        p[K3.P_SUPPORT] = 1.0
-        p[K3.P_KX], p[K3.P_KY], p[K3.P_KZ] = ts.total_stiffness()
-        p[K3.P_CX], p[K3.P_CY], p[K3.P_CZ] = ts.damping_N_s_per_m
-        p[K3.P_MX], p[K3.P_MY], p[K3.P_MZ] = ts.mass_kg
-        p[K3.P_THETA0] = math.radians(ts.theta0_deg)
+        p[layout3d.P_SUPPORT] = 1.0
+        p[layout3d.P_KX], p[layout3d.P_KY], p[layout3d.P_KZ] = ts.total_stiffness()
+        p[layout3d.P_CX], p[layout3d.P_CY], p[layout3d.P_CZ] = ts.damping_N_s_per_m
+        p[layout3d.P_MX], p[layout3d.P_MY], p[layout3d.P_MZ] = ts.mass_kg
+        p[layout3d.P_THETA0] = math.radians(ts.theta0_deg)
     return p
 
 

@@ -18,7 +18,7 @@ from robobore.cutting.fe.ale.rezone import TF_RIGID
 from robobore.cutting.fe.config.engine_settings import apply_numerics
 from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.config.spec import ModelSpec, build_spec
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import (
     advance,
     energy_check,
@@ -127,14 +127,15 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                           split_height=_split_height(cfg))
     s = cfg.solver
     spec = build_spec(cfg, mat, source)
-    p = spec.write_prm(apply_numerics(default_prm(), s, K), K, cfg.cut.cutting_speed_m_per_min)
-    p[K.P_PEN] = cfg.contact.penalty_factor
-    p[K.P_CDAMP] = cfg.contact.damping_for(cm.frame == "tool")
-    p[K.P_R] = r
-    p[K.P_NRX], p[K.P_NRY] = -math.cos(rake), math.sin(rake)
-    p[K.P_NFX], p[K.P_NFY] = math.sin(clr), -math.cos(clr)
-    p[K.P_VC] = vc
-    p[K.P_WIDTH] = cfg.cut.width_mm * 1e-3
+    p = spec.write_prm(apply_numerics(default_prm(), s, layout), layout,
+                       cfg.cut.cutting_speed_m_per_min)
+    p[layout.P_PEN] = cfg.contact.penalty_factor
+    p[layout.P_CDAMP] = cfg.contact.damping_for(cm.frame == "tool")
+    p[layout.P_R] = r
+    p[layout.P_NRX], p[layout.P_NRY] = -math.cos(rake), math.sin(rake)
+    p[layout.P_NFX], p[layout.P_NFY] = math.sin(clr), -math.cos(clr)
+    p[layout.P_VC] = vc
+    p[layout.P_WIDTH] = cfg.cut.width_mm * 1e-3
     if tool_frame:
         cx0, cy0 = mesh.tool_center  # the mesh starts round the tool
         t_contact = 0.0
@@ -147,16 +148,16 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
         t_contact = gap0 / vc
         t_end = (L + r + gap0) / vc
         x_cut_start = mesh.length + r
-    p[K.P_SAMPLE_DT] = t_end / s.n_samples
+    p[layout.P_SAMPLE_DT] = t_end / s.n_samples
     ts = cfg.tool_support
     if ts is not None:
-        p[K.P_SUPPORT] = 1.0
-        p[K.P_KX], p[K.P_KY] = ts.stiffness_N_per_m  # type: ignore[misc]
-        p[K.P_CX], p[K.P_CY] = ts.damping_N_s_per_m  # type: ignore[misc]
-        p[K.P_MX], p[K.P_MY] = ts.mass_kg  # type: ignore[misc]
+        p[layout.P_SUPPORT] = 1.0
+        p[layout.P_KX], p[layout.P_KY] = ts.stiffness_N_per_m  # type: ignore[misc]
+        p[layout.P_CX], p[layout.P_CY] = ts.damping_N_s_per_m  # type: ignore[misc]
+        p[layout.P_MX], p[layout.P_MY] = ts.mass_kg  # type: ignore[misc]
     if tool_frame:
         # the mesh travels with the tool from its start
-        p[K.P_ALE_X0], p[K.P_TCX], p[K.P_TCY] = cx0, cx0, cy0
+        p[layout.P_ALE_X0], p[layout.P_TCX], p[layout.P_TCY] = cx0, cx0, cy0
     st = make_state(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p,
                     layer=getattr(mesh, "layer", None), n_samples=s.n_samples,
                     tool_center=(cx0, cy0), twin=getattr(mesh, "twin", None),
@@ -173,7 +174,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                                   value=k, expected=f"k < {0.25 * m / dt**2:.3g} N/m for "
                                   f"mass {m} kg and time step {dt:.3g} s")
     return CuttingSetup(cfg=cfg, material=mat, mesh=mesh, state=st, h=h, vc=vc, rake=rake,
-                        t_end=t_end, t_contact=t_contact, mu=float(p[K.P_MU]),
+                        t_end=t_end, t_contact=t_contact, mu=float(p[layout.P_MU]),
                         x_cut_start=x_cut_start, spec=spec)
 
 
@@ -222,8 +223,8 @@ def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
 
     st = setup.state
     cfg = setup.cfg
-    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
-    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    cx = st.tool[layout.T_GX] + st.tool[layout.T_UX]
+    cy = st.tool[layout.T_GY] + st.tool[layout.T_UY]
     sxx, syy, szz, sxy = st.sdx, st.sdy, st.sdz, st.sdxy
     vm = np.sqrt(1.5 * (sxx**2 + syy**2 + szz**2 + 2 * sxy**2))
     ox, oy = tool_outline(cx, cy, cfg.tool.edge_radius_um * 1e-6, setup.rake,
@@ -233,7 +234,7 @@ def _final_fields(setup: CuttingSetup) -> dict[str, np.ndarray]:
             "temperature_K": st.temp.copy(), "damage": st.dmg.copy(), "von_mises_Pa": vm,
             "pressure_Pa": st.pres.copy(), "tool_outline": np.array([ox, oy]),
             "tool_center": np.array([cx, cy]), "vx": st.vx.copy(), "vy": st.vy.copy(),
-            "tool_velocity": np.array([-setup.vc + st.tool[K.T_VUX], st.tool[K.T_VUY]]),
+            "tool_velocity": np.array([-setup.vc + st.tool[layout.T_VUX], st.tool[layout.T_VUY]]),
             "deviatoric_stress_Pa": np.array([sxx, syy, szz, sxy]),
             "contact_force_N_per_m": np.array([st.cfx, st.cfy]),
             "sliding_speed_m_per_s": st.vslip.copy()}
@@ -260,16 +261,16 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     dt0 = float(st.clock[1])
     wall, steps = run_orthogonal(setup, progress, device)
     hist = st.hist
-    ok = np.isfinite(hist[:, K.H_T])
+    ok = np.isfinite(hist[:, layout.H_T])
     hh = hist[ok]
-    t = hh[:, K.H_T]
+    t = hh[:, layout.H_T]
     L = cfg.cut.length_mm * 1e-3
     frac = cfg.solver.steady_window_fraction
     t0w = setup.t_end - frac * L / setup.vc
     win = steady_window(t, t0w, setup.t_end + 1e-12)
-    fc = hh[:, K.H_FX] * 1e-3
-    ff = hh[:, K.H_FY] * 1e-3
-    cut_pos_mm = (setup.x_cut_start - hh[:, K.H_TIP_X]) * 1e3
+    fc = hh[:, layout.H_FX] * 1e-3
+    ff = hh[:, layout.H_FY] * 1e-3
+    cut_pos_mm = (setup.x_cut_start - hh[:, layout.H_TIP_X]) * 1e3
     if cfg.mesh.frame == "tool":
         from robobore.cutting.fe.ale.toolframe import measure_chip_toolframe
 
@@ -312,26 +313,26 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "eroded_chip_mass_fraction": float(
             np.sum(st.area0[(st.alive != 1) & setup.mesh.chip])
             / max(np.sum(st.area0[setup.mesh.chip]), 1e-300)),
-        "energy_external_J_per_m": float(en[K.E_EXT]),
-        "energy_plastic_J_per_m": float(en[K.E_PLAST]),
-        "energy_hourglass_J_per_m": float(en[K.E_HG]),
-        "energy_contact_J_per_m": float(en[K.E_FRIC]),
-        "energy_kinetic_J_per_m": float(en[K.E_KIN]),
-        "energy_internal_J_per_m": float(en[K.E_INT]),
-        "hourglass_fraction": float(en[K.E_HG] / max(en[K.E_INT], 1e-300)),
+        "energy_external_J_per_m": float(en[layout.E_EXT]),
+        "energy_plastic_J_per_m": float(en[layout.E_PLAST]),
+        "energy_hourglass_J_per_m": float(en[layout.E_HG]),
+        "energy_contact_J_per_m": float(en[layout.E_FRIC]),
+        "energy_kinetic_J_per_m": float(en[layout.E_KIN]),
+        "energy_internal_J_per_m": float(en[layout.E_INT]),
+        "hourglass_fraction": float(en[layout.E_HG] / max(en[layout.E_INT], 1e-300)),
     }
-    faces = hh[:, K.H_FX_RAKE:K.H_FX_RAKE + 6] * 1e-3
+    faces = hh[:, layout.H_FX_RAKE:layout.H_FX_RAKE + 6] * 1e-3
     has_faces = bool(win.any() and np.all(np.isfinite(faces[win])))
     if has_faces:  # recorded by both devices
         fm = faces[win].mean(axis=0)
         summary["force_by_face_N_per_mm"] = {
             face: {"cutting": float(fm[2 * j]), "feed": float(fm[2 * j + 1])}
-            for j, face in enumerate(K.FACES)}
+            for j, face in enumerate(layout.FACES)}
     if cfg.tool_support is not None:
         kx, ky = cfg.tool_support.stiffness_N_per_m  # type: ignore[misc]
         w = cfg.cut.width_mm
-        dx = hh[:, K.H_UX] * 1e6
-        dy = hh[:, K.H_UY] * 1e6
+        dx = hh[:, layout.H_UX] * 1e6
+        dy = hh[:, layout.H_UY] * 1e6
         summary.update({
             "tool_dx_mean_um": float(np.mean(dx[win])),
             "tool_dy_mean_um": float(np.mean(dy[win])),
@@ -345,20 +346,20 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
         "cut_length_mm": cut_pos_mm,
         "cutting_force_N_per_mm": fc,
         "feed_force_N_per_mm": ff,
-        "tool_dx_um": hh[:, K.H_UX] * 1e6,
-        "tool_dy_um": hh[:, K.H_UY] * 1e6,
-        "tool_tip_x_mm": hh[:, K.H_TIP_X] * 1e3,
-        "contact_nodes": hh[:, K.H_NCONT],
-        "energy_external_J_per_m": hh[:, K.H_EEXT],
-        "energy_kinetic_J_per_m": hh[:, K.H_EKIN],
-        "energy_internal_J_per_m": hh[:, K.H_EINT],
-        "energy_plastic_J_per_m": hh[:, K.H_EPL],
-        "energy_hourglass_J_per_m": hh[:, K.H_EHG],
-        "energy_contact_J_per_m": hh[:, K.H_EFRIC],
-        "energy_eroded_J_per_m": hh[:, K.H_EERO],
+        "tool_dx_um": hh[:, layout.H_UX] * 1e6,
+        "tool_dy_um": hh[:, layout.H_UY] * 1e6,
+        "tool_tip_x_mm": hh[:, layout.H_TIP_X] * 1e3,
+        "contact_nodes": hh[:, layout.H_NCONT],
+        "energy_external_J_per_m": hh[:, layout.H_EEXT],
+        "energy_kinetic_J_per_m": hh[:, layout.H_EKIN],
+        "energy_internal_J_per_m": hh[:, layout.H_EINT],
+        "energy_plastic_J_per_m": hh[:, layout.H_EPL],
+        "energy_hourglass_J_per_m": hh[:, layout.H_EHG],
+        "energy_contact_J_per_m": hh[:, layout.H_EFRIC],
+        "energy_eroded_J_per_m": hh[:, layout.H_EERO],
     }
     if has_faces:
-        for j, face in enumerate(K.FACES):
+        for j, face in enumerate(layout.FACES):
             history[f"{face}_cutting_force_N_per_mm"] = faces[:, 2 * j]
             history[f"{face}_feed_force_N_per_mm"] = faces[:, 2 * j + 1]
     return FEResult(summary=summary, history=history, config=cfg.model_dump(),

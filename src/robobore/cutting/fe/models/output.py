@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 
 
 @dataclass(frozen=True)
@@ -52,8 +52,8 @@ def _passed_chip(st, mesh) -> tuple[float, float, np.ndarray]:
     """Tool edge centre (x, y) and the live nodes of chip-layer material the tool has passed
     (with node splitting without the work's copies of the parting line)."""
     le = mesh.element_size
-    cx = st.tool[K.T_GX] + st.tool[K.T_UX]
-    cy = st.tool[K.T_GY] + st.tool[K.T_UY]
+    cx = st.tool[layout.T_GX] + st.tool[layout.T_UX]
+    cy = st.tool[layout.T_GY] + st.tool[layout.T_UY]
     passed = ~st.ndead & (st.x0 > cx) & (st.y0 > mesh.layer_top - 1e-3 * le)
     if mesh.twin is not None:  # node splitting: the lower copies stay with the work
         passed &= ~((mesh.twin >= 0) & ~mesh.upper)
@@ -139,8 +139,8 @@ def chip_ratio_from_velocity(st, mesh, h: float, rake: float, vc: float) -> tupl
     """
     le = mesh.element_size
     cx, cy, chip = _passed_chip(st, mesh)
-    tvx = -vc + st.tool[K.T_VUX]
-    tvy = st.tool[K.T_VUY]
+    tvx = -vc + st.tool[layout.T_VUX]
+    tvy = st.tool[layout.T_VUY]
     trx, try_ = math.sin(rake), math.cos(rake)  # along the rake face, away from the edge
     nrx, nry = -math.cos(rake), math.sin(rake)  # rake normal, into the chip
     s_along = (st.x - cx) * trx + (st.y - cy) * try_
@@ -189,7 +189,7 @@ def to_dataset(res: FEResult):
         "energy_hourglass_J_per_m": "J/m", "energy_contact_J_per_m": "J/m",
         "energy_eroded_J_per_m": "J/m", "contact_nodes": "1",
     }
-    for face in K.FACES:
+    for face in layout.FACES:
         units[f"{face}_cutting_force_N_per_mm"] = units[f"{face}_feed_force_N_per_mm"] = "N/mm"
     data = {k: ("time", np.asarray(v), {"units": units.get(k, "")})
             for k, v in hist.items() if k != "time_s"}

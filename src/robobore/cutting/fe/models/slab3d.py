@@ -39,7 +39,7 @@ from robobore.cutting.fe.config.spec import (
     WorkpieceFrame,
     build_spec,
 )
-from robobore.cutting.fe.engine import kernels3d as K3
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import energy_error
 from robobore.cutting.fe.engine.state3d import (
     FEState3,
@@ -49,6 +49,7 @@ from robobore.cutting.fe.engine.state3d import (
     make_state3,
     split_node_layer,
 )
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.errors import ConfigError
 from robobore.material import load_material
 
@@ -97,8 +98,8 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     idx = np.arange(nodes.shape[0]).reshape(nx + 1, ny + 1, n_z + 1)
     conn = hex_conn(idx)
     fixed = np.zeros(nodes.shape[0], np.int64)
-    fixed[idx[:, :, 0].ravel()] |= K3.FIX_Z
-    fixed[idx[:, :, -1].ravel()] |= K3.FIX_Z
+    fixed[idx[:, :, 0].ravel()] |= scalar3d.FIX_Z
+    fixed[idx[:, :, -1].ravel()] |= scalar3d.FIX_Z
     fixed[idx[:, 0, :].ravel()] = 7
     fixed[idx[-1, :, :].ravel()] = 7
     # parting line: double its nodes (not the fully fixed ones); the chip rows take the copies
@@ -114,13 +115,14 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
                       erode_time_step_fraction=frame.erode_time_step_fraction,
                       friction=spec2.friction, thermal=spec2.thermal,
                       hardening=spec2.hardening)
-    p = _straight_insert(spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
+    p0 = apply_numerics(default_prm3(), cfg.solver, layout3d)
+    p = _straight_insert(spec.write_prm(p0, layout3d,
                                         cfg.cut.cutting_speed_m_per_min), cfg, vc,
                          tool_frame=False)
     gap0 = 0.5 * le
     t_end = (L + re + gap0) / vc
     n_samples = cfg.solver.n_samples
-    p[K3.P_SAMPLE_DT] = t_end / n_samples
+    p[layout3d.P_SAMPLE_DT] = t_end / n_samples
     st = make_state3(nodes, conn, fixed, mat, prm=p, n_samples=n_samples,
                      tool_tip=(-(re + gap0), 0.0, 0.5 * width), twin=twin)
     return SlabSetup(state=st, t_end=t_end, width=width, vc=vc, cut_length=L)
@@ -129,16 +131,16 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
 def _straight_insert(p: np.ndarray, cfg: FEConfig, vc: float, *, tool_frame: bool) -> np.ndarray:
     # the insert with a straight edge over the slab: nose radius 1 m, the 2D wedge in every
     # normal section; the 2D config's contact
-    p[K3.P_PEN] = cfg.contact.penalty_factor
-    p[K3.P_CDAMP] = cfg.contact.damping_for(tool_frame)
-    p[K3.P_TOOL] = 1.0
-    p[K3.P_RN] = 1.0
-    p[K3.P_KAPPA] = 0.5 * math.pi
-    p[K3.P_KEND] = 0.49 * math.pi
-    p[K3.P_RAKE] = math.radians(cfg.tool.rake_deg)
-    p[K3.P_CLR] = math.radians(cfg.tool.clearance_deg)
-    p[K3.P_RE] = cfg.tool.edge_radius_um * 1e-6
-    p[K3.P_VC] = vc
+    p[layout3d.P_PEN] = cfg.contact.penalty_factor
+    p[layout3d.P_CDAMP] = cfg.contact.damping_for(tool_frame)
+    p[layout3d.P_TOOL] = 1.0
+    p[layout3d.P_RN] = 1.0
+    p[layout3d.P_KAPPA] = 0.5 * math.pi
+    p[layout3d.P_KEND] = 0.49 * math.pi
+    p[layout3d.P_RAKE] = math.radians(cfg.tool.rake_deg)
+    p[layout3d.P_CLR] = math.radians(cfg.tool.clearance_deg)
+    p[layout3d.P_RE] = cfg.tool.edge_radius_um * 1e-6
+    p[layout3d.P_VC] = vc
     return p
 
 
@@ -170,12 +172,13 @@ def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
                       erode_time_step_fraction=0.0, friction=spec2.friction,
                       thermal=spec2.thermal, hardening=spec2.hardening,
                       tool_frame=ToolFrame3D(ale_interval=spec2.frame.ale_interval))
-    p = _straight_insert(spec.write_prm(apply_numerics(default_prm3(), cfg.solver, K3), K3,
+    p0 = apply_numerics(default_prm3(), cfg.solver, layout3d)
+    p = _straight_insert(spec.write_prm(p0, layout3d,
                                         cfg.cut.cutting_speed_m_per_min), cfg, vc,
                          tool_frame=True)
     L = cfg.cut.length_mm * 1e-3
     t_end = L / vc
-    p[K3.P_SAMPLE_DT] = t_end / cfg.solver.n_samples
+    p[layout3d.P_SAMPLE_DT] = t_end / cfg.solver.n_samples
     tip = (0.0, 0.0, 0.0)
     st = make_state3(mesh.nodes, mesh.conn, toolframe_fixed(mesh), setup2.material, prm=p,
                      n_samples=cfg.solver.n_samples, tool_tip=tip)
@@ -203,15 +206,15 @@ def simulate_slab3(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
 def _slab_summary(s: SlabSetup, steps: int, steady_fraction: float) -> dict[str, Any]:
     # forces per unit width over the window, energy balance, counts
     st = s.state
-    hh = st.hist[np.isfinite(st.hist[:, K3.H_T])]
-    win = hh[:, K3.H_T] >= s.t_end - steady_fraction * s.cut_length / s.vc
+    hh = st.hist[np.isfinite(st.hist[:, scalar3d.H_T])]
+    win = hh[:, scalar3d.H_T] >= s.t_end - steady_fraction * s.cut_length / s.vc
     w_mm = s.width * 1e3
     return {
-        "cutting_force_N_per_mm": float(-np.mean(hh[win, K3.H_FX]) / w_mm),
-        "feed_force_N_per_mm": float(np.mean(hh[win, K3.H_FY]) / w_mm),
-        "out_of_plane_force_N_per_mm": float(np.mean(hh[win, K3.H_FZ]) / w_mm),
+        "cutting_force_N_per_mm": float(-np.mean(hh[win, scalar3d.H_FX]) / w_mm),
+        "feed_force_N_per_mm": float(np.mean(hh[win, scalar3d.H_FY]) / w_mm),
+        "out_of_plane_force_N_per_mm": float(np.mean(hh[win, scalar3d.H_FZ]) / w_mm),
         "energy_error": energy_error(st.en),
-        "hourglass_fraction": float(st.en[K3.E_HG] / max(st.en[K3.E_INT], 1e-300)),
+        "hourglass_fraction": float(st.en[layout.E_HG] / max(st.en[layout.E_INT], 1e-300)),
         "eroded": int(np.sum(st.alive != 1)),
         "n_elements": st.n_elements,
         "steps": int(steps),

@@ -39,6 +39,7 @@ from robobore.cutting.fe.config.boring3d import BoringFEConfig
 from robobore.cutting.fe.config.spec import build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import FEState3, element_steps3, make_state3
+from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.mesh.toolframe3d import (
     FK_SIDE,
     ToolFrame3DSizes,
@@ -60,8 +61,8 @@ def toolframe_fixed(mesh: ToolFrameMesh3D) -> np.ndarray:
     fixed = np.zeros(mesh.n_nodes, np.int64)
     e, f = np.nonzero(mesh.fkind == FK_SIDE)
     side = np.unique(mesh.conn[e[:, None], FACES_OUT[f]])
-    fixed[side] |= K3.FIX_Z
-    fixed[mesh.rigid] = K3.FIX_X | K3.FIX_Y | K3.FIX_Z
+    fixed[side] |= scalar3d.FIX_Z
+    fixed[mesh.rigid] = scalar3d.FIX_X | scalar3d.FIX_Y | scalar3d.FIX_Z
     return fixed
 
 
@@ -74,8 +75,8 @@ def attach_toolframe(st: FEState3, mesh: ToolFrameMesh3D, tip: tuple[float, floa
 
     acls, aflt = toolframe3d_ale_data(mesh)
     st.attach_tool_frame(acls, aflt, mesh.bflag)
-    st.prm[K3.P_ALE_X0] = tip[0]
-    st.prm[K3.P_ALE_Z0] = tip[2]
+    st.prm[layout3d.P_ALE_X0] = tip[0]
+    st.prm[layout3d.P_ALE_Z0] = tip[2]
 
 
 def tip_section_step(st: FEState3, mesh: ToolFrameMesh3D, dte: np.ndarray | None = None) -> float:
@@ -133,7 +134,7 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
     spec = build_boring_spec(cfg, mat, vc * 60.0, source)
     p = boring_prm(cfg, spec, ins, vc, f)
     t_end = L / vc
-    p[K3.P_SAMPLE_DT] = t_end / s.n_samples
+    p[layout3d.P_SAMPLE_DT] = t_end / s.n_samples
     tip = (0.0, 0.0, 0.0)
     st = make_state3(mesh.nodes, mesh.conn, toolframe_fixed(mesh), mat, prm=p,
                      n_samples=s.n_samples, tool_tip=tip)
@@ -141,7 +142,7 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
     if spec.tool_frame.thin_element_mass_scaling:
         dte = element_steps3(st)  # the mesh as built, once for both
         st.set_inertia_factors(thin_element_factors(st, mesh, dte))
-        st.prm[K3.P_MSF_DT] = tip_section_step(st, mesh, dte)
+        st.prm[layout3d.P_MSF_DT] = tip_section_step(st, mesh, dte)
     check_support_step(cfg, st, source)
     return BoringSetup(cfg=cfg, material=mat, insert=ins, mesh=mesh, state=st, ap=ap, f=f,
                        vc=vc, t_end=t_end, t_contact=0.0, spec=spec, x_cut_start=tip[0])

@@ -1,7 +1,7 @@
 """Heat conduction of the 3D engine: the 2D engine's thermal model on hexahedra.
 
-The same model as the 2D engine (:func:`robobore.cutting.fe.engine.kernels.conduct`,
-:func:`~robobore.cutting.fe.engine.kernels.tool_heat`), written for hexahedra in the same
+The same model as the 2D engine (:func:`robobore.cutting.fe.physics.thermal2d.conduct`,
+:func:`~robobore.cutting.fe.physics.thermal2d.tool_heat`), written for hexahedra in the same
 device-ready style (``_py`` scalar functions, bound to ``njit`` here and to
 ``numba.cuda.jit(device=True)`` in :mod:`robobore.cutting.fe.engine.gpu.backend3d`):
 
@@ -24,7 +24,7 @@ device-ready style (``_py`` scalar functions, bound to ``njit`` here and to
   proportion to their volumes.
 * **Node splitting**: a face on the parting surface joins two elements that share no nodes
   (its nodes are doubled); heat crosses it while all four of its nodes are still tied, as in
-  2D (:func:`robobore.cutting.fe.engine.kernels.parting_edge_py`).
+  2D (:func:`robobore.cutting.fe.physics.thermal2d.parting_edge_py`).
 
 Heat capacities use the initial volume ``V0`` and the material's true density (mass scaling
 scales the inertia, not the heat capacity); plastic flow is isochoric, so ``V`` stays within
@@ -70,33 +70,45 @@ def hex_face_corner_py(f, j):
     return (code >> (3 * (3 - j))) & 7
 
 
-def face_area3_py(e, f, conn, x, y, z):
-    """Area of face ``f`` of hexahedron ``e`` [m^2]: half the norm of the cross product of its
-    diagonals (exact for a plane quadrilateral; the same bits from either side of the face)."""
-    a = conn[e, hex_face_corner(f, 0)]
-    b = conn[e, hex_face_corner(f, 1)]
-    c = conn[e, hex_face_corner(f, 2)]
-    d = conn[e, hex_face_corner(f, 3)]
-    p1 = x[c] - x[a]
-    p2 = y[c] - y[a]
-    p3 = z[c] - z[a]
-    q1 = x[d] - x[b]
-    q2 = y[d] - y[b]
-    q3 = z[d] - z[b]
-    r1 = p2 * q3 - p3 * q2
-    r2 = p3 * q1 - p1 * q3
-    r3 = p1 * q2 - p2 * q1
-    return 0.5 * math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+def make_face_area3(hex_face_corner):
+    """:func:`face_area3_py` with its callees ``hex_face_corner`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def face_area3_py(e, f, conn, x, y, z):
+        """Area of face ``f`` of hexahedron ``e`` [m^2]: half the norm of the cross product of its
+        diagonals (exact for a plane quadrilateral; the same bits from either side of the face)."""
+        a = conn[e, hex_face_corner(f, 0)]
+        b = conn[e, hex_face_corner(f, 1)]
+        c = conn[e, hex_face_corner(f, 2)]
+        d = conn[e, hex_face_corner(f, 3)]
+        p1 = x[c] - x[a]
+        p2 = y[c] - y[a]
+        p3 = z[c] - z[a]
+        q1 = x[d] - x[b]
+        q2 = y[d] - y[b]
+        q3 = z[d] - z[b]
+        r1 = p2 * q3 - p3 * q2
+        r2 = p3 * q1 - p1 * q3
+        r3 = p1 * q2 - p2 * q1
+        return 0.5 * math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+
+    return face_area3_py
 
 
-def face_tied3_py(e, f, conn, pairs):
-    """True while every node of face ``f`` of element ``e`` is shared or still tied to its
-    partner (node splitting: a parting face conducts until its nodes part)."""
-    for j in range(4):
-        n = conn[e, hex_face_corner(f, j)]
-        if pairs[n, 0] >= 0 and pairs[n, 1] == 0:
-            return False
-    return True
+def make_face_tied3(hex_face_corner):
+    """:func:`face_tied3_py` with its callees ``hex_face_corner`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def face_tied3_py(e, f, conn, pairs):
+        """True while every node of face ``f`` of element ``e`` is shared or still tied to its
+        partner (node splitting: a parting face conducts until its nodes part)."""
+        for j in range(4):
+            n = conn[e, hex_face_corner(f, j)]
+            if pairs[n, 0] >= 0 and pairs[n, 1] == 0:
+                return False
+        return True
+
+    return face_tied3_py
 
 
 def hex_centroid3_py(e, conn, x, y, z, tbuf):
@@ -114,104 +126,123 @@ def hex_centroid3_py(e, conn, x, y, z, tbuf):
     tbuf[e, 2] = 0.125 * sz
 
 
-def hex_conduct3_py(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th):
-    """New temperature of hexahedron ``e`` into ``tbuf[e, 3]`` (second pass of conduction).
+def make_hex_conduct3(face_tied3, face_area3):
+    """:func:`hex_conduct3_py` with its callees ``face_tied3``, ``face_area3`` given (the
+    CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
-    Needs the centroids ``tbuf[:, 0:3]`` of every element; reads ``temp`` only, so all
-    elements can run at once. See the module docstring.
-    """
-    tbuf[e, 3] = temp[e]
-    ve = vol0[e]
-    if alive[e] != 1 or ve <= 0.0:
-        return
-    dq = 0.0
-    for f in range(6):
+    def hex_conduct3_py(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th):
+        """New temperature of hexahedron ``e`` into ``tbuf[e, 3]`` (second pass of conduction).
+
+        Needs the centroids ``tbuf[:, 0:3]`` of every element; reads ``temp`` only, so all
+        elements can run at once. See the module docstring.
+        """
+        tbuf[e, 3] = temp[e]
+        ve = vol0[e]
+        if alive[e] != 1 or ve <= 0.0:
+            return
+        dq = 0.0
+        for f in range(6):
+            nb = enbr[e, f]
+            if nb == -1:
+                continue
+            if nb <= -2:
+                nb = -nb - 2
+                if not face_tied3(e, f, conn, pairs):
+                    continue
+            if alive[nb] != 1:
+                continue
+            vn = vol0[nb]
+            d = math.sqrt((tbuf[nb, 0] - tbuf[e, 0]) ** 2 + (tbuf[nb, 1] - tbuf[e, 1]) ** 2
+                          + (tbuf[nb, 2] - tbuf[e, 2]) ** 2)
+            if d <= 0.0 or vn <= 0.0:
+                continue
+            g = kcond * face_area3(e, f, conn, x, y, z) / d * dt_th
+            gmax = rcp * min(ve, vn) / 6.0
+            if g > gmax:
+                g = gmax
+            dq += g * (temp[nb] - temp[e])
+        tbuf[e, 3] = temp[e] + dq / (rcp * ve)
+
+    return hex_conduct3_py
+
+
+def make_face_free3(face_tied3):
+    """:func:`face_free3_py` with its callees ``face_tied3`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def face_free3_py(e, f, conn, alive, enbr, pairs):
+        """True where face ``f`` of live element ``e`` is a free surface (no live neighbour
+        across it, or a parting face whose nodes have parted)."""
         nb = enbr[e, f]
         if nb == -1:
-            continue
+            return True
         if nb <= -2:
-            nb = -nb - 2
-            if not face_tied3(e, f, conn, pairs):
-                continue
-        if alive[nb] != 1:
-            continue
-        vn = vol0[nb]
-        d = math.sqrt((tbuf[nb, 0] - tbuf[e, 0]) ** 2 + (tbuf[nb, 1] - tbuf[e, 1]) ** 2
-                      + (tbuf[nb, 2] - tbuf[e, 2]) ** 2)
-        if d <= 0.0 or vn <= 0.0:
-            continue
-        g = kcond * face_area3(e, f, conn, x, y, z) / d * dt_th
-        gmax = rcp * min(ve, vn) / 6.0
-        if g > gmax:
-            g = gmax
-        dq += g * (temp[nb] - temp[e])
-    tbuf[e, 3] = temp[e] + dq / (rcp * ve)
+            return alive[-nb - 2] != 1 or not face_tied3(e, f, conn, pairs)
+        return alive[nb] != 1
+
+    return face_free3_py
 
 
-def face_free3_py(e, f, conn, alive, enbr, pairs):
-    """True where face ``f`` of live element ``e`` is a free surface (no live neighbour
-    across it, or a parting face whose nodes have parted)."""
-    nb = enbr[e, f]
-    if nb == -1:
-        return True
-    if nb <= -2:
-        return alive[-nb - 2] != 1 or not face_tied3(e, f, conn, pairs)
-    return alive[nb] != 1
+def make_tool_heat_node3(hex_face_corner, face_free3, face_area3):
+    """:func:`tool_heat_node3_py` with its callees ``hex_face_corner``, ``face_free3``,
+    ``face_area3`` given (the CPU's compiled functions here, a GPU engine's device
+    functions in its port)"""
 
-
-def tool_heat_node3_py(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
-                       temp, theat, rcp, hc, eta, t_tool, dt_th):
-    """Heat [J] node ``n`` exchanges with the insert since the last pass, into
-    ``theat[n, 1]``, and the volume of its live elements into ``theat[n, 2]``; ``theat[n, 0]``
-    holds the frictional dissipation already turned into heat. See the module docstring."""
-    q = eta * (fric[n] - theat[n, 0])
-    theat[n, 0] = fric[n]
-    touching = hc > 0.0 and (cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0)
-    if q == 0.0 and not touching:
-        theat[n, 1] = 0.0  # nothing to hand on: the element pass skips this node
-        return
-    vsum = 0.0
-    tsum = 0.0
-    for k in range(ptr[n], ptr[n + 1]):
-        e = nel[k]
-        if alive[e] == 1:
-            v = vol0[e]
-            vsum += v
-            tsum += v * temp[e]
-    theat[n, 2] = vsum
-    if vsum <= 0.0:
-        theat[n, 1] = 0.0
-        return
-    if touching:
-        an = 0.0
+    def tool_heat_node3_py(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
+                           temp, theat, rcp, hc, eta, t_tool, dt_th):
+        """Heat [J] node ``n`` exchanges with the insert since the last pass, into
+        ``theat[n, 1]``, and the volume of its live elements into ``theat[n, 2]``; ``theat[n, 0]``
+        holds the frictional dissipation already turned into heat. See the module docstring."""
+        q = eta * (fric[n] - theat[n, 0])
+        theat[n, 0] = fric[n]
+        touching = hc > 0.0 and (cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0)
+        if q == 0.0 and not touching:
+            theat[n, 1] = 0.0  # nothing to hand on: the element pass skips this node
+            return
+        vsum = 0.0
+        tsum = 0.0
         for k in range(ptr[n], ptr[n + 1]):
             e = nel[k]
-            if alive[e] != 1:
-                continue
-            c = ncorner[k]
-            for f in range(6):
-                on = False
-                for j in range(4):
-                    if hex_face_corner(f, j) == c:
-                        on = True
-                if not on or not face_free3(e, f, conn, alive, enbr, pairs):
+            if alive[e] == 1:
+                v = vol0[e]
+                vsum += v
+                tsum += v * temp[e]
+        theat[n, 2] = vsum
+        if vsum <= 0.0:
+            theat[n, 1] = 0.0
+            return
+        if touching:
+            an = 0.0
+            for k in range(ptr[n], ptr[n + 1]):
+                e = nel[k]
+                if alive[e] != 1:
                     continue
-                touch = 0  # nodes of the face in contact (n among them)
-                for j in range(4):
-                    o = conn[e, hex_face_corner(f, j)]
-                    if cf[o, 0] != 0.0 or cf[o, 1] != 0.0 or cf[o, 2] != 0.0:
-                        touch += 1
-                if touch > 2:
-                    # the face touches the insert over (touch - 2) / 2 of its area (a
-                    # triangle of three nodes, the whole face with four; an edge is a line),
-                    # shared by its nodes in contact
-                    an += face_area3(e, f, conn, x, y, z) * (touch - 2) / (2.0 * touch)
-        g = hc * an * dt_th
-        gmax = 0.25 * rcp * vsum
-        if g > gmax:
-            g = gmax
-        q += g * (t_tool - tsum / vsum)
-    theat[n, 1] = q
+                c = ncorner[k]
+                for f in range(6):
+                    on = False
+                    for j in range(4):
+                        if hex_face_corner(f, j) == c:
+                            on = True
+                    if not on or not face_free3(e, f, conn, alive, enbr, pairs):
+                        continue
+                    touch = 0  # nodes of the face in contact (n among them)
+                    for j in range(4):
+                        o = conn[e, hex_face_corner(f, j)]
+                        if cf[o, 0] != 0.0 or cf[o, 1] != 0.0 or cf[o, 2] != 0.0:
+                            touch += 1
+                    if touch > 2:
+                        # the face touches the insert over (touch - 2) / 2 of its area (a
+                        # triangle of three nodes, the whole face with four; an edge is a line),
+                        # shared by its nodes in contact
+                        an += face_area3(e, f, conn, x, y, z) * (touch - 2) / (2.0 * touch)
+            g = hc * an * dt_th
+            gmax = 0.25 * rcp * vsum
+            if g > gmax:
+                g = gmax
+            q += g * (t_tool - tsum / vsum)
+        theat[n, 1] = q
+
+    return tool_heat_node3_py
 
 
 def tool_heat_elem3_py(e, conn, alive, temp, theat, rcp):
@@ -228,24 +259,35 @@ def tool_heat_elem3_py(e, conn, alive, temp, theat, rcp):
 
 
 hex_face_corner = njit(cache=True, inline="always")(hex_face_corner_py)
-face_area3 = njit(cache=True, inline="always")(face_area3_py)
-face_tied3 = njit(cache=True, inline="always")(face_tied3_py)
-face_free3 = njit(cache=True, inline="always")(face_free3_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+face_area3_py = make_face_area3(hex_face_corner)
+face_area3 = njit(cache=False, inline="always")(face_area3_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+face_tied3_py = make_face_tied3(hex_face_corner)
+face_tied3 = njit(cache=False, inline="always")(face_tied3_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+face_free3_py = make_face_free3(face_tied3)
+face_free3 = njit(cache=False, inline="always")(face_free3_py)
 hex_centroid3 = njit(cache=True, inline="always")(hex_centroid3_py)
-hex_conduct3 = njit(cache=True, inline="always")(hex_conduct3_py)
-tool_heat_node3 = njit(cache=True, inline="always")(tool_heat_node3_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+hex_conduct3_py = make_hex_conduct3(face_tied3, face_area3)
+hex_conduct3 = njit(cache=False, inline="always")(hex_conduct3_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+tool_heat_node3_py = make_tool_heat_node3(hex_face_corner, face_free3, face_area3)
+tool_heat_node3 = njit(cache=False, inline="always")(tool_heat_node3_py)
 tool_heat_elem3 = njit(cache=True, inline="always")(tool_heat_elem3_py)
 
-#: the device functions of this module, each with the names of the functions it calls (for
-#: :func:`robobore.material.johnson_cook.rebind` in the GPU engine), in dependency order
+#: the device functions of this module in dependency order, each as (name, source, callees):
+#: a function without callees is its plain-Python source, one with callees its factory, which
+#: the GPU engine calls with the device versions of the callees named (keyword arguments)
 DEVICE_FUNCTIONS = (
     ("hex_face_corner", hex_face_corner_py, ()),
-    ("face_area3", face_area3_py, ("hex_face_corner",)),
-    ("face_tied3", face_tied3_py, ("hex_face_corner",)),
-    ("face_free3", face_free3_py, ("face_tied3",)),
+    ("face_area3", make_face_area3, ("hex_face_corner",)),
+    ("face_tied3", make_face_tied3, ("hex_face_corner",)),
+    ("face_free3", make_face_free3, ("face_tied3",)),
     ("hex_centroid3", hex_centroid3_py, ()),
-    ("hex_conduct3", hex_conduct3_py, ("face_tied3", "face_area3")),
-    ("tool_heat_node3", tool_heat_node3_py, ("hex_face_corner", "face_free3", "face_area3")),
+    ("hex_conduct3", make_hex_conduct3, ("face_tied3", "face_area3")),
+    ("tool_heat_node3", make_tool_heat_node3, ("hex_face_corner", "face_free3", "face_area3")),
     ("tool_heat_elem3", tool_heat_elem3_py, ()),
 )
 

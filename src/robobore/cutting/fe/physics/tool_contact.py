@@ -12,8 +12,10 @@ Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` ver
 * :func:`contact_force_py` -- that normal force, Coulomb friction with a shear-stress cap;
 * :func:`tool_support_step_py` -- one central-difference step of a mass on a spring/damper.
 
-All take and return floats and allocate nothing (device-function ready; see
-:func:`robobore.material.johnson_cook.rebind`).
+All take and return floats and allocate nothing (device-function ready). A function that calls
+another is written inside a factory that receives its callees (:func:`make_tool_gap`,
+:func:`make_contact_force`): the CPU versions here are made from the compiled callees, a GPU
+engine's from device functions.
 """
 
 from __future__ import annotations
@@ -31,7 +33,6 @@ from robobore.material.johnson_cook import (  # noqa: F401  (re-exports)
     jc_flow_stress_py,
     radial_return,
     radial_return_py,
-    rebind,
 )
 
 #: faces of the analytic tool (:func:`tool_face_py`)
@@ -54,27 +55,33 @@ def tool_face_py(dx, dy, nrx, nry, nfx, nfy):
     return FACE_EDGE
 
 
-def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
-    """Signed gap of point (px, py) to the rigid tool and the tool's outward normal.
+def make_tool_gap(tool_face):
+    """:func:`tool_gap_py` with its callees ``tool_face`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
 
-    The tool is the set of points within ``r`` (edge radius) of the wedge with apex at the
-    edge centre (cx, cy) bounded by the rake face (outward unit normal (nrx, nry)) and the
-    flank face (outward unit normal (nfx, nfy)). The rake face runs from the edge up along
-    t_r = (nry, -nrx); the flank runs from the edge back along t_f = (-nfy, nfx). The closest
-    face is :func:`tool_face_py`'s.
+    def tool_gap_py(px, py, cx, cy, nrx, nry, nfx, nfy, r):
+        """Signed gap of point (px, py) to the rigid tool and the tool's outward normal.
 
-    Returns ``(gap, nx, ny)``: gap > 0 outside (distance to the surface), gap < 0 inside
-    (penetration depth); (nx, ny) the outward normal of the closest surface point [m].
-    """
-    dx = px - cx
-    dy = py - cy
-    face = tool_face(dx, dy, nrx, nry, nfx, nfy)
-    if face == FACE_RAKE:
-        return dx * nrx + dy * nry - r, nrx, nry
-    if face == FACE_FLANK:
-        return dx * nfx + dy * nfy - r, nfx, nfy
-    d = math.sqrt(dx * dx + dy * dy)
-    return d - r, dx / d, dy / d
+        The tool is the set of points within ``r`` (edge radius) of the wedge with apex at the
+        edge centre (cx, cy) bounded by the rake face (outward unit normal (nrx, nry)) and the
+        flank face (outward unit normal (nfx, nfy)). The rake face runs from the edge up along
+        t_r = (nry, -nrx); the flank runs from the edge back along t_f = (-nfy, nfx). The closest
+        face is :func:`tool_face_py`'s.
+
+        Returns ``(gap, nx, ny)``: gap > 0 outside (distance to the surface), gap < 0 inside
+        (penetration depth); (nx, ny) the outward normal of the closest surface point [m].
+        """
+        dx = px - cx
+        dy = py - cy
+        face = tool_face(dx, dy, nrx, nry, nfx, nfy)
+        if face == FACE_RAKE:
+            return dx * nrx + dy * nry - r, nrx, nry
+        if face == FACE_FLANK:
+            return dx * nfx + dy * nfy - r, nfx, nfy
+        d = math.sqrt(dx * dx + dy * dy)
+        return d - r, dx / d, dy / d
+
+    return tool_gap_py
 
 
 def normal_force_py(gap, vn, mass, pen_factor, dt, damping):
@@ -93,41 +100,47 @@ def normal_force_py(gap, vn, mass, pen_factor, dt, damping):
     return fp + fd, fd
 
 
-def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
-                     damping, fox, foy):
-    """Contact force on a node touching the rigid tool [N per m of width].
+def make_contact_force(normal_force):
+    """:func:`contact_force_py` with its callees ``normal_force`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
 
-    Normal: penalty ``Fn = pen_factor * mass / dt**2 * (-gap)`` (mass-proportional penalty,
-    stable for ``pen_factor`` << 1 and independent of mass scaling: penetration under a force
-    F is F dt^2 / (pen_factor m)), plus a viscous contact damping ``-c v_n`` on the relative
-    normal velocity with ``c = 2 damping sqrt(k m)`` (``damping``: fraction of the contact
-    spring's critical damping, as LS-DYNA's VDC; 0: none), the total kept >= 0 (no
-    adhesion). Tangential: a return mapping on the trial sliding velocity ``vt* = vt + dt
-    (fo . t) / mass`` -- the velocity the node would slide with after this step's other
-    forces ``(fox, foy)`` [N/m] (its element forces) -- the stick force that stops it,
-    ``mass |vt*| / dt``, limited by Coulomb ``mu * Fn`` and by the shear-stress cap
-    ``tau_max * trib_len`` (the node's tributary contact length), opposite to ``vt*``.
-    (Stopping only the start-of-step velocity instead would let the element forces
-    re-accelerate the node every step: a viscous interface ``mass v / dt ~ rho c v`` that
-    undercuts Coulomb wherever the contact pressure is high.) (vrx, vry) is the node's
-    velocity relative to the tool [m/s]; mass the node's (scaled) mass [kg/m].
+    def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
+                         damping, fox, foy):
+        """Contact force on a node touching the rigid tool [N per m of width].
 
-    Returns ``(fx, fy, fn, ft, fd)`` with fn >= 0 the normal force, ft the signed tangential
-    component along t = (-ny, nx) and fd the damping part of fn. Zero for gap >= 0.
-    """
-    if gap >= 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
-    fn, fd = normal_force(gap, vrx * nx + vry * ny, mass, pen_factor, dt, damping)
-    tx = -ny
-    ty = nx
-    vt = vrx * tx + vry * ty + dt * (fox * tx + foy * ty) / mass
-    fstick = mass * abs(vt) / dt
-    fcap = mu * fn
-    if tau_max * trib_len < fcap:
-        fcap = tau_max * trib_len
-    fmag = fstick if fstick < fcap else fcap
-    ft = -fmag if vt > 0.0 else fmag
-    return fn * nx + ft * tx, fn * ny + ft * ty, fn, ft, fd
+        Normal: penalty ``Fn = pen_factor * mass / dt**2 * (-gap)`` (mass-proportional penalty,
+        stable for ``pen_factor`` << 1 and independent of mass scaling: penetration under a force
+        F is F dt^2 / (pen_factor m)), plus a viscous contact damping ``-c v_n`` on the relative
+        normal velocity with ``c = 2 damping sqrt(k m)`` (``damping``: fraction of the contact
+        spring's critical damping, as LS-DYNA's VDC; 0: none), the total kept >= 0 (no
+        adhesion). Tangential: a return mapping on the trial sliding velocity ``vt* = vt + dt
+        (fo . t) / mass`` -- the velocity the node would slide with after this step's other
+        forces ``(fox, foy)`` [N/m] (its element forces) -- the stick force that stops it,
+        ``mass |vt*| / dt``, limited by Coulomb ``mu * Fn`` and by the shear-stress cap
+        ``tau_max * trib_len`` (the node's tributary contact length), opposite to ``vt*``.
+        (Stopping only the start-of-step velocity instead would let the element forces
+        re-accelerate the node every step: a viscous interface ``mass v / dt ~ rho c v`` that
+        undercuts Coulomb wherever the contact pressure is high.) (vrx, vry) is the node's
+        velocity relative to the tool [m/s]; mass the node's (scaled) mass [kg/m].
+
+        Returns ``(fx, fy, fn, ft, fd)`` with fn >= 0 the normal force, ft the signed tangential
+        component along t = (-ny, nx) and fd the damping part of fn. Zero for gap >= 0.
+        """
+        if gap >= 0.0:
+            return 0.0, 0.0, 0.0, 0.0, 0.0
+        fn, fd = normal_force(gap, vrx * nx + vry * ny, mass, pen_factor, dt, damping)
+        tx = -ny
+        ty = nx
+        vt = vrx * tx + vry * ty + dt * (fox * tx + foy * ty) / mass
+        fstick = mass * abs(vt) / dt
+        fcap = mu * fn
+        if tau_max * trib_len < fcap:
+            fcap = tau_max * trib_len
+        fmag = fstick if fstick < fcap else fcap
+        ft = -fmag if vt > 0.0 else fmag
+        return fn * nx + ft * tx, fn * ny + ft * ty, fn, ft, fd
+
+    return contact_force_py
 
 
 def tool_support_step_py(u, v, force, k, c, m, dt):
@@ -143,7 +156,11 @@ def tool_support_step_py(u, v, force, k, c, m, dt):
 
 
 tool_face = njit(cache=True, inline="always")(tool_face_py)
-tool_gap = njit(cache=True)(tool_gap_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+tool_gap_py = make_tool_gap(tool_face)
+tool_gap = njit(cache=False)(tool_gap_py)
 normal_force = njit(cache=True, inline="always")(normal_force_py)
-contact_force = njit(cache=True)(contact_force_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+contact_force_py = make_contact_force(normal_force)
+contact_force = njit(cache=False)(contact_force_py)
 tool_support_step = njit(cache=True)(tool_support_step_py)

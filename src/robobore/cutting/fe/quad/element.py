@@ -68,14 +68,20 @@ def quad_retire_py(e, fex, fey, dte):
     dte[e] = 1e30
 
 
-def quad_distorted_py(e, alive, fex, fey, dte, area0, A, cmin, dlim):
-    """True (and the element retired) when quad ``e`` is inverted (``alive`` = -2: an error
-    unless the distortion limit caught it) or below the distortion limit (-1)."""
-    if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
-        alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
-        quad_retire(e, fex, fey, dte)
-        return True
-    return False
+def make_quad_distorted(quad_retire):
+    """:func:`quad_distorted_py` with its callees ``quad_retire`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def quad_distorted_py(e, alive, fex, fey, dte, area0, A, cmin, dlim):
+        """True (and the element retired) when quad ``e`` is inverted (``alive`` = -2: an error
+        unless the distortion limit caught it) or below the distortion limit (-1)."""
+        if cmin <= 0.0 or A <= 0.0 or cmin < dlim * area0[e] or A < dlim * area0[e]:
+            alive[e] = -1 if (dlim > 0.0 and A > 0.0) else -2
+            quad_retire(e, fex, fey, dte)
+            return True
+        return False
+
+    return quad_distorted_py
 
 
 def quad_bvectors_py(x1, x2, x3, x4, y1, y2, y3, y4, A):
@@ -104,183 +110,206 @@ def quad_step_py(rho_s, a0, A, K, G, bsum, trd, bv1, bv2):
     return rho_c, c, qbv, le / (qrate + math.sqrt(qrate * qrate + c * c))
 
 
-def damage_erosion_py(e, conn, x, y, alive, layer, dmg, prm, erosion):
-    """Erode quad ``e`` of the separation layer once its Johnson-Cook damage reached 1
-    (``erosion`` = ERODE_LAYER; optionally only with a node within ``prm[P_GATE]`` of the
-    tool)."""
-    if dmg[e] >= 1.0 and erosion == ERODE_LAYER and layer[e]:
-        gate = prm[P_GATE]
-        if gate < 0.0:
-            alive[e] = 0
-        else:
-            gmin = 1e30
-            for k in range(4):
-                nk = conn[e, k]
-                g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
-                                       prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
-                if g < gmin:
-                    gmin = g
-            if gmin <= gate:
+def make_damage_erosion(tool_gap):
+    """:func:`damage_erosion_py` with its callees ``tool_gap`` given (the CPU's compiled
+    functions here, a GPU engine's device functions in its port)."""
+
+    def damage_erosion_py(e, conn, x, y, alive, layer, dmg, prm, erosion):
+        """Erode quad ``e`` of the separation layer once its Johnson-Cook damage reached 1
+        (``erosion`` = ERODE_LAYER; optionally only with a node within ``prm[P_GATE]`` of the
+        tool)."""
+        if dmg[e] >= 1.0 and erosion == ERODE_LAYER and layer[e]:
+            gate = prm[P_GATE]
+            if gate < 0.0:
                 alive[e] = 0
+            else:
+                gmin = 1e30
+                for k in range(4):
+                    nk = conn[e, k]
+                    g, _gx, _gy = tool_gap(x[nk], y[nk], prm[P_TCX], prm[P_TCY], prm[P_NRX],
+                                           prm[P_NRY], prm[P_NFX], prm[P_NFY], prm[P_R])
+                    if g < gmin:
+                        gmin = g
+                if gmin <= gate:
+                    alive[e] = 0
+
+    return damage_erosion_py
 
 
 quad_area_corners = njit(cache=True, inline="always")(quad_area_corners_py)
 quad_retire = njit(cache=True, inline="always")(quad_retire_py)
-quad_distorted = njit(cache=True, inline="always")(quad_distorted_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+quad_distorted_py = make_quad_distorted(quad_retire)
+quad_distorted = njit(cache=False, inline="always")(quad_distorted_py)
 quad_bvectors = njit(cache=True, inline="always")(quad_bvectors_py)
 quad_step = njit(cache=True, inline="always")(quad_step_py)
-damage_erosion = njit(cache=True, inline="always")(damage_erosion_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+damage_erosion_py = make_damage_erosion(tool_gap)
+damage_erosion = njit(cache=False, inline="always")(damage_erosion_py)
 
 
-def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
-                    temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
-                    erosion):
-    """Stress update and nodal forces of quad ``e`` (one element, scalar code).
+def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area_corners,
+                      quad_distorted, quad_bvectors, quad_step, damage_erosion):
+    """:func:`quad_element_py` with its callees ``radial_return``, ``jc_damage_increment``,
+    ``quad_retire``, ``quad_area_corners``, ``quad_distorted``, ``quad_bvectors``,
+    ``quad_step``, ``damage_erosion`` given (the CPU's compiled functions here, a GPU
+    engine's device functions in its port)"""
 
-    The whole per-element update of :func:`element_update`: kinematics at the new
-    configuration, Jaumann rotation, elastic trial, Johnson-Cook radial return, adiabatic
-    heating, damage, bulk viscosity, stable step, internal energy, Flanagan-Belytschko
-    hourglass forces, erosion (damage, optionally gated by the tool distance; distortion;
-    time step). Reads and writes array elements only and allocates nothing, so the same
-    source is compiled for the CPU (:data:`quad_element`) and for a GPU
-    (``numba.cuda.jit(device=True)`` after :func:`robobore.material.johnson_cook.rebind`,
-    in :mod:`robobore.cutting.fe.engine.gpu.backend2d`).
+    def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                        temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
+                        prm, dt, erosion):
+        """Stress update and nodal forces of quad ``e`` (one element, scalar code).
 
-    Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
-    was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
-    """
-    if alive[e] != 1:
-        quad_retire(e, fex, fey, dte)
-        return 1e30, False
-    E = mat[jc.E_MOD]
-    nu = mat[jc.NU]
-    G = E / (2.0 * (1.0 + nu))
-    K = E / (3.0 * (1.0 - 2.0 * nu))
-    rho_s = mat[jc.RHO] * prm[P_MS]
-    rcp = mat[jc.RHO] * mat[jc.CP]
-    beta = mat[jc.BETA_TQ]
-    a_, b_, n_, c_, m_ = mat[jc.A], mat[jc.B], mat[jc.N], mat[jc.C], mat[jc.M]
-    e0, tr_, tm_, eh_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT], mat[jc.EPS_HMAX]
-    hgv = prm[P_HGV]
-    hgs = prm[P_HGS]
-    bv1 = prm[P_BV1]
-    bv2 = prm[P_BV2]
-    dlim = prm[P_DIST]
-    dt_erode = prm[P_DT_ERODE]
-    i1 = conn[e, 0]
-    i2 = conn[e, 1]
-    i3 = conn[e, 2]
-    i4 = conn[e, 3]
-    x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
-    y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
-    A, cmin = quad_area_corners(x1, x2, x3, x4, y1, y2, y3, y4)
-    if quad_distorted(e, alive, fex, fey, dte, area0, A, cmin, dlim):
-        return 1e30, alive[e] == -2
-    bx1, bx2, bx3, bx4, by1, by2, by3, by4 = quad_bvectors(x1, x2, x3, x4, y1, y2, y3, y4, A)
-    u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
-    w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
-    dvxdx = u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
-    dvxdy = u1 * by1 + u2 * by2 + u3 * by3 + u4 * by4
-    dvydx = w1 * bx1 + w2 * bx2 + w3 * bx3 + w4 * bx4
-    dvydy = w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4
-    dxx = dvxdx
-    dyy = dvydy
-    dxy = 0.5 * (dvxdy + dvydx)
-    spin = 0.5 * (dvxdy - dvydx)
-    trd = dxx + dyy
-    # old total stress (for the midpoint stress power)
-    p_old = pres[e]
-    oxx = sdx[e] - p_old
-    oyy = sdy[e] - p_old
-    oxy = sdxy[e]
-    # Jaumann rotation of the deviatoric stress (zz unaffected in plane strain)
-    sx = sdx[e]
-    sy = sdy[e]
-    sxy = sdxy[e]
-    rs = dt * spin
-    sx_r = sx + 2.0 * rs * sxy
-    sy_r = sy - 2.0 * rs * sxy
-    sxy_r = sxy + rs * (sy - sx)
-    # elastic trial
-    tr3 = trd * dt / 3.0
-    tx = sx_r + 2.0 * G * (dxx * dt - tr3)
-    ty = sy_r + 2.0 * G * (dyy * dt - tr3)
-    tz = sdz[e] + 2.0 * G * (-tr3)
-    txy = sxy_r + 2.0 * G * dxy * dt
-    p_new = p_old - K * trd * dt
-    nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
-                                                   G, a_, b_, n_, c_, m_, e0, tr_, tm_, eh_)
-    if dep > 0.0:
-        eps_p[e] += dep
-        rate[e] = dep / dt
-        wp = syld * dep
-        plast[e] += wp * A
-        temp[e] += beta * wp / rcp
-        q = syld
-        if q > 0.0:
-            triax = -p_new / q
+        The whole per-element update of :func:`element_update`: kinematics at the new
+        configuration, Jaumann rotation, elastic trial, Johnson-Cook radial return, adiabatic
+        heating, damage, bulk viscosity, stable step, internal energy, Flanagan-Belytschko
+        hourglass forces, erosion (damage, optionally gated by the tool distance; distortion;
+        time step). Reads and writes array elements only and allocates nothing, so the same
+        source is compiled for the CPU (:data:`quad_element`) and for a GPU
+        (:func:`make_quad_element` given device versions of its callees, then
+        ``numba.cuda.jit(device=True)``, in :mod:`robobore.cutting.fe.engine.gpu.device2d`).
+
+        Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
+        was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
+        """
+        if alive[e] != 1:
+            quad_retire(e, fex, fey, dte)
+            return 1e30, False
+        E = mat[jc.E_MOD]
+        nu = mat[jc.NU]
+        G = E / (2.0 * (1.0 + nu))
+        K = E / (3.0 * (1.0 - 2.0 * nu))
+        rho_s = mat[jc.RHO] * prm[P_MS]
+        rcp = mat[jc.RHO] * mat[jc.CP]
+        beta = mat[jc.BETA_TQ]
+        a_, b_, n_, c_, m_ = mat[jc.A], mat[jc.B], mat[jc.N], mat[jc.C], mat[jc.M]
+        e0, tr_, tm_, eh_ = mat[jc.EPS0], mat[jc.TROOM], mat[jc.TMELT], mat[jc.EPS_HMAX]
+        hgv = prm[P_HGV]
+        hgs = prm[P_HGS]
+        bv1 = prm[P_BV1]
+        bv2 = prm[P_BV2]
+        dlim = prm[P_DIST]
+        dt_erode = prm[P_DT_ERODE]
+        i1 = conn[e, 0]
+        i2 = conn[e, 1]
+        i3 = conn[e, 2]
+        i4 = conn[e, 3]
+        x1, x2, x3, x4 = x[i1], x[i2], x[i3], x[i4]
+        y1, y2, y3, y4 = y[i1], y[i2], y[i3], y[i4]
+        A, cmin = quad_area_corners(x1, x2, x3, x4, y1, y2, y3, y4)
+        if quad_distorted(e, alive, fex, fey, dte, area0, A, cmin, dlim):
+            return 1e30, alive[e] == -2
+        bx1, bx2, bx3, bx4, by1, by2, by3, by4 = quad_bvectors(x1, x2, x3, x4, y1, y2, y3, y4, A)
+        u1, u2, u3, u4 = vx[i1], vx[i2], vx[i3], vx[i4]
+        w1, w2, w3, w4 = vy[i1], vy[i2], vy[i3], vy[i4]
+        dvxdx = u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
+        dvxdy = u1 * by1 + u2 * by2 + u3 * by3 + u4 * by4
+        dvydx = w1 * bx1 + w2 * bx2 + w3 * bx3 + w4 * bx4
+        dvydy = w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4
+        dxx = dvxdx
+        dyy = dvydy
+        dxy = 0.5 * (dvxdy + dvydx)
+        spin = 0.5 * (dvxdy - dvydx)
+        trd = dxx + dyy
+        # old total stress (for the midpoint stress power)
+        p_old = pres[e]
+        oxx = sdx[e] - p_old
+        oyy = sdy[e] - p_old
+        oxy = sdxy[e]
+        # Jaumann rotation of the deviatoric stress (zz unaffected in plane strain)
+        sx = sdx[e]
+        sy = sdy[e]
+        sxy = sdxy[e]
+        rs = dt * spin
+        sx_r = sx + 2.0 * rs * sxy
+        sy_r = sy - 2.0 * rs * sxy
+        sxy_r = sxy + rs * (sy - sx)
+        # elastic trial
+        tr3 = trd * dt / 3.0
+        tx = sx_r + 2.0 * G * (dxx * dt - tr3)
+        ty = sy_r + 2.0 * G * (dyy * dt - tr3)
+        tz = sdz[e] + 2.0 * G * (-tr3)
+        txy = sxy_r + 2.0 * G * dxy * dt
+        p_new = p_old - K * trd * dt
+        nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
+                                                       G, a_, b_, n_, c_, m_, e0, tr_, tm_, eh_)
+        if dep > 0.0:
+            eps_p[e] += dep
+            rate[e] = dep / dt
+            wp = syld * dep
+            plast[e] += wp * A
+            temp[e] += beta * wp / rcp
+            q = syld
+            if q > 0.0:
+                triax = -p_new / q
+            else:
+                triax = 0.0
+            dmg[e] += jc_damage_increment(dep, triax, dep / dt, temp[e], mat[jc.D1],
+                                          mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
+                                          e0, tr_, tm_)
         else:
-            triax = 0.0
-        dmg[e] += jc_damage_increment(dep, triax, dep / dt, temp[e], mat[jc.D1],
-                                      mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
-                                      e0, tr_, tm_)
-    else:
-        rate[e] = 0.0
-    sdx[e] = nsx
-    sdy[e] = nsy
-    sdz[e] = nsz
-    sdxy[e] = nsxy
-    pres[e] = p_new
-    # bulk viscosity (compression only) and stable step
-    bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
-            + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
-    rho_c, c, qbv, dte_e = quad_step(rho_s, area0[e], A, K, G, bsum, trd, bv1, bv2)
-    dte[e] = dte_e
-    if dte_e < dt_erode:
-        # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
-        # element whose stable step fell below the floor is deleted
-        alive[e] = -1
-    fxx = nsx - p_new - qbv
-    fyy = nsy - p_new - qbv
-    # stress power (midpoint) -> internal energy
-    ie[e] += A * dt * (0.5 * (oxx + fxx) * dxx + 0.5 * (oyy + fyy) * dyy
-                       + (oxy + nsxy) * dxy)
-    # hourglass (Flanagan-Belytschko): gamma vectors for h = (1, -1, 1, -1)
-    hx = x1 - x2 + x3 - x4
-    hy = y1 - y2 + y3 - y4
-    g1 = 0.25 * (1.0 - hx * bx1 - hy * by1)
-    g2 = 0.25 * (-1.0 - hx * bx2 - hy * by2)
-    g3 = 0.25 * (1.0 - hx * bx3 - hy * by3)
-    g4 = 0.25 * (-1.0 - hx * bx4 - hy * by4)
-    qx = g1 * u1 + g2 * u2 + g3 * u3 + g4 * u4
-    qy = g1 * w1 + g2 * w2 + g3 * w3 + g4 * w4
-    # stiffness part: stored, co-rotated, rate-form
-    hsx = qhx[e]
-    hsy = qhy[e]
-    hsx, hsy = hsx + rs * hsy, hsy - rs * hsx
-    kh = hgs * G * A * bsum
-    hsx += dt * kh * qx
-    hsy += dt * kh * qy
-    qhx[e] = hsx
-    qhy[e] = hsy
-    cv = 2.0 * hgv * rho_c * c * math.sqrt(A)
-    Qx = hsx + cv * qx
-    Qy = hsy + cv * qy
-    hge[e] += dt * (Qx * qx + Qy * qy)
-    fex[e, 0] = A * (fxx * bx1 + nsxy * by1) + Qx * g1
-    fex[e, 1] = A * (fxx * bx2 + nsxy * by2) + Qx * g2
-    fex[e, 2] = A * (fxx * bx3 + nsxy * by3) + Qx * g3
-    fex[e, 3] = A * (fxx * bx4 + nsxy * by4) + Qx * g4
-    fey[e, 0] = A * (nsxy * bx1 + fyy * by1) + Qy * g1
-    fey[e, 1] = A * (nsxy * bx2 + fyy * by2) + Qy * g2
-    fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
-    fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
-    # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
-    damage_erosion(e, conn, x, y, alive, layer, dmg, prm, erosion)
-    return dte_e, False
+            rate[e] = 0.0
+        sdx[e] = nsx
+        sdy[e] = nsy
+        sdz[e] = nsz
+        sdxy[e] = nsxy
+        pres[e] = p_new
+        # bulk viscosity (compression only) and stable step
+        bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
+                + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
+        rho_c, c, qbv, dte_e = quad_step(rho_s, area0[e], A, K, G, bsum, trd, bv1, bv2)
+        dte[e] = dte_e
+        if dte_e < dt_erode:
+            # time-step erosion (LS-DYNA *CONTROL_TIMESTEP ERODE-type): a crushed/sheared
+            # element whose stable step fell below the floor is deleted
+            alive[e] = -1
+        fxx = nsx - p_new - qbv
+        fyy = nsy - p_new - qbv
+        # stress power (midpoint) -> internal energy
+        ie[e] += A * dt * (0.5 * (oxx + fxx) * dxx + 0.5 * (oyy + fyy) * dyy
+                           + (oxy + nsxy) * dxy)
+        # hourglass (Flanagan-Belytschko): gamma vectors for h = (1, -1, 1, -1)
+        hx = x1 - x2 + x3 - x4
+        hy = y1 - y2 + y3 - y4
+        g1 = 0.25 * (1.0 - hx * bx1 - hy * by1)
+        g2 = 0.25 * (-1.0 - hx * bx2 - hy * by2)
+        g3 = 0.25 * (1.0 - hx * bx3 - hy * by3)
+        g4 = 0.25 * (-1.0 - hx * bx4 - hy * by4)
+        qx = g1 * u1 + g2 * u2 + g3 * u3 + g4 * u4
+        qy = g1 * w1 + g2 * w2 + g3 * w3 + g4 * w4
+        # stiffness part: stored, co-rotated, rate-form
+        hsx = qhx[e]
+        hsy = qhy[e]
+        hsx, hsy = hsx + rs * hsy, hsy - rs * hsx
+        kh = hgs * G * A * bsum
+        hsx += dt * kh * qx
+        hsy += dt * kh * qy
+        qhx[e] = hsx
+        qhy[e] = hsy
+        cv = 2.0 * hgv * rho_c * c * math.sqrt(A)
+        Qx = hsx + cv * qx
+        Qy = hsy + cv * qy
+        hge[e] += dt * (Qx * qx + Qy * qy)
+        fex[e, 0] = A * (fxx * bx1 + nsxy * by1) + Qx * g1
+        fex[e, 1] = A * (fxx * bx2 + nsxy * by2) + Qx * g2
+        fex[e, 2] = A * (fxx * bx3 + nsxy * by3) + Qx * g3
+        fex[e, 3] = A * (fxx * bx4 + nsxy * by4) + Qx * g4
+        fey[e, 0] = A * (nsxy * bx1 + fyy * by1) + Qy * g1
+        fey[e, 1] = A * (nsxy * bx2 + fyy * by2) + Qy * g2
+        fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
+        fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
+        # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
+        damage_erosion(e, conn, x, y, alive, layer, dmg, prm, erosion)
+        return dte_e, False
+
+    return quad_element_py
 
 
-quad_element = njit(cache=True, inline="always")(quad_element_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+quad_element_py = make_quad_element(radial_return, jc_damage_increment, quad_retire,
+                                    quad_area_corners, quad_distorted, quad_bvectors,
+                                    quad_step, damage_erosion)
+quad_element = njit(cache=False, inline="always")(quad_element_py)
 
 
 @njit(parallel=True, cache=True)

@@ -39,152 +39,176 @@ from robobore.cutting.fe.physics.tool_contact import (
 )
 
 
-def friction_at_py(prm, speed):
-    """Coulomb coefficient at the sliding speed ``speed`` [m/s] (>= 0).
-
-    ``prm[P_MUTAB_N]`` = 0: the constant ``prm[P_MU]``; otherwise the table in
-    ``prm[P_MUTAB_V:]`` / ``prm[P_MUTAB_MU:]``, linear between its points and constant beyond
-    its ends (as Abaqus' slip-rate-dependent friction tables).
+def make_friction_at(p_mu: int, p_mutab_n: int, p_mutab_v: int, p_mutab_mu: int, name: str):
+    """The friction lookup ``friction_at(prm, speed)`` of an engine whose parameter vector
+    holds the constant coefficient at ``p_mu`` and the table's size, velocities and
+    coefficients from ``p_mutab_n``, ``p_mutab_v``, ``p_mutab_mu`` (the 2D engine's slots
+    here, the 3D engine's in :mod:`robobore.cutting.fe.hex.scalar3d`), as a plain-Python
+    function named ``name``; the slots are closed over (numba compiles them as constants).
     """
-    n = int(prm[P_MUTAB_N])
-    if n == 0:
-        return prm[P_MU]
-    if speed <= prm[P_MUTAB_V]:
-        return prm[P_MUTAB_MU]
-    for i in range(1, n):
-        v1 = prm[P_MUTAB_V + i]
-        if speed <= v1:
-            v0 = prm[P_MUTAB_V + i - 1]
-            m0 = prm[P_MUTAB_MU + i - 1]
-            return m0 + (prm[P_MUTAB_MU + i] - m0) * (speed - v0) / (v1 - v0)
-    return prm[P_MUTAB_MU + n - 1]
+
+    def friction_at(prm, speed):
+        """Coulomb coefficient at the sliding speed ``speed`` [m/s] (>= 0).
+
+        ``prm[P_MUTAB_N]`` = 0: the constant ``prm[P_MU]``; otherwise the table in
+        ``prm[P_MUTAB_V:]`` / ``prm[P_MUTAB_MU:]``, linear between its points and constant
+        beyond its ends (as Abaqus' slip-rate-dependent friction tables).
+        """
+        n = int(prm[p_mutab_n])
+        if n == 0:
+            return prm[p_mu]
+        if speed <= prm[p_mutab_v]:
+            return prm[p_mutab_mu]
+        for i in range(1, n):
+            v1 = prm[p_mutab_v + i]
+            if speed <= v1:
+                v0 = prm[p_mutab_v + i - 1]
+                m0 = prm[p_mutab_mu + i - 1]
+                return m0 + (prm[p_mutab_mu + i] - m0) * (speed - v0) / (v1 - v0)
+        return prm[p_mutab_mu + n - 1]
+
+    friction_at.__name__ = friction_at.__qualname__ = name
+    return friction_at
 
 
+#: Coulomb coefficient at a sliding speed [m/s] on the 2D engine's slots
+#: (:func:`make_friction_at`): the constant ``prm[P_MU]`` when ``prm[P_MUTAB_N]`` = 0, else the
+#: table, linear between its points, constant beyond its ends
+friction_at_py = make_friction_at(P_MU, P_MUTAB_N, P_MUTAB_V, P_MUTAB_MU, "friction_at_py")
 friction_at = njit(cache=True, inline="always")(friction_at_py)
 
 
-def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
-                 cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx,
-                 tool_vy, prm, dt, twin, tied, vslip):
-    """Gather element forces on node ``n``, add tool contact, advance its velocity and position.
+def make_quad_node(tool_gap, contact_force, friction_at):
+    """:func:`quad_node_py` with its callees ``tool_gap``, ``contact_force``,
+    ``friction_at`` given (the CPU's compiled functions here, a GPU engine's device
+    functions in its port)"""
 
-    One node of :func:`node_update` (scalar code, allocates nothing: compiled for the CPU as
-    :data:`quad_node` and for a GPU in :mod:`robobore.cutting.fe.engine.gpu.backend2d`). Returns
-    ``(fx, fy, touched)``: this node's contact force on the workpiece [N/m] (``cfx[n]``,
-    ``cfy[n]``) and whether it touched the tool. Contact uses positions at step n and
-    velocities at n-1/2; ``cfx``/``cfy`` receive the contact force on the node [N/m]; ``fric``
-    (cumulative) the frictional dissipation and the contact damping's, ``pen`` the current
-    penalty energy, ``nwork``
-    (cumulative) the contact work on the node [J/m]. A node left without a live element is
-    retired (velocity zeroed, its kinetic energy booked in ``ero_ke``).
+    def quad_node_py(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
+                     cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx,
+                     tool_vy, prm, dt, twin, tied, vslip):
+        """Gather element forces on node ``n``, add tool contact, advance its velocity and position.
 
-    Node splitting: a node with ``twin[n] >= 0`` and ``tied[n]`` moves with its twin as one
-    node (forces and masses of both, summed in a fixed order so that both copies stay
-    bitwise identical; the contact force is shared half and half). The pair is released
-    (``tied`` = 0) when it comes within ``prm[P_GATE]`` of the tool surface: the material
-    separates where it meets the cutting edge.
+        One node of :func:`node_update` (scalar code, allocates nothing: compiled for the CPU as
+        :data:`quad_node` and for a GPU in :mod:`robobore.cutting.fe.engine.gpu.backend2d`). Returns
+        ``(fx, fy, touched)``: this node's contact force on the workpiece [N/m] (``cfx[n]``,
+        ``cfy[n]``) and whether it touched the tool. Contact uses positions at step n and
+        velocities at n-1/2; ``cfx``/``cfy`` receive the contact force on the node [N/m]; ``fric``
+        (cumulative) the frictional dissipation and the contact damping's, ``pen`` the current
+        penalty energy, ``nwork``
+        (cumulative) the contact work on the node [J/m]. A node left without a live element is
+        retired (velocity zeroed, its kinetic energy booked in ``ero_ke``).
 
-    Friction: the constant ``prm[P_MU]``, or with a table (``prm[P_MUTAB_N]`` > 0) the
-    table at the node's sliding speed relative to the tool, low-pass filtered with the time
-    constant ``prm[P_SLIP_TAU]`` and kept in ``vslip[n]`` [m/s] (:func:`friction_at_py`).
-    """
-    r = prm[P_R]
-    nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
-    tau, pf = prm[P_TAU], prm[P_PEN]
-    gate = prm[P_GATE]
-    cfx[n] = 0.0
-    cfy[n] = 0.0
-    pen[n] = 0.0
-    if ndead[n]:
-        return 0.0, 0.0, False
-    tw = twin[n]
-    pair = tw >= 0 and tied[n] != 0
-    # node ids as int64 (the prange index is unsigned: mixing would give floats); a
-    # tied pair is gathered in a fixed order so that both copies compute the same sums
-    na = np.int64(n)
-    nb = np.int64(-1)
-    share = 1.0
-    if pair:
-        nb = max(na, tw)
-        na = min(na, tw)
-        share = 0.5
-    fx = 0.0
-    fy = 0.0
-    nlive = 0
-    asum = 0.0
-    m = 0.0
-    for j in range(2):
-        nk = na if j == 0 else nb
-        if nk < 0:
-            continue
-        m += mass[nk]
-        for k in range(ptr[nk], ptr[nk + 1]):
-            e = nel[k]
-            if alive[e] == 1:
-                c = ncorner[k]
-                fx -= fex[e, c]
-                fy -= fey[e, c]
-                nlive += 1
-                asum += area0[e]
-    if nlive == 0:
-        ndead[n] = 1
-        ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
-        vx[n] = 0.0
-        vy[n] = 0.0
-        return 0.0, 0.0, False
-    if fixed[n]:
-        vx[n] = 0.0
-        vy[n] = 0.0
-        return 0.0, 0.0, False
-    gap, gnx, gny = tool_gap(x[n], y[n], tool_cx, tool_cy, nrx, nry, nfx, nfy, r)
-    if pair and gap <= gate:
-        tied[n] = 0
-    fcx = 0.0
-    fcy = 0.0
-    ft = 0.0
-    fd = 0.0
-    vt0 = 0.0
-    vn0 = 0.0
-    if gap < 0.0:
-        vrx = vx[n] - tool_vx
-        vry = vy[n] - tool_vy
-        trib = math.sqrt(asum / nlive)
-        vt0 = -vrx * gny + vry * gnx
-        mu = prm[P_MU]
-        if prm[P_MUTAB_N] > 0.0:
-            # the sliding speed, filtered over the time constant prm[P_SLIP_TAU]: a contact
-            # node's velocity chatters from step to step, its mean is the material's sliding
-            tau_s = prm[P_SLIP_TAU]
-            a = dt / tau_s if tau_s > dt else 1.0  # tau_s <= dt: no filter
-            vs = vslip[n] + a * (abs(vt0) - vslip[n])
-            vslip[n] = vs
-            mu = friction_at(prm, vs)
-        fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
-                                             dt, prm[P_CDAMP], fx, fy)
-        vn0 = vrx * gnx + vry * gny
-        pen[n] = share * 0.5 * (fn - fd) * (-gap)
-    cfx[n] = share * fcx
-    cfy[n] = share * fcy
-    touched = fcx != 0.0 or fcy != 0.0
-    ox = vx[n]
-    oy = vy[n]
-    nvx = ox + dt * (fx + fcx) / m
-    nvy = oy + dt * (fy + fcy) / m
-    vx[n] = nvx
-    vy[n] = nvy
-    x[n] += dt * nvx
-    y[n] += dt * nvy
-    if gap < 0.0:
-        nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
-        vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
-        fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
-        if fd != 0.0:  # contact damping: booked with the frictional dissipation
-            vn1 = (nvx - tool_vx) * gnx + (nvy - tool_vy) * gny
-            fric[n] -= share * dt * fd * 0.5 * (vn0 + vn1)
-    return share * fcx, share * fcy, touched
+        Node splitting: a node with ``twin[n] >= 0`` and ``tied[n]`` moves with its twin as one
+        node (forces and masses of both, summed in a fixed order so that both copies stay
+        bitwise identical; the contact force is shared half and half). The pair is released
+        (``tied`` = 0) when it comes within ``prm[P_GATE]`` of the tool surface: the material
+        separates where it meets the cutting edge.
+
+        Friction: the constant ``prm[P_MU]``, or with a table (``prm[P_MUTAB_N]`` > 0) the
+        table at the node's sliding speed relative to the tool, low-pass filtered with the time
+        constant ``prm[P_SLIP_TAU]`` and kept in ``vslip[n]`` [m/s] (:func:`friction_at_py`).
+        """
+        r = prm[P_R]
+        nrx, nry, nfx, nfy = prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]
+        tau, pf = prm[P_TAU], prm[P_PEN]
+        gate = prm[P_GATE]
+        cfx[n] = 0.0
+        cfy[n] = 0.0
+        pen[n] = 0.0
+        if ndead[n]:
+            return 0.0, 0.0, False
+        tw = twin[n]
+        pair = tw >= 0 and tied[n] != 0
+        # node ids as int64 (the prange index is unsigned: mixing would give floats); a
+        # tied pair is gathered in a fixed order so that both copies compute the same sums
+        na = np.int64(n)
+        nb = np.int64(-1)
+        share = 1.0
+        if pair:
+            nb = max(na, tw)
+            na = min(na, tw)
+            share = 0.5
+        fx = 0.0
+        fy = 0.0
+        nlive = 0
+        asum = 0.0
+        m = 0.0
+        for j in range(2):
+            nk = na if j == 0 else nb
+            if nk < 0:
+                continue
+            m += mass[nk]
+            for k in range(ptr[nk], ptr[nk + 1]):
+                e = nel[k]
+                if alive[e] == 1:
+                    c = ncorner[k]
+                    fx -= fex[e, c]
+                    fy -= fey[e, c]
+                    nlive += 1
+                    asum += area0[e]
+        if nlive == 0:
+            ndead[n] = 1
+            ero_ke[n] = 0.5 * mass[n] * (vx[n] * vx[n] + vy[n] * vy[n])
+            vx[n] = 0.0
+            vy[n] = 0.0
+            return 0.0, 0.0, False
+        if fixed[n]:
+            vx[n] = 0.0
+            vy[n] = 0.0
+            return 0.0, 0.0, False
+        gap, gnx, gny = tool_gap(x[n], y[n], tool_cx, tool_cy, nrx, nry, nfx, nfy, r)
+        if pair and gap <= gate:
+            tied[n] = 0
+        fcx = 0.0
+        fcy = 0.0
+        ft = 0.0
+        fd = 0.0
+        vt0 = 0.0
+        vn0 = 0.0
+        if gap < 0.0:
+            vrx = vx[n] - tool_vx
+            vry = vy[n] - tool_vy
+            trib = math.sqrt(asum / nlive)
+            vt0 = -vrx * gny + vry * gnx
+            mu = prm[P_MU]
+            if prm[P_MUTAB_N] > 0.0:
+                # the sliding speed, filtered over the time constant prm[P_SLIP_TAU]: a contact
+                # node's velocity chatters from step to step, its mean is the material's sliding
+                tau_s = prm[P_SLIP_TAU]
+                a = dt / tau_s if tau_s > dt else 1.0  # tau_s <= dt: no filter
+                vs = vslip[n] + a * (abs(vt0) - vslip[n])
+                vslip[n] = vs
+                mu = friction_at(prm, vs)
+            fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
+                                                 dt, prm[P_CDAMP], fx, fy)
+            vn0 = vrx * gnx + vry * gny
+            pen[n] = share * 0.5 * (fn - fd) * (-gap)
+        cfx[n] = share * fcx
+        cfy[n] = share * fcy
+        touched = fcx != 0.0 or fcy != 0.0
+        ox = vx[n]
+        oy = vy[n]
+        nvx = ox + dt * (fx + fcx) / m
+        nvy = oy + dt * (fy + fcy) / m
+        vx[n] = nvx
+        vy[n] = nvy
+        x[n] += dt * nvx
+        y[n] += dt * nvy
+        if gap < 0.0:
+            nwork[n] += share * dt * (fcx * 0.5 * (ox + nvx) + fcy * 0.5 * (oy + nvy))
+            vt1 = -(nvx - tool_vx) * gny + (nvy - tool_vy) * gnx
+            fric[n] -= share * dt * ft * 0.5 * (vt0 + vt1)
+            if fd != 0.0:  # contact damping: booked with the frictional dissipation
+                vn1 = (nvx - tool_vx) * gnx + (nvy - tool_vy) * gny
+                fric[n] -= share * dt * fd * 0.5 * (vn0 + vn1)
+        return share * fcx, share * fcy, touched
+
+    return quad_node_py
 
 
-quad_node = njit(cache=True, inline="always")(quad_node_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+quad_node_py = make_quad_node(tool_gap, contact_force, friction_at)
+quad_node = njit(cache=False, inline="always")(quad_node_py)
 
 
 @njit(parallel=True, cache=True)
@@ -237,19 +261,25 @@ def contact_total(cfx, cfy):
     return fx, fy
 
 
-def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o):
-    """Node ``i``'s contact force on the tool added to its face's pair in ``out[o:o + 6]``
-    = [Fx, Fy] of the rake face, the edge arc and the flank [N/m]. A node belongs to the
-    face that gives its gap (:func:`robobore.cutting.fe.physics.tool_contact.tool_face_py`). Called
-    in increasing node order by one thread on both devices (:func:`contact_split`, the GPU's
-    block 0), so the sums have the same bits."""
-    fx = cfx[i]
-    fy = cfy[i]
-    if fx == 0.0 and fy == 0.0:
-        return
-    k = tool_face(x[i] - cx, y[i] - cy, nrx, nry, nfx, nfy)
-    out[o + 2 * k] -= fx
-    out[o + 2 * k + 1] -= fy
+def make_contact_split_node(tool_face):
+    """:func:`contact_split_node_py` with its callees ``tool_face`` given (the CPU's
+    compiled functions here, a GPU engine's device functions in its port)."""
+
+    def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o):
+        """Node ``i``'s contact force on the tool added to its face's pair in ``out[o:o + 6]``
+        = [Fx, Fy] of the rake face, the edge arc and the flank [N/m]. A node belongs to the
+        face that gives its gap (:func:`robobore.cutting.fe.physics.tool_contact.tool_face_py`).
+        Called in increasing node order by one thread on both devices (:func:`contact_split`, the
+        GPU's block 0), so the sums have the same bits."""
+        fx = cfx[i]
+        fy = cfy[i]
+        if fx == 0.0 and fy == 0.0:
+            return
+        k = tool_face(x[i] - cx, y[i] - cy, nrx, nry, nfx, nfy)
+        out[o + 2 * k] -= fx
+        out[o + 2 * k + 1] -= fy
+
+    return contact_split_node_py
 
 
 def tool_geometry_py(prm):
@@ -259,7 +289,9 @@ def tool_geometry_py(prm):
             prm[P_R])
 
 
-contact_split_node = njit(cache=True, inline="always")(contact_split_node_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+contact_split_node_py = make_contact_split_node(tool_face)
+contact_split_node = njit(cache=False, inline="always")(contact_split_node_py)
 tool_geometry = njit(cache=True, inline="always")(tool_geometry_py)
 
 

@@ -39,37 +39,45 @@ def tool_kinematics_py(tool, prm):
             tool[T_VUY])
 
 
-def tool_step_py(tool, prm, fwx, fwy, dt):
-    """Advance the tool over one step under the contact force (fwx, fwy) on the workpiece.
+def make_tool_step(tool_support_step):
+    """:func:`tool_step_py` with its callees ``tool_support_step`` given (the CPU's
+    compiled functions here, a GPU engine's device functions in its port)."""
 
-    Stores the force on the tool, integrates the support springs (when ``prm[P_SUPPORT]``),
-    moves the guide point at -vc, records the new edge centre in ``prm[P_TCX]``/``[P_TCY]``
-    (for the erosion gate) and returns the work of the tool on the workpiece over the step
-    [J/m] (midpoint velocities).
-    """
-    vc = prm[P_VC]
-    width = prm[P_WIDTH]
-    tvx = -vc + tool[T_VUX]
-    tvy = tool[T_VUY]
-    # force on the tool = - force on the workpiece [N/m]
-    tool[T_FX] = -fwx
-    tool[T_FY] = -fwy
-    if prm[P_SUPPORT] > 0.5:
-        ux, vux = tool_support_step(tool[T_UX], tool[T_VUX], -fwx * width, prm[P_KX],
-                                    prm[P_CX], prm[P_MX], dt)
-        uy, vuy = tool_support_step(tool[T_UY], tool[T_VUY], -fwy * width, prm[P_KY],
-                                    prm[P_CY], prm[P_MY], dt)
-        tool[T_UX] = ux
-        tool[T_VUX] = vux
-        tool[T_UY] = uy
-        tool[T_VUY] = vuy
-    tool[T_GX] -= vc * dt
-    tvx_new = -vc + tool[T_VUX]
-    tvy_new = tool[T_VUY]
-    prm[P_TCX] = tool[T_GX] + tool[T_UX]
-    prm[P_TCY] = tool[T_GY] + tool[T_UY]
-    return dt * (fwx * 0.5 * (tvx + tvx_new) + fwy * 0.5 * (tvy + tvy_new))
+    def tool_step_py(tool, prm, fwx, fwy, dt):
+        """Advance the tool over one step under the contact force (fwx, fwy) on the workpiece.
+
+        Stores the force on the tool, integrates the support springs (when ``prm[P_SUPPORT]``),
+        moves the guide point at -vc, records the new edge centre in ``prm[P_TCX]``/``[P_TCY]``
+        (for the erosion gate) and returns the work of the tool on the workpiece over the step
+        [J/m] (midpoint velocities).
+        """
+        vc = prm[P_VC]
+        width = prm[P_WIDTH]
+        tvx = -vc + tool[T_VUX]
+        tvy = tool[T_VUY]
+        # force on the tool = - force on the workpiece [N/m]
+        tool[T_FX] = -fwx
+        tool[T_FY] = -fwy
+        if prm[P_SUPPORT] > 0.5:
+            ux, vux = tool_support_step(tool[T_UX], tool[T_VUX], -fwx * width, prm[P_KX],
+                                        prm[P_CX], prm[P_MX], dt)
+            uy, vuy = tool_support_step(tool[T_UY], tool[T_VUY], -fwy * width, prm[P_KY],
+                                        prm[P_CY], prm[P_MY], dt)
+            tool[T_UX] = ux
+            tool[T_VUX] = vux
+            tool[T_UY] = uy
+            tool[T_VUY] = vuy
+        tool[T_GX] -= vc * dt
+        tvx_new = -vc + tool[T_VUX]
+        tvy_new = tool[T_VUY]
+        prm[P_TCX] = tool[T_GX] + tool[T_UX]
+        prm[P_TCY] = tool[T_GY] + tool[T_UY]
+        return dt * (fwx * 0.5 * (tvx + tvx_new) + fwy * 0.5 * (tvy + tvy_new))
+
+    return tool_step_py
 
 
 tool_kinematics = njit(cache=True)(tool_kinematics_py)
-tool_step = njit(cache=True)(tool_step_py)
+# a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
+tool_step_py = make_tool_step(tool_support_step)
+tool_step = njit(cache=False)(tool_step_py)

@@ -1,18 +1,19 @@
 """GPU backend of the 2D explicit engine (numba-cuda), built from the SAME scalar physics.
 
 The per-element, per-node, tool and conduction updates are the plain-Python scalar functions
-of the CPU engine (:func:`kernels.quad_element_py`, :func:`kernels.quad_node_py`,
-:func:`kernels.tool_kinematics_py`, :func:`kernels.tool_step_py`,
-:func:`kernels.quad_centroid_py`, :func:`kernels.quad_conduct_py`,
-:func:`kernels.sum_energies_py`) and the shared material/contact/support functions
-(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), re-bound
-to device versions with :func:`robobore.material.johnson_cook.rebind` and compiled with
+of the CPU engine (:func:`quad.element.quad_element_py`, :func:`quad.node_contact.quad_node_py`,
+:func:`quad.tool_motion.tool_kinematics_py`, :func:`quad.tool_motion.tool_step_py`,
+:func:`physics.thermal2d.quad_centroid_py`, :func:`physics.thermal2d.quad_conduct_py`,
+:func:`engine.chunk_loop.sum_energies_py`) and the shared material/contact/support functions
+(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), made
+with device versions of their callees by their factories
+(:mod:`robobore.cutting.fe.engine.gpu.device2d`) and compiled with
 ``numba.cuda.jit(device=True)``; the CPU engine calls the ``njit`` versions of the same
 functions from its ``prange`` loops.
 
 One time step is five kernel launches: nodes (contact count by atomic add), the contact-
 force total (one block, summed in the CPU engine's fixed lane order,
-``kernels.contact_total``: the same bits on both devices), the tool (one thread: support
+``quad.node_contact.contact_total``: the same bits on both devices), the tool (one thread: support
 springs, external work), elements (stable step by atomic min, inverted element by atomic
 max) and the step end (one thread: time, status, time-averaged histories and, at each
 sample, the energy totals summed serially in the CPU engine's order). With
@@ -37,7 +38,7 @@ The tool-frame ALE model (``mesh.frame = "tool"``) runs here too: every
 ``tf_interior_py``, the donor-cell remap ``rz_flux_py``, ``rz_velocity_py``, ``rz_write_py``,
 ``rz_node_mass_py``), a grid barrier wherever one pass reads what another wrote (14 per
 pass); the launch-per-kernel path launches one kernel per pass. The contact force by tool
-face (``kernels.contact_split``) is added by one thread in increasing node order over the
+face (``quad.node_contact.contact_split``) is added by one thread in increasing node order over the
 chunks holding a contact node: the CPU's serial order, the same bits.
 
 Layout: the device functions are bound in :mod:`robobore.cutting.fe.engine.gpu.device2d`, the
@@ -58,9 +59,10 @@ from collections.abc import Callable
 from typing import Any
 
 from robobore.cutting.fe.ale import rezone as RZ
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, RunState, kernels2
 from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
+from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
 
 __all__ = ["advance_gpu", "check_gpu_supported", "N_RED"]
@@ -108,17 +110,17 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     check_gpu_supported("q4r" if phases.element == "q4r" else "q4_bbar")
     # the tool-frame ALE pass every rz_every steps (the tool frame only), conduction every
     # cond_every steps (conduction only): the kernels of the state's phases
-    rz_every = int(st.prm[K.P_RZ_EVERY]) if phases.tool_frame else 0
-    cond_every = int(st.prm[K.P_COND_EVERY]) if phases.conduction else 0
+    rz_every = int(st.prm[layout.P_RZ_EVERY]) if phases.tool_frame else 0
+    cond_every = int(st.prm[layout.P_COND_EVERY]) if phases.conduction else 0
     require_gpu()
     (k_nodes, k_contact_sum, k_tool, k_elems, k_centroids, k_conduct, k_conduct_end,
      k_parting, k_theat_nodes, k_theat_elems, k_conduct_reset, k_finish, k_run,
      ale) = _kernels(phases)
     gn, ge = blocks(st.x.shape[0]), blocks(st.conn.shape[0])
-    erosion = int(st.prm[K.P_EROSION])
+    erosion = int(st.prm[layout.P_EROSION])
     npair = int(st.ppair.shape[0])
     gp, gs = blocks(npair), blocks(int(st.snodes.shape[0]))
-    theat = st.prm[K.P_HC] > 0.0 or st.prm[K.P_FHEAT] > 0.0
+    theat = st.prm[layout.P_HC] > 0.0 or st.prm[layout.P_FHEAT] > 0.0
 
     def launch_step(g, dred, step, tick):
         # one step as one launch per phase (the persistent kernel's phases); conduction
@@ -130,7 +132,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                               g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
                               g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"], dred)
         tick("nodes")
-        k_contact_sum[1, K.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
+        k_contact_sum[1, node_contact.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
                                         g["prm"], dred)
         tick("contact_sum")
         k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
@@ -168,7 +170,7 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                        g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"], g["nwork"])
         tick("finish")
 
-    return drive_gpu(st, t_end, names=_ARRAYS, p_tend=K.P_TEND, n_red=N_RED, k_run=k_run,
+    return drive_gpu(st, t_end, names=_ARRAYS, p_tend=layout.P_TEND, n_red=N_RED, k_run=k_run,
                      run_state=RunState, run_extra=[erosion, cond_every, int(theat), rz_every],
                      launch_step=launch_step, copy_back=_copy_back, label="simulation (GPU)",
                      chunk_steps=chunk_steps, progress=progress, check=check, profile=profile,

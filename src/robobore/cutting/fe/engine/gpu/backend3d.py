@@ -1,17 +1,17 @@
 """GPU backend of the 3D explicit engine (numba-cuda), built from the SAME scalar physics.
 
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
-(:func:`hex.element.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
-and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
-:mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
-:func:`robobore.material.johnson_cook.rebind` and compiled with
-``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-
-force total (one block, in the CPU's fixed lane order, so a run is reproducible bit for
-bit), the tool (one thread), elements (stable step by atomic min), and the step end (one
-thread: time, status, time-averaged histories); every ``solver.conduction_interval`` steps
-the heat conduction of :mod:`robobore.cutting.fe.physics.thermal3d` adds five more (centroids, new
-temperatures, their copy, the insert's heat per node, then per element). The loop stays on
-the device; the host only checks the status between chunks.
+(:func:`hex.element.hex_element_py`, :func:`hex.scalar3d.hex_node_py`,
+:func:`hex.scalar3d.tool_step_py`) and the shared material/contact/support functions
+(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), made
+with device versions of their callees by their factories and compiled with
+``numba.cuda.jit(device=True)``. One time step is five kernel launches: nodes, the contact-force
+total (one block, in the CPU's fixed lane order, so a run is reproducible bit for bit), the tool
+(one thread), elements (stable step by atomic min), and the step end (one thread: time, status,
+time-averaged histories); every ``solver.conduction_interval`` steps the heat conduction of
+:mod:`robobore.cutting.fe.physics.thermal3d` adds five more (centroids, new temperatures, their
+copy, the insert's heat per node, then per element). The loop stays on the device; the host only
+checks the status between chunks.
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``, i.e.
 ``numba-cuda``). Importing this module never needs either; :func:`require_gpu` raises a
@@ -85,8 +85,9 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     ``profile`` is asked for; the same bits as the five launches a step, without their
     host-side launch cost).
     """
-    from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine.state3d import heat_pass
+    from robobore.cutting.fe.hex import layout3d, scalar3d
+    from robobore.cutting.fe.quad import node_contact
 
     require_gpu()
     # the kernels of the state's thermal model: the heat phase for a heat-pass interval
@@ -94,8 +95,8 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     k_nodes, k_contact_sum, k_tool, k_elems, k_finish, k_thermal, k_run = _kernels(conduction)
     k_centroids, k_conduct, k_copy_temp, k_heat_nodes, k_heat_elems, k_cond_done = k_thermal
     gn, ge = blocks(st.x.shape[0]), blocks(st.conn.shape[0])
-    erosion = int(st.prm[K3.P_EROSION])
-    heat = st.prm[K3.P_HC] > 0.0 or st.prm[K3.P_FHEAT] > 0.0
+    erosion = int(st.prm[layout3d.P_EROSION])
+    heat = st.prm[layout3d.P_HC] > 0.0 or st.prm[layout3d.P_FHEAT] > 0.0
 
     def launch_step(g, dred, step, tick):
         # one step as one launch per phase (the persistent kernel's phases)
@@ -106,7 +107,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                               g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
                               g["ist"], dred, g["pairs"])
         tick("nodes")
-        k_contact_sum[1, K3.N_SUM_LANES](g["cf"], dred)
+        k_contact_sum[1, node_contact.N_SUM_LANES](g["cf"], dred)
         tick("contact_sum")
         k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
         tick("tool")
@@ -116,7 +117,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                               g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                               g["clock"], erosion, g["ist"], dred)
         tick("elements")
-        if conduction and K3.is_conduction_step_py(step, st.prm):
+        if conduction and scalar3d.is_conduction_step_py(step, st.prm):
             k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
             k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
                                     g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],
@@ -136,7 +137,7 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                        g["en"], dred)
         tick("finish")
 
-    return drive_gpu(st, t_end, names=_RUN_ARGS, p_tend=K3.P_TEND, n_red=N_RED, k_run=k_run,
+    return drive_gpu(st, t_end, names=_RUN_ARGS, p_tend=layout3d.P_TEND, n_red=N_RED, k_run=k_run,
                      run_state=RunState3, run_extra=[erosion], launch_step=launch_step,
                      copy_back=_copy_back, label="3D simulation (GPU)", chunk_steps=chunk_steps,
                      progress=progress, check=check, profile=profile, persistent=persistent)
@@ -149,10 +150,11 @@ _RUN_ARGS = RUN_ARRAYS
 
 def _copy_back(st, g) -> None:
     from robobore.cutting.fe.engine import kernels3d as K3
+    from robobore.cutting.fe.engine import layout
 
     for name in _MUTABLE:
         getattr(st, name)[...] = g[name].copy_to_host()
-    ext = float(st.en[K3.E_EXT])
+    ext = float(st.en[layout.E_EXT])
     K3.sum_energies3(st.mass, st.vx, st.vy, st.vz, st.ie, st.plast, st.hge, st.alive, st.fric,
                      st.pen, st.ero_ke, st.nwork, st.en)
-    st.en[K3.E_EXT] = ext
+    st.en[layout.E_EXT] = ext

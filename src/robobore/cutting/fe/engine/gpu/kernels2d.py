@@ -17,7 +17,7 @@ from __future__ import annotations
 import functools
 from collections import namedtuple
 
-from robobore.cutting.fe.engine import kernels as K
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
 from robobore.cutting.fe.engine.gpu.persistent import (
@@ -26,6 +26,7 @@ from robobore.cutting.fe.engine.gpu.persistent import (
     persistent_kernel,
 )
 from robobore.cutting.fe.engine.gpu.shared import bind_cuda
+from robobore.cutting.fe.quad import node_contact
 
 __all__ = ["kernels2", "RUN_ARRAYS", "RunState", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC",
            "R_SPLIT", "N_RED"]
@@ -77,16 +78,17 @@ def kernels2(phases: Phases):
         f.csplit, f.tool_geometry, f.tplace, f.tfacep, f.tsweep, f.tscopy, f.tinter, f.rflux,
         f.rvel, f.rwrite, f.rmass, f.SWEEPS, f.elem, f.node, f.kin, f.tstep, f.cent, f.cond,
         f.pedge, f.thnode, f.thelem, f.end_step, f.lsum)
-    LANES = K.N_SUM_LANES
+    LANES = node_contact.N_SUM_LANES
     float64 = _float64
     CONDUCTION = phases.conduction
 
-    I_STATUS, ST_OK = K.I_STATUS, K.STATUS_OK
-    P_COND_ACC = K.P_COND_ACC
-    P_HC, P_FHEAT, P_TTOOL = K.P_HC, K.P_FHEAT, K.P_TTOOL
-    P_TCX, P_NRX, P_NRY, P_NFX, P_NFY = K.P_TCX, K.P_NRX, K.P_NRY, K.P_NFX, K.P_NFY
-    P_ALE_X0, P_RZ_MAXMOVE, P_MS = K.P_ALE_X0, K.P_RZ_MAXMOVE, K.P_MS
-    E_EXT = K.E_EXT
+    I_STATUS, ST_OK = layout.I_STATUS, layout.STATUS_OK
+    P_COND_ACC = layout.P_COND_ACC
+    P_HC, P_FHEAT, P_TTOOL = layout.P_HC, layout.P_FHEAT, layout.P_TTOOL
+    P_TCX, P_NRX, P_NRY = layout.P_TCX, layout.P_NRX, layout.P_NRY
+    P_NFX, P_NFY = layout.P_NFX, layout.P_NFY
+    P_ALE_X0, P_RZ_MAXMOVE, P_MS = layout.P_ALE_X0, layout.P_RZ_MAXMOVE, layout.P_MS
+    E_EXT = layout.E_EXT
     KCOND, RHO, CP, TROOM = jc.KCOND, jc.RHO, jc.CP, jc.TROOM
 
     @cuda.jit(device=True)
@@ -313,7 +315,7 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red, es):
-        # the step end (one thread): history.end_step_py on the step's reductions
+        # the step end (one thread): history.make_end_step's end_step on the step's reductions
         nc = red[R_NC]
         red[R_NC] = 0.0  # the force total is rewritten by k_contact_sum every step
         end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], 0.0, nc,

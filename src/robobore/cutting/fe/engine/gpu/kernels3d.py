@@ -2,10 +2,11 @@
 engine.
 
 The per-element and per-node updates are the plain-Python scalar functions of the CPU engine
-(:func:`hex.element.hex_element_py`, :func:`kernels3d.hex_node_py`, :func:`kernels3d.tool_step_py`)
-and the shared material/contact/support functions (:mod:`robobore.material.johnson_cook`,
-:mod:`robobore.cutting.fe.physics.tool_contact`), re-bound to device versions with
-:func:`robobore.material.johnson_cook.rebind` and compiled with
+(:func:`hex.element.hex_element_py`, :func:`hex.scalar3d.hex_node_py`,
+:func:`hex.scalar3d.tool_step_py`) and the shared material/contact/support functions
+(:mod:`robobore.material.johnson_cook`, :mod:`robobore.cutting.fe.physics.tool_contact`), made
+with device versions of their callees by their factories (``make_hex_element``,
+``make_hex_node``, ...) and compiled with
 ``numba.cuda.jit(device=True)``. :func:`kernels3` returns the launch-per-kernel phases
 (nodes, contact-force total, tool, elements, step end, the heat-conduction kernels) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
@@ -66,46 +67,49 @@ def kernels3(conduction: bool):
     from numba import float64 as _float64
 
     from robobore.cutting.fe.engine import kernels3d as K3
-    from robobore.cutting.fe.hex.element import hex_element_py
+    from robobore.cutting.fe.engine import layout
+    from robobore.cutting.fe.hex import layout3d, scalar3d
+    from robobore.cutting.fe.hex.element import make_hex_element
     from robobore.cutting.fe.physics import thermal3d as T3
     from robobore.cutting.fe.physics.tool_contact import (
+        make_tool_gap,
         normal_force_py,
         tool_face_py,
-        tool_gap_py,
         tool_support_step_py,
     )
+    from robobore.cutting.fe.quad import node_contact
     from robobore.material import johnson_cook as jc
 
     dev = cuda.jit(device=True)
     dmg, ret = jc_device_functions(dev)
-    elem = dev(jc.rebind(hex_element_py, jc_return=ret, jc_damage_increment=dmg))
-    tg = dev(jc.rebind(tool_gap_py, tool_face=dev(tool_face_py)))
-    sec = dev(K3.edge_section_py)
-    gap3 = dev(jc.rebind(K3.insert_gap3_py, tool_gap=tg, edge_section=sec))
-    cf3 = dev(jc.rebind(K3.contact_force3_py, normal_force=dev(normal_force_py)))
-    fat3 = dev(K3.friction_at3_py)
-    node = dev(jc.rebind(K3.hex_node_py, insert_gap3=gap3, contact_force3=cf3,
-                         friction_at3=fat3))
+    elem = dev(make_hex_element(jc_return=ret, jc_damage_increment=dmg))
+    tg = dev(make_tool_gap(tool_face=dev(tool_face_py)))
+    sec = dev(scalar3d.edge_section_py)
+    gap3 = dev(scalar3d.make_insert_gap3(tool_gap=tg, edge_section=sec))
+    cf3 = dev(scalar3d.make_contact_force3(normal_force=dev(normal_force_py)))
+    fat3 = dev(scalar3d.friction_at3_py)
+    node = dev(scalar3d.make_hex_node(insert_gap3=gap3, contact_force3=cf3, friction_at3=fat3))
     sup = dev(tool_support_step_py)
-    kin = dev(K3.tool_kinematics_py)
-    tstep = dev(jc.rebind(K3.tool_step_py, tool_kinematics=kin, tool_support_step=sup))
-    lsum3 = dev(K3.lane_sum3_py)
+    kin = dev(scalar3d.tool_kinematics_py)
+    tstep = dev(scalar3d.make_tool_step(tool_kinematics=kin, tool_support_step=sup))
+    lsum3 = dev(scalar3d.lane_sum3_py)
     th = {}
-    for name, func, deps in T3.DEVICE_FUNCTIONS:
-        th[name] = dev(jc.rebind(func, **{d: th[d] for d in deps}))
+    for name, source, deps in T3.DEVICE_FUNCTIONS:
+        th[name] = dev(source(**{d: th[d] for d in deps}) if deps else source)
     centroid3, conduct3 = th["hex_centroid3"], th["hex_conduct3"]
     heat_node3, heat_elem3 = th["tool_heat_node3"], th["tool_heat_elem3"]
-    is_cond = dev(K3.is_conduction_step_py)
-    from robobore.cutting.fe.engine.history import bind_end_step
+    is_cond = dev(scalar3d.is_conduction_step_py)
+    from robobore.cutting.fe.engine.history import make_end_step
     RHO, CP, KCOND = jc.RHO, jc.CP, jc.KCOND
-    P_COND_T, P_HC, P_FHEAT, P_TTOOL = K3.P_COND_T, K3.P_HC, K3.P_FHEAT, K3.P_TTOOL
-    LANES = K3.N_SUM_LANES
+    P_COND_T, P_HC = layout3d.P_COND_T, layout3d.P_HC
+    P_FHEAT, P_TTOOL = layout3d.P_FHEAT, layout3d.P_TTOOL
+    LANES = node_contact.N_SUM_LANES
     float64 = _float64
 
-    I_STATUS, ST_OK, E_EXT = K3.I_STATUS, K3.STATUS_OK, K3.E_EXT
+    I_STATUS, ST_OK, E_EXT = layout.I_STATUS, layout.STATUS_OK, layout.E_EXT
     # the end of a step (robobore.cutting.fe.engine.history) bound to the 3D engine, without the
     # per-sample energy totals
-    end_step = bind_end_step(dev, K3.ENGINE3, dev(K3.tool_columns3_py), dev(no_energy_totals_py))
+    end_step = make_end_step(dev, K3.ENGINE3, dev(K3.tool_columns3_py), dev(no_energy_totals_py))
 
     @cuda.jit(device=True)
     def lanes_total(px, py, pz, pn, red):
@@ -223,7 +227,7 @@ def kernels3(conduction: bool):
 
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red):
-        # the step end (one thread): history.end_step_py on the step's reductions (no
+        # the step end (one thread): history.make_end_step's end_step on the step's reductions (no
         # per-sample energy totals: the host sums them from the copied-back state)
         end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], red[R_FZ],
                  red[R_NC], red, ist, clock, prm, tool, en, hacc, hist, ())

@@ -7,7 +7,7 @@ then its scalar settings (``RunState`` of :mod:`robobore.cutting.fe.engine.gpu.k
 ``RunState3`` of :mod:`robobore.cutting.fe.engine.gpu.kernels3d`; both name ``x``, ``conn``,
 ``ist``, ``clock``, ``tool`` and ``prm``), ``red`` the reduction slots
 (:data:`R_DTMIN`, :data:`R_BAD`, then the contact-force sums from :data:`R_SUMS`), ``cflag``
-and ``clist`` one flag and one slot per chunk of :data:`~robobore.cutting.fe.engine.kernels.
+and ``clist`` one flag and one slot per chunk of :data:`~robobore.cutting.fe.quad.node_contact.
 N_SUM_LANES` nodes. One step:
 
 1. the loop returns unless the status ``ist[I_STATUS]`` is OK; the step number
@@ -65,7 +65,8 @@ def persistent_kernel(*, n_sums: int, kinematics, node, lane_sums, tool, elem, h
     cuda = bind_cuda()
     from numba import float64, int64
 
-    from robobore.cutting.fe.engine.kernels import I_STATUS, I_STEP, N_SUM_LANES, STATUS_OK
+    from robobore.cutting.fe.engine.layout import I_STATUS, I_STEP, STATUS_OK
+    from robobore.cutting.fe.quad.node_contact import N_SUM_LANES
 
     dev = cuda.jit(device=True)
     chunks = dev(chunk_list_py)

@@ -68,9 +68,9 @@ def jc_device_functions(dev):
 
     th = dev(jc.homologous_temperature_py)
     athermal = dev(jc.jc_athermal_py)
-    fail = dev(jc.rebind(jc.jc_failure_strain_py, homologous_temperature=th))
-    dmg = dev(jc.rebind(jc.jc_damage_increment_py, jc_failure_strain=fail))
-    ret = dev(jc.rebind(jc.jc_return_py, jc_athermal=athermal, homologous_temperature=th))
+    fail = dev(jc.make_jc_failure_strain(homologous_temperature=th))
+    dmg = dev(jc.make_jc_damage_increment(jc_failure_strain=fail))
+    ret = dev(jc.make_jc_return(jc_athermal=athermal, homologous_temperature=th))
     return dmg, ret
 
 
@@ -125,7 +125,7 @@ def persistent_run(kernel, state: tuple, red, n_nodes: int, profile,
     flags and the chunk list (allocated here for ``n_nodes`` nodes); ``None`` where the caller
     launches one kernel per phase (``persistent`` False, or None with a ``profile``, or a
     cooperative launch that cannot be set up -- then with a warning)."""
-    from robobore.cutting.fe.engine.kernels import N_SUM_LANES
+    from robobore.cutting.fe.quad.node_contact import N_SUM_LANES
 
     auto = persistent is None
     if not (profile is None if auto else persistent):
@@ -220,20 +220,20 @@ def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: i
     ``copy_back(st, g)``, when ``check`` is given, at the end and on a stop); an instability
     status raises :func:`robobore.cutting.fe.status.instability_error` labelled ``label``.
     """
-    from robobore.cutting.fe.engine import kernels as K
+    from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 
     require_gpu()
     _cuda = bind_cuda()
     st.prm[p_tend] = t_end
-    st.ist[K.I_STATUS] = K.STATUS_OK
+    st.ist[layout.I_STATUS] = layout.STATUS_OK
     g = {name: _cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in names}
     red = np.zeros(n_red)
     red[0] = 1e30  # no stable step yet (R_DTMIN)
     red[1] = -1.0  # no inverted element (R_BAD)
     dred = _cuda.to_device(red)
     t_start = st.time
-    step0 = int(st.ist[K.I_STEP])
+    step0 = int(st.ist[layout.I_STEP])
     tick = profile_ticker(profile)
     run = persistent_run(k_run, run_state(*[g[name] for name in names], *run_extra), dred,
                          st.x.shape[0], profile, persistent)
@@ -243,13 +243,13 @@ def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: i
         else:
             # while the status is OK every launch sequence is exactly one step, so the host
             # knows the step number; once the status changes the launches return at once
-            step = int(st.ist[K.I_STEP])
+            step = int(st.ist[layout.I_STEP])
             for i in range(chunk_steps):
                 launch_step(g, dred, step + i, tick)
         for name in ("ist", "clock"):
             getattr(st, name)[...] = g[name].copy_to_host()
-        status = int(st.ist[K.I_STATUS])
-        if status in STATUS_TEXT or status == K.STATUS_DONE or check is not None:
+        status = int(st.ist[layout.I_STATUS])
+        if status in STATUS_TEXT or status == layout.STATUS_DONE or check is not None:
             copy_back(st, g)
         if status in STATUS_TEXT:
             raise instability_error(st, label, "a smaller solver.cfl, a larger "
@@ -258,6 +258,6 @@ def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: i
             progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
         if check is not None:
             check(st)
-        if status == K.STATUS_DONE or st.time >= t_end:
+        if status == layout.STATUS_DONE or st.time >= t_end:
             copy_back(st, g)
-            return int(st.ist[K.I_STEP]) - step0
+            return int(st.ist[layout.I_STEP]) - step0
