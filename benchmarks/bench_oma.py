@@ -21,7 +21,7 @@ import numpy as np
 
 from robobore.modal.oma import identify_operational, simulate_operational
 from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, robot_boring_truth
-from robobore.modal.virtual_robot import robot_truth
+from robobore.plan.virtual_hammer import robot_truth
 from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD as K
 
 

@@ -1,6 +1,6 @@
 """Operational (output-only) modal analysis, SSI-COV, on SYNTHETIC records (documented truth:
 ``robobore.modal.oma.simulate_operational`` of the modal truths of ``robobore.modal.virtual``
-and ``robobore.modal.virtual_robot``).
+and ``robobore.plan.virtual_hammer``).
 
 Acceptance: frequencies within 1 %, damping within 15 % of the truth under random and cutting
 excitation of the multibody robot model (IRB 6600 at the paper's posture, 300 s at 2048 Hz,
@@ -31,7 +31,7 @@ from robobore.modal.oma import (
     simulate_operational,
 )
 from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, robot_boring_truth, simulate_hammer_test
-from robobore.modal.virtual_robot import robot_truth
+from robobore.plan.virtual_hammer import robot_truth
 from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD as K_IRB
 
 runner = CliRunner()

@@ -211,7 +211,7 @@ def modes_cmd(
         res["identity"] = ident
         if hits is not None:
             res["hits"] = hits.to_dict()
-        from robobore.modal.virtual_robot import parse_header
+        from robobore.plan.virtual_hammer import parse_header
 
         meta = getattr(load_meta, "meta", None) or {}
         res.update(parse_header(meta.get("header")))
@@ -404,7 +404,7 @@ def virtual_test_cmd(
         truth, robot_info = _robot_truth(robot, robot_file, joints_deg, joint_stiffness_file,
                                          joint_stiffness, tcp_m or "0,0,0", damping_ratio,
                                          example)
-        from robobore.modal.virtual_robot import header_text, sample_rate_for
+        from robobore.plan.virtual_hammer import header_text, sample_rate_for
 
         rb_ = get_robot_for_identity(robot, robot_file)
         ident = _virtual_identity(rb_, robot_info["joints_deg"],
@@ -456,7 +456,7 @@ def virtual_test_cmd(
     info = {"file": str(out), "truth_file": str(truth_path), "synthetic": True,
             "settings": settings, "truth": truth.to_dict(), "identity": ident}
     if robot_info is not None:
-        from robobore.modal.virtual_robot import static_stiffness
+        from robobore.plan.virtual_hammer import static_stiffness
 
         info["robot"] = robot_info
         info["static_stiffness_N_per_m"] = static_stiffness(truth.with_inputs(rows))
@@ -488,7 +488,7 @@ def _robot_truth(robot: str | None, robot_file: Path | None, joints_deg: str | N
     """The modal truth of a user's robot from the CLI options (ConfigError naming the option
     when one is missing or bad)."""
     from robobore.errors import ConfigError, IdentificationError, InputError
-    from robobore.modal.virtual_robot import robot_truth
+    from robobore.plan.virtual_hammer import robot_truth
     from robobore.robot.kinematics import get_robot
 
     if example:

@@ -64,7 +64,7 @@ def robot_truth(robot: Any, joints_deg: Any, joint_stiffness_Nm_per_rad: Any, *,
     truth = ModalTruth(f, np.full(f.size, float(damping_ratio)), phi_out, u_tool.T.copy(),
                        OUTPUT_NAMES, INPUT_NAMES,
                        f"SYNTHETIC virtual hammer test of {rb.name} at "
-                       f"{', '.join(f'{v:g}' for v in q)} deg (robobore.modal.virtual_robot)")
+                       f"{', '.join(f'{v:g}' for v in q)} deg (robobore.plan.virtual_hammer)")
     ks = pm.directional_stiffness[0]
     info = {"robot": rb.name, "robot_file": rb.file, "joints_deg": q.tolist(),
             "joint_stiffness_Nm_per_rad": k.tolist(), "tcp_m": list(map(float, tcp_m)),
