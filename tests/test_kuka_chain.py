@@ -22,10 +22,13 @@ POSTURES = ("20,20,10,0,-30,0; 0,40,-10,0,30,0; -30,10,20,20,40,10; 45,30,-20,-3
             "10,50,-30,40,50,-20; -60,0,30,0,60,0")
 
 
-def _run(args, out: Path | None = None):
+def _run(args, out: Path | None = None, allow: tuple[str, ...] = ()):
+    """Run a command; no warning line on stderr except those starting with ``allow``."""
     r = runner.invoke(app, [str(a) for a in args])
     assert r.exit_code == 0, r.output
-    assert "warning:" not in r.output.lower(), r.output  # no warning line (stderr)
+    warns = [ln for ln in r.output.lower().splitlines() if "warning:" in ln]
+    assert all(any(ln.split("warning:", 1)[1].strip().startswith(a) for a in allow)
+               for ln in warns), r.output
     if out is not None:
         out.write_text(r.stdout)
         return json.loads(r.stdout)
@@ -65,8 +68,14 @@ def test_kuka_like_robot_whole_chain(tmp_path):
     t = t.replace('"../src/robobore', f'"{REPO}/src/robobore')
     t = t.replace("rotation_step_deg = 1.0", "rotation_step_deg = 10.0")
     (tmp_path / "kplan.toml").write_text(re.sub(r"(?s)\[workspace\].*", "", t))
-    plan = _run(["plan", "posture", tmp_path / "kplan.toml", "--json"], tmp_path / "p.json")
+    # the planner's model of this ASSUMED robot calibrates poorly (its link data are guesses)
+    # and its map is flat (tool axis along the flange axis): said, but no mix-up warning
+    plan = _run(["plan", "posture", tmp_path / "kplan.toml", "--json"], tmp_path / "p.json",
+                allow=("calibration:", "the critical_depth criterion does not vary"))
     assert plan["robot"] == "kr240-r2900"
     assert not any("may not belong together" in w for w in plan["warnings"])
     assert plan["measured"] is not None and plan["identity"]["synthetic"] is True
-    assert plan["recommended"]["critical_depth_mm"] > 0
+    # the lowest semi-discretisation limit over the speed range (0: some speed has no
+    # chatter-free depth)
+    assert plan["recommended"]["critical_depth_mm"] >= 0
+    assert plan["recommended"]["critical_depth_method"] == "semi-discretization"

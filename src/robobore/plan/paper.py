@@ -77,8 +77,8 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
     A = res["_arrays"]
     cand = A["cand"]
     keep = ("joints_deg", "tool_axis_rotation_deg", "branch", "branch_label",
-            "directional_stiffness_N_per_m", "critical_depth_mm", "feed_amplitude_um",
-            "criterion_value")
+            "directional_stiffness_N_per_m", "critical_depth_mm", "critical_depth_method",
+            "feed_amplitude_um", "criterion_value")
     short = {}
     for name in ("recommended", "measured"):
         e = res[name]
@@ -87,6 +87,7 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
     return {
         "criterion": res["criterion"], "criterion_unit": res["criterion_unit"],
         "counts": res["counts"], "calibration": res["calibration"],
+        "warnings": res["warnings"],
         "recommended": short["recommended"], "measured": short["measured"],
         "synthetic_inputs": res["synthetic_inputs"],
         "end_effector": "ASSUMED 60 kg spindle + bar, centre of mass 0.15 m along flange z",
