@@ -134,6 +134,16 @@ class CrossCheckResult:
                 "agrees": self.agrees, "runs": list(self.runs)}
 
 
+def _run_record(ds: Any, v: Any, **where: Any) -> dict[str, Any]:
+    """One simulated run of :func:`check_cut`: where it was (``where``) and its verdict."""
+    return {**where, "chatter": bool(v.chatter), "decided": bool(v.chatter_decided),
+            "cause": v.chatter_cause, "floquet_multiplier": v.floquet_multiplier,
+            "vibration_growth": v.vibration_growth,
+            "revolutions": int(ds.attrs["revolutions"]),
+            "samples_per_rev": int(ds.attrs["samples_per_rev"]),
+            "tool_leaves_cut": bool(v.tool_leaves_cut)}
+
+
 def run_agrees(run: dict[str, Any]) -> bool:
     """A run at ``factor`` x the critical depth agrees when it chatters above the limit and
     does not below it, or when its verdict states the tool leaving the cut."""
@@ -167,14 +177,8 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
         a = 0.8 * below
         ds = simulate(cut.structure, cut.process(a), SimulationSettings(cut.speed_rpm, a),
                       cut.insert)
-        v = classify(ds)
-        runs.append({"factor": 0.8, "sampling": 1, "depth_mm": a * 1e3, "interrupted": True,
-                     "chatter": bool(v.chatter), "decided": bool(v.chatter_decided),
-                     "cause": v.chatter_cause, "floquet_multiplier": v.floquet_multiplier,
-                     "vibration_growth": v.vibration_growth,
-                     "revolutions": int(ds.attrs["revolutions"]),
-                     "samples_per_rev": int(ds.attrs["samples_per_rev"]),
-                     "tool_leaves_cut": bool(v.tool_leaves_cut)})
+        runs.append(_run_record(ds, classify(ds), factor=0.8, sampling=1, depth_mm=a * 1e3,
+                                interrupted=True))
     if 0.0 < ac < math.inf:
         base = auto_samples_per_rev(cut.structure, cut.speed_rpm, cut.insert.n_inserts)
         for fac in factors:
@@ -187,18 +191,12 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
                 ds = simulate(cut.structure, pa,
                               SimulationSettings(cut.speed_rpm, a, samples_per_rev=base * s,
                                                  **kw), cut.insert)
-                v = classify(ds)
-                runs.append({"factor": fac, "sampling": s, "depth_mm": a * 1e3,
-                             "chatter": bool(v.chatter), "decided": bool(v.chatter_decided),
-                             "cause": v.chatter_cause,
-                             "floquet_multiplier": v.floquet_multiplier,
-                             "vibration_growth": v.vibration_growth,
-                             "revolutions": int(ds.attrs["revolutions"]),
-                             "samples_per_rev": int(ds.attrs["samples_per_rev"]),
-                             "tool_leaves_cut": bool(v.tool_leaves_cut)})
+                runs.append(_run_record(ds, classify(ds), factor=fac, sampling=s,
+                                        depth_mm=a * 1e3))
     return CrossCheckResult(cut, ac, tuple(runs), below)
 
 
-__all__ = ["CrossCheckCut", "CrossCheckResult", "run_agrees", "random_cut", "random_structure", "check_cut",
+__all__ = ["CrossCheckCut", "CrossCheckResult", "run_agrees", "random_cut", "random_structure",
+           "check_cut",
            "FREQUENCY_HZ", "DAMPING_RATIO", "STIFFNESS_N_PER_M", "SPEED_RPM", "FEED_MM_PER_REV",
            "NOSE_RADIUS_MM"]

@@ -191,29 +191,6 @@ def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
     return np.clip(w, 0.0, None)
 
 
-def steady_min_depth_ratio(structure: ToolPointStructure, process: CuttingProcess,
-                           speed_rpm: float, depth_m: float) -> float:
-    """Smallest actual/nominal depth ``1 + e_r . r(theta) / a`` of any insert along the steady
-    deflected path of the cut at depth ``depth_m`` (the process built at that depth), before
-    clipping at 0; ``inf`` for a process without depth modulation. At or below 0 the forced
-    vibration takes the insert out of the material once per revolution."""
-    process = process.at_depth(depth_m)
-    parts = _deflection_parts(structure, process, speed_rpm)
-    if parts is None:
-        return math.inf
-    rp, r0 = parts
-    if r0 is not None and depth_m > 0.0:
-        rp = rp + r0 / depth_m
-    ang = 2 * np.pi * np.arange(rp.shape[0]) / rp.shape[0]
-    N = process.n_inserts
-    lo = math.inf
-    for p in range(N):
-        B = process.basis(ang + 2 * np.pi * p / N)
-        lo = min(lo, float(np.min(1.0 + np.einsum("k,nki,ni->n", process.depth_direction, B,
-                                                  rp))))
-    return lo
-
-
 def interrupted_below(structure: ToolPointStructure, process: CuttingProcess,
                       speed_rpm: float, depth_m: float) -> float:
     """Depth [m] below which the steady forced vibration takes an insert out of the material,
@@ -278,15 +255,6 @@ def chatter_free_window(structure: ToolPointStructure, process: CuttingProcess,
     if below >= float(top) * (1.0 - 1e-3):
         return float(top), 0.0
     return below, a_c
-
-
-def steady_cut_leaves(structure: ToolPointStructure, process: CuttingProcess,
-                      speed_rpm: float, depth_m: float) -> bool:
-    """True when the steady forced vibration of the cut at ``depth_m`` takes an insert out of
-    the material (:func:`steady_min_depth_ratio` <= 0): the cut is interrupted once per
-    revolution, outside the linear model, and the time domain finds it vibrating with the
-    tool leaving the cut. The critical-depth search counts such depths as not chatter-free."""
-    return steady_min_depth_ratio(structure, process, speed_rpm, depth_m) <= 0.0
 
 
 def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: np.ndarray,
@@ -435,14 +403,8 @@ def _rho(structure, process, speed_rpm, depth_m, steps, include_process_stiffnes
 def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
                about_deflected=True, parts=False):
     """``parts``: :func:`_deflection_parts` at this speed (``False``: compute them here).
-
-    A depth-dependent (boring) process is linearised at ``depth_m`` itself
-    (:meth:`~robobore.dynamics.process.CuttingProcess.at_depth`), the chip the time domain
-    integrates at that depth; ``parts`` are then those of that process."""
-    if process.depth_dependent:
-        at = process.at_depth(depth_m)
-        if at is not process:
-            process, parts = at, False
+    ``process`` is the process at ``depth_m`` (:func:`_rho` resolves
+    :meth:`~robobore.dynamics.process.CuttingProcess.at_depth`)."""
     m = structure.n_modes
     tau = 60.0 / (process.n_inserts * speed_rpm)
     dt = tau / steps
@@ -654,6 +616,6 @@ def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> 
 __all__ = ["DEPTH_SCAN_HI_M", "DEPTH_SCAN_DECADES", "DEPTH_SCAN_RATIO", "DENSE_EIG_MAX",
            "blas_thread_limit", "depth_scan_grid", "auto_steps", "deflected_depth_weights",
            "monodromy_spectral_radius", "critical_depth_semidiscretization",
-           "steady_min_depth_ratio", "steady_cut_leaves", "interrupted_below",
+           "interrupted_below",
            "chatter_free_window", "CONTINUATION_STEP",
            "RICHARDSON_MIN_STEPS", "DEFLECTION_SAMPLES"]

@@ -256,17 +256,7 @@ def periodic_start(structure: ToolPointStructure, process: CuttingProcess, Ns: i
     velocity at t = 0, shape (m,), and the surface memory ``r_s`` per sample, shape (Ns, 3).
     (The depth-modulation stiffness is left out; it leaves a small transient.)
     """
-    N = int(process.n_inserts)
-    spp = Ns // N
-    theta = 2 * np.pi * np.arange(Ns) / Ns
-    B = process.basis(theta)  # (Ns,3,3)
-    f0 = (np.einsum("e,e,ei->i", process.width_per_depth * depth_m, process.h0, process.shear)
-          + np.einsum("e,ei->i", process.edge_per_depth * depth_m + process.edge_fixed_m,
-                      process.edge))
-    F = np.zeros((Ns, 3))
-    for p in range(N):
-        idx = (np.arange(Ns) + p * spp) % Ns
-        F += np.einsum("nki,k->ni", B[idx], f0)
+    F = _nominal_force(process, 2 * np.pi * np.arange(Ns) / Ns, depth_m)
     fm = F @ structure.directions.T  # (Ns, m)
     c = np.fft.fft(fm, axis=0) / Ns
     k = np.fft.fftfreq(Ns, 1.0 / Ns)  # harmonic numbers
