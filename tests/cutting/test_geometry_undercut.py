@@ -19,12 +19,12 @@ import pytest
 from matplotlib.path import Path as MplPath
 
 from robobore.cutting.geometry import (
-    APPROACH_ANGLE_MAX_DEG,
     BoringInsert,
     chip_area,
     edge_elements,
 )
 from robobore.errors import ConfigError
+from robobore.io.sections import APPROACH_ANGLE_MAX_DEG
 
 
 def _outline(r, kappa_deg, kappa_end_deg, far, n_arc=300):

@@ -18,16 +18,13 @@ from collections.abc import Collection, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import Field, field_validator
 
 from robobore.errors import ConfigError
+from robobore.io.sections import StrictModel
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class FESettings(_Strict):
+class FESettings(StrictModel):
     """Shorthand FE settings of the virtual tests when no ``fe_config`` is given: the
     workpiece-frame model with the a-priori parameters (see docs/fe.md; coarse but within the
     engine's checks: element size <= h/3)."""
@@ -44,7 +41,7 @@ class FESettings(_Strict):
     separation_height_um: float | None = Field(None, ge=0)
 
 
-class CalibrationConfig(_Strict):
+class CalibrationConfig(StrictModel):
     """What to calibrate: material, insert edge, grid and FE settings."""
 
     material: str = "TC4"

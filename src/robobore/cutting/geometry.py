@@ -12,7 +12,7 @@ parametrised by arc length ``s`` from the tip (``s > 0`` on the leading/major si
 * nose arc (``-r kappa' <= s <= r kappa``): local approach angle ``psi = s / r``,
   ``zeta = r sin psi``, ``drop = r (1 - cos psi)``;
 * major (lead) edge beyond it, at the approach angle ``kappa`` to the feed axis (up to
-  :data:`APPROACH_ANGLE_MAX_DEG`; above 90 deg the edge is undercut: it runs back against
+  :data:`robobore.io.sections.APPROACH_ANGLE_MAX_DEG`; above 90 deg the edge is undercut: it runs back against
   the feed as it goes outwards, as on 93 .. 107.5 deg boring bars and copying tools);
 * minor (end) edge on the trailing side at the end-cutting-edge angle ``kappa'``.
 
@@ -55,27 +55,15 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import ConfigError
-
-
-#: The approach angles (kappa_r, deg) the geometry and force model accept: from
-#: :data:`APPROACH_ANGLE_MIN_DEG` (below it the value looks like radians) to
-#: :data:`APPROACH_ANGLE_MAX_DEG` (the most undercut standard boring bars, e.g. 107.5 deg
-#: with a 35 deg V insert). One definition for every command (:func:`check_approach_angle`).
-APPROACH_ANGLE_MIN_DEG = 5.0
-APPROACH_ANGLE_MAX_DEG = 107.5
-
-
-def check_approach_angle(value: float, field: str = "insert.approach_angle_deg",
-                         file: str | None = None) -> float:
-    """``value`` (deg) if it is a plausible approach angle, else a ConfigError naming it."""
-    v = float(value)
-    if not (math.isfinite(v) and APPROACH_ANGLE_MIN_DEG <= v <= APPROACH_ANGLE_MAX_DEG):
-        hint = " (looks like radians)" if math.isfinite(v) and 0 < v < APPROACH_ANGLE_MIN_DEG \
-            else ""
-        raise ConfigError(f"approach angle out of range{hint}", file=file, field=field,
-                          value=value, expected=f"{APPROACH_ANGLE_MIN_DEG:g} .. "
-                          f"{APPROACH_ANGLE_MAX_DEG:g} deg (boring bars 45 .. 107.5 deg)")
-    return v
+from robobore.io.sections import (
+    CLEARANCE_MAX_DEG,
+    EDGE_RADIUS_MAX_UM,
+    END_EDGE_ANGLE_MAX_DEG,
+    INCLINATION_MAX_DEG,
+    NOSE_RADIUS_MAX_MM,
+    RAKE_MAX_DEG,
+    check_approach_angle,
+)
 
 
 def _check(name: str, value: float, lo: float, hi: float, unit: str, lo_open: bool = False) -> None:
@@ -110,18 +98,25 @@ class BoringInsert:
     n_inserts: int = 1
 
     def __post_init__(self) -> None:
-        _check("insert.nose_radius_m", self.nose_radius_m, 0.0, 0.01, "m", lo_open=True)
+        # the bounds of the [insert] section (robobore.io.sections), in SI
+        _check("insert.nose_radius_m", self.nose_radius_m, 0.0, NOSE_RADIUS_MAX_MM * 1e-3, "m",
+               lo_open=True)
         check_approach_angle(self.approach_angle_deg)
-        _check("insert.end_edge_angle_deg", self.end_edge_angle_deg, 0.0, 89.0, "deg", True)
+        if not (math.isfinite(self.end_edge_angle_deg)
+                and 0.0 < self.end_edge_angle_deg < END_EDGE_ANGLE_MAX_DEG):
+            raise ConfigError("out of range", field="insert.end_edge_angle_deg",
+                              value=self.end_edge_angle_deg,
+                              expected=f"a value in (0, {END_EDGE_ANGLE_MAX_DEG:g}) deg")
         if self.approach_angle_deg + self.end_edge_angle_deg >= 180.0:
             raise ConfigError("no insert: approach angle + end-edge angle >= 180 deg",
                               field="insert.end_edge_angle_deg", value=self.end_edge_angle_deg,
                               expected=f"< {180.0 - self.approach_angle_deg:g} deg (a positive "
                               "included angle)")
-        _check("insert.rake_deg", self.rake_deg, -30.0, 30.0, "deg")
-        _check("insert.inclination_deg", self.inclination_deg, -30.0, 30.0, "deg")
-        _check("insert.clearance_deg", self.clearance_deg, 0.0, 30.0, "deg")
-        _check("insert.edge_radius_m", self.edge_radius_m, 0.0, 2e-4, "m")
+        _check("insert.rake_deg", self.rake_deg, -RAKE_MAX_DEG, RAKE_MAX_DEG, "deg")
+        _check("insert.inclination_deg", self.inclination_deg, -INCLINATION_MAX_DEG,
+               INCLINATION_MAX_DEG, "deg")
+        _check("insert.clearance_deg", self.clearance_deg, 0.0, CLEARANCE_MAX_DEG, "deg")
+        _check("insert.edge_radius_m", self.edge_radius_m, 0.0, EDGE_RADIUS_MAX_UM * 1e-6, "m")
         if int(self.n_inserts) != self.n_inserts or not 1 <= self.n_inserts <= 12:
             raise ConfigError("out of range", field="insert.n_inserts", value=self.n_inserts,
                               expected="an integer in [1, 12]")
@@ -493,5 +488,4 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
 
 
 __all__ = ["BoringInsert", "EdgeElements", "chip_area", "scallop_area", "edge_elements", "lead_end",
-           "trailing_intersection", "check_approach_angle", "APPROACH_ANGLE_MIN_DEG",
-           "APPROACH_ANGLE_MAX_DEG"]
+           "trailing_intersection"]

@@ -41,6 +41,7 @@ from robobore.dynamics.config import (
 from robobore.dynamics.handoff import with_coefficients, with_equivalent
 from robobore.errors import ConfigError, InputError
 from robobore.io.config import validate_model
+from robobore.io.ranges import check_positive
 
 #: An undecided run (:attr:`~robobore.dynamics.chatter.ChatterVerdict.chatter_decided`) is
 #: lengthened, doubling its revolutions, up to this factor of the configured revolutions.
@@ -91,6 +92,8 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
 
     cfg, raw, src = _config(config, source, equivalent)
+    if feed_mm_per_rev is not None:
+        check_positive(feed_mm_per_rev, "feed_mm_per_rev", file=src, field="feed_mm_per_rev")
     if cfg.cutting is not None:
         upd = {}
         if speed_rpm is not None:
@@ -123,12 +126,8 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     if a is None:
         raise ConfigError("no depth of cut", file=src, field="depth_mm",
                           expected="a depth in mm or a [cutting] section")
-    if not (math.isfinite(n) and 1.0 <= n <= 100000.0):
-        raise ConfigError("spindle speed out of range", file=src, field="speed_rpm", value=n,
-                          expected="1 .. 100000 r/min")
-    if not (math.isfinite(a) and 0.0 < a <= 50.0):
-        raise ConfigError("depth of cut out of range", file=src, field="depth_mm", value=a,
-                          expected="0 < depth <= 50 mm")
+    check_positive(n, "speed_rpm", file=src, field="speed_rpm")
+    check_positive(a, "depth_mm", file=src, field="depth_mm")
     revs = revolutions if revolutions is not None else cfg.simulation.revolutions
     nspr = samples_per_rev if samples_per_rev is not None else cfg.simulation.samples_per_rev
     st = build_structure(cfg, src)
@@ -251,10 +250,7 @@ def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, spee
     from robobore.dynamics.semidiscretization import chatter_free_window
 
     cfg, _, src = _config(config, equivalent=equivalent)
-    if not (isinstance(speed_rpm, int | float) and math.isfinite(speed_rpm)
-            and 1.0 <= speed_rpm <= 100000.0):
-        raise ConfigError("spindle speed out of range", file=src, field="speed_rpm",
-                          value=speed_rpm, expected="1 .. 100000 r/min")
+    check_positive(speed_rpm, "speed_rpm", file=src, field="speed_rpm")
     st = build_structure(cfg, src)
     coef = build_coefficients(cfg, src) if cfg.is_boring else None
     pr = build_process(cfg, src, coefficients=coef)

@@ -207,27 +207,18 @@ def simulate_boring_cmd(
     if depth_mm is None and cfg.cutting is None:
         raise ConfigError("no depth of cut", field="--depth-mm",
                           expected="--depth-mm A (mm) or a [cutting] section")
-    if speed_rpm is not None and not (math.isfinite(speed_rpm) and 1.0 <= speed_rpm <= 1e5):
-        raise ConfigError("spindle speed out of range", field="--speed-rpm", value=speed_rpm,
-                          expected="1 .. 100000 r/min")
-    if depth_mm is not None and not (math.isfinite(depth_mm) and 0.0 < depth_mm <= 50.0):
-        raise ConfigError("depth of cut out of range", field="--depth-mm", value=depth_mm,
-                          expected="0 < depth <= 50 mm")
-    if feed_mm_per_rev is not None and not (
-            math.isfinite(feed_mm_per_rev) and 0.0 < feed_mm_per_rev <= 10.0):
-        raise ConfigError("feed out of range", field="--feed-mm-per-rev", value=feed_mm_per_rev,
-                          expected="0 < feed <= 10 mm/r")
     if pressure_MPa is not None and not (math.isfinite(pressure_MPa) and 0.0 <= pressure_MPa
                                          <= 10.0):
         raise ConfigError("pressure out of range", field="--pressure-MPa", value=pressure_MPa,
                           expected="0 .. 10 MPa")
-    from robobore.io.ranges import check_value
+    from robobore.io.ranges import check_positive, check_value
 
     for opt, v, name in (("--speed-rpm", speed_rpm, "speed_rpm"), ("--depth-mm", depth_mm,
-                         "depth_mm"), ("--feed-mm-per-rev", feed_mm_per_rev, "feed_mm_per_rev"),
-                         ("--pressure-MPa", pressure_MPa, "pressure_MPa")):
-        if v is not None:  # plausible ranges with unit-slip hints (robobore.io.ranges)
-            check_value(v, name, field=opt, kind=ConfigError)
+                         "depth_mm"), ("--feed-mm-per-rev", feed_mm_per_rev, "feed_mm_per_rev")):
+        if v is not None:  # the one range of each quantity (robobore.io.ranges)
+            check_positive(v, name, field=opt)
+    if pressure_MPa is not None:
+        check_value(pressure_MPa, "pressure_MPa", field="--pressure-MPa", kind=ConfigError)
     if out is not None and out.suffix != ".nc":
         raise ConfigError("output must be a netCDF file", field="--out", value=str(out),
                           expected="a path ending in .nc")

@@ -37,12 +37,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from robobore.dynamics.handoff import equivalent_extras, equivalent_section, with_equivalent
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
 from robobore.io.paths import resolve_config_path
+from robobore.io.sections import InsertSection, StrictModel
 
 
 def _unit(v: list[float], tol: float = 0.01) -> list[float]:
@@ -56,11 +57,7 @@ def _unit(v: list[float], tol: float = 0.01) -> list[float]:
     return [x / n for x in v]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class ModeCfg(_Strict):
+class ModeCfg(StrictModel):
     frequency_Hz: float = Field(gt=0, le=1e6)
     damping_ratio: float = Field(ge=0, lt=1)
     stiffness_N_per_m: float = Field(gt=0, le=1e12)
@@ -72,17 +69,17 @@ class ModeCfg(_Strict):
         return _unit(v)
 
 
-class StructureCfg(_Strict):
+class StructureCfg(StrictModel):
     modes: list[ModeCfg] = Field(min_length=1)
 
 
-class XYZ(_Strict):
+class XYZ(StrictModel):
     x: float
     y: float
     z: float
 
 
-class PressureFootCfg(_Strict):
+class PressureFootCfg(StrictModel):
     pressure_MPa: float = Field(0.3, ge=0, le=10)
     piston_diameter_mm: float = Field(50.0, gt=0, le=1000)
     normal: list[float] = [0.0, 0.0, 1.0]
@@ -112,7 +109,7 @@ class PressureFootCfg(_Strict):
             contact_damping_ratio=self.contact_damping_ratio)
 
 
-class EquivalentCfg(_Strict):
+class EquivalentCfg(StrictModel):
     stiffness_N_per_m: XYZ
     frequency_Hz: XYZ
     damping_ratio: XYZ | None = None
@@ -154,11 +151,11 @@ class EquivalentCfg(_Strict):
             notes=(self.note,) if self.note else ())
 
 
-class ProcessCfg(_Strict):
+class ProcessCfg(StrictModel):
     cutting_coefficient_N_per_m2: float = Field(gt=0, le=1e12)
     force_direction: list[float]
     chip_normal: list[float]
-    feed_mm_per_rev: float = Field(gt=0, le=10)
+    feed_mm_per_rev: float = Field(gt=0)  # range: robobore.io.ranges
     overlap_factor: float = Field(1.0, ge=0, le=1)
     n_inserts: int = Field(1, ge=1, le=12)
 
@@ -168,9 +165,9 @@ class ProcessCfg(_Strict):
         return _unit(v)
 
 
-class SpeedCfg(_Strict):
-    min: float = Field(gt=0, le=100000)
-    max: float = Field(gt=0, le=100000)
+class SpeedCfg(StrictModel):
+    min: float = Field(gt=0)  # range: robobore.io.ranges
+    max: float = Field(gt=0)
     count: int = Field(gt=1, le=100000)
 
     @model_validator(mode="after")
@@ -194,36 +191,11 @@ def speed_range(cfg: DynamicsConfig) -> tuple[SpeedCfg, str | None]:
                f"({d.count} speeds) is used")
 
 
-class InsertCfg(_Strict):
-    nose_radius_mm: float = Field(0.4, gt=0, le=10)
-    approach_angle_deg: float = 90.0  # range: robobore.cutting.geometry.check_approach_angle
-    end_edge_angle_deg: float = Field(5.0, gt=0, lt=90)
-    rake_deg: float = Field(7.0, ge=-30, le=30)
-    inclination_deg: float = Field(0.0, ge=-30, le=30)
-    clearance_deg: float = Field(7.0, ge=0, le=30)
-    edge_radius_um: float = Field(20.0, ge=0, le=200)
+class InsertCfg(InsertSection):
+    """The shared ``[insert]`` section (:class:`robobore.io.sections.InsertSection`) and the
+    number of inserts on the bar."""
+
     n_inserts: int = Field(1, ge=1, le=12)
-
-    # unit slips downwards, which the upper bounds do not catch: an angle in radians, an
-    # edge radius in mm (a ground edge is 2 .. 100 um; 0 = sharp, the ideal edge)
-    @field_validator("approach_angle_deg")
-    @classmethod
-    def _kappa(cls, v: float) -> float:
-        from robobore.cutting.geometry import check_approach_angle
-
-        try:
-            return check_approach_angle(v)
-        except ConfigError as exc:
-            raise ValueError(f"{exc.message} (got {v:g} deg); expected {exc.expected}"
-                             ) from None
-
-    @field_validator("edge_radius_um")
-    @classmethod
-    def _edge(cls, v: float) -> float:
-        if 0.0 < v < 0.5:
-            raise ValueError(f"edge radius {v:g} um is below 0.5 um (looks like mm; expected "
-                             "um: ground edges 2 .. 100 um, or 0 for a sharp edge)")
-        return v
 
     def to_insert(self):
         from robobore.cutting.geometry import BoringInsert
@@ -233,14 +205,15 @@ class InsertCfg(_Strict):
                             self.clearance_deg, self.edge_radius_um * 1e-6, self.n_inserts)
 
 
-class BoreCfg(_Strict):
+class BoreCfg(StrictModel):
     diameter_mm: float = Field(gt=1, le=2000)
 
 
-class CuttingCfg(_Strict):
-    speed_rpm: float = Field(gt=0, le=100000)
-    feed_mm_per_rev: float = Field(gt=0, le=5)
-    depth_mm: float = Field(gt=0, le=50)
+class CuttingCfg(StrictModel):
+    # upper bounds: the one range of each quantity, robobore.io.ranges (check_tree)
+    speed_rpm: float = Field(gt=0)
+    feed_mm_per_rev: float = Field(gt=0)
+    depth_mm: float = Field(gt=0)
     overlap_factor: float = Field(1.0, ge=0, le=1)
     depth_modulation: bool = True
     # edge (ploughing) force also on the engaged trailing side of the nose (from the tip to
@@ -248,7 +221,7 @@ class CuttingCfg(_Strict):
     trailing_edge: bool = True
 
 
-class CoefficientsCfg(_Strict):
+class CoefficientsCfg(StrictModel):
     material: str | None = None
     file: str | None = None
     oblique: bool = False
@@ -287,7 +260,7 @@ class CoefficientsCfg(_Strict):
         return self
 
 
-class SimulationCfg(_Strict):
+class SimulationCfg(StrictModel):
     revolutions: int = Field(150, ge=1, le=20000)
     samples_per_rev: int = Field(0, ge=0, le=200000)
     # a run whose chatter verdict is within the growth estimate's uncertainty is lengthened
@@ -304,7 +277,7 @@ class SimulationCfg(_Strict):
         return v
 
 
-class ModelFilesCfg(_Strict):
+class ModelFilesCfg(StrictModel):
     """``[model]``: the robot from identification outputs; paths relative to the TOML."""
 
     stiffness_file: str | None = None   # robobore identify stiffness --json
@@ -314,7 +287,7 @@ class ModelFilesCfg(_Strict):
     damping_N_s_per_m: float | None = Field(None, ge=0)
 
 
-class DynamicsConfig(_Strict):
+class DynamicsConfig(StrictModel):
     model: ModelFilesCfg | None = None
     structure: StructureCfg | None = None
     equivalent: EquivalentCfg | None = None

@@ -45,6 +45,7 @@ import xarray as xr
 from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.structure import ToolPointStructure
 from robobore.errors import ConfigError, NumericalError
+from robobore.io.ranges import check_positive
 
 
 def modal_zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -212,12 +213,8 @@ class SimulationSettings:
     divergence_limit_m: float | None = None
 
     def check(self) -> None:
-        if not (math.isfinite(self.speed_rpm) and 1.0 <= self.speed_rpm <= 100000.0):
-            raise ConfigError("spindle speed out of range", field="speed_rpm",
-                              value=self.speed_rpm, expected="1 .. 100000 r/min")
-        if not (math.isfinite(self.depth_m) and 0.0 < self.depth_m <= 0.05):
-            raise ConfigError("depth of cut out of range", field="depth_mm",
-                              value=self.depth_m * 1e3, expected="0 < depth <= 50 mm")
+        check_positive(self.speed_rpm, "speed_rpm", field="speed_rpm")
+        check_positive(self.depth_m * 1e3, "depth_mm", field="depth_mm")
         if not 1 <= int(self.revolutions) <= 20000:
             raise ConfigError("revolutions out of range", field="revolutions",
                               value=self.revolutions, expected="1 .. 20000")

@@ -365,6 +365,23 @@ def check_value(value: Any, name: str, *, file: str | None = None, row: int | No
     raise _error(kind, msg, value=v, expected=rng.describe(), **where)
 
 
+def check_positive(value: Any, name: str, *, file: str | None = None,
+                   field: str | None = None, kind: type[InputError] = ConfigError) -> float:
+    """:func:`check_value` for a quantity that must be above 0 (a cut's depth, feed and
+    speed): 0 or less is refused whether or not the range check is on, then the value is
+    checked against the range of ``name``. The command-line options, the config sections and
+    :mod:`robobore.api` call this (or :func:`check_tree`, which gives the same message for
+    an out-of-range value), so that each quantity has one range."""
+    v = check_value(value, name, file=file, field=field, kind=kind) if not (
+        isinstance(value, int | float) and not isinstance(value, bool) and value <= 0) \
+        else float(value)
+    if v <= 0.0:
+        rng = quantity_of(name)
+        raise kind("a cut needs a positive value", file=file, field=field or name, value=v,
+                   expected=f"> 0 ({rng.describe()})" if rng is not None else "> 0")
+    return v
+
+
 def check_array(values: Any, name: str, *, file: str | None = None, field: str | None = None,
                 kind: type[InputError] = DataError) -> None:
     """Check every element of a numeric array (a frequency axis, a coherence) against the
@@ -488,7 +505,7 @@ def range_table() -> list[dict[str, str]]:
 
 __all__ = ["radians_hint", "Range", "RANGES", "BY_NAME", "BY_SUFFIX", "RangeCheckWarning",
            "check_value",
-           "check_array",
+           "check_positive", "check_array",
            "check_tree", "quantity_of", "option_name", "enabled", "set_enabled", "provenance",
            "range_table",
            "ENV_VAR", "OVERRIDE_KEY"]

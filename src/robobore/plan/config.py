@@ -13,76 +13,74 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from robobore.dynamics.config import CoefficientsCfg, InsertCfg
 from robobore.errors import ConfigError, DataError, InputError
 from robobore.io.readers import load_json
+from robobore.io.sections import StrictModel
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class RobotCfg(_Strict):
+class RobotCfg(StrictModel):
     name: str = "irb6600-175-2.55"
 
 
-class LinkBendingCfg(_Strict):
+class LinkBendingCfg(StrictModel):
     link: int
     EI_Nm2: list[float]
 
 
-class IdentificationCfg(_Strict):
+class IdentificationCfg(StrictModel):
     joint_stiffness: str
     modes: str
     posture_deg: list[float] | None = None
     link_bending: list[LinkBendingCfg] = Field(default_factory=list)
 
 
-class ToolCfg(_Strict):
+class ToolCfg(StrictModel):
     tcp_m: list[float]
     mass_kg: float = Field(0.0, ge=0, le=2000)
     com_m: list[float] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     inertia_kg_m2: list[float] = Field(default_factory=lambda: [0.0] * 6)
 
 
-class BoreCfg(_Strict):
+class BoreCfg(StrictModel):
     point_m: list[float]
     axis: list[float]
     diameter_mm: float = Field(gt=1, le=2000)
 
 
-class PartCfg(_Strict):
+class PartCfg(StrictModel):
     origin_m: list[float] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     yaw_deg: float = 0.0
 
 
-class CuttingCfg(_Strict):
-    speed_rpm: float = Field(gt=0, le=100000)
-    feed_mm_per_rev: float = Field(gt=0, le=5)
-    depth_mm: float = Field(gt=0, le=50)
+class CuttingCfg(StrictModel):
+    # upper bounds: the one range of each quantity, robobore.io.ranges (check_tree)
+    speed_rpm: float = Field(gt=0)
+    feed_mm_per_rev: float = Field(gt=0)
+    depth_mm: float = Field(gt=0)
 
 
-class LobesCfg(_Strict):
+class LobesCfg(StrictModel):
     speed_min_rpm: float = Field(gt=0, le=100000)
     speed_max_rpm: float = Field(gt=0, le=100000)
 
 
-class PlanCfg(_Strict):
+class PlanCfg(StrictModel):
     rotation_step_deg: float = Field(1.0, ge=0.01, le=180)  # 36,000 rotations at most
     criterion: Literal["critical_depth", "stiffness_x", "stiffness_y", "stiffness_z",
                        "stiffness_min"] = "critical_depth"
     singularity_margin: float = Field(0.02, ge=0, le=1)
 
 
-class WorkspaceCfg(_Strict):
+class WorkspaceCfg(StrictModel):
     dx_m: list[float] = Field(min_length=1)
     dy_m: list[float] = Field(min_length=1)
     rotation_step_deg: float = Field(10.0, ge=0.01, le=180)
 
 
-class PlanConfig(_Strict):
+class PlanConfig(StrictModel):
     robot: RobotCfg = RobotCfg()
     identification: IdentificationCfg
     tool: ToolCfg

@@ -12,10 +12,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from robobore.dynamics.config import BoreCfg, InsertCfg, PressureFootCfg
 from robobore.errors import ConfigError
+from robobore.io.sections import StrictModel
 
 
 def example_dir() -> Path:
@@ -27,17 +28,13 @@ def example_config_path() -> Path:
     return example_dir() / "paper.toml"
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class XYZ(_Strict):
+class XYZ(StrictModel):
     x: float = Field(gt=0)
     y: float = Field(gt=0)
     z: float = Field(gt=0)
 
 
-class StudySection(_Strict):
+class StudySection(StrictModel):
     name: str = "paper"
     title: str = "Robotic boring of TC4: the paper's study"
     revolutions: int = Field(60, ge=10, le=5000)
@@ -56,7 +53,7 @@ class StudySection(_Strict):
     machine_tool: bool = True
 
 
-class RobotSection(_Strict):
+class RobotSection(StrictModel):
     name: str = "irb6600-175-2.55"
     campaign: str | None = None  # None: bundled SYNTHETIC campaign
     posture_deg: list[float] = Field(
@@ -64,7 +61,7 @@ class RobotSection(_Strict):
     tcp_m: list[float] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
-class ModalSection(_Strict):
+class ModalSection(StrictModel):
     file: str | None = None  # None: bundled SYNTHETIC hammer test
     band_Hz: list[float] = Field(default_factory=lambda: [3.0, 60.0], min_length=2,
                                  max_length=2, description="analysis band [lo, hi], Hz")
@@ -72,37 +69,37 @@ class ModalSection(_Strict):
     max_order: int = Field(40, ge=4, le=200)
 
 
-class MachineToolSection(_Strict):
+class MachineToolSection(StrictModel):
     note: str = ""
     stiffness_N_per_m: XYZ
     frequency_Hz: XYZ
     damping_ratio: XYZ
 
 
-class LobesSection(_Strict):
+class LobesSection(StrictModel):
     speed_min_rpm: float = Field(150.0, gt=0)
     speed_max_rpm: float = Field(1100.0, gt=0)
     count: int = Field(200, ge=10, le=5000)
     method: Literal["frequency", "semidiscretization"] = "semidiscretization"
 
 
-class MaterialSection(_Strict):
+class MaterialSection(StrictModel):
     name: str = "TC4"
 
 
-class CoefficientsSection(_Strict):
+class CoefficientsSection(StrictModel):
     file: str  # stored FE-calibrated coefficients (used by --fast)
     #: per-speed fits at two or more speeds evaluated at each condition's cutting speed
     #: (robobore.cutting.forces.coefficients_at_speed); false: the pooled set
     speed_dependent: bool = True
 
 
-class MeasuredSection(_Strict):
+class MeasuredSection(StrictModel):
     file: str | None = None
     truth_note: str = ""
 
 
-class PaperConfig(_Strict):
+class PaperConfig(StrictModel):
     study: StudySection = StudySection()
     robot: RobotSection = RobotSection()
     modal: ModalSection = ModalSection()
