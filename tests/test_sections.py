@@ -129,3 +129,14 @@ def test_one_strict_base_model_outside_the_fe_package():
                     isinstance(b, ast.Name) and b.id == "BaseModel" for b in node.bases):
                 found.append(f"{rel}:{node.lineno} {node.name}")
     assert not found, found
+
+
+def test_a_sweep_condition_has_the_same_range():
+    from pydantic import ValidationError
+
+    from robobore.study.conditions import Condition
+
+    Condition(speed_rpm=300.0, feed_mm_per_rev=0.15, depth_of_cut_mm=20.0)
+    with pytest.raises(ValidationError, match="value out of the plausible range") as exc:
+        Condition(speed_rpm=300.0, feed_mm_per_rev=0.15, depth_of_cut_mm=30.0)
+    assert RANGES["depth_mm"].describe() in str(exc.value)

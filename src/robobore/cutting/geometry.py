@@ -12,8 +12,9 @@ parametrised by arc length ``s`` from the tip (``s > 0`` on the leading/major si
 * nose arc (``-r kappa' <= s <= r kappa``): local approach angle ``psi = s / r``,
   ``zeta = r sin psi``, ``drop = r (1 - cos psi)``;
 * major (lead) edge beyond it, at the approach angle ``kappa`` to the feed axis (up to
-  :data:`robobore.io.sections.APPROACH_ANGLE_MAX_DEG`; above 90 deg the edge is undercut: it runs back against
-  the feed as it goes outwards, as on 93 .. 107.5 deg boring bars and copying tools);
+  :data:`robobore.io.sections.APPROACH_ANGLE_MAX_DEG`; above 90 deg the edge is undercut:
+  it runs back against the feed as it goes outwards, as on 93 .. 107.5 deg boring bars and
+  copying tools);
 * minor (end) edge on the trailing side at the end-cutting-edge angle ``kappa'``.
 
 Chip of a steady pass with feed ``f`` per revolution (per insert) and radial depth ``ap``

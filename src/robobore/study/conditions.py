@@ -39,11 +39,12 @@ import itertools
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
 from robobore.io.hashing import stable_hash
+from robobore.io.ranges import check_positive
 
 #: Quantities that identify a condition, in CSV/config order.
 CONDITION_FIELDS = ("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm", "pressure_MPa")
@@ -79,11 +80,18 @@ class Condition(BaseModel):
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
-    speed_rpm: float = Field(gt=0, le=100_000, description="spindle speed, r/min")
-    feed_mm_per_rev: float = Field(gt=0, le=50, description="feed per revolution, mm")
-    depth_of_cut_mm: float = Field(gt=0, le=50, description="radial depth of cut, mm")
+    # upper bounds: the one range of each quantity (robobore.io.ranges), checked below
+    speed_rpm: float = Field(gt=0, description="spindle speed, r/min")
+    feed_mm_per_rev: float = Field(gt=0, description="feed per revolution, mm")
+    depth_of_cut_mm: float = Field(gt=0, description="radial depth of cut, mm")
     pressure_MPa: float = Field(default=0.0, ge=0, le=100, description="foot pressure, MPa")
     posture: str = Field(default=DEFAULT_POSTURE, min_length=1)
+
+    @field_validator("speed_rpm", "feed_mm_per_rev", "depth_of_cut_mm")
+    @classmethod
+    def _plausible(cls, v: float, info: ValidationInfo) -> float:
+        # a ConfigError is a ValueError: pydantic reports it with the field
+        return check_positive(v, info.field_name, field=info.field_name)
 
     def to_dict(self) -> dict[str, Any]:
         return self.model_dump()
