@@ -99,6 +99,8 @@ class CoefficientsSection(_Strict):
 
 class MeasuredSection(_Strict):
     file: str | None = None
+    # observed cuts (calibrate dynamics CSV): the report shows the corrected lobes' band
+    observations: str | None = None
     truth_note: str = ""
 
 
