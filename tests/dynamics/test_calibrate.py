@@ -183,7 +183,7 @@ def test_calibrate_cli_writes_a_model_lobes_accept(tmp_path, example):
 
     # SYNTHETIC cuts: stable well below the example's limit, chatter well above it
     obs = [Observation(i + 1, n, a * 1e-3, c) for i, (n, a, c) in enumerate(
-        [(400, 0.2, False), (400, 3.0, True), (1200, 2.0, False), (1200, 30.0, True),
+        [(400, 0.2, False), (400, 3.0, True), (1200, 2.0, False), (1200, 15.0, True),
          (2200, 0.4, False), (2200, 4.0, True)])]
     csv = write_observations_csv(tmp_path / "cuts.csv", obs, "SYNTHETIC")
     out = tmp_path / "out"
@@ -220,3 +220,25 @@ def test_calibrate_cli_without_observations_is_a_clear_error(tmp_path):
     r = runner.invoke(app, ["calibrate", "dynamics", str(EXAMPLE)])
     assert r.exit_code == 2
     assert "calibration.observations" in r.output
+
+
+def test_lobes_band_option_draws_the_modal_band(tmp_path):
+    text = EXAMPLE.read_text()
+    text = text.replace('note = "example values (assumed), see file header"',
+                        'note = "example values (assumed), see file header"\n'
+                        'uncertainty = { x = { frequency_Hz = [6.8, 7.0], damping_ratio = '
+                        '[0.03, 0.04] }, y = { damping_ratio = [0.025, 0.031] } }')
+    text = text.replace("count = 300", "count = 3")
+    toml = tmp_path / "band.toml"
+    toml.write_text(text)
+    r = runner.invoke(app, ["lobes", str(toml), "--band", "--band-speeds", "3", "--json",
+                            "--plot", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    b = json.loads(r.stdout)["band"]
+    assert b["source"] == "modal intervals" and b["lobe_evaluations"] == 7
+    lo, med, hi = (np.array(b[k]) for k in ("critical_depth_p05_mm", "critical_depth_p50_mm",
+                                            "critical_depth_p95_mm"))
+    assert np.all(lo <= med) and np.all(med <= hi) and np.any(hi > lo)
+    assert (tmp_path / "lobes_band.png").stat().st_size > 0
+    r = runner.invoke(app, ["lobes", str(EXAMPLE), "--band"])
+    assert r.exit_code == 2 and "equivalent.uncertainty" in r.output

@@ -602,8 +602,6 @@ class Calibration:
 
     def to_dataset(self):
         """The band with the nominal lobes and the observations (xarray, units in attrs)."""
-        import xarray as xr
-
         ds = self.band.to_dataset()
         ds["critical_depth_nominal"] = ("speed", self.nominal_m * 1e3, {"units": "mm"})
         ds["observed_speed"] = ("cut", [o.speed_rpm for o in self.observations],
@@ -620,7 +618,7 @@ class Calibration:
                                {"units": "1 (factors); N/m (process damping)"})
         ds = ds.assign_coords(parameter=("parameter", [r["name"] for r in self.parameters()]))
         ds.attrs["posterior"] = "MAP + Laplace (log factors)"
-        return xr.Dataset(ds)
+        return ds
 
 
 def corrected_equivalent(em: Any, fit_: Fit, note: str) -> Any:
@@ -744,7 +742,7 @@ def calibrate(config: Any, observations: list[Observation],
     adv = tick("band: corrected lobes", total)
     band = lobe_band(curve, chosen.theta, chosen.cov, speeds, chosen.names, "observations",
                      depth_count=depth_count, progress=adv)
-    pn = problem.predictions(np.zeros(6))[:len(observations)]
+    pn = problem.predictions(np.zeros(6), f0.predictions[:len(observations)])[:len(observations)]
     pc = chosen.predictions[:len(observations)]
     if em is None:
         em = cfg.equivalent.to_model()

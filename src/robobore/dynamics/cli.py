@@ -82,6 +82,10 @@ def lobes_cmd(
     pr = build_process(cfg, src, coefficients=coef)
     sp, default_note = speed_range(cfg)
     speeds = np.linspace(sp.min, sp.max, sp.count)
+    if band:
+        from robobore.dynamics.cli_calibrate import band_uncertainty
+
+        band_uncertainty(cfg, src, band_speeds)
     if method not in ("frequency", "semidiscretization"):
         raise ConfigError("unknown method", field="--method", value=method,
                           expected="frequency or semidiscretization")

@@ -129,6 +129,22 @@ def register(groups: dict[str, typer.Typer]) -> None:
     groups["calibrate"].command("dynamics")(calibrate_dynamics_cmd)
 
 
+def band_uncertainty(cfg: Any, source: str, n_speeds: int) -> dict[str, Any]:
+    """The config's equivalent-model uncertainty for ``lobes --band``; a ConfigError when it
+    has none or the band's speed count is out of range (checked before the lobes run)."""
+    unc = None if cfg.equivalent is None else cfg.equivalent.uncertainty
+    if not unc:
+        raise ConfigError("no uncertainty to draw a band from", file=source,
+                          field="equivalent.uncertainty",
+                          expected="an equivalent model with 95 % ranges (model equivalent "
+                                   "from modes with intervals, or calibrate dynamics' "
+                                   "equivalent_corrected.json)")
+    if not 2 <= n_speeds <= 2000:
+        raise ConfigError("band speeds out of range", field="--band-speeds", value=n_speeds,
+                          expected="2 .. 2000 speeds")
+    return unc
+
+
 def lobes_band(cfg: Any, structure: Any, process: Any, speeds: Any, plot: Path | None,
                source: str, show: bool) -> dict[str, Any]:
     """``lobes --band``: the band of :func:`robobore.dynamics.band.modal_band` from the
@@ -137,16 +153,7 @@ def lobes_band(cfg: Any, structure: Any, process: Any, speeds: Any, plot: Path |
     from robobore.clitools import progress_bar
     from robobore.dynamics.band import band_evaluations, modal_band, modal_covariance
 
-    unc = None if cfg.equivalent is None else cfg.equivalent.uncertainty
-    if not unc:
-        raise ConfigError("no uncertainty to draw a band from", file=source,
-                          field="equivalent.uncertainty",
-                          expected="an equivalent model with 95 % ranges (model equivalent "
-                                   "from modes with intervals, or calibrate dynamics' "
-                                   "equivalent_corrected.json)")
-    if not 2 <= len(speeds) <= 2000:
-        raise ConfigError("band speeds out of range", field="--band-speeds", value=len(speeds),
-                          expected="2 .. 2000 speeds")
+    unc = band_uncertainty(cfg, source, len(speeds))
     n = band_evaluations(modal_covariance(unc)[0]) * len(speeds)
     with progress_bar("band (modal intervals)", n, show) as adv:
         b = modal_band(structure, process, speeds, unc,

@@ -114,10 +114,10 @@ __all__ = ["plot_lobes", "plot_simulation"]
 
 
 def plot_band(band, out_dir: str | Path, nominal_m=None, observations=(),
-              name: str = "lobes_band.png", title: str = "") -> Path:
+              name: str = "lobes_band.png", title: str = "", truth_m=None) -> Path:
     """Lobes with their confidence band: the probability of chatter over speed x depth
-    (shaded), the critical depth's 5/50/95 % and, when given, the nominal lobes and the observed
-    cuts (x chatter, o stable)."""
+    (shaded), the critical depth's 5/50/95 % and, when given, the nominal lobes, a SYNTHETIC
+    truth's and the observed cuts (x chatter, o stable)."""
     plt = _plt()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -133,6 +133,9 @@ def plot_band(band, out_dir: str | Path, nominal_m=None, observations=(),
     if nominal_m is not None:
         ax.plot(s, np.asarray(nominal_m) * 1e3, color="k", ls="--", lw=1.0,
                 label="nominal model")
+    if truth_m is not None:
+        ax.plot(s, np.asarray(truth_m) * 1e3, color="tab:green", lw=1.2,
+                label="SYNTHETIC truth")
     obs = list(observations)
     if obs:
         ch = [o for o in obs if o.chatter]
