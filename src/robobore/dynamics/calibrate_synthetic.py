@@ -131,4 +131,21 @@ def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (20
 
 __all__ = ["truth_structure", "synthetic_observations", "validate_seed", "validation_case", "ValidationRun",
            "TRUTH_DAMPING_FACTOR", "TRUTH_STIFFNESS_FACTOR", "TRUTH_STIFFNESS_AXIS", "N_CUTS",
-           "N_HELD_OUT", "LABEL_NOISE"]
+           "N_HELD_OUT", "LABEL_NOISE", "write_example_observations"]
+
+
+def write_example_observations(path: Any, config: Any, seed: int = 0) -> Any:
+    """Write the SYNTHETIC cuts of ``seed`` (:func:`synthetic_observations`) as an observations
+    CSV with a header saying what they are (the bundled ``examples/boring_paper_cuts.csv``)."""
+    from robobore.dynamics.calibrate import write_observations_csv
+    from robobore.dynamics.config import load_dynamics_config
+
+    cfg, _ = load_dynamics_config(config) if not hasattr(config, "equivalent") else (config, 0)
+    problem = build_problem(cfg, [Observation(1, 1000.0, 1e-3, False)])
+    obs, _, _ = synthetic_observations(problem, (200.0, 3000.0), seed)
+    return write_observations_csv(path, obs, (
+        f"SYNTHETIC observed cuts (seed {seed}): robobore.dynamics.calibrate_synthetic\n"
+        f"truth: the config's robot with damping x{TRUTH_DAMPING_FACTOR} and "
+        f"{'xyz'[TRUTH_STIFFNESS_AXIS]} stiffness x{TRUTH_STIFFNESS_FACTOR}; labels flipped "
+        f"with probability {LABEL_NOISE}\n"
+        "made by: write_example_observations(path, 'examples/boring_paper.toml', seed)"))
