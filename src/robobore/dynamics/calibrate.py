@@ -22,7 +22,10 @@ Posterior: maximum a posteriori and the Laplace approximation (MacKay 2003, *Inf
 Theory, Inference, and Learning Algorithms*, ch. 27; Bishop 2006, *Pattern Recognition and
 Machine Learning*, section 4.4) on the log factors, with the predictions linearised about the
 current estimate and re-linearised until the estimate stops moving (Gauss-Newton iteration of
-the iterated extended Kalman filter, Bell & Cathey 1993). Process damping
+the iterated extended Kalman filter, Bell & Cathey 1993), the first linearisations with a
+wider verdict spread (:data:`SPREAD_SCHEDULE`). Priors: Gaussian in the log factors, centred on
+1, correlated within the damping and within the stiffness group (:class:`LikelihoodSettings`).
+Process damping
 (``c = C a / v``, Altintas, Eynian & Onozuka 2008, added to the units' damping as the
 revolution average of a radial damper) is kept only when it lowers the Bayesian information
 criterion ``BIC = -2 ln L + p ln n`` (Schwarz 1978).

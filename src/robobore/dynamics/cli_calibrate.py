@@ -105,13 +105,21 @@ def calibrate_dynamics_cmd(
         n_ch = sum(o["verdict"] == "chatter" for o in r["observations"])
         rows.append(("observations (chatter / all)", f"{n_ch} / {len(r['observations'])}"))
         b = r["band"]
-        i = int(np.argmin(b["critical_depth_p50_mm"]))
+        from robobore.dynamics.band import DEPTH_FLOOR_M
+
+        med = np.asarray(b["critical_depth_p50_mm"])
+        floor = med <= DEPTH_FLOOR_M * 1e3 * (1 + 1e-9)
+        i = int(np.argmin(np.where(floor, np.inf, med))) if not floor.all() else 0
+        if floor.any():
+            rows.append(("speeds unstable at vanishing depth (median at the scan's bottom)",
+                         f"{int(floor.sum())} of {med.size}"))
         rows.append(("lowest median critical depth (mm)",
                      f"{fmt(b['critical_depth_p50_mm'][i])} [90 %: "
                      f"{fmt(b['critical_depth_p05_mm'][i])} .. "
                      f"{fmt(b['critical_depth_p95_mm'][i])}] at {fmt(b['speed_rpm'][i])} r/min"))
-        rows.append(("lowest nominal critical depth (mm)",
-                     fmt(min(r["nominal_critical_depth_mm"]))))
+        nom = np.asarray(r["nominal_critical_depth_mm"])
+        nom = nom[nom > DEPTH_FLOOR_M * 1e3 * (1 + 1e-9)]
+        rows.append(("lowest nominal critical depth (mm)", fmt(nom.min()) if nom.size else "-"))
         rows.append(("run time (s)", fmt(r["seconds"])))
         for f in r.get("files", []):
             rows.append(("written", f))
