@@ -89,6 +89,7 @@ def test_read_only_folder_is_refused(tmp_path, monkeypatch):
     (["sweep", EX / "sweep_demo.toml", "--out", "{file}"], "--out"),
     (["paper", "--fast", "--out", "{file}"], "--out"),
     (["calibrate", "forces", "--out", "{dir}"], "--out"),
+    (["calibrate", "dynamics", EX / "boring_paper.toml", "--out", "{file}"], "--out"),
     (["fe", "orthogonal", EX / "fe_orthogonal.toml", "--out", "{dir}"], "--out"),
     (["fe", "orthogonal", EX / "fe_orthogonal.toml", "--vtk", "{file}"], "--vtk"),
     (["fe", "boring", EX / "fe_boring_paper.toml", "--vtk", "{file}"], "--vtk"),

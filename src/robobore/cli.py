@@ -45,6 +45,7 @@ STAGE_CLIS = [
     "robobore.robot.cli",
     "robobore.modal.cli",
     "robobore.dynamics.cli",
+    "robobore.dynamics.cli_calibrate",
     "robobore.cutting.fe.cli",
     "robobore.study.cli",
     "robobore.plan.cli",

@@ -338,8 +338,9 @@ class EquivalentModel:
     identity: dict[str, Any] = field(default_factory=dict)
     #: 95 % ranges per axis propagated from the modes' intervals (empty when the modes carry
     #: none): ``{axis: {"frequency_Hz": [lo, hi], "damping_ratio": [..], "mass_kg": [..],
-    #: "damping_N_s_per_m": [..]}}``; not part of :meth:`to_dict` (the dict form is the
-    #: stability stage's contract, whose keys are fixed)
+    #: "damping_N_s_per_m": [..]}}``, or the posterior ranges of ``calibrate dynamics``
+    #: (``damping_ratio``, ``stiffness_N_per_m``); in :meth:`to_dict` under ``uncertainty``
+    #: when not empty, and what ``lobes --band`` draws its band from
     uncertainty: dict[str, dict[str, list[float]]] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ construction
@@ -353,6 +354,7 @@ class EquivalentModel:
         frame: np.ndarray | None = None,
         foot: PressureFoot | None = None,
         notes: tuple[str, ...] = (),
+        uncertainty: dict[str, dict[str, list[float]]] | None = None,
     ) -> EquivalentModel:
         """Plain constructor from numbers.
 
@@ -397,7 +399,8 @@ class EquivalentModel:
                          f"k_t = {foot.tangential_stiffness():.3e} N/m (assumed contact model)")
         return cls(stiffness_N_per_m=k, frequency_Hz=fn, damping_ratio=z,
                    frame=tuple(tuple(float(v) for v in row) for row in R), foot=foot,
-                   notes=tuple(notes))
+                   notes=tuple(notes),
+                   uncertainty=check_uncertainty(uncertainty) if uncertainty else {})
 
     @classmethod
     def from_stiffness_and_modes(
@@ -553,7 +556,10 @@ class EquivalentModel:
                 "frame": [list(r) for r in self.frame],
                 "foot": None if self.foot is None else self.foot.to_dict(),
                 "notes": list(self.notes),
-                "identity": dict(self.identity) if self.identity else None}
+                "identity": dict(self.identity) if self.identity else None,
+                **({"uncertainty": {a: {k: list(v) for k, v in u.items()}
+                                    for a, u in self.uncertainty.items()}}
+                   if self.uncertainty else {})}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], source: str = "<equivalent model>"
@@ -591,8 +597,44 @@ class EquivalentModel:
         ident = read_identity(d, source) or {}
         frame = d.get("frame", np.eye(3).tolist())
         foot = None if d.get("foot") is None else PressureFoot.from_dict(d["foot"])
+        unc = d.get("uncertainty")
         return cls(k, f, z, tuple(tuple(float(v) for v in r) for r in frame), foot,
-                   tuple(d.get("notes", ())), ident)
+                   tuple(d.get("notes", ())), ident,
+                   check_uncertainty(unc) if unc else {})
+
+
+#: Keys an axis of :attr:`EquivalentModel.uncertainty` may carry (each a ``[lo, hi]`` range).
+UNCERTAINTY_KEYS = ("frequency_Hz", "damping_ratio", "stiffness_N_per_m", "mass_kg",
+                    "damping_N_s_per_m")
+
+
+def check_uncertainty(unc: Any) -> dict[str, dict[str, list[float]]]:
+    """The ``uncertainty`` block checked: ``{axis: {key: [lo, hi]}}`` over the axes x, y, z
+    and :data:`UNCERTAINTY_KEYS`, ``0 <= lo <= hi`` finite; a ``ConfigError`` naming the key
+    otherwise."""
+    exp = "{axis: {key: [lo, hi]}} with axes x, y, z and keys " + ", ".join(UNCERTAINTY_KEYS)
+    if not isinstance(unc, dict):
+        raise ConfigError("not a table", field="uncertainty", value=type(unc).__name__,
+                          expected=exp)
+    out: dict[str, dict[str, list[float]]] = {}
+    for a, u in unc.items():
+        if a not in AXES or not isinstance(u, dict):
+            raise ConfigError("not an axis table", field=f"uncertainty.{a}", expected=exp)
+        out[a] = {}
+        for key, rng in u.items():
+            where = f"uncertainty.{a}.{key}"
+            if key not in UNCERTAINTY_KEYS:
+                raise ConfigError("unknown key", field=where, expected=exp)
+            try:
+                lo, hi = (float(v) for v in rng)
+            except (TypeError, ValueError):
+                raise ConfigError("not a [lo, hi] range", field=where, value=rng,
+                                  expected="two numbers lo <= hi") from None
+            if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo <= hi):
+                raise ConfigError("not a range", field=where, value=rng,
+                                  expected="finite 0 <= lo <= hi")
+            out[a][key] = [lo, hi]
+    return out
 
 
 def _mode_direction(md: dict[str, Any], signed: bool = False) -> np.ndarray | None:
@@ -679,4 +721,5 @@ def principal_frame(stiffness_matrix: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 __all__ = ["EquivalentModel", "PressureFoot", "DirectionUnit", "assign_modes",
            "principal_frame", "AXES", "EquivalentWarning", "check_same_robot",
-           "stiffness_mismatch_notes", "STIFFNESS_MISMATCH_FACTOR"]
+           "stiffness_mismatch_notes", "STIFFNESS_MISMATCH_FACTOR", "check_uncertainty",
+           "UNCERTAINTY_KEYS"]

@@ -56,6 +56,9 @@ def lobes_cmd(
     modes_file: Path | None = MODES_FILE_OPTION,
     equivalent_file: Path | None = EQUIVALENT_FILE_OPTION,
     plot: Path | None = typer.Option(None, "--plot", help="Write lobes.png into this folder."),
+    band: bool = typer.Option(False, "--band", help="Add the 90 % band from the equivalent "
+                              "model's uncertainty (modes' intervals or calibrate dynamics)."),
+    band_speeds: int = typer.Option(40, "--band-speeds", help="Speeds of the band."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Stability lobes: critical depth of cut vs spindle speed."""
@@ -79,6 +82,10 @@ def lobes_cmd(
     pr = build_process(cfg, src, coefficients=coef)
     sp, default_note = speed_range(cfg)
     speeds = np.linspace(sp.min, sp.max, sp.count)
+    if band:
+        from robobore.dynamics.cli_calibrate import band_uncertainty
+
+        band_uncertainty(cfg, src, band_speeds)
     if method not in ("frequency", "semidiscretization"):
         raise ConfigError("unknown method", field="--method", value=method,
                           expected="frequency or semidiscretization")
@@ -139,6 +146,11 @@ def lobes_cmd(
     if plot is not None:
         curves = stability.lobe_curves(st, pr, 12) if method == "frequency" else None
         out["plot"] = str(stability_plot(res, plot, curves, pr.label))
+    if band:
+        from robobore.dynamics.cli_calibrate import lobes_band
+
+        out["band"] = lobes_band(cfg, st, pr, np.linspace(sp.min, sp.max, band_speeds), plot,
+                                 src, not as_json)
 
     def render(r: dict[str, Any]) -> None:
         d = np.asarray(res.critical_depth_m) * 1e3

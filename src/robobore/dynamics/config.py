@@ -121,6 +121,8 @@ class EquivalentCfg(StrictModel):
     frame: list[list[float]] | None = None
     # the stiffness/frequency/damping already include a pressure foot (equivalent JSON)
     foot_included: bool = False
+    # 95 % ranges per axis ({axis: {key: [lo, hi]}}, EquivalentModel.uncertainty): `lobes --band`
+    uncertainty: dict[str, dict[str, list[float]]] | None = None
 
     @field_validator("stiffness_N_per_m", "frequency_Hz")
     @classmethod
@@ -148,7 +150,7 @@ class EquivalentCfg(StrictModel):
             damping_N_s_per_m=self.damping_N_s_per_m,
             frame=None if self.frame is None else np.asarray(self.frame, float),
             foot=None if self.pressure_foot is None else self.pressure_foot.to_foot(),
-            notes=(self.note,) if self.note else ())
+            notes=(self.note,) if self.note else (), uncertainty=self.uncertainty or {})
 
 
 class ProcessCfg(StrictModel):
@@ -287,8 +289,17 @@ class ModelFilesCfg(StrictModel):
     damping_N_s_per_m: float | None = Field(None, ge=0)
 
 
+class CalibrationCfg(StrictModel):
+    """``[calibration]``: the observed cuts of ``calibrate dynamics`` (a CSV, relative to the
+    TOML) and the verdicts' label-noise rate."""
+
+    observations: str | None = None
+    label_noise: float | None = Field(None, ge=0, lt=0.5)
+
+
 class DynamicsConfig(StrictModel):
     model: ModelFilesCfg | None = None
+    calibration: CalibrationCfg | None = None
     structure: StructureCfg | None = None
     equivalent: EquivalentCfg | None = None
     process: ProcessCfg | None = None

@@ -16,7 +16,7 @@ from robobore.errors import ConfigError, InputError
 #: the keys of :meth:`robobore.equivalent.EquivalentModel.to_dict` (``model equivalent --json``)
 EQUIVALENT_KEYS = frozenset({"stiffness_N_per_m", "frequency_Hz", "damping_ratio", "mass_kg",
                               "damping_N_s_per_m", "frame", "foot", "notes",
-                              "identity"})
+                              "identity", "uncertainty"})
 
 
 def equivalent_arg(equivalent: Any, name: str = "equivalent"):
@@ -48,7 +48,9 @@ def equivalent_section(em: Any, note: str) -> dict[str, Any]:
             "damping_ratio": dict(em.damping_ratio),
             "frame": [list(r) for r in em.frame],
             "foot_included": em.foot is not None,
-            "note": note}
+            "note": note,
+            **({"uncertainty": {a: dict(v) for a, v in em.uncertainty.items()}}
+               if em.uncertainty else {})}
 
 
 def equivalent_extras(raw: dict[str, Any], given_twice: str, otherwise: str,

@@ -111,3 +111,50 @@ def plot_simulation(ds, out_dir: str | Path) -> list[Path]:
 
 
 __all__ = ["plot_lobes", "plot_simulation"]
+
+
+def plot_band(band, out_dir: str | Path, nominal_m=None, observations=(),
+              name: str = "lobes_band.png", title: str = "", truth_m=None) -> Path:
+    """Lobes with their confidence band: the probability of chatter over speed x depth
+    (shaded), the critical depth's 5/50/95 % and, when given, the nominal lobes, a SYNTHETIC
+    truth's and the observed cuts (x chatter, o stable)."""
+    plt = _plt()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    s = band.speed_rpm
+    dep = band.depth_m * 1e3
+    pc = ax.pcolormesh(s, dep, band.p_chatter.T, cmap="Reds", vmin=0.0, vmax=1.0,
+                       shading="nearest", alpha=0.6)
+    fig.colorbar(pc, ax=ax, label="P(chatter)")
+    ax.fill_between(s, band.lower_m * 1e3, band.upper_m * 1e3, color="tab:blue", alpha=0.2,
+                    label="critical depth 5-95 %")
+    ax.plot(s, band.median_m * 1e3, color="tab:blue", lw=1.5, label="critical depth 50 %")
+    if nominal_m is not None:
+        ax.plot(s, np.asarray(nominal_m) * 1e3, color="k", ls="--", lw=1.0,
+                label="nominal model")
+    if truth_m is not None:
+        ax.plot(s, np.asarray(truth_m) * 1e3, color="tab:green", lw=1.2,
+                label="SYNTHETIC truth")
+    obs = list(observations)
+    if obs:
+        ch = [o for o in obs if o.chatter]
+        st = [o for o in obs if not o.chatter]
+        if ch:
+            ax.plot([o.speed_rpm for o in ch], [o.depth_m * 1e3 for o in ch], "x",
+                    color="darkred", ms=8, mew=2, label="observed: chatter")
+        if st:
+            ax.plot([o.speed_rpm for o in st], [o.depth_m * 1e3 for o in st], "o",
+                    mfc="none", color="darkgreen", ms=7, mew=1.5, label="observed: stable")
+    ax.set_yscale("log")
+    ax.set_ylim(dep.min(), dep.max())
+    ax.set_xlim(s.min(), s.max())
+    ax.set_xlabel("spindle speed [r/min]")
+    ax.set_ylabel("depth of cut [mm]")
+    ax.set_title(title or f"stability lobes with the 90 % band ({band.source})")
+    ax.legend(loc="lower right", fontsize=7)
+    fig.tight_layout()
+    path = out / name
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+    return path

@@ -456,6 +456,9 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     advance = _stage(progress, "lobes, comparison, report", 3)
     t = time.perf_counter()
     lob = compute_lobes(cfg, robot_model)
+    from robobore.study.paper_calibration import paper_calibration
+
+    calib = paper_calibration(cfg, cfg_path, robot_model, outdir)  # None without observations
     lap("lobes", t)
     advance(1)
     t = time.perf_counter()
@@ -510,6 +513,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         "lobe_consistency": consistency,
         "robobore_version": __version__,
         "posture_plan": summary_posture,
+        "calibration": calib,
     }
     rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
                        rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,

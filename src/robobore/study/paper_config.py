@@ -96,6 +96,8 @@ class CoefficientsSection(StrictModel):
 
 class MeasuredSection(StrictModel):
     file: str | None = None
+    # observed cuts (calibrate dynamics CSV): the report shows the corrected lobes' band
+    observations: str | None = None
     truth_note: str = ""
 
 

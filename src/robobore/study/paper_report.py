@@ -373,6 +373,16 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                        f"{cons.get('consistent', 0)} of {cons.get('checked', 0)} consistent, "
                        f"{cons.get('nonlinear', 0)} with the tool leaving the cut.")
         plt.close(fig)
+        cal = summary.get("calibration")
+        if cal:  # [measured] observations: the lobes corrected by the observed cuts
+            rep.add_image_png(Path(cal["plot"]).read_bytes(), "Lobes corrected by "
+                              f"{cal['cuts']} observed cuts (calibrate dynamics): critical "
+                              "depth 5/50/95 % and P(chatter), the cuts marked.")
+            lo, med, hi = cal["lowest_critical_depth_mm"]
+            rep.add_key_values({"corrected lowest critical depth (mm), 90 %":
+                                f"{med:.3g} [{lo:.3g} .. {hi:.3g}] at "
+                                f"{cal['at_speed_rpm']:.0f} r/min; " + ", ".join(
+                                    f"{k} {v:.3g}" for k, v in cal["factors"].items())})
         for x in cons.get("inconsistent", []):
             rep.add_text(f"Lobes and verdict disagree at n {x['speed_rpm']:g} r/min, "
                          f"P {x['pressure_MPa']:g} MPa, ap {x['depth_mm']:g} mm: {x['side']} "

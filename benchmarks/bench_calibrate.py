@@ -1,0 +1,81 @@
+"""Benchmark of ``calibrate dynamics`` (not a test): the SYNTHETIC validation over seeds.
+
+Truth robot (robobore.dynamics.calibrate_synthetic): the example robot of
+examples/boring_paper.toml with damping x0.6 in every direction and the x stiffness x1.3;
+12 observed cuts per seed (one speed per twelfth of 200-3000 r/min, depth within x/ 1.35 of
+the truth's limit, labels flipped with probability 0.1); 24 held-out speeds. Prints per seed
+and over all seeds: the share of held-out speeds whose corrected median critical depth is
+within 10 % of the truth (goal: all), the 90 % band's coverage of the truth (goal >= 85 %), the
+median relative error of the corrected and the uncorrected model, and the calibration's wall
+and CPU time on 12 observations (goal: under 1 min on 2 cores).
+
+Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_calibrate.py [--seeds 10] [--first 0]
+     [--json FILE] [--plot DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from robobore.dynamics.calibrate_synthetic import validate_seed, validation_case
+from robobore.dynamics.config import load_dynamics_config
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first", type=int, default=0)
+    ap.add_argument("--config", default=str(ROOT / "examples" / "boring_paper.toml"))
+    ap.add_argument("--json", default=None, help="write the per-seed results here")
+    ap.add_argument("--plot", default=None, help="write the first seed's band figure here")
+    args = ap.parse_args()
+    cfg, _ = load_dynamics_config(args.config)
+    case = validation_case(cfg, args.first)  # compiles the kernels (numba cache) first
+    if args.plot:
+        from robobore.dynamics.plots import plot_band
+
+        cal = case["calibration"]
+        p = plot_band(cal.band, args.plot, cal.nominal_m, case["observations"],
+                      name=f"calibrate_synthetic_seed{args.first}.png", truth_m=case["truth"],
+                      title=f"SYNTHETIC seed {args.first}: corrected lobes, 90 % band, truth")
+        print(f"figure: {p}")
+    runs = []
+    print(f"SYNTHETIC calibration validation, {args.config}, NUMBA_NUM_THREADS="
+          f"{os.environ.get('NUMBA_NUM_THREADS', '-')}, {os.cpu_count()} CPUs")
+    print(f"{'seed':>4} {'within10%':>9} {'cover90':>8} {'err corr':>8} {'err nom':>8} "
+          f"{'flip':>4} {'wall s':>7} {'cpu s':>6}")
+    for seed in range(args.first, args.first + args.seeds):
+        r = validate_seed(cfg, seed)
+        runs.append(r)
+        print(f"{seed:4d} {r.within_10pct:9.2f} {r.coverage_90:8.2f} "
+              f"{r.median_error_corrected:8.3f} {r.median_error_uncorrected:8.3f} "
+              f"{r.flipped:4d} {r.seconds:7.1f} {r.cpu_seconds:6.1f}", flush=True)
+    w = np.array([r.within_10pct for r in runs])
+    c = np.array([r.coverage_90 for r in runs])
+    ec = np.array([r.median_error_corrected for r in runs])
+    eu = np.array([r.median_error_uncorrected for r in runs])
+    wu = np.array([r.within_10pct_uncorrected for r in runs])
+    t = np.array([r.seconds for r in runs])
+    cpu = np.array([r.cpu_seconds for r in runs])
+    print(f"over {len(runs)} seeds x 24 held-out speeds:")
+    print(f"  corrected within 10 % of the truth: {w.mean():.1%} of speeds "
+          f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}")
+    print(f"  90 % band covers the truth: {c.mean():.1%} (seeds: min {c.min():.0%})")
+    print(f"  median relative error: corrected {np.median(ec):.3f}, uncorrected "
+          f"{np.median(eu):.3f}")
+    print(f"  calibrate (12 observations, band at 24 speeds): wall {np.median(t):.1f} s median "
+          f"(max {t.max():.1f}), CPU {np.median(cpu):.1f} s median; "
+          f"{len(runs) / t.sum() * 60:.2f} calibrations per minute")
+    if args.json:
+        Path(args.json).write_text(json.dumps([r.to_dict() for r in runs], indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
