@@ -279,11 +279,16 @@ class CoefficientsCfg(_Strict):
             raise ValueError("speed_dependent = false applies to calibrated coefficients (file "
                              "or inline per_speed_fits); the measured TC4 default is always "
                              "interpolated at the cutting speed")
-        if self.material is not None and self.material.upper() not in ("TC4", "TI6AL4V",
-                                                                         "TI-6AL-4V"):
+        from robobore.cutting.forces import TC4_FE_NAMES, TC4_NAMES
+
+        if self.material is not None and self.material.upper() not in TC4_NAMES + TC4_FE_NAMES:
             raise ValueError(f"unknown material {self.material!r}; expected 'TC4' (Ti-6Al-4V, "
-                             "the measured default), or a coefficients file / inline "
+                             "the measured default), 'TC4-FE' (the paper example's "
+                             "FE-calibrated set, opt-in), or a coefficients file / inline "
                              "Ktc_N_per_m2 for another material")
+        if self.material is not None and self.material.upper() in TC4_FE_NAMES and self.oblique:
+            raise ValueError("oblique applies to the measured TC4 default; the FE-calibrated "
+                             "'TC4-FE' set is for the paper's insert (inclination 0)")
         return self
 
 
@@ -475,7 +480,9 @@ def cutting_speed_m_per_min(cfg: DynamicsConfig) -> float | None:
 
 def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
     """The cutting coefficients of ``[coefficients]`` at the config's cutting speed pi D n:
-    the measured TC4 default interpolated at vc; a calibration (file, or inline values with
+    the measured TC4 default interpolated at vc (``material = "TC4"``, also without a
+    ``[coefficients]`` section); the paper example's FE-calibrated set with
+    ``material = "TC4-FE"`` (opt-in; warned outside its 37.7 m/min); a calibration (file, or inline values with
     ``per_speed_fits``) with fits at several speeds evaluated at vc
     (:func:`robobore.cutting.forces.coefficients_at_speed`; ``speed_dependent = false``: the
     pooled set); inline values as given."""
@@ -483,6 +490,8 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
 
     c = cfg.coefficients
     vc = cutting_speed_m_per_min(cfg)
+    if c is not None and c.material is not None and c.material.upper() in forces.TC4_FE_NAMES:
+        return forces.tc4_fe_coefficients(vc)
     if c is None or c.material is not None:
         if c is not None and c.oblique:
             return forces.ti64_oblique_coefficients(cfg.insert.to_insert(),
