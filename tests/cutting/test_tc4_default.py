@@ -157,3 +157,18 @@ def test_measured_set_predicts_real_forces_better_than_the_fe_set():
     assert max(loto_c) < 0.07 and max(loto_f) < 0.10
     assert np.mean(loto_f) < 0.5 * np.mean(fe_f)
     assert max(fe_f) > 0.15
+
+
+def test_a_coefficients_file_content_passed_inline_keeps_its_domain():
+    """The studies (paper, sweep) pass a calibration inline (``inline_coefficients``): its
+    ``grid`` goes with it, so their per-condition runs carry the same warnings as the file."""
+    content = forces.read_coefficients_file(forces.TC4_FE_FILE)
+    inline = forces.inline_coefficients(content)
+    assert inline["grid"]["cutting_speed_m_per_min"] == [37.7]
+    for n in (150.0, 300.0):
+        by_file = run_boring(_cfg({"material": "TC4-FE"}, n, feed=0.5))["warnings"]
+        by_inline = run_boring(_cfg(inline, n, feed=0.5))["warnings"]
+        by_content = run_boring(_cfg(content, n, feed=0.5))["warnings"]
+        assert by_file == by_inline == by_content
+        assert any("chip thicknesses 60-90 um" in w for w in by_file)
+        assert any("37.7 m/min" in w for w in by_file) == (n == 150.0)

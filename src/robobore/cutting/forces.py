@@ -322,6 +322,11 @@ def inline_coefficients(data: dict[str, Any], speed_dependent: bool = True) -> d
     with ``speed_dependent`` False the table says ``speed_dependent = false``)."""
     inner = data.get("coefficients", data)
     out = {k: v for k, v in inner.items() if k.startswith("K") or k == "provenance"}
+    g = data.get("grid")
+    if isinstance(g, dict):
+        out["grid"] = {k: [float(x) for x in g[k]] for k in
+                       ("uncut_chip_thickness_um", "cutting_speed_m_per_min")
+                       if isinstance(g.get(k), list)}
     fits = read_per_speed_fits(data)
     if len(fits) >= 2:
         base = CuttingCoefficients.from_dict(inner)

@@ -266,6 +266,10 @@ class CoefficientsCfg(_Strict):
     #: with per-speed fits at two or more speeds, evaluate them at the cutting speed pi D n
     #: (linear in ln(vc), held outside the calibrated speeds); false: the pooled set
     speed_dependent: bool = True
+    #: the calibration's grid (``uncut_chip_thickness_um``, ``cutting_speed_m_per_min``), inline
+    #: with the K values: the domain the set's warnings are judged on
+    #: (``robobore.cutting.forces.calibrated_domain``); from a ``file`` it is read from the file
+    grid: dict[str, list[float]] | None = None
 
     @model_validator(mode="after")
     def _one(self):
@@ -503,11 +507,13 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
                                         vc, speed_dependent=c.speed_dependent)
     d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
     d["provenance"] = c.provenance
+    data: dict[str, Any] = {"coefficients": d}
     if c.per_speed_fits is not None:
-        data = {"coefficients": d, "per_speed_fits": c.per_speed_fits}
-        return forces.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
-                                            source=source)
-    return forces.CuttingCoefficients.from_dict(d, source=source)
+        data["per_speed_fits"] = c.per_speed_fits
+    if c.grid is not None:
+        data["grid"] = c.grid
+    return forces.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
+                                        source=source)
 
 
 def lobe_coefficient_note(cfg: DynamicsConfig, coefficients: Any = None,
