@@ -348,10 +348,11 @@ def test_process_takes_the_cutting_stage_objects(chain):
     from robobore.cutting.forces import read_coefficients_file
 
     em = chain["robot"]
-    ref = api.stability_lobes(_process(), em, method="frequency")
+    ref = api.stability_lobes({**_process(), "coefficients": api.bundled_fe_coefficients()}, em,
+                              method="frequency")
     # one calibrated speed: the file's content, its set at any speed and the table agree
     for coef in (read_coefficients_file(api.bundled_coefficients_path()),
-                 api.cutting_coefficients(37.7)):
+                 api.cutting_coefficients(37.7, api.bundled_coefficients_path())):
         got = api.stability_lobes({**_process(), "coefficients": coef}, em, method="frequency")
         np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
     # a different set gives different lobes (the coefficients are used)
@@ -365,8 +366,10 @@ def test_process_takes_the_cutting_stage_objects(chain):
         api.stability_lobes({**_process(), "coefficients": 3.0}, em, method="frequency")
 
 
-def test_bundled_coefficients_are_the_stored_calibration():
-    c = api.bundled_coefficients()
-    assert c["Ktc_N_per_m2"] > 0 and c["Kfc_N_per_m2"] > 0 and "FE" in c["provenance"]
+def test_bundled_coefficients_are_the_measured_default_and_fe_is_opt_in():
+    assert api.bundled_coefficients() == {"material": "TC4"}
     k = api.cutting_coefficients(37.7)
-    assert k.Ktc > 0 and k.Kte > 0
+    assert k.Ktc > 0 and k.Kte > 0 and "measured orthogonal forces" in k.provenance
+    assert api.bundled_fe_coefficients() == {"material": "TC4-FE"}
+    fe = api.cutting_coefficients(37.7, api.bundled_coefficients_path())
+    assert "FE-calibrated" in fe.provenance and fe.warnings == ()

@@ -56,6 +56,23 @@ def test_kuka_like_robot_whole_chain(tmp_path):
     lob = _run(["lobes", EX / "boring_process.toml", "--equivalent-file",
                 tmp_path / "keq.json", "--method", "frequency", "--json"], tmp_path / "l.json")
     assert min(lob["critical_depth_mm"]) > 0
+    # a user's own robot at 380 r/min, ap 0.02 mm (below the depth where the forced vibration
+    # takes the tool out of the cut): no two samplings give contradicting decided verdicts
+    # (1266 samples/rev alone said chatter; the doubled run says otherwise, so it is undecided)
+    runs = []
+    for spr in ("1266", None, "4000"):
+        runs.append(_run(["simulate", "boring", EX / "boring_process.toml", "--equivalent-file",
+                          tmp_path / "keq.json", "--speed-rpm", "380", "--depth-mm", "0.02",
+                          "--json"] + ([] if spr is None else ["--samples-per-rev", spr]),
+                         tmp_path / "sim.json"))
+    decided = {r["chatter"] for r in runs if r["chatter_decided"]}
+    assert len(decided) == 1, [(r["samples_per_rev"], r["chatter"], r["chatter_decided"])
+                               for r in runs]
+    for r in runs:
+        sc = r["sampling_check"]
+        assert r["tool_leaves_cut"] and sc["samples_per_rev"] == 2 * r["samples_per_rev"]
+        assert r["chatter_decided"] == sc["agrees"]
+        assert sc["agrees"] or any("changes with the sampling" in w for w in r["reasons"])
     fk = _run(["robot", "fk", "--robot-file", KUKA, f"--joints-deg={Q}", "--json"],
               tmp_path / "fk.json")
     t = (EX / "plan_paper_bore.toml").read_text()
@@ -69,9 +86,11 @@ def test_kuka_like_robot_whole_chain(tmp_path):
     t = t.replace("rotation_step_deg = 1.0", "rotation_step_deg = 10.0")
     (tmp_path / "kplan.toml").write_text(re.sub(r"(?s)\[workspace\].*", "", t))
     # the planner's model of this ASSUMED robot calibrates poorly (its link data are guesses)
-    # and its map is flat (tool axis along the flange axis): said, but no mix-up warning
+    # and its map is flat (tool axis along the flange axis); the default TC4 coefficients are
+    # used above their measured speeds (37.7 vs 5-30 m/min): said, but no mix-up warning
     plan = _run(["plan", "posture", tmp_path / "kplan.toml", "--json"], tmp_path / "p.json",
-                allow=("calibration:", "the critical_depth criterion does not vary"))
+                allow=("calibration:", "the critical_depth criterion does not vary",
+                       "coefficients: cutting speed 37.7 m/min outside the measured"))
     assert plan["robot"] == "kr240-r2900"
     assert not any("may not belong together" in w for w in plan["warnings"])
     assert plan["measured"] is not None and plan["identity"]["synthetic"] is True

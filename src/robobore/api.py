@@ -59,7 +59,8 @@ def bundled_hammer_test_path() -> Path:
 
 
 def bundled_coefficients_path() -> Path:
-    """The paper example's stored FE-calibrated TC4 cutting coefficients (JSON)."""
+    """The paper example's stored FE-calibrated TC4 cutting coefficients (JSON; the opt-in
+    set, :func:`bundled_fe_coefficients`)."""
     return _data("paper_example", "tc4_fe_coefficients.json")
 
 
@@ -360,25 +361,35 @@ def equivalent_model(stiffness: Any, modes: Any, *, foot_pressure_MPa: float | N
 
 
 # ----------------------------------------------------------------------------- cutting
-def bundled_coefficients(speed_dependent: bool = True) -> dict[str, Any]:
-    """The paper example's FE-calibrated TC4 coefficients as the ``coefficients`` table of a
-    process config (Ktc, Krc, Kfc N/m^2, Kte, Kre, Kfe N/m, provenance, and the per-speed
-    fits that the boring model evaluates at each condition's cutting speed)."""
-    from robobore.cutting.forces import inline_coefficients, read_coefficients_file
+def bundled_coefficients() -> dict[str, Any]:
+    """The default TC4 coefficients as the ``coefficients`` table of a process config:
+    ``{"material": "TC4"}``, the fit of the measured orthogonal forces of Ducobu et al.
+    (CIRP 2022), interpolated at each condition's cutting speed, the same set as
+    ``material = "TC4"`` of the CLI configs (docs/process.md, "The TC4 coefficient sets":
+    why this one, and its domain 5-30 m/min, 40-80 um)."""
+    return {"material": "TC4"}
 
-    return inline_coefficients(read_coefficients_file(bundled_coefficients_path()),
-                               speed_dependent)
+
+def bundled_fe_coefficients() -> dict[str, Any]:
+    """The paper example's FE-calibrated TC4 set (opt-in) as the ``coefficients`` table of a
+    process config: ``{"material": "TC4-FE"}`` (the stored file
+    :func:`bundled_coefficients_path`). Calibrated at 37.7 m/min, h 60-90 um, for a 7 deg
+    rake: outputs at other speeds or thicker chips say so in their warnings."""
+    return {"material": "TC4-FE"}
 
 
 def cutting_coefficients(cutting_speed_m_per_min: float | None = None,
                          path: str | Path | None = None):
-    """Cutting coefficients of a coefficients file (None: the bundled FE-calibrated TC4
-    set) at a cutting speed [m/min] -> ``CuttingCoefficients`` (SI)."""
-    from robobore.cutting.forces import load_coefficients
+    """Cutting coefficients at a cutting speed [m/min] -> ``CuttingCoefficients`` (SI): of a
+    coefficients file, or (None) the default measured TC4 set at that speed (30 m/min, the
+    fastest measured, when no speed is given)."""
+    from robobore.cutting.forces import load_coefficients, ti64_coefficients
 
     v = _number_arg(cutting_speed_m_per_min, "cutting_speed_m_per_min", "m/min")
     path = _path_arg(path, "path")
-    return load_coefficients(bundled_coefficients_path() if path is None else path, v)
+    if path is None:
+        return ti64_coefficients(30.0 if v is None else v)
+    return load_coefficients(path, v)
 
 
 # ----------------------------------------------------------------------------- dynamics
@@ -415,7 +426,8 @@ def stability_lobes(process: Any, equivalent: Any = None, *,
 
 
 __all__ = ["DEFAULT_ROBOT", "PAPER_POSTURE_DEG", "PAPER_BAND_HZ", "bundled_campaign_path",
-           "bundled_hammer_test_path", "bundled_coefficients_path", "load_campaign",
+           "bundled_hammer_test_path", "bundled_coefficients_path", "bundled_fe_coefficients",
+           "load_campaign",
            "identify_joint_stiffness", "stiffness_at_pose", "directional_stiffness",
            "load_hammer_test", "frf", "cmif", "identify_modes", "equivalent_model",
            "bundled_coefficients", "cutting_coefficients", "simulate_boring",

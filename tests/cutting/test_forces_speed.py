@@ -172,12 +172,15 @@ def test_inline_per_speed_fits_as_the_paper_study_passes_them(tmp_path):
 
 def test_bundled_paper_calibration_has_one_speed_so_the_study_uses_its_one_set():
     """The bundled file has one speed (37.7 m/min): the inline table is the coefficients as
-    they are (no per-speed fits), so the paper study's conditions are unchanged."""
+    they are (no per-speed fits), so the paper study's conditions are unchanged; the
+    calibration's grid goes with them (the domain of their warnings)."""
     from robobore.study.paper_config import example_dir
 
     d = read_coefficients_file(example_dir() / "tc4_fe_coefficients.json")
     assert list(d["per_speed_fits"]) == ["37.7"]
-    assert inline_coefficients(d) == dict(d["coefficients"])
+    inline = inline_coefficients(d)
+    assert inline.pop("grid") == d["grid"]
+    assert inline == dict(d["coefficients"])
 
 
 def test_speed_dependent_false_with_the_measured_default_is_refused(tmp_path):

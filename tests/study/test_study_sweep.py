@@ -101,6 +101,26 @@ def _unstorable(condition, context):
     return xr.Dataset({"stable": ((), True)}, attrs={"nested": {"not": "netCDF"}})
 
 
+def _warned(condition, context):
+    w = ("cutting speed 37.7 m/min outside the measured 5-30 m/min"
+         if condition["speed_rpm"] > 250 else "")
+    return xr.Dataset({"stable": ((), True)},
+                      attrs={"coefficient_warnings": "; ".join(x for x in (
+                          w, "chip thicknesses 40-80 um, used up to 95 um") if x)})
+
+
+def test_coefficient_warnings_of_the_conditions_are_the_sweeps(tmp_path):
+    plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(200, 300),
+                                           feeds=(0.1,)))
+    out = run_sweep(plan, tmp_path / "a", workers=0, runner=_warned)
+    n = len(plan.items)
+    assert out.computed == n and out.to_dict()["warnings"] == list(out.warnings)
+    assert out.warnings == (f"coefficients ({n} of {n} conditions): chip thicknesses 40-80 um, "
+                            "used up to 95 um",
+                            f"coefficients ({n // 2} of {n} conditions): cutting speed 37.7 "
+                            "m/min outside the measured 5-30 m/min")
+
+
 def test_bad_runner_results_become_failures(tmp_path):
     plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(300,), feeds=(0.1,)))
     out = run_sweep(plan, tmp_path / "a", workers=0, runner=_not_a_dataset)

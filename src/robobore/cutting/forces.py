@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -232,9 +232,22 @@ def coefficients_at_speed(data: dict[str, Any], cutting_speed_m_per_min: float |
     """
     inner = data.get("coefficients", data)
     base = CuttingCoefficients.from_dict(inner, source=source)
+    h_rng, v_rng = calibrated_domain(data)
+    base = replace(base, chip_thickness_range_m=h_rng)
     fits = read_per_speed_fits(data, source)
     if len(fits) < 2:
-        return base
+        if v_rng is None or cutting_speed_m_per_min is None:
+            return base
+        vc = float(cutting_speed_m_per_min)
+        lo, hi = v_rng
+        if lo * (1 - SPEED_TOLERANCE) <= vc <= hi * (1 + SPEED_TOLERANCE):
+            return base
+        at = f"{lo:g} m/min" if hi == lo else f"{lo:g}-{hi:g} m/min"
+        w = (f"cutting speed {vc:.4g} m/min outside the calibrated speed{'' if hi == lo else 's'}"
+             f" {at} of the cutting coefficients: the set is used as calibrated there "
+             "(no speed dependence)")
+        return replace(base, provenance=base.provenance + "; " + w, warnings=(w,),
+                       speed_m_per_min=vc)
     speeds = np.array(list(fits))
     rng = f"{speeds[0]:g}-{speeds[-1]:g} m/min"
     why = None
@@ -250,7 +263,8 @@ def coefficients_at_speed(data: dict[str, Any], cutting_speed_m_per_min: float |
                 "are not used")
         return CuttingCoefficients(base.Ktc, base.Krc, base.Kfc, base.Kte, base.Kre, base.Kfe,
                                    provenance=base.provenance + "; " + note,
-                                   warnings=(note,) if speed_dependent else ())
+                                   warnings=(note,) if speed_dependent else (),
+                                   chip_thickness_range_m=h_rng)
     vc = float(cutting_speed_m_per_min)
     if not (math.isfinite(vc) and vc > 0):
         raise ConfigError("cutting speed must be positive and finite", file=source,
@@ -273,7 +287,32 @@ def coefficients_at_speed(data: dict[str, Any], cutting_speed_m_per_min: float |
         warnings = (w,)
     return CuttingCoefficients(Ktc=vals["Ktc_N_per_m2"], Krc=0.0, Kfc=vals["Kfc_N_per_m2"],
                                Kte=vals["Kte_N_per_m"], Kre=0.0, Kfe=vals["Kfe_N_per_m"],
-                               provenance=prov, warnings=warnings, speed_m_per_min=vq)
+                               provenance=prov, warnings=warnings, speed_m_per_min=vq,
+                               chip_thickness_range_m=h_rng)
+
+
+#: A cutting speed within this relative distance of a calibrated speed range counts as inside
+#: it (a 40 mm bore at 300 r/min cuts at 37.699 m/min; the paper's FE set is at 37.7).
+SPEED_TOLERANCE = 0.01
+
+
+def calibrated_domain(data: dict[str, Any]
+                      ) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
+    """``(chip thickness range [m], cutting speed range [m/min])`` a coefficients-file
+    content was calibrated over, from its ``grid`` (``uncut_chip_thickness_um``,
+    ``cutting_speed_m_per_min``, as ``robobore calibrate forces`` writes it); None where the
+    file does not say."""
+    g = data.get("grid") if isinstance(data, dict) else None
+    out: list[tuple[float, float] | None] = []
+    for key, scale in (("uncut_chip_thickness_um", 1e-6), ("cutting_speed_m_per_min", 1.0)):
+        v = g.get(key) if isinstance(g, dict) else None
+        try:
+            a = np.asarray(v, float).ravel() if v is not None else np.empty(0)
+        except (TypeError, ValueError):
+            a = np.empty(0)
+        a = a[np.isfinite(a) & (a > 0)]
+        out.append((float(a.min()) * scale, float(a.max()) * scale) if a.size else None)
+    return out[0], out[1]
 
 
 def inline_coefficients(data: dict[str, Any], speed_dependent: bool = True) -> dict[str, Any]:
@@ -283,6 +322,11 @@ def inline_coefficients(data: dict[str, Any], speed_dependent: bool = True) -> d
     with ``speed_dependent`` False the table says ``speed_dependent = false``)."""
     inner = data.get("coefficients", data)
     out = {k: v for k, v in inner.items() if k.startswith("K") or k == "provenance"}
+    g = data.get("grid")
+    if isinstance(g, dict):
+        out["grid"] = {k: [float(x) for x in g[k]] for k in
+                       ("uncut_chip_thickness_um", "cutting_speed_m_per_min")
+                       if isinstance(g.get(k), list)}
     fits = read_per_speed_fits(data)
     if len(fits) >= 2:
         base = CuttingCoefficients.from_dict(inner)
@@ -367,6 +411,22 @@ def ti64_coefficients(cutting_speed_m_per_min: float | None = 30.0) -> CuttingCo
 
 #: Uncut chip thicknesses [m] of the measured TC4 data the default coefficients are fitted to.
 TI64_CHIP_THICKNESS_M = (40e-6, 80e-6)
+
+#: The FE-calibrated TC4 set of the paper example (rake 7 deg, edge radius 20 um, h 60-90 um,
+#: 37.7 m/min): opt-in as ``material = "TC4-FE"``; the validated default is the measured set
+#: (:func:`ti64_coefficients`; the evidence: docs/process.md, "The TC4 coefficient sets").
+TC4_FE_FILE = Path(__file__).resolve().parents[1] / "data" / "paper_example" / \
+    "tc4_fe_coefficients.json"
+#: Names of the TC4 sets for ``[coefficients] material``: the measured default, the FE opt-in.
+TC4_NAMES = ("TC4", "TI6AL4V", "TI-6AL-4V")
+TC4_FE_NAMES = ("TC4-FE",)
+
+
+def tc4_fe_coefficients(cutting_speed_m_per_min: float | None = None) -> CuttingCoefficients:
+    """The paper example's FE-calibrated TC4 set (:data:`TC4_FE_FILE`), with the warning of a
+    cutting speed outside its calibrated 37.7 m/min and its chip-thickness range 60-90 um
+    (:meth:`CuttingCoefficients.domain_warnings`)."""
+    return load_coefficients(TC4_FE_FILE, cutting_speed_m_per_min)
 
 
 @dataclass(frozen=True)
@@ -526,5 +586,7 @@ __all__ = ["CuttingCoefficients", "load_coefficients", "coefficients_at_speed",
            "read_per_speed_fits", "inline_coefficients", "PER_SPEED_KEYS",
            "fit_linear_edge_model", "ducobu_fits",
            "ti64_coefficients", "orthogonal_parameters_from_data", "orthogonal_to_oblique",
+           "tc4_fe_coefficients", "calibrated_domain", "TC4_FE_FILE", "TC4_NAMES",
+           "TC4_FE_NAMES", "SPEED_TOLERANCE",
            "ti64_oblique_coefficients", "ElementForces", "element_forces",
            "rotating_to_boring", "boring_forces", "OrthogonalParameters"]

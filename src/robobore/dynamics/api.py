@@ -14,7 +14,10 @@ the process; a dict config's ``coefficients`` may be the cutting stage's
 The summary's verdicts (:mod:`robobore.dynamics.chatter`): ``chatter`` (the vibration
 grows from pitch to pitch: the Floquet multiplier of the simulated cut above 1, or a
 nonlinear cause named in ``chatter_cause``), ``chatter_decided`` (False when the multiplier is
-within its uncertainty of 1 even after the run was lengthened), ``surface_finish`` ("ok" /
+within its uncertainty of 1 even after the run was lengthened, or when the tool leaves the
+cut and the same run at twice the samples per revolution, ``sampling_check``, gives the other
+verdict: an interrupted cut whose nonsmooth force the time domain does not resolve),
+``surface_finish`` ("ok" /
 "rough": Ra after form removal against ``ra_tolerance_um``; None without a tolerance),
 ``tool_leaves_cut``, and ``stable``: the paper's criterion (vibratory when Ra exceeds the
 tolerance, the cut chatters or the run diverged; None without a tolerance otherwise), also
@@ -26,6 +29,7 @@ documented resolution (1 nm, :data:`robobore.dynamics.chatter.AMPLITUDE_RESOLUTI
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -154,6 +158,30 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
             break
         run_revs *= 2
     revs = run_revs
+    # where the tool leaves the cut the force is not smooth in the displacement and the
+    # verdict can depend on where the steps fall: the same run at twice the samples per
+    # revolution must agree, or the verdict is undecided (said, with both verdicts)
+    sampling_check = None
+    if v.tool_leaves_cut and not int(ds.attrs["diverged"]):
+        spr2 = 2 * int(ds.attrs["samples_per_rev"])
+        try:
+            v2 = classify(simulate(st, pr, SimulationSettings(float(n), a * 1e-3, run_revs,
+                                                              spr2), ins),
+                          ra_tolerance_m=None if tol is None else tol * 1e-6)
+        except ConfigError:  # the doubled run is over the size guard: no check
+            v2 = None
+        if v2 is not None:
+            sampling_check = {"samples_per_rev": spr2, "chatter": bool(v2.chatter),
+                              "agrees": bool(v2.chatter == v.chatter)}
+            if v2.chatter != v.chatter:
+                v = replace(v, chatter_decided=False, reasons=v.reasons + (
+                    f"undecided: the tool leaves the cut and the verdict changes with the "
+                    f"sampling ({'chatter' if v.chatter else 'no chatter'} at "
+                    f"{int(ds.attrs['samples_per_rev'])} samples per revolution, "
+                    f"{'chatter' if v2.chatter else 'no chatter'} at {spr2}): an interrupted, "
+                    "nonlinear cut that the time domain does not resolve; below the depth "
+                    "where the forced vibration leaves the cut (interrupted_below_mm of "
+                    "`robobore lobes`) the cut is not chatter-free",))
     s = summarize(ds)
     out: dict[str, Any] = {
         "stable": v.paper_stable,
@@ -163,6 +191,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         "tool_leaves_cut": v.tool_leaves_cut,
         "chatter_frequency_Hz": v.chatter_frequency_Hz,
         "chatter_decided": v.chatter_decided,
+        "sampling_check": sampling_check,
         "chatter_cause": v.chatter_cause,
         "floquet_multiplier": v.floquet_multiplier,
         "floquet_multiplier_se": v.floquet_multiplier_se,

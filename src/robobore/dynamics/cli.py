@@ -259,8 +259,11 @@ def simulate_boring_cmd(
         ch = "CHATTER" if r["chatter"] else "no"
         if r["chatter_cause"] not in (None, "regenerative"):
             ch += f" ({r['chatter_cause']})"
+        sc = r.get("sampling_check")
         if not r["chatter_decided"]:
-            ch += " (undecided: at the stability limit)"
+            ch += (" (undecided: changes with the sampling, see reasons)"
+                   if sc is not None and not sc["agrees"] else
+                   " (undecided: at the stability limit)")
         paper = {None: "not judged (no Ra tolerance)", True: "stable",
                  False: "VIBRATORY"}[r["stable"]]
         res_um = r["amplitude_resolution_um"]

@@ -241,6 +241,10 @@ class CoefficientsCfg(StrictModel):
     #: with per-speed fits at two or more speeds, evaluate them at the cutting speed pi D n
     #: (linear in ln(vc), held outside the calibrated speeds); false: the pooled set
     speed_dependent: bool = True
+    #: the calibration's grid (``uncut_chip_thickness_um``, ``cutting_speed_m_per_min``), inline
+    #: with the K values: the domain the set's warnings are judged on
+    #: (``robobore.cutting.forces.calibrated_domain``); from a ``file`` it is read from the file
+    grid: dict[str, list[float]] | None = None
 
     @model_validator(mode="after")
     def _one(self):
@@ -254,11 +258,16 @@ class CoefficientsCfg(StrictModel):
             raise ValueError("speed_dependent = false applies to calibrated coefficients (file "
                              "or inline per_speed_fits); the measured TC4 default is always "
                              "interpolated at the cutting speed")
-        if self.material is not None and self.material.upper() not in ("TC4", "TI6AL4V",
-                                                                         "TI-6AL-4V"):
+        from robobore.cutting.forces import TC4_FE_NAMES, TC4_NAMES
+
+        if self.material is not None and self.material.upper() not in TC4_NAMES + TC4_FE_NAMES:
             raise ValueError(f"unknown material {self.material!r}; expected 'TC4' (Ti-6Al-4V, "
-                             "the measured default), or a coefficients file / inline "
+                             "the measured default), 'TC4-FE' (the paper example's "
+                             "FE-calibrated set, opt-in), or a coefficients file / inline "
                              "Ktc_N_per_m2 for another material")
+        if self.material is not None and self.material.upper() in TC4_FE_NAMES and self.oblique:
+            raise ValueError("oblique applies to the measured TC4 default; the FE-calibrated "
+                             "'TC4-FE' set is for the paper's insert (inclination 0)")
         return self
 
 
@@ -459,7 +468,9 @@ def cutting_speed_m_per_min(cfg: DynamicsConfig) -> float | None:
 
 def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
     """The cutting coefficients of ``[coefficients]`` at the config's cutting speed pi D n:
-    the measured TC4 default interpolated at vc; a calibration (file, or inline values with
+    the measured TC4 default interpolated at vc (``material = "TC4"``, also without a
+    ``[coefficients]`` section); the paper example's FE-calibrated set with
+    ``material = "TC4-FE"`` (opt-in; warned outside its 37.7 m/min); a calibration (file, or inline values with
     ``per_speed_fits``) with fits at several speeds evaluated at vc
     (:func:`robobore.cutting.forces.coefficients_at_speed`; ``speed_dependent = false``: the
     pooled set); inline values as given."""
@@ -467,6 +478,8 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
 
     c = cfg.coefficients
     vc = cutting_speed_m_per_min(cfg)
+    if c is not None and c.material is not None and c.material.upper() in forces.TC4_FE_NAMES:
+        return forces.tc4_fe_coefficients(vc)
     if c is None or c.material is not None:
         if c is not None and c.oblique:
             return forces.ti64_oblique_coefficients(cfg.insert.to_insert(),
@@ -478,11 +491,13 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
                                         vc, speed_dependent=c.speed_dependent)
     d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
     d["provenance"] = c.provenance
+    data: dict[str, Any] = {"coefficients": d}
     if c.per_speed_fits is not None:
-        data = {"coefficients": d, "per_speed_fits": c.per_speed_fits}
-        return forces.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
-                                            source=source)
-    return forces.CuttingCoefficients.from_dict(d, source=source)
+        data["per_speed_fits"] = c.per_speed_fits
+    if c.grid is not None:
+        data["grid"] = c.grid
+    return forces.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
+                                        source=source)
 
 
 def lobe_coefficient_note(cfg: DynamicsConfig, coefficients: Any = None,

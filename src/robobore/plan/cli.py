@@ -84,15 +84,17 @@ def posture_cmd(
         if r.get("synthetic_inputs"):
             rows.append(("inputs", "SYNTHETIC identification results"))
         rows.append(("critical depth method",
-                     f"semi-discretization for the best {SD_TOP} of a frequency-domain screen "
-                     "and the measured posture (critical_depth_method per candidate)"))
+                     f"semi-discretization at {fmt(r['cutting']['speed_rpm'])} r/min (the "
+                     f"cutting speed) for the best {SD_TOP} of a frequency-domain screen and "
+                     "the measured posture (critical_depth_method per candidate); b_min: the "
+                     "lowest over the speed range"))
         for w in r.get("warnings", []):
             rows.append(("warning", w))
         rows.append(("wall time (s)", r["wall_time_s"]))
         stdout.print(kv_table("posture plan", rows))
         t = Table(title=f"best {top} candidates", header_style="bold")
         for c in ("rot (deg)", "branch", "k_x", "k_y", "k_z (N/um)", "f1 (Hz)",
-                  "b_crit (mm)", "feed amp (um)"):
+                  "b_crit (mm)", "b_min range (mm)", "feed amp (um)"):
             t.add_column(c, justify="right")
         crit = np.array([c.get("critical_depth_mm") or np.inf if r["criterion"] ==
                          "critical_depth" else 0.0 for c in r["candidates"]])
@@ -112,6 +114,7 @@ def posture_cmd(
                       fmt(c["modes"][0]["frequency_Hz"]),
                       fmt(c["critical_depth_mm"]) + (
                           "" if c["critical_depth_method"] == "semi-discretization" else " (FD)"),
+                      fmt(c["critical_depth_range_min_mm"]),
                       fmt(c["feed_amplitude_um"]))
         stdout.print(t)
 

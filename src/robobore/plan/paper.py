@@ -77,8 +77,8 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
     A = res["_arrays"]
     cand = A["cand"]
     keep = ("joints_deg", "tool_axis_rotation_deg", "branch", "branch_label",
-            "directional_stiffness_N_per_m", "critical_depth_mm", "critical_depth_method",
-            "feed_amplitude_um", "criterion_value")
+            "directional_stiffness_N_per_m", "critical_depth_mm", "critical_depth_range_min_mm",
+            "critical_depth_method", "feed_amplitude_um", "criterion_value")
     short = {}
     for name in ("recommended", "measured"):
         e = res[name]
@@ -115,8 +115,9 @@ def add_posture_section(rep: Any, plan: dict[str, Any]) -> None:
         "Every posture that holds the paper's bore (tool-axis rotation in 1 deg steps x every "
         "inverse-kinematics branch, inside the joint limits, away from singularities) rated "
         "with the pose-dependent elastic multibody model (robobore plan; docs/plan.md), "
-        "calibrated to the identified modes at the paper's posture. Criterion: the lowest "
-        "critical depth of cut over the lobe speed range. End effector: "
+        "calibrated to the identified modes at the paper's posture. Criterion: the "
+        "critical depth of cut at the cutting speed (semi-discretisation; the lowest over the "
+        "lobe speed range beside it). End effector: "
         f"{plan['end_effector']}." + (" Identification inputs are SYNTHETIC."
                                       if plan["synthetic_inputs"] else ""))
     m = plan["map"]
@@ -136,7 +137,7 @@ def add_posture_section(rep: Any, plan: dict[str, Any]) -> None:
         ax.plot(mea["tool_axis_rotation_deg"], mea["criterion_value"], "D", ms=8, mfc="none",
                 color="k", mew=1.5, label="paper's posture")
     ax.set_xlabel("tool-axis rotation [deg]")
-    ax.set_ylabel("lowest critical depth over the speed range [mm]")
+    ax.set_ylabel("critical depth at the cutting speed [mm]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     ws = plan.get("workspace")
@@ -166,7 +167,8 @@ def add_posture_section(rep: Any, plan: dict[str, Any]) -> None:
                      "rotation [deg]": e["tool_axis_rotation_deg"], "branch": e["branch"],
                      "k x/y/z [N/um]": "/".join(f"{k[a] * 1e-6:.3g}" for a in "xyz"),
                      "f1 [Hz]": e["first_frequency_Hz"],
-                     "critical depth [mm]": e["critical_depth_mm"],
+                     "critical depth at the cutting speed [mm]": e["critical_depth_mm"],
+                     "lowest over the speed range [mm]": e["critical_depth_range_min_mm"],
                      "feed amplitude [um]": e["feed_amplitude_um"]})
     rep.add_table(rows, caption="Recommended posture and the paper's posture")
     c = plan["calibration"]

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-CRITERION_LABEL = {"critical_depth": "lowest critical depth over the speed range [mm]",
+CRITERION_LABEL = {"critical_depth": "critical depth at the cutting speed [mm]",
                    "stiffness_x": "stiffness along X (horizontal) [N/µm]",
                    "stiffness_y": "stiffness along Y [N/µm]",
                    "stiffness_z": "stiffness along Z (feed) [N/µm]",

@@ -14,15 +14,20 @@ calibrated pose-dependent model (:mod:`robobore.plan.model`):
    when inside the joint limits and at least ``singularity_margin`` from a singularity
    (smallest singular value of the Jacobian with its translational rows divided by the
    robot's reach ``L = sum |a_i| + |d_i|``: dimensionless, 0 at a singularity);
-3. per candidate: directional stiffness in the boring frame, modes, the lowest critical depth
-   over ``[lobes]`` speed range, and the feed-direction amplitude of the steady cut at
+3. per candidate: directional stiffness in the boring frame, modes, the critical depth at the
+   ``[cutting]`` speed (the speed the cut runs at; the lowest critical depth over the
+   ``[lobes]`` speed range is reported beside it, ``critical_depth_range_min_mm``: on a robot
+   it is often 0 at every candidate, some speed of the range having no chatter-free depth,
+   and would rank nothing), and the feed-direction amplitude of the steady cut at
    ``[cutting]`` (half peak-to-peak of Z of the periodic orbit the time-domain simulation
    starts on and settles to, :func:`robobore.plan.scoring.steady_feed_amplitude`: the same
    computation, so the same number as ``simulate boring`` on the same structure). The
    critical depth of every candidate is first screened by the zero-order frequency domain
    (:mod:`robobore.plan.chatter`); the best :data:`SD_TOP` of the screen and the measured
-   posture are then rated by the semi-discretisation lobes of the stability module (the
-   method of ``robobore lobes``; ``critical_depth_method`` says which a value comes from);
+   posture are then rated by the semi-discretisation of the stability module (the method of
+   ``robobore lobes``: :func:`~robobore.dynamics.semidiscretization.chatter_free_window` at
+   the cutting speed, the lobes over the range for the range minimum;
+   ``critical_depth_method`` says which a value comes from);
 4. recommendation: the candidate with the largest value of the criterion
    (``critical_depth`` by default, among the semi-discretisation-rated candidates, or
    ``stiffness_x``/``stiffness_y``/``stiffness_z``/``stiffness_min``).
@@ -90,6 +95,15 @@ def _flat_map_warning(crit: np.ndarray, name: str) -> list[str]:
     return []
 
 
+def _coefficient_warnings(process: Any) -> list[str]:
+    """The cutting coefficients' domain warnings at the plan's cut (a cutting speed or chip
+    thickness outside the set's calibrated range), each prefixed ``coefficients:``."""
+    g = getattr(process, "geometry", None)
+    if g is None:
+        return []
+    return [f"coefficients: {w}" for w in g.coefficients.domain_warnings(process.h0)]
+
+
 def _same_posture(q1: np.ndarray, q2: np.ndarray, tol: float = 1e-6) -> bool:
     d = np.angle(np.exp(1j * (np.asarray(q1) - np.asarray(q2))))
     return bool(np.max(np.abs(d)) < tol)
@@ -110,6 +124,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     """The posture plan for validated inputs (see :func:`plan_posture`)."""
     from contextlib import nullcontext
 
+    from robobore.dynamics.semidiscretization import chatter_free_window
     from robobore.dynamics.stability import lobes_semidiscretization
     from robobore.plan.model import PoseModel, ToolBody, calibrate
     from robobore.robot.kinematics import fk
@@ -183,27 +198,35 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
                                         kind="stable")[:SD_TOP]]
     rated = sorted(set(order) | ({meas_idx} if meas_idx is not None else set()))
     sd_lobes = {}
+    at_speed: dict[int, tuple[float, float]] = {}
+    structures: dict[int, Any] = {}
     by_structure: dict[tuple, Any] = {}
+    n_cut = float(cfg.cutting.speed_rpm)
 
     def sd(idx: int):
         # candidates with the same structure (a tool-axis rotation about the flange axis)
-        # share their lobes
+        # share their lobes: (lobes over the range, (interrupted below, limit) at the speed)
         st = model.modes(cand.q_rad[idx]).structure(0, PLAN_MODE_SHARE)
         key = (tuple(np.round(st.frequency_Hz, 6)), tuple(np.round(st.damping_ratio, 8)),
                tuple(np.round(st.stiffness_N_per_m, 0)), tuple(np.round(st.directions, 6).ravel()))
         if key not in by_structure:
-            by_structure[key] = lobes_semidiscretization(st, process, speeds)
+            by_structure[key] = (lobes_semidiscretization(st, process, speeds),
+                                 chatter_free_window(st, process, n_cut), st)
         return by_structure[key]
+
+    def rate(idx: int) -> None:
+        L, win, st = sd(idx)
+        sd_lobes[idx], at_speed[idx] = L, win
+        structures[idx] = st
+        ev["critical_depth_m"][idx] = float(win[1])
+        ev["critical_depth_range_min_m"][idx] = float(np.min(L.critical_depth_m))
+        ev["critical_speed_rpm"][idx] = float(speeds[int(np.argmin(L.critical_depth_m))])
+        ev["chatter_frequency_Hz"][idx] = math.nan
+        method[idx] = "semi-discretization"
 
     with pf("semi-discretisation lobes", len(rated)) as adv:
         for idx in rated:
-            L = sd(idx)
-            sd_lobes[idx] = L
-            ev["critical_depth_m"][idx] = float(np.min(L.critical_depth_m))
-            k = int(np.argmin(L.critical_depth_m))
-            ev["critical_speed_rpm"][idx] = float(speeds[k])
-            ev["chatter_frequency_Hz"][idx] = math.nan
-            method[idx] = "semi-discretization"
+            rate(idx)
             adv(1)
     ev["critical_depth_method"] = method
     crit = criterion_values(cfg.plan.criterion, ev["stiffness_N_per_m"], ev["critical_depth_m"])
@@ -212,9 +235,9 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         else crit
     best = recommend(pick, cand.q_rad, inp.q_meas_rad)
     if best not in sd_lobes:
-        sd_lobes[best] = sd(best)
-        ev["critical_depth_m"][best] = float(np.min(sd_lobes[best].critical_depth_m))
-        method[best] = "semi-discretization"
+        rate(best)
+        crit = criterion_values(cfg.plan.criterion, ev["stiffness_N_per_m"],
+                                ev["critical_depth_m"])
     entries = [_entry(i, cand, ev) for i in range(cand.q_rad.shape[0])]
     # the semi-discretisation lobes at the recommended and measured postures
     lobes = {}
@@ -222,11 +245,16 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         if idx is None:
             continue
         L = sd_lobes[idx]
+        below, lim = at_speed[idx]
         lobes[name] = {"method": L.method, "speed_rpm": speeds.tolist(),
                        "critical_depth_mm": (L.critical_depth_m * 1e3).tolist(),
                        "interrupted_below_mm": (L.interrupted_below_m * 1e3).tolist(),
-                       "critical_depth_at_speed_mm": float(np.interp(
-                           cfg.cutting.speed_rpm, speeds, L.critical_depth_m * 1e3))}
+                       "cutting_speed_rpm": n_cut,
+                       "critical_depth_at_speed_mm": float(lim * 1e3),
+                       "interrupted_below_at_speed_mm": float(below * 1e3),
+                       # the structure these lobes are of ([structure] modes of a
+                       # `robobore lobes` / `simulate boring` config)
+                       "tool_point_modes": [m.to_dict() for m in structures[idx].modes()]}
     equivalent = {}
     for name, idx in (("recommended", best), ("measured", meas_idx)):
         if idx is not None:
@@ -259,7 +287,8 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "lobes": lobes,
         "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
-        "warnings": warn + cal.warnings() + _flat_map_warning(crit0, cfg.plan.criterion),
+        "warnings": warn + cal.warnings() + _flat_map_warning(crit0, cfg.plan.criterion)
+        + _coefficient_warnings(process),
         "identity": make_identity(
             "plan", robot=robot.name, robot_hash=robot.description_hash(),
             robot_file=robot.file or None, joints_deg=entries[best]["joints_deg"],
@@ -278,6 +307,7 @@ def _entry(i: int, cand: Candidates, ev: dict[str, np.ndarray]) -> dict[str, Any
 
     k = ev["stiffness_N_per_m"][i]
     b = ev["critical_depth_m"][i]
+    bm = ev["critical_depth_range_min_m"][i]
     return {
         "joints_deg": np.degrees(cand.q_rad[i]).tolist(),
         "tool_axis_rotation_deg": float(cand.rotation_deg[i]),
@@ -287,6 +317,8 @@ def _entry(i: int, cand: Candidates, ev: dict[str, np.ndarray]) -> dict[str, Any
         "modes": [{"frequency_Hz": float(fr), "damping_ratio": float(z)}
                   for fr, z in zip(ev["frequency_Hz"][i], ev["damping_ratio"][i], strict=True)],
         "critical_depth_mm": None if not math.isfinite(b) else float(b * 1e3),
+        "critical_depth_range_min_mm": None if not math.isfinite(bm) else float(bm * 1e3),
+        "critical_speed_rpm": float(ev["critical_speed_rpm"][i]),
         "critical_depth_method": str(ev["critical_depth_method"][i]),
         "chatter_frequency_Hz": float(ev["chatter_frequency_Hz"][i]),
         "feed_amplitude_um": float(ev["feed_amplitude_m"][i] * 1e6),
@@ -314,8 +346,11 @@ def results_dataset(result: dict[str, Any]) -> Any:
             "frequency": (("candidate", "mode"), ev["frequency_Hz"], {"units": "Hz"}),
             "damping_ratio": (("candidate", "mode"), ev["damping_ratio"]),
             "critical_depth": (("candidate",), ev["critical_depth_m"] * 1e3,
-                               {"units": "mm", "long_name": "lowest critical depth over the "
-                                "speed range"}),
+                               {"units": "mm", "long_name": "critical depth at the cutting "
+                                "speed"}),
+            "critical_depth_range_min": (("candidate",), ev["critical_depth_range_min_m"] * 1e3,
+                                         {"units": "mm", "long_name": "lowest critical depth "
+                                          "over the speed range"}),
             "chatter_frequency": (("candidate",), ev["chatter_frequency_Hz"], {"units": "Hz"}),
             "feed_amplitude": (("candidate",), ev["feed_amplitude_m"] * 1e6, {"units": "um"}),
             "singularity_measure": (("candidate",), cand.singularity),

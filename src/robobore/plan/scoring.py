@@ -63,7 +63,11 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
              ) -> dict[str, np.ndarray]:
     """Stiffness, modes, critical depth (frequency-domain screen) and the steady feed
     amplitude per candidate (chunks of 512); ``mode_share``: the feed amplitude's structure
-    leaves out modes below that share of the tool-point flexibility."""
+    leaves out modes below that share of the tool-point flexibility.
+
+    ``critical_depth_m`` is the limit at the ``[cutting]`` speed (the speed the cut runs at:
+    the value candidates are ranked by); ``critical_depth_range_min_m`` the lowest point of
+    the envelope over the ``[lobes]`` speed range, at ``critical_speed_rpm``."""
     from robobore.plan.chatter import critical_depth_range
 
     n = cand.q_rad.shape[0]
@@ -71,7 +75,8 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
     out = {"frequency_Hz": np.empty((n, nj)), "damping_ratio": np.empty((n, nj)),
            "stiffness_N_per_m": np.empty((n, 3)), "critical_depth_m": np.empty(n),
            "chatter_frequency_Hz": np.empty(n), "critical_speed_rpm": np.empty(n),
-           "feed_amplitude_m": np.empty(n)}
+           "critical_depth_range_min_m": np.empty(n), "feed_amplitude_m": np.empty(n)}
+    n_cut = float(cfg.cutting.speed_rpm)
     for s in range(0, n, 512):
         e = min(n, s + 512)
         pm = model.modes(cand.q_rad[s:e])
@@ -81,9 +86,12 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
         b, fch, nch = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
                                            cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm,
                                            process.n_inserts)
+        out["critical_depth_range_min_m"][s:e] = b
+        out["critical_speed_rpm"][s:e] = nch
+        b, fch, _ = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0, n_cut,
+                                         n_cut, process.n_inserts)
         out["critical_depth_m"][s:e] = b
         out["chatter_frequency_Hz"][s:e] = fch
-        out["critical_speed_rpm"][s:e] = nch
         for k in range(e - s):
             out["feed_amplitude_m"][s + k] = steady_feed_amplitude(
                 pm.structure(k, mode_share), process, cfg.cutting.depth_mm * 1e-3,

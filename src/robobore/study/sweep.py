@@ -184,6 +184,9 @@ class _Recorder:
         self.index_every_s = index_every_s
         self._last_index = time.monotonic()
         self._pairs = [(i.key, i.condition) for i in plan.items]
+        #: the runners' coefficient warnings (dataset attribute ``coefficient_warnings``, "; "
+        #: separated) -> number of conditions computed in this run that carry it
+        self.coefficient_warnings: dict[str, int] = {}
 
     def record(self, item: SweepItem, res: dict[str, Any]) -> None:
         if res.get("ok"):
@@ -196,6 +199,9 @@ class _Recorder:
                     worker=res.get("worker"),
                 )
                 self.computed += 1
+                for w in str(res["dataset"].attrs.get("coefficient_warnings", "")).split("; "):
+                    if w.strip():
+                        self.coefficient_warnings[w] = self.coefficient_warnings.get(w, 0) + 1
             except (DataError, TypeError, ValueError) as exc:
                 # the result breaks the summary contract or cannot be stored as netCDF
                 # (e.g. a dict-valued attribute): a failure of this condition, not the sweep
@@ -298,8 +304,26 @@ def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: 
         store=store.root, total=len(plan.items), skipped=skipped, computed=rec.computed,
         failed=len(rec.failures), pending=index["counts"]["failed"] + index["counts"]["pending"],
         wall_time_s=time.perf_counter() - t0, mode=mode, failures=tuple(rec.failures),
-        warnings=tuple(bad),
+        warnings=tuple(bad) + coefficient_warning_lines(rec.coefficient_warnings,
+                                                        len(plan.items)),
     )
+
+
+#: At most this many distinct coefficient warnings are listed by a sweep (then a count).
+MAX_COEFFICIENT_WARNINGS = 10
+
+
+def coefficient_warning_lines(counts: dict[str, int], total: int) -> tuple[str, ...]:
+    """One line per distinct coefficient warning of the computed conditions ("coefficients
+    (n of N conditions): ..."), the most frequent first, at most
+    :data:`MAX_COEFFICIENT_WARNINGS` and a line saying how many more."""
+    items = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+    out = [f"coefficients ({n} of {total} conditions): {w}"
+           for w, n in items[:MAX_COEFFICIENT_WARNINGS]]
+    if len(items) > MAX_COEFFICIENT_WARNINGS:
+        out.append(f"coefficients: {len(items) - MAX_COEFFICIENT_WARNINGS} more distinct "
+                   "warnings (each condition's `coefficient_warnings` in its Dataset)")
+    return tuple(out)
 
 
 def _forget_failed_client(exc: BaseException) -> None:
@@ -434,4 +458,6 @@ __all__ = [
     "execute",
     "run_sweep",
     "plan_from_file",
+    "coefficient_warning_lines",
+    "MAX_COEFFICIENT_WARNINGS",
 ]
