@@ -98,8 +98,68 @@ def _matmul_into(A, B, out):  # pragma: no cover - numba
 def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
     """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
 
-    Taylor series of degree 16 on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2`` (truncation
-    below 1e-18 relative), then ``s`` doublings: ``Phi(2h) = Phi^2``,
+    The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
+    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
+    whose norm is of the order of the modes' angular frequencies rather than their squares,
+    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
+    (:func:`_step_matrices_taylor` on ``L'``)."""
+    k_n, n, _ = L.shape
+    M = np.zeros((n, n))
+    for q in range(k_n):
+        for i in range(n):
+            for j in range(n):
+                M[i, j] += abs(L[q, i, j])
+    d = np.ones(n)
+    for _ in range(100):
+        done = True
+        for i in range(n):
+            c = 0.0
+            r = 0.0
+            for j in range(n):
+                if j != i:
+                    c += M[j, i]
+                    r += M[i, j]
+            if c == 0.0 or r == 0.0:
+                continue
+            tot = c + r
+            f = 1.0
+            g = r / 2.0
+            while c < g:
+                f *= 2.0
+                c *= 4.0
+            g = r * 2.0
+            while c >= g:
+                f /= 2.0
+                c /= 4.0
+            if (c + r) / f < 0.95 * tot:
+                done = False
+                d[i] *= f
+                for j in range(n):
+                    M[j, i] *= f
+                    M[i, j] /= f
+        if done:
+            break
+    Lb = np.empty_like(L)
+    for q in range(k_n):
+        for i in range(n):
+            for j in range(n):
+                Lb[q, i, j] = L[q, i, j] * d[j] / d[i]
+    _step_matrices_taylor(Lb, dt, Phi, G0, G1)
+    for q in range(k_n):
+        for i in range(n):
+            for j in range(n):
+                sc = d[i] / d[j]
+                Phi[q, i, j] *= sc
+                G0[q, i, j] *= sc
+                G1[q, i, j] *= sc
+
+
+@nb.njit(cache=True)
+def _step_matrices_taylor(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+
+    Taylor series on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2``, of the lowest degree (at
+    most 16) whose first omitted term is below 1e-17 relative, then ``s`` doublings: ``Phi(2h) = Phi^2``,
     ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the integral at h)."""
     k_n, n, _ = L.shape
     T = np.empty((n, n))
@@ -126,7 +186,15 @@ def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
                 Phi[q, i, j] = T[i, j]
                 G0[q, i, j] = T[i, j] * h
                 G1[q, i, j] = T[i, j] * h * h * 0.5
-        for m in range(1, 17):
+        nh = nrm / 2.0**s  # ||L h||_1 <= 1/2
+        deg = 16
+        term = nh
+        for j in range(1, 17):  # term = nh^(j+1) / (j+1)!
+            term *= nh / (j + 1)
+            if term < 1e-17:
+                deg = j
+                break
+        for m in range(1, deg + 1):
             _matmul_into(T, A, W1)  # T <- T A / m  (= A^m / m!)
             for i in range(n):
                 for j in range(n):
@@ -502,7 +570,7 @@ def _arnoldi(Phi, P0, P1, r, m, v0, V, H, Q, x, xn, w):  # pragma: no cover - nu
 
 
 #: Arnoldi basis size of the spectral radius of large monodromy matrices.
-ARNOLDI_VECTORS = 20
+ARNOLDI_VECTORS = 16
 #: Explicit restarts (from the dominant Ritz vector) before the dense solver takes over.
 ARNOLDI_RESTARTS = 30
 #: Relative residual of the dominant Ritz pair at which the Arnoldi iteration stops.
