@@ -7,8 +7,8 @@
    (speed x depth) stability map, 5 modes. Target: < 5 s on 2 cores.
 
 3. ``--reference-tree PATH``: ``simulate boring`` runs (``robobore.dynamics.api.run_boring``
-   with the config's own sampling and run length) of examples/boring_paper.toml at four
-   conditions, this tree against another checkout's ``src`` in subprocesses, alternated
+   with the config's own sampling and run length) of examples/boring_paper.toml at the
+   ``CONDITIONS``, this tree against another checkout's ``src`` in subprocesses, alternated
    ``--pairs`` times; prints the median wall time of each tree, the samples per revolution
    and revolutions each chose, and the ratio of the medians (the trees share the load).
 
@@ -57,9 +57,11 @@ def best_of(fn, repeat=5):
 
 
 ROOT = Path(__file__).resolve().parents[1]
-#: (speed r/min, depth mm) of the paired time-domain runs: the paper's condition, below and
-#: above the example robot's limit at other speeds
-CONDITIONS = [(300.0, 0.15), (300.0, 0.05), (700.0, 0.1), (1000.0, 0.3)]
+#: (speed r/min, depth mm) of the paired time-domain runs: the paper's condition, two far
+#: from the example robot's limit, and 0.8 / 1.0 / 1.25 x its limit at 554 r/min (0.695 mm),
+#: where growth is slow and an undecided run is lengthened
+CONDITIONS = [(300.0, 0.15), (700.0, 0.1), (1000.0, 0.3), (554.3, 0.556), (554.3, 0.695),
+              (554.3, 0.869)]
 
 CHILD = r"""
 import json, sys, time
@@ -106,7 +108,7 @@ def paired_timedomain(ref: Path, pairs: int) -> None:
               f" chatter {mine[0][i]['chatter']}), reference {r:.2f} s "
               f"({theirs[0][i]['samples_per_rev']} x {theirs[0][i]['revolutions']}, chatter "
               f"{theirs[0][i]['chatter']}); this/reference {m / r:.2f}")
-    print(f"  all four: this tree {statistics.median(tot_m):.2f} s, reference "
+    print(f"  all: this tree {statistics.median(tot_m):.2f} s, reference "
           f"{statistics.median(tot_r):.2f} s; this/reference "
           f"{statistics.median(tot_m) / statistics.median(tot_r):.2f}")
 
