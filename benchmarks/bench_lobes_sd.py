@@ -4,9 +4,12 @@ Prints the wall time per speed of ``lobes_semidiscretization`` over ``--speeds``
 150-1100 r/min (one BLAS thread, numba compiled beforehand) and the spectral radii it
 evaluated per speed; with ``--reference-tree PATH`` the same run of another checkout's
 ``src`` in a subprocess, alternated ``--pairs`` times, and the ratio of the medians (the two
-trees share the machine's load).
+trees share the machine's load). With ``--depth-tree PATH`` (a checkout of the same model,
+e.g. main) the largest relative change of the finite critical depths against that tree's and
+whether the same speeds are 0 / stable up to the scan top.
 
-    python benchmarks/bench_lobes_sd.py [--speeds 48] [--reference-tree ../main] [--pairs 3]
+    python benchmarks/bench_lobes_sd.py [--speeds 48] [--reference-tree ../b2e27da] [--pairs 3]
+                                        [--depth-tree ../main]
 """
 
 from __future__ import annotations
@@ -52,11 +55,15 @@ def main() -> None:
     ap.add_argument("--speeds", type=int, default=48)
     ap.add_argument("--reference-tree", type=Path, default=None)
     ap.add_argument("--pairs", type=int, default=3)
+    ap.add_argument("--depth-tree", type=Path, default=None)
     a = ap.parse_args()
     load = os.getloadavg()[0]
     mine, ref = [], []
+    depths = None
     for _ in range(a.pairs if a.reference_tree else 1):
-        mine.append(run(ROOT, a.speeds)["ms_per_speed"])
+        r = run(ROOT, a.speeds)
+        depths = r["critical_depth_mm"]
+        mine.append(r["ms_per_speed"])
         if a.reference_tree:
             ref.append(run(a.reference_tree, a.speeds)["ms_per_speed"])
     print(f"semi-discretisation lobes, examples/boring_paper.toml, {a.speeds} speeds "
@@ -66,6 +73,15 @@ def main() -> None:
         print(f"reference {a.reference_tree}: {statistics.median(ref):.1f} ms/speed "
               f"({', '.join(f'{v:.1f}' for v in ref)}); ratio reference/this "
               f"{statistics.median(ref) / statistics.median(mine):.2f}")
+    if a.depth_tree is not None:
+        other = run(a.depth_tree, a.speeds)["critical_depth_mm"]
+        same = all((x == y) or (0 < x < 1e9 and 0 < y < 1e9)
+                   for x, y in zip(depths, other, strict=True))
+        rel = [abs(x / y - 1) for x, y in zip(depths, other, strict=True)
+               if 0 < y < float("inf") and 0 < x < float("inf")]
+        print(f"critical depths against {a.depth_tree}: max relative change "
+              f"{100 * max(rel):.3f} % over {len(rel)} finite limits; same speeds at 0 / "
+              f"stable: {same}")
 
 
 if __name__ == "__main__":

@@ -10,6 +10,11 @@ lobes, comparison and checks, report (with results.nc and the posture map), tota
 Usage::
 
     python benchmarks/bench_paper.py [--mode fast|cold|both] [--workers 2] [--keep DIR]
+                                     [--reference-tree PATH --pairs 2]
+
+``--reference-tree PATH``: the same mode with this tree's and that checkout's ``src`` on
+``PYTHONPATH``, alternated ``--pairs`` times, and the ratio of the median wall times (the two
+share the machine's load).
 
 Each mode runs the real command (``python -m robobore paper``) in a subprocess with a fresh
 output folder and (cold) a fresh, empty ``ROBOBORE_CACHE_DIR`` and numba cache is NOT
@@ -30,10 +35,14 @@ import time
 from pathlib import Path
 
 
-def run(mode: str, workers: int, keep: Path | None) -> dict:
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(mode: str, workers: int, keep: Path | None, tree: Path = ROOT) -> dict:
     tmp = Path(tempfile.mkdtemp(prefix=f"bench-paper-{mode}-"))
     out = (keep / mode) if keep else tmp / "out"
     env = dict(os.environ)
+    env["PYTHONPATH"] = str(tree / "src")
     env["ROBOBORE_CACHE_DIR"] = str(tmp / "cache")  # cold: empty FE cache
     cmd = [sys.executable, "-m", "robobore", "paper", "--out", str(out), "--json",
            "--workers", str(workers)]
@@ -59,8 +68,26 @@ def main() -> None:
     ap.add_argument("--mode", choices=("fast", "cold", "both"), default="both")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--keep", type=Path, default=None, help="keep outputs under this folder")
+    ap.add_argument("--reference-tree", type=Path, default=None)
+    ap.add_argument("--pairs", type=int, default=2)
     a = ap.parse_args()
     modes = ("fast", "cold") if a.mode == "both" else (a.mode,)
+    if a.reference_tree is not None:
+        for m in modes:
+            mine, ref = [], []
+            for _ in range(a.pairs):
+                for tree, acc in ((ROOT, mine), (a.reference_tree, ref)):
+                    r = run(m, a.workers, None, tree)
+                    acc.append(r["wall_s"])
+                    print(f"{m:>5} {tree}: {r['wall_s']:.1f} s, load "
+                          f"{r['load_before'][0]:.1f} -> {r['load_after'][0]:.1f}; stages: "
+                          + ", ".join(f"{k} {v:.1f} s" for k, v in (r["timings_s"] or {}).items()))
+            import statistics
+
+            print(f"{m:>5}: this tree median {statistics.median(mine):.1f} s, reference "
+                  f"{statistics.median(ref):.1f} s; ratio reference/this "
+                  f"{statistics.median(ref) / statistics.median(mine):.2f}")
+        return
     print(f"# robobore paper wall time, {os.cpu_count()} CPUs, workers {a.workers}")
     for m in modes:
         r = run(m, a.workers, a.keep)

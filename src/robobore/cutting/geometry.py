@@ -420,9 +420,15 @@ def _trailing_nodes(insert: BoringInsert, s_i: float, n: int) -> np.ndarray:
     return np.linspace(s_i, 0.0, n + 1)
 
 
+@functools.lru_cache(maxsize=8)
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1] (computed once per order)."""
+    return np.polynomial.legendre.leggauss(n)
+
+
 def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
                   n_elements: int = 40, n_quad: int = 16, trailing_edge: bool = True,
-                  n_trailing: int | None = None) -> EdgeElements:
+                  n_trailing: int | None = None, exact_area: bool = True) -> EdgeElements:
     """Discretise the engaged edge for depth ``depth_m`` [m] and feed per insert ``feed_m`` [m].
 
     The chip is attributed to the edge by radial levels ``d`` (slices at constant radius): the
@@ -442,6 +448,8 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
     relative to the leading edge, at least 1; the arc / minor-edge corner is an element
     boundary) with ``h = db = 0``, their length ``dS`` and local approach angle ``kappa < 0``.
     They come first (ordered by ``s``); the chip-area identity is unchanged.
+    ``exact_area=False`` skips the separate exact integral (:func:`chip_area`): ``area`` is
+    then ``area_elements``, for callers that use only the elements.
     """
     _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
     _check("feed_m", feed_m, 0.0, 0.01, "m", lo_open=True)
@@ -459,15 +467,15 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
     s = 0.5 * (edges[1:] + edges[:-1])
     dS = np.diff(edges)
     zeta, drop, kl, _ = insert.point(s)
-    xg, wg = np.polynomial.legendre.leggauss(n_quad)
+    xg, wg = _gauss_legendre(int(n_quad))
     d1, d2 = d_edges[:-1, None], d_edges[1:, None]
     dd = 0.5 * (d1 + d2) + 0.5 * (d2 - d1) * xg[None, :]
     integrand = np.minimum(feed_m, _width_at_drop(insert, dd))
     area_e = (0.5 * (d2 - d1)[:, 0]) * (integrand * wg[None, :]).sum(axis=1)
     h = area_e / dS
     db = dS.copy()
-    area = chip_area(insert, depth_m, feed_m)
     area_elements = float((h * db).sum())
+    area = chip_area(insert, depth_m, feed_m) if exact_area else area_elements
     n_tr = 0
     z_i = 0.0
     if trailing_edge:

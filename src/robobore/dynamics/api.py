@@ -271,11 +271,12 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
 
 
 def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, speed_rpm: float,
-                      equivalent: Any = None) -> dict[str, Any]:
+                      equivalent: Any = None, guess_mm: float | None = None) -> dict[str, Any]:
     """The semi-discretisation answer of :func:`lobes` at one speed: ``critical_depth_mm``
     (None: stable up to the scan top; 0: no chatter-free depth) and
     ``interrupted_below_mm`` (:func:`robobore.dynamics.semidiscretization.chatter_free_window`)
-    of the config's robot and process."""
+    of the config's robot and process. ``guess_mm``: the limit at a neighbouring speed (the
+    lobes' own), to continue from as :func:`lobes` does instead of the depth scan."""
     from robobore.dynamics.semidiscretization import chatter_free_window
 
     cfg, _, src = _config(config, equivalent=equivalent)
@@ -283,7 +284,9 @@ def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, spee
     st = build_structure(cfg, src)
     coef = build_coefficients(cfg, src) if cfg.is_boring else None
     pr = build_process(cfg, src, coefficients=coef)
-    below, a = chatter_free_window(st, pr, float(speed_rpm))
+    guess = (float(guess_mm) * 1e-3 if guess_mm is not None and math.isfinite(guess_mm)
+             and guess_mm > 0.0 else None)
+    below, a = chatter_free_window(st, pr, float(speed_rpm), guess_m=guess)
     return {"speed_rpm": float(speed_rpm),
             "critical_depth_mm": a * 1e3 if math.isfinite(a) else None,
             "interrupted_below_mm": below * 1e3}

@@ -252,7 +252,8 @@ def boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dept
     ``h``; they add to the nominal force and the steady deflection, not to the regenerative
     directional matrix nor to the depth-modulation stiffness."""
     fz = feed_per_rev_m / insert.n_inserts
-    el = edge_elements(insert, depth_m, fz, n_elements, trailing_edge=trailing_edge)
+    el = edge_elements(insert, depth_m, fz, n_elements, trailing_edge=trailing_edge,
+                       exact_area=False)
     trail = el.trailing
     hmin = 0.25 * insert.edge_radius_m if min_chip_thickness_m is None else min_chip_thickness_m
     shearing = el.h >= hmin

@@ -21,14 +21,33 @@ from scipy.linalg import expm
 from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.structure import ToolPointStructure
 
-try:  # a single BLAS thread: the many mid-size eigenproblems are slower multi-threaded
-    from threadpoolctl import threadpool_limits as blas_thread_limit
-except ImportError:  # pragma: no cover - optional
-    from contextlib import nullcontext as _null
+from contextlib import contextmanager, nullcontext
 
-    def blas_thread_limit(*_a, **_k):  # type: ignore[no-redef]
-        """No-op stand-in for ``threadpoolctl.threadpool_limits`` when it is not installed."""
-        return _null()
+try:  # a single BLAS thread: the many mid-size eigenproblems are slower multi-threaded
+    from threadpoolctl import ThreadpoolController
+except ImportError:  # pragma: no cover - optional
+    ThreadpoolController = None
+
+_BLAS = {"controller": None, "depth": 0}
+
+
+@contextmanager
+def blas_thread_limit(limits: int = 1):
+    """Limit BLAS to ``limits`` threads inside the block (``threadpoolctl``; a no-op without
+    it). The libraries are looked up once per process, and a nested block inside another one
+    of this function keeps the outer limit without querying the libraries again."""
+    if ThreadpoolController is None or _BLAS["depth"] > 0:
+        ctx = nullcontext()
+    else:
+        if _BLAS["controller"] is None:
+            _BLAS["controller"] = ThreadpoolController()
+        ctx = _BLAS["controller"].limit(limits=limits)
+    _BLAS["depth"] += 1
+    try:
+        with ctx:
+            yield
+    finally:
+        _BLAS["depth"] -= 1
 
 
 #: Depth range of the critical-depth scan [m]: the largest depth of cut a config accepts (50 mm)
@@ -38,9 +57,10 @@ DEPTH_SCAN_DECADES = 4.0
 #: Ratio between neighbouring depths of the scan grid (an unstable window narrower than this
 #: in depth can be missed between two grid points).
 DEPTH_SCAN_RATIO = 1.25
-#: Monodromy matrices up to this size are solved densely; larger ones by ARPACK (the few
-#: eigenvalues of largest modulus), falling back to the dense solver if ARPACK does not converge.
-DENSE_EIG_MAX = 120
+#: Monodromy matrices up to this size are solved densely; larger ones by an explicitly
+#: restarted Arnoldi iteration on the matrix-free product (the eigenvalue of largest modulus),
+#: falling back to the dense solver if it does not converge.
+DENSE_EIG_MAX = 40
 #: Richardson extrapolation of the spectral radius (:func:`monodromy_spectral_radius`) when
 #: half the steps are at least this many.
 RICHARDSON_MIN_STEPS = 12
@@ -78,8 +98,68 @@ def _matmul_into(A, B, out):  # pragma: no cover - numba
 def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
     """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
 
-    Taylor series of degree 16 on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2`` (truncation
-    below 1e-18 relative), then ``s`` doublings: ``Phi(2h) = Phi^2``,
+    The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
+    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
+    whose norm is of the order of the modes' angular frequencies rather than their squares,
+    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
+    (:func:`_step_matrices_taylor` on ``L'``)."""
+    k_n, n, _ = L.shape
+    M = np.zeros((n, n))
+    for q in range(k_n):
+        for i in range(n):
+            for j in range(n):
+                M[i, j] += abs(L[q, i, j])
+    d = np.ones(n)
+    for _ in range(100):
+        done = True
+        for i in range(n):
+            c = 0.0
+            r = 0.0
+            for j in range(n):
+                if j != i:
+                    c += M[j, i]
+                    r += M[i, j]
+            if c == 0.0 or r == 0.0:
+                continue
+            tot = c + r
+            f = 1.0
+            g = r / 2.0
+            while c < g:
+                f *= 2.0
+                c *= 4.0
+            g = r * 2.0
+            while c >= g:
+                f /= 2.0
+                c /= 4.0
+            if (c + r) / f < 0.95 * tot:
+                done = False
+                d[i] *= f
+                for j in range(n):
+                    M[j, i] *= f
+                    M[i, j] /= f
+        if done:
+            break
+    Lb = np.empty_like(L)
+    for q in range(k_n):
+        for i in range(n):
+            for j in range(n):
+                Lb[q, i, j] = L[q, i, j] * d[j] / d[i]
+    _step_matrices_taylor(Lb, dt, Phi, G0, G1)
+    for q in range(k_n):
+        for i in range(n):
+            for j in range(n):
+                sc = d[i] / d[j]
+                Phi[q, i, j] *= sc
+                G0[q, i, j] *= sc
+                G1[q, i, j] *= sc
+
+
+@nb.njit(cache=True)
+def _step_matrices_taylor(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+
+    Taylor series on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2``, of the lowest degree (at
+    most 16) whose first omitted term is below 1e-17 relative, then ``s`` doublings: ``Phi(2h) = Phi^2``,
     ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the integral at h)."""
     k_n, n, _ = L.shape
     T = np.empty((n, n))
@@ -106,7 +186,15 @@ def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
                 Phi[q, i, j] = T[i, j]
                 G0[q, i, j] = T[i, j] * h
                 G1[q, i, j] = T[i, j] * h * h * 0.5
-        for m in range(1, 17):
+        nh = nrm / 2.0**s  # ||L h||_1 <= 1/2
+        deg = 16
+        term = nh
+        for j in range(1, 17):  # term = nh^(j+1) / (j+1)!
+            term *= nh / (j + 1)
+            if term < 1e-17:
+                deg = j
+                break
+        for m in range(1, deg + 1):
             _matmul_into(T, A, W1)  # T <- T A / m  (= A^m / m!)
             for i in range(n):
                 for j in range(n):
@@ -246,15 +334,50 @@ def chatter_free_window(structure: ToolPointStructure, process: CuttingProcess,
     is stable up to it). Depths between the two are chatter-free. When the cut is interrupted
     at the limit itself there is no chatter-free depth at that speed: the critical depth is
     then reported as 0 (with ``interrupted_below_m`` the linear limit)."""
-    a_c = critical_depth_semidiscretization(structure, process, speed_rpm, guess_m=guess_m,
-                                            **kwargs)
+    return _window(structure, process, speed_rpm, guess_m, None, **kwargs)[:2]
+
+
+def _window(structure, process, speed_rpm, guess_m, slope, depth_hi_m=DEPTH_SCAN_HI_M,
+            steps=0, tol=1e-3, include_process_stiffness=True, about_deflected=True,
+            decades=DEPTH_SCAN_DECADES, ratio=DEPTH_SCAN_RATIO):
+    """:func:`chatter_free_window` and the slope of :func:`_critical_depth`."""
+    a_c, sl = _critical_depth(structure, process, speed_rpm, depth_hi_m, steps, tol,
+                              include_process_stiffness, about_deflected, decades, ratio,
+                              guess_m, slope)
     if a_c == 0.0:
-        return 0.0, 0.0
-    top = a_c if math.isfinite(a_c) else kwargs.get("depth_hi_m", DEPTH_SCAN_HI_M)
+        return 0.0, 0.0, sl
+    top = a_c if math.isfinite(a_c) else depth_hi_m
     below = interrupted_below(structure, process, speed_rpm, float(top) * (1.0 - 1e-3))
     if below >= float(top) * (1.0 - 1e-3):
-        return float(top), 0.0
-    return below, a_c
+        return float(top), 0.0, sl
+    return below, a_c, sl
+
+
+def chatter_free_windows(structure: ToolPointStructure, process: CuttingProcess,
+                         speeds_rpm: np.ndarray, depth_hi_m: float = DEPTH_SCAN_HI_M,
+                         steps: int = 0, progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`chatter_free_window` at each speed of ``speeds_rpm`` in turn, each search
+    continued from the last finite linear limit of the speeds before (``guess_m``; the
+    interruption does not move it; a speed stable up to ``depth_hi_m`` starts the grid scan
+    again) and started with the slope of ``log rho`` over ``log a`` measured there. Returns ``(interrupted_below_m, critical_depth_m)``, each (n,); ``progress(1)``
+    is called after each speed."""
+    speeds = np.asarray(speeds_rpm, float)
+    out = np.empty(speeds.size)
+    below = np.zeros(speeds.size)
+    prev, slope = None, None
+    with blas_thread_limit(1):
+        for i, n in enumerate(speeds):
+            below[i], out[i], sl = _window(structure, process, float(n), prev, slope,
+                                           depth_hi_m=depth_hi_m, steps=steps)
+            lin = out[i] if out[i] > 0.0 else below[i]
+            if 0.0 < lin < depth_hi_m:
+                prev, slope = float(lin), sl
+            elif not np.isfinite(lin):  # stable up to the top: the scan again
+                prev, slope = None, None
+            # a 0 (unstable down to the scan's lowest depth) keeps the last finite limit
+            if progress is not None:
+                progress(1)
+    return below, out
 
 
 def _modal_mats(structure: ToolPointStructure, process: CuttingProcess, theta: np.ndarray,
@@ -339,22 +462,124 @@ def _spectral_radius(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m:
 
     if n <= DENSE_EIG_MAX:
         return dense()
-    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, LinearOperator, eigs
+    rnd = _START_VECTORS.get(("random", n))
+    if rnd is None:
+        rnd = np.random.default_rng(12345).standard_normal(n)  # deterministic start vector
+        rnd /= np.linalg.norm(rnd)
+        _START_VECTORS[("random", n)] = rnd
+    warm = _START_VECTORS.get(("warm", n))
+    v = rnd.copy() if warm is None else (1.0 - ARNOLDI_RANDOM_SHARE) * warm + (
+        ARNOLDI_RANDOM_SHARE * rnd)
+    K = min(n - 1, ARNOLDI_VECTORS)
+    V = np.empty((K + 1, n))
+    H = np.empty((K + 1, K))
+    work = (np.empty((2 * r, m)), np.empty(2 * m), np.empty(2 * m), np.empty(n))
+    for _ in range(ARNOLDI_RESTARTS):
+        k = _arnoldi(Phi, P0, P1, r, m, v, V, H, *work)
+        if k < 0:  # overflow far beyond the limit: unstable
+            return math.inf
+        try:
+            ev, Y = np.linalg.eig(H[:k, :k])
+        except np.linalg.LinAlgError:
+            return dense()
+        i = int(np.argmax(np.abs(ev)))
+        lam = abs(ev[i])
+        y = Y[:, i] / np.linalg.norm(Y[:, i])
+        v = V[:k].T @ (y.real + y.imag)
+        nv = float(np.linalg.norm(v))
+        if not (nv > 0.0 and math.isfinite(nv)):
+            return dense()
+        v /= nv
+        resid = abs(H[k, k - 1] * y[k - 1]) if k == K else 0.0
+        if resid <= ARNOLDI_TOL * max(lam, 1e-300):
+            if len(_START_VECTORS) > 64:
+                _START_VECTORS.clear()
+            _START_VECTORS[("warm", n)] = v
+            return float(lam)
+    return dense()
 
-    buf = np.empty((n, 1))
 
-    def mv(v: np.ndarray) -> np.ndarray:
-        _propagate(Phi, P0, P1, r, m, np.ascontiguousarray(v, float).reshape(n, 1), buf)
-        return buf[:, 0].copy()
+@nb.njit(cache=True)
+def _arnoldi(Phi, P0, P1, r, m, v0, V, H, Q, x, xn, w):  # pragma: no cover - numba
+    """Arnoldi factorisation of the monodromy of :func:`_propagate` from ``v0``: orthonormal
+    rows ``V[0..k]`` and the Hessenberg matrix ``H[:k+1, :k]`` (Gram-Schmidt twice), ``k`` =
+    ``V.shape[0] - 1`` or fewer where the Krylov space closes (an invariant subspace, ``k``
+    returned with ``H[k, k-1]`` irrelevant). -1 when a product overflows. The work arrays
+    ``Q`` (2r, m), ``x``, ``xn`` (2m) and ``w`` (n) are overwritten; nothing is allocated."""
+    K = V.shape[0] - 1
+    n = v0.size
+    n2 = 2 * m
+    kc = Phi.shape[0]
+    nrm = 0.0
+    for a in range(n):
+        nrm += v0[a] * v0[a]
+    nrm = math.sqrt(nrm)
+    for a in range(n):
+        V[0, a] = v0[a] / nrm
+    for i in range(K + 1):
+        for j in range(K):
+            H[i, j] = 0.0
+    for j in range(K):
+        # w = U V[j]: r steps, the delayed values in a buffer indexed by time
+        for s_ in range(1, r + 1):
+            for a in range(m):
+                Q[r - s_, a] = V[j, n2 + (s_ - 1) * m + a]
+        for a in range(n2):
+            x[a] = V[j, a]
+        for i in range(r):
+            for a in range(m):
+                Q[i + r, a] = x[a]
+            p = i % kc
+            for a in range(n2):
+                acc = 0.0
+                for b in range(n2):
+                    acc += Phi[p, a, b] * x[b]
+                for b in range(m):
+                    acc += P0[p, a, b] * Q[i, b] + P1[p, a, b] * Q[i + 1, b]
+                xn[a] = acc
+            for a in range(n2):
+                x[a] = xn[a]
+        for a in range(n2):
+            w[a] = x[a]
+        for s_ in range(1, r + 1):
+            for a in range(m):
+                w[n2 + (s_ - 1) * m + a] = Q[2 * r - s_, a]
+        wn0 = 0.0
+        for a in range(n):
+            wn0 += w[a] * w[a]
+        if not math.isfinite(wn0):
+            return -1
+        for _ in range(2):
+            for i in range(j + 1):
+                h = 0.0
+                for a in range(n):
+                    h += V[i, a] * w[a]
+                H[i, j] += h
+                for a in range(n):
+                    w[a] -= h * V[i, a]
+        wn = 0.0
+        for a in range(n):
+            wn += w[a] * w[a]
+        wn = math.sqrt(wn)
+        H[j + 1, j] = wn
+        if wn <= 1e-13 * math.sqrt(wn0) or wn == 0.0:
+            return j + 1
+        for a in range(n):
+            V[j + 1, a] = w[a] / wn
+    return K
 
-    op = LinearOperator((n, n), matvec=mv, dtype=float)
-    v0 = np.random.default_rng(12345).standard_normal(n)  # deterministic start vector
-    try:
-        ev = eigs(op, k=4, which="LM", tol=1e-9, ncv=min(n - 1, 20), maxiter=50 * n, v0=v0,
-                  return_eigenvectors=False)
-    except (ArpackNoConvergence, ArpackError, ValueError, np.linalg.LinAlgError):
-        return dense()
-    return float(np.max(np.abs(ev)))
+
+#: Arnoldi basis size of the spectral radius of large monodromy matrices.
+ARNOLDI_VECTORS = 16
+#: Explicit restarts (from the dominant Ritz vector) before the dense solver takes over.
+ARNOLDI_RESTARTS = 30
+#: Relative residual of the dominant Ritz pair at which the Arnoldi iteration stops.
+ARNOLDI_TOL = 1e-10
+#: Share of the fixed random vector in the Arnoldi start vector; the rest is the dominant
+#: eigenvector of the last monodromy of the same dimension (a neighbouring depth or speed),
+#: so that the iteration starts near the answer yet sees every direction.
+ARNOLDI_RANDOM_SHARE = 0.3
+_START_VECTORS: dict = {}
 
 
 def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingProcess,
@@ -374,14 +599,21 @@ def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingPro
 
 
 def _rho(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
-         about_deflected, parts=False):
+         about_deflected, parts=False, known=None):
     """Spectral radius with ``steps`` per delay, extrapolated to zero step (Richardson).
 
     First-order semi-discretisation converges as the square of the step (Insperger, Stepan &
     Turi 2008): ``rho(r) = rho* + C / r^2``, so the spectral radius with ``steps`` and with
     half of them give ``rho* = rho(r) + (rho(r) - rho(r/2)) / 3``. On the example robot at
     700 r/min (0.9 x its limit) 100 steps give 0.98392, 200 give 0.98414 and 800 give 0.98420;
-    the extrapolation from 100 and 50 steps gives 0.98419."""
+    the extrapolation from 100 and 50 steps gives 0.98419.
+
+    ``known`` (a dict kept by the critical-depth search at one speed): where the spectral
+    radius with ``steps`` is farther from 1 than :data:`RICHARDSON_SIGN_MARGIN` times the
+    largest extrapolation correction met so far (``known["correction"]``, at least
+    :data:`RICHARDSON_SIGN_MIN`), the half-step solution is skipped and that value plus the
+    last correction returned: the side of 1 is then certain, and the value only guides the
+    search. Without ``known`` the extrapolation is always made."""
     with np.errstate(over="ignore", invalid="ignore"):
         if process.depth_dependent:
             at = process.at_depth(depth_m)
@@ -393,11 +625,25 @@ def _rho(structure, process, speed_rpm, depth_m, steps, include_process_stiffnes
                          include_process_stiffness, about_deflected, parts)
         half = steps // 2
         if math.isfinite(rho) and half >= RICHARDSON_MIN_STEPS:
+            if known is not None and "correction" in known and abs(rho - 1.0) > max(
+                    RICHARDSON_SIGN_MIN, RICHARDSON_SIGN_MARGIN * known["largest"]):
+                return max(0.0, rho + known["correction"])
             rho_h = _monodromy(structure, process, speed_rpm, depth_m, half,
                                include_process_stiffness, about_deflected, parts)
             if math.isfinite(rho_h):
-                rho = max(0.0, rho + (rho - rho_h) / 3.0)
+                c = (rho - rho_h) / 3.0
+                if known is not None:
+                    known["correction"] = c
+                    known["largest"] = max(abs(c), known.get("largest", 0.0))
+                rho = max(0.0, rho + c)
     return rho if math.isfinite(rho) else math.inf
+
+
+#: The Richardson half-step is skipped in the critical-depth search where the spectral radius
+#: with the full steps is farther from 1 than this many times the largest correction met at
+#: the speed (:func:`_rho`), and at least :data:`RICHARDSON_SIGN_MIN` from it.
+RICHARDSON_SIGN_MARGIN = 10.0
+RICHARDSON_SIGN_MIN = 0.02
 
 
 def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_stiffness,
@@ -408,34 +654,164 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
     m = structure.n_modes
     tau = 60.0 / (process.n_inserts * speed_rpm)
     dt = tau / steps
-    om = structure.omega
-    base = np.zeros((2 * m, 2 * m))
-    base[:m, m:] = np.eye(m)
-    base[m:, :m] = -np.diag(om**2)
-    base[m:, m:] = -np.diag(2 * structure.damping_ratio * om)
     constant = (not process.rotating) or process.n_inserts == 0
     n_th = 1 if constant else steps
-    # coefficient angle at the middle of each step (delay = one insert pitch)
-    theta = (np.arange(n_th) + 0.5) * dt * 2 * np.pi * speed_rpm / 60.0
-    wts = None
+    rp = np.zeros((1, 3))
+    weighted = False
     if about_deflected:
         if parts is False:
             parts = _deflection_parts(structure, process, speed_rpm)
         if parts is not None:
-            wts = _deflected_weights(parts, process, theta, depth_m)
-    W, Pm = _modal_mats(structure, process, theta, include_process_stiffness, wts)
-    L = np.broadcast_to(base, (n_th, 2 * m, 2 * m)).copy()
-    L[:, m:, :m] += -depth_m * W + Pm
-    Phi, G0, G1 = np.empty_like(L), np.empty_like(L), np.empty_like(L)
-    _step_matrices_batch(L, float(dt), Phi, G0, G1)
-    if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0)) and np.all(np.isfinite(G1))):
+            rp, r0 = parts
+            if r0 is not None and depth_m > 0.0:
+                rp = rp + r0 / depth_m
+            weighted = True
+    core = np.einsum("e,ei,ej->ij", process.width_per_depth, process.shear, process.normal)
+    vec = (np.einsum("e,e,ei->i", process.width_per_depth, process.h0, process.shear)
+           + np.einsum("e,ei->i", process.edge_per_depth, process.edge))
+    L = np.empty((n_th, 2 * m, 2 * m))
+    W = np.empty((n_th, m, m))
+    _step_coefficients(bool(process.rotating), int(process.n_inserts), float(dt),
+                       float(speed_rpm), core, vec, np.asarray(process.depth_direction, float),
+                       np.ascontiguousarray(structure.directions, dtype=float),
+                       1.0 / np.asarray(structure.modal_mass, float),
+                       np.asarray(structure.omega, float),
+                       np.asarray(structure.damping_ratio, float), np.ascontiguousarray(rp),
+                       weighted, float(depth_m), bool(include_process_stiffness), L, W)
+    Phi, P0, P1 = np.empty_like(L), np.empty((n_th, 2 * m, m)), np.empty((n_th, 2 * m, m))
+    if not _delay_matrices(L, W, float(dt), float(process.overlap * depth_m), Phi, P0, P1):
         return math.inf
-    Rq = np.zeros((n_th, 2 * m, m))
-    Rq[:, m:, :] = process.overlap * depth_m * W
-    P1 = (G1 / dt) @ Rq             # multiplies q_{i-r+1}
-    P0 = (G0 - G1 / dt) @ Rq        # multiplies q_{i-r}
-    return _spectral_radius(np.ascontiguousarray(Phi), np.ascontiguousarray(P0),
-                            np.ascontiguousarray(P1), int(steps), int(m))
+    return _spectral_radius(Phi, P0, P1, int(steps), int(m))
+
+
+@nb.njit(cache=True)
+def _step_coefficients(rotating, N, dt, speed_rpm, core, vec, dd, D, minv, om, zeta, rp,
+                       weighted, depth, with_p, L, W):  # pragma: no cover - numba
+    """System matrices ``L`` (k, 2m, 2m) and the regenerative modal matrices ``W`` (k, m, m)
+    per unit depth at the middle of each of the ``k`` steps (one for a constant process).
+
+    At bar angle ``theta``: ``A = sum_p g_p B_p^T core B_p`` (:meth:`~robobore.dynamics.
+    process.CuttingProcess.directional_matrix`; ``g_p = max(0, 1 + dd . B_p r(theta))`` along
+    the steady deflected path ``r``, interpolated periodically in ``rp``, or 1 without
+    ``weighted``), ``P = sum_p B_p^T vec dd^T B_p`` (:meth:`~robobore.dynamics.process.
+    CuttingProcess.process_stiffness`, only ``with_p``), ``W = M^-1 D A D^T``,
+    ``L = [[0, I], [-Omega^2 - a W + M^-1 D P D^T, -2 zeta Omega]]``."""
+    k_n = L.shape[0]
+    m = D.shape[0]
+    M_r = rp.shape[0]
+    B = np.zeros((3, 3))
+    A = np.zeros((3, 3))
+    P = np.zeros((3, 3))
+    T = np.zeros((3, 3))
+    rr = np.zeros(3)
+    two_pi = 2.0 * math.pi
+    for q in range(k_n):
+        th = (q + 0.5) * dt * two_pi * speed_rpm / 60.0
+        rr[0] = rr[1] = rr[2] = 0.0
+        if weighted:
+            t = th % two_pi
+            u = t / two_pi * M_r
+            i0 = int(math.floor(u))
+            f = u - i0
+            i0 = i0 % M_r
+            i1 = (i0 + 1) % M_r
+            for c in range(3):
+                rr[c] = (1.0 - f) * rp[i0, c] + f * rp[i1, c]
+        for a in range(3):
+            for b in range(3):
+                A[a, b] = 0.0
+                P[a, b] = 0.0
+        for p in range(max(N, 1)):
+            for a in range(3):
+                for b in range(3):
+                    B[a, b] = 0.0
+            if rotating:
+                tp = th + two_pi * p / N
+                c_, s_ = math.cos(tp), math.sin(tp)
+                B[0, 0], B[0, 1] = -s_, c_
+                B[1, 0], B[1, 1] = c_, s_
+                B[2, 2] = 1.0
+            else:
+                B[0, 0] = B[1, 1] = B[2, 2] = 1.0
+            g = 1.0
+            if weighted:
+                g = 1.0
+                for a in range(3):
+                    acc = 0.0
+                    for b in range(3):
+                        acc += B[a, b] * rr[b]
+                    g += dd[a] * acc
+                g = max(g, 0.0)
+            # A += g B^T core B ; P += B^T (vec dd^T) B
+            for a in range(3):
+                for b in range(3):
+                    acc = 0.0
+                    for c in range(3):
+                        acc += core[a, c] * B[c, b]
+                    T[a, b] = acc
+            for a in range(3):
+                for b in range(3):
+                    acc = 0.0
+                    for c in range(3):
+                        acc += B[c, a] * T[c, b]
+                    A[a, b] += g * acc
+            if with_p:
+                for a in range(3):
+                    bv = 0.0
+                    for c in range(3):
+                        bv += B[c, a] * vec[c]
+                    for b in range(3):
+                        bd = 0.0
+                        for c in range(3):
+                            bd += dd[c] * B[c, b]
+                        P[a, b] += bv * bd
+        for j in range(2 * m):
+            for k in range(2 * m):
+                L[q, j, k] = 0.0
+        for j in range(m):
+            L[q, j, m + j] = 1.0
+            L[q, m + j, j] = -om[j] * om[j]
+            L[q, m + j, m + j] = -2.0 * zeta[j] * om[j]
+            for k in range(m):
+                w_ = 0.0
+                p_ = 0.0
+                for a in range(3):
+                    for b in range(3):
+                        w_ += D[j, a] * A[a, b] * D[k, b]
+                        p_ += D[j, a] * P[a, b] * D[k, b]
+                W[q, j, k] = minv[j] * w_
+                L[q, m + j, k] += -depth * minv[j] * w_ + minv[j] * p_
+
+
+@nb.njit(cache=True)
+def _delay_matrices(L, W, dt, overlap_depth, Phi, P0, P1):  # pragma: no cover - numba
+    """Step matrices (:func:`_step_matrices_batch`) and the delayed-term matrices of
+    :func:`_propagate`: with ``Rq = [0; mu a W]`` (2m, m), ``P1 = Gamma1 Rq / dt``
+    (multiplies ``q_{i-r+1}``) and ``P0 = (Gamma0 - Gamma1 / dt) Rq`` (``q_{i-r}``). False
+    when a step matrix is not finite (far beyond the limit)."""
+    k_n, n2, _ = L.shape
+    m = n2 // 2
+    G0 = np.empty_like(L)
+    G1 = np.empty_like(L)
+    _step_matrices_batch(L, dt, Phi, G0, G1)
+    for q in range(k_n):
+        for a in range(n2):
+            for b in range(n2):
+                if not (math.isfinite(Phi[q, a, b]) and math.isfinite(G0[q, a, b])
+                        and math.isfinite(G1[q, a, b])):
+                    return False
+        for a in range(n2):
+            for b in range(m):
+                acc0 = 0.0
+                acc1 = 0.0
+                for c in range(m):
+                    rq = overlap_depth * W[q, c, b]
+                    g1 = G1[q, a, m + c] / dt
+                    acc1 += g1 * rq
+                    acc0 += (G0[q, a, m + c] - g1) * rq
+                P0[q, a, b] = acc0
+                P1[q, a, b] = acc1
+    return True
 
 
 def auto_steps(structure: ToolPointStructure, process: CuttingProcess, speed_rpm: float,
@@ -486,36 +862,125 @@ def critical_depth_semidiscretization(structure: ToolPointStructure, process: Cu
     number counts as unstable. Never raises for a valid structure and process. Where the
     steady forced vibration takes the tool out of the material below the limit, the linear
     limit is not the whole answer: :func:`chatter_free_window` gives both ends."""
+    return _critical_depth(structure, process, speed_rpm, depth_hi_m, steps, tol,
+                           include_process_stiffness, about_deflected, decades, ratio,
+                           guess_m, None)[0]
+
+
+def _critical_depth(structure, process, speed_rpm, depth_hi_m, steps, tol,
+                    include_process_stiffness, about_deflected, decades, ratio, guess_m,
+                    slope):
+    """:func:`critical_depth_semidiscretization` and the slope ``d log rho / d log a`` at the
+    crossing (``None`` where none was measured), given a ``slope`` hint (or ``None``)."""
     steps = steps or auto_steps(structure, process, speed_rpm)
     parts = (_deflection_parts(structure, process, speed_rpm)
              if about_deflected and not process.depth_dependent else False)
 
+    known: dict = {}
+
     def rho(b: float) -> float:
         r = _rho(structure, process, speed_rpm, b, steps, include_process_stiffness,
-                 about_deflected, parts)
+                 about_deflected, parts, known)
         return r if r == r else math.inf  # NaN counts as unstable
 
     with blas_thread_limit(1):
         if guess_m is not None and 0.0 < guess_m < depth_hi_m:
-            return _continue(rho, guess_m, depth_hi_m, tol, decades, ratio)
-        return _scan(rho, depth_hi_m, tol, decades, ratio)
+            return _continue(rho, guess_m, depth_hi_m, tol, decades, ratio, slope)
+        return _scan(rho, depth_hi_m, tol, decades, ratio), None
 
 
-#: First relative step of the continuation bracket (:func:`critical_depth_semidiscretization`).
+#: First relative step of the continuation bracket (:func:`critical_depth_semidiscretization`)
+#: when the secant steps from the guess do not bracket the crossing.
 CONTINUATION_STEP = 0.03
+#: Slope ``d log rho / d log a`` assumed at the guess when no neighbouring speed gave one.
+CONTINUATION_SLOPE = 0.5
+#: Largest secant step of the continuation, in ``log a`` (a factor of 1.5 in depth).
+CONTINUATION_MAX_STEP = math.log(1.5)
+#: Secant steps of the continuation before it falls back to the doubling bracket.
+CONTINUATION_SECANT_STEPS = 4
+
+
+def _log_rho(r: float) -> float:
+    return math.log(r) if math.isfinite(r) and r > 0.0 else (
+        math.inf if r >= 1.0 else math.log(1e-300))
 
 
 def _continue(rho, guess: float, depth_hi_m: float, tol: float, decades: float,
-              ratio: float) -> float:
-    """Crossing of ``rho = 1`` bracketed outwards from ``guess``, after checking the scan's
-    lowest depth (unstable there: the grid scan)."""
+              ratio: float, slope: float | None = None) -> tuple[float, float | None]:
+    """Crossing of ``rho = 1`` found from ``guess``, after checking the scan's lowest depth
+    (unstable there: the grid scan); returns it and the slope of ``log rho`` over ``log a``
+    at the final bracket.
+
+    Secant steps on ``f = log rho`` over ``x = log a`` (the first with the ``slope`` hint,
+    each aimed a quarter of the tolerance past the estimated root, so that a good estimate
+    brackets the crossing in one evaluation, and at most :data:`CONTINUATION_MAX_STEP`);
+    once two points lie on either side of ``rho = 1`` the bracket is narrowed by
+    :func:`_narrow`. When the secant steps do not bracket the crossing (no finite slope, a
+    slope of the wrong sign, or :data:`CONTINUATION_SECANT_STEPS` steps) the bracket is grown
+    outwards from the last point (``1 +- CONTINUATION_STEP``, doubling)."""
     lowest = float(depth_scan_grid(depth_hi_m, decades, ratio)[0])
-    if guess <= lowest or rho(lowest) >= 1.0:
-        return _scan(rho, depth_hi_m, tol, decades, ratio)
-    r_g = rho(guess)
+    if guess <= lowest:
+        return _scan(rho, depth_hi_m, tol, decades, ratio), None
+    r = rho(guess)  # first: near the crossing, it measures the extrapolation correction
+    if rho(lowest) >= 1.0:
+        return _scan(rho, depth_hi_m, tol, decades, ratio), None
+    x_lo, x_hi = math.log(lowest), math.log(depth_hi_m)
+    width_tol = math.log1p(tol)
+    x = math.log(guess)
+    f = _log_rho(r)
+    s = slope if slope is not None and math.isfinite(slope) and slope > 0.0 else (
+        CONTINUATION_SLOPE)
+    pts = [(x, r, f)]
+    for _ in range(CONTINUATION_SECANT_STEPS):
+        if not math.isfinite(f) or not s > 0.0:
+            break
+        d = -f / s
+        d += math.copysign(0.25 * width_tol, d if d != 0.0 else -f)
+        d = max(-CONTINUATION_MAX_STEP, min(CONTINUATION_MAX_STEP, d))
+        xn = min(max(x + d, x_lo), x_hi)
+        if xn == x:
+            break
+        rn = rho(math.exp(xn))
+        fn = _log_rho(rn)
+        if (rn >= 1.0) != (r >= 1.0):  # bracketed
+            pts.append((xn, rn, fn))
+            lo, hi = ((x, r), (xn, rn)) if r < 1.0 else ((xn, rn), (x, r))
+            a = _narrow(rho, math.exp(lo[0]), lo[1], math.exp(hi[0]), hi[1], tol, pts)
+            return a, _bracket_slope(pts)
+        if not math.isfinite(fn):
+            x, r, f = xn, rn, fn
+            break
+        s = (fn - f) / (xn - x)
+        x, r, f = xn, rn, fn
+        pts.append((x, r, f))
+        if x >= x_hi and r < 1.0:
+            return math.inf, None
+    a = _grow(rho, math.exp(x), r, depth_hi_m, lowest, tol, decades, ratio)
+    return a, None
+
+
+def _bracket_slope(pts) -> float | None:
+    """Slope of ``log rho`` over ``log a`` between the two finite points nearest the
+    crossing on either side (``pts``: the evaluated ``(log a, rho, log rho)``)."""
+    st = [p for p in pts if p[1] < 1.0 and math.isfinite(p[2])]
+    un = [p for p in pts if p[1] >= 1.0 and math.isfinite(p[2])]
+    if not st or not un:
+        return None
+    a = max(st, key=lambda p: p[2])
+    b = min(un, key=lambda p: p[2])
+    if b[0] == a[0]:
+        return None
+    sl = (b[2] - a[2]) / (b[0] - a[0])
+    return sl if sl > 0.0 else None
+
+
+def _grow(rho, start: float, r_start: float, depth_hi_m: float, lowest: float, tol: float,
+          decades: float, ratio: float) -> float:
+    """Crossing bracketed outwards from ``start`` (``1 +- CONTINUATION_STEP``, doubling), then
+    narrowed; the grid scan where the cut is unstable down to the lowest depth."""
     step = 1.0 + CONTINUATION_STEP
-    if r_g < 1.0:
-        lo, r_lo = guess, r_g
+    if r_start < 1.0:
+        lo, r_lo = start, r_start
         while True:
             hi = min(lo * step, depth_hi_m)
             r_hi = rho(hi)
@@ -525,7 +990,7 @@ def _continue(rho, guess: float, depth_hi_m: float, tol: float, decades: float,
                 return math.inf
             lo, r_lo, step = hi, r_hi, step * step
     else:
-        hi, r_hi = guess, r_g
+        hi, r_hi = start, r_start
         while True:
             lo = max(hi / step, lowest)
             r_lo = rho(lo)
@@ -561,7 +1026,8 @@ def _scan(rho, depth_hi_m: float, tol: float, decades: float, ratio: float) -> f
     return _narrow(rho, lo, r_lo, hi, r_hi, tol)
 
 
-def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> float:
+def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float,
+            record: list | None = None) -> float:
     """Illinois false position on ``f = log rho`` over ``x = log a`` between a stable ``lo``
     and an unstable ``hi``, to a relative width ``tol``. Once the secant through the bracket
     puts the root within ``tol`` of the last point, the next point is placed just past that
@@ -576,8 +1042,9 @@ def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float) -> 
 
     def update(x: float, rx: float) -> float:
         nonlocal x0, x1, f0, f1, t0, t1, side
-        fx = math.log(rx) if math.isfinite(rx) and rx > 0 else (
-            math.inf if rx >= 1.0 else math.log(1e-300))
+        fx = _log_rho(rx)
+        if record is not None:
+            record.append((x, rx, fx))
         if rx >= 1.0:
             x1, f1, t1 = x, fx, fx
             if side == -1 and math.isfinite(f0):
@@ -617,5 +1084,6 @@ __all__ = ["DEPTH_SCAN_HI_M", "DEPTH_SCAN_DECADES", "DEPTH_SCAN_RATIO", "DENSE_E
            "blas_thread_limit", "depth_scan_grid", "auto_steps", "deflected_depth_weights",
            "monodromy_spectral_radius", "critical_depth_semidiscretization",
            "interrupted_below",
-           "chatter_free_window", "CONTINUATION_STEP",
+           "chatter_free_window", "chatter_free_windows", "CONTINUATION_STEP",
+           "CONTINUATION_SLOPE", "CONTINUATION_MAX_STEP", "CONTINUATION_SECANT_STEPS",
            "RICHARDSON_MIN_STEPS", "DEFLECTION_SAMPLES"]

@@ -33,8 +33,7 @@ from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_HI_M,
     auto_steps,
-    blas_thread_limit,
-    chatter_free_window,
+    chatter_free_windows,
     critical_depth_semidiscretization,
     deflected_depth_weights,
     depth_scan_grid,
@@ -221,18 +220,8 @@ def lobes_semidiscretization(structure: ToolPointStructure, process: CuttingProc
     ``inf`` at a speed: stable up to ``depth_hi_m`` (reported as unconditionally stable up to
     that depth). ``absolute_limit_m`` is the smallest finite critical depth (``inf`` if none)."""
     speeds = np.asarray(speed_rpm, float)
-    out = np.empty(speeds.size)
-    below = np.zeros(speeds.size)
-    with blas_thread_limit(1):
-        prev = None
-        for i, n in enumerate(speeds):
-            below[i], out[i] = chatter_free_window(structure, process, float(n), guess_m=prev,
-                                                   depth_hi_m=depth_hi_m, steps=steps)
-            # continue from the linear limit (the interruption does not move it)
-            lin = out[i] if out[i] > 0.0 else below[i]
-            prev = float(lin) if 0.0 < lin < depth_hi_m else None
-            if progress is not None:
-                progress(1)
+    below, out = chatter_free_windows(structure, process, speeds, depth_hi_m=depth_hi_m,
+                                      steps=steps, progress=progress)
     fin = out[np.isfinite(out)]
     alim = float(fin.min()) if fin.size else math.inf
     return LobeResult(speeds, out, np.full(speeds.size, np.nan), alim, math.nan,

@@ -294,13 +294,26 @@ def _orbit_kernel(Phi, Gam, Pm, Fm, half_dt, X_out):  # pragma: no cover - numba
     Ns, m, K = Fm.shape
     n = 2 * m
     T = np.eye(n)
+    T2 = np.empty((n, n))
     c = np.zeros((n, K))
+    c2 = np.empty((n, K))
     A = np.zeros((n, n))
     b = np.zeros((n, K))
-    for i in range(Ns):
+    for i in range(Ns):  # T <- A T, c <- A c + b, without allocation
         _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
-        T = A @ T
-        c = A @ c + b
+        for r in range(n):
+            for j in range(n):
+                acc = 0.0
+                for k in range(n):
+                    acc += A[r, k] * T[k, j]
+                T2[r, j] = acc
+            for j in range(K):
+                acc = b[r, j]
+                for k in range(n):
+                    acc += A[r, k] * c[k, j]
+                c2[r, j] = acc
+        T, T2 = T2, T
+        c, c2 = c2, c
     M = np.eye(n) - T
     if abs(np.linalg.det(M)) < 1e-300:
         return False
@@ -308,7 +321,13 @@ def _orbit_kernel(Phi, Gam, Pm, Fm, half_dt, X_out):  # pragma: no cover - numba
     for i in range(Ns):
         X_out[i] = x
         _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
-        x = A @ x + b
+        for r in range(n):
+            for j in range(K):
+                acc = b[r, j]
+                for k in range(n):
+                    acc += A[r, k] * x[k, j]
+                c2[r, j] = acc
+        x[:, :] = c2
     return True
 
 

@@ -274,14 +274,17 @@ LOBE_MARGIN = 0.10
 
 
 def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
-                     rows: list[dict[str, Any]]) -> dict[str, Any]:
+                     rows: list[dict[str, Any]],
+                     lobes: dict[str, Any] | None = None) -> dict[str, Any]:
     """The swept robot conditions at the base feed against the semi-discretisation limit at
     their own speed and foot pressure (the lobes of :func:`compute_lobes`, evaluated at the
     condition's speed): each is ``"above"`` (depth > (1 + LOBE_MARGIN) x limit), ``"below"``
     (< (1 - LOBE_MARGIN) x limit) or ``"near"``, and consistent when above means chatter and
     below means no chatter, or its verdict states the tool leaving the cut. Returns the
     counts and one record per condition; ``inconsistent`` lists the conditions that break
-    the rule."""
+    the rule. ``lobes`` (:func:`compute_lobes`): each limit is continued from the lobes'
+    limit interpolated at the condition's speed, as the lobes themselves are computed,
+    instead of a fresh depth scan."""
     from robobore.dynamics.api import critical_depth_at
 
     base_f = float(cfg.study.base["feed_mm_per_rev"])
@@ -301,7 +304,8 @@ def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
                     **(dyn["equivalent"].get("pressure_foot") or {}), "pressure_MPa": p}
             dyn["cutting"] = {"speed_rpm": n, "feed_mm_per_rev": base_f,
                               "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
-            v = critical_depth_at(dyn, n)["critical_depth_mm"]
+            v = critical_depth_at(dyn, n, guess_mm=_lobe_guess_mm(lobes, p, n))[
+                "critical_depth_mm"]
             cache[(n, p)] = math.inf if v is None else float(v)
         lim = cache[(n, p)]
         a = float(r["depth_of_cut_mm"])
@@ -321,6 +325,25 @@ def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
             "checked": len(records), "consistent": len(records) - len(bad),
             "nonlinear": sum(1 for x in records if x["tool_leaves_cut"]),
             "inconsistent": bad, "conditions": records}
+
+
+def _lobe_guess_mm(lobes: dict[str, Any] | None, pressure_MPa: float,
+                   speed_rpm: float) -> float | None:
+    """The limit of :func:`compute_lobes`' lobes at ``pressure_MPa`` interpolated at
+    ``speed_rpm`` (finite positive limits only; None outside their speeds or without)."""
+    if not lobes:
+        return None
+    label = "P = 0" if pressure_MPa == 0.0 else f"P = {pressure_MPa:g} MPa"
+    L = lobes.get(label)
+    if not L:
+        return None
+    sp = np.asarray(L.get("speed_rpm", []), float)
+    a = np.asarray([math.nan if v is None else v for v in L.get("critical_depth_mm", [])],
+                   float)
+    ok = np.isfinite(a) & (a > 0.0)
+    if sp.size != a.size or ok.sum() < 2 or not sp[ok].min() <= speed_rpm <= sp[ok].max():
+        return None
+    return float(np.interp(speed_rpm, sp[ok], a[ok]))
 
 
 # ----------------------------------------------------------------------------- outputs
@@ -471,7 +494,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
                 for r in rows if r["system"] == "robot" and r["summary"]]
         cmp = compare(table, sims)
     checks = qualitative_checks(rows, cfg)
-    consistency = lobe_consistency(cfg, robot_model, rows)
+    consistency = lobe_consistency(cfg, robot_model, rows, lob)
     lap("comparison", t)
     advance(1)
     t = time.perf_counter()
