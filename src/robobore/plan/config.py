@@ -51,6 +51,7 @@ class BoreCfg(_Strict):
     point_m: list[float]
     axis: list[float]
     diameter_mm: float = Field(gt=1, le=2000)
+    x_hint: list[float] | None = None
 
 
 class PartCfg(_Strict):
@@ -133,6 +134,8 @@ class PlanInputs:
     modes_file: Path | None
     synthetic: bool = False
     link_bending: tuple[Any, ...] = ()
+    notes: tuple[str, ...] = ()
+    x_hint: np.ndarray | None = None
 
 
 def _resolve(base: Path, name: str) -> Path:
@@ -140,20 +143,20 @@ def _resolve(base: Path, name: str) -> Path:
     return p if p.is_absolute() else base.parent / p
 
 
-def load_plan_config(path: str | Path) -> PlanInputs:
-    """Read, validate and resolve a plan config (errors name the file, key, value, unit)."""
+def load_plan_config(path: str | Path, x_hint: Any = None) -> PlanInputs:
+    """Read, validate and resolve a plan config (errors name the file, key, value, unit).
+
+    ``x_hint`` (3 numbers, the frame of ``bore.axis``) overrides ``bore.x_hint``: the
+    boring frame's X is its projection onto the plane normal to the bore axis."""
     from robobore.dynamics.structure import check_unit_vector
     from robobore.io.config import load_toml, validate_model
-    from robobore.robot.kinematics import get_robot
     from robobore.robot.stiffness import JointStiffness
 
     p = Path(path)
     raw = load_toml(p)
     cfg = validate_model(PlanConfig, raw, source=p)
     f = str(p)
-    rname = cfg.robot.name
-    rpath = _resolve(p, rname) if rname.endswith(".toml") else None
-    robot = get_robot(str(rpath) if rpath is not None else rname, file=f, field="robot.name")
+    robot, robot_notes = _plan_robot(cfg, raw, p)
     if not robot.links:
         raise ConfigError(
             f"robot '{robot.name}' has no inertial data (mass, centre of mass and inertia per "
@@ -179,6 +182,19 @@ def load_plan_config(path: str | Path) -> PlanInputs:
                                    "of mass, flange frame")
     point = _vec3(cfg.bore.point_m, f, "bore.point_m", "m")
     axis = check_unit_vector(cfg.bore.axis, "bore.axis", file=f)
+    from robobore.robot.stiffness import process_frame, x_hint_arg
+
+    hint = x_hint_arg(x_hint if x_hint is not None else cfg.bore.x_hint,
+                      "--x-hint" if x_hint is not None else "bore.x_hint",
+                      None if x_hint is not None else f)
+    if hint is not None:
+        try:
+            process_frame(np.column_stack([np.zeros(3), np.zeros(3), axis]), "boring",
+                          x_hint=hint)
+        except ConfigError as exc:
+            raise ConfigError(exc.message, file=None if x_hint is not None else f,
+                              field="--x-hint" if x_hint is not None else "bore.x_hint",
+                              value=list(hint), expected=exc.expected) from None
     if cfg.part is not None:
         o = _vec3(cfg.part.origin_m, f, "part.origin_m", "m")
         y = math.radians(cfg.part.yaw_deg)
@@ -186,6 +202,7 @@ def load_plan_config(path: str | Path) -> PlanInputs:
                        [0, 0, 1.0]])
         point = o + Rz @ point
         axis = Rz @ axis
+        hint = None if hint is None else Rz @ hint
     if cfg.lobes.speed_max_rpm <= cfg.lobes.speed_min_rpm:
         raise ConfigError("empty speed range", file=f, field="lobes.speed_max_rpm",
                           value=cfg.lobes.speed_max_rpm,
@@ -232,10 +249,10 @@ def load_plan_config(path: str | Path) -> PlanInputs:
 
     id_s = read_identity(sdata, str(sfile))
     id_m = read_identity(mdata, str(mfile))
-    named = isinstance(raw.get("robot"), dict) and "name" in raw["robot"]
+    named = _names_robot(raw)
     for ident, fl in ((id_s, sfile), (id_m, mfile)):
         check_robot(ident, str(fl), robot.name, robot.description_hash(),
-                    f"robot.name in {f}" if named else f"the default robot of {f} (robot.name)",
+                    f"robot.name in {f}" if named else f"the robot of {f}",
                     verb="was identified for" if fl == sfile else "is a hammer test of")
     if id_s is not None and id_m is not None:
         check_pair({"robot": id_s.get("robot"), "robot_hash": id_s.get("robot_hash")},
@@ -270,7 +287,38 @@ def load_plan_config(path: str | Path) -> PlanInputs:
     synthetic = bool(sdata.get("synthetic", False)) or bool(mdata.get("synthetic", False))
     return PlanInputs(cfg, raw, p, robot, np.asarray(js.k_Nm_per_rad, float), fz[:, 0],
                       fz[:, 1], np.radians(qm), tcp, point, axis, sfile, mfile, synthetic,
-                      _link_bending(cfg, robot, f))
+                      _link_bending(cfg, robot, f), tuple(robot_notes), hint)
+
+
+def _names_robot(raw: dict[str, Any]) -> bool:
+    return isinstance(raw.get("robot"), dict) and "name" in raw["robot"]
+
+
+def _plan_robot(cfg: PlanConfig, raw: dict[str, Any], p: Path) -> tuple[Any, list[str]]:
+    """The plan's robot: ``robot.name``, or (the config names none) the robot the joint
+    stiffness file (else the modes file) was identified for, said in a note; the default
+    robot when neither the config nor the files name one."""
+    from robobore.io.identity import read_identity
+    from robobore.robot.description import robot_of_identity
+    from robobore.robot.kinematics import get_robot
+
+    f = str(p)
+    if not _names_robot(raw):
+        for key in ("joint_stiffness", "modes"):
+            fl = _resolve(p, getattr(cfg.identification, key))
+            if not fl.is_file():
+                continue
+            data = _read_json(fl, f, f"identification.{key}")
+            ident = read_identity(data, str(fl))
+            if ident is None and isinstance(data.get("robot"), str) and data["robot"]:
+                ident = {"robot": data["robot"]}
+            if ident is not None and ident.get("robot"):
+                rb = robot_of_identity(ident, str(fl))
+                return rb, [f"robot {rb.name} taken from {fl} ({f} names no robot.name)"]
+    rname = cfg.robot.name
+    rpath = _resolve(p, rname) if rname.endswith(".toml") else None
+    return get_robot(str(rpath) if rpath is not None else rname, file=f,
+                     field="robot.name"), []
 
 
 def _link_bending(cfg: PlanConfig, robot: Any, f: str) -> tuple[Any, ...]:

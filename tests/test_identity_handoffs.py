@@ -1,0 +1,183 @@
+"""Identity where files are handed on: a plan config without a robot adopts the files'
+robot and says so; the boring frame's X hint; a modal model that does not fit the
+stiffness file; identity in the coefficients and FE results JSON."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from robobore.cli import app
+from robobore.errors import ConfigError
+
+runner = CliRunner()
+REPO = Path(__file__).resolve().parents[1]
+EX = REPO / "examples"
+KUKA = EX / "robots" / "kr240-r2900.toml"
+
+
+def _plan_copy(tmp_path: Path, *, robot_section: bool = True, **subs: str) -> Path:
+    shutil.copytree(EX / "plan_paper_bore", tmp_path / "plan_paper_bore")
+    cfg = (EX / "plan_paper_bore.toml").read_text().replace(
+        '"../src/robobore', f'"{REPO}/src/robobore')
+    if not robot_section:
+        cfg = re.sub(r'\[robot\]\nname = "irb6600-175-2.55"\n', "", cfg)
+        assert "[robot]" not in cfg
+    for a, b in subs.items():
+        assert a in cfg, a
+        cfg = cfg.replace(a, b)
+    p = tmp_path / "p.toml"
+    p.write_text(cfg)
+    return p
+
+
+def _set_identity(path: Path, **identity) -> None:
+    d = json.loads(path.read_text())
+    d.setdefault("identity", {}).update(identity)
+    path.write_text(json.dumps(d))
+
+
+# --- a plan config without robot.name ---------------------------------------------------------
+
+
+def test_plan_without_robot_adopts_the_stiffness_files_robot_and_says_so(tmp_path):
+    from robobore.plan.config import load_plan_config
+
+    p = _plan_copy(tmp_path, robot_section=False)
+    kuka = {"robot": "kr240-r2900", "robot_hash": "5bff4dea45217869", "robot_file": str(KUKA)}
+    for name in ("joint_stiffness.json", "modes.json"):
+        _set_identity(tmp_path / "plan_paper_bore" / name, **kuka)
+    inp = load_plan_config(p)
+    assert inp.robot.name == "kr240-r2900"
+    assert len(inp.notes) == 1 and "kr240-r2900" in inp.notes[0]
+    assert "joint_stiffness.json" in inp.notes[0]
+
+
+def test_plan_without_robot_keeps_the_default_for_the_bundled_files(tmp_path):
+    from robobore.plan.config import load_plan_config
+
+    inp = load_plan_config(_plan_copy(tmp_path, robot_section=False))
+    assert inp.robot.name == "irb6600-175-2.55"
+    assert inp.notes and "irb6600-175-2.55" in inp.notes[0]
+
+
+def test_plan_without_robot_stiffness_and_modes_of_different_robots_refused(tmp_path):
+    from robobore.plan.config import load_plan_config
+
+    p = _plan_copy(tmp_path, robot_section=False)
+    _set_identity(tmp_path / "plan_paper_bore" / "joint_stiffness.json", robot="kr240-r2900",
+                  robot_hash="5bff4dea45217869", robot_file=str(KUKA))
+    _set_identity(tmp_path / "plan_paper_bore" / "modes.json", robot="irb6600-175-2.55")
+    with pytest.raises(ConfigError) as ei:
+        load_plan_config(p)
+    msg = str(ei.value)
+    assert "kr240-r2900" in msg and "irb6600-175-2.55" in msg and "modes.json" in msg
+
+
+def test_plan_named_robot_still_refuses_another_robots_file(tmp_path):
+    from robobore.plan.config import load_plan_config
+
+    p = _plan_copy(tmp_path)
+    _set_identity(tmp_path / "plan_paper_bore" / "joint_stiffness.json", robot="kr240-r2900",
+                  robot_hash="5bff4dea45217869")
+    with pytest.raises(ConfigError, match="robot.name"):
+        load_plan_config(p)
+
+
+def test_plan_without_robot_old_file_naming_a_robot_is_adopted(tmp_path):
+    """A stiffness file without identity block but with its top-level "robot" key."""
+    from robobore.plan.config import load_plan_config
+
+    p = _plan_copy(tmp_path, robot_section=False)
+    for name in ("joint_stiffness.json", "modes.json"):
+        f = tmp_path / "plan_paper_bore" / name
+        d = json.loads(f.read_text())
+        d.pop("identity", None)
+        f.write_text(json.dumps(d))
+    inp = load_plan_config(p)
+    assert inp.robot.name == json.loads(
+        (tmp_path / "plan_paper_bore" / "joint_stiffness.json").read_text())["robot"]
+    assert inp.notes
+
+
+# --- the boring frame's X hint ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize("axis", [(0, 0, -1.0), (0, 0, 1.0), (1.0, 0, 0), (0.3, -0.5, 0.8)])
+def test_x_hint_sets_the_boring_frames_x(axis):
+    from robobore.plan.candidates import boring_frame
+
+    z = np.asarray(axis) / np.linalg.norm(axis)
+    h = np.array([0.2, 1.0, 0.1])
+    R = boring_frame(np.asarray(axis, float), h)
+    x = h - (h @ z) * z
+    assert np.allclose(R[:, 0], x / np.linalg.norm(x))
+    assert np.allclose(R[:, 2], z)
+    assert np.allclose(R.T @ R, np.eye(3)) and np.linalg.det(R) > 0
+
+
+def test_x_hint_along_the_bore_axis_or_not_a_vector_refused():
+    from robobore.robot.stiffness import process_frame, x_hint_arg
+
+    R = np.column_stack([np.zeros(3), np.zeros(3), [0, 0, 1.0]])
+    with pytest.raises(ConfigError, match="along the bore axis"):
+        process_frame(R, "boring", x_hint=[0, 0, 2.0])
+    for bad in ([0, 0, 0], [1, 2], ["a", 1, 2], [np.nan, 0, 1]):
+        with pytest.raises(ConfigError, match="not a direction"):
+            x_hint_arg(bad)
+
+
+def test_plan_config_x_hint_checked_and_rotated_with_the_part(tmp_path):
+    from robobore.plan.config import load_plan_config
+
+    axis = "axis = [-0.9992052193, -0.0398392954, -0.0013267225]"
+    p = _plan_copy(tmp_path, **{axis: "axis = [0.0, 0.0, -1.0]\nx_hint = [0.0, 0.0, 1.0]"})
+    with pytest.raises(ConfigError) as ei:
+        load_plan_config(p)
+    assert ei.value.field == "bore.x_hint" and str(p) in str(ei.value)
+    p.write_text(p.read_text().replace("x_hint = [0.0, 0.0, 1.0]", "x_hint = [0.0, 2.0, 0.0]"))
+    inp = load_plan_config(p)
+    assert np.allclose(inp.x_hint, [0, 1, 0])
+    inp2 = load_plan_config(p, x_hint=[1.0, 0.0, 0.0])  # the CLI's --x-hint wins
+    assert np.allclose(inp2.x_hint, [1, 0, 0])
+
+
+def test_plan_posture_vertical_bore_with_x_hint(tmp_path):
+    """A vertical bore the paper's robot reaches (the measured posture's tool point, axis
+    down): the plan's boring frame takes X from --x-hint, and the directional stiffness of
+    the recommended posture is the same posture's with X and Y from that frame."""
+    from robobore.plan.posture import plan_posture
+
+    axis = "axis = [-0.9992052193, -0.0398392954, -0.0013267225]"
+    p = _plan_copy(tmp_path, **{axis: "axis = [0.0, 0.0, -1.0]",
+                                "rotation_step_deg = 1.0": "rotation_step_deg = 30.0"})
+    p.write_text(re.sub(r"(?s)\[workspace\].*", "", p.read_text()))
+    r0 = plan_posture(p)
+    r1 = plan_posture(p, x_hint=[0.0, 1.0, 0.0])
+    cols0 = np.array(r0["bore"]["boring_frame_columns"])
+    cols1 = np.array(r1["bore"]["boring_frame_columns"])
+    assert np.allclose(cols0[0], [1, 0, 0]) and np.allclose(cols1[0], [0, 1, 0])
+    assert r1["bore"]["x_hint"] == [0.0, 1.0, 0.0]
+    # the same candidates; X and Y stiffness swap roles between the two frames
+    k0 = {tuple(np.round(c["joints_deg"], 3)): c["directional_stiffness_N_per_m"]
+          for c in r0["candidates"]}
+    k1 = {tuple(np.round(c["joints_deg"], 3)): c["directional_stiffness_N_per_m"]
+          for c in r1["candidates"]}
+    common = sorted(set(k0) & set(k1))
+    assert common
+    for q in common:
+        assert k1[q]["x"] == pytest.approx(k0[q]["y"], rel=1e-9)
+        assert k1[q]["y"] == pytest.approx(k0[q]["x"], rel=1e-9)
+        assert k1[q]["z"] == pytest.approx(k0[q]["z"], rel=1e-9)
+
+
+def test_plan_cli_x_hint_option_parsed(tmp_path):
+    p = _plan_copy(tmp_path)
+    r = runner.invoke(app, ["plan", "posture", str(p), "--x-hint", "1,2"])
+    assert r.exit_code == 2 and "--x-hint" in r.output
