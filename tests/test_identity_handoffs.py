@@ -181,3 +181,156 @@ def test_plan_cli_x_hint_option_parsed(tmp_path):
     p = _plan_copy(tmp_path)
     r = runner.invoke(app, ["plan", "posture", str(p), "--x-hint", "1,2"])
     assert r.exit_code == 2 and "--x-hint" in r.output
+
+
+# --- identity of the cutting coefficients -----------------------------------------------------
+
+TC4_FILE = REPO / "src" / "robobore" / "data" / "paper_example" / "tc4_fe_coefficients.json"
+
+
+def _dyn_cfg(tmp_path: Path, coef_file: Path, *, material: str | None = None,
+             **subs: str) -> Path:
+    cfg = (EX / "boring_paper.toml").read_text()
+    sec = f'file = "{coef_file}"' + (f'\nmaterial = "{material}"' if material else "")
+    cfg = cfg.replace('[coefficients]\nmaterial = "TC4"', f"[coefficients]\n{sec}")
+    for a, b in subs.items():
+        assert a in cfg, a
+        cfg = cfg.replace(a, b)
+    p = tmp_path / "d.toml"
+    p.write_text(cfg)
+    return p
+
+
+def _coefficients(path: Path):
+    from robobore.dynamics.config import build_coefficients, load_dynamics_config
+
+    cfg, _ = load_dynamics_config(path)
+    return build_coefficients(cfg, str(path))
+
+
+def test_calibration_writes_the_coefficients_identity():
+    """The identity block calibrate() writes: material, the insert edge, what produced it."""
+    from robobore.io.identity import cut_identity_of, make_identity
+
+    d = json.loads(TC4_FILE.read_text())
+    ident = cut_identity_of(d, str(TC4_FILE))  # the bundled file: its top-level keys
+    assert ident["material"] == "TC4"
+    assert ident["insert"] == {"rake_deg": 7.0, "edge_radius_um": 20.0, "inclination_deg": 0.0,
+                               "clearance_deg": 7.0}
+    blk = make_identity("cutting coefficients", material="TC4", insert=d["insert"])
+    assert blk["insert"]["rake_deg"] == 7.0 and blk["material"] == "TC4"
+
+
+def test_coefficients_file_of_the_configs_insert_and_material_accepted(tmp_path):
+    c = _coefficients(_dyn_cfg(tmp_path, TC4_FILE, material="Ti-6Al-4V"))
+    assert c.Ktc > 0 and "not checked" not in c.provenance
+
+
+def test_coefficients_file_for_another_rake_refused_naming_both(tmp_path):
+    p = _dyn_cfg(tmp_path, TC4_FILE, **{"rake_deg = 7.0": "rake_deg = 0.0"})
+    with pytest.raises(ConfigError) as ei:
+        _coefficients(p)
+    msg = str(ei.value)
+    assert str(TC4_FILE) in msg and str(p) in msg and "rake_deg = 7" in msg
+    assert "rake_deg = 0" in msg
+
+
+def test_coefficients_file_for_another_edge_radius_refused(tmp_path):
+    p = _dyn_cfg(tmp_path, TC4_FILE, **{"edge_radius_um = 20.0": "edge_radius_um = 50.0"})
+    with pytest.raises(ConfigError, match="edge_radius_um"):
+        _coefficients(p)
+
+
+def test_coefficients_file_for_another_material_refused(tmp_path):
+    f = tmp_path / "inconel.json"
+    d = json.loads(TC4_FILE.read_text())
+    d["identity"] = {"kind": "cutting coefficients", "material": "IN718",
+                     "insert": d["insert"], "source": "test"}
+    f.write_text(json.dumps(d))
+    with pytest.raises(ConfigError) as ei:
+        _coefficients(_dyn_cfg(tmp_path, f, material="TC4"))
+    assert "IN718" in str(ei.value) and "TC4" in str(ei.value) and str(f) in str(ei.value)
+    # without coefficients.material the config does not say: accepted
+    assert _coefficients(_dyn_cfg(tmp_path, f)).Ktc > 0
+
+
+def test_old_coefficients_file_without_identity_accepted_with_a_note(tmp_path):
+    f = tmp_path / "old.json"
+    d = json.loads(TC4_FILE.read_text())
+    for k in ("material", "insert", "identity"):
+        d.pop(k, None)
+    f.write_text(json.dumps(d))
+    c = _coefficients(_dyn_cfg(tmp_path, f, **{"rake_deg = 7.0": "rake_deg = 0.0"}))
+    assert str(f) in c.provenance and "not checked" in c.provenance
+
+
+def test_malformed_coefficients_identity_named(tmp_path):
+    f = tmp_path / "bad.json"
+    d = json.loads(TC4_FILE.read_text())
+    d["identity"] = {"kind": "cutting coefficients", "insert": {"rake_deg": "seven"}}
+    f.write_text(json.dumps(d))
+    with pytest.raises(ConfigError) as ei:
+        _coefficients(_dyn_cfg(tmp_path, f))
+    assert ei.value.field == "identity.insert.rake_deg" and str(f) in str(ei.value)
+
+
+# --- identity of the FE results ---------------------------------------------------------------
+
+
+def test_fe_result_identity_records_material_and_insert():
+    from robobore.cutting.fe.config.boring3d import load_boring_config
+    from robobore.cutting.fe.config.orthogonal import load_fe_config
+    from robobore.io.identity import fe_identity, read_identity
+
+    cfg = load_fe_config(EX / "fe_orthogonal.toml")
+    ident = fe_identity("fe orthogonal", cfg, "fe_orthogonal.toml")
+    assert ident["material"] == cfg.material.name
+    assert ident["insert"]["rake_deg"] == cfg.tool.rake_deg
+    assert ident["insert"]["edge_radius_um"] == cfg.tool.edge_radius_um
+    assert "fe_orthogonal.toml" in ident["source"] and ident["synthetic"] is None
+    assert read_identity({"identity": ident}, "x.json")["insert"] == ident["insert"]
+    bcfg = load_boring_config(EX / "fe_boring_paper.toml")
+    bident = fe_identity("fe boring", bcfg, "fe_boring_paper.toml")
+    assert bident["insert"]["nose_radius_mm"] == bcfg.insert.nose_radius_mm
+    assert bident["insert"]["rake_deg"] == bcfg.insert.rake_deg
+
+
+def test_fe_boring_refuses_a_coefficients_file_of_another_insert(tmp_path):
+    """Refused before the FE run starts (the check reads the file and the config only)."""
+    d = json.loads(TC4_FILE.read_text())
+    d["identity"] = {"kind": "cutting coefficients", "material": "TC4",
+                     "insert": {"rake_deg": 15.0, "edge_radius_um": 20.0,
+                                "inclination_deg": 0.0}}
+    f = tmp_path / "rake15.json"
+    f.write_text(json.dumps(d))
+    r = runner.invoke(app, ["fe", "boring", str(EX / "fe_boring_paper.toml"),
+                            "--coefficients", str(f)])
+    assert r.exit_code == 2, r.output
+    out = " ".join(r.output.split())
+    assert "rake15.json" in out and "rake_deg = 15" in out
+
+
+def test_calibrate_forces_writes_an_identity_the_readers_check(tmp_path):
+    """calibrate() (on fitted-to-known forces, no FE run) writes the identity block; the
+    written file is refused by a config whose insert has another edge radius."""
+    from robobore.cutting import calibrate as cal
+    from robobore.cutting import calibration_config as calcfg
+
+    cfg = calcfg.calibration_from_mapping(
+        {"calibration": {"uncut_chip_thickness_um": [60.0, 90.0],
+                         "cutting_speed_m_per_min": [40.0]},
+         "insert": {"rake_deg": 7.0, "edge_radius_um": 10.0, "clearance_deg": 7.0},
+         "material": {"name": "TC4"}}, source="test.toml")
+    recs = [{"h_um": h, "vc_m_per_min": 40.0, "Fc_N_per_m": 3e4 + 1.6e9 * h * 1e-6,
+             "Ff_N_per_m": 4e4 + 0.4e9 * h * 1e-6, "cached": False,
+             "fe": {"chip_ratio": None}} for h in (60.0, 90.0)]
+    data = cal.calibrate(cfg, recs)
+    ident = data["identity"]
+    assert ident["kind"] == "cutting coefficients" and ident["material"] == cfg.material
+    assert ident["insert"]["edge_radius_um"] == 10.0 and "calibrate forces" in ident["source"]
+    f = tmp_path / "c.json"
+    f.write_text(json.dumps(data))
+    with pytest.raises(ConfigError, match="edge_radius_um = 10"):
+        _coefficients(_dyn_cfg(tmp_path, f))  # boring_paper.toml: edge radius 20 um
+    ok = _dyn_cfg(tmp_path, f, **{"edge_radius_um = 20.0": "edge_radius_um = 10.0"})
+    assert _coefficients(ok).Ktc == pytest.approx(1.6e9, rel=1e-9)
