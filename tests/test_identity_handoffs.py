@@ -334,3 +334,70 @@ def test_calibrate_forces_writes_an_identity_the_readers_check(tmp_path):
         _coefficients(_dyn_cfg(tmp_path, f))  # boring_paper.toml: edge radius 20 um
     ok = _dyn_cfg(tmp_path, f, **{"edge_radius_um = 20.0": "edge_radius_um = 10.0"})
     assert _coefficients(ok).Ktc == pytest.approx(1.6e9, rel=1e-9)
+
+
+# --- a modal model that does not fit the stiffness file --------------------------------------
+
+
+@pytest.fixture(scope="module")
+def example_files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ex")
+    out = {}
+    for kind in ("stiffness", "modes"):
+        r = runner.invoke(app, ["identify", kind, "--example", "--json"])
+        assert r.exit_code == 0, r.output
+        out[kind] = d / f"{kind}.json"
+        out[kind].write_text(r.stdout)
+    return out
+
+
+def _modes_variant(src: Path, dst: Path, how: str) -> Path:
+    d = json.loads(src.read_text())
+    if how == "one":
+        d["modes"] = d["modes"][:1]
+    elif how == "two":
+        d["modes"] = d["modes"][:2]
+    elif how == "kHz":
+        d["modes"][0]["frequency_Hz"] *= 10
+    elif how == "tripled":
+        d["modes"] = d["modes"] * 3
+    dst.write_text(json.dumps(d))
+    return dst
+
+
+@pytest.mark.parametrize("how,words", [("one", "has 1 mode"), ("two", "has 2 mode"),
+                                       ("kHz", "outside the band")])
+def test_equivalent_refuses_modes_that_do_not_fit(example_files, tmp_path, how, words):
+    m = _modes_variant(example_files["modes"], tmp_path / f"m_{how}.json", how)
+    r = runner.invoke(app, ["model", "equivalent", "--stiffness-file",
+                            str(example_files["stiffness"]), "--modes-file", str(m)])
+    assert r.exit_code == 2, r.output
+    out = " ".join(r.output.split())
+    assert words in out and m.name in out
+    if how != "kHz":
+        assert "stiffness.json" in out
+
+
+@pytest.mark.parametrize("how,words", [("one", "has 1 mode"), ("two", "has 2 mode"),
+                                       ("kHz", "outside the band"), ("tripled", "has 15 modes")])
+def test_plan_refuses_modes_that_do_not_fit(example_files, tmp_path, how, words):
+    from robobore.errors import DataError
+    from robobore.plan.config import load_plan_config
+
+    p = _plan_copy(tmp_path)
+    mf = tmp_path / "plan_paper_bore" / "modes.json"
+    _modes_variant(example_files["modes"], mf, how)
+    with pytest.raises((ConfigError, DataError)) as ei:
+        load_plan_config(p)
+    msg = str(ei.value)
+    assert words in msg and str(mf) in msg
+    if how in ("one", "two", "tripled"):
+        assert "joint_stiffness.json" in msg
+
+
+def test_plan_accepts_the_example_modes_file(example_files, tmp_path):
+    from robobore.plan.config import load_plan_config
+
+    p = _plan_copy(tmp_path)
+    shutil.copy(example_files["modes"], tmp_path / "plan_paper_bore" / "modes.json")
+    assert load_plan_config(p).modes_f_Hz.size == 5

@@ -161,7 +161,8 @@ def load_plan_config(path: str | Path, x_hint: Any = None) -> PlanInputs:
         raise ConfigError(
             f"robot '{robot.name}' has no inertial data (mass, centre of mass and inertia per "
             "link), which the pose-dependent dynamic model needs",
-            file=robot.file or f, field="links" if robot.file else "robot.name", value=rname,
+            file=robot.file or f, field="links" if robot.file else "robot.name",
+            value=robot.file or robot.name,
             expected=f"{robot.n_joints} [[links]] tables with mass_kg, com_m and inertia_kg_m2 "
                      "(see robot/library/irb6600-175-2.55.toml)")
     # tool point: metres, flange frame
@@ -244,6 +245,7 @@ def load_plan_config(path: str | Path, x_hint: Any = None) -> PlanInputs:
         raise DataError("mode frequencies must be > 0 Hz and damping ratios >= 0",
                         file=str(mfile), field="modes", value=fz.tolist(),
                         expected="frequency_Hz > 0, damping_ratio >= 0")
+    _check_mode_count(fz, mdata, mfile, sfile, robot, _link_bending(cfg, robot, f))
     # what the files describe (robobore.io.identity): one robot, the config's
     from robobore.io.identity import check_pair, check_robot, read_identity
 
@@ -288,6 +290,34 @@ def load_plan_config(path: str | Path, x_hint: Any = None) -> PlanInputs:
     return PlanInputs(cfg, raw, p, robot, np.asarray(js.k_Nm_per_rad, float), fz[:, 0],
                       fz[:, 1], np.radians(qm), tcp, point, axis, sfile, mfile, synthetic,
                       _link_bending(cfg, robot, f), tuple(robot_notes), hint)
+
+
+def _check_mode_count(fz: np.ndarray, mdata: dict[str, Any], mfile: Path, sfile: Path,
+                      robot: Any, link_bending: tuple[Any, ...]) -> None:
+    """The modes fit the model the stiffness file sets up: inside the band they were
+    identified in, at least one per direction of the tool point, at most one per elastic
+    coordinate of the model (the joints of the stiffness file, plus the bending coordinates
+    of ``link_bending``)."""
+    from robobore.equivalent import check_modes_in_band
+    from robobore.plan.bending import compliant_planes, redundancy
+
+    check_modes_in_band([{"frequency_Hz": float(v)} for v in fz[:, 0]], mdata.get("band_Hz"),
+                        str(mfile))
+    n_dof = robot.n_joints if not compliant_planes(link_bending) else int(
+        redundancy(robot, link_bending)[1].size)
+    n = fz.shape[0]
+    if n < 3:
+        raise DataError(
+            f"{mfile} has {n} mode(s): too few to calibrate the {robot.n_joints}-joint model of "
+            f"{sfile} at the measured posture", file=str(mfile), field="modes", value=n,
+            expected="at least 3 modes (one per direction of the tool point)")
+    if n > n_dof:
+        raise DataError(
+            f"{mfile} has {n} modes; the model of {sfile} ({robot.name}, {robot.n_joints} "
+            f"joint stiffnesses{', with link bending' if n_dof > robot.n_joints else ''}) has "
+            f"{n_dof}", file=str(mfile), field="modes", value=n,
+            expected=f"at most {n_dof} modes (the lowest modes of the arm; modes of the tool, "
+                     "the part or the floor left out, or [[identification.link_bending]])")
 
 
 def _names_robot(raw: dict[str, Any]) -> bool:
