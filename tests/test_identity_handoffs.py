@@ -401,3 +401,26 @@ def test_plan_accepts_the_example_modes_file(example_files, tmp_path):
     p = _plan_copy(tmp_path)
     shutil.copy(example_files["modes"], tmp_path / "plan_paper_bore" / "modes.json")
     assert load_plan_config(p).modes_f_Hz.size == 5
+
+
+def test_api_directional_stiffness_adopts_the_files_robot_and_says_so():
+    """api.directional_stiffness(robot=None) of a stiffness that records the KUKA-like
+    robot uses that robot's kinematics (the same numbers as robot=its file) and warns."""
+    import warnings
+
+    from robobore import api
+
+    js = {"joint_stiffness_Nm_per_rad": [3e6, 4e6, 2.5e6, 5e5, 4.5e5, 3e5],
+          "identity": {"kind": "joint stiffness", "robot": "kr240-r2900",
+                       "robot_hash": "5bff4dea45217869", "robot_file": str(KUKA)}}
+    q = [20, 20, 10, 0, -30, 0]
+    with pytest.warns(UserWarning, match="taken from"):
+        k = api.directional_stiffness(js, q)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ref = api.directional_stiffness(js, q, robot=str(KUKA))
+        irb = api.directional_stiffness({"joint_stiffness_Nm_per_rad":
+                                         js["joint_stiffness_Nm_per_rad"]}, q)
+    assert k == ref and k != irb
+    with pytest.raises(ConfigError, match="kr240-r2900"):
+        api.directional_stiffness(js, q, robot="irb6600-175-2.55")
