@@ -424,3 +424,23 @@ def test_api_directional_stiffness_adopts_the_files_robot_and_says_so():
     assert k == ref and k != irb
     with pytest.raises(ConfigError, match="kr240-r2900"):
         api.directional_stiffness(js, q, robot="irb6600-175-2.55")
+
+
+def test_fe_validate_announces_its_default_store_and_records_the_identity(tmp_path,
+                                                                           monkeypatch):
+    """Without --out the resumable store goes to ./fe_validate_<config>, said on stderr
+    before the work; the JSON carries the FE identity (the FE run itself is stubbed)."""
+    shared = REPO.parent / "shared" / "data" / "ti64_orthogonal_cutting_forces.json"
+    meas = shared if shared.is_file() else (
+        REPO / "src" / "robobore" / "cutting" / "coefficients" /
+        "ti64_orthogonal_cutting_forces.json")
+    monkeypatch.setattr("robobore.cutting.fe.models.validate.run_validation",
+                        lambda *a, **k: {"points": [], "summary": {}})
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, ["fe", "validate", str(EX / "fe_orthogonal.toml"), "--measured",
+                            str(meas), "--json"])
+    assert r.exit_code == 0, r.output
+    out = " ".join(r.output.split())
+    assert "no --out given" in out and "fe_validate_fe_orthogonal" in out
+    d = json.loads(r.stdout[r.stdout.index("{"):])
+    assert d["identity"]["kind"] == "fe validate" and d["identity"]["material"]
