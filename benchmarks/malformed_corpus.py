@@ -306,7 +306,13 @@ def json_cases(kind: str, fname: str, good: dict, argv, slips: list[tuple[str, f
     return cases
 
 
-def build_corpus(workdir: Path) -> list[Case]:
+#: the description prefixes of benchmarks/malformed_corpus_measured.py
+MEASURED_PREFIXES = ("meas:", "cut:", "cmp:", "paper:", "oma:", "uff:", "vht:", "fit:", "api2:")
+
+
+def build_corpus(workdir: Path, only: list[str] | None = None) -> list[Case]:
+    if only and all(o in MEASURED_PREFIXES for o in only):  # those cases' fixtures only
+        return measured_cases(workdir / "fixtures_measured")
     cases: list[Case] = []
     # --- process TOMLs through the CLI
     cases += toml_cases("process TOML (lobes)", EX / "lobes_single_point.toml",
@@ -527,6 +533,7 @@ def build_corpus(workdir: Path) -> list[Case]:
                           opt_files, _cli(*args, "--json"), True, (name,)))
     cases += more_cases(workdir / "fixtures")
     cases += identity_cases(workdir / "fixtures_identity")
+    cases += measured_cases(workdir / "fixtures_measured")
     return cases
 
 
@@ -547,7 +554,12 @@ def _kind_of(desc: str, argv: list[str]) -> str:
              "unit": "unit slips in identification / model files",
              "plan": "planner (plan posture)", "fe": "FE validation (measured file)",
              "api": "Python API", "sweep": "sweep (--scheduler, runner)",
-             "csv": "CSV separators, CSV as UFF"}
+             "csv": "CSV separators, CSV as UFF",
+             "meas": "detect chatter", "cut": "measure cut", "cmp": "compare with a manifest",
+             "paper": "compare on a paper folder", "oma": "identify modes --operational",
+             "uff": "UFF variants (identify modes)",
+             "vht": "virtual hammer test --robot-file",
+             "fit": "files that do not fit (modes, coefficients)", "api2": "Python API"}
     if head in kinds:
         return kinds[head]
     r = rest.lower()
@@ -586,6 +598,19 @@ def identity_cases(fixtures: Path) -> list[Case]:
 
     out = []
     for desc, argv, pattern, mode in ident.build(fixtures):
+        cmd = argv if mode == "script" else _cli(*argv)
+        out.append(Case(_kind_of(desc, argv), desc, {}, cmd, mode != "script", (),
+                        pattern=pattern, mode=mode))
+    return out
+
+
+def measured_cases(fixtures: Path) -> list[Case]:
+    """The cases of benchmarks/malformed_corpus_measured.py as :class:`Case` objects."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import malformed_corpus_measured as meas
+
+    out = []
+    for desc, argv, pattern, mode in meas.build(fixtures):
         cmd = argv if mode == "script" else _cli(*argv)
         out.append(Case(_kind_of(desc, argv), desc, {}, cmd, mode != "script", (),
                         pattern=pattern, mode=mode))
@@ -745,11 +770,14 @@ def main() -> None:
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--only", default="",
-                    help="run only the cases whose input path or description contains this")
+                    help="run only the cases whose input path or description contains this "
+                         "(several: TEXT1|TEXT2)")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    cases = [c for c in build_corpus(out) if a.only in c.path_kind or a.only in c.desc]
+    only = a.only.split("|")
+    cases = [c for c in build_corpus(out, only)
+             if any(o in c.path_kind or o in c.desc for o in only)]
     t0 = time.perf_counter()
     with ThreadPoolExecutor(a.workers) as ex:
         done = list(ex.map(lambda ic: run_case(ic[0], ic[1], out, a.timeout), enumerate(cases)))

@@ -330,6 +330,8 @@ def identify_modes(data: Any = None, *, band_Hz: Any = PAPER_BAND_HZ,
     lo, hi = _band_arg(band_Hz)
     n_modes = _int_arg(n_modes, "n_modes", 1, 100)
     max_order = _int_arg(max_order, "max_order", 1, 1000, allow_none=False)
+    if isinstance(data, str | Path):  # a file: read it (errors name it)
+        data = load_hammer_test(data)
     data = load_hammer_test() if data is None else data
     return _identify(frf(data), band_Hz=(lo, hi), n_modes=n_modes, select=select,
                      max_order=max_order)

@@ -300,9 +300,10 @@ class DirectionUnit:
     damping_ratio: float
 
 
-def _check_modes_in_band(ml: list[dict[str, Any]], band: Any) -> None:
+def check_modes_in_band(ml: list[dict[str, Any]], band: Any, file: str | None = None) -> None:
     """Modes identified in a band (``band_Hz`` of ``robobore identify modes --json``) lie in
-    it: a frequency far outside is a value edited or scaled by hand (kHz for Hz)."""
+    it (within 10 %): a frequency far outside is a value edited or scaled by hand (kHz for
+    Hz), or modes of another test; a ConfigError naming ``file``."""
     if not (isinstance(band, list | tuple) and len(band) == 2
             and all(isinstance(b, int | float) and not isinstance(b, bool) for b in band)):
         return
@@ -312,7 +313,7 @@ def _check_modes_in_band(ml: list[dict[str, Any]], band: Any) -> None:
         if not lo * 0.9 <= f <= hi * 1.1:
             hint = " (looks like kHz or a scaled value)" if f > hi * 1.1 else ""
             raise ConfigError(f"mode frequency outside the band it was identified in{hint}",
-                              field=f"modes[{i}].frequency_Hz", value=f,
+                              file=file, field=f"modes[{i}].frequency_Hz", value=f,
                               expected=f"{lo:g} .. {hi:g} Hz (the file's band_Hz)")
 
 
@@ -464,7 +465,13 @@ class EquivalentModel:
                                   expected='{"frequency_Hz": .., "damping_ratio": ..}')
             _positive(f"modes[{i}].frequency_Hz", md.get("frequency_Hz"), "Hz")
             _nonneg(f"modes[{i}].damping_ratio", md.get("damping_ratio", 0.0), "(ratio)")
-        _check_modes_in_band(ml, modes.get("band_Hz"))
+        check_modes_in_band(ml, modes.get("band_Hz"))
+        if len(ml) < len(AXES) and assignment is None:
+            raise ConfigError(
+                f"{names[1]} has {len(ml)} mode(s); {names[0]} gives the stiffness along "
+                f"{len(AXES)} directions ({', '.join(AXES)}), each of which needs its mode",
+                field="modes", value=len(ml),
+                expected=f"{len(AXES)} or more modes, or an assignment of modes to the axes")
         if R is not None:  # compare mode directions with the principal axes
             ml = [dict(md) for md in ml]
             for md in ml:
@@ -722,4 +729,4 @@ def principal_frame(stiffness_matrix: np.ndarray) -> tuple[np.ndarray, np.ndarra
 __all__ = ["EquivalentModel", "PressureFoot", "DirectionUnit", "assign_modes",
            "principal_frame", "AXES", "EquivalentWarning", "check_same_robot",
            "stiffness_mismatch_notes", "STIFFNESS_MISMATCH_FACTOR", "check_uncertainty",
-           "UNCERTAINTY_KEYS"]
+           "UNCERTAINTY_KEYS", "check_modes_in_band"]

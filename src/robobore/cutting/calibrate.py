@@ -147,6 +147,10 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
     hs = ", ".join(f"{x:g}" for x in cfg.uncut_chip_thickness_um)
     vs = ", ".join(f"{x:g}" for x in cfg.cutting_speed_m_per_min)
     model = fe_model_description(cfg)
+    from robobore.io.identity import make_identity
+
+    insert = {"rake_deg": cfg.rake_deg, "edge_radius_um": cfg.edge_radius_um,
+              "inclination_deg": cfg.inclination_deg, "clearance_deg": cfg.fe.clearance_deg}
     prov = (f"FE-calibrated ({cfg.material}; robobore {__version__} 2D FE, {model['summary']}): "
             f"OLS fit "
             f"Fc = Kte + Ktc h, Ff = Kfe + Kfc h over h = {hs} um x vc = {vs} m/min; "
@@ -197,9 +201,10 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
                        "energy_error": r["fe"].get("energy_error"),
                        "fe_wall_time_s": r["fe"].get("wall_time_s")} for r in records],
         "material": cfg.material,
-        "insert": {"rake_deg": cfg.rake_deg, "edge_radius_um": cfg.edge_radius_um,
-                   "inclination_deg": cfg.inclination_deg,
-                   "clearance_deg": cfg.fe.clearance_deg},
+        "insert": insert,
+        "identity": make_identity("cutting coefficients", material=cfg.material, insert=insert,
+                                  source=f"robobore {__version__} calibrate forces: "
+                                         f"2D FE, {model['summary']}"),
         "fe_settings": None if cfg.fe_config is not None else cfg.fe.model_dump(mode="json"),
         "fe_model": model,
         "grid": {"uncut_chip_thickness_um": cfg.uncut_chip_thickness_um,

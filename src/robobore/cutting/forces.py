@@ -351,6 +351,25 @@ def load_coefficients(path: str | Path, cutting_speed_m_per_min: float | None = 
                                  speed_dependent=speed_dependent, source=str(path))
 
 
+def check_coefficients_identity(coef: CuttingCoefficients, path: str | Path, *,
+                                material: str | None, insert: Any, material_by: str,
+                                insert_by: str) -> CuttingCoefficients:
+    """``coef`` (read from ``path``) if the file was made for ``material`` (None: not
+    checked) and the edge of ``insert`` (rake, edge radius, inclination;
+    :func:`robobore.io.identity.check_insert`), else a ConfigError naming the file, the
+    config and both values. A file that records neither is accepted, with a note in the
+    provenance."""
+    import dataclasses
+
+    from robobore.io.identity import check_cut_file
+
+    note = check_cut_file(path, material=material, insert=insert, material_by=material_by,
+                          insert_by=insert_by)
+    if note is None:
+        return coef
+    return dataclasses.replace(coef, provenance=f"{coef.provenance}; {note}")
+
+
 # ---------------------------------------------------------------------------- fitting
 def fit_linear_edge_model(h_m: np.ndarray, force_N_per_m: np.ndarray) -> tuple[float, float]:
     """Least-squares fit ``F = Ke + Kc h`` (per unit width); returns ``(Kc [N/m^2], Ke [N/m])``."""
@@ -582,7 +601,7 @@ def boring_forces(insert: BoringInsert, depth_m: float, feed_per_rev_m: float,
             "elements": el, "element_forces": ef}
 
 
-__all__ = ["CuttingCoefficients", "load_coefficients", "coefficients_at_speed",
+__all__ = ["CuttingCoefficients", "load_coefficients", "check_coefficients_identity", "coefficients_at_speed",
            "read_per_speed_fits", "inline_coefficients", "PER_SPEED_KEYS",
            "fit_linear_edge_model", "ducobu_fits",
            "ti64_coefficients", "orthogonal_parameters_from_data", "orthogonal_to_oblique",

@@ -248,9 +248,13 @@ class CoefficientsCfg(StrictModel):
 
     @model_validator(mode="after")
     def _one(self):
-        given = [self.material is not None, self.file is not None, self.Ktc_N_per_m2 is not None]
+        given = [self.material is not None and self.file is None, self.file is not None,
+                 self.Ktc_N_per_m2 is not None]
         if sum(given) != 1:
-            raise ValueError("give exactly one of material, file or Ktc_N_per_m2 (+ others)")
+            raise ValueError("give exactly one of material, file or Ktc_N_per_m2 (+ others); "
+                             "material with file names the file's material (checked)")
+        if self.file is not None:  # material: what the file must be for (checked on reading)
+            return self
         if self.per_speed_fits is not None and self.Ktc_N_per_m2 is None:
             raise ValueError("per_speed_fits go with inline Ktc_N_per_m2 (+ others); a "
                              "coefficients file carries its own")
@@ -478,17 +482,21 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
 
     c = cfg.coefficients
     vc = cutting_speed_m_per_min(cfg)
-    if c is not None and c.material is not None and c.material.upper() in forces.TC4_FE_NAMES:
+    if (c is not None and c.material is not None and c.file is None
+            and c.material.upper() in forces.TC4_FE_NAMES):
         return forces.tc4_fe_coefficients(vc)
-    if c is None or c.material is not None:
+    if c is None or (c.material is not None and c.file is None):
         if c is not None and c.oblique:
             return forces.ti64_oblique_coefficients(cfg.insert.to_insert(),
                                                     30.0 if vc is None else vc)
         return forces.ti64_coefficients(vc)
     if c.file is not None:
-        return forces.load_coefficients(resolve_config_path(c.file, source, "coefficients.file",
-                                                            what="coefficients file"),
-                                        vc, speed_dependent=c.speed_dependent)
+        cf = resolve_config_path(c.file, source, "coefficients.file", what="coefficients file")
+        coef = forces.load_coefficients(cf, vc, speed_dependent=c.speed_dependent)
+        return forces.check_coefficients_identity(
+            coef, cf, material=c.material, insert=cfg.insert,
+            material_by=f"coefficients.material of {source or 'the config'}",
+            insert_by=f"[insert] of {source or 'the config'}")
     d = {k: v for k, v in c.model_dump().items() if v is not None and k.startswith("K")}
     d["provenance"] = c.provenance
     data: dict[str, Any] = {"coefficients": d}

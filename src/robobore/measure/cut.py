@@ -207,9 +207,14 @@ def read_cut_record(path: str | Path, sample_rate_Hz: float | None = None) -> Re
         else:
             _, data, _ = read_csv_table(p, "a DynoWare export", skip_lines=hi, delimiter=delim,
                                         header=header)
-        return _from_table(header, data, src, hi + 1, rate if rate else sample_rate_Hz, True)
+        from robobore.measure.records import with_synthetic_mark
+
+        return with_synthetic_mark(_from_table(header, data, src, hi + 1,
+                                               rate if rate else sample_rate_Hz, True), p)
+    from robobore.measure.records import with_synthetic_mark
+
     header, data, hl = read_csv_table(p, "a force/displacement record")
-    return _from_table(header, data, src, hl, sample_rate_Hz, False)
+    return with_synthetic_mark(_from_table(header, data, src, hl, sample_rate_Hz, False), p)
 
 
 def _cutting_span(F: np.ndarray, fs: float) -> tuple[int, int]:
@@ -272,6 +277,13 @@ def cut_quantities(record: Record, speed_rpm: float | None = None,
     names = record.channels
     fi = [i for i, c in enumerate(names) if c in ("Fx", "Fy", "Fz")]
     di = [i for i, c in enumerate(names) if c in ("x", "y", "z")]
+    sig = record.signals[fi or di]
+    if sig.size and np.all(np.ptp(sig, axis=1) <= 1e-9 * (np.max(np.abs(sig), axis=1) + 1e-300)):
+        raise DataError("every force / displacement channel is constant: the record holds no "
+                        "cut (a channel not connected, or a record of the idle bar)", file=src,
+                        field=", ".join(names[i] for i in (fi or di)),
+                        value=[float(v) for v in sig[:, 0]],
+                        expected="a record of a cut (forces or displacements that vary)")
     src_speed = "given"
     if speed_rpm is None:
         use = fi or di

@@ -398,6 +398,9 @@ def virtual_test_cmd(
     check_output_file(Path(str(out) + ".truth.json"), "OUT", "the ground-truth JSON")
     robot_info = None
     header = None
+    if robot is not None and robot_file is not None:
+        raise ConfigError("the robot is given twice", field="--robot", value=robot,
+                          expected=f"--robot NAME or --robot-file PATH ({robot_file}), not both")
     if joint_stiffness_file is not None or (
             joint_stiffness is not None and (robot is not None or robot_file is not None)):
         # the robot's own multibody model at the posture
@@ -537,8 +540,8 @@ def _robot_truth(robot: str | None, robot_file: Path | None, joints_deg: str | N
     try:
         return robot_truth(rb, q, k, tcp_m=tcp, damping_ratio=damping_ratio)
     except InputError as exc:
-        raise ConfigError(exc.message, field=exc.field, value=exc.value,
-                          expected=exc.expected) from None
+        raise ConfigError(exc.message, file=exc.file or rb.file or None, field=exc.field,
+                          value=exc.value, expected=exc.expected) from None
 
 
 def get_robot_for_identity(robot: str | None, robot_file: Path | None) -> Any:

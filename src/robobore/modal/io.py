@@ -106,7 +106,9 @@ def _uff_sets(path: Path, need: int | None = 58) -> list[dict[str, Any]]:
         raise DataError(f"cannot read: {exc.strerror or exc}", file=str(p)) from None
     first = next((ln.strip() for ln in head.splitlines() if ln.strip()), b"")
     if first != b"-1":  # every universal file starts with a "    -1" delimiter line
-        kind = ("a CSV / text table" if any(c in first for c in (b",", b";", b"\t"))
+        table = next((ln.strip() for ln in head.splitlines()
+                      if ln.strip() and not ln.lstrip().startswith(b"#")), b"")
+        kind = ("a CSV / text table" if any(c in table for c in (b",", b";", b"\t"))
                 else "not a universal file")
         raise DataError(f"{kind}: its first line is {first[:60].decode('latin-1')!r}, not "
                         "the UFF delimiter '-1'", file=str(p),

@@ -20,16 +20,17 @@ POSITION_TOL_M = 1e-4
 AXIS_TOL_DEG = 0.05
 
 
-def boring_frame(axis: np.ndarray) -> np.ndarray:
+def boring_frame(axis: np.ndarray, x_hint: Any = None) -> np.ndarray:
     """Columns X (horizontal, vertical x Z), Y = Z x X, Z = the bore axis (a unit vector; a
-    vertical one takes X from the base x axis, :func:`robobore.robot.stiffness.process_frame`);
-    the robot stage's ``"boring"`` frame of a tool whose z axis is the bore axis."""
+    vertical one takes X from the base x axis, ``x_hint`` from the hint projected,
+    :func:`robobore.robot.stiffness.process_frame`); the robot stage's ``"boring"`` frame of
+    a tool whose z axis is the bore axis."""
     from robobore.robot.stiffness import process_frame
 
     z = np.asarray(axis, float) / np.linalg.norm(axis)
     R = np.zeros((3, 3))
     R[:, 2] = z
-    return process_frame(R, "boring")
+    return process_frame(R, "boring", x_hint=x_hint)
 
 
 def rotation_of(Rb: np.ndarray, R_flange: np.ndarray) -> float:
@@ -64,7 +65,8 @@ class Candidates:
 
 
 def enumerate_candidates(robot: Any, point: np.ndarray, axis: np.ndarray, tcp: np.ndarray,
-                         rotations_deg: np.ndarray, margin: float) -> Candidates:
+                         rotations_deg: np.ndarray, margin: float,
+                         x_hint: Any = None) -> Candidates:
     """Every verified posture on the rotation grid x IK branches (see module docstring)."""
     from robobore.plan.ik import N_BRANCHES, ik_all, is_supported
     from robobore.robot.kinematics import fk_jacobian
@@ -74,7 +76,7 @@ def enumerate_candidates(robot: Any, point: np.ndarray, axis: np.ndarray, tcp: n
                           "posture planner's closed-form inverse kinematics needs one",
                           file=robot.file or None, field="robot",
                           expected="D-H data of the Pieper class (docs/plan.md)")
-    Rb = boring_frame(axis)
+    Rb = boring_frame(axis, x_hint)
     psi = np.radians(rotations_deg)
     c, s = np.cos(psi), np.sin(psi)
     Rz = np.zeros((psi.size, 3, 3))

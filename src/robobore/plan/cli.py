@@ -19,6 +19,10 @@ def posture_cmd(
                                     help="Folder for posture_plan.nc and posture_plan.json."),
     plot: Path | None = typer.Option(None, "--plot", help="Write PNG plots into this folder."),
     top: int = typer.Option(10, "--top", help="Rows of the candidate table (best first)."),
+    x_hint: str | None = typer.Option(
+        None, "--x-hint", help="x,y,z: the boring frame's X is this direction projected onto "
+        "the plane normal to the bore axis (overrides bore.x_hint; default: horizontal, for a "
+        "vertical bore the base x axis projected)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Rate every posture that reaches a bore (tool-axis rotation x IK branch) by stiffness,
@@ -37,7 +41,12 @@ def posture_cmd(
     def factory(desc: str, total: int):
         return progress_bar(desc, total, not as_json)
 
-    result = plan_posture(config, progress_factory=factory)
+    hint = None
+    if x_hint is not None:
+        from robobore.clitools import parse_floats
+
+        hint = parse_floats(x_hint, 3, "--x-hint", "(a direction, base frame)")
+    result = plan_posture(config, progress_factory=factory, x_hint=hint)
     ws = None
     inp = result["_arrays"]["inputs"]
     if inp.cfg.workspace is not None:
@@ -90,6 +99,8 @@ def posture_cmd(
                      "lowest over the speed range"))
         for w in r.get("warnings", []):
             rows.append(("warning", w))
+        for n in r.get("notes", []):
+            rows.append(("note", n))
         rows.append(("wall time (s)", r["wall_time_s"]))
         stdout.print(kv_table("posture plan", rows))
         t = Table(title=f"best {top} candidates", header_style="bold")

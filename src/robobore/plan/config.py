@@ -48,6 +48,7 @@ class BoreCfg(StrictModel):
     point_m: list[float]
     axis: list[float]
     diameter_mm: float = Field(gt=1, le=2000)
+    x_hint: list[float] | None = None
 
 
 class PartCfg(StrictModel):
@@ -131,6 +132,8 @@ class PlanInputs:
     modes_file: Path | None
     synthetic: bool = False
     link_bending: tuple[Any, ...] = ()
+    notes: tuple[str, ...] = ()
+    x_hint: np.ndarray | None = None
 
 
 def _resolve(base: Path, name: str) -> Path:
@@ -138,25 +141,26 @@ def _resolve(base: Path, name: str) -> Path:
     return p if p.is_absolute() else base.parent / p
 
 
-def load_plan_config(path: str | Path) -> PlanInputs:
-    """Read, validate and resolve a plan config (errors name the file, key, value, unit)."""
+def load_plan_config(path: str | Path, x_hint: Any = None) -> PlanInputs:
+    """Read, validate and resolve a plan config (errors name the file, key, value, unit).
+
+    ``x_hint`` (3 numbers, the frame of ``bore.axis``) overrides ``bore.x_hint``: the
+    boring frame's X is its projection onto the plane normal to the bore axis."""
     from robobore.dynamics.structure import check_unit_vector
     from robobore.io.config import load_toml, validate_model
-    from robobore.robot.kinematics import get_robot
     from robobore.robot.stiffness import JointStiffness
 
     p = Path(path)
     raw = load_toml(p)
     cfg = validate_model(PlanConfig, raw, source=p)
     f = str(p)
-    rname = cfg.robot.name
-    rpath = _resolve(p, rname) if rname.endswith(".toml") else None
-    robot = get_robot(str(rpath) if rpath is not None else rname, file=f, field="robot.name")
+    robot, robot_notes = _plan_robot(cfg, raw, p)
     if not robot.links:
         raise ConfigError(
             f"robot '{robot.name}' has no inertial data (mass, centre of mass and inertia per "
             "link), which the pose-dependent dynamic model needs",
-            file=robot.file or f, field="links" if robot.file else "robot.name", value=rname,
+            file=robot.file or f, field="links" if robot.file else "robot.name",
+            value=robot.file or robot.name,
             expected=f"{robot.n_joints} [[links]] tables with mass_kg, com_m and inertia_kg_m2 "
                      "(see robot/library/irb6600-175-2.55.toml)")
     # tool point: metres, flange frame
@@ -177,6 +181,19 @@ def load_plan_config(path: str | Path) -> PlanInputs:
                                    "of mass, flange frame")
     point = _vec3(cfg.bore.point_m, f, "bore.point_m", "m")
     axis = check_unit_vector(cfg.bore.axis, "bore.axis", file=f)
+    from robobore.robot.stiffness import process_frame, x_hint_arg
+
+    hint = x_hint_arg(x_hint if x_hint is not None else cfg.bore.x_hint,
+                      "--x-hint" if x_hint is not None else "bore.x_hint",
+                      None if x_hint is not None else f)
+    if hint is not None:
+        try:
+            process_frame(np.column_stack([np.zeros(3), np.zeros(3), axis]), "boring",
+                          x_hint=hint)
+        except ConfigError as exc:
+            raise ConfigError(exc.message, file=None if x_hint is not None else f,
+                              field="--x-hint" if x_hint is not None else "bore.x_hint",
+                              value=list(hint), expected=exc.expected) from None
     if cfg.part is not None:
         o = _vec3(cfg.part.origin_m, f, "part.origin_m", "m")
         y = math.radians(cfg.part.yaw_deg)
@@ -184,6 +201,7 @@ def load_plan_config(path: str | Path) -> PlanInputs:
                        [0, 0, 1.0]])
         point = o + Rz @ point
         axis = Rz @ axis
+        hint = None if hint is None else Rz @ hint
     if cfg.lobes.speed_max_rpm <= cfg.lobes.speed_min_rpm:
         raise ConfigError("empty speed range", file=f, field="lobes.speed_max_rpm",
                           value=cfg.lobes.speed_max_rpm,
@@ -225,15 +243,16 @@ def load_plan_config(path: str | Path) -> PlanInputs:
         raise DataError("mode frequencies must be > 0 Hz and damping ratios >= 0",
                         file=str(mfile), field="modes", value=fz.tolist(),
                         expected="frequency_Hz > 0, damping_ratio >= 0")
+    _check_mode_count(fz, mdata, mfile, sfile, robot, _link_bending(cfg, robot, f))
     # what the files describe (robobore.io.identity): one robot, the config's
     from robobore.io.identity import check_pair, check_robot, read_identity
 
     id_s = read_identity(sdata, str(sfile))
     id_m = read_identity(mdata, str(mfile))
-    named = isinstance(raw.get("robot"), dict) and "name" in raw["robot"]
+    named = _names_robot(raw)
     for ident, fl in ((id_s, sfile), (id_m, mfile)):
         check_robot(ident, str(fl), robot.name, robot.description_hash(),
-                    f"robot.name in {f}" if named else f"the default robot of {f} (robot.name)",
+                    f"robot.name in {f}" if named else f"the robot of {f}",
                     verb="was identified for" if fl == sfile else "is a hammer test of")
     if id_s is not None and id_m is not None:
         check_pair({"robot": id_s.get("robot"), "robot_hash": id_s.get("robot_hash")},
@@ -268,7 +287,66 @@ def load_plan_config(path: str | Path) -> PlanInputs:
     synthetic = bool(sdata.get("synthetic", False)) or bool(mdata.get("synthetic", False))
     return PlanInputs(cfg, raw, p, robot, np.asarray(js.k_Nm_per_rad, float), fz[:, 0],
                       fz[:, 1], np.radians(qm), tcp, point, axis, sfile, mfile, synthetic,
-                      _link_bending(cfg, robot, f))
+                      _link_bending(cfg, robot, f), tuple(robot_notes), hint)
+
+
+def _check_mode_count(fz: np.ndarray, mdata: dict[str, Any], mfile: Path, sfile: Path,
+                      robot: Any, link_bending: tuple[Any, ...]) -> None:
+    """The modes fit the model the stiffness file sets up: inside the band they were
+    identified in, at least one per direction of the tool point, at most one per elastic
+    coordinate of the model (the joints of the stiffness file, plus the bending coordinates
+    of ``link_bending``)."""
+    from robobore.equivalent import check_modes_in_band
+    from robobore.plan.bending import compliant_planes, redundancy
+
+    check_modes_in_band([{"frequency_Hz": float(v)} for v in fz[:, 0]], mdata.get("band_Hz"),
+                        str(mfile))
+    n_dof = robot.n_joints if not compliant_planes(link_bending) else int(
+        redundancy(robot, link_bending)[1].size)
+    n = fz.shape[0]
+    if n < 3:
+        raise DataError(
+            f"{mfile} has {n} mode(s): too few to calibrate the {robot.n_joints}-joint model of "
+            f"{sfile} at the measured posture", file=str(mfile), field="modes", value=n,
+            expected="at least 3 modes (one per direction of the tool point)")
+    if n > n_dof:
+        raise DataError(
+            f"{mfile} has {n} modes; the model of {sfile} ({robot.name}, {robot.n_joints} "
+            f"joint stiffnesses{', with link bending' if n_dof > robot.n_joints else ''}) has "
+            f"{n_dof}", file=str(mfile), field="modes", value=n,
+            expected=f"at most {n_dof} modes (the lowest modes of the arm; modes of the tool, "
+                     "the part or the floor left out, or [[identification.link_bending]])")
+
+
+def _names_robot(raw: dict[str, Any]) -> bool:
+    return isinstance(raw.get("robot"), dict) and "name" in raw["robot"]
+
+
+def _plan_robot(cfg: PlanConfig, raw: dict[str, Any], p: Path) -> tuple[Any, list[str]]:
+    """The plan's robot: ``robot.name``, or (the config names none) the robot the joint
+    stiffness file (else the modes file) was identified for, said in a note; the default
+    robot when neither the config nor the files name one."""
+    from robobore.io.identity import read_identity
+    from robobore.robot.description import robot_of_identity
+    from robobore.robot.kinematics import get_robot
+
+    f = str(p)
+    if not _names_robot(raw):
+        for key in ("joint_stiffness", "modes"):
+            fl = _resolve(p, getattr(cfg.identification, key))
+            if not fl.is_file():
+                continue
+            data = _read_json(fl, f, f"identification.{key}")
+            ident = read_identity(data, str(fl))
+            if ident is None and isinstance(data.get("robot"), str) and data["robot"]:
+                ident = {"robot": data["robot"]}
+            if ident is not None and ident.get("robot"):
+                rb = robot_of_identity(ident, str(fl))
+                return rb, [f"robot {rb.name} taken from {fl} ({f} names no robot.name)"]
+    rname = cfg.robot.name
+    rpath = _resolve(p, rname) if rname.endswith(".toml") else None
+    return get_robot(str(rpath) if rpath is not None else rname, file=f,
+                     field="robot.name"), []
 
 
 def _link_bending(cfg: PlanConfig, robot: Any, f: str) -> tuple[Any, ...]:

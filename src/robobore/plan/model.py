@@ -64,9 +64,9 @@ from robobore.robot.kinematics import Robot, fk_jacobian
 from robobore.robot.stiffness import process_frame
 
 
-def boring_frames(T: np.ndarray) -> np.ndarray:
+def boring_frames(T: np.ndarray, x_hint: Any = None) -> np.ndarray:
     """Boring frames (n, 3, 3) for tool transforms (n, 4, 4); see process_frame."""
-    return np.stack([process_frame(t[:3, :3], "boring") for t in T])
+    return np.stack([process_frame(t[:3, :3], "boring", x_hint=x_hint) for t in T])
 
 
 @dataclass(frozen=True)
@@ -135,6 +135,8 @@ class PoseModel:
     link_scale: np.ndarray | None = None
     robot_file: str | None = None
     link_bending: tuple[LinkBending, ...] = ()
+    #: the boring frame's X hint (base frame; robobore.robot.stiffness.process_frame)
+    x_hint: tuple[float, float, float] | None = None
 
     @property
     def n_dof(self) -> int:
@@ -197,7 +199,7 @@ class PoseModel:
         """Modes, tool-point modal vectors and compliance at postures Q (n, nj) or (nj,)."""
         Q = np.atleast_2d(np.asarray(Q_rad, float))
         T, J = fk_jacobian(self.robot, Q, self.tcp_m)
-        R = self._frames(T, Q, frame)
+        R = self._frames(T, Q, frame, self.x_hint)
         if compliant_planes(self.link_bending):
             return self._modes_elastic(Q, T, R)
         M = self.mass_matrix(Q)
@@ -219,9 +221,10 @@ class PoseModel:
         return PostureModes(w / (2 * np.pi), zeta, u, phi, Cq, np.asarray(R), T)
 
     @staticmethod
-    def _frames(T: np.ndarray, Q: np.ndarray, frame: str | np.ndarray) -> np.ndarray:
+    def _frames(T: np.ndarray, Q: np.ndarray, frame: str | np.ndarray,
+                x_hint: Any = None) -> np.ndarray:
         if isinstance(frame, str) and frame == "boring":
-            return boring_frames(T)
+            return boring_frames(T, x_hint)
         if isinstance(frame, str):
             return np.stack([process_frame(t[:3, :3], frame) for t in T])
         return np.broadcast_to(np.asarray(frame, float), (Q.shape[0], 3, 3))

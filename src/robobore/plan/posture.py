@@ -109,14 +109,16 @@ def _same_posture(q1: np.ndarray, q2: np.ndarray, tol: float = 1e-6) -> bool:
     return bool(np.max(np.abs(d)) < tol)
 
 
-def plan_posture(config: str | Path, *, progress_factory: Any = None) -> dict[str, Any]:
+def plan_posture(config: str | Path, *, progress_factory: Any = None,
+                 x_hint: Any = None) -> dict[str, Any]:
     """Run the posture plan of a config file; returns the result (JSON contract + arrays).
+    ``x_hint`` overrides the config's ``bore.x_hint`` (the boring frame's X direction).
 
     ``progress_factory(description, total)`` -> context manager yielding ``advance(n)``
     (optional; :func:`robobore.clitools.progress_bar`).
     """
     t0 = time.perf_counter()
-    return run_plan(load_plan_config(config), progress_factory=progress_factory, t0=t0)
+    return run_plan(load_plan_config(config, x_hint), progress_factory=progress_factory, t0=t0)
 
 
 def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
@@ -134,7 +136,8 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     tool = ToolBody(cfg.tool.mass_kg, tuple(cfg.tool.com_m), tuple(cfg.tool.inertia_kg_m2))
     model0 = PoseModel(robot, inp.k_Nm_per_rad, np.zeros(robot.n_joints), tool=tool,
                        link_bending=inp.link_bending,
-                       tcp_m=tuple(inp.tcp_m), robot_file=robot.file or None)
+                       tcp_m=tuple(inp.tcp_m), robot_file=robot.file or None,
+                       x_hint=None if inp.x_hint is None else tuple(inp.x_hint))
     cal = calibrate(model0, inp.q_meas_rad, inp.modes_f_Hz, inp.modes_zeta)
     model = cal.model
     from robobore.io.ranges import radians_hint
@@ -154,7 +157,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     A0 = process.mean_directional_matrix()
     from robobore.io.identity import make_identity
 
-    Rb = boring_frame(inp.bore_axis)
+    Rb = boring_frame(inp.bore_axis, inp.x_hint)
     # measured posture: does it hold this bore? anchor the rotation grid at its angle
     Tm = fk(robot, inp.q_meas_rad, inp.tcp_m)
     meas_pos_err = float(np.linalg.norm(Tm[:3, 3] - inp.bore_point_m))
@@ -163,7 +166,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
     anchor = rotation_of(Rb, Tm[:3, :3]) if meas_reaches else 0.0
     rot = rotation_grid(cfg.plan.rotation_step_deg, anchor)
     cand = enumerate_candidates(robot, inp.bore_point_m, inp.bore_axis, inp.tcp_m, rot,
-                                cfg.plan.singularity_margin)
+                                cfg.plan.singularity_margin, inp.x_hint)
     if cand.n_reached == 0:
         raise InputError(
             "the bore is out of the robot's reach at every tool-axis rotation and IK branch",
@@ -274,6 +277,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
                                    "axis_deg": meas_ax_err},
         "calibration": cal.to_dict(),
         "bore": {"point_m": inp.bore_point_m.tolist(), "axis": inp.bore_axis.tolist(),
+                 "x_hint": None if inp.x_hint is None else inp.x_hint.tolist(),
                  "boring_frame_columns": Rb.T.tolist()},
         "tcp_m": inp.tcp_m.tolist(),
         "counts": {"rotations": int(rot.size), "ik_solutions_tried": cand.n_tried,
@@ -287,6 +291,7 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
         "lobes": lobes,
         "equivalent_model": equivalent,
         "synthetic_inputs": bool(inp.synthetic),
+        "notes": list(inp.notes),
         "warnings": warn + cal.warnings() + _flat_map_warning(crit0, cfg.plan.criterion)
         + _coefficient_warnings(process),
         "identity": make_identity(
@@ -388,7 +393,7 @@ def workspace_map(result: dict[str, Any], progress: Any = None) -> dict[str, Any
         for ix, dx in enumerate(ws.dx_m):
             pt = inp.bore_point_m + np.array([dx, dy, 0.0])
             cand = enumerate_candidates(inp.robot, pt, inp.bore_axis, inp.tcp_m, rot,
-                                        inp.cfg.plan.singularity_margin)
+                                        inp.cfg.plan.singularity_margin, inp.x_hint)
             if cand.q_rad.shape[0]:
                 ev = evaluate(model, inp.robot, cand, process, A0, inp.cfg)
                 c = criterion_values(inp.cfg.plan.criterion, ev["stiffness_N_per_m"],

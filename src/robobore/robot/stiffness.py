@@ -165,8 +165,25 @@ def principal_stiffness(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return 1.0 / lam, V
 
 
+def x_hint_arg(x_hint: Any, field: str = "x_hint", file: str | None = None) -> np.ndarray | None:
+    """``x_hint`` as a unit 3-vector (base frame), or None; a ConfigError naming ``field``."""
+    if x_hint is None:
+        return None
+    try:
+        h = np.asarray(x_hint, float).reshape(-1)
+    except (TypeError, ValueError):
+        h = np.zeros(0)
+    if h.shape != (3,) or not np.all(np.isfinite(h)) or np.linalg.norm(h) == 0:
+        raise ConfigError("not a direction", file=file, field=field, value=x_hint,
+                          expected="[x, y, z]: 3 finite numbers, not all zero (robot base "
+                                   "frame; the boring frame's X is their projection onto the "
+                                   "plane normal to the bore axis)")
+    return h / np.linalg.norm(h)
+
+
 def process_frame(
-    R_world_tool: np.ndarray, frame: str | np.ndarray = "boring", *, vertical: Any = (0, 0, 1)
+    R_world_tool: np.ndarray, frame: str | np.ndarray = "boring", *, vertical: Any = (0, 0, 1),
+    x_hint: Any = None,
 ) -> np.ndarray:
     """Rotation ``R_world_process`` (columns: process X, Y, Z in the world frame).
 
@@ -174,13 +191,27 @@ def process_frame(
     = feed, X = normalise(vertical x Z) horizontal, Y = Z x X), or a 3x3 rotation matrix.
     A feed axis within :data:`VERTICAL_TOL_DEG` of the vertical (a vertical bore, up or
     down) leaves "horizontal" undefined: X is then the robot base's x axis projected onto
-    the plane normal to Z (Y = Z x X).
+    the plane normal to Z (Y = Z x X). ``x_hint`` (a direction in the base frame) sets the
+    boring frame's X for any bore axis: its projection onto the plane normal to Z; a hint
+    within :data:`VERTICAL_TOL_DEG` of the bore axis is refused.
     """
     if isinstance(frame, str):
         if frame == "base":
             return np.eye(3)
         if frame == "tool":
             return np.asarray(R_world_tool, float).copy()
+        if frame == "boring" and x_hint is not None:
+            z = np.asarray(R_world_tool, float)[:, 2]
+            h = x_hint_arg(x_hint)
+            x = h - (h @ z) * z
+            nx = np.linalg.norm(x)
+            if nx < math.sin(math.radians(VERTICAL_TOL_DEG)):
+                raise ConfigError("x_hint lies along the bore axis: it sets no X",
+                                  field="x_hint", value=np.round(h, 6).tolist(),
+                                  expected=f"a direction more than {VERTICAL_TOL_DEG:g} deg "
+                                           "from the bore axis (robot base frame)")
+            x /= nx
+            return np.column_stack([x, np.cross(z, x), z])
         if frame == "boring":
             z = np.asarray(R_world_tool, float)[:, 2]
             v = np.asarray(vertical, float)
@@ -440,6 +471,7 @@ __all__ = [
     "directional_stiffness",
     "principal_stiffness",
     "process_frame",
+    "x_hint_arg",
     "directional_stiffness_xyz",
     "directional_stiffness_map",
     "stiffness_at",

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import csv
 import io
+import re
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -232,9 +233,10 @@ MANIFEST_COLUMNS = (*CONDITION_FIELDS, "posture", "stable", "n_inserts", *RECORD
 
 
 def _is_manifest(text: str) -> bool:
-    for cells in csv.reader(io.StringIO(text.lstrip("\ufeff"))):
-        if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
+    for line in text.lstrip("\ufeff").splitlines():
+        if not line.strip() or line.lstrip().startswith("#"):
             continue
+        cells = re.split(r"[,;\t|]", line)  # any of the separators a measured CSV may use
         return any(c.strip() in RECORD_COLUMNS for c in cells)
     return False
 
@@ -245,8 +247,11 @@ def parse_manifest_csv(text: str, source: str = "<manifest>", base: str | Path =
     record files (paths relative to ``base``)."""
     from robobore.measure.cut import cut_quantities, read_cut_record
 
+    from robobore.io.readers import comma_separated
+
     if text.startswith("\ufeff"):
         text = text[1:]
+    text = comma_separated(text, MANIFEST_COLUMNS)  # ';', tab or '|' separated: read too
     lines = [(i + 1, c) for i, c in enumerate(csv.reader(io.StringIO(text)))
              if c and not all(not x.strip() for x in c) and not c[0].lstrip().startswith("#")]
     header_line, header = lines[0][0], [h.strip() for h in lines[0][1]]
@@ -304,8 +309,9 @@ def parse_manifest_csv(text: str, source: str = "<manifest>", base: str | Path =
             if not path.is_file():
                 raise DataError("record file not found", file=source, row=row, field=col,
                                 value=name, expected="a record file, relative to the manifest")
-            q = cut_quantities(read_cut_record(path), cond["speed_rpm"], n_ins)
-            info[col] = {"file": str(path), "chatter": q["chatter"],
+            crec = read_cut_record(path)
+            q = cut_quantities(crec, cond["speed_rpm"], n_ins)
+            info[col] = {"file": str(path), "kind": crec.kind, "chatter": q["chatter"],
                          "chatter_frequency_Hz": q["chatter_frequency_Hz"],
                          "cutting_time_s": q["cutting_time_s"]}
             if col == "force_file":
@@ -332,6 +338,11 @@ def parse_manifest_csv(text: str, source: str = "<manifest>", base: str | Path =
                             expected="each condition once (one record set per condition)")
         seen[key] = row
         found.update(values)
+        if not any(rec.get(col, "") for col in RECORD_COLUMNS):
+            raise DataError("no record file in this row", file=source, row=row,
+                            field=", ".join(c for c in RECORD_COLUMNS if c in header),
+                            expected="a force_file and/or displacement_file to measure (a "
+                                     "condition not measured: leave its row out)")
         rows.append(MeasuredRow(row=row, condition=cond, values=values))
         recs.append(info)
         if progress is not None:
@@ -371,7 +382,10 @@ class Comparison:
             "groups": self.groups, "agreement": self.agreement, "conditions": list(self.rows),
             "unmatched_measured": list(self.unmatched_measured), "undefined": list(self.undefined),
             "warnings": list(self.warnings),
-            **({"measured_records": list(self.records)} if self.records else {}),
+            **({"measured_records": list(self.records),
+                "measured_synthetic": any(isinstance(v, dict) and v.get("kind") == "SYNTHETIC"
+                                          for r in self.records for v in r.values())}
+               if self.records else {}),
         }
 
     def table_rows(self) -> list[dict[str, Any]]:

@@ -146,6 +146,11 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
         from robobore.cutting.forces import read_coefficients_file
 
         data = read_coefficients_file(p)  # clear errors for a corrupt file; ranges checked
+        from robobore.io.identity import check_insert, check_material, cut_identity_of
+
+        ident = cut_identity_of(data, str(p))  # made for this config's material and insert?
+        check_material(ident, str(p), cfg.material.name, f"[material] name of {cfg_path}")
+        check_insert(ident, str(p), cfg.insert, f"[insert] of {cfg_path}")
         data["file"] = str(p)
         data["mode"] = "stored (--fast)"
         return data

@@ -108,6 +108,9 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
         files["png_forces"] = str(_plot_forces(res, Path(plot) / "fe_forces.png"))
     result = dict(res.summary)
     result["warnings"] = validation_warnings(cfg)
+    from robobore.io.identity import fe_identity
+
+    result["identity"] = fe_identity("fe orthogonal", cfg, str(config))
     if files:
         result["files"] = files
 
@@ -182,7 +185,7 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
     from robobore.io.config import load_toml
 
     base = load_toml(config)
-    parse_config(base, str(config))  # the base config's own errors first
+    base_cfg = parse_config(base, str(config))  # the base config's own errors first
     meas = read_measured(measured)
     pts = None if points is None else parse_points(points)
     default_out = out is None
@@ -200,6 +203,9 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
         result = run_validation(base, meas, source=str(config), points=pts, out_dir=out,
                                 device=device, progress=prog)
     result["measured_file"] = str(measured)
+    from robobore.io.identity import fe_identity
+
+    result["identity"] = fe_identity("fe validate", base_cfg, str(config))
     if plot is not None:
         result.setdefault("files", {})["png_validation"] = str(
             _plot_validation(result, Path(plot) / "fe_validation.png"))

@@ -120,11 +120,17 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     from robobore.io.outputs import check_output_dir
 
     check_output_dir(vtk, "--vtk", "the VTU meshes")
+    from robobore.io.identity import check_cut_file, fe_identity
+
+    notes = [] if coefficients is None else [n for n in [check_cut_file(
+        coefficients, material=cfg.material.name, insert=cfg.insert,
+        material_by=f"[material] name of {config}", insert_by=f"[insert] of {config}")] if n]
     with fraction_progress("FE boring (3D)", enabled=not as_json) as prog:
         res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
     result = dict(res.summary)
     result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients)
-    result["warnings"] = boring_warnings(cfg, result)
+    result["warnings"] = boring_warnings(cfg, result) + notes
+    result["identity"] = fe_identity("fe boring", cfg, str(config))
     if vtk is not None:
         result["files"] = {"vtk": [str(p) for p in write_vtk(res, vtk)]}
 
