@@ -3,14 +3,16 @@
 Truth robot (robobore.dynamics.calibrate_synthetic): the example robot of
 examples/boring_paper.toml with damping x0.6 in every direction and the x stiffness x1.3;
 12 observed cuts per seed (one speed per twelfth of 200-3000 r/min, depth within x/ 1.35 of
-the truth's limit, labels flipped with probability 0.1); 24 held-out speeds. Prints per seed
-and over all seeds: the share of held-out speeds whose corrected median critical depth is
+the truth's limit, labels flipped with probability 0.1); 24 held-out speeds. Two
+configurations of the same cuts: ``verdicts`` (chatter or stable only) and ``amplitude``
+(verdicts, and the stable cuts' feed amplitude with 5 % + 0.1 um measurement noise). Prints per
+configuration, per seed and over all seeds: the share of held-out speeds whose corrected median critical depth is
 within 10 % of the truth (goal: all), the 90 % band's coverage of the truth (goal >= 85 %), the
 median relative error of the corrected and the uncorrected model, and the calibration's wall
 and CPU time on 12 observations (goal: under 1 min on 2 cores).
 
 Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_calibrate.py [--seeds 10] [--first 0]
-     [--json FILE] [--plot DIR]
+     [--observed verdicts|amplitude|both] [--json FILE] [--plot DIR]
 """
 
 from __future__ import annotations
@@ -22,7 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from robobore.dynamics.calibrate_synthetic import validate_seed, validation_case
+from robobore.dynamics.band import critical_depths
+from robobore.dynamics.calibrate import Observation, build_problem
+from robobore.dynamics.calibrate_synthetic import truth_structure, validate_seed, validation_case
 from robobore.dynamics.config import load_dynamics_config
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,26 +37,45 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first", type=int, default=0)
     ap.add_argument("--config", default=str(ROOT / "examples" / "boring_paper.toml"))
+    ap.add_argument("--observed", choices=("verdicts", "amplitude", "both"), default="both",
+                    help="what the cuts carry: verdicts only, verdicts + feed amplitude, both runs")
     ap.add_argument("--json", default=None, help="write the per-seed results here")
     ap.add_argument("--plot", default=None, help="write the first seed's band figure here")
     args = ap.parse_args()
     cfg, _ = load_dynamics_config(args.config)
-    case = validation_case(cfg, args.first)  # compiles the kernels (numba cache) first
+    configs = {"verdicts": [False], "amplitude": [True], "both": [False, True]}[args.observed]
+    out = []
+    for amp in configs:
+        out += run_config(cfg, args, amp)
+    if args.json:
+        Path(args.json).write_text(json.dumps(out, indent=2) + "\n")
+
+
+def run_config(cfg, args, amp: bool) -> list[dict]:
+    label = "verdicts + feed amplitude" if amp else "verdicts only"
     if args.plot:
+        case = validation_case(cfg, args.first, feed_amplitude=amp)
         from robobore.dynamics.plots import plot_band
 
         cal = case["calibration"]
+        tag = "_amplitude" if amp else ""
         p = plot_band(cal.band, args.plot, cal.nominal_m, case["observations"],
-                      name=f"calibrate_synthetic_seed{args.first}.png", truth_m=case["truth"],
-                      title=f"SYNTHETIC seed {args.first}: corrected lobes, 90 % band, truth")
+                      name=f"calibrate_synthetic_seed{args.first}{tag}.png",
+                      truth_m=case["truth"],
+                      title=f"SYNTHETIC seed {args.first} ({label}): corrected lobes, 90 % band, "
+                            "truth")
         print(f"figure: {p}")
+    else:  # compiles the kernels (numba cache) before the timed runs
+        pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
+        critical_depths(truth_structure(pb.structure), pb.process, np.array([1e3]))
     runs = []
-    print(f"SYNTHETIC calibration validation, {args.config}, NUMBA_NUM_THREADS="
-          f"{os.environ.get('NUMBA_NUM_THREADS', '-')}, {os.cpu_count()} CPUs")
+    print(f"SYNTHETIC calibration validation ({label}), {args.config}, NUMBA_NUM_THREADS="
+          f"{os.environ.get('NUMBA_NUM_THREADS', '-')}, {os.cpu_count()} CPUs, load average "
+          f"{os.getloadavg()[0]:.1f}")
     print(f"{'seed':>4} {'within10%':>9} {'cover90':>8} {'err corr':>8} {'err nom':>8} "
           f"{'flip':>4} {'wall s':>7} {'cpu s':>6}")
     for seed in range(args.first, args.first + args.seeds):
-        r = validate_seed(cfg, seed)
+        r = validate_seed(cfg, seed, feed_amplitude=amp)
         runs.append(r)
         print(f"{seed:4d} {r.within_10pct:9.2f} {r.coverage_90:8.2f} "
               f"{r.median_error_corrected:8.3f} {r.median_error_uncorrected:8.3f} "
@@ -64,7 +87,7 @@ def main() -> None:
     wu = np.array([r.within_10pct_uncorrected for r in runs])
     t = np.array([r.seconds for r in runs])
     cpu = np.array([r.cpu_seconds for r in runs])
-    print(f"over {len(runs)} seeds x 24 held-out speeds:")
+    print(f"{label}, over {len(runs)} seeds x 24 held-out speeds:")
     print(f"  corrected within 10 % of the truth: {w.mean():.1%} of speeds "
           f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}")
     print(f"  90 % band covers the truth: {c.mean():.1%} (seeds: min {c.min():.0%})")
@@ -73,8 +96,7 @@ def main() -> None:
     print(f"  calibrate (12 observations, band at 24 speeds): wall {np.median(t):.1f} s median "
           f"(max {t.max():.1f}), CPU {np.median(cpu):.1f} s median; "
           f"{len(runs) / t.sum() * 60:.2f} calibrations per minute")
-    if args.json:
-        Path(args.json).write_text(json.dumps([r.to_dict() for r in runs], indent=2) + "\n")
+    return [r.to_dict() for r in runs]
 
 
 if __name__ == "__main__":

@@ -14,9 +14,19 @@ Likelihood (one term per observation):
 * chatter frequency (chatter cuts): Gaussian about ``f_j sqrt(1 + 2 zeta_j)`` of the unit
   nearest the observed frequency (the single-mode chatter frequency at the lobe minimum), with a
   standard deviation of 2 % plus the mode's half-power half-width ``zeta_j f_j``;
-* feed amplitude (stable cuts): Gaussian in ``ln`` of the steady forced response's half
-  peak-to-peak feed displacement
-  (:func:`~robobore.dynamics.timedomain.nominal_cut_deflection`), 20 % standard deviation.
+* feed amplitude (stable cuts): Gaussian about the steady forced response's half
+  peak-to-peak feed displacement ``A``
+  (:func:`~robobore.dynamics.timedomain.nominal_cut_deflection`, the orbit the time domain
+  starts from), standard deviation ``sqrt((r A)^2 + f^2)`` for a measurement noise of ``r``
+  relative plus ``f`` absolute (5 % + 0.1 um, a grating scale's; :class:`LikelihoodSettings`). The amplitude depends on the stiffness and the damping of
+  every direction (the depth-modulation stiffness couples x and y into the feed), so stable
+  cuts pin the stiffness and the verdicts then pin the damping.
+
+Parametrisation: log factors on the damping ratio and on the stiffness per direction. The
+lobes alone depend on a direction's dynamic stiffness at resonance, close to ``k zeta``, so
+verdicts alone pin the sum of the two log factors of a direction and leave their difference to
+the prior; the Laplace covariance carries that ridge into the band (the band is as sure as the
+lobes are, not as the factors are). Feed amplitudes break the ridge.
 
 Posterior: maximum a posteriori and the Laplace approximation (MacKay 2003, *Information
 Theory, Inference, and Learning Algorithms*, ch. 27; Bishop 2006, *Pattern Recognition and
@@ -217,7 +227,9 @@ class LikelihoodSettings:
     the surface is no better). ``verdict_spread``: ``s``, the spread of the verdict about the
     limit in ``ln`` depth (0.1: a cut within about 10 % of its limit grows or decays so slowly
     that a test cut of a few seconds may show either). ``frequency_sd``: relative part of the
-    chatter frequency's standard deviation; ``amplitude_sd``: the feed amplitude's in ``ln``.
+    chatter frequency's standard deviation; ``amplitude_sd`` and ``amplitude_floor_m``: the
+    feed amplitude's measurement noise, relative (0.05) and absolute (1e-7 m: a grating scale
+    of 0.1 um resolution); raise them where the forced-response model itself is less sure.
     Priors on the log factors: ``damping_prior_sd`` 0.42 (90 % within x/ 2: identified robot
     damping ratios scatter by that much between tests, postures and in the cut),
     ``stiffness_prior_sd`` 0.25 (90 % within x/ 1.5: static stiffness identified within tens
@@ -232,7 +244,8 @@ class LikelihoodSettings:
     label_noise: float = 0.1
     verdict_spread: float = 0.1
     frequency_sd: float = 0.02
-    amplitude_sd: float = 0.2
+    amplitude_sd: float = 0.05
+    amplitude_floor_m: float = 1e-7
     damping_prior_sd: float = 0.42
     stiffness_prior_sd: float = 0.25
     process_damping_ref: float = 1e5
@@ -363,9 +376,10 @@ class CalibrationProblem:
             ll += float(np.sum(-0.5 * ((fobs - fp) / sd) ** 2 - np.log(sd)))
             k += fobs.size
         if aobs.size:
-            ap = pred[k:k + aobs.size]
+            ap = np.exp(pred[k:k + aobs.size])
             ok = np.isfinite(ap)
-            ll += float(np.sum(-0.5 * ((aobs[ok] - ap[ok]) / s.amplitude_sd) ** 2))
+            sd = np.hypot(s.amplitude_sd * ap[ok], s.amplitude_floor_m)
+            ll += float(np.sum(-0.5 * ((np.exp(aobs[ok]) - ap[ok]) / sd) ** 2 - np.log(sd)))
         return ll
 
     def _zeta_near(self, fobs: np.ndarray, theta: np.ndarray | None) -> np.ndarray:
@@ -591,6 +605,7 @@ class Calibration:
             "model_selection": sel,
             "likelihood": {"label_noise": s.label_noise, "verdict_spread": s.verdict_spread,
                            "frequency_sd": s.frequency_sd, "amplitude_sd": s.amplitude_sd,
+                           "amplitude_floor_um": s.amplitude_floor_m * 1e6,
                            "damping_prior_sd": s.damping_prior_sd,
                            "stiffness_prior_sd": s.stiffness_prior_sd,
                            "prior_correlation": s.prior_correlation},

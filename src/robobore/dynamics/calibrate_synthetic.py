@@ -11,6 +11,18 @@ a depth ``a_truth(n) exp(u)``, ``u`` uniform in +-0.3 (the test cuts of an engin
 brackets the limit within a factor 1.35 either side); the label is the truth's verdict (chatter
 above its semi-discretisation linear limit) flipped with probability 0.1 (label noise).
 Held-out speeds: 24 speeds drawn uniformly over the range with the same seed.
+
+Feed amplitudes (``feed_amplitude=True``): every stable cut carries the feed amplitude a
+grating scale measures, the truth's steady periodic orbit at the cut
+(:func:`~robobore.dynamics.timedomain.nominal_cut_deflection`, half peak-to-peak of the feed
+displacement) with a measurement noise of :data:`AMPLITUDE_NOISE_REL` (5 %) relative plus
+:data:`AMPLITUDE_NOISE_ABS_M` (0.1 um) absolute, drawn from a second random stream of the seed
+so that the cuts and the verdicts are the same with and without them; a reading below the
+scale's resolution (0.1 um) is not reported. A chattering cut's
+amplitude is set by the chatter's own limit cycle (the tool leaving the cut), which the linear
+forced response does not predict, so chatter cuts carry none. Chatter frequencies are not
+made: the frequency of the semi-discretisation's critical eigenvalue is not a public result of
+the stability code, and the frequency-domain lobes' frequency belongs to a different limit.
 Every observation and result made here is labelled SYNTHETIC.
 """
 
@@ -33,6 +45,20 @@ N_CUTS = 12
 N_HELD_OUT = 24
 DEPTH_SPREAD_LN = 0.3
 LABEL_NOISE = 0.1
+#: Measurement noise of the SYNTHETIC feed amplitudes: relative, and absolute [m].
+AMPLITUDE_NOISE_REL = 0.05
+AMPLITUDE_NOISE_ABS_M = 1e-7
+
+
+def truth_feed_amplitude(truth, process, speed_rpm: float, depth_m: float) -> float:
+    """Half peak-to-peak feed (z) displacement [m] of the truth's steady cut (the orbit of
+    :func:`~robobore.dynamics.timedomain.nominal_cut_deflection`)."""
+    from robobore.dynamics.timedomain import nominal_cut_deflection
+
+    pr = process.at_depth(depth_m)
+    r1, r0 = nominal_cut_deflection(truth, pr, speed_rpm)
+    z = depth_m * r1[:, 2] + r0[:, 2]
+    return 0.5 * float(z.max() - z.min())
 
 
 def truth_structure(structure):
@@ -43,10 +69,12 @@ def truth_structure(structure):
                             log_k)
 
 
-def synthetic_observations(problem, speed_range: tuple[float, float], seed: int
+def synthetic_observations(problem, speed_range: tuple[float, float], seed: int,
+                           feed_amplitude: bool = False
                            ) -> tuple[list[Observation], np.ndarray, np.ndarray]:
-    """SYNTHETIC cuts of the truth robot (module docstring): the observations, the held-out
-    speeds and the truth's critical depths there [m]."""
+    """SYNTHETIC cuts of the truth robot (module docstring): the observations (stable cuts
+    with their measured feed amplitude when ``feed_amplitude``), the held-out speeds and the
+    truth's critical depths there [m]."""
     rng = np.random.default_rng(seed)
     lo, hi = speed_range
     edges = np.linspace(lo, hi, N_CUTS + 1)
@@ -59,6 +87,18 @@ def synthetic_observations(problem, speed_range: tuple[float, float], seed: int
     obs = [Observation(i + 1, float(n), float(a), bool(c != f))
            for i, (n, a, c, f) in enumerate(zip(speeds, depth, chatter, flip, strict=True))]
     held = np.sort(rng.uniform(lo, hi, N_HELD_OUT))
+    if feed_amplitude:
+        from dataclasses import replace
+
+        rng2 = np.random.default_rng([seed, 1])
+        noise = rng2.standard_normal((N_CUTS, 2))
+        for i, o in enumerate(obs):
+            if o.chatter:
+                continue
+            a = truth_feed_amplitude(truth, problem.process, o.speed_rpm, o.depth_m)
+            a = a * (1.0 + AMPLITUDE_NOISE_REL * noise[i, 0]) + AMPLITUDE_NOISE_ABS_M * noise[i, 1]
+            if a >= AMPLITUDE_NOISE_ABS_M:
+                obs[i] = replace(o, feed_amplitude_m=float(a))
     return obs, held, critical_depths(truth, problem.process, held)
 
 
@@ -67,7 +107,7 @@ class ValidationRun:
     """One seed: the fraction of held-out speeds whose corrected median critical depth is
     within 10 % of the truth, the 90 % band's coverage of the truth, the median relative error
     of the corrected and of the uncorrected model, labels flipped, the calibration's run time
-    and CPU time [s], the MAP factors."""
+    and CPU time [s], the MAP factors, whether the stable cuts carried feed amplitudes."""
 
     seed: int
     within_10pct: float
@@ -79,6 +119,7 @@ class ValidationRun:
     seconds: float
     cpu_seconds: float
     factors: dict[str, float]
+    feed_amplitude: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {"seed": self.seed, "within_10pct": self.within_10pct,
@@ -88,20 +129,23 @@ class ValidationRun:
                 "within_10pct_uncorrected": self.within_10pct_uncorrected,
                 "flipped_labels": self.flipped, "seconds": self.seconds,
                 "cpu_seconds": self.cpu_seconds,
-                "factors": self.factors, "kind": "SYNTHETIC"}
+                "factors": self.factors, "feed_amplitude": self.feed_amplitude,
+                "kind": "SYNTHETIC"}
 
 
 def validation_case(config: Any, seed: int,
                     speed_range: tuple[float, float] = (200.0, 3000.0),
-                    settings: LikelihoodSettings | None = None) -> dict[str, Any]:
-    """The SYNTHETIC cuts of ``seed`` and their calibration: ``observations``, ``held_out``
+                    settings: LikelihoodSettings | None = None,
+                    feed_amplitude: bool = False) -> dict[str, Any]:
+    """The SYNTHETIC cuts of ``seed`` (with feed amplitudes when ``feed_amplitude``) and
+    their calibration: ``observations``, ``held_out``
     speeds, the ``truth``'s critical depths there [m], the ``calibration`` (band at the
     held-out speeds), ``flipped`` labels, its wall and CPU ``seconds``."""
     from robobore.dynamics.config import load_dynamics_config
 
     cfg, _ = load_dynamics_config(config) if not hasattr(config, "equivalent") else (config, 0)
     problem = build_problem(cfg, [Observation(1, 1000.0, 1e-3, False)], settings)
-    obs, held, truth = synthetic_observations(problem, speed_range, seed)
+    obs, held, truth = synthetic_observations(problem, speed_range, seed, feed_amplitude)
     a_t = critical_depths(truth_structure(problem.structure), problem.process,
                           np.array([o.speed_rpm for o in obs]))
     flipped = sum(int(o.chatter != (o.depth_m > a)) for o, a in zip(obs, a_t, strict=True))
@@ -113,10 +157,11 @@ def validation_case(config: Any, seed: int,
 
 
 def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (200.0, 3000.0),
-                  settings: LikelihoodSettings | None = None) -> ValidationRun:
+                  settings: LikelihoodSettings | None = None,
+                  feed_amplitude: bool = False) -> ValidationRun:
     """Make the SYNTHETIC cuts of ``seed``, calibrate on them, compare at the held-out
     speeds (:func:`validation_case`)."""
-    c = validation_case(config, seed, speed_range, settings)
+    c = validation_case(config, seed, speed_range, settings, feed_amplitude)
     cal, truth = c["calibration"], c["truth"]
     b = cal.band
     err_c = np.abs(b.median_m / truth - 1.0)
@@ -126,12 +171,13 @@ def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (20
     return ValidationRun(seed, float(np.mean(err_c <= 0.1)), float(np.mean(cover)),
                          float(np.median(err_c)), float(np.median(err_u)),
                          float(np.mean(err_u <= 0.1)), int(c["flipped"]), c["seconds"],
-                         c["cpu_seconds"], factors)
+                         c["cpu_seconds"], factors, feed_amplitude)
 
 
 __all__ = ["truth_structure", "synthetic_observations", "validate_seed", "validation_case", "ValidationRun",
            "TRUTH_DAMPING_FACTOR", "TRUTH_STIFFNESS_FACTOR", "TRUTH_STIFFNESS_AXIS", "N_CUTS",
-           "N_HELD_OUT", "LABEL_NOISE", "write_example_observations"]
+           "N_HELD_OUT", "LABEL_NOISE", "write_example_observations", "truth_feed_amplitude",
+           "AMPLITUDE_NOISE_REL", "AMPLITUDE_NOISE_ABS_M"]
 
 
 def write_example_observations(path: Any, config: Any, seed: int = 0) -> Any:
