@@ -8,8 +8,10 @@ Pipeline (:func:`run_paper`), on the bundled SYNTHETIC example data by default
 2. the five best-supported modes of the hammer test (``modal.identify``);
 3. the equivalent model (``equivalent``: k from 1, f_n and zeta from 2, m = k / w_n^2, modes
    assigned to X, Y, Z by their direction) without and with the pressure foot;
-4. the force model: FE-calibrated coefficients (``cutting.calibrate``; ``fast``: the stored
-   file of the example, made by the same command);
+4. the force model: the FE calibration (``cutting.calibrate``; ``fast``: the stored file of
+   the example, made by the same command) and the set the boring model uses
+   (``paper_config.model_coefficients``: the measured TC4 default unless ``[coefficients]
+   material = "TC4-FE"`` chooses the calibration);
 5. the sweep of the paper's kind of conditions (one factor at a time around the paper's
    Fig. 7 condition) for the robot at P = 0 and 0.3 MPa and for a stiff machine tool, on Dask
    with a resumable results store under ``OUT/sweep``;
