@@ -138,6 +138,40 @@ def test_study_conditions_of_the_example():
                  c["pressure_MPa"]) for c in conds}) == 36
 
 
+def test_paper_coefficient_set_is_the_measured_default_unless_chosen():
+    """The bundled config runs the boring model on the measured TC4 default; [coefficients]
+    material = "TC4-FE" chooses the stored calibration inline, with its own domain."""
+    cfg, raw, path = pc.load_paper_config()
+    fe = pp.load_or_calibrate(cfg, raw, path, True, 1)
+    assert pc.model_coefficients(cfg, fe) == {"material": "TC4"}
+    assert pp.dynamics_model(cfg, pp.build_equivalent(
+        pp.identify_stiffness(cfg, path), pp.identify_modes(cfg, path), cfg.pressure_foot),
+        fe, "machine_tool")["dynamics"]["coefficients"] == {"material": "TC4"}
+    cs = pc.coefficient_set(cfg, fe)
+    assert cs["name"] == "TC4" and cs["domain"]["cutting_speed_m_per_min"] == [5.0, 30.0]
+    # 200 r/min on the 40 mm bore is 25.1 m/min: inside, not warned; 300 r/min is not
+    assert not any(w.startswith("coefficient set TC4 at 200 r/min") for w in cs["warnings"])
+    assert cs["warnings"][0].startswith("coefficient set TC4 at 300 r/min (the base")
+    cfg.coefficients.material = "TC4-FE"
+    inline = pc.model_coefficients(cfg, fe)
+    assert inline["Ktc_N_per_m2"] == fe["coefficients"]["Ktc_N_per_m2"]
+    assert inline["grid"]["cutting_speed_m_per_min"] == [37.7]
+    cs = pc.coefficient_set(cfg, fe)
+    assert cs["name"] == "TC4-FE"
+    assert cs["domain"] == {"cutting_speed_m_per_min": [37.7, 37.7],
+                            "uncut_chip_thickness_um": [60.0, 90.0]}
+    assert not any("at 300 r/min" in w for w in cs["warnings"])  # 37.699 m/min: calibrated
+    assert any("at 200 r/min" in w for w in cs["warnings"])
+
+
+def test_paper_coefficient_set_name_is_checked(tmp_path):
+    p = _small_config(tmp_path)
+    p.write_text(p.read_text().replace('material = "TC4"\nfile', 'material = "FE"\nfile'))
+    with pytest.raises(ConfigError) as ei:
+        pc.load_paper_config(p)
+    assert "coefficients.material" in str(ei.value) and "TC4-FE" in str(ei.value)
+
+
 def test_bad_paper_config(tmp_path):
     p = _small_config(tmp_path, extra="\n[unknown]\nx = 1\n")
     with pytest.raises(ConfigError) as e:
@@ -301,6 +335,33 @@ def test_paper_fast_small_run_outputs(small_run):
         assert int((ds["system"] == "machine_tool").sum()) == 4
     s = json.loads((out / "paper_summary.json").read_text())
     assert s["coefficients_mode"] == "stored (--fast)"
+    # the boring model runs on the measured TC4 default; the report names it, its domain,
+    # and that the base condition's 37.7 m/min lies above the measured 5-30 m/min
+    cs = s["coefficient_set"]
+    assert cs["name"] == "TC4"
+    assert cs["domain"] == {"cutting_speed_m_per_min": [5.0, 30.0],
+                            "uncut_chip_thickness_um": [40.0, 80.0]}
+    assert cs["base_cutting_speed_m_per_min"] == pytest.approx(37.699, abs=1e-3)
+    base_w = [w for w in s["warnings"] if "(the base condition)" in w]
+    assert len(base_w) == 1 and "37.7 m/min outside the measured 5-30 m/min" in base_w[0]
+    assert "800 r/min" in " ".join(s["warnings"])
+    from robobore.cutting.forces import ti64_coefficients
+
+    assert cs["coefficients"]["Ktc_N_per_m2"] == pytest.approx(ti64_coefficients(37.7).Ktc)
+    html = (out / "report.html").read_text()
+    assert "Coefficient set TC4:" in html and "Coefficient warnings" in html
+    assert "37.7 m/min outside the measured 5-30 m/min" in html
+    assert "opt-in set TC4-FE, not used above" in html
+    # the runs themselves were simulated with the default set (their stored provenance)
+    import netCDF4
+
+    from robobore.study.store import ResultsStore
+
+    recs = list(ResultsStore.open_existing(out / "sweep").records())
+    with netCDF4.Dataset(recs[0].path) as nc:
+        assert "Ducobu" in nc.getncattr("coefficients_provenance")
+    assert any("37.7 m/min outside the measured" in w for r in recs
+               for w in r.coefficient_warnings)
     assert s["comparison"]["groups"]
     assert any("pressure foot" in c["finding"] for c in s["qualitative_checks"])
     eq = s["equivalent_model"]
@@ -352,6 +413,36 @@ def test_cli_paper_json_and_resume(tmp_path, small_run):
     assert d["sweep"]["computed"] == 0
     assert d["sweep"]["skipped"] == res["computed"]
     assert (d["stable"], d["vibratory"]) == (res["stable"], res["vibratory"])
+    # nothing recomputed, the coefficient set's own warnings still said
+    assert d["coefficient_set"]["name"] == "TC4"
+    assert any("(the base condition)" in w for w in d["warnings"])
+
+
+def test_compare_carries_the_runs_coefficient_warnings(small_run):
+    """``robobore compare`` on the paper job's results: the compared runs' coefficient
+    warnings (the measured TC4 set above its 5-30 m/min) in the JSON ``warnings`` with the
+    number of compared conditions each applies to, and in the human output."""
+    from typer.testing import CliRunner
+
+    from robobore.cli import app
+    from robobore.study.compare import compare_results
+
+    _, out, _ = small_run
+    cmp = compare_results(EX / "measured_synthetic.csv", out)
+    n = len(cmp.rows)
+    cw = [w for w in cmp.warnings if w.startswith("coefficients (")]
+    speed_w = [w for w in cw if "37.7 m/min outside the measured 5-30 m/min" in w]
+    assert len(speed_w) == 1
+    # every compared robot condition at 300 r/min carries it, and no other
+    k = sum(1 for r in cmp.rows if r["condition"]["speed_rpm"] == 300.0)
+    assert 0 < k <= n and speed_w[0].startswith(f"coefficients ({k} of {n} conditions)")
+    assert any("800 r/min" not in w and "101 m/min" in w for w in cw)
+    r = CliRunner().invoke(app, ["compare", str(EX / "measured_synthetic.csv"), str(out),
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["warnings"] == list(cmp.warnings)
+    r = CliRunner().invoke(app, ["compare", str(EX / "measured_synthetic.csv"), str(out)])
+    assert r.exit_code == 0 and "37.7 m/min outside the measured" in " ".join(r.output.split())
 
 
 def test_synthetic_measured_is_reproducible(tmp_path):
@@ -384,6 +475,7 @@ def test_deepest_cut_roughness_is_after_form_removal():
                              cfg.pressure_foot)
     coeffs = dict(pp.load_or_calibrate(cfg, raw, path, True, 1))
     coeffs["coefficients"] = dict(_LOW_FEED_COEFFICIENTS, provenance="test")
+    cfg.coefficients.material = "TC4-FE"  # the calibration (here replaced) is the model's set
     model = pp.dynamics_model(cfg, eq, coeffs, "robot")
     from robobore.study.runners import boring_runner
 

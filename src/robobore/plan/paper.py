@@ -28,9 +28,12 @@ WORKSPACE_ROTATION_STEP_DEG = 10.0
 
 
 def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: dict[str, Any],
-                       coeffs: dict[str, Any]) -> dict[str, Any]:
+                       coeffs: dict[str, Any], coefficients: dict[str, Any] | None = None
+                       ) -> dict[str, Any]:
     """Plan for the paper's bore (compact, JSON-ready); ``{"error": msg}`` when it cannot be
-    made (for instance a robot without inertial data), so the report says why."""
+    made (for instance a robot without inertial data), so the report says why. The plan's
+    ``[coefficients]`` table is ``coefficients`` (the study's set), or the coefficients-file
+    content ``coeffs`` inline when it is None."""
     from robobore.cutting.forces import inline_coefficients
     from robobore.plan.config import PlanConfig, PlanInputs
     from robobore.plan.posture import run_plan, workspace_map
@@ -59,7 +62,8 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
             "cutting": {"speed_rpm": float(base["speed_rpm"]),
                         "feed_mm_per_rev": float(base["feed_mm_per_rev"]),
                         "depth_mm": float(base["depth_of_cut_mm"])},
-            "coefficients": inline_coefficients(coeffs, cfg.coefficients.speed_dependent),
+            "coefficients": (inline_coefficients(coeffs, cfg.coefficients.speed_dependent)
+                             if coefficients is None else coefficients),
             "lobes": {"speed_min_rpm": cfg.lobes.speed_min_rpm,
                       "speed_max_rpm": cfg.lobes.speed_max_rpm},
             "workspace": {"dx_m": list(WORKSPACE_SHIFTS_M), "dy_m": list(WORKSPACE_SHIFTS_M),

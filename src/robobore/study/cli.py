@@ -253,9 +253,14 @@ def _render_paper(res: dict[str, Any]) -> None:
         ("stable, paper's criterion", res["stable"]),
         ("vibratory, paper's criterion", res["vibratory"]),
         ("failed", len(res["failed"])),
-        ("force coefficients", res.get("coefficients_mode")),
+        ("force coefficients (boring model)", (res.get("coefficient_set") or {}).get("name")),
+        ("force calibration (report's FE section)", res.get("coefficients_mode")),
         ("wall time, s", res["wall_time_s"]),
     ]))
+    sweep_w = set((res.get("sweep") or {}).get("warnings", []))  # printed on stderr
+    for w in res.get("warnings", []):
+        if w not in sweep_w:
+            stdout.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     if res["failed"]:
         t = Table(title="failed conditions", header_style="bold red")
         for c in ("system", "condition", "error"):
@@ -288,8 +293,8 @@ def paper_cmd(
     config: Path | None = typer.Argument(
         None, help="Paper study config TOML (default: the bundled SYNTHETIC example)."),
     out: Path = typer.Option(Path("paper-results"), "--out", help="Output folder."),
-    fast: bool = typer.Option(False, "--fast", help="Use the stored FE-calibrated "
-                              "coefficients instead of running the FE calibration."),
+    fast: bool = typer.Option(False, "--fast", help="Use the stored force calibration "
+                              "([coefficients] file) instead of running the FE calibration."),
     workers: int = typer.Option(2, "--workers", min=0, help="Dask worker processes for the "
                                 "sweep and FE processes (0 = serial, no Dask)."),
     allow_failures: bool = ALLOW_FAILURES_OPTION,

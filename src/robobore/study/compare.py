@@ -371,7 +371,8 @@ class Comparison:
     quantities: tuple[str, ...] = field(default_factory=tuple)
     system: str | None = None  # the simulated system compared (e.g. "robot")
     systems: tuple[str, ...] = field(default_factory=tuple)  # systems in the results store
-    #: likely unit slips: a measured column off the simulation by a power of ten in most rows
+    #: likely unit slips: a measured column off the simulation by a power of ten in most
+    #: rows; with :func:`compare_results` also the compared runs' coefficient warnings
     warnings: tuple[str, ...] = field(default_factory=tuple)
     records: tuple[dict[str, Any], ...] = field(default_factory=tuple)  # a manifest's records
 
@@ -584,8 +585,11 @@ def compare_results(measured_csv: str | Path, results_dir: str | Path,
     store_dir = resolve_store_dir(results_dir)
     store = ResultsStore.open_existing(store_dir)
     by_system: dict[str, list[tuple[dict[str, Any], dict[str, Any]]]] = {}
+    coef_w: dict[str, list[tuple[dict[str, Any], tuple[str, ...]]]] = {}
     for r in store.records():
-        by_system.setdefault(result_system(r.path), []).append((r.condition, r.summary))
+        sysname = result_system(r.path)
+        by_system.setdefault(sysname, []).append((r.condition, r.summary))
+        coef_w.setdefault(sysname, []).append((r.condition, r.coefficient_warnings))
     if not by_system:
         raise DataError("the results store has no finished condition", file=str(store_dir),
                         expected="a folder with results written by 'robobore sweep' or "
@@ -607,7 +611,26 @@ def compare_results(measured_csv: str | Path, results_dir: str | Path,
     cmp = compare(table, by_system[chosen])
     from dataclasses import replace
 
-    return replace(cmp, system=chosen, systems=systems, records=table.records)
+    warn = cmp.warnings + coefficient_warnings(cmp, coef_w[chosen], table.has_posture)
+    return replace(cmp, system=chosen, systems=systems, records=table.records,
+                   warnings=warn)
+
+
+def coefficient_warnings(cmp: Comparison,
+                         runs: Iterable[tuple[dict[str, Any], tuple[str, ...]]],
+                         with_posture: bool) -> tuple[str, ...]:
+    """The coefficient warnings of the simulated runs ``cmp`` compares (``(condition,
+    warnings)`` per stored run: the runner's ``coefficient_warnings``, a set used outside its
+    calibrated speeds or chip thicknesses), one line per distinct warning with the number
+    of compared conditions it applies to (:func:`robobore.study.sweep.coefficient_warning_lines`)."""
+    from robobore.study.sweep import coefficient_warning_lines
+
+    by_key = {_match_key(c, with_posture): w for c, w in runs}
+    counts: dict[str, int] = {}
+    for r in cmp.rows:
+        for w in by_key.get(_match_key(r["condition"], with_posture), ()):
+            counts[w] = counts.get(w, 0) + 1
+    return coefficient_warning_lines(counts, len(cmp.rows))
 
 
 __all__ = [
@@ -621,6 +644,7 @@ __all__ = [
     "RECORD_COLUMNS",
     "compare",
     "compare_results",
+    "coefficient_warnings",
     "result_system",
     "resolve_store_dir",
 ]

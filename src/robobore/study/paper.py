@@ -8,8 +8,10 @@ Pipeline (:func:`run_paper`), on the bundled SYNTHETIC example data by default
 2. the five best-supported modes of the hammer test (``modal.identify``);
 3. the equivalent model (``equivalent``: k from 1, f_n and zeta from 2, m = k / w_n^2, modes
    assigned to X, Y, Z by their direction) without and with the pressure foot;
-4. the force model: FE-calibrated coefficients (``cutting.calibrate``; ``fast``: the stored
-   file of the example, made by the same command);
+4. the force model: the FE calibration (``cutting.calibrate``; ``fast``: the stored file of
+   the example, made by the same command) and the set the boring model uses
+   (``paper_config.model_coefficients``: the measured TC4 default unless ``[coefficients]
+   material = "TC4-FE"`` chooses the calibration);
 5. the sweep of the paper's kind of conditions (one factor at a time around the paper's
    Fig. 7 condition) for the robot at P = 0 and 0.3 MPa and for a stiff machine tool, on Dask
    with a resumable results store under ``OUT/sweep``;
@@ -38,7 +40,8 @@ import numpy as np
 from robobore.dynamics.config import PressureFootCfg
 from robobore.errors import ConfigError
 from robobore.study.paper_checks import qualitative_checks
-from robobore.study.paper_config import PaperConfig, load_paper_config
+from robobore.study.paper_config import (PaperConfig, coefficient_set, load_paper_config,
+                                         model_coefficients)
 
 RUNNER = "boring"
 PAPER_DAMPING_N_S_PER_M = 23.7  # the paper's equivalent damping coefficient
@@ -166,12 +169,10 @@ def dynamics_model(cfg: PaperConfig, eq: Any, coeffs: dict[str, Any],
                    system: str) -> dict[str, Any]:
     """The ``[model]`` of the boring runner for the robot (equivalent, no foot; the foot is
     set per condition) or the machine tool."""
-    from robobore.cutting.forces import inline_coefficients
-
     dyn: dict[str, Any] = {
         "insert": cfg.insert.model_dump(), "bore": cfg.bore.model_dump(),
-        # the pooled values, with the per-speed fits when the calibration has several speeds
-        "coefficients": inline_coefficients(coeffs, cfg.coefficients.speed_dependent),
+        # the measured TC4 default, or the calibration ("TC4-FE") inline
+        "coefficients": model_coefficients(cfg, coeffs),
         "simulation": {"revolutions": cfg.study.revolutions,
                        "ra_tolerance_um": cfg.study.ra_tolerance_um},
     }
@@ -458,6 +459,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     advance = None if fast else _stage(progress, "FE force calibration", n_fe)
     coeffs = load_or_calibrate(cfg, raw, cfg_path, fast, max(nw, 1), progress=advance)
     lap("force_calibration", t)
+    cset = coefficient_set(cfg, coeffs, coeffs.get("mode"))
     write_json(outdir / "coefficients.json", {k: v for k, v in coeffs.items()
                                               if k not in ("file",)})
     robot_model = dynamics_model(cfg, eq, coeffs, "robot")
@@ -509,7 +511,8 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     write_json(outdir / "equivalent_model.json", eq_json)
     from robobore.plan.paper import paper_posture_plan
 
-    summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs)
+    summary_posture = paper_posture_plan(cfg, cfg_path, stiff, modes, coeffs,
+                                         model_coefficients(cfg, coeffs))
     done = [r for r in rows if r["summary"]]
     n_stable = sum(1 for r in done if r["summary"].get("stable") is True)
     n_vib = sum(1 for r in done if r["summary"].get("stable") is False)
@@ -533,7 +536,9 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         "modes_Hz": [m["frequency_Hz"] for m in modes["modes"]],
         "equivalent_model": {"without_foot": eq["without_foot"].table(),
                              "with_foot": eq["with_foot"].table()},
-        "coefficients": coeffs["coefficients"],
+        "coefficients": cset["coefficients"], "coefficient_set": cset,
+        "warnings": cset["warnings"] + [w for w in outcome.warnings
+                                        if w.startswith("coefficients")],
         "coefficients_mode": coeffs.get("mode"),
         "comparison": None if cmp is None else {"groups": cmp.groups,
                                                 "agreement": cmp.agreement},

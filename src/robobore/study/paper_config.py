@@ -12,7 +12,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from robobore.dynamics.config import BoreCfg, InsertCfg, PressureFootCfg
 from robobore.errors import ConfigError
@@ -88,10 +88,34 @@ class MaterialSection(StrictModel):
 
 
 class CoefficientsSection(StrictModel):
-    file: str  # stored FE-calibrated coefficients (used by --fast)
+    #: the set the boring model (sweep, lobes, posture plan) uses: "TC4" the measured default
+    #: (robobore.cutting.forces.ti64_coefficients, 5-30 m/min, h 40-80 um); "TC4-FE" the
+    #: force calibration of this config (``file`` with --fast, the FE runs of [calibration]
+    #: otherwise), also the way to use a coefficients file of one's own
+    material: str = "TC4"
+    #: the stored force calibration (FE-calibrated coefficients): the report's FE
+    #: force-model section with --fast, and the set used with material = "TC4-FE"
+    file: str
     #: per-speed fits at two or more speeds evaluated at each condition's cutting speed
     #: (robobore.cutting.forces.coefficients_at_speed); false: the pooled set
     speed_dependent: bool = True
+
+    @field_validator("material")
+    @classmethod
+    def _material(cls, v: str) -> str:
+        from robobore.cutting.forces import TC4_FE_NAMES, TC4_NAMES
+
+        if v.upper() not in TC4_NAMES + TC4_FE_NAMES:
+            raise ValueError(f"unknown coefficient set {v!r}; expected 'TC4' (the measured "
+                             "default) or 'TC4-FE' (this config's force calibration: the "
+                             "stored file with --fast, the FE calibration otherwise)")
+        return v
+
+    def uses_calibration(self) -> bool:
+        """True when the boring model uses this config's force calibration ("TC4-FE")."""
+        from robobore.cutting.forces import TC4_FE_NAMES
+
+        return self.material.upper() in TC4_FE_NAMES
 
 
 class MeasuredSection(StrictModel):
@@ -114,6 +138,64 @@ class PaperConfig(StrictModel):
     coefficients: CoefficientsSection
     measured: MeasuredSection = MeasuredSection()
     lobes: LobesSection = LobesSection()
+
+
+def model_coefficients(cfg: PaperConfig, calibration: dict[str, Any]) -> dict[str, Any]:
+    """The ``[coefficients]`` table of the boring model of every stage (sweep, lobes, lobe
+    check, posture plan): ``{"material": "TC4"}`` (the measured default, interpolated at each
+    condition's cutting speed) or, with ``material = "TC4-FE"``, the force calibration
+    ``calibration`` (a coefficients-file content) inline, with its grid and per-speed fits."""
+    from robobore.cutting.forces import inline_coefficients
+
+    if cfg.coefficients.uses_calibration():
+        return inline_coefficients(calibration, cfg.coefficients.speed_dependent)
+    return {"material": "TC4"}
+
+
+def coefficient_set(cfg: PaperConfig, calibration: dict[str, Any],
+                    mode: str | None = None) -> dict[str, Any]:
+    """What the report and ``paper_summary.json`` say about the set the boring model uses:
+    ``name``, ``description``, the calibrated ``domain`` (cutting speeds [m/min], uncut chip
+    thicknesses [um]), the values at the base condition's cutting speed (``coefficients``)
+    and ``warnings``: the set's own warning at each study speed outside its calibrated
+    speeds (the base condition's first). The per-condition warnings (chip thickness
+    included) are the sweep's."""
+    from robobore.cutting import forces
+
+    if cfg.coefficients.uses_calibration():
+        h, v = forces.calibrated_domain(calibration)
+        name = "TC4-FE"
+        desc = ("this config's force calibration (FE-calibrated, opt-in: [coefficients] "
+                f"material = \"TC4-FE\"; {mode or 'calibration'})")
+    else:
+        fits = sorted(forces.ducobu_fits())
+        h, v = forces.TI64_CHIP_THICKNESS_M, (fits[0], fits[-1])
+        name = "TC4"
+        desc = ("the measured TC4 default (least-squares fit of measured orthogonal forces, "
+                "Ducobu et al., CIRP 2022), interpolated at each condition's cutting speed; "
+                "the FE-calibrated set is opt-in ([coefficients] material = \"TC4-FE\")")
+    n_base = float(cfg.study.base["speed_rpm"])
+    speeds = [n_base] + sorted({float(n) for n in cfg.study.speed_rpm} - {n_base})
+    warnings: list[str] = []
+    base_c = None
+    for n in speeds:  # the base condition's speed first
+        vc = math.pi * cfg.bore.diameter_mm * 1e-3 * n
+        c = (forces.coefficients_at_speed(calibration, vc,
+                                          speed_dependent=cfg.coefficients.speed_dependent)
+             if cfg.coefficients.uses_calibration() else forces.ti64_coefficients(vc))
+        base_c = c if base_c is None else base_c
+        warnings += [f"coefficient set {name} at {n:g} r/min"
+                     + (" (the base condition)" if n == n_base else "") + f": {w}"
+                     for w in c.warnings]
+    vc_base = math.pi * cfg.bore.diameter_mm * 1e-3 * float(cfg.study.base["speed_rpm"])
+    return {
+        "name": name, "description": desc,
+        "domain": {"cutting_speed_m_per_min": None if v is None else [v[0], v[1]],
+                   "uncut_chip_thickness_um": None if h is None else
+                   [round(h[0] * 1e6, 6), round(h[1] * 1e6, 6)]},
+        "base_cutting_speed_m_per_min": vc_base,
+        "coefficients": base_c.to_dict(), "warnings": warnings,
+    }
 
 
 def load_paper_config(path: str | Path | None = None) -> tuple[PaperConfig, dict[str, Any], Path]:
@@ -181,6 +263,6 @@ def _resolve_files(cfg: PaperConfig, raw: dict[str, Any], p: Path) -> dict[str, 
     return raw
 
 
-__all__ = ["PaperConfig", "load_paper_config", "example_config_path", "example_dir",
+__all__ = ["PaperConfig", "load_paper_config", "model_coefficients", "coefficient_set", "example_config_path", "example_dir",
            "StudySection", "RobotSection", "ModalSection", "MachineToolSection",
            "LobesSection", "MaterialSection", "CoefficientsSection", "MeasuredSection", "XYZ"]

@@ -3,7 +3,9 @@
 
 :func:`build_report` returns a :class:`robobore.study.report.Report` with: inputs (SYNTHETIC
 labels), the stiffness and mode tables, the equivalent model (with / without the foot, and
-what the paper's c = 23.7 N s/m implies), the FE calibration (points, fit, coefficients),
+what the paper's c = 23.7 N s/m implies), the coefficient set of the boring model (its
+calibrated domain and the warnings where the study leaves it), the FE calibration (points,
+fit, coefficients; the opt-in set unless the config chooses it),
 figures like the paper's (force over half a revolution; feed amplitude over time; force and
 feed amplitude against speed, feed and depth for robot and machine tool with each point
 marked by its verdict; force and rotational acceleration as chatter develops; machined
@@ -189,6 +191,45 @@ def force_model_validation(rep: Report, coeffs: dict[str, Any],
                  "validation.")
 
 
+def _set_label(cset: dict[str, Any] | None) -> str:
+    if not cset:
+        return "n/a"
+    d = cset.get("domain") or {}
+    v, h = d.get("cutting_speed_m_per_min"), d.get("uncut_chip_thickness_um")
+    return (f"{cset.get('name')} (calibrated: "
+            + ("speeds n/a" if not v else f"{v[0]:g}-{v[1]:g} m/min") + ", "
+            + ("chip thicknesses n/a" if not h else f"h {h[0]:g}-{h[1]:g} um") + ")")
+
+
+def coefficient_set_section(rep: Report, cset: dict[str, Any], warnings: list[str]) -> None:
+    """The section naming the coefficient set of the boring model (sweep, lobes, posture
+    plan): its description, calibrated domain, values at the base speed, and the warnings
+    where the study uses it outside its calibrated speeds or chip thicknesses (the same list
+    as ``warnings`` in ``paper_summary.json``)."""
+    rep.add_section("Force model used by the simulations")
+    if not cset:
+        rep.add_note("The coefficient set is not known.")
+        return
+    d = cset["domain"]
+    rep.add_text(f"Coefficient set {cset['name']}: {cset['description']}.")
+    c = cset["coefficients"]
+    rep.add_key_values({
+        "set": cset["name"],
+        "calibrated cutting speeds [m/min]": "n/a" if not d["cutting_speed_m_per_min"] else
+        "{:g}-{:g}".format(*d["cutting_speed_m_per_min"]),
+        "calibrated uncut chip thicknesses [um]": "n/a" if not d["uncut_chip_thickness_um"]
+        else "{:g}-{:g}".format(*d["uncut_chip_thickness_um"]),
+        "base condition's cutting speed [m/min]": f"{cset['base_cutting_speed_m_per_min']:.3g}",
+        **{f"{k} at the base speed": c[k] for k in ("Ktc_N_per_m2", "Kte_N_per_m",
+                                                     "Kfc_N_per_m2", "Kfe_N_per_m")},
+        "provenance": c.get("provenance", ""),
+    }, caption="Coefficient set of the boring model")
+    if warnings:
+        rep.add_note(f"{len(warnings)} coefficient warning(s): the set is used outside its "
+                     "calibrated domain (table below; 'warnings' in paper_summary.json).")
+        rep.add_table([{"warning": w} for w in warnings], caption="Coefficient warnings")
+
+
 def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict[str, Any],
                  eq: dict[str, Any], coeffs: dict[str, Any], rows: list[dict[str, Any]],
                  store: Any, lobes: dict[str, Any], cmp: Any, checks: list[dict[str, Any]],
@@ -209,7 +250,8 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
         "tool leaves the cut": summary.get("tool_leaves_cut"),
         "stable / vibratory by the paper's criterion (Ra > "
         f"{cfg.study.ra_tolerance_um:g} um)": f"{summary['stable']} / {summary['vibratory']}",
-        "force coefficients": summary.get("coefficients_mode"),
+        "force coefficients (boring model)": _set_label(summary.get("coefficient_set")),
+        "coefficient warnings": len(summary.get("warnings") or []),
         "robobore version": summary.get("robobore_version"),
     }, caption="Run")
     if summary["failed"]:
@@ -275,15 +317,25 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                  + ". The simulations use the identified damping.")
 
     # ---------------------------------------------------------------- forces
-    rep.add_section("Force model (FE-calibrated)")
+    cset = summary.get("coefficient_set") or {}
+    fe_used = cset.get("name") == "TC4-FE"
+    coefficient_set_section(rep, cset, summary.get("warnings") or [])
+    rep.add_section("Force model (FE-calibrated)" if fe_used else
+                    "Force model: the FE calibration (opt-in set TC4-FE, not used above)")
     c = coeffs["coefficients"]
+    if not fe_used:
+        rep.add_text("The FE engine's own result for the paper's insert and chip: the set "
+                     "the boring model uses with [coefficients] material = \"TC4-FE\". The "
+                     "simulations of this report use the coefficient set of the section "
+                     "above.")
     rep.add_text(f"Coefficients: {coeffs.get('mode')}. {c.get('provenance', '')}")
     force_model_fe_text(rep, coeffs)
     se = coeffs.get("standard_errors", {})
     rep.add_table([{"coefficient": k, "value": c[k], "standard error": se.get(k)}
                    for k in ("Ktc_N_per_m2", "Kte_N_per_m", "Kfc_N_per_m2", "Kfe_N_per_m",
                              "Krc_N_per_m2", "Kre_N_per_m")],
-                  caption="Mechanistic coefficients used by the boring model")
+                  caption="Mechanistic coefficients used by the boring model" if fe_used
+                  else "Mechanistic coefficients of the FE calibration (opt-in)")
     if coeffs.get("fe_points"):
         from robobore.cutting.calibrate import predicted_forces
 
@@ -433,7 +485,9 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     # ---------------------------------------------------------------- checks
     rep.add_section("Paper's findings")
     rep.add_text("Each qualitative finding of the paper is checked on our results (computed "
-                 "from the sweep, not written by hand).")
+                 "from the sweep, not written by hand), with the coefficient set "
+                 f"{_set_label(cset)}; a finding marked NO is one where our model, with this "
+                 "set, differs from the paper.")
     rep.add_text("Findings about vibrating or not are checked twice: with the chatter "
                  "verdict (does the vibration grow) and, separately, with the paper's own "
                  "criterion (Ra above the tolerance); the 'checked by' column says which.")
@@ -472,4 +526,4 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     return rep
 
 
-__all__ = ["build_report", "force_model_fe_text", "force_model_validation"]
+__all__ = ["build_report", "coefficient_set_section", "force_model_fe_text", "force_model_validation"]

@@ -64,6 +64,8 @@ class StoredResult:
     attempt: int
     wall_time_s: float | None
     runner: str | None
+    #: the runner's coefficient warnings (attribute ``coefficient_warnings``, "; " separated)
+    coefficient_warnings: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -317,6 +319,8 @@ class ResultsStore:
             key=key, condition=cond, summary=summary, path=p,
             attempt=int(attrs.get("robobore_attempt", 1)),
             wall_time_s=None if wt < 0 else wt, runner=attrs.get("robobore_runner"),
+            coefficient_warnings=tuple(w for w in str(attrs.get("coefficient_warnings", ""))
+                                       .split("; ") if w.strip()),
         )
 
     def records(self, keys: Iterable[str] | None = None) -> Iterator[StoredResult]:
