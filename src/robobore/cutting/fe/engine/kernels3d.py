@@ -353,9 +353,9 @@ RUN_CHUNK3 = {
 
 def run_chunk3_for(spec):
     """The compiled 3D chunk function of a
-    :class:`~robobore.cutting.fe.config.spec.BoringSpec`: the tool frame's ALE pass for
-    ``spec.tool_frame``, the heat pass for a ``Conduction`` thermal model
+    :class:`~robobore.cutting.fe.config.spec.ModelSpec` with a 3D frame: the tool frame's
+    ALE pass for a ``ToolFrame3D``, the heat pass for a ``Conduction`` thermal model
     (:data:`RUN_CHUNK3`)."""
     from robobore.cutting.fe.config.spec import Conduction
 
-    return RUN_CHUNK3[(spec.tool_frame is not None, isinstance(spec.thermal, Conduction))]
+    return RUN_CHUNK3[(spec.frame.tool_frame, isinstance(spec.thermal, Conduction))]
