@@ -41,7 +41,7 @@ def _run(cfg, label: str) -> dict:
     simulate_orthogonal(warm)
     t_warm = time.perf_counter() - t0
     load0 = os.getloadavg()[0]
-    s = simulate_orthogonal(cfg).summary
+    s = simulate_orthogonal(cfg).to_dict()
     load1 = os.getloadavg()[0]
     print(f"{label}: frame {cfg.mesh.frame}, {cfg.cut.length_mm:g} mm, "
           f"{cfg.mesh.element_size_um:g} um elements, conduction "

@@ -132,7 +132,7 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
         d["solver"]["mass_scaling"] = ms
         r = simulate_boring(parse_boring_config(d))
         cmp_ = compare_with_mechanistic(r, coefficients)
-        s = r.summary
+        s = r.to_dict()
         row = {"element_size_um": le, "force_rotating_N": s["force_rotating_N"],
                "force_rotating_std_N": s["force_rotating_std_N"],
                "force_amplitude_N": s["force_amplitude_N"], "energy_error": s["energy_error"],
@@ -162,7 +162,7 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
     d["tool_support"] = {"stiffness_N_per_m": 4.0e8, "damping_N_s_per_m": 632.0,
                          "mass_kg": 1.0e-3}
     r = simulate_boring(parse_boring_config(d))
-    s = r.summary
+    s = r.to_dict()
     res["support"] = {k: s[k] for k in ("tool_dz_mean_um", "tool_dz_static_um",
                                         "feed_amplitude_um", "force_rotating_N",
                                         "energy_error")}

@@ -246,7 +246,7 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
         for dev in devices:
             cfg = parse_boring_config(_boring_dict(le, ms, cut_mm))
             r = simulate_boring(cfg, device=dev)
-            s = r.summary
+            s = r.to_dict()
             by[dev] = {k: s[k] for k in ("force_rotating_N", "force_mean_N",
                                          "force_amplitude_N", "energy_error",
                                          "hourglass_fraction", "n_elements", "steps",
@@ -313,7 +313,7 @@ def ortho2d(devices: list[str], length_mm: float | None, le: float | None,
     by = {}
     for dev in devices:
         r = simulate_orthogonal(cfg.model_copy(deep=True), device=dev)
-        s = r.summary
+        s = r.to_dict()
         by[dev] = {k: s.get(k) for k in ("cutting_force_N_per_mm", "feed_force_N_per_mm",
                                          "chip_ratio", "peak_temperature_K", "energy_error",
                                          "n_elements", "steps", "wall_time_s",

@@ -26,7 +26,8 @@ def main() -> None:
 
     import numba
 
-    from robobore.cutting.fe.ale.remap3d import remap3d, remap3d_inputs
+    from robobore.cutting.fe.ale.groups3d import ToolFrameAle3
+    from robobore.cutting.fe.ale.remap3d import remap3d, remap3d_groups, remap3d_inputs
     from robobore.cutting.fe.ale.rezone import TF_RIGID
     from robobore.cutting.fe.ale.rezone3d import rezone3d, toolframe3d_ale_data, toolframe3d_targets
     from robobore.cutting.fe.hex.layout3d import (
@@ -68,23 +69,21 @@ def main() -> None:
         a = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in a0.items()}
         return a, aflt0.copy()
 
+    def groups(a):
+        nodes, cells, elems, work = remap3d_groups(a)
+        return nodes, cells, elems, work._replace(xn=xn, yn=yn, zn=zn)
+
     def run_rezone(a, aflt):
-        return rezone3d(a["x"], a["y"], a["z"], a["vx"], a["vy"], a["vz"], a["mass"],
-                        a["fixed"], a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"],
-                        a["bflag"], a["sd"], a["pres"], a["eps_p"], a["temp"], a["dmg"],
-                        a["qh"], a["vol0"], rho_s, a["msf"], 293.15, 0, xn, yn, zn, a["buf"],
-                        a["vbuf"], scratch, x0, y0, z0, acls, aflt, off_x, 0.0, 0.25, prm,
-                        off_x, 0.0, 0.0)
+        ale = ToolFrameAle3(x0=x0, y0=y0, z0=z0, acls=acls, aflt=aflt, scratch=scratch)
+        return rezone3d(*groups(a), ale, rho_s, 293.15, 0, prm, (off_x, 0.0, 0.25),
+                        (off_x, 0.0, 0.0))
 
     def run_targets(a, aflt):
         toolframe3d_targets(a["x"], a["y"], a["z"], xn, yn, zn, x0, y0, z0, acls, aflt, off_x,
                             0.0, 0.25, prm, off_x, 0.0, 0.0, scratch)
 
     def run_remap(a, aflt):
-        remap3d(a["x"], a["y"], a["z"], xn, yn, zn, a["vx"], a["vy"], a["vz"], a["mass"],
-                a["fixed"], a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"],
-                a["sd"], a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
-                rho_s, a["msf"], 293.15, 0, a["buf"], a["vbuf"])
+        remap3d(*groups(a), rho_s, 293.15, 0)
 
     print(f"paper mesh, {args.element_um:g} um elements: {n} nodes, {ne} hexahedra; "
           f"{numba.get_num_threads()} thread(s)")

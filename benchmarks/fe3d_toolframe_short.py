@@ -69,14 +69,14 @@ def main() -> None:
         from robobore.cutting.fe.models.toolframe3d import toolframe_mesh_summary
 
         out = {"element_size_um": cfg.mesh.element_size_um, "mass_scaling": a.mass_scaling,
-               "toolframe_mesh": toolframe_mesh_summary(setup.mesh), "time_step_s": dt,
+               "toolframe_mesh": toolframe_mesh_summary(setup.mesh).to_dict(), "time_step_s": dt,
                "cut_length_mm": cfg.cut.cut_length_mm,
                "steps_for_the_cut": cfg.cut.cut_length_mm * 1e-3 / (vc * dt)}
         print(json.dumps(out, indent=1))
         return
     cfg.cut.cut_length_mm = a.steps * dt * vc * 1e3
     res = simulate_boring(cfg, source=a.config)
-    r = res.summary
+    r = res.to_dict()
     keys = ("force_rotating_N", "force_rotating_std_N", "averaging_window_mm", "energy_error",
             "hourglass_fraction", "steps", "time_step_s", "wall_time_s",
             "element_updates_per_s", "n_elements", "n_nodes", "toolframe_mesh",

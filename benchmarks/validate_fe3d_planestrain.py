@@ -56,10 +56,10 @@ def main() -> None:
     cfg = parse_config(d)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cpus")
     t0 = time.perf_counter()
-    r2 = simulate_orthogonal(cfg).summary
+    r2 = simulate_orthogonal(cfg).to_dict()
     w2 = time.perf_counter() - t0
     t0 = time.perf_counter()
-    r3 = simulate_slab3(cfg)
+    r3 = simulate_slab3(cfg).to_dict()
     w3 = time.perf_counter() - t0
     out = {"config": d, "2d": {k: r2[k] for k in ("cutting_force_N_per_mm",
                                                   "feed_force_N_per_mm", "energy_error",

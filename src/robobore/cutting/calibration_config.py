@@ -315,20 +315,22 @@ def fe_model_description(cfg: CalibrationConfig) -> dict[str, Any]:
     """The FE model of the virtual tests in words, with its validation status: whether its
     physics (frame, friction, material, conduction) are the engine's validated defaults."""
     from robobore.cutting.fe.config.orthogonal import parse_config
+    from robobore.cutting.fe.models.choose import choose_orthogonal
 
     h0, v0 = cfg.uncut_chip_thickness_um[0], cfg.cutting_speed_m_per_min[0]
     c = parse_config(fe_config_dict(cfg, h0, v0))
     ref = parse_config({k: c.model_dump()[k] for k in ("tool", "cut")} |
                        {"mesh": {"element_size_um": c.mesh.element_size_um}})
-    same = (c.mesh.frame == ref.mesh.frame
+    model = choose_orthogonal(c)
+    same = (type(model) is type(choose_orthogonal(ref))
             and c.contact.model_dump() == ref.contact.model_dump()
             and c.material.model_dump() == ref.material.model_dump()
             and c.parameters == ref.parameters
             and c.solver.heat_conduction == ref.solver.heat_conduction
             and c.tool_support is None)
     law = c.friction_law()
-    summary = (f"{c.mesh.frame}-frame model, {c.mesh.element_size_um:g} um elements, "
-               f"{c.cut.length_mm:g} mm of {'tool travel' if c.mesh.frame == 'tool' else 'cut'}, "
+    summary = (f"{model.frame}-frame model, {c.mesh.element_size_um:g} um elements, "
+               f"{c.cut.length_mm:g} mm of {'tool travel' if model.tool_frame else 'cut'}, "
                f"friction {law}, parameters {c.parameters}")
     validation = ("the engine's validated model (docs/fe.md, 'Model choice': Fc within 10 % "
                   "and Ff within 25 % of the nine measured Ti6Al4V points, h 40-80 um, "

@@ -32,7 +32,7 @@ def run_fe_point(fe_cfg: dict[str, Any]) -> dict[str, Any]:
     from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
     res = simulate_orthogonal(parse_config(fe_cfg))
-    s = res.summary
+    s = res.to_dict()
     out: dict[str, Any] = {}
     for k in _SUMMARY_KEYS:
         v = s.get(k)

@@ -43,15 +43,15 @@ def supported():
 
 def test_energy_balance_and_no_nan(rigid):
     s = rigid.summary
-    assert s["energy_error"] < 0.05  # acceptance: energy balance error < 5 %
+    assert s.energy_error < 0.05  # acceptance: energy balance error < 5 %
     for k, v in rigid.history.items():
         assert np.all(np.isfinite(v)), k
     # plastic work dominates the external work in cutting; hourglass stays a small share
-    assert 0.6 < s["energy_plastic_J_per_m"] / s["energy_external_J_per_m"] < 1.0
-    assert s["hourglass_fraction"] < 0.10
+    assert 0.6 < s.energy_plastic_J_per_m / s.energy_external_J_per_m < 1.0
+    assert s.hourglass_fraction < 0.10
     # a chip forms (heated by plastic work) and the separation layer erodes
-    assert s["peak_temperature_K"] > 600.0
-    assert s["eroded_damage"] > 5
+    assert s.peak_temperature_K > 600.0
+    assert s.eroded_damage > 5
 
 
 def test_work_equals_force_times_distance(rigid):
@@ -63,10 +63,10 @@ def test_work_equals_force_times_distance(rigid):
 
 def test_chip_ratio_within_measured_band(rigid):
     """Acceptance: chip ratio within the measured value +-30 % (1.23 at 60 um, 30 m/min)."""
-    r = rigid.summary["chip_ratio"]
+    r = rigid.summary.chip_ratio
     assert math.isfinite(r)
     assert abs(r - R_MEAS) <= 0.3 * R_MEAS
-    phi = rigid.summary["shear_angle_deg"]
+    phi = rigid.summary.shear_angle_deg
     assert phi == pytest.approx(math.degrees(math.atan2(math.cos(math.radians(15)),
                                                         r - math.sin(math.radians(15)))))
 
@@ -76,8 +76,8 @@ def test_chip_ratio_within_measured_band(rigid):
 def test_forces_within_acceptance(rigid):
     """Issue 5 acceptance: Fc within 10 %, Ff within 35 % of the measurement."""
     s = rigid.summary
-    assert abs(s["cutting_force_N_per_mm"] - FC_MEAS) <= 0.10 * FC_MEAS
-    assert abs(s["feed_force_N_per_mm"] - FF_MEAS) <= 0.35 * FF_MEAS
+    assert abs(s.cutting_force_N_per_mm - FC_MEAS) <= 0.10 * FC_MEAS
+    assert abs(s.feed_force_N_per_mm - FF_MEAS) <= 0.35 * FF_MEAS
 
 
 def test_tool_support_mean_deflection_is_force_over_stiffness(supported):
@@ -86,21 +86,22 @@ def test_tool_support_mean_deflection_is_force_over_stiffness(supported):
     # mean of m u'' + c u' + k u = F over the window: k <u> = <F> (to the residual
     # oscillation of the decaying transient)
     width_mm = BASE["cut"]["width_mm"]
-    assert s["tool_dx_mean_um"] == pytest.approx(
-        s["cutting_force_N_per_mm"] * width_mm / k * 1e6, rel=0.05)
-    assert s["tool_dx_mean_um"] == pytest.approx(s["tool_dx_static_um"], rel=0.05)
+    assert s.tool_support.tool_dx_mean_um == pytest.approx(
+        s.cutting_force_N_per_mm * width_mm / k * 1e6, rel=0.05)
+    sup = s.tool_support
+    assert sup.tool_dx_mean_um == pytest.approx(sup.tool_dx_static_um, rel=0.05)
 
 
 def test_tool_vibration_changes_forces(rigid, supported):
     hr = rigid.history
     hs = supported.history
     # the tool is pushed back and overshoots (damping ratio 0.3: ~37 % overshoot) ...
-    static = supported.summary["tool_dx_static_um"]
+    static = supported.summary.tool_support.tool_dx_static_um
     assert np.max(hs["tool_dx_um"]) > 1.1 * static
     # ... which changes the force history compared with the rigidly guided tool
     n = min(len(hr["time_s"]), len(hs["time_s"]))
     diff = np.abs(hs["cutting_force_N_per_mm"][:n] - hr["cutting_force_N_per_mm"][:n])
-    assert np.max(diff) > 0.1 * rigid.summary["cutting_force_N_per_mm"]
+    assert np.max(diff) > 0.1 * rigid.summary.cutting_force_N_per_mm
 
 
 def test_force_by_face_sums_to_the_total(rigid):
@@ -111,12 +112,12 @@ def test_force_by_face_sums_to_the_total(rigid):
         parts = sum(h[f"{face}_{comp}_force_N_per_mm"] for face in ("rake", "edge", "flank"))
         tot = h[f"{comp}_force_N_per_mm"]
         assert np.allclose(parts, tot, rtol=1e-9, atol=1e-9 * np.max(np.abs(tot)))
-    f = rigid.summary["force_by_face_N_per_mm"]
+    f = rigid.summary.force_by_face_N_per_mm
     # with rake 15 deg and mu 0.18 the rake face pulls the tool into the work (feed < 0,
     # N (mu cos a - sin a) < 0); the edge arc pushes it out (feed > 0); both resist the cut
-    assert f["rake"]["feed"] < 0.0
-    assert f["edge"]["feed"] > 0.0
-    assert f["rake"]["cutting"] > 0.0 and f["edge"]["cutting"] > 0.0
+    assert f.rake.feed < 0.0
+    assert f.edge.feed > 0.0
+    assert f.rake.cutting > 0.0 and f.edge.cutting > 0.0
 
 
 def test_contact_split_classifies_by_face():

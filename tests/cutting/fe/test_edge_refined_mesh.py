@@ -118,8 +118,8 @@ def test_band_extent_must_be_positive():
 def test_short_cut_on_refined_mesh():
     res = simulate_orthogonal(_cfg())
     s = res.summary
-    assert s["energy_error"] < 0.05
-    assert np.isfinite(s["cutting_force_N_per_mm"]) and s["cutting_force_N_per_mm"] > 0
+    assert s.energy_error < 0.05
+    assert np.isfinite(s.cutting_force_N_per_mm) and s.cutting_force_N_per_mm > 0
     # the tool parted the material at the edge: copies of released pairs moved apart
     twin = setup_orthogonal(_cfg()).mesh.twin
     f = res.final

@@ -8,14 +8,18 @@ tests/cutting/fe/test_fe_threads.py), so any change to the code that is meant to
 physics (a restructure, a faster loop) must reproduce these digits. A change that is meant to
 change the physics updates them in the same commit, with the reason in the commit message.
 The runs go through the CLI (`robobore fe orthogonal|boring CONFIG --json`), so the test does
-not depend on how the engine's modules are laid out.
+not depend on how the engine's modules are laid out; each run's whole JSON (its keys in order
+and their values to 1e-9, the wall time and throughput aside) is held to the one stored in
+``tests/cutting/fe/contract/``, the JSON contract of the typed results' ``to_dict``.
 
-Regenerate: ``python tests/cutting/fe/test_fe_digits.py`` prints the current digits.
+Regenerate: ``python tests/cutting/fe/test_fe_digits.py`` prints the current digits;
+``--contract`` also rewrites the stored JSON.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -72,7 +76,8 @@ EXPECTED: dict[str, dict] = {
 }
 
 
-def run_case(name: str, tmp: Path) -> dict:
+def run_json(name: str, tmp: Path) -> dict:
+    """The whole JSON ``robobore fe ... --json`` writes for the case ``name``."""
     example, (sec, key), length, sub, keys, other = CASES[name]
     d = load_toml(_EX / example)
     d[sec][key] = length
@@ -83,27 +88,59 @@ def run_case(name: str, tmp: Path) -> dict:
     out = subprocess.run([sys.executable, "-m", "robobore", "fe", sub, str(cfg), "--json"],
                          capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stderr[-2000:]
-    res = json.loads(out.stdout)
-    return {k: res[k] for k in keys}
+    return json.loads(out.stdout)
 
 
-def _close(a, b, rel: float = 1e-9) -> bool:
+def run_case(name: str, tmp: Path) -> dict:
+    return {k: run_json(name, tmp)[k] for k in CASES[name][4]}
+
+
+def _close(a, b, rel: float = 1e-9, floor: float = 1e-300) -> bool:
     if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_close(a[k], b[k], rel) for k in a)
-    if isinstance(a, int) and not isinstance(a, bool):
-        return a == b
-    return abs(a - b) <= rel * max(abs(a), abs(b), 1e-300)
+        return (isinstance(b, dict) and list(a) == list(b)
+                and all(_close(a[k], b[k], rel, floor) for k in a))
+    if isinstance(a, list):
+        return (isinstance(b, list) and len(a) == len(b)
+                and all(_close(x, y, rel, floor) for x, y in zip(a, b, strict=True)))
+    if isinstance(a, float) and isinstance(b, float):
+        if math.isnan(a) or math.isnan(b):
+            return math.isnan(a) and math.isnan(b)
+        return abs(a - b) <= max(rel * max(abs(a), abs(b)), floor)
+    return type(a) is type(b) and a == b
+
+
+#: the whole JSON of each case at the stored commit, timing figures set to None
+#: (tests/cutting/fe/contract/CASE.json): the run's JSON contract, key by key
+_CONTRACT = Path(__file__).parent / "contract"
+_TIMING = ("wall_time_s", "element_updates_per_s")
+#: the absolute floor of the JSON comparison: the X and Y means of the boring-frame force
+#: over a revolution are sums that cancel to round-off (~1e-16 N; a force component of the
+#: run's ~1e-15 relative round-off moves them by as much), compared to 1e-12 in their unit
+_FLOOR = 1e-12
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(CASES))
 def test_engine_reproduces_stored_digits(name, tmp_path):
-    got = run_case(name, tmp_path)
+    res = run_json(name, tmp_path)
+    got = {k: res[k] for k in CASES[name][4]}
     assert _close(got, EXPECTED[name]), (name, got, EXPECTED[name])
+    # the same keys in the same order, the same values (to 1e-9), as the stored JSON
+    stored = json.loads((_CONTRACT / f"{name}.json").read_text())
+    for k in _TIMING:
+        assert isinstance(res[k], float) and res[k] > 0.0
+        res[k] = None
+    bad = [k for k in stored if k not in res or not _close(stored[k], res[k], floor=_FLOOR)]
+    assert list(res) == list(stored) and not bad, (name, bad, list(res))
 
 
 if __name__ == "__main__":
     import tempfile
 
     with tempfile.TemporaryDirectory() as t:
-        print(json.dumps({n: run_case(n, Path(t)) for n in CASES}, indent=1))
+        runs = {n: run_json(n, Path(t)) for n in CASES}
+    print(json.dumps({n: {k: r[k] for k in CASES[n][4]} for n, r in runs.items()}, indent=1))
+    if "--contract" in sys.argv:  # rewrite the stored JSON of each case
+        for n, r in runs.items():
+            (_CONTRACT / f"{n}.json").write_text(json.dumps({**r, **dict.fromkeys(_TIMING)},
+                                                            indent=1))

@@ -183,6 +183,7 @@ def test_the_boring_spec_and_its_slots():
         EdgePathLayer,
         HexElement,
         ToolFrame3D,
+        WorkpieceFrame3D,
         build_boring_spec,
     )
     from robobore.cutting.fe.engine.state3d import default_prm3
@@ -195,9 +196,9 @@ def test_the_boring_spec_and_its_slots():
         mat = load_material(cfg.material.name,
                             hardening_strain_limit=cfg.material.strain_limit())
         s = build_boring_spec(cfg, mat, 37.7)
-        assert s.tool_frame == ToolFrame3D(ale_interval=10, thin_element_mass_scaling=True)
-        assert s.separation is None and not s.damage_erosion
-        assert s.element == HexElement(0.05, 0.05) and isinstance(s.thermal, Conduction)
+        assert s.frame == ToolFrame3D(ale_interval=10, element=HexElement(0.05, 0.05),
+                                      thin_element_mass_scaling=True)
+        assert isinstance(s.thermal, Conduction)
         assert isinstance(s.friction, SlidingSpeedFriction)
         assert s.hardening == HardeningHold(0.6)
         p = s.write_prm(default_prm3(), layout3d, 37.7)
@@ -207,13 +208,14 @@ def test_the_boring_spec_and_its_slots():
     assert cfg.solver.mass_scaling == 400.0 and cfg.cut.cut_length_mm == 0.02
     # the workpiece frame: the erosion layer with damage erosion by default
     s = build_boring_spec(parse_boring_config(_boring()), mat, 37.7)
-    assert s.tool_frame is None and s.separation == EdgePathLayer() and s.damage_erosion
+    assert isinstance(s.frame, WorkpieceFrame3D) and not s.frame.tool_frame
+    assert s.frame.separation == EdgePathLayer() and s.frame.damage_erosion
     p = s.write_prm(default_prm3(), layout3d, 37.7)
     assert p[layout3d.P_GATE] == -1.0 and p[layout3d.P_EROSION] == layout3d.ERODE_LAYER
     ns = parse_boring_config(_boring(mesh={"separation": "node_split", "chip_rows": 4},
                                      solver={"separation_gate_um": 1.0}))
     s2 = build_boring_spec(ns, mat, 37.7)
-    assert s2.separation == NodeSplit(height_um=5.0, gate_um=1.0)
+    assert s2.frame.separation == NodeSplit(height_um=5.0, gate_um=1.0)
     assert s2.write_prm(default_prm3(), layout3d, 37.7)[layout3d.P_GATE] == pytest.approx(1e-6)
 
 
@@ -234,3 +236,42 @@ def test_a_boring_key_without_a_place_is_an_error(sections, field, words):
     with pytest.raises(ConfigError) as ei:
         parse_boring_config(_boring(**copy.deepcopy(sections)), "b.toml")
     assert ei.value.field == field and words in str(ei.value) and "b.toml" in str(ei.value)
+
+
+def test_a_spec_of_parts_that_do_not_belong_together_cannot_be_built():
+    from robobore.cutting.fe.config.spec import (
+        EdgePathLayer,
+        HexElement,
+        ModelSpec,
+        ToolFrame3D,
+        WorkpieceFrame3D,
+    )
+
+    hexa = HexElement(0.05, 0.05)
+    rest = {"friction": CoulombFriction(mu=0.3, shear_limit_MPa=500.0),
+            "thermal": Adiabatic(), "hardening": HardeningHold(0.6)}
+    # a tool frame has no separation and no erosion: there is no field to give them
+    with pytest.raises(TypeError):
+        ToolFrame3D(ale_interval=10, element=hexa,
+                    separation=NodeSplit(height_um=5.0, gate_um=1.0))  # type: ignore[call-arg]
+    # a 2D separation, element or frame where a 3D one belongs is a ConfigError
+    with pytest.raises(ConfigError) as ei:
+        WorkpieceFrame3D(separation=ErosionLayer("centred", None, True, None),
+                         damage_erosion=True, erode_time_step_fraction=0.0, element=hexa)
+    assert ei.value.field == "mesh.separation" and "EdgePathLayer" in str(ei.value)
+    with pytest.raises(ConfigError) as ei:
+        WorkpieceFrame3D(separation=EdgePathLayer(), damage_erosion=True,
+                         erode_time_step_fraction=0.0, element=OnePointQuad(0.1, 0.1))
+    assert ei.value.field == "solver.element"
+    with pytest.raises(ConfigError) as ei:
+        ToolFrame(ale_interval=10, element=hexa)  # type: ignore[arg-type]
+    assert ei.value.field == "solver.element"
+    with pytest.raises(ConfigError) as ei:
+        ModelSpec(frame=NodeSplit(height_um=5.0, gate_um=1.0), **rest)  # type: ignore[arg-type]
+    assert ei.value.field == "mesh.frame"
+    with pytest.raises(ConfigError) as ei:
+        ModelSpec(frame=ToolFrame3D(ale_interval=10, element=hexa),
+                  **{**rest, "thermal": PlainHardening()})  # type: ignore[arg-type]
+    assert ei.value.field == "solver.heat_conduction"
+    ok = ModelSpec(frame=ToolFrame3D(ale_interval=10, element=hexa), **rest)
+    assert ok.frame.tool_frame and ok.frame.dim == 3

@@ -145,13 +145,13 @@ def test_short_tool_frame_cut():
                         "solver": {"mass_scaling": 100, "n_samples": 20}})
     res = simulate_orthogonal(cfg)
     s = res.summary
-    assert s["cutting_force_N_per_mm"] > 20.0 and s["feed_force_N_per_mm"] > 5.0
-    assert s["eroded_damage"] == 0 and s["eroded_distortion"] == 0
-    assert s["energy_error"] < 0.05
-    assert s["averaging_window_mm"][1] == pytest.approx(0.02, rel=0.05)
+    assert s.cutting_force_N_per_mm > 20.0 and s.feed_force_N_per_mm > 5.0
+    assert s.eroded_damage == 0 and s.eroded_distortion == 0
+    assert s.energy_error < 0.05
+    assert s.averaging_window_mm[1] == pytest.approx(0.02, rel=0.05)
     f = res.final
     # the mesh travelled with the tool: the inflow face is 20 um further in -x
-    assert np.isfinite(s["chip_ratio"]) and np.isfinite(s["chip_ratio_velocity"])
+    assert np.isfinite(s.chip_ratio) and np.isfinite(s.chip_ratio_velocity)
     assert f["tool_center"][0] == pytest.approx(-20e-6, rel=1e-3)
 
 

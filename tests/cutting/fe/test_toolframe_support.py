@@ -33,9 +33,9 @@ def test_soft_support_deflects_by_force_over_stiffness_and_changes_the_forces():
     assert soft_cfg.mesh.frame == "tool"
     soft = simulate_orthogonal(soft_cfg).summary
     for ax in ("x", "y"):
-        static = soft[f"tool_d{ax}_static_um"]
+        static = getattr(soft.tool_support, f"tool_d{ax}_static_um")
         assert static > 5.0  # a soft support: several um
-        assert soft[f"tool_d{ax}_mean_um"] == pytest.approx(static, rel=0.05)
-    change = soft["cutting_force_N_per_mm"] / rigid["cutting_force_N_per_mm"] - 1.0
+        assert getattr(soft.tool_support, f"tool_d{ax}_mean_um") == pytest.approx(static, rel=0.05)
+    change = soft.cutting_force_N_per_mm / rigid.cutting_force_N_per_mm - 1.0
     assert change < -0.10
-    assert soft["energy_error"] < 0.05
+    assert soft.energy_error < 0.05

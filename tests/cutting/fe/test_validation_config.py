@@ -90,7 +90,7 @@ def test_calibrated_set_meets_the_bands_at_the_contract_point():
 
     s = simulate_orthogonal(load_fe_config(_EXAMPLE)).summary
     fc_meas, ff_meas = 118.23, 50.3
-    assert abs(s["cutting_force_N_per_mm"] - fc_meas) <= 0.10 * fc_meas
-    assert abs(s["feed_force_N_per_mm"] - ff_meas) <= 0.25 * ff_meas
-    assert 0.7 * 1.18 <= s["chip_ratio"] <= 1.3 * 1.97
-    assert s["energy_error"] < 0.05
+    assert abs(s.cutting_force_N_per_mm - fc_meas) <= 0.10 * fc_meas
+    assert abs(s.feed_force_N_per_mm - ff_meas) <= 0.25 * ff_meas
+    assert 0.7 * 1.18 <= s.chip_ratio <= 1.3 * 1.97
+    assert s.energy_error < 0.05

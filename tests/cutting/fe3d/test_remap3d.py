@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.ale.groups3d import Cells3, ElementState3, Nodes3, RemapWork3
 from robobore.cutting.fe.ale.remap import BF_OPEN, BF_VIRGIN, rz_flux_py, rz_velocity_py
 from robobore.cutting.fe.ale.remap3d import (
     FACES_OUT,
@@ -325,10 +326,15 @@ def test_runs_on_the_engine_state_and_keeps_its_lumped_masses():
     new = _interior_move(nodes, inner, 0.2, 4)
     buf = np.zeros((st.n_elements, N_RZ3))
     vbuf = np.zeros((nodes.shape[0], 3))
-    remap3d(st.x, st.y, st.z, new[:, 0].copy(), new[:, 1].copy(), new[:, 2].copy(), st.vx,
-            st.vy, st.vz, st.mass, st.fixed, st.conn, st.alive, st.ptr, st.nel, st.enbr,
-            np.zeros((0, 6), np.int64), st.sd, st.pres, st.eps_p, st.temp, st.dmg, st.qh,
-            st.vol0, rho_s, np.zeros(0), mat.T_room, VEL_MOMENTUM, buf, vbuf)
+    remap3d(Nodes3(x=st.x, y=st.y, z=st.z, vx=st.vx, vy=st.vy, vz=st.vz, mass=st.mass,
+                   fixed=st.fixed, ptr=st.ptr, nel=st.nel),
+            Cells3(conn=st.conn, alive=st.alive, fnbr=st.enbr,
+                   bflag=np.zeros((0, 6), np.int64)),
+            ElementState3(sd=st.sd, pres=st.pres, eps_p=st.eps_p, temp=st.temp, dmg=st.dmg,
+                          qh=st.qh, vol0=st.vol0, msf=np.zeros(0)),
+            RemapWork3(xn=new[:, 0].copy(), yn=new[:, 1].copy(), zn=new[:, 2].copy(), buf=buf,
+                       vbuf=vbuf),
+            rho_s, mat.T_room, VEL_MOMENTUM)
     assert np.array_equal(st.nodes(), new)
     want = np.zeros(nodes.shape[0])
     np.add.at(want, conn.ravel(), np.repeat(st.vol0 * rho_s / 8.0, 8))

@@ -5,6 +5,7 @@ erodes, the energy balances)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -87,7 +88,7 @@ def test_a_cut_outside_the_tool_frame_mesh_names_the_way_out():
     assert ei.value.field == "mesh.frame" and "deep.toml" in msg
     assert "reaches past the nose" in msg and 'frame = "workpiece"' in msg
     d["mesh"]["frame"] = "workpiece"
-    assert setup_boring(parse_boring_config(d)).spec.tool_frame is None
+    assert not setup_boring(parse_boring_config(d)).spec.frame.tool_frame
 
 
 def test_tool_frame_is_cpu_only():
@@ -159,18 +160,18 @@ def test_tool_frame_summary_has_the_mesh_facts():
     s = setup_boring(cfg)
     cfg.cut.cut_length_mm = 150 * float(s.state.clock[1]) * s.vc * 1e3
     r = simulate_boring(cfg).summary
-    tf = r["toolframe_mesh"]
-    assert r["frame"] == "tool" and r["separation"] is None and "mesh_shape" not in r
-    assert (tf["nodes"], tf["hexahedra"]) == (s.mesh.n_nodes, s.mesh.n_elements)
-    assert tf["t_min_um"] == pytest.approx(8.0)
-    assert tf["chip_area_mm2"] == pytest.approx(r["chip_area_mm2"], rel=1e-12)
-    assert 0.0 < tf["clamp_area_fraction"] < 0.1
+    tf = r.toolframe_mesh
+    assert r.frame == "tool" and r.separation is None and r.mesh_shape is None
+    assert (tf.nodes, tf.hexahedra) == (s.mesh.n_nodes, s.mesh.n_elements)
+    assert tf.t_min_um == pytest.approx(8.0)
+    assert tf.chip_area_mm2 == pytest.approx(r.chip_area_mm2, rel=1e-12)
+    assert 0.0 < tf.clamp_area_fraction < 0.1
     # a few passes of a short travel: the inflow and outflow change the mass by far less
     # than a percent
-    assert tf["mass_ratio"] == pytest.approx(1.0, abs=1e-2)
-    assert r["eroded_damage"] == 0 and r["eroded_distortion"] == 0
+    assert tf.mass_ratio == pytest.approx(1.0, abs=1e-2)
+    assert r.eroded_damage == 0 and r.eroded_distortion == 0
     # the pre-shaped chip stands above the pre-bore surface (y = ap)
-    assert r["chip_max_height_um"] > 10.0
+    assert r.chip_max_height_um > 10.0
 
 
 def test_a_radial_deflection_the_mesh_does_not_follow_is_reported():
@@ -190,14 +191,15 @@ def test_a_radial_deflection_the_mesh_does_not_follow_is_reported():
     r, h = res.summary, res.history
     th = h["bar_angle_rad"]
     uy = -np.cos(th) * h["tool_dX_um"] - np.sin(th) * h["tool_dY_um"]
-    tf = r["toolframe_mesh"]
-    assert tf["edge_element_um"] == pytest.approx(16.6 / 4)
-    assert tf["radial_deflection_max_um"] == pytest.approx(np.max(np.abs(uy)), rel=1e-9)
-    assert tf["radial_deflection_max_um"] > 0.0
-    status = boring_warnings(cfg, {})
+    tf = r.toolframe_mesh
+    assert tf.edge_element_um == pytest.approx(16.6 / 4)
+    assert tf.radial_deflection_max_um == pytest.approx(np.max(np.abs(uy)), rel=1e-9)
+    assert tf.radial_deflection_max_um > 0.0
+    status = boring_warnings(cfg)
     for frac, warned in ((0.5, False), (2.0, True)):
-        tf["radial_deflection_max_um"] = frac * RADIAL_DEFLECTION_LIMIT * tf["edge_element_um"]
-        w = boring_warnings(cfg, r)
+        d = frac * RADIAL_DEFLECTION_LIMIT * tf.edge_element_um
+        w = boring_warnings(cfg, replace(
+            r, toolframe_mesh=replace(tf, radial_deflection_max_um=d)))
         assert w[0] == status[0] and len(w) == 1 + warned
         if warned:
             assert "radial deflection" in w[1] and "edge element" in w[1]

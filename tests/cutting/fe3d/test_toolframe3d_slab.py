@@ -47,11 +47,11 @@ def test_toolframe_slab_forces_match_2d_engine():
     cfg = parse_config(CFG)
     r2 = simulate_orthogonal(cfg).summary
     r3 = simulate_slab3_toolframe(cfg)
-    assert r3["eroded"] == 0
-    assert r3["energy_error"] < 0.05
-    assert abs(r3["out_of_plane_force_N_per_mm"]) < 1e-3 * r3["cutting_force_N_per_mm"]
-    assert r3["cutting_force_N_per_mm"] == pytest.approx(r2["cutting_force_N_per_mm"], rel=0.10)
-    assert r3["feed_force_N_per_mm"] == pytest.approx(r2["feed_force_N_per_mm"], rel=0.25)
+    assert r3.eroded == 0
+    assert r3.energy_error < 0.05
+    assert abs(r3.out_of_plane_force_N_per_mm) < 1e-3 * r3.cutting_force_N_per_mm
+    assert r3.cutting_force_N_per_mm == pytest.approx(r2.cutting_force_N_per_mm, rel=0.10)
+    assert r3.feed_force_N_per_mm == pytest.approx(r2.feed_force_N_per_mm, rel=0.25)
 
 
 def test_toolframe_slab_needs_the_tool_frame():

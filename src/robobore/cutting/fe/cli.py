@@ -40,10 +40,11 @@ def validation_warnings(cfg) -> list[str]:
     (docs/fe.md, "Validation against the measured forces"), in words: printed with every run
     so that a result is never read as validated where it is not."""
     from robobore.cutting.calibration_config import domain_departures
+    from robobore.cutting.fe.models.choose import choose_orthogonal
     from robobore.material.friction import friction_law
 
     out = []
-    if cfg.mesh.frame == "workpiece":
+    if not choose_orthogonal(cfg).tool_frame:
         out.append("workpiece-frame model: not the validated model; its feed force is far "
                    "below the tool-frame model's and the measured forces (17.8 against 47.9 "
                    "N/mm at h 30 um, docs/fe.md, \"Tool-frame ALE model\")")
@@ -106,7 +107,7 @@ def run_orthogonal_cli(config, as_json, plot, vtk, out, device="cpu") -> None:
         for f in ("temperature_K", "eps_p", "von_mises_Pa"):
             files[f"png_{f}"] = str(plot_chip(res, Path(plot) / f"fe_chip_{f}.png", f))
         files["png_forces"] = str(_plot_forces(res, Path(plot) / "fe_forces.png"))
-    result = dict(res.summary)
+    result = res.to_dict()
     result["warnings"] = validation_warnings(cfg)
     from robobore.io.identity import fe_identity
 
@@ -145,7 +146,7 @@ def _plot_forces(res, path: Path) -> Path:
                     color="C0", lw=0.8, label=f"Fc {face}")
             ax.plot(h["cut_length_mm"], h[f"{face}_feed_force_N_per_mm"], style,
                     color="C1", lw=0.8, label=f"Ff {face}")
-    a, b = res.summary["averaging_window_mm"]
+    a, b = res.summary.averaging_window_mm
     ax.axvspan(a, b, color="0.9", label="averaging window")
     ax.set_xlabel("length of cut [mm]")
     ax.set_ylabel("force on the tool [N/mm]")

@@ -66,13 +66,15 @@ THRUST_LIMIT = (
 RADIAL_DEFLECTION_LIMIT = 0.1
 
 
-def boring_warnings(cfg, summary: dict) -> list[str]:
+def boring_warnings(cfg, summary=None) -> list[str]:
     """What a 3D boring run's numbers rest on, in words, printed with every run: the frame's
     validation status and, in the tool frame on a support, a radial deflection of the insert
     the mesh does not follow (docs/fe3d.md, "Tool-frame 3D model", "Limits")."""
-    out = [TOOL_FRAME_STATUS if cfg.mesh.frame == "tool" else THRUST_LIMIT]
-    tf = summary.get("toolframe_mesh") or {}
-    d, edge = tf.get("radial_deflection_max_um"), tf.get("edge_element_um")
+    from robobore.cutting.fe.models.choose import choose_boring
+
+    out = [TOOL_FRAME_STATUS if choose_boring(cfg).tool_frame else THRUST_LIMIT]
+    tf = None if summary is None else summary.toolframe_mesh
+    d, edge = (None, None) if tf is None else (tf.radial_deflection_max_um, tf.edge_element_um)
     if d is not None and edge and d > RADIAL_DEFLECTION_LIMIT * edge:
         out.append(f"the insert's radial deflection on its support reached {d:.3g} um, "
                    f"{100 * d / edge:.0f} % of the edge element ({edge:.3g} um); the tool-frame "
@@ -100,23 +102,16 @@ def boring_cmd(
 @handle_errors
 def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     from robobore.cutting.fe.models.boring3d import (
-        check_boring_device,
         compare_with_mechanistic,
         load_boring_config,
         simulate_boring,
         write_vtk,
     )
-    from robobore.errors import ConfigError
+    from robobore.cutting.fe.models.choose import check_device, choose_boring
 
-    if device not in ("cpu", "gpu"):
-        raise ConfigError("unknown device", field="--device", value=device,
-                          expected="cpu or gpu")
+    check_device(device)
     cfg = load_boring_config(config)
-    check_boring_device(cfg, device, str(config))
-    if device == "gpu":
-        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
-
-        require_gpu()
+    choose_boring(cfg, device, str(config))  # the device's checks, before anything is built
     from robobore.io.outputs import check_output_dir
 
     check_output_dir(vtk, "--vtk", "the VTU meshes")
@@ -127,9 +122,9 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
         material_by=f"[material] name of {config}", insert_by=f"[insert] of {config}")] if n]
     with fraction_progress("FE boring (3D)", enabled=not as_json) as prog:
         res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
-    result = dict(res.summary)
+    result = res.to_dict()
     result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients)
-    result["warnings"] = boring_warnings(cfg, result) + notes
+    result["warnings"] = boring_warnings(cfg, res.summary) + notes
     result["identity"] = fe_identity("fe boring", cfg, str(config))
     if vtk is not None:
         result["files"] = {"vtk": [str(p) for p in write_vtk(res, vtk)]}

@@ -60,6 +60,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe.ale.groups3d import Cells3, ElementState3, Nodes3, RemapWork3
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
 
 __all__ = [
@@ -67,7 +68,8 @@ __all__ = [
     "VEL_TAYLOR", "dv_py", "hex_volume_py", "hex_volume", "face_corner_py", "swept_face_py",
     "swept_face", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
     "rz3_taylor_py", "rz3_taylor", "rz3_write_py", "rz3_write", "rz3_node_mass_py",
-    "rz3_node_mass", "remap3d", "remap3d_py", "remap3d_inputs", "remap3d_outputs", "element_volumes3",
+    "rz3_node_mass", "remap3d", "remap3d_loops", "remap3d_py", "remap3d_inputs", "remap3d_groups",
+    "remap3d_outputs", "element_volumes3",
 ]
 
 #: corners of each face, cyclic with the right-hand normal pointing out of the element; the
@@ -466,16 +468,38 @@ def rz3_node_mass_py(n, ptr, nel, alive, vol0, rho_s, msf, mass):
 rz3_node_mass = njit(cache=True, inline="always")(rz3_node_mass_py)
 
 
+@njit(cache=True)
+def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
+    """One remap pass from the nodes' ``x, y, z`` to the new positions ``work.xn, yn, zn``
+    (then copied into ``x, y, z``): element state, reference volumes, nodal velocities and
+    lumped masses. The arrays come grouped (:mod:`robobore.cutting.fe.ale.groups3d`):
+    ``nodes`` a :class:`Nodes3`, ``cells`` a :class:`Cells3`, ``elems`` an
+    :class:`ElementState3` (``msf`` the elements' inertia factors: the lumped masses are
+    ``rho_s vol0 msf / 8`` a corner; empty: 1), ``work`` a :class:`RemapWork3` (``buf``
+    (e, :data:`N_RZ3)`, ``vbuf`` (n, 3) work arrays); ``rho_s`` the mass-scaled density
+    [kg/m^3], ``t_room`` the virgin material's temperature [K], ``vel_mode``
+    :data:`VEL_MOMENTUM` or :data:`VEL_TAYLOR`. Returns the number of nodes whose velocity
+    was remapped. Allocates nothing.
+
+    The groups are unpacked here, in sequential code, and the parallel loops
+    (:func:`remap3d_loops`, called from here only) take the arrays one by one: with the
+    arrays read from named tuples inside a ``parallel=True`` function, numba's parallel
+    loops do not give the remap's results (the pressures, velocities and masses of
+    ``tests/cutting/fe3d/test_remap3d.py`` differ; the same source compiled without
+    ``parallel`` is exact)."""
+    return remap3d_loops(nodes.x, nodes.y, nodes.z, work.xn, work.yn, work.zn, nodes.vx,
+                         nodes.vy, nodes.vz, nodes.mass, nodes.fixed, cells.conn, cells.alive,
+                         nodes.ptr, nodes.nel, cells.fnbr, cells.bflag, elems.sd, elems.pres,
+                         elems.eps_p, elems.temp, elems.dmg, elems.qh, elems.vol0, rho_s,
+                         elems.msf, t_room, vel_mode, work.buf, work.vbuf)
+
+
 @njit(parallel=True, cache=True)
-def remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag,
-            sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode, buf, vbuf):
-    """One remap pass from ``x, y, z`` to the new positions ``xn, yn, zn`` (then copied into
-    ``x, y, z``): element state, reference volumes, nodal velocities and lumped masses.
-    ``buf`` (e, :data:`N_RZ3`) and ``vbuf`` (n, 3) are work arrays; ``rho_s`` the
-    mass-scaled density [kg/m^3], ``msf`` (e,) the elements' inertia factors (the lumped
-    masses are ``rho_s vol0 msf / 8`` a corner; empty: 1), ``t_room`` the virgin
-    material's temperature [K], ``vel_mode`` :data:`VEL_MOMENTUM` or :data:`VEL_TAYLOR`. Returns the number of nodes
-    whose velocity was remapped. Allocates nothing."""
+def remap3d_loops(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr,
+                  bflag, sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode,
+                  buf, vbuf):
+    """The parallel loops of :func:`remap3d` (the arrays of its groups, in this order; called
+    from :func:`remap3d` only)."""
     nn = x.shape[0]
     ne = conn.shape[0]
     for e in prange(ne):
@@ -565,6 +589,24 @@ def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,
     }
 
 
+def remap3d_groups(a: dict, new: np.ndarray | None = None
+                   ) -> tuple[Nodes3, Cells3, ElementState3, RemapWork3]:
+    """The groups :func:`remap3d` takes from the arrays of :func:`remap3d_inputs` (the same
+    arrays, not copies); ``new`` (n, 3) the new positions (None: empty ``xn, yn, zn``, for
+    a pass that places the nodes itself)."""
+    n = a["x"].shape[0]
+    new_xyz = ((np.empty(n), np.empty(n), np.empty(n)) if new is None else
+               tuple(np.ascontiguousarray(new[:, k], np.float64).copy() for k in range(3)))
+    nodes = Nodes3(x=a["x"], y=a["y"], z=a["z"], vx=a["vx"], vy=a["vy"], vz=a["vz"],
+                   mass=a["mass"], fixed=a["fixed"], ptr=a["ptr"], nel=a["nel"])
+    cells = Cells3(conn=a["conn"], alive=a["alive"], fnbr=a["fnbr"], bflag=a["bflag"])
+    elems = ElementState3(sd=a["sd"], pres=a["pres"], eps_p=a["eps_p"], temp=a["temp"],
+                          dmg=a["dmg"], qh=a["qh"], vol0=a["vol0"], msf=a["msf"])
+    work = RemapWork3(xn=new_xyz[0], yn=new_xyz[1], zn=new_xyz[2], buf=a["buf"],
+                      vbuf=a["vbuf"])
+    return nodes, cells, elems, work
+
+
 def remap3d_outputs(a: dict, moved: int) -> dict:
     """The result dict of :func:`remap3d_py` from the arrays of :func:`remap3d_inputs` after
     a pass."""
@@ -590,10 +632,5 @@ def remap3d_py(old: np.ndarray, new: np.ndarray, conn: np.ndarray, fields: dict,
     a = remap3d_inputs(old, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
                        alive=alive, t_room=t_room)
     new = np.ascontiguousarray(new, np.float64)
-    moved = remap3d(a["x"], a["y"], a["z"], new[:, 0].copy(), new[:, 1].copy(),
-                    new[:, 2].copy(), a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
-                    a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
-                    a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
-                    float(rho_s), a["msf"], float(t_room), int(vel_mode), a["buf"],
-                    a["vbuf"])
+    moved = remap3d(*remap3d_groups(a, new), float(rho_s), float(t_room), int(vel_mode))
     return remap3d_outputs(a, moved)

@@ -56,9 +56,11 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.ale import rezone as RZ
+from robobore.cutting.fe.ale.groups3d import ToolFrameAle3
 from robobore.cutting.fe.ale.remap3d import (
     VEL_MOMENTUM,
     remap3d,
+    remap3d_groups,
     remap3d_inputs,
     remap3d_outputs,
 )
@@ -203,32 +205,30 @@ def toolframe3d_targets_loops(x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x
         tf_interior(n, x, y, xn, yn, x0, y0, acls, aflt, off_x, max_move)
 
 
-#: the placement's loops compiled on their own, and inlined into :func:`rezone3d` (whose
-#: ``prange`` loops they become)
+#: the placement's loops compiled on their own (called by :func:`rezone3d`)
 toolframe3d_targets = njit(parallel=True, cache=True)(toolframe3d_targets_loops)
-_targets = njit(inline="always")(toolframe3d_targets_loops)
 
 
-@njit(parallel=True, cache=True)
-def rezone3d(x, y, z, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr, bflag, sd, pres,
-             eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode, xn, yn, zn, buf, vbuf,
-             scratch, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm, cx, cy, cz):
+@njit(cache=True)
+def rezone3d(nodes, cells, elems, work, ale, rho_s, t_room, vel_mode, prm, travel, tip):
     """One tool-frame ALE pass of the 3D engine: the placement (:func:`toolframe3d_targets`)
-    into ``xn, yn, zn``, then :func:`robobore.cutting.fe.ale.remap3d.remap3d` (arguments as
-    there: the state's fields, ``fnbr`` the face neighbours, ``bflag`` the outline flux types,
-    ``buf`` (e, ``N_RZ3``), ``vbuf`` (n, 3) work arrays), which copies the new positions into
-    ``x, y, z``. ``scratch`` (n, 3) work array; ``x0, y0, z0`` (n,) the nodes' places at the
-    start; ``acls`` (n, 7), ``aflt`` (n, 6) the tool-frame data
-    (:func:`toolframe3d_ale_data`; ``aflt[:, 4:6]`` carried from pass to pass); ``off_x``,
-    ``off_z`` the insert's travel since the start [m]; ``max_move`` the move limit as a
-    fraction of the local size; ``prm`` the engine's parameter vector and ``cx, cy, cz`` the
-    insert tip's current position (the "off tool" correction). Returns the number of nodes
-    whose velocity was remapped. Allocates nothing."""
-    _targets(x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm, cx, cy,
-             cz, scratch)
-    return remap3d(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr,
-                   bflag, sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode,
-                   buf, vbuf)
+    into ``work.xn, yn, zn``, then :func:`robobore.cutting.fe.ale.remap3d.remap3d`
+    (``nodes, cells, elems, work, rho_s, t_room, vel_mode`` as there), which copies the new
+    positions into the nodes' ``x, y, z``. ``ale`` the
+    :class:`~robobore.cutting.fe.ale.groups3d.ToolFrameAle3` (the places at the start, the
+    tool-frame data of :func:`toolframe3d_ale_data`, ``aflt[:, 4:6]`` carried from pass to
+    pass, the scratch array); ``travel`` = ``(off_x, off_z, max_move)``: the insert's travel
+    since the start [m] and the move limit as a fraction of the local size; ``prm`` the
+    engine's parameter vector and ``tip`` = ``(cx, cy, cz)`` the insert tip's current
+    position (the "off tool" correction). Returns the number of nodes whose velocity was
+    remapped. Allocates nothing."""
+    off_x, off_z, max_move = travel
+    cx, cy, cz = tip
+    # the parallel placement takes the arrays one by one (see remap3d)
+    toolframe3d_targets(nodes.x, nodes.y, nodes.z, work.xn, work.yn, work.zn, ale.x0, ale.y0,
+                        ale.z0, ale.acls, ale.aflt, off_x, off_z, max_move, prm, cx, cy, cz,
+                        ale.scratch)
+    return remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode)
 
 
 def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarray,
@@ -277,15 +277,13 @@ def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: n
     if prm is None:
         prm = np.zeros(N_PRM)
     n = places.shape[0]
-    moved = rezone3d(a["x"], a["y"], a["z"], a["vx"], a["vy"], a["vz"], a["mass"], a["fixed"],
-                     a["conn"], a["alive"], a["ptr"], a["nel"], a["fnbr"], a["bflag"], a["sd"],
-                     a["pres"], a["eps_p"], a["temp"], a["dmg"], a["qh"], a["vol0"],
-                     float(rho_s), a["msf"], float(t_room), int(vel_mode), np.empty(n),
-                     np.empty(n), np.empty(n), a["buf"], a["vbuf"], np.zeros((n, 3)),
-                     places[:, 0].copy(), places[:, 1].copy(), places[:, 2].copy(),
-                     np.ascontiguousarray(acls, np.int64), aflt, float(off_x), float(off_z),
-                     float(max_move), np.ascontiguousarray(prm, np.float64), float(tip[0]),
-                     float(tip[1]), float(tip[2]))
+    ale = ToolFrameAle3(x0=places[:, 0].copy(), y0=places[:, 1].copy(), z0=places[:, 2].copy(),
+                        acls=np.ascontiguousarray(acls, np.int64), aflt=aflt,
+                        scratch=np.zeros((n, 3)))
+    moved = rezone3d(*remap3d_groups(a), ale, float(rho_s), float(t_room), int(vel_mode),
+                     np.ascontiguousarray(prm, np.float64),
+                     (float(off_x), float(off_z), float(max_move)),
+                     (float(tip[0]), float(tip[1]), float(tip[2])))
     return remap3d_outputs(a, moved)
 
 

@@ -1,8 +1,8 @@
 """The config's solver, thermal and friction settings written into an engine's parameter
 vector (shared by the 2D and 3D engines: each passes its kernel module, whose ``P_*``
 indices the settings go to). The model-choice slots are written by the typed model specs
-(:mod:`robobore.cutting.fe.config.spec`: ``ModelSpec.write_prm`` for the orthogonal model,
-``BoringSpec.write_prm`` for the boring model and the 3D slab cross-check);
+(:mod:`robobore.cutting.fe.config.spec`: ``ModelSpec.write_prm``, for the orthogonal model, the
+boring model and the 3D slab cross-check);
 :func:`apply_numerics` writes the numerics every model uses; :func:`apply_friction_settings`
 and :func:`apply_thermal_settings` write one section's friction or heat through the spec's
 ``write_friction`` / ``write_thermal``.

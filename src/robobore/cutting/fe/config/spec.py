@@ -16,6 +16,13 @@ the spec is what they choose, one type per variant, each carrying only the value
 * hardening: :class:`PlainHardening` or :class:`HardeningHold` (the plastic strain beyond
   which the Johnson-Cook hardening term is held).
 
+The 3D engine (the boring model, the 3D slab) has its own frames in the same spec:
+:class:`ToolFrame3D` (the tool-frame ALE mesh: no separation, no erosion) and
+:class:`WorkpieceFrame3D` (its separation, :class:`NodeSplit` or :class:`EdgePathLayer`, damage
+and time-step erosion), each with the :class:`HexElement`. Each frame writes its own slots of
+the parameter vector (``write_prm``) and says whether it is a tool frame (``tool_frame``) and
+which engine it runs on (``dim``).
+
 A combination without a meaning (a gate in the tool frame, a B-bar element with hourglass
 coefficients, a tool temperature in an adiabatic run) has no type to be built from.
 :func:`build_spec` builds the spec from the config and raises a ConfigError naming any key the
@@ -27,7 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
@@ -38,12 +45,21 @@ __all__ = [
     "ToolFrame", "NodeSplit", "ErosionLayer", "OnePointQuad", "BBarQuad", "WorkpieceFrame",
     "CoulombFriction", "SlidingSpeedFriction", "Adiabatic", "Conduction", "PlainHardening",
     "HardeningHold", "ModelSpec", "build_spec", "friction_spec", "thermal_spec", "write_friction",
-    "write_thermal", "MODEL_KEYS", "HexElement", "EdgePathLayer", "BoringSpec",
+    "write_thermal", "MODEL_KEYS", "HexElement", "EdgePathLayer", "WorkpieceFrame3D",
     "build_boring_spec", "BORING_MODEL_KEYS", "ToolFrame3D",
 ]
 
 
 # --- frame, separation, element
+
+def _check_type(value: Any, types: tuple[type, ...], field: str) -> None:
+    """ConfigError unless ``value`` is one of ``types`` (a spec built from parts that do not
+    belong together)."""
+    if not isinstance(value, types):
+        raise ConfigError("model choice without a meaning", field=field,
+                          value=type(value).__name__,
+                          expected=" or ".join(t.__name__ for t in types))
+
 
 @dataclass(frozen=True)
 class OnePointQuad:
@@ -52,10 +68,18 @@ class OnePointQuad:
     hourglass_viscous: float
     hourglass_stiffness: float
 
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """The hourglass slots (``P_HGV``, ``P_HGS``) of the layout ``k``."""
+        p[k.P_HGV] = self.hourglass_viscous
+        p[k.P_HGS] = self.hourglass_stiffness
+
 
 @dataclass(frozen=True)
 class BBarQuad:
     """The fully integrated B-bar quadrilateral: no hourglass modes, no coefficients."""
+
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """No slot: the B-bar element has no hourglass control."""
 
 
 @dataclass(frozen=True)
@@ -69,6 +93,22 @@ class ToolFrame:
     element: OnePointQuad
     #: largest node move of an ALE pass, fraction of the local element size
     MAX_MOVE = 0.2
+    #: the mesh stays round the tool (the contact damping and the compiled step follow)
+    tool_frame: ClassVar[bool] = True
+    #: the engine: 2 (quadrilaterals) or 3 (hexahedra)
+    dim: ClassVar[int] = 2
+
+    def __post_init__(self) -> None:
+        _check_type(self.element, (OnePointQuad,), "solver.element")
+
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """The frame's slots of the 2D layout ``k``: no erosion, no gate, the ALE pass."""
+        p[k.P_EROSION] = k.ERODE_NONE
+        p[k.P_DT_ERODE] = 0.0
+        p[k.P_GATE] = -1.0
+        p[k.P_RZ_EVERY] = self.ale_interval
+        p[k.P_RZ_MAXMOVE] = ToolFrame.MAX_MOVE
+        self.element.write_prm(p, k)
 
 
 @dataclass(frozen=True)
@@ -101,6 +141,27 @@ class WorkpieceFrame:
     separation: NodeSplit | ErosionLayer
     element: OnePointQuad | BBarQuad
     erode_time_step_fraction: float
+    tool_frame: ClassVar[bool] = False
+    dim: ClassVar[int] = 2
+
+    def __post_init__(self) -> None:
+        _check_type(self.separation, (NodeSplit, ErosionLayer), "mesh.separation")
+        _check_type(self.element, (OnePointQuad, BBarQuad), "solver.element")
+
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """The frame's slots of the 2D layout ``k``: time-step erosion, the separation's
+        erosion and gate, no ALE pass."""
+        sep = self.separation
+        p[k.P_DT_ERODE] = -self.erode_time_step_fraction
+        if isinstance(sep, NodeSplit):
+            p[k.P_EROSION] = k.ERODE_NONE
+            p[k.P_GATE] = sep.gate_um * 1e-6
+        else:
+            p[k.P_EROSION] = k.ERODE_LAYER if sep.damage_erosion else k.ERODE_NONE
+            p[k.P_GATE] = -1.0 if sep.gate_um is None else sep.gate_um * 1e-6
+        p[k.P_RZ_EVERY] = 0
+        p[k.P_RZ_MAXMOVE] = ToolFrame.MAX_MOVE
+        self.element.write_prm(p, k)
 
 
 @dataclass(frozen=True)
@@ -109,6 +170,11 @@ class HexElement:
 
     hourglass_viscous: float
     hourglass_stiffness: float
+
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """The hourglass slots (``P_HGV``, ``P_HGS``) of the 3D layout ``k``."""
+        p[k.P_HGV] = self.hourglass_viscous
+        p[k.P_HGS] = self.hourglass_stiffness
 
 
 @dataclass(frozen=True)
@@ -170,44 +236,35 @@ class HardeningHold:
 
 @dataclass(frozen=True)
 class ModelSpec:
-    """The model choices of an FE config (see the module docstring)."""
+    """The model choices of an FE config (see the module docstring): one spec for the three
+    models, the frame telling them apart -- :class:`ToolFrame` or :class:`WorkpieceFrame`
+    (the orthogonal 2D model), :class:`ToolFrame3D` or :class:`WorkpieceFrame3D` (the 3D
+    boring model and the 3D slab). Each frame carries its element and only the options it
+    has (a tool frame has no separation and no erosion); parts that do not belong together
+    raise a ConfigError when the spec is built."""
 
-    frame: ToolFrame | WorkpieceFrame
+    frame: ToolFrame | WorkpieceFrame | ToolFrame3D | WorkpieceFrame3D
     friction: CoulombFriction | SlidingSpeedFriction
     thermal: Adiabatic | Conduction
     hardening: PlainHardening | HardeningHold
 
+    def __post_init__(self) -> None:
+        _check_type(self.frame, (ToolFrame, WorkpieceFrame, ToolFrame3D, WorkpieceFrame3D),
+                    "mesh.frame")
+        _check_type(self.friction, (CoulombFriction, SlidingSpeedFriction), "contact.friction")
+        _check_type(self.thermal, (Adiabatic, Conduction), "solver.heat_conduction")
+        _check_type(self.hardening, (PlainHardening, HardeningHold), "material")
+
     def write_prm(self, p: np.ndarray, layout: Any, vc_m_per_min: float) -> np.ndarray:
-        """Write the model-choice slots of an engine's parameter vector ``p`` (returned):
+        """Write the model-choice slots of the engine's parameter vector ``p`` (returned):
         frame, separation, element, erosion, friction and thermal slots. ``layout`` is the
         engine's layout module (its ``P_*`` indices and ``ERODE_*`` codes:
-        :mod:`robobore.cutting.fe.engine.layout`). The element type,
-        the frame and the thermal model also choose the compiled step
-        (:func:`robobore.cutting.fe.engine.chunk_loop.step_for`)."""
-        k = layout
-        fr = self.frame
-        if isinstance(fr, ToolFrame):
-            element: OnePointQuad | BBarQuad = fr.element
-            p[k.P_EROSION] = k.ERODE_NONE
-            p[k.P_DT_ERODE] = 0.0
-            p[k.P_GATE] = -1.0
-            p[k.P_RZ_EVERY] = fr.ale_interval
-            p[k.P_RZ_MAXMOVE] = ToolFrame.MAX_MOVE
-        else:
-            element = fr.element
-            sep = fr.separation
-            p[k.P_DT_ERODE] = -fr.erode_time_step_fraction
-            if isinstance(sep, NodeSplit):
-                p[k.P_EROSION] = k.ERODE_NONE
-                p[k.P_GATE] = sep.gate_um * 1e-6
-            else:
-                p[k.P_EROSION] = k.ERODE_LAYER if sep.damage_erosion else k.ERODE_NONE
-                p[k.P_GATE] = -1.0 if sep.gate_um is None else sep.gate_um * 1e-6
-            p[k.P_RZ_EVERY] = 0
-            p[k.P_RZ_MAXMOVE] = ToolFrame.MAX_MOVE
-        if isinstance(element, OnePointQuad):
-            p[k.P_HGV] = element.hourglass_viscous
-            p[k.P_HGS] = element.hourglass_stiffness
+        :mod:`robobore.cutting.fe.engine.layout` for a 2D frame,
+        :mod:`robobore.cutting.fe.hex.layout3d` for a 3D one). The element type, the frame
+        and the thermal model also choose the compiled step
+        (:func:`robobore.cutting.fe.engine.chunk_loop.step_for`,
+        :func:`robobore.cutting.fe.engine.kernels3d.run_chunk3_for`)."""
+        self.frame.write_prm(p, layout)
         write_friction(p, self.friction, layout, vc_m_per_min)
         write_thermal(p, self.thermal, layout)
         return p
@@ -418,57 +475,58 @@ class ToolFrame3D:
     velocities are remapped by the 2D engine's Taylor step."""
 
     ale_interval: int
+    element: HexElement
     #: inertia factors on the elements whose stable step is below the nose-tip section's
     #: smallest (:func:`robobore.cutting.fe.models.toolframe3d.thin_element_factors`)
     thin_element_mass_scaling: bool = True
     #: largest node move of an ALE pass, fraction of the local element size (the 2D value)
     MAX_MOVE = ToolFrame.MAX_MOVE
+    tool_frame: ClassVar[bool] = True
+    dim: ClassVar[int] = 3
+
+    def __post_init__(self) -> None:
+        _check_type(self.element, (HexElement,), "solver.element")
+
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """The frame's slots of the 3D layout ``k``: no erosion, no gate, the ALE pass with
+        the Taylor velocity remap."""
+        from robobore.cutting.fe.ale.remap3d import VEL_TAYLOR
+
+        self.element.write_prm(p, k)
+        p[k.P_DT_ERODE] = 0.0
+        p[k.P_EROSION] = k.ERODE_NONE
+        p[k.P_GATE] = -1.0
+        p[k.P_RZ_EVERY] = self.ale_interval
+        p[k.P_RZ_MAXMOVE] = self.MAX_MOVE
+        p[k.P_RZ_VEL] = VEL_TAYLOR
 
 
 @dataclass(frozen=True)
-class BoringSpec:
-    """The model choices of a 3D boring config: the frame -- the workpiece frame
-    (``tool_frame`` None) with its separation, :class:`NodeSplit` (parting surface, gate) or
-    :class:`EdgePathLayer`, and damage erosion of the layer elements on the edge path (both
-    separations have them) on or off and time-step erosion; or the tool frame
-    (:class:`ToolFrame3D`: ``separation`` None, no erosion) --, the hexahedron, friction,
-    thermal model and hardening."""
+class WorkpieceFrame3D:
+    """The Lagrangian 3D workpiece block: its separation, :class:`NodeSplit` (parting
+    surface, gate) or :class:`EdgePathLayer`; damage erosion of the layer elements on the
+    edge path on or off (both separations have them); time-step erosion (the fraction of
+    the initial smallest step below which an element erodes; 0: off); the hexahedron."""
 
-    separation: NodeSplit | EdgePathLayer | None
+    separation: NodeSplit | EdgePathLayer
     damage_erosion: bool
-    element: HexElement
     erode_time_step_fraction: float
-    friction: CoulombFriction | SlidingSpeedFriction
-    thermal: Adiabatic | Conduction
-    hardening: PlainHardening | HardeningHold
-    tool_frame: ToolFrame3D | None = None
+    element: HexElement
+    tool_frame: ClassVar[bool] = False
+    dim: ClassVar[int] = 3
 
-    def write_prm(self, p: np.ndarray, layout: Any, vc_m_per_min: float) -> np.ndarray:
-        """Write the model-choice slots of the 3D parameter vector ``p`` (returned);
-        ``layout`` the 3D layout module (:mod:`robobore.cutting.fe.hex.layout3d`). The frame
-        also chooses the compiled step
-        (:func:`robobore.cutting.fe.engine.kernels3d.run_chunk3_for`)."""
-        k = layout
-        p[k.P_HGV] = self.element.hourglass_viscous
-        p[k.P_HGS] = self.element.hourglass_stiffness
-        tf = self.tool_frame
-        if tf is not None:
-            from robobore.cutting.fe.ale.remap3d import VEL_TAYLOR
+    def __post_init__(self) -> None:
+        _check_type(self.separation, (NodeSplit, EdgePathLayer), "mesh.separation")
+        _check_type(self.element, (HexElement,), "solver.element")
 
-            p[k.P_DT_ERODE] = 0.0
-            p[k.P_EROSION] = k.ERODE_NONE
-            p[k.P_GATE] = -1.0
-            p[k.P_RZ_EVERY] = tf.ale_interval
-            p[k.P_RZ_MAXMOVE] = tf.MAX_MOVE
-            p[k.P_RZ_VEL] = VEL_TAYLOR
-        else:
-            p[k.P_DT_ERODE] = -self.erode_time_step_fraction
-            p[k.P_EROSION] = k.ERODE_LAYER if self.damage_erosion else k.ERODE_NONE
-            sep = self.separation
-            p[k.P_GATE] = sep.gate_um * 1e-6 if isinstance(sep, NodeSplit) else -1.0
-        write_friction(p, self.friction, layout, vc_m_per_min)
-        write_thermal(p, self.thermal, layout)
-        return p
+    def write_prm(self, p: np.ndarray, k: Any) -> None:
+        """The frame's slots of the 3D layout ``k``: time-step and damage erosion, the
+        parting surface's gate."""
+        self.element.write_prm(p, k)
+        p[k.P_DT_ERODE] = -self.erode_time_step_fraction
+        p[k.P_EROSION] = k.ERODE_LAYER if self.damage_erosion else k.ERODE_NONE
+        sep = self.separation
+        p[k.P_GATE] = sep.gate_um * 1e-6 if isinstance(sep, NodeSplit) else -1.0
 
 
 #: the keys of a 3D boring config that belong to one model variant (see MODEL_KEYS)
@@ -484,17 +542,16 @@ BORING_MODEL_KEYS = (
 
 
 def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
-                      source: str | None = None) -> BoringSpec:
-    """The :class:`BoringSpec` of a validated 3D boring config (``material`` as loaded,
-    ``vc_m_per_min`` the cutting speed at the bore wall). Raises ConfigError naming a key the
-    config gives that the chosen variants have no place for (for example
+                      source: str | None = None) -> ModelSpec:
+    """The :class:`ModelSpec` (a 3D frame) of a validated 3D boring config (``material`` as
+    loaded, ``vc_m_per_min`` the cutting speed at the bore wall). Raises ConfigError naming a
+    key the config gives that the chosen variants have no place for (for example
     ``solver.separation_gate_um`` with ``mesh.separation = "erosion_layer"``)."""
     keys = _Keys(cfg, BORING_MODEL_KEYS)
     sep: NodeSplit | EdgePathLayer | None
     tool_keys = ("mesh.edge_element_um", "mesh.slice_spacing_um", "mesh.t_min_um",
                  "mesh.margin_slices", "mesh.initial_chip_ratio", "solver.ale_interval",
                  "solver.thin_element_mass_scaling")
-    tool_frame = None
     if cfg.mesh.frame == "tool":
         keys.exclude("tool3d", "mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm",
                      "mesh.separation", "mesh.separation_height_um", "mesh.chip_rows",
@@ -502,9 +559,6 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
                      "solver.erode_time_step_fraction")
         for key in tool_keys:
             keys.get(key)
-        tool_frame = ToolFrame3D(
-            ale_interval=int(keys.get("solver.ale_interval")),
-            thin_element_mass_scaling=bool(keys.get("solver.thin_element_mass_scaling")))
         sep = None
     else:
         keys.exclude("workpiece", *tool_keys)
@@ -530,12 +584,17 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
     s = cfg.solver
     limit = material.hardening_strain_limit
     keys.check(source)
-    return BoringSpec(
-        separation=sep, damage_erosion=tool_frame is None and s.erosion == "layer",
-        element=HexElement(float(s.hourglass_viscous), float(s.hourglass_stiffness)),
-        erode_time_step_fraction=float(s.erode_time_step_fraction),
+    element = HexElement(float(s.hourglass_viscous), float(s.hourglass_stiffness))
+    frame: ToolFrame3D | WorkpieceFrame3D = (
+        ToolFrame3D(ale_interval=int(s.ale_interval), element=element,
+                    thin_element_mass_scaling=bool(s.thin_element_mass_scaling))
+        if sep is None else
+        WorkpieceFrame3D(separation=sep, damage_erosion=s.erosion == "layer",
+                         erode_time_step_fraction=float(s.erode_time_step_fraction),
+                         element=element))
+    return ModelSpec(
+        frame=frame,
         friction=friction_spec(cfg.contact, vc_m_per_min),
         thermal=thermal_spec(s, cfg.contact, material),
         hardening=(HardeningHold(float(limit)) if limit is not None and math.isfinite(limit)
-                   else PlainHardening()),
-        tool_frame=tool_frame)
+                   else PlainHardening()))

@@ -41,6 +41,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
+from robobore.cutting.fe.ale.groups3d import Cells3, ElementState3, Nodes3, RemapWork3, ToolFrameAle3
 from robobore.cutting.fe.ale.rezone3d import rezone3d
 from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
 from robobore.cutting.fe.engine.step_loop import make_chunk_loop
@@ -269,11 +270,17 @@ def _remesh3(s, step):
         if prm[P_MSF_DT] > 0.0 and s.msf.shape[0] > 0:
             renew_inertia_factors(s.msf, s.dte, s.alive, prm[P_MSF_DT])
         cx, cy, cz, _vx, _vy, _vz = tool_kinematics(s.tool, prm)
-        rezone3d(s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.conn, s.alive, s.ptr,
-                 s.nel, s.enbr, s.bflag, s.sd, s.pres, s.eps_p, s.temp, s.dmg, s.qh, s.vol0,
-                 mat[jc.RHO] * prm[P_MS], s.msf, mat[jc.TROOM], int(prm[P_RZ_VEL]), s.xn, s.yn,
-                 s.zn, s.buf, s.vbuf, s.scratch, s.x0, s.y0, s.z0, s.acls, s.aflt,
-                 cx - prm[P_ALE_X0], cz - prm[P_ALE_Z0], prm[P_RZ_MAXMOVE], prm, cx, cy, cz)
+        nodes = Nodes3(x=s.x, y=s.y, z=s.z, vx=s.vx, vy=s.vy, vz=s.vz, mass=s.mass,
+                       fixed=s.fixed, ptr=s.ptr, nel=s.nel)
+        cells = Cells3(conn=s.conn, alive=s.alive, fnbr=s.enbr, bflag=s.bflag)
+        elems = ElementState3(sd=s.sd, pres=s.pres, eps_p=s.eps_p, temp=s.temp, dmg=s.dmg,
+                              qh=s.qh, vol0=s.vol0, msf=s.msf)
+        work = RemapWork3(xn=s.xn, yn=s.yn, zn=s.zn, buf=s.buf, vbuf=s.vbuf)
+        ale = ToolFrameAle3(x0=s.x0, y0=s.y0, z0=s.z0, acls=s.acls, aflt=s.aflt,
+                            scratch=s.scratch)
+        rezone3d(nodes, cells, elems, work, ale, mat[jc.RHO] * prm[P_MS], mat[jc.TROOM],
+                 int(prm[P_RZ_VEL]), prm,
+                 (cx - prm[P_ALE_X0], cz - prm[P_ALE_Z0], prm[P_RZ_MAXMOVE]), (cx, cy, cz))
 
 
 @njit(inline="always")
@@ -353,9 +360,9 @@ RUN_CHUNK3 = {
 
 def run_chunk3_for(spec):
     """The compiled 3D chunk function of a
-    :class:`~robobore.cutting.fe.config.spec.BoringSpec`: the tool frame's ALE pass for
-    ``spec.tool_frame``, the heat pass for a ``Conduction`` thermal model
+    :class:`~robobore.cutting.fe.config.spec.ModelSpec` with a 3D frame: the tool frame's
+    ALE pass for a ``ToolFrame3D``, the heat pass for a ``Conduction`` thermal model
     (:data:`RUN_CHUNK3`)."""
     from robobore.cutting.fe.config.spec import Conduction
 
-    return RUN_CHUNK3[(spec.tool_frame is not None, isinstance(spec.thermal, Conduction))]
+    return RUN_CHUNK3[(spec.frame.tool_frame, isinstance(spec.thermal, Conduction))]

@@ -18,8 +18,9 @@ from typing import Any
 
 from robobore.io.memory import available_memory_bytes, check_memory
 
-__all__ = ["FE2D_BYTES_PER_ELEMENT", "FE3D_BYTES_PER_ELEMENT", "fe2d_elements", "check_fe2d",
-           "fe3d_elements", "toolframe3d_elements", "check_fe3d"]
+__all__ = ["FE2D_BYTES_PER_ELEMENT", "FE3D_BYTES_PER_ELEMENT", "fe2d_elements",
+           "toolframe2d_elements", "workpiece2d_elements", "check_fe2d", "fe3d_elements",
+           "workpiece3d_elements", "toolframe3d_elements", "check_fe3d"]
 
 #: 2D explicit FE: bytes per quadrilateral element at the peak. The arrays of a set-up run
 #: (mesh, node and element state, contact) measure 770-1050 bytes per element on the bundled
@@ -31,22 +32,34 @@ FE3D_BYTES_PER_ELEMENT = 1500
 
 
 def fe2d_elements(cfg: Any) -> float:
-    """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`).
+    """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`)
+    on its frame: :func:`toolframe2d_elements` or :func:`workpiece2d_elements` (the choice of
+    the config check, before the model is chosen)."""
+    if getattr(cfg.mesh, "frame", "workpiece") == "tool":
+        return toolframe2d_elements(cfg)
+    return workpiece2d_elements(cfg)
 
-    Workpiece frame: ``(length_mm + ahead_mm) / le`` columns times the rows of the fine zone
-    (``(1 + fine_depth_factor) h / le``) plus the graded rows below it. Tool frame: the
-    domain round the edge (inflow + back + chip length by depth + chip height) over
-    ``le^2``. A lower estimate of the count (the coarse rows are few).
-    """
+
+def toolframe2d_elements(cfg: Any) -> float:
+    """Element count of a 2D tool-frame config: the domain round the edge (inflow + back +
+    chip length by depth + chip height) over ``le^2``."""
     m, cut = cfg.mesh, cfg.cut
     le = float(m.element_size_um)
     h = float(cut.uncut_chip_thickness_um)
-    if getattr(m, "frame", "workpiece") == "tool":
-        chip = m.chip_length_um or max(1.5 * h, 80.0)
-        width = ((m.inflow_length_um or max(1.5 * h, 60.0))
-                 + (m.back_length_um or max(2.0 * h, 120.0)) + chip)
-        height = (m.depth_um or max(2.5 * h, 120.0)) + m.initial_chip_ratio * h + chip
-        return width * height / le**2
+    chip = m.chip_length_um or max(1.5 * h, 80.0)
+    width = ((m.inflow_length_um or max(1.5 * h, 60.0))
+             + (m.back_length_um or max(2.0 * h, 120.0)) + chip)
+    height = (m.depth_um or max(2.5 * h, 120.0)) + m.initial_chip_ratio * h + chip
+    return width * height / le**2
+
+
+def workpiece2d_elements(cfg: Any) -> float:
+    """Element count of a 2D workpiece-frame config: ``(length_mm + ahead_mm) / le`` columns
+    times the rows of the fine zone (``(1 + fine_depth_factor) h / le``) plus the graded rows
+    below it. A lower estimate of the count (the coarse rows are few)."""
+    m, cut = cfg.mesh, cfg.cut
+    le = float(m.element_size_um)
+    h = float(cut.uncut_chip_thickness_um)
     length_um = (float(cut.length_mm) + float(m.ahead_mm)) * 1e3
     rows = (1.0 + float(m.fine_depth_factor)) * h / le
     g = float(m.grading)
@@ -68,15 +81,21 @@ def check_fe2d(cfg: Any, source: str | None = None) -> None:
 
 
 def fe3d_elements(cfg: Any) -> float:
-    """Element count of a 3D boring FE config (:class:`BoringFEConfig`). Workpiece frame: the
-    block the mesh builder fills, ``(cut_length + ahead)`` along the cut, from half a feed
-    behind the insert to the end of its engaged edge plus two side margins along the feed,
-    and ``ap + max(depth_factor ap, 4 le)`` deep, over ``le^3``. Tool frame
-    (``mesh.frame = "tool"``): :func:`toolframe3d_elements`."""
-    from robobore.cutting.geometry import lead_end
-
+    """Element count of a 3D boring FE config (:class:`BoringFEConfig`) on its frame:
+    :func:`toolframe3d_elements` (``mesh.frame = "tool"``) or :func:`workpiece3d_elements`
+    (the choice of the config check, before the model is chosen)."""
     if getattr(cfg.mesh, "frame", "workpiece") == "tool":
         return toolframe3d_elements(cfg)
+    return workpiece3d_elements(cfg)
+
+
+def workpiece3d_elements(cfg: Any) -> float:
+    """Element count of a workpiece-frame 3D boring config: the block the mesh builder
+    fills, ``(cut_length + ahead)`` along the cut, from half a feed behind the insert to the
+    end of its engaged edge plus two side margins along the feed, and
+    ``ap + max(depth_factor ap, 4 le)`` deep, over ``le^3``."""
+    from robobore.cutting.geometry import lead_end
+
     le = float(cfg.mesh.element_size_um) * 1e-6
     ap = float(cfg.cut.depth_of_cut_mm) * 1e-3
     f = float(cfg.cut.feed_mm_per_rev) * 1e-3

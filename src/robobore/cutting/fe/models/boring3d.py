@@ -47,22 +47,21 @@ from robobore.cutting.fe.config.boring3d import (
     load_boring_config,
     parse_boring_config,
 )
-from robobore.cutting.fe.config.spec import build_boring_spec
-from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import energy_check
-from robobore.cutting.fe.engine.state3d import (
-    FEState3,
-    advance3,
-    energy_error,
-    make_state3,
-)
+from robobore.cutting.fe.engine.state3d import FEState3, energy_error
 from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
 from robobore.cutting.fe.models.boring_setup import BoringSetup, boring_prm, check_support_step
+from robobore.cutting.fe.models.choose import choose_boring
+from robobore.cutting.fe.models.results import (
+    XYZ,
+    BoringSummary,
+    Energies3D,
+    RotatingForce,
+    ToolSupport3D,
+)
 from robobore.cutting.geometry import chip_area
-from robobore.errors import ConfigError
-from robobore.material import load_material
 
 __all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "BoringMesh",
            "build_boring_mesh", "parting_surface", "BoringSetup", "setup_boring", "simulate_boring",
@@ -71,51 +70,26 @@ __all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "Borin
 
 
 def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:
-    """Mesh, insert, support and state for ``cfg`` (``mesh.frame = "tool"``:
-    :func:`robobore.cutting.fe.models.toolframe3d.setup_boring_toolframe`)."""
-    if cfg.mesh.frame == "tool":
-        from robobore.cutting.fe.models.toolframe3d import setup_boring_toolframe
-
-        return setup_boring_toolframe(cfg, source)
-    mat = load_material(cfg.material.name, source=source,
-                        hardening_strain_limit=cfg.material.strain_limit())
-    ins = cfg.insert.to_insert()
-    ap = cfg.cut.depth_of_cut_mm * 1e-3
-    f = cfg.cut.feed_mm_per_rev * 1e-3
-    le = cfg.mesh.element_size_um * 1e-6
-    L = cfg.cut.cut_length_mm * 1e-3
-    R = 0.5 * cfg.cut.bore_diameter_mm * 1e-3
-    n_rps = cfg.cut.speed_rpm / 60.0
-    vc = 2 * math.pi * R * n_rps
-    split = cfg.mesh.separation == "node_split"
-    mesh = build_boring_mesh(ins, ap, f, le, L, cfg.mesh.depth_factor,
-                             cfg.mesh.side_margin_um * 1e-6, cfg.mesh.ahead_mm * 1e-3,
-                             split_height=cfg.mesh.separation_height_um * 1e-6 if split
-                             else None, chip_rows=cfg.mesh.chip_rows)
-    s = cfg.solver
-    spec = build_boring_spec(cfg, mat, vc * 60.0, source)
-    p = boring_prm(cfg, spec, ins, vc, f)
-    gap0 = 0.5 * le
-    x0 = -(ins.edge_radius_m + gap0)
-    t_contact = gap0 / vc
-    t_end = (L + ins.edge_radius_m + gap0) / vc
-    p[layout3d.P_SAMPLE_DT] = t_end / s.n_samples
-    st = make_state3(mesh.nodes, mesh.conn, mesh.fixed, mat, prm=p, n_samples=s.n_samples,
-                     tool_tip=(x0, 0.0, 0.0), layer=mesh.layer, twin=mesh.twin)
-    check_support_step(cfg, st, source)
-    return BoringSetup(cfg=cfg, material=mat, insert=ins, mesh=mesh, state=st, ap=ap, f=f,
-                       vc=vc, t_end=t_end, t_contact=t_contact, spec=spec,
-                       x_cut_start=-(ins.edge_radius_m
-                                     + 0.5 * cfg.mesh.element_size_um * 1e-6))
+    """Mesh, insert, support and state for ``cfg``, on the frame the config chooses
+    (:func:`robobore.cutting.fe.models.choose.choose_boring`)."""
+    return choose_boring(cfg, source=source).setup(source)
 
 
-@dataclass
+@dataclass(frozen=True)
 class BoringFEResult:
-    """Summary (JSON-ready dict), histories (arrays over samples) and the final state."""
+    """Outcome of a 3D boring run: its figures, histories and the final state."""
 
-    summary: dict[str, Any]
+    #: the run's figures (:class:`robobore.cutting.fe.models.results.BoringSummary`)
+    summary: BoringSummary
+    #: arrays over the samples, named with their unit (``time_s``, ``force_X_N``...)
     history: dict[str, np.ndarray]
+    #: the model as set up, its state at the end of the run
     setup: BoringSetup
+
+    def to_dict(self) -> dict[str, Any]:
+        """The summary's JSON (the keys ``robobore fe boring --json`` writes before the
+        mechanistic comparison and the warnings)."""
+        return self.summary.to_dict()
 
 
 def _mean_sliding_speed(st: FEState3) -> float | None:
@@ -132,14 +106,10 @@ def _mean_amp(v: np.ndarray) -> tuple[float, float]:
 
 
 def check_boring_device(cfg: BoringFEConfig, device: str, source: str | None = None) -> None:
-    """ConfigError for the GPU with the tool frame (the default frame; its ALE pass runs on
-    the CPU only)."""
-    if device == "gpu" and cfg.mesh.frame == "tool":
-        raise ConfigError("the 3D tool-frame model (the default mesh.frame) runs on the CPU "
-                          "only", file=source, field="--device", value=device,
-                          expected='cpu, or set [mesh] frame = "workpiece" in the config for '
-                          "the GPU (the workpiece-frame model: radial and feed forces 22-38 % "
-                          "low at the paper's condition, docs/fe3d.md)")
+    """ConfigError for an unknown device, the GPU with the tool frame (the default frame;
+    its ALE pass runs on the CPU only) or a GPU that is not there
+    (:func:`robobore.cutting.fe.models.choose.choose_boring`)."""
+    choose_boring(cfg, device, source)
 
 
 def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
@@ -152,28 +122,14 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     """
     from robobore.cutting.forces import rotating_to_boring
 
-    check_boring_device(cfg, device, source)
-    setup = setup_boring(cfg, source)
+    model = choose_boring(cfg, device, source)
+    setup = model.setup(source)
     st = setup.state
     dt0 = float(st.clock[1])
     mass0 = float(np.sum(st.vol0))
-    limit = cfg.solver.energy_error_limit
-
-    check = energy_check(setup.t_contact, setup.t_end, limit)
-
+    check = energy_check(setup.t_contact, setup.t_end, cfg.solver.energy_error_limit)
     t0 = time.perf_counter()
-    if device == "gpu":
-        from robobore.cutting.fe.engine.gpu.backend3d import advance3_gpu
-
-        steps = advance3_gpu(st, setup.t_end, chunk_steps=cfg.solver.chunk_steps,
-                             progress=progress, check=check)
-    elif device == "cpu":
-        steps = advance3(st, setup.t_end, chunk_steps=cfg.solver.chunk_steps,
-                         progress=progress, check=check,
-                         step=None if setup.spec is None else K3.run_chunk3_for(setup.spec))
-    else:
-        raise ConfigError("unknown device", field="--device", value=device,
-                          expected="cpu or gpu")
+    steps = model.advance(st, setup.t_end, progress=progress, check=check, spec=setup.spec)
     wall = time.perf_counter() - t0
     hh = st.hist[np.isfinite(st.hist[:, scalar3d.H_T])]
     t = hh[:, scalar3d.H_T]
@@ -195,83 +151,60 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
     n_el = st.n_elements
     cut_mm = (hh[:, scalar3d.H_TIPX] - setup.x_cut_start) * 1e3
     alive = st.alive == 1
-    # the pre-bore surface's highest point: the workpiece block's top; ap in the tool frame
-    # (whose initial mesh carries the pre-shaped chip above it)
-    ytop_max = (setup.ap if cfg.mesh.frame == "tool"
-                else float(np.max(setup.mesh.nodes[:, 1])))
-    summary: dict[str, Any] = {
-        "force_rotating_N": {"tangential": ft_m, "radial": fr_m, "feed": fz_m},
-        "force_rotating_std_N": {"tangential": float(np.std(Ft[win])),
-                                 "radial": float(np.std(Fr[win])),
-                                 "feed": float(np.std(Fz[win]))},
-        "force_mean_N": dict(zip("xyz", (float(v) for v in FB.mean(axis=1)), strict=True)),
-        "force_amplitude_N": dict(zip("xyz", (float(v) for v in
-                                              0.5 * (FB.max(axis=1) - FB.min(axis=1))),
-                                      strict=True)),
-        "force_at_run_angle_N": dict(zip("xyz", (float(np.mean(v[win])) for v in FBt),
-                                         strict=True)),
-        "bar_angle_deg": [float(np.degrees(thr[0])), float(np.degrees(thr[-1]))],
-        "averaging_window_mm": [float(cut_mm[win][0]), float(cut_mm[win][-1])],
-        "chip_area_mm2": chip_area(setup.insert, setup.ap, setup.f) * 1e6,
-        "chip_max_height_um": float((np.max(st.y[~st.ndead]) - ytop_max) * 1e6),
-        "peak_temperature_K": float(np.max(st.temp[alive])) if alive.any() else math.nan,
-        "energy_error": energy_error(en),
-        "energy_J": {"external": float(en[layout.E_EXT]), "kinetic": float(en[layout.E_KIN]),
-                     "internal": float(en[layout.E_INT]), "plastic": float(en[layout.E_PLAST]),
-                     "hourglass": float(en[layout.E_HG]), "contact": float(en[layout.E_FRIC]),
-                     "eroded": float(en[layout.E_ERODED])},
-        "hourglass_fraction": float(en[layout.E_HG] / max(en[layout.E_INT], 1e-300)),
-        "feed_amplitude_um": None,
-        "wall_time_s": wall,
-        "element_updates_per_s": n_el * steps / max(wall, 1e-12),
-        "steps": int(steps),
-        "time_step_s": dt0,
-        "n_elements": n_el,
-        "n_nodes": int(st.x.shape[0]),
-        "frame": cfg.mesh.frame,
-        "element_size_um": cfg.mesh.element_size_um,
-        "cutting_speed_m_per_min": setup.vc * 60.0,
-        "friction_coefficient": float(st.prm[layout3d.P_MU]),
-        "friction_law": cfg.friction_law(),
-        "sliding_speed_mean_m_per_s": _mean_sliding_speed(st),
-        "separation": cfg.mesh.separation if cfg.mesh.frame == "workpiece" else None,
-        "pairs_parted": int(np.sum((st.twin >= 0) & (st.tied == 0)) // 2),
-        "eroded_damage": int(np.sum(st.alive == 0)),
-        "eroded_distortion": int(np.sum(st.alive == -1)),
-        "device": device,
-    }
-    if cfg.mesh.frame == "tool":
-        from robobore.cutting.fe.models.toolframe3d import toolframe_mesh_summary
-
-        summary["toolframe_mesh"] = toolframe_mesh_summary(setup.mesh)
-        # material in the mesh at the end over the start (inflow - outflow of the passes)
-        summary["toolframe_mesh"]["mass_ratio"] = float(np.sum(st.vol0)) / mass0
-        if st.msf.shape[0] > 0:
-            # the inertia added to the thin chip elements (thin_element_factors)
-            summary["toolframe_mesh"]["inertia_factor_max"] = float(np.max(st.msf))
-            summary["toolframe_mesh"]["inertia_factor_elements"] = int(np.sum(st.msf > 1.0))
-            summary["toolframe_mesh"]["added_inertia_fraction"] = float(
-                np.sum(st.vol0 * (st.msf - 1.0)) / np.sum(st.vol0))
-    else:
-        summary["mesh_shape"] = list(setup.mesh.shape)
+    facts = model.mesh_facts(setup, hh, mass0)
+    support = None
+    feed_amp = None
     if cfg.tool_support is not None:
-        if cfg.mesh.frame == "tool":
-            # the insert's deflection along the wall normal (local y; tool_kinematics_py),
-            # which the tool-frame mesh's placement does not follow, against the edge element
-            uy = -np.cos(thr) * hh[:, scalar3d.H_UX] - np.sin(thr) * hh[:, scalar3d.H_UY]
-            tf = summary["toolframe_mesh"]
-            tf["radial_deflection_max_um"] = float(np.max(np.abs(uy))) * 1e6
-            tf["edge_element_um"] = setup.mesh.sizes.edge * 1e6
         k = cfg.tool_support.total_stiffness()
         uz = hh[:, scalar3d.H_UZ] * 1e6
-        mean_z, amp_z = _mean_amp(uz[win])
-        summary.update({
-            "feed_amplitude_um": amp_z,
-            "tool_dz_mean_um": mean_z,
-            "tool_dz_static_um": fz_m / k[2] * 1e6 if k[2] > 0 else math.nan,
-            "tool_dx_mean_um": float(np.mean(hh[win, scalar3d.H_UX]) * 1e6),
-            "tool_dy_mean_um": float(np.mean(hh[win, scalar3d.H_UY]) * 1e6),
-        })
+        mean_z, feed_amp = _mean_amp(uz[win])
+        support = ToolSupport3D(
+            tool_dz_mean_um=mean_z,
+            tool_dz_static_um=fz_m / k[2] * 1e6 if k[2] > 0 else math.nan,
+            tool_dx_mean_um=float(np.mean(hh[win, scalar3d.H_UX]) * 1e6),
+            tool_dy_mean_um=float(np.mean(hh[win, scalar3d.H_UY]) * 1e6))
+    fb_amp = 0.5 * (FB.max(axis=1) - FB.min(axis=1))
+    summary = BoringSummary(
+        force_rotating_N=RotatingForce(ft_m, fr_m, fz_m),
+        force_rotating_std_N=RotatingForce(float(np.std(Ft[win])), float(np.std(Fr[win])),
+                                           float(np.std(Fz[win]))),
+        force_mean_N=XYZ(*(float(v) for v in FB.mean(axis=1))),
+        force_amplitude_N=XYZ(*(float(v) for v in fb_amp)),
+        force_at_run_angle_N=XYZ(*(float(np.mean(v[win])) for v in FBt)),
+        bar_angle_deg=(float(np.degrees(thr[0])), float(np.degrees(thr[-1]))),
+        averaging_window_mm=(float(cut_mm[win][0]), float(cut_mm[win][-1])),
+        chip_area_mm2=chip_area(setup.insert, setup.ap, setup.f) * 1e6,
+        chip_max_height_um=float((np.max(st.y[~st.ndead]) - facts.top) * 1e6),
+        peak_temperature_K=float(np.max(st.temp[alive])) if alive.any() else math.nan,
+        energy_error=energy_error(en),
+        energy_J=Energies3D(
+            external=float(en[layout.E_EXT]), kinetic=float(en[layout.E_KIN]),
+            internal=float(en[layout.E_INT]), plastic=float(en[layout.E_PLAST]),
+            hourglass=float(en[layout.E_HG]), contact=float(en[layout.E_FRIC]),
+            eroded=float(en[layout.E_ERODED])),
+        hourglass_fraction=float(en[layout.E_HG] / max(en[layout.E_INT], 1e-300)),
+        feed_amplitude_um=feed_amp,
+        wall_time_s=wall,
+        element_updates_per_s=n_el * steps / max(wall, 1e-12),
+        steps=int(steps),
+        time_step_s=dt0,
+        n_elements=n_el,
+        n_nodes=int(st.x.shape[0]),
+        frame=model.frame,
+        element_size_um=cfg.mesh.element_size_um,
+        cutting_speed_m_per_min=setup.vc * 60.0,
+        friction_coefficient=float(st.prm[layout3d.P_MU]),
+        friction_law=cfg.friction_law(),
+        sliding_speed_mean_m_per_s=_mean_sliding_speed(st),
+        separation=facts.separation,
+        pairs_parted=int(np.sum((st.twin >= 0) & (st.tied == 0)) // 2),
+        eroded_damage=int(np.sum(st.alive == 0)),
+        eroded_distortion=int(np.sum(st.alive == -1)),
+        device=device,
+        toolframe_mesh=facts.toolframe_mesh,
+        mesh_shape=facts.mesh_shape,
+        tool_support=support,
+    )
     history = {
         "time_s": t, "cut_length_mm": cut_mm, "bar_angle_rad": thr,
         "force_tangential_N": Ft, "force_radial_N": Fr, "force_feed_N": Fz,
@@ -302,7 +235,7 @@ def compare_with_mechanistic(result: BoringFEResult,
     coef = (ti64_coefficients(s.vc * 60.0) if coefficients is None
             else load_coefficients(coefficients, s.vc * 60.0))
     mech = boring_forces(s.insert, s.ap, s.f, coef)
-    fe = result.summary["force_rotating_N"]
+    fe = result.summary.force_rotating_N.to_dict()
     out: dict[str, Any] = {"coefficients": coef.provenance if hasattr(coef, "provenance")
                            else str(coefficients)}
     for comp, key in (("tangential", "tangential_N"), ("radial", "radial_N"),

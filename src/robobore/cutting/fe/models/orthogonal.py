@@ -10,7 +10,6 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -19,18 +18,15 @@ from robobore.cutting.fe.config.engine_settings import apply_numerics
 from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.config.spec import ModelSpec, build_spec
 from robobore.cutting.fe.engine import layout
-from robobore.cutting.fe.engine.chunk_driver import (
-    advance,
-    energy_check,
-    energy_error,
-)
-from robobore.cutting.fe.engine.chunk_loop import phases_of, step_for
+from robobore.cutting.fe.engine.chunk_driver import energy_check, energy_error
+from robobore.cutting.fe.engine.chunk_loop import phases_of
 from robobore.cutting.fe.engine.state2d import (
     FEState,
     default_prm,
     make_state,
 )
 from robobore.cutting.fe.mesh.orthogonal import CuttingMesh, build_edge_refined_mesh, build_mesh
+from robobore.cutting.fe.models.choose import choose_orthogonal
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
@@ -89,7 +85,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     rake = math.radians(cfg.tool.rake_deg)
     clr = math.radians(cfg.tool.clearance_deg)
     cm = cfg.mesh
-    tool_frame = cm.frame == "tool"
+    tool_frame = choose_orthogonal(cfg, source=source).tool_frame
     if tool_frame:
         from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 
@@ -130,7 +126,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     p = spec.write_prm(apply_numerics(default_prm(), s, layout), layout,
                        cfg.cut.cutting_speed_m_per_min)
     p[layout.P_PEN] = cfg.contact.penalty_factor
-    p[layout.P_CDAMP] = cfg.contact.damping_for(cm.frame == "tool")
+    p[layout.P_CDAMP] = cfg.contact.damping_for(tool_frame)
     p[layout.P_R] = r
     p[layout.P_NRX], p[layout.P_NRY] = -math.cos(rake), math.sin(rake)
     p[layout.P_NFX], p[layout.P_NFY] = math.sin(clr), -math.cos(clr)
@@ -179,16 +175,9 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
 
 
 def check_device(device: str, cfg: FEConfig, source: str | None = None) -> None:
-    """ConfigError unless ``device`` is "cpu" or a usable "gpu" that runs every option."""
-    if device not in ("cpu", "gpu"):
-        raise ConfigError("unknown device", field="--device", value=device,
-                          expected="cpu or gpu")
-    if device == "gpu":
-        from robobore.cutting.fe.engine.gpu.backend2d import check_gpu_supported
-        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
-
-        check_gpu_supported(cfg.solver.element, source)
-        require_gpu()
+    """ConfigError unless ``device`` is "cpu" or a usable "gpu" that runs every option
+    (:func:`robobore.cutting.fe.models.choose.choose_orthogonal`)."""
+    choose_orthogonal(cfg, device, source)
 
 
 def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None = None,
@@ -198,23 +187,11 @@ def run_orthogonal(setup: CuttingSetup, progress: Callable[[float], None] | None
     ``device``: "cpu" (numba, parallel; the default) or "gpu" (numba-cuda,
     :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`).
     """
-    check_device(device, setup.cfg)
+    model = choose_orthogonal(setup.cfg, device)
     st = setup.state
-    limit = setup.cfg.solver.energy_error_limit
-
-    check = energy_check(setup.t_contact, setup.t_end, limit)
-
+    check = energy_check(setup.t_contact, setup.t_end, setup.cfg.solver.energy_error_limit)
     t0 = time.perf_counter()
-    if device == "gpu":
-        from robobore.cutting.fe.engine.gpu.backend2d import advance_gpu
-
-        steps = advance_gpu(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
-                            progress=progress, check=check)
-    else:
-        # the loop compiled for the spec's element, frame and thermal model
-        steps = advance(st, setup.t_end, chunk_steps=setup.cfg.solver.chunk_steps,
-                        progress=progress, check=check,
-                        step=None if setup.spec is None else step_for(setup.spec))
+    steps = model.advance(st, setup.t_end, progress=progress, check=check, spec=setup.spec)
     return time.perf_counter() - t0, steps
 
 
@@ -248,14 +225,15 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     ``device``: "cpu" (default) or "gpu" (see :func:`run_orthogonal`); checked before the
     mesh is built.
     """
-    from robobore.cutting.fe.models.output import (
-        FEResult,
-        chip_ratio_from_velocity,
-        measure_chip,
-        steady_window,
+    from robobore.cutting.fe.models.output import FEResult, steady_window
+    from robobore.cutting.fe.models.results import (
+        FaceForce,
+        FaceForces,
+        OrthogonalSummary,
+        ToolSupport2D,
     )
 
-    check_device(device, cfg, source)
+    model = choose_orthogonal(cfg, device, source)
     setup = setup_orthogonal(cfg, source)
     st = setup.state
     dt0 = float(st.clock[1])
@@ -271,76 +249,69 @@ def simulate_orthogonal(cfg: FEConfig, *, source: str | None = None,
     fc = hh[:, layout.H_FX] * 1e-3
     ff = hh[:, layout.H_FY] * 1e-3
     cut_pos_mm = (setup.x_cut_start - hh[:, layout.H_TIP_X]) * 1e3
-    if cfg.mesh.frame == "tool":
-        from robobore.cutting.fe.ale.toolframe import measure_chip_toolframe
-
-        chip, r_vel, n_vel = measure_chip_toolframe(st, setup.mesh, setup.h, setup.rake,
-                                                    setup.vc)
-    else:
-        chip = measure_chip(st, setup.mesh, setup.h, setup.rake, setup.vc)
-        r_vel, n_vel = chip_ratio_from_velocity(st, setup.mesh, setup.h, setup.rake,
-                                                setup.vc)
+    chip, r_vel, n_vel = model.measure_chip(setup)
     en = st.en
     n_el = st.n_elements
-    summary: dict[str, Any] = {
-        "cutting_force_N_per_mm": float(np.mean(fc[win])),
-        "feed_force_N_per_mm": float(np.mean(ff[win])),
-        "cutting_force_std_N_per_mm": float(np.std(fc[win])),
-        "feed_force_std_N_per_mm": float(np.std(ff[win])),
-        "averaging_window_mm": [float(cut_pos_mm[win][0]) if win.any() else math.nan,
-                                float(cut_pos_mm[win][-1]) if win.any() else math.nan],
-        "chip_ratio": chip.ratio,
-        "chip_ratio_points": chip.n_points,
-        "chip_ratio_velocity": r_vel,
-        "chip_ratio_velocity_points": n_vel,
-        "chip_thickness_um": chip.thickness * 1e6,
-        "shear_angle_deg": chip.shear_angle_deg,
-        "peak_temperature_K": float(np.max(st.temp[st.alive == 1])),
-        "energy_error": energy_error(en),
-        "wall_time_s": wall,
-        "element_updates_per_s": n_el * steps / max(wall, 1e-12),
-        "steps": int(steps),
-        "device": device,
-        "time_step_s": dt0,
-        "n_elements": n_el,
-        "n_nodes": int(st.x.shape[0]),
-        "friction_coefficient": setup.mu,
-        "friction_law": cfg.friction_law(),
-        "uncut_chip_thickness_um": cfg.cut.uncut_chip_thickness_um,
-        "cutting_speed_m_per_min": cfg.cut.cutting_speed_m_per_min,
-        "eroded_damage": int(np.sum(st.alive == 0)),
-        "eroded_distortion": int(np.sum(st.alive == -1)),
-        "eroded_chip_mass_fraction": float(
-            np.sum(st.area0[(st.alive != 1) & setup.mesh.chip])
-            / max(np.sum(st.area0[setup.mesh.chip]), 1e-300)),
-        "energy_external_J_per_m": float(en[layout.E_EXT]),
-        "energy_plastic_J_per_m": float(en[layout.E_PLAST]),
-        "energy_hourglass_J_per_m": float(en[layout.E_HG]),
-        "energy_contact_J_per_m": float(en[layout.E_FRIC]),
-        "energy_kinetic_J_per_m": float(en[layout.E_KIN]),
-        "energy_internal_J_per_m": float(en[layout.E_INT]),
-        "hourglass_fraction": float(en[layout.E_HG] / max(en[layout.E_INT], 1e-300)),
-    }
     faces = hh[:, layout.H_FX_RAKE:layout.H_FX_RAKE + 6] * 1e-3
     has_faces = bool(win.any() and np.all(np.isfinite(faces[win])))
+    by_face = None
     if has_faces:  # recorded by both devices
         fm = faces[win].mean(axis=0)
-        summary["force_by_face_N_per_mm"] = {
-            face: {"cutting": float(fm[2 * j]), "feed": float(fm[2 * j + 1])}
-            for j, face in enumerate(layout.FACES)}
+        by_face = FaceForces(**{face: FaceForce(cutting=float(fm[2 * j]),
+                                                feed=float(fm[2 * j + 1]))
+                                for j, face in enumerate(layout.FACES)})
+    fc_mean, ff_mean = float(np.mean(fc[win])), float(np.mean(ff[win]))
+    support = None
     if cfg.tool_support is not None:
         kx, ky = cfg.tool_support.stiffness_N_per_m  # type: ignore[misc]
         w = cfg.cut.width_mm
         dx = hh[:, layout.H_UX] * 1e6
         dy = hh[:, layout.H_UY] * 1e6
-        summary.update({
-            "tool_dx_mean_um": float(np.mean(dx[win])),
-            "tool_dy_mean_um": float(np.mean(dy[win])),
-            "tool_dx_std_um": float(np.std(dx[win])),
-            "tool_dy_std_um": float(np.std(dy[win])),
-            "tool_dx_static_um": summary["cutting_force_N_per_mm"] * w / kx * 1e6,
-            "tool_dy_static_um": summary["feed_force_N_per_mm"] * w / ky * 1e6,
-        })
+        support = ToolSupport2D(
+            tool_dx_mean_um=float(np.mean(dx[win])), tool_dy_mean_um=float(np.mean(dy[win])),
+            tool_dx_std_um=float(np.std(dx[win])), tool_dy_std_um=float(np.std(dy[win])),
+            tool_dx_static_um=fc_mean * w / kx * 1e6, tool_dy_static_um=ff_mean * w / ky * 1e6)
+    summary = OrthogonalSummary(
+        cutting_force_N_per_mm=fc_mean,
+        feed_force_N_per_mm=ff_mean,
+        cutting_force_std_N_per_mm=float(np.std(fc[win])),
+        feed_force_std_N_per_mm=float(np.std(ff[win])),
+        averaging_window_mm=(float(cut_pos_mm[win][0]) if win.any() else math.nan,
+                             float(cut_pos_mm[win][-1]) if win.any() else math.nan),
+        chip_ratio=chip.ratio,
+        chip_ratio_points=chip.n_points,
+        chip_ratio_velocity=r_vel,
+        chip_ratio_velocity_points=n_vel,
+        chip_thickness_um=chip.thickness * 1e6,
+        shear_angle_deg=chip.shear_angle_deg,
+        peak_temperature_K=float(np.max(st.temp[st.alive == 1])),
+        energy_error=energy_error(en),
+        wall_time_s=wall,
+        element_updates_per_s=n_el * steps / max(wall, 1e-12),
+        steps=int(steps),
+        device=device,
+        time_step_s=dt0,
+        n_elements=n_el,
+        n_nodes=int(st.x.shape[0]),
+        friction_coefficient=setup.mu,
+        friction_law=cfg.friction_law(),
+        uncut_chip_thickness_um=cfg.cut.uncut_chip_thickness_um,
+        cutting_speed_m_per_min=cfg.cut.cutting_speed_m_per_min,
+        eroded_damage=int(np.sum(st.alive == 0)),
+        eroded_distortion=int(np.sum(st.alive == -1)),
+        eroded_chip_mass_fraction=float(
+            np.sum(st.area0[(st.alive != 1) & setup.mesh.chip])
+            / max(np.sum(st.area0[setup.mesh.chip]), 1e-300)),
+        energy_external_J_per_m=float(en[layout.E_EXT]),
+        energy_plastic_J_per_m=float(en[layout.E_PLAST]),
+        energy_hourglass_J_per_m=float(en[layout.E_HG]),
+        energy_contact_J_per_m=float(en[layout.E_FRIC]),
+        energy_kinetic_J_per_m=float(en[layout.E_KIN]),
+        energy_internal_J_per_m=float(en[layout.E_INT]),
+        hourglass_fraction=float(en[layout.E_HG] / max(en[layout.E_INT], 1e-300)),
+        force_by_face_N_per_mm=by_face,
+        tool_support=support,
+    )
     history = {
         "time_s": t,
         "cut_length_mm": cut_pos_mm,

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from robobore.cutting.fe.engine import layout
+from robobore.cutting.fe.models.results import OrthogonalSummary
 
 
 @dataclass(frozen=True)
@@ -157,17 +158,22 @@ def chip_ratio_from_velocity(st, mesh, h: float, rake: float, vc: float) -> tupl
     return (vc / vm if vm > 0.0 else math.nan), n
 
 
-@dataclass
+@dataclass(frozen=True)
 class FEResult:
-    """Outcome of an orthogonal-cutting run (SI inside; summary keys in human units)."""
+    """Outcome of an orthogonal-cutting run (SI inside; summary fields in human units)."""
 
-    summary: dict[str, Any]
+    #: the run's figures (:class:`robobore.cutting.fe.models.results.OrthogonalSummary`)
+    summary: OrthogonalSummary
+    #: arrays over the samples, named with their unit (``time_s``, ``cutting_force_N_per_mm``...)
     history: dict[str, np.ndarray]
+    #: the full config after defaults (``FEConfig.model_dump()``)
     config: dict[str, Any]
+    #: the final mesh and fields (coordinates, connectivity, element fields, the tool outline)
     final: dict[str, np.ndarray] = field(repr=False)
 
     def to_dict(self) -> dict[str, Any]:
-        return dict(self.summary)
+        """The summary's JSON (the keys ``robobore fe orthogonal --json`` writes)."""
+        return self.summary.to_dict()
 
 
 def steady_window(t: np.ndarray, t_start: float, t_end: float) -> np.ndarray:
@@ -194,12 +200,13 @@ def to_dataset(res: FEResult):
     data = {k: ("time", np.asarray(v), {"units": units.get(k, "")})
             for k, v in hist.items() if k != "time_s"}
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"})})
-    for k, v in res.summary.items():
+    summary = res.summary.to_dict()
+    for k, v in summary.items():
         if isinstance(v, bool):
             ds.attrs[k] = int(v)
         elif isinstance(v, int | float | str):
             ds.attrs[k] = v
-    for face, f in res.summary.get("force_by_face_N_per_mm", {}).items():
+    for face, f in summary.get("force_by_face_N_per_mm", {}).items():
         for comp, val in f.items():
             ds.attrs[f"{face}_{comp}_force_N_per_mm"] = val
     return ds
@@ -247,16 +254,16 @@ def plot_chip(res: FEResult, path: str | Path, field_name: str = "temperature_K"
     ax.fill(tx * 1e3, ty * 1e3, color="0.6", alpha=0.8, lw=0.5, ec="k")
     cx = float(f["tool_center"][0]) * 1e3
     w = window_mm if window_mm is not None else 0.5
-    h = float(res.summary["uncut_chip_thickness_um"]) * 1e-3
+    h = float(res.summary.uncut_chip_thickness_um) * 1e-3
     ax.set_xlim(cx - 0.5 * w, cx + 0.5 * w)
     ax.set_ylim(-3.5 * h, 0.6 * w)
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
     s = res.summary
-    ax.set_title(f"Fc = {s['cutting_force_N_per_mm']:.1f} N/mm, "
-                 f"Ff = {s['feed_force_N_per_mm']:.1f} N/mm, chip ratio = "
-                 f"{s['chip_ratio']:.2f}")
+    ax.set_title(f"Fc = {s.cutting_force_N_per_mm:.1f} N/mm, "
+                 f"Ff = {s.feed_force_N_per_mm:.1f} N/mm, chip ratio = "
+                 f"{s.chip_ratio:.2f}")
     from robobore.io.results import save_figure
 
     p = Path(path)

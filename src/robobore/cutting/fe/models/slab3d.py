@@ -34,9 +34,10 @@ from robobore.cutting.fe.config.engine_settings import (
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
 from robobore.cutting.fe.config.spec import (
-    BoringSpec,
     HexElement,
+    ModelSpec,
     WorkpieceFrame,
+    WorkpieceFrame3D,
     build_spec,
 )
 from robobore.cutting.fe.engine import layout
@@ -50,6 +51,8 @@ from robobore.cutting.fe.engine.state3d import (
     split_node_layer,
 )
 from robobore.cutting.fe.hex import layout3d, scalar3d
+from robobore.cutting.fe.models.choose import choose_orthogonal
+from robobore.cutting.fe.models.results import SlabSummary
 from robobore.errors import ConfigError
 from robobore.material import load_material
 
@@ -69,7 +72,7 @@ class SlabSetup:
 def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
                 ahead: float = 0.1e-3) -> SlabSetup:
     """3D plane-strain slab of the 2D config ``cfg`` (workpiece frame, node splitting only)."""
-    if cfg.mesh.frame != "workpiece":
+    if choose_orthogonal(cfg).tool_frame:
         raise ConfigError("the 3D slab cross-check is a workpiece-frame model",
                           field="mesh.frame", value=cfg.mesh.frame, expected='"workpiece"')
     if cfg.mesh.separation != "node_split":
@@ -109,12 +112,11 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     spec2 = build_spec(cfg, mat)
     frame = spec2.frame
     assert isinstance(frame, WorkpieceFrame)
-    spec = BoringSpec(separation=frame.separation, damage_erosion=cfg.solver.erosion == "layer",
-                      element=HexElement(cfg.solver.hourglass_viscous,
-                                         cfg.solver.hourglass_stiffness),
-                      erode_time_step_fraction=frame.erode_time_step_fraction,
-                      friction=spec2.friction, thermal=spec2.thermal,
-                      hardening=spec2.hardening)
+    spec = ModelSpec(frame=WorkpieceFrame3D(
+        separation=frame.separation, damage_erosion=cfg.solver.erosion == "layer",
+        erode_time_step_fraction=frame.erode_time_step_fraction,
+        element=HexElement(cfg.solver.hourglass_viscous, cfg.solver.hourglass_stiffness)),
+        friction=spec2.friction, thermal=spec2.thermal, hardening=spec2.hardening)
     p0 = apply_numerics(default_prm3(), cfg.solver, layout3d)
     p = _straight_insert(spec.write_prm(p0, layout3d,
                                         cfg.cut.cutting_speed_m_per_min), cfg, vc,
@@ -156,7 +158,7 @@ def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
     from robobore.cutting.fe.models.orthogonal import setup_orthogonal
     from robobore.cutting.fe.models.toolframe3d import attach_toolframe, toolframe_fixed
 
-    if cfg.mesh.frame != "tool":
+    if not choose_orthogonal(cfg).tool_frame:
         raise ConfigError("the tool-frame slab needs the 2D tool-frame model",
                           field="mesh.frame", value=cfg.mesh.frame, expected='"tool"')
     setup2 = setup_orthogonal(cfg)
@@ -166,12 +168,11 @@ def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
     width = n_z * le
     mesh = extrude_toolframe_mesh(setup2.mesh, np.linspace(-0.5 * width, 0.5 * width, n_z + 1))
     vc = cfg.cut.cutting_speed_m_per_min / 60.0
-    spec = BoringSpec(separation=None, damage_erosion=False,
-                      element=HexElement(spec2.frame.element.hourglass_viscous,
-                                         spec2.frame.element.hourglass_stiffness),
-                      erode_time_step_fraction=0.0, friction=spec2.friction,
-                      thermal=spec2.thermal, hardening=spec2.hardening,
-                      tool_frame=ToolFrame3D(ale_interval=spec2.frame.ale_interval))
+    spec = ModelSpec(frame=ToolFrame3D(
+        ale_interval=spec2.frame.ale_interval,
+        element=HexElement(spec2.frame.element.hourglass_viscous,
+                           spec2.frame.element.hourglass_stiffness)),
+        friction=spec2.friction, thermal=spec2.thermal, hardening=spec2.hardening)
     p0 = apply_numerics(default_prm3(), cfg.solver, layout3d)
     p = _straight_insert(spec.write_prm(p0, layout3d,
                                         cfg.cut.cutting_speed_m_per_min), cfg, vc,
@@ -187,7 +188,7 @@ def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
 
 
 def simulate_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
-                             progress: Any = None) -> dict[str, Any]:
+                             progress: Any = None) -> SlabSummary:
     """Run the tool-frame slab (:func:`setup_slab3_toolframe`); the outputs of
     :func:`simulate_slab3`."""
     s = setup_slab3_toolframe(cfg, n_z=n_z)
@@ -196,27 +197,28 @@ def simulate_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2, steady_fraction: fl
 
 
 def simulate_slab3(cfg: FEConfig, *, n_z: int = 2, steady_fraction: float = 0.5,
-                   **kw: Any) -> dict[str, Any]:
-    """Run the slab; forces on the tool per unit width [N/mm] averaged over the last
-    ``steady_fraction`` of the cut, energy error, hourglass fraction, eroded elements."""
+                   **kw: Any) -> SlabSummary:
+    """Run the slab; a :class:`robobore.cutting.fe.models.results.SlabSummary`: forces on the
+    tool per unit width [N/mm] averaged over the last ``steady_fraction`` of the cut, energy
+    error, hourglass fraction, eroded elements."""
     s = setup_slab3(cfg, n_z=n_z, **kw)
     return _slab_summary(s, advance3(s.state, s.t_end), steady_fraction)
 
 
-def _slab_summary(s: SlabSetup, steps: int, steady_fraction: float) -> dict[str, Any]:
+def _slab_summary(s: SlabSetup, steps: int, steady_fraction: float) -> SlabSummary:
     # forces per unit width over the window, energy balance, counts
     st = s.state
     hh = st.hist[np.isfinite(st.hist[:, scalar3d.H_T])]
     win = hh[:, scalar3d.H_T] >= s.t_end - steady_fraction * s.cut_length / s.vc
     w_mm = s.width * 1e3
-    return {
-        "cutting_force_N_per_mm": float(-np.mean(hh[win, scalar3d.H_FX]) / w_mm),
-        "feed_force_N_per_mm": float(np.mean(hh[win, scalar3d.H_FY]) / w_mm),
-        "out_of_plane_force_N_per_mm": float(np.mean(hh[win, scalar3d.H_FZ]) / w_mm),
-        "energy_error": energy_error(st.en),
-        "hourglass_fraction": float(st.en[layout.E_HG] / max(st.en[layout.E_INT], 1e-300)),
-        "eroded": int(np.sum(st.alive != 1)),
-        "n_elements": st.n_elements,
-        "steps": int(steps),
-        "final_time_step_s": float(st.clock[1]),
-    }
+    return SlabSummary(
+        cutting_force_N_per_mm=float(-np.mean(hh[win, scalar3d.H_FX]) / w_mm),
+        feed_force_N_per_mm=float(np.mean(hh[win, scalar3d.H_FY]) / w_mm),
+        out_of_plane_force_N_per_mm=float(np.mean(hh[win, scalar3d.H_FZ]) / w_mm),
+        energy_error=energy_error(st.en),
+        hourglass_fraction=float(st.en[layout.E_HG] / max(st.en[layout.E_INT], 1e-300)),
+        eroded=int(np.sum(st.alive != 1)),
+        n_elements=st.n_elements,
+        steps=int(steps),
+        final_time_step_s=float(st.clock[1]),
+    )

@@ -30,8 +30,6 @@ checked from the start of the run).
 from __future__ import annotations
 
 import math
-from typing import Any
-
 import numpy as np
 
 from robobore.cutting.fe.ale.remap3d import FACES_OUT
@@ -47,6 +45,7 @@ from robobore.cutting.fe.mesh.toolframe3d import (
     build_toolframe3d_mesh,
 )
 from robobore.cutting.fe.models.boring_setup import BoringSetup, boring_prm, check_support_step
+from robobore.cutting.fe.models.results import ToolFrameMeshSummary
 from robobore.errors import ConfigError
 from robobore.material import Material, load_material
 
@@ -139,7 +138,7 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
     st = make_state3(mesh.nodes, mesh.conn, toolframe_fixed(mesh), mat, prm=p,
                      n_samples=s.n_samples, tool_tip=tip)
     attach_toolframe(st, mesh, tip)
-    if spec.tool_frame.thin_element_mass_scaling:
+    if spec.frame.thin_element_mass_scaling:
         dte = element_steps3(st)  # the mesh as built, once for both
         st.set_inertia_factors(thin_element_factors(st, mesh, dte))
         st.prm[layout3d.P_MSF_DT] = tip_section_step(st, mesh, dte)
@@ -148,22 +147,22 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
                        vc=vc, t_end=t_end, t_contact=0.0, spec=spec, x_cut_start=tip[0])
 
 
-def toolframe_mesh_summary(mesh: ToolFrameMesh3D) -> dict[str, Any]:
-    """The mesh facts of a tool-frame run for its JSON: nodes, hexahedra, slices (engaged,
-    margin), the clamp ``t_min``, the shortest element edge and the chip areas of
+def toolframe_mesh_summary(mesh: ToolFrameMesh3D) -> ToolFrameMeshSummary:
+    """The mesh facts of a tool-frame run: nodes, hexahedra, slices (engaged, margin), the
+    clamp ``t_min``, the shortest element edge and the chip areas of
     :attr:`ToolFrameMesh3D.areas` [mm^2] (a run adds ``mass_ratio``: the mass in the mesh
     at the end over that at the start)."""
     a = mesh.areas
-    return {
-        "nodes": mesh.n_nodes,
-        "hexahedra": mesh.n_elements,
-        "slices": int(mesh.z_slices.size),
-        "engaged_slices": int(np.sum(mesh.engaged)),
-        "t_min_um": mesh.sizes.t_min * 1e6,
-        "min_element_edge_um": mesh.min_edge * 1e6,
-        "chip_area_mm2": a.get("chip", math.nan) * 1e6,
-        "mesh_chip_area_mm2": a.get("mesh_above_edge", math.nan) * 1e6,
-        "clamp_area_mm2": a.get("clamp", math.nan) * 1e6,
-        "clamp_area_fraction": a.get("clamp_mesh", math.nan) / a["chip"] if "chip" in a
+    return ToolFrameMeshSummary(
+        nodes=mesh.n_nodes,
+        hexahedra=mesh.n_elements,
+        slices=int(mesh.z_slices.size),
+        engaged_slices=int(np.sum(mesh.engaged)),
+        t_min_um=mesh.sizes.t_min * 1e6,
+        min_element_edge_um=mesh.min_edge * 1e6,
+        chip_area_mm2=a.get("chip", math.nan) * 1e6,
+        mesh_chip_area_mm2=a.get("mesh_above_edge", math.nan) * 1e6,
+        clamp_area_mm2=a.get("clamp", math.nan) * 1e6,
+        clamp_area_fraction=a.get("clamp_mesh", math.nan) / a["chip"] if "chip" in a
         else math.nan,
-    }
+    )

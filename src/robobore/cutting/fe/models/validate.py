@@ -292,13 +292,13 @@ def run_validation(base: dict[str, Any], measured: list[MeasuredPoint], *,
             res = simulate(pl.cfg, source=source, progress=prog, device=device)
             s = res.summary
             stored = {"inputs": pl.inputs,
-                      "result": {"cutting_force_N_per_mm": _finite(s.get("cutting_force_N_per_mm")),
-                                 "feed_force_N_per_mm": _finite(s.get("feed_force_N_per_mm")),
-                                 "chip_ratio": _finite(s.get("chip_ratio")),
-                                 "energy_error": _finite(s.get("energy_error")),
-                                 "steps": s.get("steps"), "n_elements": s.get("n_elements"),
-                                 "element_updates_per_s": _finite(s.get("element_updates_per_s")),
-                                 "friction_law": s.get("friction_law"),
+                      "result": {"cutting_force_N_per_mm": _finite(s.cutting_force_N_per_mm),
+                                 "feed_force_N_per_mm": _finite(s.feed_force_N_per_mm),
+                                 "chip_ratio": _finite(s.chip_ratio),
+                                 "energy_error": _finite(s.energy_error),
+                                 "steps": s.steps, "n_elements": s.n_elements,
+                                 "element_updates_per_s": _finite(s.element_updates_per_s),
+                                 "friction_law": s.friction_law,
                                  "wall_time_s": time.perf_counter() - t0}}
             if pl.path is not None:
                 from robobore.io.results import write_json
