@@ -1,22 +1,19 @@
 """The ``[solver]`` keys the 2D orthogonal and the 3D boring configs share, with one meaning
 and one default in both (:class:`SolverSettings`); each config's ``SolverSection`` extends it
-with the keys of its own engine (:mod:`.orthogonal`, :mod:`.boring3d`). :class:`Strict` is the
-base of every config section: unknown keys are an error.
+with the keys of its own engine (:mod:`.orthogonal`, :mod:`.boring3d`). ``Strict`` is
+:class:`robobore.io.sections.StrictModel`, the base of every config section: unknown keys are
+an error.
 """
 
 from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from robobore.io.sections import StrictModel as Strict
 
 __all__ = ["Strict", "SolverSettings"]
-
-
-class Strict(BaseModel):
-    """A config section that refuses unknown keys."""
-
-    model_config = ConfigDict(extra="forbid")
 
 
 class SolverSettings(Strict):
