@@ -15,6 +15,14 @@ from the surface left by the previous passes:
   trailing side of the nose (``h0 = 0``, depth-independent length ``edge_fixed_m``) -- while
   the insert cuts at all and vanish when it has left the cut (switching them element by
   element at ``h = 0`` would act as a relay and sustain an artificial micro-vibration);
+* the entry into and exit from the cut are located within the step: ``h_e`` and the depth
+  factor are linear over the step (the velocity extrapolation below), the shearing force is
+  integrated over the part of the step where both are positive (midpoint rule on that part)
+  and the edge force is weighted by the insert's in-cut fraction, so that the force impulse
+  of a step the tool leaves or enters the cut in is second order in the step (switched per
+  whole step it is first order, and the interrupted cut does not converge in the sampling);
+  a step wholly in the cut is the plain midpoint rule; the surface at an angular sample is
+  renewed when its midpoint is cut;
 * the modal equations are integrated by exact discretisation with the force held over the step
   (zero-order hold; unconditionally stable, exact for the free response), the force being
   evaluated with the displacement extrapolated to the step midpoint (second order in the
