@@ -4,8 +4,8 @@ A KUKA KR 240 R2900-like arm (``examples/robots/kr240-r2900.toml``, ASSUMED link
 the chain a user runs (all SYNTHETIC: virtual campaign, stiffness identification, virtual hammer
 test, modal identification, equivalent model), then ``simulate boring
 examples/boring_process.toml --equivalent-file ... --speed-rpm 380 --depth-mm 0.02`` at
-``--samples-per-rev`` 1266, the default, 4000 and twice the default (and the last two at 240
-revolutions instead of the example's 60), beside the
+``--samples-per-rev`` 1266, the default, 4000 and twice the default (and the default and twice it at 240
+revolutions instead of the example's 60, and all four at 120), beside the
 semi-discretisation critical depth at 380 r/min (``robobore lobes``' answer at that speed).
 
     python benchmarks/kuka_sampling.py
@@ -64,6 +64,7 @@ def main() -> None:
               f"interrupted below {at['interrupted_below_mm']:.4g} mm")
         base = None
         for spr, revs in ((1266, None), (None, None), (4000, None), ("2x", None),
+                          (1266, 120), (None, 120), (4000, 120), ("2x", 120),
                           (None, 240), ("2x", 240)):
             args = ["simulate", "boring", PROCESS, "--equivalent-file", eq, "--speed-rpm",
                     "380", "--depth-mm", "0.02", "--json"]
@@ -84,7 +85,7 @@ def main() -> None:
                   f"{r['chatter_cause']}; same run at 2 x samples/rev: "
                   f"{(r['sampling_check'] or {}).get('chatter')}), Floquet multiplier "
                   f"{'-' if rho is None else f'{rho:.5f}'}, "
-                  f"tool leaves cut {r['tool_leaves_cut']}, diverged {r['diverged']}, feed "
+                  f"tool leaves cut {r['tool_leaves_cut']} (by {r['tool_leaves_cut_cause']}), diverged {r['diverged']}, feed "
                   f"amplitude {feed}, Ra {r['roughness_Ra_um']} um, revolutions "
                   f"{r['revolutions']}", flush=True)
     print(f"{time.perf_counter() - t0:.1f} s")

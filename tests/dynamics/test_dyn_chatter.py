@@ -155,6 +155,9 @@ def test_verdict_tool_leaves_cut():
     z, h = _cusps(0.1e-3, 0.4e-3)
     v = classify(_cut(X, NS, z, h, area=area))
     assert v.tool_leaves_cut and 0 < v.tool_left_cut_fraction < 0.02
+    # the motion repeats every pitch: the forced vibration interrupts the cut, no chatter
+    assert not v.chatter and v.chatter_decided
+    assert v.tool_leaves_cut_cause == "forced vibration" and v.chatter_cause is None
     assert v.surface_finish is None  # no tolerance given
     # without a tolerance the paper's criterion is not judged (never "stable" by default)
     assert v.paper_stable is None and v.verdicts()["paper_criterion"] is None

@@ -16,7 +16,8 @@ grows from pitch to pitch: the Floquet multiplier of the simulated cut above 1, 
 nonlinear cause named in ``chatter_cause``), ``chatter_decided`` (False when the multiplier is
 within its uncertainty of 1 even after the run was lengthened, or when the tool leaves the
 cut and the same run at twice the samples per revolution, ``sampling_check``, gives the other
-verdict: an interrupted cut whose nonsmooth force the time domain does not resolve),
+verdict), ``tool_leaves_cut_cause`` (why the tool leaves the cut: "forced vibration", not
+chatter, or "regenerative vibration"; None while it stays in the cut),
 ``surface_finish`` ("ok" /
 "rough": Ra after form removal against ``ra_tolerance_um``; None without a tolerance),
 ``tool_leaves_cut``, and ``stable``: the paper's criterion (vibratory when Ra exceeds the
@@ -179,7 +180,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
                     f"sampling ({'chatter' if v.chatter else 'no chatter'} at "
                     f"{int(ds.attrs['samples_per_rev'])} samples per revolution, "
                     f"{'chatter' if v2.chatter else 'no chatter'} at {spr2}): an interrupted, "
-                    "nonlinear cut that the time domain does not resolve; below the depth "
+                    "nonlinear cut; below the depth "
                     "where the forced vibration leaves the cut (interrupted_below_mm of "
                     "`robobore lobes`) the cut is not chatter-free",))
     s = summarize(ds)
@@ -193,6 +194,7 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         "chatter_decided": v.chatter_decided,
         "sampling_check": sampling_check,
         "chatter_cause": v.chatter_cause,
+        "tool_leaves_cut_cause": v.tool_leaves_cut_cause,
         "floquet_multiplier": v.floquet_multiplier,
         "floquet_multiplier_se": v.floquet_multiplier_se,
         "vibration_growth": v.vibration_growth,

@@ -13,10 +13,16 @@ A cut gets separate, named verdicts (:func:`classify`, :class:`ChatterVerdict`):
   (:data:`DECISION_SIGMAS`), else the run is too short to decide near the limit and says so
   (``chatter_decided`` false, a reason naming the multiplier; ``simulate`` callers lengthen the
   run). Where the tool leaves the cut in the last ``tail_fraction`` of the run the cut is
-  nonlinear (the chip is interrupted; the multiplier of the linear cut no longer describes
-  it): chatter is then vibration that grew from the quietest point of the first half and
-  stays (:func:`vibration_growth` and :func:`amplitude_growth` both above ``growth_limit``),
-  and the reason names the nonlinear cause. A run that diverged (tool-point displacement above
+  nonlinear (the chip is interrupted) and the verdict names why the tool leaves it
+  (``tool_leaves_cut_cause``): ``"forced vibration"`` -- the motion repeats every pitch to
+  below :data:`AMPLITUDE_RESOLUTION_M` (a bounded forced vibration interrupts the cut; growth
+  ratios of sub-resolution values are not findings), or the multiplier, fitted as above,
+  decides that the regenerative vibration decays: no chatter; ``"regenerative vibration"``
+  -- the vibration grew from the quietest point of the first half and stays
+  (:func:`vibration_growth` and :func:`amplitude_growth` both above ``growth_limit``) to a
+  regenerative displacement beyond the linear range (:data:`LINEAR_FRACTION` of the depth),
+  or the multiplier decides that it grows: chatter (``chatter_cause`` "tool leaves the cut"
+  or "regenerative"); ``"undecided"`` otherwise. A run that diverged (tool-point displacement above
   the divergence limit) is chatter. A cut whose vibration does not grow is not chatter,
   however rough. Reported with it: the chatter frequency (largest spectral peak away from the
   tooth-passing harmonics ``k N n / 60``, in the last ``tail_fraction`` of the run; none for a
@@ -234,6 +240,7 @@ class ChatterVerdict:
     floquet_multiplier_se: float = math.nan
     chatter_decided: bool = True
     chatter_cause: str | None = None
+    tool_leaves_cut_cause: str | None = None
 
     def verdicts(self) -> dict[str, Any]:
         """The named verdicts: ``chatter``, ``surface_finish``, ``tool_leaves_cut``,
@@ -247,6 +254,14 @@ class ChatterVerdict:
         d = dict(self.__dict__)
         d["reasons"] = list(self.reasons)
         return d
+
+
+def _regenerative_tail(X: np.ndarray, samples_per_delay: int) -> float:
+    """Largest regenerative displacement ``|r(t) - r(t - tau)|`` over the last delay [m]."""
+    s = int(samples_per_delay)
+    if X.shape[0] < 2 * s:
+        return math.inf
+    return float(np.linalg.norm(X[-s:] - X[-2 * s:-s], axis=1).max())
 
 
 def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | None = None,
@@ -279,27 +294,45 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
         LINEAR_FRACTION * depth if math.isfinite(depth) and depth > 0 else None))
     decided = True
     cause = None
+    left_cause = None
     reasons = []
     if diverged:
         chatter, cause = True, "diverged"
         reasons.append(f"chatter: vibration diverged (tool-point displacement above "
                        f"{float(ds.attrs['divergence_limit_m']) * 1e3:.3g} mm at "
                        f"t = {float(ds.attrs['diverged_at_s']):.4g} s)")
-    elif left > 0:
-        chatter = grows
-        if chatter:
-            cause = "tool leaves the cut"
-            reasons.append(f"chatter: vibration grows and the tool leaves the cut (nonlinear: "
-                           f"regenerative envelope x{g:.3g}, feed amplitude "
-                           f"x{ag['feed']:.3g}, radial x{ag['radial']:.3g}) at {fpk:.4g} Hz")
+    elif left > 0 and _regenerative_tail(X, spd) < AMPLITUDE_RESOLUTION_M:
+        # the tool leaves the cut, but the motion repeats every insert pitch to below the
+        # amplitude resolution: a bounded forced vibration that interrupts the cut, not
+        # chatter (growth ratios of sub-resolution values are not findings)
+        chatter, left_cause = False, "forced vibration"
+        reasons.append(f"no chatter: the forced vibration takes the tool out of the cut and "
+                       f"the motion repeats every insert pitch (regenerative displacement "
+                       f"{_regenerative_tail(X, spd) * 1e9:.2g} nm, below the "
+                       f"{AMPLITUDE_RESOLUTION_M * 1e9:g} nm resolution)")
+    elif left > 0 and grows and _regenerative_tail(X, spd) > LINEAR_FRACTION * depth:
+        # regenerative vibration grown out of the linear range takes the tool out of the cut
+        chatter, cause, left_cause = True, "tool leaves the cut", "regenerative vibration"
+        reasons.append(f"chatter: vibration grows and the tool leaves the cut (nonlinear: "
+                       f"regenerative envelope x{g:.3g}, feed amplitude "
+                       f"x{ag['feed']:.3g}, radial x{ag['radial']:.3g}) at {fpk:.4g} Hz")
     elif not math.isfinite(rho):
         chatter, decided = grows, False
+        if left > 0:
+            left_cause = "undecided"
         reasons.append("undecided: the run is too short for a growth estimate (fewer than 7 "
                        "insert pitches); lengthen [simulation] revolutions")
     else:
         ln = math.log(rho) if rho > 0 else -math.inf
         decided = abs(ln) > max(DECISION_SIGMAS * se, DECISION_FLOOR)
         chatter = rho > 1.0
+        if left > 0:
+            left_cause = ("undecided" if not decided else
+                          "regenerative vibration" if chatter else "forced vibration")
+            if decided and not chatter:
+                reasons.append(f"no chatter: the forced vibration takes the tool out of the "
+                               f"cut; the regenerative vibration decays x{rho:.4g} per insert "
+                               f"pitch (+-{se:.2g} in ln)")
         if chatter:
             cause = "regenerative"
             reasons.append(f"chatter: vibration grows x{rho:.4g} per insert pitch (Floquet "
@@ -326,7 +359,7 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
     freq = fpk if (chatter and not diverged and math.isfinite(fpk) and fpk > 0) else None
     return ChatterVerdict(chatter, finish, left > 0, paper_stable, g, ag["feed"], ag["radial"],
                           ratio, freq, fpk, ra, rz, slope, r_ok, left, tuple(reasons),
-                          rho, se, decided, cause)
+                          rho, se, decided, cause, left_cause if left > 0 else None)
 
 
 __all__ = ["vibration_growth", "amplitude_growth", "harmonic_analysis", "classify",

@@ -271,7 +271,8 @@ def simulate_boring_cmd(
                 else f"below {res_um * 1e3:g} nm (resolution)")
         rows = [("chatter (vibration grows)", ch),
                 ("surface finish (Ra, form removed)", fin),
-                ("tool leaves the cut", "YES" if r["tool_leaves_cut"] else "no"),
+                ("tool leaves the cut", f"YES ({r.get('tool_leaves_cut_cause')})"
+                 if r["tool_leaves_cut"] else "no"),
                 ("paper's criterion (Ra > tolerance or chatter)", paper),
                 ("chatter frequency (Hz)", r["chatter_frequency_Hz"]
                  if r["chatter_frequency_Hz"] is not None else "-"),

@@ -15,6 +15,14 @@ from the surface left by the previous passes:
   trailing side of the nose (``h0 = 0``, depth-independent length ``edge_fixed_m``) -- while
   the insert cuts at all and vanish when it has left the cut (switching them element by
   element at ``h = 0`` would act as a relay and sustain an artificial micro-vibration);
+* the entry into and exit from the cut are located within the step: ``h_e`` and the depth
+  factor are linear over the step (the velocity extrapolation below), the shearing force is
+  integrated over the part of the step where both are positive (midpoint rule on that part)
+  and the edge force is weighted by the insert's in-cut fraction, so that the force impulse
+  of a step the tool leaves or enters the cut in is second order in the step (switched per
+  whole step it is first order, and the interrupted cut does not converge in the sampling);
+  a step wholly in the cut is the plain midpoint rule; the surface at an angular sample is
+  renewed when its midpoint is cut;
 * the modal equations are integrated by exact discretisation with the force held over the step
   (zero-order hold; unconditionally stable, exact for the free response), the force being
   evaluated with the displacement extrapolated to the step midpoint (second order in the
@@ -71,6 +79,22 @@ def modal_zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.
     return Phi, Gam
 
 
+@nb.njit(cache=True, inline="always")
+def _positive_part(v, dv):  # pragma: no cover - compiled
+    """The part ``[lo, hi]`` of ``s`` in ``[0, 1]`` where ``v + (s - 1/2) dv > 0`` (a value
+    linear over the step, ``v`` at its midpoint); ``lo >= hi`` when there is none."""
+    va = v - 0.5 * dv
+    vb = v + 0.5 * dv
+    if va > 0.0 and vb > 0.0:
+        return 0.0, 1.0
+    if va <= 0.0 and vb <= 0.0:
+        return 1.0, 0.0
+    sz = va / (va - vb)  # the zero crossing
+    if va > 0.0:
+        return 0.0, sz
+    return sz, 1.0
+
+
 @nb.njit(cache=True)
 def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, shr, edg, dd,
                      inv_depth, mu, om, zeta, minv, half_dt, q, qd, sr, tlast, F_out, X_out,
@@ -89,6 +113,9 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, sh
         rx = 0.0
         ry = 0.0
         rz = 0.0
+        vx = 0.0
+        vy = 0.0
+        vz = 0.0
         for j in range(m):
             px += D[j, 0] * q[j]
             py += D[j, 1] * q[j]
@@ -97,6 +124,13 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, sh
             rx += D[j, 0] * qm
             ry += D[j, 1] * qm
             rz += D[j, 2] * qm
+            # displacement change over the step (the same linear extrapolation)
+            vx += D[j, 0] * qd[j]
+            vy += D[j, 1] * qd[j]
+            vz += D[j, 2] * qd[j]
+        vx *= 2.0 * half_dt
+        vy *= 2.0 * half_dt
+        vz *= 2.0 * half_dt
         fx = 0.0
         fy = 0.0
         fz = 0.0
@@ -109,14 +143,24 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, sh
             c0 = basis[jj, 0, 0] * ux + basis[jj, 0, 1] * uy + basis[jj, 0, 2] * uz
             c1 = basis[jj, 1, 0] * ux + basis[jj, 1, 1] * uy + basis[jj, 1, 2] * uz
             c2 = basis[jj, 2, 0] * ux + basis[jj, 2, 1] * uy + basis[jj, 2, 2] * uz
+            # change of the chip-frame displacement over the step
+            d0 = basis[jj, 0, 0] * vx + basis[jj, 0, 1] * vy + basis[jj, 0, 2] * vz
+            d1 = basis[jj, 1, 0] * vx + basis[jj, 1, 1] * vy + basis[jj, 1, 2] * vz
+            d2 = basis[jj, 2, 0] * vx + basis[jj, 2, 1] * vy + basis[jj, 2, 2] * vz
             g = 1.0
+            dg = 0.0
             if inv_depth > 0.0:
                 a0 = basis[jj, 0, 0] * rx + basis[jj, 0, 1] * ry + basis[jj, 0, 2] * rz
                 a1 = basis[jj, 1, 0] * rx + basis[jj, 1, 1] * ry + basis[jj, 1, 2] * rz
                 a2 = basis[jj, 2, 0] * rx + basis[jj, 2, 1] * ry + basis[jj, 2, 2] * rz
                 g = 1.0 + inv_depth * (dd[0] * a0 + dd[1] * a1 + dd[2] * a2)
-                if g < 0.0:
-                    g = 0.0
+                dg = inv_depth * (dd[0] * d0 + dd[1] * d1 + dd[2] * d2)
+            # depth factor over the step: g(s) = g + (s - 1/2) dg, s in [0, 1]; the part of
+            # the step with g > 0
+            glo = 0.0
+            ghi = 1.0
+            if g - 0.5 * dg <= 0.0 or g + 0.5 * dg <= 0.0:
+                glo, ghi = _positive_part(g, dg)
             area = 0.0
             f0 = 0.0
             f1 = 0.0
@@ -124,26 +168,64 @@ def _simulate_kernel(n_steps, Ns, N, Phi, Gam, D, basis, h0, w, ds, dsf, nrm, sh
             e0 = 0.0
             e1 = 0.0
             e2 = 0.0
+            ilo = 1.0  # the part of the step in which the insert cuts (any element)
+            ihi = 0.0
+            mid_cut = False
             for e in range(E):
                 h = passes * h0[e] - (nrm[e, 0] * c0 + nrm[e, 1] * c1 + nrm[e, 2] * c2)
+                if w[e] <= 0.0:
+                    continue  # no shearing width (a rubbing-only element): no chip
                 if h > 0.0 and g > 0.0:
-                    a = h * w[e] * g
+                    mid_cut = True
+                dh = -(nrm[e, 0] * d0 + nrm[e, 1] * d1 + nrm[e, 2] * d2)
+                if ghi > glo and h - 0.5 * dh > 0.0 and h + 0.5 * dh > 0.0 and glo == 0.0 \
+                        and ghi == 1.0:
+                    # in the cut over the whole step: the midpoint rule
+                    a = h * w[e] * (g if g > 0.0 else 0.0)
+                    lo = 0.0
+                    hi = 1.0
+                else:
+                    # the chip crosses zero within the step: the in-cut part [lo, hi]
+                    # (h > 0 and g > 0, both linear in s), the midpoint rule over it
+                    lo, hi = _positive_part(h, dh)
+                    if glo > lo:
+                        lo = glo
+                    if ghi < hi:
+                        hi = ghi
+                    a = 0.0
+                    if hi > lo:
+                        sm = 0.5 * (lo + hi) - 0.5
+                        a = (hi - lo) * (h + sm * dh) * w[e] * (g + sm * dg)
+                if hi > lo:
+                    if lo < ilo:
+                        ilo = lo
+                    if hi > ihi:
+                        ihi = hi
+                if a > 0.0:
                     area += a
                     f0 += shr[e, 0] * a
                     f1 += shr[e, 1] * a
                     f2 += shr[e, 2] * a
-                # engaged edge length: the leading part stretches with the actual depth,
-                # the trailing side of the nose (dsf, set by the feed) does not
-                s = ds[e] * g + dsf[e]
-                e0 += edg[e, 0] * s
-                e1 += edg[e, 1] * s
-                e2 += edg[e, 2] * s
-            if area > 0.0:
-                # edge (ploughing) forces act on the nominally engaged edge while the insert
-                # is in the cut; switching them per element at h = 0 would make a relay
+            if ihi > ilo:
+                # edge (ploughing) forces act on the nominally engaged edge over the part of
+                # the step in which the insert is in the cut (switching them per element at
+                # h = 0 would make a relay); the engaged edge length: the leading part
+                # stretches with the actual depth, the trailing side of the nose (dsf, set
+                # by the feed) does not
+                ge = g + (0.5 * (ilo + ihi) - 0.5) * dg
+                if ge < 0.0:
+                    ge = 0.0
+                frac = ihi - ilo
+                for e in range(E):
+                    s = (ds[e] * ge + dsf[e]) * frac
+                    e0 += edg[e, 0] * s
+                    e1 += edg[e, 1] * s
+                    e2 += edg[e, 2] * s
                 f0 += e0
                 f1 += e1
                 f2 += e2
+            if mid_cut:
+                # the angular sample is cut at its midpoint: the surface there is new
                 sr[jj, 0] = rx
                 sr[jj, 1] = ry
                 sr[jj, 2] = rz
