@@ -142,3 +142,20 @@ def test_operational_uff_records(tmp_path):
     back = load_operational(p)
     np.testing.assert_allclose(back.data, rec.data, rtol=1e-12)
     assert back.channel_names == rec.channel_names and back.sample_rate_Hz == 256.0
+
+
+def test_no_stable_pole_names_the_file_channels_and_expectation(tmp_path):
+    """A one-channel record of a pure tone in noise has no damped pole stable over the
+    orders: the error names the file, the channel count, the record length and what is
+    expected, and suggests more channels."""
+    fs = 200.0
+    t = np.arange(0.0, 60.0, 1.0 / fs)
+    y = np.sin(2 * np.pi * 9.0 * t) + 0.3 * np.random.default_rng(0).standard_normal(t.size)
+    p = tmp_path / "one.npz"
+    np.savez(p, data=y[None, :], sample_rate_Hz=fs)
+    r = runner.invoke(app, ["identify", "modes", "--operational", str(p), "--band-hz", "3",
+                            "60"])
+    assert r.exit_code == 2, r.output
+    out = " ".join(r.output.split())
+    assert "one.npz" in out and "1 response channel of 60 s" in out
+    assert "expected at least one physical pole" in out and "more channels" in out

@@ -390,9 +390,13 @@ def _identify_operational(rec: OperationalRecord, band_Hz: tuple[float, float],
     phys = [c for c in clusters if c.cluster_size >= need
             and not _is_harmonic(c.frequency_Hz, c.damping_ratio, f_rot)]
     if not phys:
-        raise IdentificationError(f"no pole is stable over {need} orders in {band[0]:g}-"
-                                  f"{band[1]:g} Hz (besides rotation harmonics): raise "
-                                  "--max-order, lengthen the record or check the band")
+        raise IdentificationError(
+            f"no pole is stable over {need} of the model orders 1-{max_order} in "
+            f"{band[0]:g}-{band[1]:g} Hz (besides rotation harmonics), from {l} response "
+            f"channel{'s' if l != 1 else ''} of {y.shape[1] / fs:.3g} s; expected at least one "
+            "physical pole: raise --max-order, lengthen the record"
+            + (", record more channels (one channel separates few modes)" if l == 1 else "")
+            + " or check the band")
     phys.sort(key=lambda c: c.frequency_Hz)
     # shares and shapes at the highest order, nearest pole per mode
     lam, phi, wgt = ssi_poles(model, 2 * max_order, with_share=True)
