@@ -146,8 +146,12 @@ def test_modal_band_collapses_to_nominal_and_widens_with_the_intervals(example):
             for i, a in enumerate("xyz")}
     b0 = modal_band(st, pr, speeds, zero)
     assert b0.evaluations == 1
-    assert np.array_equal(b0.median_m, nominal)
-    assert np.array_equal(b0.lower_m, nominal) and np.array_equal(b0.upper_m, nominal)
+    # equal to round-off: the spectral radii come from an Arnoldi iteration warm-started from
+    # the previous eigenvector, so two calls agree to ~1e-13, far inside the root's 1e-3
+    same = dict(rtol=1e-11, atol=0.0)
+    np.testing.assert_allclose(b0.median_m, nominal, **same)
+    np.testing.assert_allclose(b0.lower_m, nominal, **same)
+    np.testing.assert_allclose(b0.upper_m, nominal, **same)
     assert set(np.unique(b0.p_chatter)) <= {0.0, 1.0}
     half = {a: {k: [v * 0.99, v * 1.01] if k == "damping_ratio" else [v, v]
                 for k, (v, _) in u.items()} for a, u in zero.items()}
