@@ -131,7 +131,10 @@ def test_intervals_propagate_to_the_equivalent_model():
         assert u["mass_kg"][0] < em.mass_kg[a] < u["mass_kg"][1]  # m = k / w^2
         assert u["damping_N_s_per_m"][0] < em.damping_N_s_per_m[a] < \
             u["damping_N_s_per_m"][1]
-    assert "uncertainty" not in em.to_dict()  # the stability stage's contract is unchanged
+    # the ranges travel in the equivalent JSON (lobes --band reads them) and come back equal
+    d = em.to_dict()
+    assert d["uncertainty"] == em.uncertainty
+    assert EquivalentModel.from_dict(d).uncertainty == em.uncertainty
     # modes without intervals: none
     plain = EquivalentModel.from_stiffness_and_modes(
         ks, identify_modes(estimate_frf(rec).frf, band_Hz=(3.0, 60.0),

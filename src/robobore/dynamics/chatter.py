@@ -20,7 +20,8 @@ A cut gets separate, named verdicts (:func:`classify`, :class:`ChatterVerdict`):
   decides that the regenerative vibration decays: no chatter; ``"regenerative vibration"``
   -- the vibration grew from the quietest point of the first half and stays
   (:func:`vibration_growth` and :func:`amplitude_growth` both above ``growth_limit``) to a
-  regenerative displacement beyond the linear range (:data:`LINEAR_FRACTION` of the depth),
+  regenerative displacement beyond the linear range (:data:`LINEAR_FRACTION` of the chip: the
+  feed per insert, or the depth where smaller),
   or the multiplier decides that it grows: chatter (``chatter_cause`` "tool leaves the cut"
   or "regenerative"); ``"undecided"`` otherwise. A run that diverged (tool-point displacement above
   the divergence limit) is chatter. A cut whose vibration does not grow is not chatter,
@@ -264,6 +265,13 @@ def _regenerative_tail(X: np.ndarray, samples_per_delay: int) -> float:
     return float(np.linalg.norm(X[-s:] - X[-2 * s:-s], axis=1).max())
 
 
+def _chip_scale(ds: xr.Dataset, depth: float, n_inserts: int) -> float:
+    """The size of the chip [m]: the feed per insert, or the depth where it is smaller."""
+    fz = float(ds.attrs.get("feed_per_rev_m", math.nan)) / max(int(n_inserts), 1)
+    vals = [v for v in (fz, depth) if math.isfinite(v) and v > 0]
+    return min(vals) if vals else math.inf
+
+
 def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | None = None,
              tail_fraction: float = 0.3) -> ChatterVerdict:
     """The verdicts on a simulation Dataset (:func:`~robobore.dynamics.timedomain.simulate`);
@@ -310,8 +318,12 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
                        f"the motion repeats every insert pitch (regenerative displacement "
                        f"{_regenerative_tail(X, spd) * 1e9:.2g} nm, below the "
                        f"{AMPLITUDE_RESOLUTION_M * 1e9:g} nm resolution)")
-    elif left > 0 and grows and _regenerative_tail(X, spd) > LINEAR_FRACTION * depth:
-        # regenerative vibration grown out of the linear range takes the tool out of the cut
+    elif left > 0 and grows and _regenerative_tail(X, spd) > LINEAR_FRACTION * _chip_scale(
+            ds, depth, N):
+        # regenerative vibration grown out of the linear range takes the tool out of the cut:
+        # the regenerative displacement is a fraction of the chip thickness (the feed per
+        # insert sets it; the depth where it is smaller) -- a forced vibration that
+        # interrupts the cut leaves it orders of magnitude below
         chatter, cause, left_cause = True, "tool leaves the cut", "regenerative vibration"
         reasons.append(f"chatter: vibration grows and the tool leaves the cut (nonlinear: "
                        f"regenerative envelope x{g:.3g}, feed amplitude "
