@@ -309,16 +309,16 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
         reasons.append(f"chatter: vibration diverged (tool-point displacement above "
                        f"{float(ds.attrs['divergence_limit_m']) * 1e3:.3g} mm at "
                        f"t = {float(ds.attrs['diverged_at_s']):.4g} s)")
-    elif left > 0 and _regenerative_tail(X, spd) < AMPLITUDE_RESOLUTION_M:
+    elif left > 0 and (tail := _regenerative_tail(X, spd)) < AMPLITUDE_RESOLUTION_M:
         # the tool leaves the cut, but the motion repeats every insert pitch to below the
         # amplitude resolution: a bounded forced vibration that interrupts the cut, not
         # chatter (growth ratios of sub-resolution values are not findings)
         chatter, left_cause = False, "forced vibration"
         reasons.append(f"no chatter: the forced vibration takes the tool out of the cut and "
                        f"the motion repeats every insert pitch (regenerative displacement "
-                       f"{_regenerative_tail(X, spd) * 1e9:.2g} nm, below the "
+                       f"{tail * 1e9:.2g} nm, below the "
                        f"{AMPLITUDE_RESOLUTION_M * 1e9:g} nm resolution)")
-    elif left > 0 and grows and _regenerative_tail(X, spd) > LINEAR_FRACTION * _chip_scale(
+    elif left > 0 and grows and tail > LINEAR_FRACTION * _chip_scale(
             ds, depth, N):
         # regenerative vibration grown out of the linear range takes the tool out of the cut:
         # the regenerative displacement is a fraction of the chip thickness (the feed per
