@@ -101,13 +101,15 @@ def lobes_verdicts(tmp: Path) -> Path:
     for s, a in runs:
         run = api.simulate_boring(process, robot, speed_rpm=float(s), depth_mm=float(a),
                                   revolutions=60)
-        kind = ("chatter" if run["chatter"] else
+        kind = ("undecided" if not run["chatter_decided"] else
+                "chatter" if run["chatter"] else
                 "leaves" if run["tool_leaves_cut"] else "steady")
         pts.append((s, a, kind))
     for kind, mk, col, lab in (
             ("steady", "o", "tab:green", "time domain: no chatter, in the cut"),
             ("leaves", "^", "tab:orange", "time domain: no chatter, the tool leaves the cut"),
-            ("chatter", "x", "tab:red", "time domain: chatter")):
+            ("chatter", "x", "tab:red", "time domain: chatter"),
+            ("undecided", "s", "tab:gray", "time domain: undecided (at its limit)")):
         sel = [(s, a) for s, a, k in pts if k == kind]
         if sel:
             ax.plot(*zip(*sel, strict=True), mk, color=col, ms=8, mew=2, ls="none", label=lab)
@@ -123,8 +125,10 @@ def lobes_verdicts(tmp: Path) -> Path:
     out = HERE / "lobes_verdicts.png"
     fig.savefig(out, dpi=110)
     plt.close(fig)
-    agree = sum(1 for s, a, k in pts if (k == "chatter") == (a > d[np.argmin(abs(n - s))]))
-    print(f"  lobes: {agree}/{len(pts)} time-domain chatter verdicts on the lobes' side; "
+    decided = [(s, a, k) for s, a, k in pts if k != "undecided"]
+    agree = sum(1 for s, a, k in decided if (k == "chatter") == (a > d[np.argmin(abs(n - s))]))
+    print(f"  lobes: {agree}/{len(decided)} decided time-domain verdicts on the lobes' side "
+          f"({len(pts) - len(decided)} undecided); "
           + ", ".join(f"{s:.0f} r/min {a:.3f} mm {k}" for s, a, k in pts))
     return out
 
@@ -137,7 +141,6 @@ def posture_map(tmp: Path) -> Path:
     src = EXAMPLES / "plan_paper_bore.toml"
     txt = src.read_text(encoding="utf-8")
     for old, new in (('"plan_paper_bore/', f'"{EXAMPLES.as_posix()}/plan_paper_bore/'),
-                     ('"../src/', f'"{ROOT.as_posix()}/src/'),
                      ("[plan]\nrotation_step_deg = 1.0", "[plan]\nrotation_step_deg = 3.0"),
                      ("rotation_step_deg = 10.0", "rotation_step_deg = 20.0")):
         if old not in txt:
