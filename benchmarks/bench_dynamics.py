@@ -72,6 +72,7 @@ out = []
 for n, a in conds:
     t = time.perf_counter()
     s = run_boring(cfg, speed_rpm=n, depth_mm=a)
+    s = s.to_dict() if hasattr(s, "to_dict") else s  # a reference tree may return the dict
     dt = time.perf_counter() - t
     out.append({"speed_rpm": n, "depth_mm": a, "wall_s": dt, "chatter": s.get("chatter"),
                 "samples_per_rev": s.get("samples_per_rev"),

@@ -60,8 +60,8 @@ def main() -> None:
                 "identity", "mass_kg", "notes", "stiffness_N_per_m")
         at = critical_depth_at(PROCESS, 380.0, equivalent={k: v for k, v in e.items()
                                                            if k in keys})
-        print(f"semi-discretisation at 380 r/min: critical depth {at['critical_depth_mm']} mm, "
-              f"interrupted below {at['interrupted_below_mm']:.4g} mm")
+        print(f"semi-discretisation at 380 r/min: critical depth {at.critical_depth_mm} mm, "
+              f"interrupted below {at.interrupted_below_mm:.4g} mm")
         base = None
         for spr, revs in ((1266, None), (None, None), (4000, None), ("2x", None),
                           (1266, 120), (None, 120), (4000, 120), ("2x", 120),

@@ -65,9 +65,9 @@ def main() -> None:
         at = critical_depth_at(cfg, n)
         lb = lobes(cfg)
         sim = run_boring(cfg)
-        b_plan, b_lob = e["critical_depth_mm"], at["critical_depth_mm"]
-        m_plan, m_lob = e["critical_depth_range_min_mm"], float(np.min(lb["critical_depth_mm"]))
-        a_plan, a_sim = e["feed_amplitude_um"], sim["feed_amplitude_um"]
+        b_plan, b_lob = e["critical_depth_mm"], at.critical_depth_mm
+        m_plan, m_lob = e["critical_depth_range_min_mm"], float(np.min(lb.critical_depth_mm))
+        a_plan, a_sim = e["feed_amplitude_um"], sim.feed_amplitude_um
         db = abs(b_plan / b_lob - 1.0) if b_lob else abs(b_plan - b_lob)
         da = abs(a_plan / a_sim - 1.0)
         worst_b, worst_a = max(worst_b, db), max(worst_a, da)
@@ -75,8 +75,8 @@ def main() -> None:
               f"{b_lob:.6g} mm ({100 * db:.3g} %); lowest over the range: planner "
               f"{m_plan:.6g} mm, lobes {m_lob:.6g} mm; feed amplitude: planner {a_plan:.5g} "
               f"um, simulate boring {a_sim:.5g} um ({100 * da:.3g} %; chatter "
-              f"{sim['chatter']}, {sim['revolutions']} revolutions, "
-              f"{sim['samples_per_rev']} samples/rev)")
+              f"{sim.chatter}, {sim.revolutions} revolutions, "
+              f"{sim.samples_per_rev} samples/rev)")
     print(f"largest deviation: critical depth {100 * worst_b:.3g} % (target 1 %), feed "
           f"amplitude {100 * worst_a:.3g} % (target 10 %); {time.perf_counter() - t0:.1f} s")
 

@@ -95,9 +95,9 @@ def test_readme_example_identifies_the_bundled_ground_truth(readme_run):
 def test_readme_example_foot_raises_the_lobes_and_the_run_agrees(readme_run):
     ns = readme_run
     lb, lf = ns["lobes"], ns["lobes_foot"]
-    speeds = np.asarray(lb["speed_rpm"])
+    speeds = np.asarray(lb.speed_rpm)
     assert speeds[0] == 150.0 and speeds[-1] == 1100.0 and speeds.size == 39
-    d, df = np.asarray(lb["critical_depth_mm"]), np.asarray(lf["critical_depth_mm"])
+    d, df = np.asarray(lb.critical_depth_mm), np.asarray(lf.critical_depth_mm)
     assert np.all(d >= 0) and np.all(df >= 0)
     # a robot: chatter within a few tenths of a mm at most speeds, never above the scan;
     # no chatter-free depth near the forced resonances (425-475 r/min: the 6.9 Hz mode;
@@ -106,7 +106,7 @@ def test_readme_example_foot_raises_the_lobes_and_the_run_agrees(readme_run):
     # instability needs no cut (27 of 39 speeds finite)
     assert np.mean((d > 0) & np.isfinite(d)) >= 0.6
     assert np.median(d) < 1.0
-    below = np.asarray(lb["interrupted_below_mm"])
+    below = np.asarray(lb.interrupted_below_mm)
     assert below.shape == d.shape and np.all(below >= 0)
     assert np.all(d[d > 0] > below[d > 0])  # chatter-free window between the two
     # the pressure foot adds stiffness and damping: every axis stiffer, lobes higher
@@ -114,15 +114,15 @@ def test_readme_example_foot_raises_the_lobes_and_the_run_agrees(readme_run):
         assert ns["robot_foot"].stiffness_N_per_m[a] > ns["robot"].stiffness_N_per_m[a]
     assert df.min() > np.median(d)
     assert np.median(df) > 2 * np.median(d)
-    assert lb["mode_coupling_limit_mm"] is None or lb["mode_coupling_limit_mm"] > 0
+    assert lb.mode_coupling_limit_mm is None or lb.mode_coupling_limit_mm > 0
     # time domain at the cutting condition (300 r/min, 0.05 mm) vs the lobes there
     i = int(np.argmin(np.abs(speeds - 300.0)))
     assert speeds[i] == 300.0
     run = ns["run"]
-    assert run["speed_rpm"] == 300.0 and run["depth_mm"] == 0.05
-    assert (d[i] > 0.05) == (not run["chatter"])
-    assert not run["diverged"]
-    assert 0.0 < run["roughness_Ra_um"] < 10.0
+    assert run.speed_rpm == 300.0 and run.depth_mm == 0.05
+    assert (d[i] > 0.05) == (not run.chatter)
+    assert not run.diverged
+    assert 0.0 < run.roughness_Ra_um < 10.0
     assert ns["share"]["with foot"] >= ns["share"]["without foot"]
 
 
@@ -273,20 +273,20 @@ def test_lobes_take_the_model_or_its_dict_form_like_the_equivalent_section(chain
     proc = _process()
     # reference: the [equivalent] section written by hand from the model's values
     ref = api.stability_lobes({**proc, "equivalent": _section(em)}, method="frequency")
-    assert np.all(np.asarray(ref["critical_depth_mm"]) > 0)
+    assert np.all(np.asarray(ref.critical_depth_mm) > 0)
     for eq in (em, em.to_dict(), json.loads(json.dumps(em.to_dict()))):
         got = api.stability_lobes(proc, eq, method="frequency")
-        np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
-        assert got["mode_coupling_limit_mm"] == ref["mode_coupling_limit_mm"]
+        np.testing.assert_array_equal(got.critical_depth_mm, ref.critical_depth_mm)
+        assert got.mode_coupling_limit_mm == ref.mode_coupling_limit_mm
     # a TOML process config, and the CLI's --equivalent-file route, give the same lobes
     toml = tmp_path / "process.toml"
     toml.write_text(dump_toml(proc))
     got = api.stability_lobes(toml, em, method="frequency")
-    np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
+    np.testing.assert_array_equal(got.critical_depth_mm, ref.critical_depth_mm)
     (tmp_path / "eq.json").write_text(json.dumps(em.to_dict()))
     (tmp_path / "files.toml").write_text('[model]\nequivalent_file = "eq.json"\n' + dump_toml(proc))
     got = api.stability_lobes(tmp_path / "files.toml", method="frequency")
-    np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
+    np.testing.assert_array_equal(got.critical_depth_mm, ref.critical_depth_mm)
     # a validated DynamicsConfig with the model given separately
     from robobore.dynamics.config import DynamicsConfig
     from robobore.io.config import validate_model
@@ -294,7 +294,7 @@ def test_lobes_take_the_model_or_its_dict_form_like_the_equivalent_section(chain
     cfg = validate_model(DynamicsConfig, {**proc, "equivalent": _section(em)})
     cfg_proc = cfg.model_copy(update={"equivalent": None})
     got = api.stability_lobes(cfg_proc, em, method="frequency")
-    np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
+    np.testing.assert_array_equal(got.critical_depth_mm, ref.critical_depth_mm)
 
 
 def _section(em: EquivalentModel) -> dict:
@@ -307,7 +307,7 @@ def test_boring_run_takes_the_model_or_its_dict_form(chain):
     a = api.simulate_boring(_process(), em, revolutions=12)
     b = api.simulate_boring(_process(), em.to_dict(), revolutions=12)
     assert a == b
-    assert a["force_amplitude_N"]["x"] > 0
+    assert a.force_amplitude_N.x > 0
 
 
 def test_dynamics_refuses_a_wrong_model_or_a_model_given_twice(chain):
@@ -334,10 +334,10 @@ def test_config_foot_applies_to_a_model_without_one(chain):
     with_foot = api.stability_lobes(proc, em, method="frequency")
     ref = api.stability_lobes(_process(), api.equivalent_model(
         chain["pose"], chain["modes"], foot_pressure_MPa=0.3), method="frequency")
-    np.testing.assert_allclose(with_foot["critical_depth_mm"], ref["critical_depth_mm"],
+    np.testing.assert_allclose(with_foot.critical_depth_mm, ref.critical_depth_mm,
                                rtol=1e-12)
     bare = api.stability_lobes(_process(), em, method="frequency")
-    assert np.median(with_foot["critical_depth_mm"]) > np.median(bare["critical_depth_mm"])
+    assert np.median(with_foot.critical_depth_mm) > np.median(bare.critical_depth_mm)
     with pytest.raises(ConfigError):  # a model that includes a foot gets no second one
         api.stability_lobes(proc, api.equivalent_model(chain["pose"], chain["modes"],
                                                        foot_pressure_MPa=0.3),
@@ -354,14 +354,14 @@ def test_process_takes_the_cutting_stage_objects(chain):
     for coef in (read_coefficients_file(api.bundled_coefficients_path()),
                  api.cutting_coefficients(37.7, api.bundled_coefficients_path())):
         got = api.stability_lobes({**_process(), "coefficients": coef}, em, method="frequency")
-        np.testing.assert_array_equal(got["critical_depth_mm"], ref["critical_depth_mm"])
+        np.testing.assert_array_equal(got.critical_depth_mm, ref.critical_depth_mm)
     # a different set gives different lobes (the coefficients are used)
     k = api.cutting_coefficients(37.7)
     from dataclasses import replace
 
     got = api.stability_lobes({**_process(), "coefficients": replace(k, Ktc=2 * k.Ktc)}, em,
                               method="frequency")
-    assert np.median(got["critical_depth_mm"]) < np.median(ref["critical_depth_mm"])
+    assert np.median(got.critical_depth_mm) < np.median(ref.critical_depth_mm)
     with pytest.raises(ConfigError):
         api.stability_lobes({**_process(), "coefficients": 3.0}, em, method="frequency")
 

@@ -329,7 +329,7 @@ def test_process_coefficients_file_is_config_relative(tmp_path, monkeypatch):
     r = run_boring(cfgdir / "c.toml", revolutions=4, samples_per_rev=64)
     (cfgdir / "coef.json").write_text(json.dumps(stray))
     r2 = run_boring(cfgdir / "c.toml", revolutions=4, samples_per_rev=64)
-    assert r2["force_mean_N"]["x"] != pytest.approx(r["force_mean_N"]["x"], rel=0.1)
+    assert r2.force_mean_N.x != pytest.approx(r.force_mean_N.x, rel=0.1)
     (cfgdir / "coef.json").unlink()
     res = runner.invoke(app, ["simulate", "boring", str(cfgdir / "c.toml"), "--json"])
     assert res.exit_code == 2

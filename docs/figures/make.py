@@ -78,14 +78,14 @@ def lobes_verdicts(tmp: Path) -> Path:
         "speed_rpm": {"min": 150.0, "max": 1100.0, "count": 39},
     }
     lobes = api.stability_lobes(process, robot)
-    n = np.asarray(lobes["speed_rpm"], float)
-    d = np.asarray(lobes["critical_depth_mm"], float)
+    n = np.asarray(lobes.speed_rpm, float)
+    d = np.asarray(lobes.critical_depth_mm, float)
     fig, ax = plt.subplots(figsize=(8, 4.5))
     top = float(np.nanmax(d[np.isfinite(d)])) * 2.2
     ax.fill_between(n, np.where(np.isfinite(d), d, top), top, color="tab:red", alpha=0.10,
                     label="unstable (lobes)")
     ax.plot(n, d, color="tab:blue", lw=1.6, label="critical depth (semi-discretisation)")
-    ib = lobes.get("interrupted_below_mm")
+    ib = lobes.interrupted_below_mm
     if ib is not None:
         ib = np.asarray(ib, float)
         ax.plot(n, np.where(ib > 0, ib, np.nan), color="tab:orange", lw=1.0, ls="--",
@@ -101,9 +101,9 @@ def lobes_verdicts(tmp: Path) -> Path:
     for s, a in runs:
         run = api.simulate_boring(process, robot, speed_rpm=float(s), depth_mm=float(a),
                                   revolutions=60)
-        kind = ("undecided" if not run["chatter_decided"] else
-                "chatter" if run["chatter"] else
-                "leaves" if run["tool_leaves_cut"] else "steady")
+        kind = ("undecided" if not run.chatter_decided else
+                "chatter" if run.chatter else
+                "leaves" if run.tool_leaves_cut else "steady")
         pts.append((s, a, kind))
     for kind, mk, col, lab in (
             ("steady", "o", "tab:green", "time domain: no chatter, in the cut"),

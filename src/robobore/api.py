@@ -9,7 +9,8 @@ window (docs/api.md)::
         --identify_modes--> ModalAnalysis (.result: ModalResult) ---------------------+
                                   equivalent_model(stiffness, modes) --> EquivalentModel
     process config (dict or TOML: insert, bore, cutting, coefficients, speed range)
-        + EquivalentModel --stability_lobes / simulate_boring--> dicts (the CLI's --json)
+        + EquivalentModel --stability_lobes / simulate_boring--> LobesResult / BoringResult
+                                  (frozen records; .to_dict(): the CLI's --json)
 
 Each step takes the previous step's object or its dict form (the JSON of the matching
 ``robobore`` command), so results saved as JSON can re-enter anywhere. The functions are
@@ -30,9 +31,12 @@ from __future__ import annotations
 
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robobore.errors import InputError
+
+if TYPE_CHECKING:
+    from robobore.dynamics.results import BoringResult, LobesResult
 
 #: the robot of the bundled example (``robobore robot list``)
 DEFAULT_ROBOT = "irb6600-175-2.55"
@@ -398,13 +402,14 @@ def cutting_coefficients(cutting_speed_m_per_min: float | None = None,
 def simulate_boring(process: Any, equivalent: Any = None, *, speed_rpm: float | None = None,
                     depth_mm: float | None = None, feed_mm_per_rev: float | None = None,
                     pressure_MPa: float | None = None, revolutions: int | None = None,
-                    return_dataset: bool = False) -> dict[str, Any]:
-    """Time-domain boring at one condition -> the ``robobore simulate boring --json`` summary
-    (forces N, feed amplitude um, Ra/Rz um, verdicts; ``"dataset"`` with the time histories
-    if asked). ``process``: a process config (dict, TOML path or ``DynamicsConfig``: insert,
-    bore, cutting, coefficients, simulation); ``equivalent``: the robot as an
-    ``EquivalentModel`` or its dict form (None: the config's own structure). Conditions given
-    here replace the config's."""
+                    return_dataset: bool = False) -> BoringResult:
+    """Time-domain boring at one condition -> ``BoringResult``
+    (:mod:`robobore.dynamics.results`; ``.to_dict()``: the ``robobore simulate boring --json``
+    summary): forces N, feed amplitude um, Ra/Rz um, verdicts; ``.dataset`` with the time
+    histories if asked. ``process``: a process config (dict, TOML path or
+    ``DynamicsConfig``: insert, bore, cutting, coefficients, simulation); ``equivalent``: the
+    robot as an ``EquivalentModel`` or its dict form (None: the config's own structure).
+    Conditions given here replace the config's."""
     from robobore.dynamics.api import run_boring
 
     return run_boring(process, speed_rpm=speed_rpm, depth_mm=depth_mm,
@@ -415,10 +420,11 @@ def simulate_boring(process: Any, equivalent: Any = None, *, speed_rpm: float | 
 
 def stability_lobes(process: Any, equivalent: Any = None, *,
                     method: str = "semidiscretization", progress: Any = None
-                    ) -> dict[str, Any]:
-    """Stability lobes over the config's ``speed_rpm`` range -> the ``robobore lobes --json``
-    contents: ``speed_rpm``, ``critical_depth_mm`` (inf: stable up to the 50 mm scan, 0:
-    unstable at vanishing depth), ``chatter_frequency_Hz``, ``mode_coupling_limit_mm``.
+                    ) -> LobesResult:
+    """Stability lobes over the config's ``speed_rpm`` range -> ``LobesResult``
+    (``.to_dict()``: the ``robobore lobes --json`` contents without ``notes``):
+    ``speed_rpm``, ``critical_depth_mm`` (inf: stable up to the 50 mm scan, 0: unstable at
+    vanishing depth), ``chatter_frequency_Hz``, ``mode_coupling_limit_mm``.
     ``method``: "semidiscretization" (rotating bar, depth modulation) or "frequency"
     (zero-order, fast); ``progress``: a callback called with 1 after each speed
     (semi-discretisation)."""

@@ -200,11 +200,11 @@ def test_simulate_reports_a_speed_outside_the_calibrated_range(tmp_path):
     (tmp_path / "coef.json").write_text(json.dumps(_data(speeds=(10.0, 20.0))))
     p = _dyn_config(tmp_path, 'file = "coef.json"')
     r = run_boring(p, revolutions=4, samples_per_rev=64)  # 300 r/min, D 40 mm: 37.7 m/min
-    assert len(r["coefficient_warnings"]) == 1
-    assert "37.7 m/min outside the calibrated speeds 10-20" in r["coefficient_warnings"][0]
+    assert len(r.coefficient_warnings) == 1
+    assert "37.7 m/min outside the calibrated speeds 10-20" in r.coefficient_warnings[0]
     r2 = run_boring(p, speed_rpm=120.0, revolutions=4, samples_per_rev=64)  # 15.1 m/min
-    assert r2["coefficient_warnings"] == []
-    assert "interpolated linearly in ln(vc) at 15.08 m/min" in r2["coefficients_provenance"]
+    assert r2.coefficient_warnings == ()
+    assert "interpolated linearly in ln(vc) at 15.08 m/min" in r2.coefficients_provenance
     cfg, _ = load_dynamics_config(p)
     assert "300 r/min (vc 37.7 m/min)" in lobe_coefficient_note(cfg)
     (tmp_path / "one.json").write_text(json.dumps(_data(speeds=(20.0,))))

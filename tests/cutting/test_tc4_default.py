@@ -92,13 +92,13 @@ def test_outputs_say_when_the_set_is_outside_its_domain(coefficients):
         cfg = _cfg(coefficients, n, feed=0.5)
         r = run_boring(cfg)
         speed_outside = coefficients["material"] == "TC4-FE" or n == 900.0
-        assert any("outside" in w and "m/min" in w for w in r["warnings"]) == speed_outside
-        assert any("chip thicknesses" in w and "extrapolated" in w for w in r["warnings"])
+        assert any("outside" in w and "m/min" in w for w in r.warnings) == speed_outside
+        assert any("chip thicknesses" in w and "extrapolated" in w for w in r.warnings)
         lb = lobes(cfg)
-        assert any("chip thicknesses" in w for w in lb["warnings"])
-        assert any("m/min" in w for w in lb["warnings"]) == speed_outside
+        assert any("chip thicknesses" in w for w in lb.warnings)
+        assert any("m/min" in w for w in lb.warnings) == speed_outside
     inside = run_boring(_cfg({"material": "TC4"}, 150.0, feed=0.1))
-    assert inside["warnings"] == []
+    assert inside.warnings == ()
 
 
 def test_cli_table_prints_the_domain_warning(tmp_path):
@@ -166,9 +166,9 @@ def test_a_coefficients_file_content_passed_inline_keeps_its_domain():
     inline = forces.inline_coefficients(content)
     assert inline["grid"]["cutting_speed_m_per_min"] == [37.7]
     for n in (150.0, 300.0):
-        by_file = run_boring(_cfg({"material": "TC4-FE"}, n, feed=0.5))["warnings"]
-        by_inline = run_boring(_cfg(inline, n, feed=0.5))["warnings"]
-        by_content = run_boring(_cfg(content, n, feed=0.5))["warnings"]
+        by_file = run_boring(_cfg({"material": "TC4-FE"}, n, feed=0.5)).warnings
+        by_inline = run_boring(_cfg(inline, n, feed=0.5)).warnings
+        by_content = run_boring(_cfg(content, n, feed=0.5)).warnings
         assert by_file == by_inline == by_content
         assert any("chip thicknesses 60-90 um" in w for w in by_file)
         assert any("37.7 m/min" in w for w in by_file) == (n == 150.0)

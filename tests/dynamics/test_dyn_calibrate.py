@@ -248,7 +248,7 @@ def test_calibrate_cli_writes_a_model_lobes_accept(tmp_path, example):
                     + str(out / "equivalent_corrected.json") + '"\n\n'
                     + text[text.index("[insert]"):])
     b = critical_depth_at(toml, 1200.0)
-    assert b["critical_depth_mm"] is not None and a["critical_depth_mm"] is not None
+    assert b.critical_depth_mm is not None and a.critical_depth_mm is not None
 
 
 def test_calibrate_cli_without_observations_is_a_clear_error(tmp_path):

@@ -153,11 +153,11 @@ def test_api_run_boring_overrides():
     base = run_boring(ex, revolutions=20)
     more_feed = run_boring(ex, feed_mm_per_rev=0.3, revolutions=20)
     foot = run_boring(ex, pressure_MPa=0.3, revolutions=20)
-    assert more_feed["force_amplitude_N"]["x"] > base["force_amplitude_N"]["x"]
-    assert foot["feed_amplitude_um"] < base["feed_amplitude_um"]
-    assert base["speed_rpm"] == 300.0 and base["depth_mm"] == 0.05
+    assert more_feed.force_amplitude_N.x > base.force_amplitude_N.x
+    assert foot.feed_amplitude_um < base.feed_amplitude_um
+    assert base.speed_rpm == 300.0 and base.depth_mm == 0.05
     d = lobes(EX / "lobes_single_point.toml", method="frequency")
-    assert len(d["critical_depth_mm"]) == 601
+    assert len(d.critical_depth_mm) == 601
 
 
 def test_model_equivalent_from_json_files(tmp_path):

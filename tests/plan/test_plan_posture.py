@@ -121,11 +121,11 @@ def test_rated_at_the_cutting_speed_as_the_lobes_and_simulate_boring(paper_resul
            "cutting": co.cutting.model_dump(),
            "coefficients": co.coefficients.model_dump(exclude_none=True)}
     at = critical_depth_at(cfg, co.cutting.speed_rpm)
-    assert r["measured"]["critical_depth_mm"] == pytest.approx(at["critical_depth_mm"],
+    assert r["measured"]["critical_depth_mm"] == pytest.approx(at.critical_depth_mm,
                                                                rel=0.01)
     sim = run_boring(cfg)
-    assert not sim["chatter"]
-    assert r["measured"]["feed_amplitude_um"] == pytest.approx(sim["feed_amplitude_um"],
+    assert not sim.chatter
+    assert r["measured"]["feed_amplitude_um"] == pytest.approx(sim.feed_amplitude_um,
                                                                rel=0.10)
 
 

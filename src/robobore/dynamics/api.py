@@ -1,10 +1,14 @@
 """One-call entry points of the process stage for other stages (sweeps, reports).
 
 :func:`run_boring` simulates one cutting condition from a config (path, dict or validated
-:class:`~robobore.dynamics.config.DynamicsConfig`) and returns the same JSON-ready summary as
-``robobore simulate boring --json``; :func:`lobes` returns the ``robobore lobes --json``
-contents. Conditions given as arguments override the config (speed, depth, feed, foot
-pressure), so a sweep needs only one config file. Both take the robot as the
+:class:`~robobore.dynamics.config.DynamicsConfig`) and returns a
+:class:`~robobore.dynamics.results.BoringResult`, whose ``to_dict()`` is the JSON-ready
+summary of ``robobore simulate boring --json``; :func:`lobes` returns a
+:class:`~robobore.dynamics.results.LobesResult` (the ``robobore lobes --json`` contents) and
+:func:`critical_depth_at` a :class:`~robobore.dynamics.results.CriticalDepth` (the fields of
+each documented in :mod:`robobore.dynamics.results`). Conditions given as arguments
+override the config (speed, depth, feed, foot pressure), so a sweep needs only one config
+file. Both take the robot as the
 equivalent-model stage's object (``equivalent=``, an
 :class:`~robobore.equivalent.EquivalentModel` or its dict form) when the config holds only
 the process; a dict config's ``coefficients`` may be the cutting stage's
@@ -44,6 +48,14 @@ from robobore.dynamics.config import (
     resolve_model_files,
 )
 from robobore.dynamics.handoff import with_coefficients, with_equivalent
+from robobore.dynamics.results import (
+    BoringResult,
+    CriticalDepth,
+    LobesResult,
+    SamplingCheck,
+    Vector3,
+    Verdicts,
+)
 from robobore.errors import ConfigError, InputError
 from robobore.io.config import validate_model
 from robobore.io.ranges import check_positive
@@ -82,8 +94,9 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
                feed_mm_per_rev: float | None = None, pressure_MPa: float | None = None,
                revolutions: int | None = None, samples_per_rev: int | None = None,
                return_dataset: bool = False, source: str | None = None,
-               equivalent: Any = None) -> dict[str, Any]:
-    """Simulate one condition; returns the summary dict (and ``"dataset"`` if asked).
+               equivalent: Any = None) -> BoringResult:
+    """Simulate one condition; returns the summary (:class:`BoringResult`, its ``to_dict()``
+    the ``simulate boring --json`` contents; ``dataset`` and ``config`` set if asked).
 
     ``source`` names where a dict or model config came from (a file, a section), for error
     messages. ``equivalent``: the robot as the equivalent-model stage's
@@ -172,8 +185,8 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
         except ConfigError:  # the doubled run is over the size guard: no check
             v2 = None
         if v2 is not None:
-            sampling_check = {"samples_per_rev": spr2, "chatter": bool(v2.chatter),
-                              "agrees": bool(v2.chatter == v.chatter)}
+            sampling_check = SamplingCheck(samples_per_rev=spr2, chatter=bool(v2.chatter),
+                                           agrees=bool(v2.chatter == v.chatter))
             if v2.chatter != v.chatter:
                 v = replace(v, chatter_decided=False, reasons=v.reasons + (
                     f"undecided: the tool leaves the cut and the verdict changes with the "
@@ -184,55 +197,55 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
                     "where the forced vibration leaves the cut (interrupted_below_mm of "
                     "`robobore lobes`) the cut is not chatter-free",))
     s = summarize(ds)
-    out: dict[str, Any] = {
-        "stable": v.paper_stable,
-        "verdicts": v.verdicts(),
-        "chatter": v.chatter,
-        "surface_finish": v.surface_finish,
-        "tool_leaves_cut": v.tool_leaves_cut,
-        "chatter_frequency_Hz": v.chatter_frequency_Hz,
-        "chatter_decided": v.chatter_decided,
-        "sampling_check": sampling_check,
-        "chatter_cause": v.chatter_cause,
-        "tool_leaves_cut_cause": v.tool_leaves_cut_cause,
-        "floquet_multiplier": v.floquet_multiplier,
-        "floquet_multiplier_se": v.floquet_multiplier_se,
-        "vibration_growth": v.vibration_growth,
-        "feed_amplitude_growth": v.feed_amplitude_growth,
-        "radial_amplitude_growth": v.radial_amplitude_growth,
-        "force_mean_N": s["force_mean_N"],
-        "force_amplitude_N": s["force_amplitude_N"],
-        "feed_amplitude_um": s["feed_amplitude_m"] * 1e6,
-        "feed_amplitude_resolved": resolved(s["feed_amplitude_m"]),
-        "amplitude_resolution_um": AMPLITUDE_RESOLUTION_M * 1e6,
-        "nonharmonic_energy_ratio": v.nonharmonic_energy_ratio,
-        "roughness_Ra_um": ds.attrs["Ra_m"] * 1e6,
-        "roughness_Rz_um": ds.attrs["Rz_m"] * 1e6,
-        "roughness_Ra_with_form_um": ds.attrs["Ra_with_form_m"] * 1e6,
-        "form_slope_um_per_mm": ds.attrs["form_slope_um_per_mm"],
-        "ra_tolerance_um": tol,
-        "tool_left_cut_fraction": v.tool_left_cut_fraction,
-        "reasons": list(v.reasons),
-        "diverged": bool(ds.attrs["diverged"]),
-        "speed_rpm": float(n), "depth_mm": float(a), "revolutions": int(revs),
-        "revolutions_simulated": int(ds.attrs["revolutions"]),
-        "samples_per_rev": int(ds.attrs["samples_per_rev"]), "process": pr.label,
-        "model": "robobore.dynamics time-domain boring (regenerative, mechanistic forces)",
+    coef_warn = tuple([] if coef is None else coef.domain_warnings(pr.h0))
+    return BoringResult(
+        stable=v.paper_stable,
+        verdicts=Verdicts(**v.verdicts()),
+        chatter=v.chatter,
+        surface_finish=v.surface_finish,
+        tool_leaves_cut=v.tool_leaves_cut,
+        chatter_frequency_Hz=v.chatter_frequency_Hz,
+        chatter_decided=v.chatter_decided,
+        sampling_check=sampling_check,
+        chatter_cause=v.chatter_cause,
+        tool_leaves_cut_cause=v.tool_leaves_cut_cause,
+        floquet_multiplier=v.floquet_multiplier,
+        floquet_multiplier_se=v.floquet_multiplier_se,
+        vibration_growth=v.vibration_growth,
+        feed_amplitude_growth=v.feed_amplitude_growth,
+        radial_amplitude_growth=v.radial_amplitude_growth,
+        force_mean_N=Vector3(**s["force_mean_N"]),
+        force_amplitude_N=Vector3(**s["force_amplitude_N"]),
+        feed_amplitude_um=s["feed_amplitude_m"] * 1e6,
+        feed_amplitude_resolved=resolved(s["feed_amplitude_m"]),
+        amplitude_resolution_um=AMPLITUDE_RESOLUTION_M * 1e6,
+        nonharmonic_energy_ratio=v.nonharmonic_energy_ratio,
+        roughness_Ra_um=ds.attrs["Ra_m"] * 1e6,
+        roughness_Rz_um=ds.attrs["Rz_m"] * 1e6,
+        roughness_Ra_with_form_um=ds.attrs["Ra_with_form_m"] * 1e6,
+        form_slope_um_per_mm=ds.attrs["form_slope_um_per_mm"],
+        ra_tolerance_um=tol,
+        tool_left_cut_fraction=v.tool_left_cut_fraction,
+        reasons=tuple(v.reasons),
+        diverged=bool(ds.attrs["diverged"]),
+        speed_rpm=float(n), depth_mm=float(a), revolutions=int(revs),
+        revolutions_simulated=int(ds.attrs["revolutions"]),
+        samples_per_rev=int(ds.attrs["samples_per_rev"]), process=pr.label,
+        model="robobore.dynamics time-domain boring (regenerative, mechanistic forces)",
         # the set used at this condition's cutting speed (speed-dependent coefficients)
-        "coefficients_provenance": None if coef is None else coef.provenance,
-        "coefficient_warnings": [] if coef is None else coef.domain_warnings(pr.h0),
-    }
-    out["warnings"] = list(out["coefficient_warnings"])
-    if return_dataset:
-        out["dataset"] = ds
-        out["config"] = raw
-    return out
+        coefficients_provenance=None if coef is None else coef.provenance,
+        coefficient_warnings=coef_warn,
+        warnings=coef_warn,
+        dataset=ds if return_dataset else None,
+        config=raw if return_dataset else None,
+    )
 
 
 def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
           method: str = "semidiscretization", progress=None,
-          equivalent: Any = None) -> dict[str, Any]:
-    """Lobes of a config (``robobore lobes --json`` contents, without notes).
+          equivalent: Any = None) -> LobesResult:
+    """Lobes of a config (:class:`LobesResult`: the ``robobore lobes --json`` contents,
+    without ``notes`` and ``process``).
 
     ``method``: ``"semidiscretization"`` (default; includes the rotating bar's periodic
     directions and depth modulation) or ``"frequency"`` (zero-order, fast). ``equivalent``:
@@ -257,24 +270,23 @@ def lobes(config: str | Path | dict[str, Any] | DynamicsConfig,
     else:
         raise ConfigError("unknown method", field="method", value=method,
                           expected="frequency or semidiscretization")
-    d = res.to_dict()
     mc = stability.mode_coupling_limit(st, pr)
-    d["mode_coupling_limit_mm"] = mc * 1e3 if math.isfinite(mc) else None
-    if default_note is not None:
-        d["speed_note"] = default_note
-    d["warnings"] = [] if coef is None else coef.domain_warnings(pr.h0)
+    note = None
     if coef is not None:
         from robobore.dynamics.config import lobe_coefficient_note
 
         note = lobe_coefficient_note(cfg, coef)
-        if note is not None:
-            d["coefficient_note"] = note
-    return d
+    return LobesResult(**res.to_dict(),
+                       mode_coupling_limit_mm=mc * 1e3 if math.isfinite(mc) else None,
+                       speed_note=default_note,
+                       warnings=tuple([] if coef is None else coef.domain_warnings(pr.h0)),
+                       coefficient_note=note)
 
 
 def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, speed_rpm: float,
-                      equivalent: Any = None, guess_mm: float | None = None) -> dict[str, Any]:
-    """The semi-discretisation answer of :func:`lobes` at one speed: ``critical_depth_mm``
+                      equivalent: Any = None, guess_mm: float | None = None) -> CriticalDepth:
+    """The semi-discretisation answer of :func:`lobes` at one speed
+    (:class:`CriticalDepth`): ``critical_depth_mm``
     (None: stable up to the scan top; 0: no chatter-free depth) and
     ``interrupted_below_mm`` (:func:`robobore.dynamics.semidiscretization.chatter_free_window`)
     of the config's robot and process. ``guess_mm``: the limit at a neighbouring speed (the
@@ -289,9 +301,10 @@ def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, spee
     guess = (float(guess_mm) * 1e-3 if guess_mm is not None and math.isfinite(guess_mm)
              and guess_mm > 0.0 else None)
     below, a = chatter_free_window(st, pr, float(speed_rpm), guess_m=guess)
-    return {"speed_rpm": float(speed_rpm),
-            "critical_depth_mm": a * 1e3 if math.isfinite(a) else None,
-            "interrupted_below_mm": below * 1e3}
+    return CriticalDepth(speed_rpm=float(speed_rpm),
+                         critical_depth_mm=a * 1e3 if math.isfinite(a) else None,
+                         interrupted_below_mm=below * 1e3)
 
 
-__all__ = ["run_boring", "lobes", "critical_depth_at", "UNDECIDED_MAX_FACTOR"]
+__all__ = ["run_boring", "lobes", "critical_depth_at", "UNDECIDED_MAX_FACTOR", "BoringResult",
+           "LobesResult", "CriticalDepth"]

@@ -208,6 +208,8 @@ def simulate_boring_cmd(
 ) -> None:
     """Time-domain boring simulation with regeneration; chatter, surface-finish,
     tool-leaves-cut and paper's-criterion verdicts."""
+    from dataclasses import replace
+
     from robobore.dynamics.api import run_boring
     from robobore.dynamics.config import load_dynamics_config
     from robobore.io.results import write_netcdf
@@ -239,13 +241,13 @@ def simulate_boring_cmd(
     check_output_file(out, "--out", "the netCDF Dataset")
     check_output_dir(plot, "--plot", "the PNG plots")
     with progress_bar("simulating", None, not as_json):
-        result = run_boring(cfg, speed_rpm, depth_mm, feed_mm_per_rev=feed_mm_per_rev,
-                            pressure_MPa=pressure_MPa, revolutions=revolutions,
-                            samples_per_rev=samples_per_rev, return_dataset=True,
-                            source=str(config))
-    ds = result.pop("dataset")
-    result.pop("config")
-    speed_rpm, depth_mm = result["speed_rpm"], result["depth_mm"]
+        res = run_boring(cfg, speed_rpm, depth_mm, feed_mm_per_rev=feed_mm_per_rev,
+                         pressure_MPa=pressure_MPa, revolutions=revolutions,
+                         samples_per_rev=samples_per_rev, return_dataset=True,
+                         source=str(config))
+    ds = res.dataset
+    result = replace(res, dataset=None, config=None).to_dict()
+    speed_rpm, depth_mm = res.speed_rpm, res.depth_mm
     if out is not None:
         write_netcdf(ds, out, config=raw)
         result["out"] = str(out)

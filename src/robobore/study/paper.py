@@ -267,7 +267,7 @@ def compute_lobes(cfg: PaperConfig, robot_model: dict[str, Any]) -> dict[str, An
                           "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
         dyn["speed_rpm"] = {"min": cfg.lobes.speed_min_rpm, "max": cfg.lobes.speed_max_rpm,
                             "count": cfg.lobes.count}
-        d = lobes(dyn, method=cfg.lobes.method)
+        d = lobes(dyn, method=cfg.lobes.method).to_dict()
         out[label] = {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
                       for k, v in d.items()}
     return out
@@ -310,8 +310,8 @@ def lobe_consistency(cfg: PaperConfig, robot_model: dict[str, Any],
                     **(dyn["equivalent"].get("pressure_foot") or {}), "pressure_MPa": p}
             dyn["cutting"] = {"speed_rpm": n, "feed_mm_per_rev": base_f,
                               "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
-            v = critical_depth_at(dyn, n, guess_mm=_lobe_guess_mm(lobes, p, n))[
-                "critical_depth_mm"]
+            v = critical_depth_at(dyn, n,
+                                  guess_mm=_lobe_guess_mm(lobes, p, n)).critical_depth_mm
             cache[(n, p)] = math.inf if v is None else float(v)
         lim = cache[(n, p)]
         a = float(r["depth_of_cut_mm"])

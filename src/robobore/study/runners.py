@@ -84,15 +84,15 @@ def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
                               expected=exc.expected) from None
         raise
     system = model.get("system", "robot")
-    r = run_boring(cfg, source=f"{src} [model.dynamics]" if src else None,
-                   speed_rpm=float(condition["speed_rpm"]),
-                   depth_mm=float(condition["depth_of_cut_mm"]),
-                   feed_mm_per_rev=float(condition["feed_mm_per_rev"]),
-                   pressure_MPa=(float(condition.get("pressure_MPa", 0.0))
-                                 if system == "robot" else None),
-                   return_dataset=True)
-    full = r.pop("dataset")
-    r.pop("config", None)
+    res = run_boring(cfg, source=f"{src} [model.dynamics]" if src else None,
+                     speed_rpm=float(condition["speed_rpm"]),
+                     depth_mm=float(condition["depth_of_cut_mm"]),
+                     feed_mm_per_rev=float(condition["feed_mm_per_rev"]),
+                     pressure_MPa=(float(condition.get("pressure_MPa", 0.0))
+                                   if system == "robot" else None),
+                     return_dataset=True)
+    full = res.dataset
+    r = res.to_dict()  # the simulate boring --json keys (and the dataset, the config)
     ns = int(full.attrs["samples_per_rev"])
     keep = int(opts.get("samples_per_rev_stored", 120))
     stride = max(1, ns // max(keep, 1))
