@@ -74,8 +74,9 @@ def main() -> None:
                        ("paper bore, spindle 0.2 m off the flange axis", [0.2, 0.0, 0.3])):
         cfg = _config(tcp)
         t0 = time.perf_counter()
-        r = plan_posture(cfg)
+        res = plan_posture(cfg)
         dt = time.perf_counter() - t0
+        r = res.to_dict()
         c = r["counts"]
         print(f"{label}: {c['rotations']} rotations x 8 branches = {c['ik_solutions_tried']} IK "
               f"solutions, {c['reaching']} reach, {c['candidates']} candidates rated "
@@ -83,10 +84,10 @@ def main() -> None:
               f"{r['speed_range_rpm'][1]:g} r/min): {dt:.2f} s "
               f"({c['candidates'] / dt:.0f} candidates/s, including calibration and config)")
     # worst case of the rating: 2880 postures
-    A = r["_arrays"]
-    model, process = A["model"], A["process"]
+    A = res.arrays
+    model, process = A.model, A.process
     rng = np.random.default_rng(0)
-    Q = A["cand"].q_rad[rng.integers(0, A["cand"].q_rad.shape[0], 2880)]
+    Q = A.cand.q_rad[rng.integers(0, A.cand.q_rad.shape[0], 2880)]
     t_modes, t_depth = _rate(model, Q, process)
     print(f"2880 postures: modes {t_modes:.2f} s, critical depth {t_depth:.2f} s, "
           f"total {t_modes + t_depth:.2f} s ({2880 / (t_modes + t_depth):.0f} postures/s)")

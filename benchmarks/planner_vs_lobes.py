@@ -28,9 +28,9 @@ from robobore.dynamics.api import critical_depth_at, lobes, run_boring
 from robobore.plan.posture import SD_SPEEDS, plan_posture
 
 
-def dynamics_config(result: dict, modes: list[dict]) -> dict:
+def dynamics_config(result, modes: list[dict]) -> dict:
     """A dynamics config dict of the plan's process on the structure ``modes``."""
-    inp = result["_arrays"]["inputs"]
+    inp = result.arrays.inputs
     c = inp.cfg
     cfg = {"structure": {"modes": modes}, "insert": c.insert.model_dump(),
            "bore": {"diameter_mm": c.bore.diameter_mm},
@@ -51,7 +51,8 @@ def main() -> None:
     path = Path(sys.argv[1]) if len(sys.argv) > 1 else (
         Path(__file__).resolve().parents[1] / "examples" / "plan_paper_bore.toml")
     t0 = time.perf_counter()
-    res = plan_posture(path)
+    plan = plan_posture(path)
+    res = plan.to_dict()
     t_plan = time.perf_counter() - t0
     print(f"plan of {path.name}: {res['counts']['candidates']} candidates in {t_plan:.1f} s; "
           f"cutting {res['cutting']}")
@@ -60,7 +61,7 @@ def main() -> None:
         e, L = res[name], res["lobes"].get(name)
         if e is None or L is None:
             continue
-        cfg = dynamics_config(res, L["tool_point_modes"])
+        cfg = dynamics_config(plan, L["tool_point_modes"])
         n = float(res["cutting"]["speed_rpm"])
         at = critical_depth_at(cfg, n)
         lb = lobes(cfg)

@@ -185,7 +185,7 @@ def test_plan_warns_on_a_calibration_that_does_not_fit(tmp_path):
                                                             "rotation_step_deg = 10.0")
     cfg = _re.sub(r"(?s)\[workspace\].*", "", cfg)
     (tmp_path / "p.toml").write_text(cfg)
-    r = plan_posture(tmp_path / "p.toml")
+    r = plan_posture(tmp_path / "p.toml").to_dict()
     assert r["calibration"]["rms_frequency_residual_percent"] > CALIBRATION_WARN_PERCENT
     assert r["warnings"] and "joint_stiffness.json" in r["warnings"][0]
 
@@ -214,5 +214,5 @@ def test_plan_posture_in_radians(tmp_path):
     d.pop("identity", None)
     d.pop("posture_deg", None)
     mfile.write_text(json.dumps(d))
-    r = plan_posture(tmp_path / "p.toml")
+    r = plan_posture(tmp_path / "p.toml").to_dict()
     assert any("radians?" in w for w in r["warnings"])

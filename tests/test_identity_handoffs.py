@@ -158,8 +158,8 @@ def test_plan_posture_vertical_bore_with_x_hint(tmp_path):
     p = _plan_copy(tmp_path, **{axis: "axis = [0.0, 0.0, -1.0]",
                                 "rotation_step_deg = 1.0": "rotation_step_deg = 30.0"})
     p.write_text(re.sub(r"(?s)\[workspace\].*", "", p.read_text()))
-    r0 = plan_posture(p)
-    r1 = plan_posture(p, x_hint=[0.0, 1.0, 0.0])
+    r0 = plan_posture(p).to_dict()
+    r1 = plan_posture(p, x_hint=[0.0, 1.0, 0.0]).to_dict()
     cols0 = np.array(r0["bore"]["boring_frame_columns"])
     cols1 = np.array(r1["bore"]["boring_frame_columns"])
     assert np.allclose(cols0[0], [1, 0, 0]) and np.allclose(cols1[0], [0, 1, 0])

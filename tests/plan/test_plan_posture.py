@@ -4,6 +4,7 @@ test time, so the tests do not depend on their exact numbers."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -16,7 +17,9 @@ from typer.testing import CliRunner
 
 from robobore.cli import app
 from robobore.errors import ConfigError, DataError, InputError
-from robobore.plan.posture import plan_posture, public
+from robobore.io.records import json_mismatches
+from robobore.io.results import to_jsonable
+from robobore.plan.posture import plan_posture
 from robobore.robot.kinematics import fk, get_robot
 
 runner = CliRunner()
@@ -65,7 +68,7 @@ def paper_result(ident, tmp_path_factory):
 
 
 def test_paper_bore_every_candidate_reaches_within_limits(paper_result):
-    r = paper_result
+    r = paper_result.to_dict()
     rb = get_robot("irb6600-175-2.55")
     point, axis = np.asarray(r["bore"]["point_m"]), np.asarray(r["bore"]["axis"])
     Q = np.radians([c["joints_deg"] for c in r["candidates"]])
@@ -82,7 +85,7 @@ def test_paper_bore_every_candidate_reaches_within_limits(paper_result):
 
 
 def test_paper_bore_recommended_is_best_and_paper_posture_is_a_candidate(paper_result):
-    r = paper_result
+    r = paper_result.to_dict()
     rated = [c for c in r["candidates"]
              if c["critical_depth_method"] == "semi-discretization"]
     crit = np.array([c["critical_depth_mm"] for c in rated], float)
@@ -111,11 +114,11 @@ def test_rated_at_the_cutting_speed_as_the_lobes_and_simulate_boring(paper_resul
     `simulate boring` on that structure within 10 % (measured: 0 % and 4e-4 %)."""
     from robobore.dynamics.api import critical_depth_at, run_boring
 
-    r = paper_result
+    r = paper_result.to_dict()
     rated = [c for c in r["candidates"] if c["critical_depth_method"] == "semi-discretization"]
     assert all(c["critical_depth_range_min_mm"] == 0.0 for c in rated)
     assert all(c["critical_depth_mm"] > 0.0 for c in rated)
-    co = r["_arrays"]["inputs"].cfg
+    co = paper_result.arrays.inputs.cfg
     cfg = {"structure": {"modes": r["lobes"]["measured"]["tool_point_modes"]},
            "insert": co.insert.model_dump(), "bore": {"diameter_mm": co.bore.diameter_mm},
            "cutting": co.cutting.model_dump(),
@@ -130,7 +133,7 @@ def test_rated_at_the_cutting_speed_as_the_lobes_and_simulate_boring(paper_resul
 
 
 def test_json_contract(paper_result):
-    r = public(paper_result)
+    r = paper_result.to_dict()
     json.dumps(r)  # serialisable as is
     assert {"recommended", "candidates", "criterion", "wall_time_s"} <= set(r)
     # the bundled inputs belong together (calibration 29 % rms: no mix-up warning), but the
@@ -155,7 +158,7 @@ def test_json_contract(paper_result):
 def test_stiffness_criterion_recommends_the_stiffest(ident, tmp_path):
     cfg = write_config(tmp_path, ident, criterion='criterion = "stiffness_min"',
                        rotation_step_deg="rotation_step_deg = 10.0")
-    r = plan_posture(cfg)
+    r = plan_posture(cfg).to_dict()
     kmin = np.array([min(c["directional_stiffness_N_per_m"].values()) for c in r["candidates"]])
     rec = r["recommended"]
     assert min(rec["directional_stiffness_N_per_m"].values()) >= kmin.max() * (1 - 1e-6)
@@ -172,10 +175,23 @@ def test_offset_spindle_changes_the_map(ident, tmp_path):
                        point_m=f"point_m = {T[:3, 3].tolist()}",
                        axis=f"axis = {T[:3, 2].tolist()}",
                        rotation_step_deg="rotation_step_deg = 5.0")
-    r = plan_posture(cfg)
+    r = plan_posture(cfg).to_dict()
     k = np.array([c["directional_stiffness_N_per_m"]["x"] for c in r["candidates"]])
     assert k.max() / k.min() > 1.05
     assert r["measured"] is not None
+
+
+def _same(a, b, rel: float = 1e-9) -> bool:
+    """``a`` and ``b`` (parsed JSON) equal, floats within ``rel``."""
+    if isinstance(a, dict):
+        return isinstance(b, dict) and list(a) == list(b) and all(
+            _same(a[k], b[k], rel) for k in a)
+    if isinstance(a, list):
+        return isinstance(b, list) and len(a) == len(b) and all(
+            _same(x, y, rel) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float):
+        return math.isclose(a, b, rel_tol=rel, abs_tol=1e-300)
+    return a == b
 
 
 def test_cli_writes_netcdf_json_and_plots(ident, tmp_path):
@@ -192,7 +208,26 @@ def test_cli_writes_netcdf_json_and_plots(ident, tmp_path):
     assert ds.sizes["candidate"] == len(d["candidates"])
     assert int(ds.attrs["recommended_candidate"]) >= 0
     ds.close()
-    assert json.loads((out / "posture_plan.json").read_text())["criterion"] == "critical_depth"
+    written = json.loads((out / "posture_plan.json").read_text())
+    assert written["criterion"] == "critical_depth"
+    # the JSON is the PostureResult's to_dict(), key for key (the wall time aside), and keeps
+    # to the stored contract (contract/plan_posture.json)
+    spec = json.loads((Path(__file__).parent / "contract" / "plan_posture.json").read_text())
+    assert json_mismatches(written, spec["keys"]) == []
+    assert json_mismatches({k: v for k, v in d.items() if k not in ("out", "plots")},
+                           spec["keys"]) == []
+    res = plan_posture(cfg)
+    mine = json.loads(json.dumps(to_jsonable(res.to_dict())))
+    assert list(mine) == list(written)
+    # a second plan in the same process: the semi-discretisation lobes' warm-started
+    # eigenvalue iteration differs by round-off between calls (1e-13), so numbers are
+    # compared to 1e-9 relative, everything else exactly
+    assert _same(mine["lobes"], written["lobes"])
+    assert {k: v for k, v in mine.items() if k not in ("wall_time_s", "lobes")} == {
+        k: v for k, v in written.items() if k not in ("wall_time_s", "lobes")}
+    assert res.recommended.joints_deg == tuple(written["recommended"]["joints_deg"])
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        res.criterion = "stiffness_x"  # type: ignore[misc]
     assert (plots / "posture_map.png").stat().st_size > 0
     # readable table by default
     r2 = runner.invoke(app, ["plan", "posture", str(cfg)])
@@ -292,8 +327,8 @@ def test_missing_identification_file(ident, tmp_path):
 def test_part_frame_placement_gives_the_same_bore(ident, tmp_path, paper_result):
     """[bore] in a part frame placed by [part] origin_m / yaw_deg: the same bore in the base
     frame gives the same candidates."""
-    p = np.asarray(paper_result["bore"]["point_m"])
-    a = np.asarray(paper_result["bore"]["axis"])
+    p = np.asarray(paper_result.bore.point_m)
+    a = np.asarray(paper_result.bore.axis)
     yaw = math.radians(30.0)
     Rz = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0],
                    [0, 0, 1.0]])
@@ -302,11 +337,11 @@ def test_part_frame_placement_gives_the_same_bore(ident, tmp_path, paper_result)
                        axis=f"axis = {(Rz.T @ a).tolist()}",
                        rotation_step_deg="rotation_step_deg = 10.0")
     cfg.write_text(cfg.read_text() + f"\n[part]\norigin_m = {origin.tolist()}\nyaw_deg = 30.0\n")
-    r = plan_posture(cfg)
+    r = plan_posture(cfg).to_dict()
     assert np.allclose(r["bore"]["point_m"], p, atol=1e-12)
     assert r["measured"] is not None
     assert r["recommended"]["critical_depth_mm"] == pytest.approx(
-        paper_result["recommended"]["critical_depth_mm"], rel=1e-9)
+        paper_result.recommended.critical_depth_mm, rel=1e-9)
 
 
 def test_link_bending_data_flow_through_the_plan(ident, tmp_path):
@@ -316,9 +351,9 @@ def test_link_bending_data_flow_through_the_plan(ident, tmp_path):
           'link_bending = [{link = 2, EI_Nm2 = [5.7e7, 7.2e7]}, '
           '{link = 4, EI_Nm2 = [1.6e7, 1.6e7]}]')
     step = "rotation_step_deg = 30.0"
-    r0 = plan_posture(write_config(tmp_path / "a", ident, rotation_step_deg=step))
+    r0 = plan_posture(write_config(tmp_path / "a", ident, rotation_step_deg=step)).to_dict()
     r1 = plan_posture(write_config(tmp_path / "b", ident, posture_deg=lb,
-                                   rotation_step_deg=step))
+                                   rotation_step_deg=step)).to_dict()
     assert [d["link"] for d in r1["calibration"]["link_bending"]] == [2, 4]
     assert r0["calibration"]["link_bending"] == []
     k0, k1 = (r["recommended"]["directional_stiffness_N_per_m"] for r in (r0, r1))

@@ -27,10 +27,12 @@ def posture_cmd(
 ) -> None:
     """Rate every posture that reaches a bore (tool-axis rotation x IK branch) by stiffness,
     modes and critical depth with the calibrated pose-dependent model; recommend the best."""
+    from dataclasses import replace
+
     import numpy as np
 
     from robobore.io.results import write_json, write_netcdf
-    from robobore.plan.posture import plan_posture, public, results_dataset, workspace_map
+    from robobore.plan.posture import plan_posture, results_dataset, workspace_map
 
     if out is not None and out.exists() and not out.is_dir():
         raise ConfigError("--out must be a folder", field="--out", value=str(out),
@@ -48,13 +50,13 @@ def posture_cmd(
         hint = parse_floats(x_hint, 3, "--x-hint", "(a direction, base frame)")
     result = plan_posture(config, progress_factory=factory, x_hint=hint)
     ws = None
-    inp = result["_arrays"]["inputs"]
+    inp = result.arrays.inputs
     if inp.cfg.workspace is not None:
         n = len(inp.cfg.workspace.dx_m) * len(inp.cfg.workspace.dy_m)
         with progress_bar("workspace map", n, not as_json) as adv:
             ws = workspace_map(result, adv)
-        result["workspace"] = ws
-    pub = public(result)
+        result = replace(result, workspace=ws)
+    pub = result.to_dict()
     for w in pub.get("warnings", []):
         from robobore.clitools import stderr
 

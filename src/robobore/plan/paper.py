@@ -78,25 +78,26 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
         ws = workspace_map(res)
     except RoboboreError as exc:
         return {"error": str(exc)}
-    A = res["_arrays"]
-    cand = A["cand"]
+    A = res.arrays
+    cand = A.cand
     keep = ("joints_deg", "tool_axis_rotation_deg", "branch", "branch_label",
             "directional_stiffness_N_per_m", "critical_depth_mm", "critical_depth_range_min_mm",
             "critical_depth_method", "feed_amplitude_um", "criterion_value")
     short = {}
+    d = res.to_dict()
     for name in ("recommended", "measured"):
-        e = res[name]
+        e = d[name]
         short[name] = None if e is None else {kk: e[kk] for kk in keep} | {
             "first_frequency_Hz": e["modes"][0]["frequency_Hz"]}
     return {
-        "criterion": res["criterion"], "criterion_unit": res["criterion_unit"],
-        "counts": res["counts"], "calibration": res["calibration"],
-        "warnings": res["warnings"],
+        "criterion": d["criterion"], "criterion_unit": d["criterion_unit"],
+        "counts": d["counts"], "calibration": d["calibration"],
+        "warnings": d["warnings"],
         "recommended": short["recommended"], "measured": short["measured"],
-        "synthetic_inputs": res["synthetic_inputs"],
+        "synthetic_inputs": d["synthetic_inputs"],
         "end_effector": "ASSUMED 60 kg spindle + bar, centre of mass 0.15 m along flange z",
         "map": {"rotation_deg": cand.rotation_deg.tolist(), "branch": cand.branch.tolist(),
-                "criterion": A["criterion"].tolist()},
+                "criterion": A.criterion.tolist()},
         "workspace": ws,
         "wall_time_s": time.perf_counter() - t0,
     }

@@ -43,11 +43,13 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from robobore.dynamics.results import Vector3
 from robobore.errors import InputError
 from robobore.plan.candidates import (
     AXIS_TOL_DEG,
@@ -60,6 +62,16 @@ from robobore.plan.candidates import (
     rotation_of,
 )
 from robobore.plan.config import PlanInputs, load_plan_config
+from robobore.plan.results import (
+    BoreFrame,
+    Candidate,
+    PlanArrays,
+    PlanCounts,
+    PlanMode,
+    PostureError,
+    PostureLobes,
+    PostureResult,
+)
 from robobore.plan.scoring import (
     CRITERION_UNITS,
     build_process,
@@ -110,8 +122,9 @@ def _same_posture(q1: np.ndarray, q2: np.ndarray, tol: float = 1e-6) -> bool:
 
 
 def plan_posture(config: str | Path, *, progress_factory: Any = None,
-                 x_hint: Any = None) -> dict[str, Any]:
-    """Run the posture plan of a config file; returns the result (JSON contract + arrays).
+                 x_hint: Any = None) -> PostureResult:
+    """Run the posture plan of a config file; returns the :class:`PostureResult` (its
+    ``to_dict()`` the JSON contract, its ``arrays`` the in-memory candidates and model).
     ``x_hint`` overrides the config's ``bore.x_hint`` (the boring frame's X direction).
 
     ``progress_factory(description, total)`` -> context manager yielding ``advance(n)``
@@ -122,7 +135,7 @@ def plan_posture(config: str | Path, *, progress_factory: Any = None,
 
 
 def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
-             t0: float | None = None) -> dict[str, Any]:
+             t0: float | None = None) -> PostureResult:
     """The posture plan for validated inputs (see :func:`plan_posture`)."""
     from contextlib import nullcontext
 
@@ -249,96 +262,97 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
             continue
         L = sd_lobes[idx]
         below, lim = at_speed[idx]
-        lobes[name] = {"method": L.method, "speed_rpm": speeds.tolist(),
-                       "critical_depth_mm": (L.critical_depth_m * 1e3).tolist(),
-                       "interrupted_below_mm": (L.interrupted_below_m * 1e3).tolist(),
-                       "cutting_speed_rpm": n_cut,
-                       "critical_depth_at_speed_mm": float(lim * 1e3),
-                       "interrupted_below_at_speed_mm": float(below * 1e3),
-                       # the structure these lobes are of ([structure] modes of a
-                       # `robobore lobes` / `simulate boring` config)
-                       "tool_point_modes": [m.to_dict() for m in structures[idx].modes()]}
+        lobes[name] = PostureLobes(
+            method=L.method, speed_rpm=tuple(speeds.tolist()),
+            critical_depth_mm=tuple((L.critical_depth_m * 1e3).tolist()),
+            interrupted_below_mm=tuple((L.interrupted_below_m * 1e3).tolist()),
+            cutting_speed_rpm=n_cut,
+            critical_depth_at_speed_mm=float(lim * 1e3),
+            interrupted_below_at_speed_mm=float(below * 1e3),
+            # the structure these lobes are of ([structure] modes of a
+            # `robobore lobes` / `simulate boring` config)
+            tool_point_modes=tuple(m.to_dict() for m in structures[idx].modes()))
     equivalent = {}
     for name, idx in (("recommended", best), ("measured", meas_idx)):
         if idx is not None:
             equivalent[name] = model.equivalent(cand.q_rad[idx]).table()
     wall = time.perf_counter() - t0
-    result = {
-        "config": f,
-        "robot": robot.name,
-        "criterion": cfg.plan.criterion,
-        "criterion_unit": CRITERION_UNITS[cfg.plan.criterion],
-        "recommended": entries[best] | {"criterion_value": float(crit[best])},
-        "measured": None if meas_idx is None else entries[meas_idx] | {
-            "criterion_value": float(crit[meas_idx])},
-        "measured_posture_deg": np.degrees(inp.q_meas_rad).tolist(),
-        "measured_posture_reaches_bore": meas_reaches,
-        "measured_posture_error": {"position_mm": meas_pos_err * 1e3,
-                                   "axis_deg": meas_ax_err},
-        "calibration": cal.to_dict(),
-        "bore": {"point_m": inp.bore_point_m.tolist(), "axis": inp.bore_axis.tolist(),
-                 "x_hint": None if inp.x_hint is None else inp.x_hint.tolist(),
-                 "boring_frame_columns": Rb.T.tolist()},
-        "tcp_m": inp.tcp_m.tolist(),
-        "counts": {"rotations": int(rot.size), "ik_solutions_tried": cand.n_tried,
-                   "reaching": cand.n_reached, "inside_limits": cand.n_in_limits,
-                   "candidates": int(cand.q_rad.shape[0])},
-        "max_position_error_mm": float(cand.position_error_m.max() * 1e3),
-        "max_axis_error_deg": float(cand.axis_error_deg.max()),
-        "speed_range_rpm": [cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm],
-        "cutting": cfg.cutting.model_dump(),
-        "candidates": entries,
-        "lobes": lobes,
-        "equivalent_model": equivalent,
-        "synthetic_inputs": bool(inp.synthetic),
-        "notes": list(inp.notes),
-        "warnings": warn + cal.warnings() + _flat_map_warning(crit0, cfg.plan.criterion)
-        + _coefficient_warnings(process),
-        "identity": make_identity(
+    return PostureResult(
+        config=f,
+        robot=robot.name,
+        criterion=cfg.plan.criterion,
+        criterion_unit=CRITERION_UNITS[cfg.plan.criterion],
+        recommended=replace(entries[best], criterion_value=float(crit[best])),
+        measured=None if meas_idx is None else replace(
+            entries[meas_idx], criterion_value=float(crit[meas_idx])),
+        measured_posture_deg=tuple(np.degrees(inp.q_meas_rad).tolist()),
+        measured_posture_reaches_bore=meas_reaches,
+        measured_posture_error=PostureError(position_mm=meas_pos_err * 1e3,
+                                            axis_deg=meas_ax_err),
+        calibration=cal.to_dict(),
+        bore=BoreFrame(point_m=tuple(inp.bore_point_m.tolist()),
+                       axis=tuple(inp.bore_axis.tolist()),
+                       x_hint=None if inp.x_hint is None else tuple(inp.x_hint.tolist()),
+                       boring_frame_columns=tuple(tuple(c) for c in Rb.T.tolist())),
+        tcp_m=tuple(inp.tcp_m.tolist()),
+        counts=PlanCounts(rotations=int(rot.size), ik_solutions_tried=cand.n_tried,
+                          reaching=cand.n_reached, inside_limits=cand.n_in_limits,
+                          candidates=int(cand.q_rad.shape[0])),
+        max_position_error_mm=float(cand.position_error_m.max() * 1e3),
+        max_axis_error_deg=float(cand.axis_error_deg.max()),
+        speed_range_rpm=(cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm),
+        cutting=cfg.cutting.model_dump(),
+        candidates=tuple(entries),
+        lobes=lobes,
+        equivalent_model=equivalent,
+        synthetic_inputs=bool(inp.synthetic),
+        notes=tuple(inp.notes),
+        warnings=tuple(warn + cal.warnings() + _flat_map_warning(crit0, cfg.plan.criterion)
+                       + _coefficient_warnings(process)),
+        identity=make_identity(
             "plan", robot=robot.name, robot_hash=robot.description_hash(),
-            robot_file=robot.file or None, joints_deg=entries[best]["joints_deg"],
+            robot_file=robot.file or None, joints_deg=list(entries[best].joints_deg),
             tcp_m=inp.tcp_m.tolist(), frame="boring", synthetic=bool(inp.synthetic),
             source=f),
-        "wall_time_s": wall,
-    }
-    result["_arrays"] = {"cand": cand, "ev": ev, "criterion": crit, "best": best,
-                         "measured": meas_idx, "rotations": rot, "model": model,
-                         "inputs": inp, "process": process}
-    return result
+        wall_time_s=wall,
+        arrays=PlanArrays(cand=cand, ev=ev, criterion=crit, best=best, measured=meas_idx,
+                          rotations=rot, model=model, inputs=inp, process=process),
+    )
 
 
-def _entry(i: int, cand: Candidates, ev: dict[str, np.ndarray]) -> dict[str, Any]:
+def _entry(i: int, cand: Candidates, ev: dict[str, np.ndarray]) -> Candidate:
     from robobore.plan.ik import branch_label
 
     k = ev["stiffness_N_per_m"][i]
     b = ev["critical_depth_m"][i]
     bm = ev["critical_depth_range_min_m"][i]
-    return {
-        "joints_deg": np.degrees(cand.q_rad[i]).tolist(),
-        "tool_axis_rotation_deg": float(cand.rotation_deg[i]),
-        "branch": int(cand.branch[i]),
-        "branch_label": branch_label(int(cand.branch[i])),
-        "directional_stiffness_N_per_m": {"x": float(k[0]), "y": float(k[1]), "z": float(k[2])},
-        "modes": [{"frequency_Hz": float(fr), "damping_ratio": float(z)}
-                  for fr, z in zip(ev["frequency_Hz"][i], ev["damping_ratio"][i], strict=True)],
-        "critical_depth_mm": None if not math.isfinite(b) else float(b * 1e3),
-        "critical_depth_range_min_mm": None if not math.isfinite(bm) else float(bm * 1e3),
-        "critical_speed_rpm": float(ev["critical_speed_rpm"][i]),
-        "critical_depth_method": str(ev["critical_depth_method"][i]),
-        "chatter_frequency_Hz": float(ev["chatter_frequency_Hz"][i]),
-        "feed_amplitude_um": float(ev["feed_amplitude_m"][i] * 1e6),
-        "singularity_measure": float(cand.singularity[i]),
-        "position_error_mm": float(cand.position_error_m[i] * 1e3),
-        "axis_error_deg": float(cand.axis_error_deg[i]),
-    }
+    return Candidate(
+        joints_deg=tuple(np.degrees(cand.q_rad[i]).tolist()),
+        tool_axis_rotation_deg=float(cand.rotation_deg[i]),
+        branch=int(cand.branch[i]),
+        branch_label=branch_label(int(cand.branch[i])),
+        directional_stiffness_N_per_m=Vector3(x=float(k[0]), y=float(k[1]), z=float(k[2])),
+        modes=tuple(PlanMode(frequency_Hz=float(fr), damping_ratio=float(z))
+                    for fr, z in zip(ev["frequency_Hz"][i], ev["damping_ratio"][i],
+                                     strict=True)),
+        critical_depth_mm=None if not math.isfinite(b) else float(b * 1e3),
+        critical_depth_range_min_mm=None if not math.isfinite(bm) else float(bm * 1e3),
+        critical_speed_rpm=float(ev["critical_speed_rpm"][i]),
+        critical_depth_method=str(ev["critical_depth_method"][i]),
+        chatter_frequency_Hz=float(ev["chatter_frequency_Hz"][i]),
+        feed_amplitude_um=float(ev["feed_amplitude_m"][i] * 1e6),
+        singularity_measure=float(cand.singularity[i]),
+        position_error_mm=float(cand.position_error_m[i] * 1e3),
+        axis_error_deg=float(cand.axis_error_deg[i]),
+    )
 
 
-def results_dataset(result: dict[str, Any]) -> Any:
+def results_dataset(result: PostureResult) -> Any:
     """The candidates as an xarray Dataset (dims candidate, joint, mode, axis)."""
     import xarray as xr
 
-    A = result["_arrays"]
-    cand, ev = A["cand"], A["ev"]
+    A = result.arrays
+    cand, ev = A.cand, A.ev
     n, nj = cand.q_rad.shape
     nm = ev["frequency_Hz"].shape[1]
     ds = xr.Dataset(
@@ -359,33 +373,28 @@ def results_dataset(result: dict[str, Any]) -> Any:
             "chatter_frequency": (("candidate",), ev["chatter_frequency_Hz"], {"units": "Hz"}),
             "feed_amplitude": (("candidate",), ev["feed_amplitude_m"] * 1e6, {"units": "um"}),
             "singularity_measure": (("candidate",), cand.singularity),
-            "criterion": (("candidate",), A["criterion"],
-                          {"name": result["criterion"], "units": result["criterion_unit"]}),
+            "criterion": (("candidate",), A.criterion,
+                          {"name": result.criterion, "units": result.criterion_unit}),
         },
         coords={"candidate": np.arange(n), "joint": np.arange(1, nj + 1),
                 "mode": np.arange(1, nm + 1), "axis": ["x", "y", "z"]},
-        attrs={"recommended_candidate": A["best"],
-               "measured_candidate": -1 if A["measured"] is None else A["measured"],
-               "criterion": result["criterion"], "robot": result["robot"],
-               "synthetic_inputs": int(result["synthetic_inputs"])},
+        attrs={"recommended_candidate": A.best,
+               "measured_candidate": -1 if A.measured is None else A.measured,
+               "criterion": result.criterion, "robot": result.robot,
+               "synthetic_inputs": int(result.synthetic_inputs)},
     )
     return ds
 
 
-def public(result: dict[str, Any]) -> dict[str, Any]:
-    """The result without the in-memory arrays (the JSON contract)."""
-    return {k: v for k, v in result.items() if not k.startswith("_")}
-
-
-def workspace_map(result: dict[str, Any], progress: Any = None) -> dict[str, Any] | None:
+def workspace_map(result: PostureResult, progress: Any = None) -> dict[str, Any] | None:
     """Best criterion value over rotations x branches at each part placement of
     ``[workspace]`` (the bore point shifted by (dx, dy) in the base frame)."""
-    inp: PlanInputs = result["_arrays"]["inputs"]
+    inp: PlanInputs = result.arrays.inputs
     ws = inp.cfg.workspace
     if ws is None:
         return None
-    model = result["_arrays"]["model"]
-    process = result["_arrays"]["process"]
+    model = result.arrays.model
+    process = result.arrays.process
     A0 = process.mean_directional_matrix()
     rot = rotation_grid(ws.rotation_step_deg)
     best = np.full((len(ws.dy_m), len(ws.dx_m)), np.nan)
@@ -407,4 +416,4 @@ def workspace_map(result: dict[str, Any], progress: Any = None) -> dict[str, Any
             "criterion": inp.cfg.plan.criterion, "rotation_step_deg": ws.rotation_step_deg}
 
 
-__all__ = ["plan_posture", "run_plan", "results_dataset", "public", "workspace_map"]
+__all__ = ["plan_posture", "run_plan", "results_dataset", "workspace_map", "PostureResult"]
