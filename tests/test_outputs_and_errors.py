@@ -335,7 +335,11 @@ def test_paper_exits_1_when_a_condition_failed(monkeypatch, tmp_path):
                "failed": [{"key": "k", "system": "robot", "error": "ConfigError: boom",
                            "condition": {"speed_rpm": 300.0, "feed_mm_per_rev": 0.1,
                                          "depth_of_cut_mm": 0.1, "pressure_MPa": 0.0}}]}
-    monkeypatch.setattr(paper, "run_paper", lambda *a, **k: summary)
+    from types import SimpleNamespace
+
+    # run_paper's PaperSummary, as far as the CLI reads it (its to_dict())
+    monkeypatch.setattr(paper, "run_paper", lambda *a, **k: SimpleNamespace(
+        to_dict=lambda: summary))
     r = _cli("paper", "--fast", "--out", tmp_path / "p")
     assert r.exit_code == 1
     assert "1 of 3 conditions failed" in r.output and "boom" in r.output

@@ -252,11 +252,38 @@ def small_run(tmp_path_factory):
     out = tmp / "out"
     res = pp.run_paper(cfg, out, fast=True, workers=0,
                        progress=lambda *a: PROGRESS_CALLS.append(a))
-    return res, out, cfg
+    SMALL_RESULT.append(res)
+    return res.to_dict(), out, cfg
 
 
 #: the ``progress(task, done, total)`` calls of the ``small_run`` study
 PROGRESS_CALLS: list[tuple] = []
+#: the PaperSummary the ``small_run`` study returned
+SMALL_RESULT: list = []
+CONTRACT = Path(__file__).parent / "contract"
+
+
+def test_paper_summary_is_the_written_json_and_the_stored_contract(small_run):
+    """run_paper returns a frozen PaperSummary; its to_dict() is paper_summary.json, key for
+    key, and keeps to contract/paper_summary.json (keys in order, JSON types)."""
+    import dataclasses
+
+    from robobore.io.records import json_mismatches, json_types
+    from robobore.io.results import to_jsonable
+    from robobore.study.results import PaperSummary
+
+    _, out, _ = small_run
+    res = SMALL_RESULT[0]
+    assert isinstance(res, PaperSummary)
+    spec = json.loads((CONTRACT / "paper_summary.json").read_text())["keys"]
+    assert json_types(PaperSummary) == spec
+    written = json.loads((out / "paper_summary.json").read_text())
+    assert json.loads(json.dumps(to_jsonable(res.to_dict()))) == written
+    assert list(res.to_dict()) == list(written)
+    assert json_mismatches(written, spec) == []
+    assert res.computed == written["computed"] and res.report == written["report"]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        res.computed = 0  # type: ignore[misc]
 
 
 def test_paper_reports_progress_through_the_callback(small_run):

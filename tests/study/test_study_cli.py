@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from conftest import write_sweep_toml
 from typer.testing import CliRunner
 
 from robobore.cli import app
+from robobore.io.records import json_mismatches
+
+CONTRACT = Path(__file__).parent / "contract"
 
 
 def test_sweep_json_then_resume(tmp_path, sweep_toml):
@@ -20,6 +24,18 @@ def test_sweep_json_then_resume(tmp_path, sweep_toml):
     assert d["runner"] == "demo" and d["mode"] == "serial (no Dask)"
     d2 = json.loads(r.invoke(app, args).stdout)
     assert (d2["computed"], d2["skipped"]) == (0, 12)
+    # the JSON keeps to the stored contract; after name and runner it is the SweepOutcome's
+    # to_dict() (the same resumed run in-process; its wall time aside)
+    spec = json.loads((CONTRACT / "sweep.json").read_text())["keys"]
+    assert json_mismatches(d, spec) == [] and json_mismatches(d2, spec) == []
+    from robobore.study.sweep import plan_from_file, run_sweep
+
+    out = run_sweep(plan_from_file(sweep_toml), tmp_path / "s", workers=0)
+    timing = ("wall_time_s", "conditions_per_s")
+    mine = json.loads(json.dumps(out.to_dict()))
+    assert {k: v for k, v in mine.items() if k not in timing} == {
+        k: v for k, v in d2.items() if k not in ("name", "runner", *timing)}
+    assert list(d2)[2:] == list(mine)
     res = r.invoke(app, args[:-1])  # table output
     assert res.exit_code == 0 and "already done" in res.output
 

@@ -236,6 +236,19 @@ def test_cli_compare_json_and_report(tmp_path, sweep_toml):
                               "--json", "--report", str(tmp_path / "cmp.html")])
     assert res.exit_code == 0, res.output
     d = json.loads(res.stdout)
+    # the JSON keeps to the stored contract; before measured and results it is the
+    # Comparison's to_dict() (the same comparison in-process)
+    from pathlib import Path
+
+    from robobore.io.records import json_mismatches
+    from robobore.io.results import to_jsonable
+    from robobore.study.compare import compare_results
+
+    spec = json.loads((Path(__file__).parent / "contract" / "compare.json").read_text())
+    assert json_mismatches(d, spec["keys"]) == []
+    mine = json.loads(json.dumps(to_jsonable(
+        compare_results(tmp_path / "m.csv", tmp_path / "s").to_dict())))
+    assert mine == {k: v for k, v in d.items() if k not in ("measured", "results", "report")}
     errs = [e["rel_error"] for r in d["conditions"] for e in r["quantities"].values()]
     assert max(errs) == pytest.approx(1 - 1 / 1.08, rel=1e-9)
     assert min(errs) == pytest.approx(0.0, abs=1e-12)

@@ -315,7 +315,7 @@ def paper_cmd(
     with warnings.catch_warnings(), \
             stage_progress(sys.stderr.isatty() and not as_json) as progress:
         warnings.simplefilter("ignore", StoreWarning)  # printed below, one line each
-        res = run_paper(config, out, fast=fast, workers=workers, progress=progress)
+        res = run_paper(config, out, fast=fast, workers=workers, progress=progress).to_dict()
     for w in res.get("sweep", {}).get("warnings", []):
         stderr.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     emit(res, as_json, _render_paper)

@@ -358,23 +358,37 @@ def parse_manifest_csv(text: str, source: str = "<manifest>", base: str | Path =
                          records=tuple(recs))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Comparison:
-    """Result of :func:`compare` (all relative errors are fractions, not %)."""
+    """Result of :func:`compare` (all relative errors are fractions, not %). ``to_dict()``:
+    the ``robobore compare --json`` keys before ``measured`` and ``results`` (contract in
+    tests/study/contract/compare.json)."""
 
+    #: one row per matched condition: condition, group, per-quantity measured / simulated /
+    #: relative error (``conditions`` in the JSON)
     rows: tuple[dict[str, Any], ...]
+    #: the relative-error statistics per group and quantity
     groups: dict[str, dict[str, Any]]
+    #: the agreement over all rows per quantity
     agreement: dict[str, Any]
+    #: where the groups come from ("measured" or "simulated")
     group_source: str
+    #: measured rows without a simulated condition
     unmatched_measured: tuple[dict[str, Any], ...] = field(default_factory=tuple)
+    #: quantities whose relative error is undefined (a zero measured value, no simulated
+    #: value), with the reason
     undefined: tuple[dict[str, Any], ...] = field(default_factory=tuple)
+    #: the compared quantities
     quantities: tuple[str, ...] = field(default_factory=tuple)
-    system: str | None = None  # the simulated system compared (e.g. "robot")
-    systems: tuple[str, ...] = field(default_factory=tuple)  # systems in the results store
+    #: the simulated system compared (e.g. "robot")
+    system: str | None = None
+    #: the systems in the results store (``systems_in_store`` in the JSON)
+    systems: tuple[str, ...] = field(default_factory=tuple)
     #: likely unit slips: a measured column off the simulation by a power of ten in most
     #: rows; with :func:`compare_results` also the compared runs' coefficient warnings
     warnings: tuple[str, ...] = field(default_factory=tuple)
-    records: tuple[dict[str, Any], ...] = field(default_factory=tuple)  # a manifest's records
+    #: a manifest's records (``measured_records`` in the JSON, with ``measured_synthetic``)
+    records: tuple[dict[str, Any], ...] = field(default_factory=tuple)
 
     def to_dict(self) -> dict[str, Any]:
         return {

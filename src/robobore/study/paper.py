@@ -42,6 +42,7 @@ from robobore.errors import ConfigError
 from robobore.study.paper_checks import qualitative_checks
 from robobore.study.paper_config import (PaperConfig, coefficient_set, load_paper_config,
                                          model_coefficients)
+from robobore.study.results import PaperSummary
 
 RUNNER = "boring"
 PAPER_DAMPING_N_S_PER_M = 23.7  # the paper's equivalent damping coefficient
@@ -415,8 +416,9 @@ def _stage(progress: Callable[[str, int, int], None] | None, task: str,
 def run_paper(config: str | Path | None = None, out: str | Path = "paper-results", *,
               fast: bool = False, workers: int | None = None,
               progress: Callable[[str, int, int], None] | None = None,
-              browser_check: bool = False) -> dict[str, Any]:
-    """Run the whole study (see module doc); returns the JSON summary (also written).
+              browser_check: bool = False) -> PaperSummary:
+    """Run the whole study (see module doc); returns the :class:`PaperSummary` (its
+    ``to_dict()`` is ``paper_summary.json``, also written).
 
     ``progress(task, done, total)``, if given, is called as each stage advances; the stages
     in order: "identify robot and modes", "FE force calibration" (not with ``fast``),
@@ -561,9 +563,11 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     timings["total"] = time.perf_counter() - t0
     summary["timings_s"] = timings
     summary["wall_time_s"] = timings["total"]
-    write_json(outdir / "paper_summary.json", summary)
+    result = PaperSummary(**{k: tuple(v) if isinstance(v, list) else v
+                             for k, v in summary.items()})
+    write_json(outdir / "paper_summary.json", result.to_dict())
     advance(1)
-    return summary
+    return result
 
 
 __all__ = ["run_paper", "identify_stiffness", "identify_modes", "build_equivalent",

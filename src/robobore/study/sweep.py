@@ -120,18 +120,28 @@ class SweepPlan:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SweepOutcome:
-    """What a sweep run did."""
+    """What a sweep run did (``to_dict()``: the ``robobore sweep --json`` keys after ``name``
+    and ``runner``; contract in tests/study/contract/sweep.json)."""
 
+    #: the results store's folder
     store: Path
+    #: conditions of the plan
     total: int
-    skipped: int  # already done before this run
-    computed: int  # finished in this run
-    failed: int  # failed in this run
-    pending: int  # still not done (failed or never run) after this run
+    #: already done before this run
+    skipped: int
+    #: finished in this run
+    computed: int
+    #: failed in this run
+    failed: int
+    #: still not done (failed or never run) after this run
+    pending: int
+    #: wall time of the run [s]
     wall_time_s: float
+    #: how the conditions ran (serial, a Dask local cluster, a Dask scheduler)
     mode: str
+    #: the failed conditions: key, condition, error
     failures: tuple[dict[str, Any], ...] = field(default_factory=tuple)
     #: store problems met and repaired (result files set aside and recomputed)
     warnings: tuple[str, ...] = field(default_factory=tuple)
