@@ -4,9 +4,9 @@ For each cut: the semi-discretisation critical depth a_c, then `simulate` at 0.8
 1.25 a_c at the default sampling and at twice it; the cut agrees when both 0.8 runs say no
 chatter and both 1.25 runs say chatter. A critical depth of 0 (no chatter-free depth) is
 checked too: the time domain at 1.25 x the depth below which the steady cut is interrupted
-(or at the scan's lowest depth, 5 um, where the cut is in the material down to vanishing
-depth), where the lobes say chatter, must say chatter, or the disagreement is counted and
-printed. ``--fixed`` checks the lobes of the process linearised
+(or the first depth above it, in steps of 1.25, where the steady cut is in the material; at
+the scan's lowest depth, 5 um, where the cut is in the material down to vanishing depth),
+where the lobes say chatter, must say chatter, or the disagreement is counted and printed. ``--fixed`` checks the lobes of the process linearised
 once at 0.05 mm (widths scaled with the depth) instead of the process rebuilt at each depth.
 
     python benchmarks/chatter_agreement.py --cuts 100 --seed 44 [--fixed] [--json out.json]

@@ -8,7 +8,8 @@ measurement is involved). :func:`check_cut` computes the semi-discretisation cri
 default sampling and at twice it: the lobes and the time domain agree when the first two say
 no chatter and the last two say chatter. Where the critical depth is 0 (no chatter-free
 depth), the time domain at a depth where the lobes say chatter -- 1.25 x the depth below which
-the steady cut is interrupted, or the scan's lowest depth where it is in the material down to
+the steady cut is interrupted (or the first depth above it, in steps of 1.25, where the steady
+cut is in the material), or the scan's lowest depth where it is in the material down to
 vanishing depth -- must say chatter (:attr:`CrossCheckResult.zero_confirmed`). ``benchmarks/chatter_agreement.py`` runs the set
 and prints the agreement table; ``tests/dynamics/test_dyn_agreement.py`` holds a sample of
 it.
@@ -131,8 +132,10 @@ class CrossCheckResult:
     def zero_confirmed(self) -> bool | None:
         """For a speed without a chatter-free depth (critical depth 0): whether the time
         domain says chatter at the depth where the lobes say chatter as soon as the cut is in
-        the material (1.25 x ``interrupted_below_m``, or the scan's lowest depth where the
-        cut is in the material down to vanishing depth). None when there is no such run."""
+        the material (1.25 x ``interrupted_below_m`` or the first depth above it, in steps of
+        1.25, where the steady cut is in the material; the scan's lowest depth where the cut
+        is in the material down to vanishing depth). None when there is no such run (the
+        steady cut interrupted up to 20 mm)."""
         runs = [r for r in self.runs if r.get("zero_check")]
         return None if not runs else all(r["chatter"] for r in runs)
 
@@ -181,6 +184,7 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
         chatter_free_window,
         critical_depth_semidiscretization,
         depth_scan_grid,
+        interrupted_below,
         monodromy_spectral_radius,
     )
     from robobore.dynamics.timedomain import SimulationSettings, simulate, auto_samples_per_rev
@@ -199,11 +203,17 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
                       cut.insert)
         runs.append(_run_record(ds, classify(ds), factor=0.8, sampling=1, depth_mm=a * 1e3,
                                 interrupted=True))
-    if ac == 0.0 and 1.25 * below <= MAX_SIMULATED_DEPTH_M:
+    a = 1.25 * below if below > 0.0 else float(depth_scan_grid()[0])
+    if ac == 0.0 and process is None:
+        # where the steady cut is interrupted at and above the linear limit, the first depth
+        # above it (steps of 1.25) where the steady cut is in the material
+        while a <= MAX_SIMULATED_DEPTH_M and interrupted_below(
+                cut.structure, pr, cut.speed_rpm, a) >= a:
+            a *= 1.25
+    if ac == 0.0 and a <= MAX_SIMULATED_DEPTH_M:
         # no chatter-free depth: the lobes say chatter as soon as the cut is in the material
         # (just above the interrupted cut, or at the scan's lowest depth where it is in the
         # material down to vanishing depth); the time domain there must say chatter
-        a = 1.25 * below if below > 0.0 else float(depth_scan_grid()[0])
         rho_sd = monodromy_spectral_radius(cut.structure, pr, cut.speed_rpm, a)
         ds = simulate(cut.structure, cut.process(a), SimulationSettings(cut.speed_rpm, a),
                       cut.insert)
