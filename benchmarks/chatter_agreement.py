@@ -2,7 +2,11 @@
 
 For each cut: the semi-discretisation critical depth a_c, then `simulate` at 0.8 a_c and
 1.25 a_c at the default sampling and at twice it; the cut agrees when both 0.8 runs say no
-chatter and both 1.25 runs say chatter. ``--fixed`` checks the lobes of the process linearised
+chatter and both 1.25 runs say chatter. A critical depth of 0 (no chatter-free depth) is
+checked too: the time domain at 1.25 x the depth below which the steady cut is interrupted
+(or the first depth above it, in steps of 1.25, where the steady cut is in the material; at
+the scan's lowest depth, 5 um, where the cut is in the material down to vanishing depth),
+where the lobes say chatter, must say chatter, or the disagreement is counted and printed. ``--fixed`` checks the lobes of the process linearised
 once at 0.05 mm (widths scaled with the depth) instead of the process rebuilt at each depth.
 
     python benchmarks/chatter_agreement.py --cuts 100 --seed 44 [--fixed] [--json out.json]
@@ -45,6 +49,19 @@ def main() -> None:
             if ic is not None:
                 counts["interrupted"] = counts.get("interrupted", 0) + 1
                 counts["interrupted_confirmed"] = counts.get("interrupted_confirmed", 0) + ic
+            zc = res.zero_confirmed
+            if zc is not None:
+                counts["zero_checked"] = counts.get("zero_checked", 0) + 1
+                counts["zero_confirmed"] = counts.get("zero_confirmed", 0) + zc
+                if not zc:
+                    z = [r for r in res.runs if r.get("zero_check")][0]
+                    print(f"{cut.label}: n {cut.speed_rpm:.0f} f {cut.feed_per_rev_m * 1e3:.3f} "
+                          f"r {cut.insert.nose_radius_m * 1e3:.2f} limit 0 (interrupted "
+                          f"below {res.interrupted_below_m * 1e3:.4g} mm) -> time domain at "
+                          f"{z['depth_mm']:.4g} mm: no chatter (multiplier "
+                          f"{z['floquet_multiplier']:.4f}, decided {z['decided']}, tool leaves "
+                          f"the cut {z['tool_leaves_cut']}; SD radius "
+                          f"{z['sd_spectral_radius']:.4f})", flush=True)
             continue
         counts["agree" if res.agrees else "disagree"] += 1
         counts["nonlinear"] = counts.get("nonlinear", 0) + int(res.nonlinear)
@@ -64,6 +81,10 @@ def main() -> None:
           f"limit 0 because the steady cut is interrupted up to the linear limit: "
           f"{counts.get('interrupted', 0)} (time domain finds the tool leaving the cut below "
           f"it: {counts.get('interrupted_confirmed', 0)})")
+    print(f"limit 0 checked by the time domain where the lobes say chatter: "
+          f"{counts.get('zero_checked', 0)}, it says chatter on "
+          f"{counts.get('zero_confirmed', 0)} (disagree: "
+          f"{counts.get('zero_checked', 0) - counts.get('zero_confirmed', 0)})")
     print(f"lobes: {'fixed at 0.05 mm' if a.fixed else 'rebuilt at each depth'}; "
           f"{a.cuts} cuts (seed {a.seed}), {n_app} with a finite limit: agree "
           f"{counts['agree']}/{n_app}; limit 0: {counts['zero']}, stable to 50 mm: "

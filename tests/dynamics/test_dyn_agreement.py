@@ -23,9 +23,10 @@ def test_time_domain_agrees_with_the_lobes_on_random_cuts():
     default sampling and at twice it, on every cut with a finite limit (the verdict's
     nonlinear cause is not needed: none of these runs relies on it); where the lobes find no
     chatter-free depth because the steady cut is interrupted, the time domain finds the tool
-    leaving the cut."""
+    leaving the cut; where they find none at all (critical depth 0), the time domain at the
+    depth where they say chatter as soon as the cut is in the material says chatter."""
     rng = np.random.default_rng(44)
-    finite = interrupted = 0
+    finite = zero = 0
     for i in range(16):
         res = check_cut(random_cut(rng, label=f"cut {i}"))
         if res.applicable:
@@ -33,10 +34,14 @@ def test_time_domain_agrees_with_the_lobes_on_random_cuts():
             for r in res.runs:
                 assert r["chatter"] == (r["factor"] > 1.0), (i, res.to_dict())
                 assert run_agrees(r)
-        elif res.interrupted_confirmed is not None:
-            interrupted += 1
+            continue
+        if res.interrupted_confirmed is not None:
             assert res.interrupted_confirmed, (i, res.to_dict())
-    assert finite >= 8
+        if res.zero_confirmed is not None:
+            zero += 1
+            assert res.zero_confirmed, (i, res.to_dict())
+            assert all(run_agrees(r) for r in res.runs if r.get("zero_check"))
+    assert finite >= 8 and zero >= 1
 
 
 def test_fixed_linearisation_is_what_disagrees():

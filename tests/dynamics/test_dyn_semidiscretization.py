@@ -270,3 +270,34 @@ count = 5
     assert "unconditionally stable up to 50 mm" in d["notes"][0]
     r = runner.invoke(app, ["lobes", str(p)])
     assert r.exit_code == 0 and "none up to 50" in r.output
+
+
+def test_radius_above_one_where_the_cut_is_interrupted_leaves_the_window_above(tmp_path):
+    """The identified example robot at 1100 r/min: the spectral radius is above 1 at vanishing
+    depth, where the steady cut is interrupted (the depth-independent trailing-edge force
+    pulls the tool out of a shallow cut), so the linearisation says nothing there. The
+    chatter-free window starts where the cut stays in the material and ends at the first
+    crossing of 1 above it; inside it (0.05 mm) the radius and the simulated multiplier
+    agree and the time domain decides no chatter."""
+    from robobore.dynamics.chatter import classify
+    from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
+    from robobore.dynamics.semidiscretization import chatter_free_window, interrupted_below
+    from robobore.dynamics.timedomain import SimulationSettings, simulate
+
+    s, m = _identified(tmp_path)
+    cfg, _ = load_dynamics_config(EX / "boring_process.toml", s, m)
+    st, pr = build_structure(cfg), build_process(cfg)
+    n = 1100.0
+    below, ac = chatter_free_window(st, pr, n)
+    assert 0.0 < below < 0.05e-3 < ac < 0.5e-3
+    assert monodromy_spectral_radius(st, pr, n, 5e-6) >= 1.0  # the linear answer down there
+    assert interrupted_below(st, pr, n, 0.9 * below) >= 0.9 * below  # but the cut is out
+    assert interrupted_below(st, pr, n, 1.1 * below) < 1.1 * below
+    assert monodromy_spectral_radius(st, pr, n, 0.99 * ac) < 1.0
+    assert monodromy_spectral_radius(st, pr, n, 1.01 * ac) >= 1.0
+    a = 0.05e-3
+    rho = monodromy_spectral_radius(st, pr, n, a)
+    v = classify(simulate(st, pr, SimulationSettings(n, a, revolutions=150),
+                          cfg.insert.to_insert()))
+    assert v.chatter_decided and not v.chatter and not v.tool_leaves_cut
+    assert rho < 1.0 and abs(v.floquet_multiplier - rho) < 5e-3

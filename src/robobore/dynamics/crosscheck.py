@@ -6,7 +6,11 @@ and a speed drawn from documented ranges (:func:`random_cut`; SYNTHETIC ground t
 measurement is involved). :func:`check_cut` computes the semi-discretisation critical depth
 ``a_c`` of the cut and simulates it in the time domain at ``0.8 a_c`` and ``1.25 a_c``, at the
 default sampling and at twice it: the lobes and the time domain agree when the first two say
-no chatter and the last two say chatter. ``benchmarks/chatter_agreement.py`` runs the set
+no chatter and the last two say chatter. Where the critical depth is 0 (no chatter-free
+depth), the time domain at a depth where the lobes say chatter -- 1.25 x the depth below which
+the steady cut is interrupted (or the first depth above it, in steps of 1.25, where the steady
+cut is in the material), or the scan's lowest depth where it is in the material down to
+vanishing depth -- must say chatter (:attr:`CrossCheckResult.zero_confirmed`). ``benchmarks/chatter_agreement.py`` runs the set
 and prints the agreement table; ``tests/dynamics/test_dyn_agreement.py`` holds a sample of
 it.
 
@@ -37,6 +41,9 @@ SPEED_RPM = (150.0, 1500.0)
 FEED_MM_PER_REV = (0.05, 0.5)
 NOSE_RADIUS_MM = (0.2, 1.2)
 BORE_DIAMETER_M = 0.04
+#: Deepest run of :func:`check_cut` [m] (the time domain's depth range ends
+#: at 20 mm).
+MAX_SIMULATED_DEPTH_M = 0.02
 #: Depth at which a process is first built (its geometry is rebuilt at every trial depth).
 REFERENCE_DEPTH_M = 0.05e-3
 
@@ -122,6 +129,17 @@ class CrossCheckResult:
         return None if not runs else all(r["tool_leaves_cut"] for r in runs)
 
     @property
+    def zero_confirmed(self) -> bool | None:
+        """For a speed without a chatter-free depth (critical depth 0): whether the time
+        domain says chatter at the depth where the lobes say chatter as soon as the cut is in
+        the material (1.25 x ``interrupted_below_m`` or the first depth above it, in steps of
+        1.25, where the steady cut is in the material; the scan's lowest depth where the cut
+        is in the material down to vanishing depth). None when there is no such run (the
+        steady cut interrupted up to 20 mm)."""
+        runs = [r for r in self.runs if r.get("zero_check")]
+        return None if not runs else all(r["chatter"] for r in runs)
+
+    @property
     def nonlinear(self) -> bool:
         """Some run leaves the linear model (the tool leaves the cut)."""
         return any(r["tool_leaves_cut"] for r in self.runs)
@@ -146,7 +164,10 @@ def _run_record(ds: Any, v: Any, **where: Any) -> dict[str, Any]:
 
 def run_agrees(run: dict[str, Any]) -> bool:
     """A run at ``factor`` x the critical depth agrees when it chatters above the limit and
-    does not below it, or when its verdict states the tool leaving the cut."""
+    does not below it, or when its verdict states the tool leaving the cut; a run checking a
+    critical depth of 0 (``zero_check``) agrees when it chatters."""
+    if run.get("zero_check"):
+        return bool(run["chatter"])
     return bool(run["tool_leaves_cut"] or run["chatter"] == (run["factor"] > 1.0))
 
 
@@ -162,6 +183,9 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
     from robobore.dynamics.semidiscretization import (
         chatter_free_window,
         critical_depth_semidiscretization,
+        depth_scan_grid,
+        interrupted_below,
+        monodromy_spectral_radius,
     )
     from robobore.dynamics.timedomain import SimulationSettings, simulate, auto_samples_per_rev
 
@@ -171,7 +195,7 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
     else:
         below, ac = 0.0, critical_depth_semidiscretization(cut.structure, pr, cut.speed_rpm)
     runs: list[dict[str, Any]] = []
-    if ac == 0.0 and below > 0.0 and 0.8 * below <= 0.05:
+    if ac == 0.0 and below > 0.0 and 0.8 * below <= MAX_SIMULATED_DEPTH_M:
         # no chatter-free depth: the steady cut is interrupted up to the linear limit; the
         # time domain at 0.8 x that limit must find the tool leaving the cut
         a = 0.8 * below
@@ -179,11 +203,27 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
                       cut.insert)
         runs.append(_run_record(ds, classify(ds), factor=0.8, sampling=1, depth_mm=a * 1e3,
                                 interrupted=True))
+    a = 1.25 * below if below > 0.0 else float(depth_scan_grid()[0])
+    if ac == 0.0 and process is None:
+        # where the steady cut is interrupted at and above the linear limit, the first depth
+        # above it (steps of 1.25) where the steady cut is in the material
+        while a <= MAX_SIMULATED_DEPTH_M and interrupted_below(
+                cut.structure, pr, cut.speed_rpm, a) >= a:
+            a *= 1.25
+    if ac == 0.0 and a <= MAX_SIMULATED_DEPTH_M:
+        # no chatter-free depth: the lobes say chatter as soon as the cut is in the material
+        # (just above the interrupted cut, or at the scan's lowest depth where it is in the
+        # material down to vanishing depth); the time domain there must say chatter
+        rho_sd = monodromy_spectral_radius(cut.structure, pr, cut.speed_rpm, a)
+        ds = simulate(cut.structure, cut.process(a), SimulationSettings(cut.speed_rpm, a),
+                      cut.insert)
+        runs.append(_run_record(ds, classify(ds), factor=None, sampling=1, depth_mm=a * 1e3,
+                                zero_check=True, sd_spectral_radius=rho_sd))
     if 0.0 < ac < math.inf:
         base = auto_samples_per_rev(cut.structure, cut.speed_rpm, cut.insert.n_inserts)
         for fac in factors:
             a = fac * ac
-            if a > 0.05:
+            if a > MAX_SIMULATED_DEPTH_M:
                 continue
             pa = cut.process(a)
             for s in sampling:

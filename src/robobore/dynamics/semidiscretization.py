@@ -333,7 +333,11 @@ def chatter_free_window(structure: ToolPointStructure, process: CuttingProcess,
     (:func:`interrupted_below`, evaluated at the limit, or at the top of the scan when the cut
     is stable up to it). Depths between the two are chatter-free. When the cut is interrupted
     at the limit itself there is no chatter-free depth at that speed: the critical depth is
-    then reported as 0 (with ``interrupted_below_m`` the linear limit)."""
+    then reported as 0 (with ``interrupted_below_m`` the linear limit). Where the spectral
+    radius is at or above 1 at vanishing depth because the steady cut is interrupted there
+    (the linearisation does not hold), the linear limit is the first crossing above the depth
+    up to which the cut stays interrupted (:func:`_above_interruption`); 0 with
+    ``interrupted_below_m`` 0 only where the cut is in the material at vanishing depth."""
     return _window(structure, process, speed_rpm, guess_m, None, **kwargs)[:2]
 
 
@@ -344,13 +348,72 @@ def _window(structure, process, speed_rpm, guess_m, slope, depth_hi_m=DEPTH_SCAN
     a_c, sl = _critical_depth(structure, process, speed_rpm, depth_hi_m, steps, tol,
                               include_process_stiffness, about_deflected, decades, ratio,
                               guess_m, slope)
+    floor = 0.0  # the cut is interrupted below this depth, each depth with its own geometry
     if a_c == 0.0:
-        return 0.0, 0.0, sl
+        floor, a_c = _above_interruption(structure, process, speed_rpm, depth_hi_m, steps, tol,
+                                         include_process_stiffness, about_deflected, decades,
+                                         ratio)
+        if a_c == 0.0:
+            return floor, 0.0, sl
     top = a_c if math.isfinite(a_c) else depth_hi_m
     below = interrupted_below(structure, process, speed_rpm, float(top) * (1.0 - 1e-3))
     if below >= float(top) * (1.0 - 1e-3):
         return float(top), 0.0, sl
-    return below, a_c, sl
+    return max(below, floor), a_c, sl
+
+
+def _above_interruption(structure, process, speed_rpm, depth_hi_m, steps, tol,
+                        include_process_stiffness, about_deflected, decades, ratio
+                        ) -> tuple[float, float]:
+    """``(interrupted_below_m, critical_depth_m)`` where the spectral radius is at or above 1
+    at vanishing depth (:func:`_scan` gave 0).
+
+    Where the steady cut at the scan's lowest depth is interrupted (each depth with its own
+    chip geometry, :func:`interrupted_below`), the linearisation does not hold there and its
+    radius says nothing about chatter: the depth up to which the cut stays interrupted is
+    found on the scan grid from the bottom up (narrowed to a relative width ``tol``), and the
+    linear limit is the first crossing of ``rho = 1`` above it (the grid scan from there, then
+    :func:`_narrow`). ``(below, 0)`` when the cut is unstable as soon as it is in the
+    material, ``(below, inf)`` when it is stable from there up to ``depth_hi_m``; ``(0, 0)``
+    when the cut is in the material at the lowest depth (an instability at vanishing depth,
+    e.g. the depth-modulation stiffness) and ``(depth_hi_m, 0)`` when it is interrupted up to
+    the scan's top."""
+    grid = depth_scan_grid(depth_hi_m, decades, ratio)
+
+    def interrupted(a: float) -> bool:
+        return interrupted_below(structure, process, speed_rpm, a) >= a
+
+    if not interrupted(float(grid[0])):
+        return 0.0, 0.0
+    k = 1
+    while k < grid.size and interrupted(float(grid[k])):
+        k += 1
+    if k == grid.size:
+        return float(depth_hi_m), 0.0
+    lo, hi = float(grid[k - 1]), float(grid[k])
+    while hi / lo - 1.0 > tol:
+        mid = math.sqrt(lo * hi)
+        if interrupted(mid):
+            lo = mid
+        else:
+            hi = mid
+    steps = steps or auto_steps(structure, process, speed_rpm)
+
+    def rho(b: float) -> float:
+        r = _rho(structure, process, speed_rpm, b, steps, include_process_stiffness,
+                 about_deflected)
+        return r if r == r else math.inf  # NaN counts as unstable
+
+    r_prev = rho(hi)
+    if r_prev >= 1.0:
+        return lo, 0.0
+    prev = hi
+    for a1 in grid[k + 1:]:
+        r1 = rho(float(a1))
+        if r1 >= 1.0:
+            return lo, _narrow(rho, prev, r_prev, float(a1), r1, tol)
+        prev, r_prev = float(a1), r1
+    return lo, math.inf
 
 
 def chatter_free_windows(structure: ToolPointStructure, process: CuttingProcess,
