@@ -254,13 +254,144 @@ def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
 
 
 def _deflection_parts_uncached(structure, process, speed_rpm):
-    from robobore.dynamics.timedomain import nominal_cut_deflection
-
-    parts = nominal_cut_deflection(structure, process, speed_rpm, DEFLECTION_SAMPLES)
-    if parts is None:
+    """:func:`~robobore.dynamics.timedomain.nominal_cut_deflection` at
+    :data:`DEFLECTION_SAMPLES` samples per revolution, by :func:`_deflection_kernel` (the
+    same orbit of the same map, its step matrices and forces formed in the kernel from the
+    process's three-vectors)."""
+    N = int(process.n_inserts)
+    Ns = int(math.ceil(DEFLECTION_SAMPLES / N) * N)
+    Phi, Gam = _zoh(structure, 60.0 / (float(speed_rpm) * Ns))
+    vec = ((process.width_per_depth * process.h0) @ process.shear
+           + process.edge_per_depth @ process.edge)
+    fixed = process.edge_fixed_m @ process.edge
+    out = np.empty((Ns, 3, 2))
+    if not _deflection_kernel(Phi, Gam, np.ascontiguousarray(structure.directions, dtype=float),
+                              np.asarray(process.depth_direction, float), vec, fixed, N,
+                              30.0 / (float(speed_rpm) * Ns), out):
         return None
-    r1, r0 = parts
-    return (r1, r0) if np.any(process.edge_fixed_m) else (r1, None)
+    r1 = np.ascontiguousarray(out[:, :, 0])
+    return (r1, np.ascontiguousarray(out[:, :, 1])) if np.any(process.edge_fixed_m) else (
+        r1, None)
+
+
+_ZOH: dict = {}
+
+
+def _zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~robobore.dynamics.timedomain.modal_zoh`, kept per structure and step."""
+    key = (id(structure), float(dt))
+    hit = _ZOH.get(key)
+    if hit is not None and hit[0] is structure:
+        return hit[1]
+    from robobore.dynamics.timedomain import modal_zoh
+
+    out = modal_zoh(structure, dt)
+    if len(_ZOH) > 4096:
+        _ZOH.clear()
+    _ZOH[key] = (structure, out)
+    return out
+
+
+@nb.njit(cache=True)
+def _deflection_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, out):  # pragma: no cover - numba
+    """Steady nominal-cut tool-point displacement per unit depth and of the depth-independent
+    edge force, ``out`` (Ns, 3, 2), at the step starts ``2 pi i / Ns``: the periodic orbit of
+    the time-domain map on the nominal chip (``robobore.dynamics.timedomain._orbit_kernel``:
+    per mode ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))``, the Ns steps composed,
+    ``x_0 = T x_0 + c`` solved). At the step midpoint ``theta_i`` and insert ``p``
+    (``theta_i + 2 pi p / N``, basis ``B_p``): ``Pm_i = sum_p (D B_p^T vec)(D B_p^T dd)^T``
+    (the depth-modulation stiffness), load cases ``Fm_i = sum_p D B_p^T (vec, fixed)``.
+    False when ``I - T`` is singular (no orbit)."""
+    Ns = out.shape[0]
+    m = D.shape[0]
+    n = 2 * m
+    Pm = np.zeros((Ns, m, m))
+    Fm = np.zeros((Ns, m, 2))
+    two_pi = 2.0 * math.pi
+    fv = np.empty(3)
+    ff = np.empty(3)
+    fe = np.empty(3)
+    u = np.empty(m)
+    for i in range(Ns):
+        th = two_pi * (i + 0.5) / Ns
+        for p in range(N):
+            tp = th + two_pi * p / N
+            c_, s_ = math.cos(tp), math.sin(tp)
+            # B^T x = x_t e_t + x_r e_r + x_z e_z, e_t = (-s, c, 0), e_r = (c, s, 0)
+            fv[0], fv[1], fv[2] = -s_ * vec[0] + c_ * vec[1], c_ * vec[0] + s_ * vec[1], vec[2]
+            ff[0], ff[1], ff[2] = (-s_ * fixed[0] + c_ * fixed[1],
+                                   c_ * fixed[0] + s_ * fixed[1], fixed[2])
+            fe[0], fe[1], fe[2] = -s_ * dd[0] + c_ * dd[1], c_ * dd[0] + s_ * dd[1], dd[2]
+            for j in range(m):
+                u[j] = D[j, 0] * fv[0] + D[j, 1] * fv[1] + D[j, 2] * fv[2]
+                Fm[i, j, 0] += u[j]
+                Fm[i, j, 1] += D[j, 0] * ff[0] + D[j, 1] * ff[1] + D[j, 2] * ff[2]
+            for k in range(m):
+                vk = D[k, 0] * fe[0] + D[k, 1] * fe[1] + D[k, 2] * fe[2]
+                for j in range(m):
+                    Pm[i, j, k] += u[j] * vk
+    T = np.eye(n)
+    T2 = np.empty((n, n))
+    c = np.zeros((n, 2))
+    c2 = np.empty((n, 2))
+    A = np.zeros((n, n))
+    b = np.zeros((n, 2))
+    for i in range(Ns):  # T <- A T, c <- A c + b
+        _orbit_step(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
+        for r in range(n):
+            for j in range(n):
+                acc = 0.0
+                for k in range(n):
+                    acc += A[r, k] * T[k, j]
+                T2[r, j] = acc
+            for j in range(2):
+                acc = b[r, j]
+                for k in range(n):
+                    acc += A[r, k] * c[k, j]
+                c2[r, j] = acc
+        T, T2 = T2, T
+        c, c2 = c2, c
+    M = np.eye(n) - T
+    if abs(np.linalg.det(M)) < 1e-300:
+        return False
+    x = np.ascontiguousarray(np.linalg.solve(M, c))
+    for i in range(Ns):
+        for o in range(3):
+            for kk in range(2):
+                acc = 0.0
+                for j in range(m):
+                    acc += x[j, kk] * D[j, o]
+                out[i, o, kk] = acc
+        _orbit_step(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
+        for r in range(n):
+            for j in range(2):
+                acc = b[r, j]
+                for k in range(n):
+                    acc += A[r, k] * x[k, j]
+                c2[r, j] = acc
+        x[:, :] = c2
+    return True
+
+
+@nb.njit(cache=True)
+def _orbit_step(Phi, Gam, Pm_i, Fm_i, half_dt, A, b):  # pragma: no cover - numba
+    """One step of the nominal-chip map of :func:`_deflection_kernel` into ``A`` (2m, 2m) and
+    ``b`` (2m, K)."""
+    m = Phi.shape[0]
+    A[:, :] = 0.0
+    for j in range(m):
+        A[j, j] = Phi[j, 0, 0]
+        A[j, m + j] = Phi[j, 0, 1]
+        A[m + j, j] = Phi[j, 1, 0]
+        A[m + j, m + j] = Phi[j, 1, 1]
+        for k in range(m):
+            A[j, k] += Gam[j, 0] * Pm_i[j, k]
+            A[j, m + k] += Gam[j, 0] * Pm_i[j, k] * half_dt
+            A[m + j, k] += Gam[j, 1] * Pm_i[j, k]
+            A[m + j, m + k] += Gam[j, 1] * Pm_i[j, k] * half_dt
+        for c in range(Fm_i.shape[1]):
+            b[j, c] = Gam[j, 0] * Fm_i[j, c]
+            b[m + j, c] = Gam[j, 1] * Fm_i[j, c]
 
 
 def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
