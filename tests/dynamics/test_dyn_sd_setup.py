@@ -50,3 +50,64 @@ def test_deflection_without_trailing_edge_has_no_fixed_part(structure):
     r1, _ = nominal_cut_deflection(structure, pr, 500.0, sd.DEFLECTION_SAMPLES)
     assert q0 is None
     assert np.abs(q1 - r1).max() <= 1e-11 * np.abs(r1).max()
+
+
+def _process_from_edge_elements(ins, c, depth_m, feed_m, trailing):
+    """The process arrays of :func:`boring_process` formed from
+    :func:`robobore.cutting.geometry.edge_elements` (the reference the compiled pass follows)."""
+    from robobore.cutting.geometry import edge_elements
+
+    el = edge_elements(ins, depth_m, feed_m / ins.n_inserts, 24, trailing_edge=trailing,
+                       exact_area=False)
+    trail = el.trailing
+    sk, ck = np.sin(el.kappa), np.cos(el.kappa)
+    one = np.ones_like(sk)
+    return {"h0": el.h, "width_per_depth": el.db / depth_m * (el.h >= 0.25 * ins.edge_radius_m),
+            "edge_per_depth": np.where(trail, 0.0, el.dS / depth_m),
+            "edge_fixed_m": np.where(trail, el.dS, 0.0),
+            "normal": np.column_stack([0 * one, -ck, -sk]),
+            "shear": np.column_stack([-c.Ktc * one, -c.Kfc * ck - c.Krc * sk,
+                                      -c.Kfc * sk + c.Krc * ck]),
+            "edge": np.column_stack([-c.Kte * one, -c.Kfe * ck - c.Kre * sk,
+                                     -c.Kfe * sk + c.Kre * ck])}
+
+
+@pytest.mark.parametrize("kappa_deg,end_deg", [(45.0, 5.0), (90.0, 5.0), (95.0, 30.0),
+                                               (107.0, 3.0)])
+@pytest.mark.parametrize("feed_m", [0.05e-3, 0.3e-3, 1.5e-3])
+@pytest.mark.parametrize("trailing", [True, False])
+def test_process_elements_are_the_edge_elements(kappa_deg, end_deg, feed_m, trailing):
+    """Depths inside the nose and beyond it, feeds whose trailing contact ends on the arc and
+    on the straight minor edge, 1 and 3 inserts: the same elements as edge_elements."""
+    c = ti64_coefficients()
+    for n_ins in (1, 3):
+        ins = BoringInsert(nose_radius_m=0.4e-3, approach_angle_deg=kappa_deg,
+                           end_edge_angle_deg=end_deg, n_inserts=n_ins)
+        for depth in np.geomspace(5e-6, 0.05, 13):
+            ref = _process_from_edge_elements(ins, c, float(depth), feed_m, trailing)
+            pr = boring_process(ins, c, float(depth), feed_m, trailing_edge=trailing)
+            for name, v in ref.items():
+                got = getattr(pr, name)
+                assert got.shape == v.shape, name
+                assert np.abs(got - v).max() <= 1e-13 * max(np.abs(v).max(), 1e-300), name
+
+
+def test_process_at_depth_keeps_the_geometry_and_label():
+    ins = BoringInsert(nose_radius_m=0.8e-3, approach_angle_deg=75.0, n_inserts=2)
+    pr = boring_process(ins, ti64_coefficients(), 1e-3, 0.2e-3)
+    at = pr.at_depth(0.4e-3)
+    assert at.geometry == pr.geometry and at.label == pr.label
+    assert at.reference_depth_m == 0.4e-3
+    ref = boring_process(ins, ti64_coefficients(), 0.4e-3, 0.2e-3)
+    assert np.array_equal(at.h0, ref.h0) and np.array_equal(at.edge, ref.edge)
+
+
+@pytest.mark.parametrize("bad", [{"depth_m": 0.0}, {"depth_m": 0.06}, {"feed_per_rev_m": 0.0},
+                                 {"n_elements": 0}])
+def test_process_bad_input_is_named(bad):
+    from robobore.errors import ConfigError
+
+    args = {"depth_m": 1e-3, "feed_per_rev_m": 0.1e-3, "n_elements": 24, **bad}
+    with pytest.raises(ConfigError) as e:
+        boring_process(BoringInsert(), ti64_coefficients(), **args)
+    assert ("depth" in str(e.value)) or ("feed" in str(e.value)) or ("element" in str(e.value))
