@@ -111,3 +111,25 @@ def test_process_bad_input_is_named(bad):
     with pytest.raises(ConfigError) as e:
         boring_process(BoringInsert(), ti64_coefficients(), **args)
     assert ("depth" in str(e.value)) or ("feed" in str(e.value)) or ("element" in str(e.value))
+
+
+@pytest.mark.parametrize("scale", [1e-2, 1.0, 300.0])
+def test_modal_step_matrices_equal_the_augmented_exponential(scale):
+    """The step matrices formed on the blocks of the modal system matrix (the last m columns
+    of both Gammas) equal scipy's exponential of the augmented matrix, from a small
+    regenerative term to one that needs doublings."""
+    rng = np.random.default_rng(5)
+    m, k = 3, 16
+    om = 2 * np.pi * np.array([6.9, 16.8, 24.6])
+    L = np.zeros((k, 2 * m, 2 * m))
+    for q in range(k):
+        L[q, :m, m:] = np.eye(m)
+        L[q, m:, :m] = -np.diag(om**2) + 0.1 * scale * np.outer(om, om) * rng.standard_normal(
+            (m, m))
+        L[q, m:, m:] = np.diag(-2 * 0.03 * om)
+    dt = 0.4 / k
+    Phi, G0, G1 = np.empty_like(L), np.empty((k, 2 * m, m)), np.empty((k, 2 * m, m))
+    sd._step_matrices_modal(L, dt, Phi, G0, G1)
+    R = sd._step_matrices(L, dt)
+    for got, ref in ((Phi, R[0]), (G0, R[1][:, :, m:]), (G1, R[2][:, :, m:])):
+        assert np.abs(got - ref).max() <= 1e-12 * np.abs(ref).max()

@@ -95,14 +95,9 @@ def _matmul_into(A, B, out):  # pragma: no cover - numba
 
 
 @nb.njit(cache=True)
-def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
-
-    The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
-    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
-    whose norm is of the order of the modes' angular frequencies rather than their squares,
-    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
-    (:func:`_step_matrices_taylor` on ``L'``)."""
+def _balance(L):  # pragma: no cover - numba
+    """Diagonal scaling ``d`` (powers of 2) balancing the sum of the moduli of the stack ``L``
+    (k, n, n) (Parlett & Reinsch 1969): ``D^-1 L D`` has rows and columns of like norms."""
     k_n, n, _ = L.shape
     M = np.zeros((n, n))
     for q in range(k_n):
@@ -139,6 +134,20 @@ def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
                     M[i, j] /= f
         if done:
             break
+    return d
+
+
+@nb.njit(cache=True)
+def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+
+    The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
+    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
+    whose norm is of the order of the modes' angular frequencies rather than their squares,
+    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
+    (:func:`_step_matrices_taylor` on ``L'``)."""
+    k_n, n, _ = L.shape
+    d = _balance(L)
     Lb = np.empty_like(L)
     for q in range(k_n):
         for i in range(n):
@@ -216,6 +225,110 @@ def _step_matrices_taylor(L, dt, Phi, G0, G1):  # pragma: no cover - numba
                     G0[q, i, j] = W2[i, j] + G0[q, i, j]
                     Phi[q, i, j] = W3[i, j]
             h *= 2.0
+
+
+@nb.njit(cache=True)
+def _step_matrices_modal(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """:func:`_step_matrices_batch` for the modal system matrices of :func:`_step_coefficients`
+    (``L = [[0, I], [K, C]]``, ``C`` diagonal), ``G0`` and ``G1`` only their last ``m``
+    columns (k, 2m, m), the ones the delayed term multiplies.
+
+    The same balancing, Taylor degree and doublings; each Taylor product ``T A`` uses the
+    blocks of ``A = L' h`` (a diagonal upper right and lower right, a full lower left), which
+    the balancing keeps."""
+    k_n, n, _ = L.shape
+    m = n // 2
+    d = _balance(L)
+    T = np.empty((n, n))
+    W1 = np.empty((n, n))
+    W3 = np.empty((n, n))
+    V1 = np.empty((n, m))
+    V2 = np.empty((n, m))
+    A21 = np.empty((m, m))
+    e12 = np.empty(m)
+    g22 = np.empty(m)
+    for q in range(k_n):
+        nrm = 0.0
+        for j in range(n):
+            c = 0.0
+            for i in range(n):
+                c += abs(L[q, i, j] * d[j] / d[i])
+            nrm = max(nrm, c)
+        nrm *= dt
+        s = 0
+        if nrm > 0.5:
+            s = int(math.ceil(math.log2(nrm / 0.5)))
+        h = dt / 2.0**s
+        for j in range(m):
+            e12[j] = L[q, j, m + j] * d[m + j] / d[j] * h
+            g22[j] = L[q, m + j, m + j] * h
+            for k in range(m):
+                A21[j, k] = L[q, m + j, k] * d[k] / d[m + j] * h
+        for i in range(n):
+            for j in range(n):
+                T[i, j] = 1.0 if i == j else 0.0
+                Phi[q, i, j] = T[i, j]
+            for j in range(m):
+                G0[q, i, j] = T[i, m + j] * h
+                G1[q, i, j] = T[i, m + j] * h * h * 0.5
+        nh = nrm / 2.0**s
+        deg = 16
+        term = nh
+        for j in range(1, 17):
+            term *= nh / (j + 1)
+            if term < 1e-17:
+                deg = j
+                break
+        for mm in range(1, deg + 1):
+            # T <- T A / mm with A = [[0, diag e12], [A21, diag g22]]
+            for i in range(n):
+                for k in range(m):
+                    acc = 0.0
+                    for c in range(m):
+                        acc += T[i, m + c] * A21[c, k]
+                    W1[i, k] = acc
+                for k in range(m):
+                    W1[i, m + k] = T[i, k] * e12[k] + T[i, m + k] * g22[k]
+            for i in range(n):
+                for j in range(n):
+                    T[i, j] = W1[i, j] / mm
+            c0 = h / (mm + 1)
+            c1 = h * h / ((mm + 1) * (mm + 2))
+            for i in range(n):
+                for j in range(n):
+                    Phi[q, i, j] += T[i, j]
+                for j in range(m):
+                    G0[q, i, j] += c0 * T[i, m + j]
+                    G1[q, i, j] += c1 * T[i, m + j]
+        for _ in range(s):
+            for i in range(n):
+                for j in range(m):
+                    a1 = 0.0
+                    a2 = 0.0
+                    for k in range(n):
+                        a1 += Phi[q, i, k] * G1[q, k, j]
+                        a2 += Phi[q, i, k] * G0[q, k, j]
+                    V1[i, j] = a1
+                    V2[i, j] = a2
+                for j in range(n):
+                    acc = 0.0
+                    for k in range(n):
+                        acc += Phi[q, i, k] * Phi[q, k, j]
+                    W3[i, j] = acc
+            for i in range(n):
+                for j in range(m):
+                    G1[q, i, j] = V1[i, j] + h * G0[q, i, j] + G1[q, i, j]
+                    G0[q, i, j] = V2[i, j] + G0[q, i, j]
+                for j in range(n):
+                    Phi[q, i, j] = W3[i, j]
+            h *= 2.0
+        for i in range(n):
+            for j in range(n):
+                Phi[q, i, j] *= d[i] / d[j]
+            for j in range(m):
+                sc = d[i] / d[m + j]
+                G0[q, i, j] *= sc
+                G1[q, i, j] *= sc
 
 
 def deflected_depth_weights(structure: ToolPointStructure, process: CuttingProcess,
@@ -916,20 +1029,22 @@ def _step_coefficients(rotating, N, dt, speed_rpm, core, vec, dd, D, minv, om, z
 
 @nb.njit(cache=True)
 def _delay_matrices(L, W, dt, overlap_depth, Phi, P0, P1):  # pragma: no cover - numba
-    """Step matrices (:func:`_step_matrices_batch`) and the delayed-term matrices of
+    """Step matrices (:func:`_step_matrices_modal`) and the delayed-term matrices of
     :func:`_propagate`: with ``Rq = [0; mu a W]`` (2m, m), ``P1 = Gamma1 Rq / dt``
     (multiplies ``q_{i-r+1}``) and ``P0 = (Gamma0 - Gamma1 / dt) Rq`` (``q_{i-r}``). False
     when a step matrix is not finite (far beyond the limit)."""
     k_n, n2, _ = L.shape
     m = n2 // 2
-    G0 = np.empty_like(L)
-    G1 = np.empty_like(L)
-    _step_matrices_batch(L, dt, Phi, G0, G1)
+    G0 = np.empty((k_n, n2, m))
+    G1 = np.empty((k_n, n2, m))
+    _step_matrices_modal(L, dt, Phi, G0, G1)
     for q in range(k_n):
         for a in range(n2):
             for b in range(n2):
-                if not (math.isfinite(Phi[q, a, b]) and math.isfinite(G0[q, a, b])
-                        and math.isfinite(G1[q, a, b])):
+                if not math.isfinite(Phi[q, a, b]):
+                    return False
+            for b in range(m):
+                if not (math.isfinite(G0[q, a, b]) and math.isfinite(G1[q, a, b])):
                     return False
         for a in range(n2):
             for b in range(m):
@@ -937,9 +1052,9 @@ def _delay_matrices(L, W, dt, overlap_depth, Phi, P0, P1):  # pragma: no cover -
                 acc1 = 0.0
                 for c in range(m):
                     rq = overlap_depth * W[q, c, b]
-                    g1 = G1[q, a, m + c] / dt
+                    g1 = G1[q, a, c] / dt
                     acc1 += g1 * rq
-                    acc0 += (G0[q, a, m + c] - g1) * rq
+                    acc0 += (G0[q, a, c] - g1) * rq
                 P0[q, a, b] = acc0
                 P1[q, a, b] = acc1
     return True
