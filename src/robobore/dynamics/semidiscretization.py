@@ -793,14 +793,12 @@ def _arnoldi(Phi, P0, P1, r, m, v0, V, H, Q, x, xn, w):  # pragma: no cover - nu
             wn0 += w[a] * w[a]
         if not math.isfinite(wn0):
             return -1
-        for _ in range(2):
+        for _ in range(2):  # classical Gram-Schmidt, twice (BLAS products)
+            Vj = V[:j + 1]
+            hv = np.dot(Vj, w)
             for i in range(j + 1):
-                h = 0.0
-                for a in range(n):
-                    h += V[i, a] * w[a]
-                H[i, j] += h
-                for a in range(n):
-                    w[a] -= h * V[i, a]
+                H[i, j] += hv[i]
+            w -= np.dot(hv, Vj)
         wn = 0.0
         for a in range(n):
             wn += w[a] * w[a]
