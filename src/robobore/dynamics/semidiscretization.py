@@ -903,22 +903,56 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
             if r0 is not None and depth_m > 0.0:
                 rp = rp + r0 / depth_m
             weighted = True
-    core = np.einsum("e,ei,ej->ij", process.width_per_depth, process.shear, process.normal)
-    vec = (np.einsum("e,e,ei->i", process.width_per_depth, process.h0, process.shear)
-           + np.einsum("e,ei->i", process.edge_per_depth, process.edge))
+    core, vec, dd = _process_matrices(process)
+    D, minv, om, zeta = _structure_arrays(structure)
     L = np.empty((n_th, 2 * m, 2 * m))
     W = np.empty((n_th, m, m))
     _step_coefficients(bool(process.rotating), int(process.n_inserts), float(dt),
-                       float(speed_rpm), core, vec, np.asarray(process.depth_direction, float),
-                       np.ascontiguousarray(structure.directions, dtype=float),
-                       1.0 / np.asarray(structure.modal_mass, float),
-                       np.asarray(structure.omega, float),
-                       np.asarray(structure.damping_ratio, float), np.ascontiguousarray(rp),
-                       weighted, float(depth_m), bool(include_process_stiffness), L, W)
+                       float(speed_rpm), core, vec, dd, D, minv, om, zeta,
+                       np.ascontiguousarray(rp), weighted, float(depth_m),
+                       bool(include_process_stiffness), L, W)
     Phi, P0, P1 = np.empty_like(L), np.empty((n_th, 2 * m, m)), np.empty((n_th, 2 * m, m))
     if not _delay_matrices(L, W, float(dt), float(process.overlap * depth_m), Phi, P0, P1):
         return math.inf
     return _spectral_radius(Phi, P0, P1, int(steps), int(m))
+
+
+def _process_matrices(process: CuttingProcess) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``core = sum_e w_e shear_e n_e^T``, ``vec = sum_e (w_e h0_e shear_e + s_e edge_e)``
+    (:meth:`~robobore.dynamics.process.CuttingProcess.directional_matrix` and
+    :meth:`~robobore.dynamics.process.CuttingProcess.process_stiffness` per unit depth) and
+    the depth direction, kept with the process (for the same array objects: a copy made by
+    :func:`dataclasses.replace` shares the memo, not necessarily the arrays)."""
+    src = (process.width_per_depth, process.shear, process.normal, process.h0,
+           process.edge_per_depth, process.edge, process.depth_direction)
+    hit = process.memo.get("sd_matrices")
+    if hit is not None and all(a is b for a, b in zip(hit[0], src, strict=True)):
+        return hit[1]
+    core = np.einsum("e,ei,ej->ij", process.width_per_depth, process.shear, process.normal)
+    vec = (np.einsum("e,e,ei->i", process.width_per_depth, process.h0, process.shear)
+           + np.einsum("e,ei->i", process.edge_per_depth, process.edge))
+    out = (core, vec, np.asarray(process.depth_direction, float))
+    process.memo["sd_matrices"] = (src, out)
+    return out
+
+
+_STRUCTURES: dict = {}
+
+
+def _structure_arrays(structure: ToolPointStructure):
+    """Modal directions (contiguous), inverse modal masses, angular frequencies and damping
+    ratios, kept per structure (keyed by its values)."""
+    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
+           structure.stiffness_N_per_m.tobytes(), np.asarray(structure.directions).tobytes())
+    hit = _STRUCTURES.get(key)
+    if hit is None:
+        hit = (np.ascontiguousarray(structure.directions, dtype=float),
+               1.0 / np.asarray(structure.modal_mass, float), np.asarray(structure.omega, float),
+               np.asarray(structure.damping_ratio, float))
+        if len(_STRUCTURES) > 256:
+            _STRUCTURES.clear()
+        _STRUCTURES[key] = hit
+    return hit
 
 
 @nb.njit(cache=True)
