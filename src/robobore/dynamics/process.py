@@ -51,14 +51,7 @@ import numba as nb
 import numpy as np
 
 from robobore.cutting.forces import CuttingCoefficients
-from robobore.cutting.geometry import (
-    BoringInsert,
-    _check,
-    _gauss_legendre,
-    _s_of_drop_lead,
-    _s_of_zeta_trail,
-    trailing_intersection,
-)
+from robobore.cutting.geometry import BoringInsert, trailing_intersection
 from robobore.errors import ConfigError
 
 
@@ -275,17 +268,21 @@ def _boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dep
     ``exact_area=False``), computed by :func:`_process_arrays` in one compiled pass: the same
     element boundaries, 16-point Gauss-Legendre chip areas and trailing-side nodes."""
     fz = feed_per_rev_m / insert.n_inserts
-    _check("depth_m", depth_m, 0.0, 0.05, "m", lo_open=True)
-    _check("feed_m", fz, 0.0, 0.01, "m", lo_open=True)
+    _check_range("depth_m", depth_m, 0.05, "m")
+    _check_range("feed_m", fz, 0.01, "m")
     if int(n_elements) != n_elements or n_elements < 1:
         raise ConfigError("need at least one element", field="n_elements", value=n_elements,
                           expected="an integer >= 1")
     n = int(n_elements)
     r, k, ke = insert.nose_radius_m, insert.kappa, insert.kappa_end
-    s_end = _s_of_drop_lead(insert, depth_m)
+    d_arc = r * (1 - math.cos(k))  # arc length of the leading edge down to the depth
+    s_end = (r * math.acos(1 - depth_m / r) if depth_m <= d_arc
+             else r * k + (depth_m - d_arc) / math.sin(k))
     s_i, n_str, n_arc = 0.0, 0, 0
-    if trailing_edge:
-        s_i = _s_of_zeta_trail(insert, trailing_intersection(insert, depth_m, fz))
+    if trailing_edge:  # arc length (< 0) of the trailing contact's end
+        z = -trailing_intersection(insert, depth_m, fz)
+        s_i = (-r * math.asin(min(z / r, 1.0)) if z <= r * math.sin(ke)
+               else -(r * ke + (z - r * math.sin(ke)) / math.cos(ke)))
         n_t = max(1, round(n * (-s_i) / s_end))
         s_corner = -r * ke
         if s_i < s_corner:
@@ -299,7 +296,7 @@ def _boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dep
     c = coefficients
     h0, wpd, epd, efix = np.empty(E), np.empty(E), np.empty(E), np.empty(E)
     normal, shear, edge = np.empty((E, 3)), np.empty((E, 3)), np.empty((E, 3))
-    xg, wg = _gauss_legendre(16)
+    xg, wg = _GAUSS_16
     _process_arrays(r, k, ke, math.isclose(k, math.pi / 2), float(depth_m), float(fz), n,
                     float(s_end), float(s_i), n_str, n_arc, float(hmin),
                     np.array([c.Ktc, c.Krc, c.Kfc, c.Kte, c.Kre, c.Kfe], float), xg, wg,
@@ -318,6 +315,17 @@ def _boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dep
         depth_direction=np.array([0.0, 1.0, 0.0]) if depth_modulation else np.zeros(3),
         overlap=float(overlap), feed_per_rev_m=feed_per_rev_m, reference_depth_m=depth_m,
         label=label, edge_fixed_m=efix, geometry=geometry)
+
+
+#: 16-point Gauss-Legendre nodes and weights on [-1, 1] (the chip areas of edge_elements)
+_GAUSS_16 = np.polynomial.legendre.leggauss(16)
+
+
+def _check_range(name: str, value: float, hi: float, unit: str) -> None:
+    """``value`` in ``(0, hi]`` or a :class:`~robobore.errors.ConfigError` naming it."""
+    if not (math.isfinite(value) and 0.0 < value <= hi):
+        raise ConfigError("out of range", field=name, value=value,
+                          expected=f"a value in (0.0, {hi}] {unit}")
 
 
 @nb.njit(cache=True, inline="always")
