@@ -133,3 +133,17 @@ def test_modal_step_matrices_equal_the_augmented_exponential(scale):
     R = sd._step_matrices(L, dt)
     for got, ref in ((Phi, R[0]), (G0, R[1][:, :, m:]), (G1, R[2][:, :, m:])):
         assert np.abs(got - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+def test_process_matrices_follow_a_replaced_copy():
+    """A copy by dataclasses.replace shares the memo but not the arrays: its per-unit-depth
+    matrices are its own."""
+    from dataclasses import replace
+
+    pr = boring_process(BoringInsert(), ti64_coefficients(), 1e-3, 0.1e-3)
+    core, vec, _ = sd._process_matrices(pr)
+    pr2 = replace(pr, shear=2.0 * pr.shear)
+    core2, vec2, _ = sd._process_matrices(pr2)
+    assert np.allclose(core2, 2.0 * core, rtol=1e-14, atol=0.0)
+    assert not np.allclose(vec2, vec)
+    assert sd._process_matrices(pr)[0] is not core2

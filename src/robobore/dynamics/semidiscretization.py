@@ -391,17 +391,19 @@ _ZOH: dict = {}
 
 
 def _zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~robobore.dynamics.timedomain.modal_zoh`, kept per structure and step."""
-    key = (id(structure), float(dt))
+    """:func:`~robobore.dynamics.timedomain.modal_zoh`, kept per structure (keyed by its
+    values) and step."""
+    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
+           structure.stiffness_N_per_m.tobytes(), float(dt))
     hit = _ZOH.get(key)
-    if hit is not None and hit[0] is structure:
-        return hit[1]
+    if hit is not None:
+        return hit
     from robobore.dynamics.timedomain import modal_zoh
 
     out = modal_zoh(structure, dt)
     if len(_ZOH) > 4096:
         _ZOH.clear()
-    _ZOH[key] = (structure, out)
+    _ZOH[key] = out
     return out
 
 
