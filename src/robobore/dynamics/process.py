@@ -344,7 +344,8 @@ def _edge_point(s, r, k, ke):  # pragma: no cover - numba
 
 @nb.njit(cache=True, inline="always")
 def _profile_width(d, r, k, ke, k90):  # pragma: no cover - numba
-    """Width of the tool profile at drop ``d`` [m] (``robobore.cutting.geometry._width_at_drop``)."""
+    """Width of the tool profile at drop ``d`` [m] (as ``_width_at_drop`` of
+    :mod:`robobore.cutting.geometry`)."""
     x = r - min(d, 2 * r)
     circ = math.sqrt(max(r * r - x * x, 0.0))
     d_lead, d_trail = r * (1 - math.cos(k)), r * (1 - math.cos(ke))

@@ -73,7 +73,8 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
 
     ``Lc`` is one (n, n) matrix or a stack (k, n, n); the result has the same leading shape.
     Reference implementation (scipy's Pade expm of the augmented 3n x 3n matrix); the
-    monodromy uses :func:`_step_matrices_modal`; tests compare both compiled kernels with this one."""
+    monodromy uses :func:`_step_matrices_modal`; tests compare both compiled kernels with
+    this one."""
     n = Lc.shape[-1]
     H = np.zeros(Lc.shape[:-2] + (3 * n, 3 * n))
     H[..., :n, :n] = Lc
