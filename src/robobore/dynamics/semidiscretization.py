@@ -73,7 +73,8 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
 
     ``Lc`` is one (n, n) matrix or a stack (k, n, n); the result has the same leading shape.
     Reference implementation (scipy's Pade expm of the augmented 3n x 3n matrix); the
-    monodromy uses :func:`_step_matrices_batch`, which tests compare with this one."""
+    monodromy uses :func:`_step_matrices_modal`; tests compare both compiled kernels with
+    this one."""
     n = Lc.shape[-1]
     H = np.zeros(Lc.shape[:-2] + (3 * n, 3 * n))
     H[..., :n, :n] = Lc
@@ -95,14 +96,9 @@ def _matmul_into(A, B, out):  # pragma: no cover - numba
 
 
 @nb.njit(cache=True)
-def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
-
-    The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
-    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
-    whose norm is of the order of the modes' angular frequencies rather than their squares,
-    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
-    (:func:`_step_matrices_taylor` on ``L'``)."""
+def _balance(L):  # pragma: no cover - numba
+    """Diagonal scaling ``d`` (powers of 2) balancing the sum of the moduli of the stack ``L``
+    (k, n, n) (Parlett & Reinsch 1969): ``D^-1 L D`` has rows and columns of like norms."""
     k_n, n, _ = L.shape
     M = np.zeros((n, n))
     for q in range(k_n):
@@ -139,6 +135,20 @@ def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
                     M[i, j] /= f
         if done:
             break
+    return d
+
+
+@nb.njit(cache=True)
+def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+
+    The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
+    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
+    whose norm is of the order of the modes' angular frequencies rather than their squares,
+    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
+    (:func:`_step_matrices_taylor` on ``L'``)."""
+    k_n, n, _ = L.shape
+    d = _balance(L)
     Lb = np.empty_like(L)
     for q in range(k_n):
         for i in range(n):
@@ -218,6 +228,110 @@ def _step_matrices_taylor(L, dt, Phi, G0, G1):  # pragma: no cover - numba
             h *= 2.0
 
 
+@nb.njit(cache=True)
+def _step_matrices_modal(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """:func:`_step_matrices_batch` for the modal system matrices of :func:`_step_coefficients`
+    (``L = [[0, I], [K, C]]``, ``C`` diagonal), ``G0`` and ``G1`` only their last ``m``
+    columns (k, 2m, m), the ones the delayed term multiplies.
+
+    The same balancing, Taylor degree and doublings; each Taylor product ``T A`` uses the
+    blocks of ``A = L' h`` (a diagonal upper right and lower right, a full lower left), which
+    the balancing keeps."""
+    k_n, n, _ = L.shape
+    m = n // 2
+    d = _balance(L)
+    T = np.empty((n, n))
+    W1 = np.empty((n, n))
+    W3 = np.empty((n, n))
+    V1 = np.empty((n, m))
+    V2 = np.empty((n, m))
+    A21 = np.empty((m, m))
+    e12 = np.empty(m)
+    g22 = np.empty(m)
+    for q in range(k_n):
+        nrm = 0.0
+        for j in range(n):
+            c = 0.0
+            for i in range(n):
+                c += abs(L[q, i, j] * d[j] / d[i])
+            nrm = max(nrm, c)
+        nrm *= dt
+        s = 0
+        if nrm > 0.5:
+            s = int(math.ceil(math.log2(nrm / 0.5)))
+        h = dt / 2.0**s
+        for j in range(m):
+            e12[j] = L[q, j, m + j] * d[m + j] / d[j] * h
+            g22[j] = L[q, m + j, m + j] * h
+            for k in range(m):
+                A21[j, k] = L[q, m + j, k] * d[k] / d[m + j] * h
+        for i in range(n):
+            for j in range(n):
+                T[i, j] = 1.0 if i == j else 0.0
+                Phi[q, i, j] = T[i, j]
+            for j in range(m):
+                G0[q, i, j] = T[i, m + j] * h
+                G1[q, i, j] = T[i, m + j] * h * h * 0.5
+        nh = nrm / 2.0**s
+        deg = 16
+        term = nh
+        for j in range(1, 17):
+            term *= nh / (j + 1)
+            if term < 1e-17:
+                deg = j
+                break
+        for mm in range(1, deg + 1):
+            # T <- T A / mm with A = [[0, diag e12], [A21, diag g22]]
+            for i in range(n):
+                for k in range(m):
+                    acc = 0.0
+                    for c in range(m):
+                        acc += T[i, m + c] * A21[c, k]
+                    W1[i, k] = acc
+                for k in range(m):
+                    W1[i, m + k] = T[i, k] * e12[k] + T[i, m + k] * g22[k]
+            for i in range(n):
+                for j in range(n):
+                    T[i, j] = W1[i, j] / mm
+            c0 = h / (mm + 1)
+            c1 = h * h / ((mm + 1) * (mm + 2))
+            for i in range(n):
+                for j in range(n):
+                    Phi[q, i, j] += T[i, j]
+                for j in range(m):
+                    G0[q, i, j] += c0 * T[i, m + j]
+                    G1[q, i, j] += c1 * T[i, m + j]
+        for _ in range(s):
+            for i in range(n):
+                for j in range(m):
+                    a1 = 0.0
+                    a2 = 0.0
+                    for k in range(n):
+                        a1 += Phi[q, i, k] * G1[q, k, j]
+                        a2 += Phi[q, i, k] * G0[q, k, j]
+                    V1[i, j] = a1
+                    V2[i, j] = a2
+                for j in range(n):
+                    acc = 0.0
+                    for k in range(n):
+                        acc += Phi[q, i, k] * Phi[q, k, j]
+                    W3[i, j] = acc
+            for i in range(n):
+                for j in range(m):
+                    G1[q, i, j] = V1[i, j] + h * G0[q, i, j] + G1[q, i, j]
+                    G0[q, i, j] = V2[i, j] + G0[q, i, j]
+                for j in range(n):
+                    Phi[q, i, j] = W3[i, j]
+            h *= 2.0
+        for i in range(n):
+            for j in range(n):
+                Phi[q, i, j] *= d[i] / d[j]
+            for j in range(m):
+                sc = d[i] / d[m + j]
+                G0[q, i, j] *= sc
+                G1[q, i, j] *= sc
+
+
 def deflected_depth_weights(structure: ToolPointStructure, process: CuttingProcess,
                             speed_rpm: float, theta: np.ndarray,
                             depth_m: float | None = None) -> np.ndarray | None:
@@ -254,13 +368,141 @@ def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
 
 
 def _deflection_parts_uncached(structure, process, speed_rpm):
-    from robobore.dynamics.timedomain import nominal_cut_deflection
-
-    parts = nominal_cut_deflection(structure, process, speed_rpm, DEFLECTION_SAMPLES)
-    if parts is None:
+    """:func:`~robobore.dynamics.timedomain.nominal_cut_deflection` at
+    :data:`DEFLECTION_SAMPLES` samples per revolution, by :func:`_deflection_kernel` (the
+    same orbit of the same map, its step matrices and forces formed in the kernel from the
+    process's three-vectors)."""
+    N = int(process.n_inserts)
+    Ns = int(math.ceil(DEFLECTION_SAMPLES / N) * N)
+    Phi, Gam = _zoh(structure, 60.0 / (float(speed_rpm) * Ns))
+    vec = ((process.width_per_depth * process.h0) @ process.shear
+           + process.edge_per_depth @ process.edge)
+    fixed = process.edge_fixed_m @ process.edge
+    out = np.empty((Ns, 3, 2))
+    if not _deflection_kernel(Phi, Gam, np.ascontiguousarray(structure.directions, dtype=float),
+                              np.asarray(process.depth_direction, float), vec, fixed, N,
+                              30.0 / (float(speed_rpm) * Ns), out):
         return None
-    r1, r0 = parts
-    return (r1, r0) if np.any(process.edge_fixed_m) else (r1, None)
+    r1 = np.ascontiguousarray(out[:, :, 0])
+    return (r1, np.ascontiguousarray(out[:, :, 1])) if np.any(process.edge_fixed_m) else (
+        r1, None)
+
+
+_ZOH: dict = {}
+
+
+def _zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~robobore.dynamics.timedomain.modal_zoh`, kept per structure (keyed by its
+    values) and step."""
+    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
+           structure.stiffness_N_per_m.tobytes(), float(dt))
+    hit = _ZOH.get(key)
+    if hit is not None:
+        return hit
+    from robobore.dynamics.timedomain import modal_zoh
+
+    out = modal_zoh(structure, dt)
+    if len(_ZOH) > 4096:
+        _ZOH.clear()
+    _ZOH[key] = out
+    return out
+
+
+@nb.njit(cache=True)
+def _deflection_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, out):  # pragma: no cover - numba
+    """Steady nominal-cut tool-point displacement per unit depth and of the depth-independent
+    edge force, ``out`` (Ns, 3, 2), at the step starts ``2 pi i / Ns``: the periodic orbit of
+    the time-domain map on the nominal chip (``robobore.dynamics.timedomain._orbit_kernel``:
+    per mode ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))``, the Ns steps composed,
+    ``x_0 = T x_0 + c``, solved). At the step midpoint ``theta_i`` and insert ``p``
+    (``theta_i + 2 pi p / N``, basis ``B_p``): the depth-modulation stiffness
+    ``Pm_i = sum_p u_p v_p^T`` with ``u_p = D B_p^T vec``, ``v_p = D B_p^T dd``, and the load
+    cases ``Fm_i = sum_p D B_p^T (vec, fixed)``. A step is the per-mode ``Phi`` plus one
+    rank-one term per insert, ``(Gam u_p)(v_p, half_dt v_p)^T``, and is applied as such.
+    False when ``I - T`` is singular (no orbit)."""
+    Ns = out.shape[0]
+    m = D.shape[0]
+    n = 2 * m
+    U = np.zeros((Ns, N, m))
+    Vv = np.zeros((Ns, N, m))
+    Fm = np.zeros((Ns, m, 2))
+    two_pi = 2.0 * math.pi
+    for i in range(Ns):
+        th = two_pi * (i + 0.5) / Ns
+        for p in range(N):
+            tp = th + two_pi * p / N
+            c_, s_ = math.cos(tp), math.sin(tp)
+            # B^T x = x_t e_t + x_r e_r + x_z e_z, e_t = (-s, c, 0), e_r = (c, s, 0)
+            fv0, fv1, fv2 = -s_ * vec[0] + c_ * vec[1], c_ * vec[0] + s_ * vec[1], vec[2]
+            ff0, ff1, ff2 = (-s_ * fixed[0] + c_ * fixed[1], c_ * fixed[0] + s_ * fixed[1],
+                             fixed[2])
+            fe0, fe1, fe2 = -s_ * dd[0] + c_ * dd[1], c_ * dd[0] + s_ * dd[1], dd[2]
+            for j in range(m):
+                u = D[j, 0] * fv0 + D[j, 1] * fv1 + D[j, 2] * fv2
+                U[i, p, j] = u
+                Vv[i, p, j] = D[j, 0] * fe0 + D[j, 1] * fe1 + D[j, 2] * fe2
+                Fm[i, j, 0] += u
+                Fm[i, j, 1] += D[j, 0] * ff0 + D[j, 1] * ff1 + D[j, 2] * ff2
+    # X <- A X + b (X: T (n, n) with b = 0, or c (n, 2) with b = Gam Fm_i)
+    T = np.eye(n)
+    T2 = np.empty((n, n))
+    c = np.zeros((n, 2))
+    c2 = np.empty((n, 2))
+    bt = np.empty(n)
+    bc = np.empty(2)
+    for i in range(Ns):
+        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, T, T2, True, bt)
+        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, c, c2, False, bc)
+        T, T2 = T2, T
+        c, c2 = c2, c
+    M = np.eye(n) - T
+    if abs(np.linalg.det(M)) < 1e-300:
+        return False
+    x = np.ascontiguousarray(np.linalg.solve(M, c))
+    x2 = np.empty((n, 2))
+    for i in range(Ns):
+        for o in range(3):
+            for kk in range(2):
+                acc = 0.0
+                for j in range(m):
+                    acc += x[j, kk] * D[j, o]
+                out[i, o, kk] = acc
+        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, x, x2, False, bc)
+        x, x2 = x2, x
+    return True
+
+
+@nb.njit(cache=True)
+def _orbit_step(Phi, Gam, U, Vv, Fm_i, half_dt, X, Y, homogeneous, w):  # pragma: no cover
+    """``Y = A X`` (``homogeneous``) or ``Y = A X + b`` for one step of
+    :func:`_deflection_kernel`: ``A = blockdiag_j Phi_j + sum_p (Gam u_p)(v_p, half_dt v_p)^T``
+    in the state order ``(q_1..q_m, q'_1..q'_m)``, ``b = Gam Fm_i``; ``w`` (X's columns) is
+    work space."""
+    m = Phi.shape[0]
+    ncol = X.shape[1]
+    for j in range(m):
+        for col in range(ncol):
+            x0 = X[j, col]
+            x1 = X[m + j, col]
+            Y[j, col] = Phi[j, 0, 0] * x0 + Phi[j, 0, 1] * x1
+            Y[m + j, col] = Phi[j, 1, 0] * x0 + Phi[j, 1, 1] * x1
+    for p in range(U.shape[0]):
+        for col in range(ncol):
+            acc = 0.0
+            for k in range(m):
+                acc += Vv[p, k] * (X[k, col] + half_dt * X[m + k, col])
+            w[col] = acc
+        for j in range(m):
+            g0 = Gam[j, 0] * U[p, j]
+            g1 = Gam[j, 1] * U[p, j]
+            for col in range(ncol):
+                Y[j, col] += g0 * w[col]
+                Y[m + j, col] += g1 * w[col]
+    if not homogeneous:
+        for j in range(m):
+            for col in range(ncol):
+                Y[j, col] += Gam[j, 0] * Fm_i[j, col]
+                Y[m + j, col] += Gam[j, 1] * Fm_i[j, col]
 
 
 def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
@@ -612,14 +854,12 @@ def _arnoldi(Phi, P0, P1, r, m, v0, V, H, Q, x, xn, w):  # pragma: no cover - nu
             wn0 += w[a] * w[a]
         if not math.isfinite(wn0):
             return -1
-        for _ in range(2):
+        for _ in range(2):  # classical Gram-Schmidt, twice (BLAS products)
+            Vj = V[:j + 1]
+            hv = np.dot(Vj, w)
             for i in range(j + 1):
-                h = 0.0
-                for a in range(n):
-                    h += V[i, a] * w[a]
-                H[i, j] += h
-                for a in range(n):
-                    w[a] -= h * V[i, a]
+                H[i, j] += hv[i]
+            w -= np.dot(hv, Vj)
         wn = 0.0
         for a in range(n):
             wn += w[a] * w[a]
@@ -729,22 +969,56 @@ def _monodromy(structure, process, speed_rpm, depth_m, steps, include_process_st
             if r0 is not None and depth_m > 0.0:
                 rp = rp + r0 / depth_m
             weighted = True
-    core = np.einsum("e,ei,ej->ij", process.width_per_depth, process.shear, process.normal)
-    vec = (np.einsum("e,e,ei->i", process.width_per_depth, process.h0, process.shear)
-           + np.einsum("e,ei->i", process.edge_per_depth, process.edge))
+    core, vec, dd = _process_matrices(process)
+    D, minv, om, zeta = _structure_arrays(structure)
     L = np.empty((n_th, 2 * m, 2 * m))
     W = np.empty((n_th, m, m))
     _step_coefficients(bool(process.rotating), int(process.n_inserts), float(dt),
-                       float(speed_rpm), core, vec, np.asarray(process.depth_direction, float),
-                       np.ascontiguousarray(structure.directions, dtype=float),
-                       1.0 / np.asarray(structure.modal_mass, float),
-                       np.asarray(structure.omega, float),
-                       np.asarray(structure.damping_ratio, float), np.ascontiguousarray(rp),
-                       weighted, float(depth_m), bool(include_process_stiffness), L, W)
+                       float(speed_rpm), core, vec, dd, D, minv, om, zeta,
+                       np.ascontiguousarray(rp), weighted, float(depth_m),
+                       bool(include_process_stiffness), L, W)
     Phi, P0, P1 = np.empty_like(L), np.empty((n_th, 2 * m, m)), np.empty((n_th, 2 * m, m))
     if not _delay_matrices(L, W, float(dt), float(process.overlap * depth_m), Phi, P0, P1):
         return math.inf
     return _spectral_radius(Phi, P0, P1, int(steps), int(m))
+
+
+def _process_matrices(process: CuttingProcess) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``core = sum_e w_e shear_e n_e^T``, ``vec = sum_e (w_e h0_e shear_e + s_e edge_e)``
+    (:meth:`~robobore.dynamics.process.CuttingProcess.directional_matrix` and
+    :meth:`~robobore.dynamics.process.CuttingProcess.process_stiffness` per unit depth) and
+    the depth direction, kept with the process (for the same array objects: a copy made by
+    :func:`dataclasses.replace` shares the memo, not necessarily the arrays)."""
+    src = (process.width_per_depth, process.shear, process.normal, process.h0,
+           process.edge_per_depth, process.edge, process.depth_direction)
+    hit = process.memo.get("sd_matrices")
+    if hit is not None and all(a is b for a, b in zip(hit[0], src, strict=True)):
+        return hit[1]
+    core = np.einsum("e,ei,ej->ij", process.width_per_depth, process.shear, process.normal)
+    vec = (np.einsum("e,e,ei->i", process.width_per_depth, process.h0, process.shear)
+           + np.einsum("e,ei->i", process.edge_per_depth, process.edge))
+    out = (core, vec, np.asarray(process.depth_direction, float))
+    process.memo["sd_matrices"] = (src, out)
+    return out
+
+
+_STRUCTURES: dict = {}
+
+
+def _structure_arrays(structure: ToolPointStructure):
+    """Modal directions (contiguous), inverse modal masses, angular frequencies and damping
+    ratios, kept per structure (keyed by its values)."""
+    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
+           structure.stiffness_N_per_m.tobytes(), np.asarray(structure.directions).tobytes())
+    hit = _STRUCTURES.get(key)
+    if hit is None:
+        hit = (np.ascontiguousarray(structure.directions, dtype=float),
+               1.0 / np.asarray(structure.modal_mass, float), np.asarray(structure.omega, float),
+               np.asarray(structure.damping_ratio, float))
+        if len(_STRUCTURES) > 256:
+            _STRUCTURES.clear()
+        _STRUCTURES[key] = hit
+    return hit
 
 
 @nb.njit(cache=True)
@@ -848,20 +1122,22 @@ def _step_coefficients(rotating, N, dt, speed_rpm, core, vec, dd, D, minv, om, z
 
 @nb.njit(cache=True)
 def _delay_matrices(L, W, dt, overlap_depth, Phi, P0, P1):  # pragma: no cover - numba
-    """Step matrices (:func:`_step_matrices_batch`) and the delayed-term matrices of
+    """Step matrices (:func:`_step_matrices_modal`) and the delayed-term matrices of
     :func:`_propagate`: with ``Rq = [0; mu a W]`` (2m, m), ``P1 = Gamma1 Rq / dt``
     (multiplies ``q_{i-r+1}``) and ``P0 = (Gamma0 - Gamma1 / dt) Rq`` (``q_{i-r}``). False
     when a step matrix is not finite (far beyond the limit)."""
     k_n, n2, _ = L.shape
     m = n2 // 2
-    G0 = np.empty_like(L)
-    G1 = np.empty_like(L)
-    _step_matrices_batch(L, dt, Phi, G0, G1)
+    G0 = np.empty((k_n, n2, m))
+    G1 = np.empty((k_n, n2, m))
+    _step_matrices_modal(L, dt, Phi, G0, G1)
     for q in range(k_n):
         for a in range(n2):
             for b in range(n2):
-                if not (math.isfinite(Phi[q, a, b]) and math.isfinite(G0[q, a, b])
-                        and math.isfinite(G1[q, a, b])):
+                if not math.isfinite(Phi[q, a, b]):
+                    return False
+            for b in range(m):
+                if not (math.isfinite(G0[q, a, b]) and math.isfinite(G1[q, a, b])):
                     return False
         for a in range(n2):
             for b in range(m):
@@ -869,9 +1145,9 @@ def _delay_matrices(L, W, dt, overlap_depth, Phi, P0, P1):  # pragma: no cover -
                 acc1 = 0.0
                 for c in range(m):
                     rq = overlap_depth * W[q, c, b]
-                    g1 = G1[q, a, m + c] / dt
+                    g1 = G1[q, a, c] / dt
                     acc1 += g1 * rq
-                    acc0 += (G0[q, a, m + c] - g1) * rq
+                    acc0 += (G0[q, a, c] - g1) * rq
                 P0[q, a, b] = acc0
                 P1[q, a, b] = acc1
     return True
