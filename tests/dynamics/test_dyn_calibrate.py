@@ -212,6 +212,38 @@ def test_synthetic_feed_amplitude_uses_the_prediction_model(example):
     assert ll[0] > ll[1] + 1.0
 
 
+def test_synthetic_chatter_frequency_is_the_likelihood_prediction(example):
+    """The SYNTHETIC chatter frequency (the truth's critical multiplier at the cut) is the
+    calibration's prediction at the truth's factors, and the frequency term prefers the truth
+    to the uncorrected model."""
+    from dataclasses import replace
+
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.dynamics.calibrate_synthetic import (
+        TRUTH_DAMPING_FACTOR,
+        TRUTH_STIFFNESS_FACTOR,
+        truth_chatter_frequency,
+        truth_structure,
+    )
+
+    cfg, _, _ = example
+    cuts = [Observation(1, 655.0, 0.32e-3, True), Observation(2, 2195.0, 1.08e-3, True),
+            Observation(3, 2892.0, 1.7e-3, True)]
+    pb = build_problem(cfg, cuts)
+    truth = truth_structure(pb.structure)
+    t_truth = np.log([TRUTH_DAMPING_FACTOR] * 3 + [TRUTH_STIFFNESS_FACTOR, 1.0, 1.0])
+    fr = [truth_chatter_frequency(truth, pb.process, o.speed_rpm, o.depth_m) for o in cuts]
+    pb2 = build_problem(cfg, [replace(o, chatter_frequency_Hz=f) for o, f in zip(cuts, fr,
+                                                                                strict=True)])
+    n = len(cuts)
+    p_truth = pb2.predictions(t_truth)
+    assert p_truth[n:] == pytest.approx(fr, rel=1e-9)
+    assert all(3.0 < f < 40.0 for f in fr)  # near the example robot's modes (6.9-24.6 Hz)
+    ll = [pb2.log_likelihood(np.concatenate([np.zeros(n), pb2.predictions(t)[n:]]), t)
+          for t in (t_truth, np.zeros(6))]
+    assert ll[0] > ll[1]
+
+
 def test_calibrate_cli_writes_a_model_lobes_accept(tmp_path, example):
     from robobore.dynamics.api import critical_depth_at
     from robobore.dynamics.calibrate import Observation, write_observations_csv
