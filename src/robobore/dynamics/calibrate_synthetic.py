@@ -136,7 +136,9 @@ class ValidationRun:
     """One seed: the fraction of held-out speeds whose corrected median critical depth is
     within 10 % of the truth, the 90 % band's coverage of the truth, the median relative error
     of the corrected and of the uncorrected model, labels flipped, the calibration's run time
-    and CPU time [s], the MAP factors, whether the stable cuts carried feed amplitudes."""
+    and CPU time [s], the MAP factors, whether the stable cuts carried feed amplitudes and the
+    chatter cuts chatter frequencies, and the share within 10 % the band itself forecasts
+    (:func:`within_10pct_share`)."""
 
     seed: int
     within_10pct: float
@@ -150,6 +152,7 @@ class ValidationRun:
     factors: dict[str, float]
     feed_amplitude: bool = False
     chatter_frequency: bool = False
+    expected_within_10pct: float = float("nan")
 
     def to_dict(self) -> dict[str, Any]:
         return {"seed": self.seed, "within_10pct": self.within_10pct,
@@ -160,7 +163,8 @@ class ValidationRun:
                 "flipped_labels": self.flipped, "seconds": self.seconds,
                 "cpu_seconds": self.cpu_seconds,
                 "factors": self.factors, "feed_amplitude": self.feed_amplitude,
-                "chatter_frequency": self.chatter_frequency, "kind": "SYNTHETIC"}
+                "chatter_frequency": self.chatter_frequency,
+                "expected_within_10pct": self.expected_within_10pct, "kind": "SYNTHETIC"}
 
 
 def validation_case(config: Any, seed: int,
@@ -189,6 +193,19 @@ def validation_case(config: Any, seed: int,
             "flipped": flipped, "seconds": dt, "cpu_seconds": cpu}
 
 
+def within_10pct_share(log_sd: np.ndarray) -> np.ndarray:
+    """The probability, per speed, that the truth lies within 10 % of the band's median when
+    the truth is distributed as the band says (Gaussian in ``ln a_crit`` with ``log_sd``): the
+    share of held-out speeds within 10 % that the band itself forecasts. A band as wide as the
+    information in the cuts allows forecasts fewer speeds within 10 % than all of them."""
+    from scipy.stats import norm
+
+    sd = np.asarray(log_sd, float)
+    with np.errstate(divide="ignore"):
+        p = norm.cdf(np.log(1.1) / sd) - norm.cdf(np.log(0.9) / sd)
+    return np.where(sd > 0, p, 1.0)
+
+
 def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (200.0, 3000.0),
                   settings: LikelihoodSettings | None = None,
                   feed_amplitude: bool = False,
@@ -202,16 +219,19 @@ def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (20
     err_u = np.abs(cal.nominal_m / truth - 1.0)
     cover = (b.lower_m <= truth) & (truth <= b.upper_m)
     factors = {r["name"]: r["value"] for r in cal.parameters()}
+    expected = float(np.mean(within_10pct_share(b.log_sd)))
     return ValidationRun(seed, float(np.mean(err_c <= 0.1)), float(np.mean(cover)),
                          float(np.median(err_c)), float(np.median(err_u)),
                          float(np.mean(err_u <= 0.1)), int(c["flipped"]), c["seconds"],
-                         c["cpu_seconds"], factors, feed_amplitude, chatter_frequency)
+                         c["cpu_seconds"], factors, feed_amplitude, chatter_frequency,
+                         expected)
 
 
 __all__ = ["truth_structure", "synthetic_observations", "validate_seed", "validation_case", "ValidationRun",
            "TRUTH_DAMPING_FACTOR", "TRUTH_STIFFNESS_FACTOR", "TRUTH_STIFFNESS_AXIS", "N_CUTS",
            "N_HELD_OUT", "LABEL_NOISE", "write_example_observations", "truth_feed_amplitude",
            "AMPLITUDE_NOISE_REL", "AMPLITUDE_NOISE_ABS_M", "FREQUENCY_NOISE_REL",
+           "within_10pct_share",
            "truth_chatter_frequency"]
 
 
