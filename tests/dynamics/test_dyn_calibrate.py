@@ -309,3 +309,25 @@ def test_lobes_band_option_draws_the_modal_band(tmp_path):
     assert (tmp_path / "lobes_band.png").stat().st_size > 0
     r = runner.invoke(app, ["lobes", str(EXAMPLE), "--band"])
     assert r.exit_code == 2 and "equivalent.uncertainty" in r.output
+
+
+
+def test_chatter_frequency_prediction_is_finite_where_the_monodromy_overflows(example,
+                                                                              monkeypatch):
+    """Far beyond the limit the prediction is the branch nearest the observed frequency (within
+    half a branch spacing); where the monodromy overflows (no multiplier) it is half a
+    spacing off, finite, so that the fit's finite differences stay finite."""
+    import math
+
+    import robobore.dynamics.calibrate as cal
+
+    cfg, _, _ = example
+    o = cal.Observation(1, 700.0, 15e-3, True, chatter_frequency_Hz=17.0)
+    pb = cal.build_problem(cfg, [o])
+    half = 0.5 * 700.0 / 60.0
+    pred = pb.predictions(np.zeros(6))
+    assert abs(pred[1] - 17.0) <= half + 1e-9
+    monkeypatch.setattr(cal, "critical_multiplier",
+                        lambda *a, **k: (complex("nan"), math.nan, -1))
+    pred = pb.predictions(np.zeros(6))
+    assert np.all(np.isfinite(pred)) and pred[1] == pytest.approx(17.0 + half)

@@ -336,9 +336,11 @@ class CalibrationProblem:
         for o in obs:
             if o.chatter and o.chatter_frequency_Hz is not None:
                 st = self.structure_at(theta, o.depth_m, o.speed_rpm)
-                _, f, _ = critical_multiplier(st, self.processes[o.feed_mm_per_rev],
-                                              o.speed_rpm, o.depth_m,
+                pr = self.processes[o.feed_mm_per_rev]
+                _, f, _ = critical_multiplier(st, pr, o.speed_rpm, o.depth_m,
                                               near_Hz=o.chatter_frequency_Hz)
+                if not math.isfinite(f):  # overflow far beyond the limit: half a branch off
+                    f = o.chatter_frequency_Hz + 0.5 * pr.n_inserts * o.speed_rpm / 60.0
                 extra.append(f)
         for o in obs:
             if not o.chatter and o.feed_amplitude_m is not None:
