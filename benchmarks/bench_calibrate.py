@@ -3,16 +3,20 @@
 Truth robot (robobore.dynamics.calibrate_synthetic): the example robot of
 examples/boring_paper.toml with damping x0.6 in every direction and the x stiffness x1.3;
 12 observed cuts per seed (one speed per twelfth of 200-3000 r/min, depth within x/ 1.35 of
-the truth's limit, labels flipped with probability 0.1); 24 held-out speeds. Two
-configurations of the same cuts: ``verdicts`` (chatter or stable only) and ``amplitude``
-(verdicts, and the stable cuts' feed amplitude with 5 % + 0.1 um measurement noise). Prints per
-configuration, per seed and over all seeds: the share of held-out speeds whose corrected median critical depth is
-within 10 % of the truth (goal: all), the 90 % band's coverage of the truth (goal >= 85 %), the
-median relative error of the corrected and the uncorrected model, and the calibration's wall
+the truth's limit, labels flipped with probability 0.1); 24 held-out speeds. What the same
+cuts carry: ``verdicts`` (chatter or stable only), ``frequency`` (verdicts, and the chatter
+cuts' chatter frequency with 1 % measurement noise), ``amplitude`` (verdicts, and the stable
+cuts' feed amplitude with 5 % + 0.1 um measurement noise), ``frequency+amplitude`` (all of
+them); ``both``: the verdicts and the amplitude runs. Prints per configuration, per seed and
+over all seeds: the share of held-out speeds whose corrected median critical depth is within
+10 % of the truth (goal: all) beside the share the band's own width forecasts
+(calibrate_synthetic.within_10pct_share), the 90 % band's coverage of the truth (goal >= 85 %),
+the median relative error of the corrected and the uncorrected model, and the calibration's wall
 and CPU time on 12 observations (goal: under 1 min on 2 cores).
 
 Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_calibrate.py [--seeds 10] [--first 0]
-     [--observed verdicts|amplitude|both] [--json FILE] [--plot DIR]
+     [--observed verdicts|frequency|amplitude|frequency+amplitude|both] [--json FILE]
+     [--plot DIR]
 """
 
 from __future__ import annotations
@@ -37,28 +41,36 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first", type=int, default=0)
     ap.add_argument("--config", default=str(ROOT / "examples" / "boring_paper.toml"))
-    ap.add_argument("--observed", choices=("verdicts", "amplitude", "both"), default="both",
-                    help="what the cuts carry: verdicts only, verdicts + feed amplitude, both runs")
+    ap.add_argument("--observed", choices=("verdicts", "frequency", "amplitude",
+                                            "frequency+amplitude", "both"),
+                    default="frequency+amplitude",
+                    help="what the cuts carry: verdicts only, verdicts + chatter frequency, "
+                         "verdicts + feed amplitude, all of them; both: the verdicts and the "
+                         "amplitude runs")
     ap.add_argument("--json", default=None, help="write the per-seed results here")
     ap.add_argument("--plot", default=None, help="write the first seed's band figure here")
     args = ap.parse_args()
     cfg, _ = load_dynamics_config(args.config)
-    configs = {"verdicts": [False], "amplitude": [True], "both": [False, True]}[args.observed]
+    configs = {"verdicts": [(False, False)], "frequency": [(False, True)],
+               "amplitude": [(True, False)], "frequency+amplitude": [(True, True)],
+               "both": [(False, False), (True, False)]}[args.observed]
     out = []
-    for amp in configs:
-        out += run_config(cfg, args, amp)
+    for amp, freq in configs:
+        out += run_config(cfg, args, amp, freq)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=2) + "\n")
 
 
-def run_config(cfg, args, amp: bool) -> list[dict]:
-    label = "verdicts + feed amplitude" if amp else "verdicts only"
+def run_config(cfg, args, amp: bool, freq: bool = False) -> list[dict]:
+    label = {(False, False): "verdicts only", (True, False): "verdicts + feed amplitude",
+             (False, True): "verdicts + chatter frequency",
+             (True, True): "verdicts + chatter frequency + feed amplitude"}[(amp, freq)]
     if args.plot:
-        case = validation_case(cfg, args.first, feed_amplitude=amp)
+        case = validation_case(cfg, args.first, feed_amplitude=amp, chatter_frequency=freq)
         from robobore.dynamics.plots import plot_band
 
         cal = case["calibration"]
-        tag = "_amplitude" if amp else ""
+        tag = ("_frequency" if freq else "") + ("_amplitude" if amp else "")
         p = plot_band(cal.band, args.plot, cal.nominal_m, case["observations"],
                       name=f"calibrate_synthetic_seed{args.first}{tag}.png",
                       truth_m=case["truth"],
@@ -72,12 +84,13 @@ def run_config(cfg, args, amp: bool) -> list[dict]:
     print(f"SYNTHETIC calibration validation ({label}), {args.config}, NUMBA_NUM_THREADS="
           f"{os.environ.get('NUMBA_NUM_THREADS', '-')}, {os.cpu_count()} CPUs, load average "
           f"{os.getloadavg()[0]:.1f}")
-    print(f"{'seed':>4} {'within10%':>9} {'cover90':>8} {'err corr':>8} {'err nom':>8} "
-          f"{'flip':>4} {'wall s':>7} {'cpu s':>6}")
+    print(f"{'seed':>4} {'within10%':>9} {'forecast':>8} {'cover90':>8} {'err corr':>8} "
+          f"{'err nom':>8} {'flip':>4} {'wall s':>7} {'cpu s':>6}")
     for seed in range(args.first, args.first + args.seeds):
-        r = validate_seed(cfg, seed, feed_amplitude=amp)
+        r = validate_seed(cfg, seed, feed_amplitude=amp, chatter_frequency=freq)
         runs.append(r)
-        print(f"{seed:4d} {r.within_10pct:9.2f} {r.coverage_90:8.2f} "
+        print(f"{seed:4d} {r.within_10pct:9.2f} {r.expected_within_10pct:8.2f} "
+              f"{r.coverage_90:8.2f} "
               f"{r.median_error_corrected:8.3f} {r.median_error_uncorrected:8.3f} "
               f"{r.flipped:4d} {r.seconds:7.1f} {r.cpu_seconds:6.1f}", flush=True)
     w = np.array([r.within_10pct for r in runs])
@@ -85,11 +98,13 @@ def run_config(cfg, args, amp: bool) -> list[dict]:
     ec = np.array([r.median_error_corrected for r in runs])
     eu = np.array([r.median_error_uncorrected for r in runs])
     wu = np.array([r.within_10pct_uncorrected for r in runs])
+    we = np.array([r.expected_within_10pct for r in runs])
     t = np.array([r.seconds for r in runs])
     cpu = np.array([r.cpu_seconds for r in runs])
     print(f"{label}, over {len(runs)} seeds x 24 held-out speeds:")
     print(f"  corrected within 10 % of the truth: {w.mean():.1%} of speeds "
-          f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}")
+          f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}; "
+          f"the band's own forecast: {we.mean():.1%}")
     print(f"  90 % band covers the truth: {c.mean():.1%} (seeds: min {c.min():.0%})")
     print(f"  median relative error: corrected {np.median(ec):.3f}, uncorrected "
           f"{np.median(eu):.3f}")

@@ -212,6 +212,38 @@ def test_synthetic_feed_amplitude_uses_the_prediction_model(example):
     assert ll[0] > ll[1] + 1.0
 
 
+def test_synthetic_chatter_frequency_is_the_likelihood_prediction(example):
+    """The SYNTHETIC chatter frequency (the truth's critical multiplier at the cut) is the
+    calibration's prediction at the truth's factors, and the frequency term prefers the truth
+    to the uncorrected model."""
+    from dataclasses import replace
+
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.dynamics.calibrate_synthetic import (
+        TRUTH_DAMPING_FACTOR,
+        TRUTH_STIFFNESS_FACTOR,
+        truth_chatter_frequency,
+        truth_structure,
+    )
+
+    cfg, _, _ = example
+    cuts = [Observation(1, 655.0, 0.32e-3, True), Observation(2, 2195.0, 1.08e-3, True),
+            Observation(3, 2892.0, 1.7e-3, True)]
+    pb = build_problem(cfg, cuts)
+    truth = truth_structure(pb.structure)
+    t_truth = np.log([TRUTH_DAMPING_FACTOR] * 3 + [TRUTH_STIFFNESS_FACTOR, 1.0, 1.0])
+    fr = [truth_chatter_frequency(truth, pb.process, o.speed_rpm, o.depth_m) for o in cuts]
+    pb2 = build_problem(cfg, [replace(o, chatter_frequency_Hz=f) for o, f in zip(cuts, fr,
+                                                                                strict=True)])
+    n = len(cuts)
+    p_truth = pb2.predictions(t_truth)
+    assert p_truth[n:] == pytest.approx(fr, rel=1e-9)
+    assert all(3.0 < f < 40.0 for f in fr)  # near the example robot's modes (6.9-24.6 Hz)
+    ll = [pb2.log_likelihood(np.concatenate([np.zeros(n), pb2.predictions(t)[n:]]), t)
+          for t in (t_truth, np.zeros(6))]
+    assert ll[0] > ll[1]
+
+
 def test_calibrate_cli_writes_a_model_lobes_accept(tmp_path, example):
     from robobore.dynamics.api import critical_depth_at
     from robobore.dynamics.calibrate import Observation, write_observations_csv
@@ -277,3 +309,25 @@ def test_lobes_band_option_draws_the_modal_band(tmp_path):
     assert (tmp_path / "lobes_band.png").stat().st_size > 0
     r = runner.invoke(app, ["lobes", str(EXAMPLE), "--band"])
     assert r.exit_code == 2 and "equivalent.uncertainty" in r.output
+
+
+
+def test_chatter_frequency_prediction_is_finite_where_the_monodromy_overflows(example,
+                                                                              monkeypatch):
+    """Far beyond the limit the prediction is the branch nearest the observed frequency (within
+    half a branch spacing); where the monodromy overflows (no multiplier) it is half a
+    spacing off, finite, so that the fit's finite differences stay finite."""
+    import math
+
+    import robobore.dynamics.calibrate as cal
+
+    cfg, _, _ = example
+    o = cal.Observation(1, 700.0, 15e-3, True, chatter_frequency_Hz=17.0)
+    pb = cal.build_problem(cfg, [o])
+    half = 0.5 * 700.0 / 60.0
+    pred = pb.predictions(np.zeros(6))
+    assert abs(pred[1] - 17.0) <= half + 1e-9
+    monkeypatch.setattr(cal, "critical_multiplier",
+                        lambda *a, **k: (complex("nan"), math.nan, -1))
+    pred = pb.predictions(np.zeros(6))
+    assert np.all(np.isfinite(pred)) and pred[1] == pytest.approx(17.0 + half)

@@ -120,3 +120,23 @@ def test_undamped_mode_coupling_closed_form():
     roots = np.roots([a * a + 4 * c, 2 * (k1 - k2) * a, (k1 - k2) ** 2])
     p = min(r.real for r in roots if abs(r.imag) < 1e-9 and r.real > 0)
     assert mode_coupling_limit(st, pr, damped=False) == pytest.approx(p / K, rel=1e-6)
+
+
+@pytest.mark.parametrize("k", [0, 2])
+def test_critical_multiplier_frequency_closed_form(sdof, contract_process, k):
+    """At an SDOF lobe minimum (closed form above) the semi-discretisation's critical Floquet
+    multiplier lies on the unit circle at the limit and its chatter frequency is
+    ``f_n sqrt(1 + 2 zeta)`` (0.5 %); just below the limit the multiplier is inside."""
+    from robobore.dynamics.semidiscretization import critical_multiplier
+
+    pk = sdof_pocket_speeds(250.0, 0.012, 1, 4)[k]
+    a = critical_depth_semidiscretization(sdof, contract_process, pk)
+    mu, f, mode = critical_multiplier(sdof, contract_process, pk, a)
+    assert abs(mu) == pytest.approx(1.0, abs=5e-3)
+    assert f == pytest.approx(250 * np.sqrt(1.024), rel=5e-3)
+    assert mode == 0
+    mu_lo, f_lo, _ = critical_multiplier(sdof, contract_process, pk, 0.8 * a)
+    assert abs(mu_lo) < 0.99
+    # the branch nearest a given frequency is one insert period's harmonic away
+    _, f_up, _ = critical_multiplier(sdof, contract_process, pk, a, near_Hz=f + pk / 60.0)
+    assert f_up == pytest.approx(f + pk / 60.0, rel=1e-9)

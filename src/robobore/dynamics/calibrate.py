@@ -11,9 +11,14 @@ Likelihood (one term per observation):
 * verdict: ``P(chatter) = eps + (1 - 2 eps) Phi(ln(a / a_crit(n)) / s)``, ``a_crit`` the
   semi-discretisation linear limit at the cut's speed (and feed), ``eps`` the label-noise rate,
   ``s`` the spread of the verdict about the limit (:class:`LikelihoodSettings`);
-* chatter frequency (chatter cuts): Gaussian about ``f_j sqrt(1 + 2 zeta_j)`` of the unit
-  nearest the observed frequency (the single-mode chatter frequency at the lobe minimum), with a
-  standard deviation of 2 % plus the mode's half-power half-width ``zeta_j f_j``;
+* chatter frequency (chatter cuts): Gaussian about the frequency of the semi-discretisation's
+  critical Floquet multiplier at the cut's speed and depth
+  (:func:`~robobore.dynamics.semidiscretization.critical_multiplier`, the branch ``(arg mu /
+  2 pi + k) / T`` nearest the observed frequency), standard deviation ``frequency_sd`` (2 %)
+  of it, mixed at the label-noise rate ``eps`` with a frequency uniform over one branch
+  spacing ``1 / T`` (a detector that reports a peak of no chatter branch). The frequency
+  says which direction carries the chatter at each speed, and so how the dynamic stiffness
+  is shared between the directions, which verdicts alone leave to the prior;
 * feed amplitude (stable cuts): Gaussian about the steady forced response's half
   peak-to-peak feed displacement ``A``
   (:func:`~robobore.dynamics.timedomain.nominal_cut_deflection`, the orbit the time domain
@@ -67,6 +72,7 @@ from robobore.dynamics.band import (
 from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_HI_M,
     critical_depth_semidiscretization,
+    critical_multiplier,
 )
 from robobore.dynamics.structure import ToolPointStructure
 from robobore.errors import ConfigError, InputError
@@ -226,8 +232,10 @@ class LikelihoodSettings:
     chatter detector's goal of 92 % right on real records, rounded up; a verdict by ear or by
     the surface is no better). ``verdict_spread``: ``s``, the spread of the verdict about the
     limit in ``ln`` depth (0.1: a cut within about 10 % of its limit grows or decays so slowly
-    that a test cut of a few seconds may show either). ``frequency_sd``: relative part of the
-    chatter frequency's standard deviation; ``amplitude_sd`` and ``amplitude_floor_m``: the
+    that a test cut of a few seconds may show either). ``frequency_sd``: relative standard
+    deviation of a measured chatter frequency about the model's (0.02: a spectrum of a cut of a
+    few seconds resolves a few tenths of a hertz, and the model's frequency moves by about 1 %
+    between the limit and a cut 30 % above it); ``amplitude_sd`` and ``amplitude_floor_m``: the
     feed amplitude's measurement noise, relative (0.05) and absolute (1e-7 m: a grating scale
     of 0.1 um resolution); raise them where the forced-response model itself is less sure.
     Priors on the log factors: ``damping_prior_sd`` 0.42 (90 % within x/ 2: identified robot
@@ -325,11 +333,15 @@ class CalibrationProblem:
                                                   o.speed_rpm, guess_m=gm)
             g[i] = math.log(float(clipped(a)))
         extra = []
-        st0 = self.structure_at(theta)
         for o in obs:
             if o.chatter and o.chatter_frequency_Hz is not None:
-                j = int(np.argmin(np.abs(st0.frequency_Hz[:3] - o.chatter_frequency_Hz)))
-                extra.append(st0.frequency_Hz[j] * math.sqrt(1.0 + 2.0 * st0.damping_ratio[j]))
+                st = self.structure_at(theta, o.depth_m, o.speed_rpm)
+                pr = self.processes[o.feed_mm_per_rev]
+                _, f, _ = critical_multiplier(st, pr, o.speed_rpm, o.depth_m,
+                                              near_Hz=o.chatter_frequency_Hz)
+                if not math.isfinite(f):  # overflow far beyond the limit: half a branch off
+                    f = o.chatter_frequency_Hz + 0.5 * pr.n_inserts * o.speed_rpm / 60.0
+                extra.append(f)
         for o in obs:
             if not o.chatter and o.feed_amplitude_m is not None:
                 extra.append(math.log(max(self.feed_amplitude(theta, o), 1e-15)))
@@ -371,9 +383,11 @@ class CalibrationProblem:
         k = n
         if fobs.size:
             fp = pred[k:k + fobs.size]
-            zeta = self._zeta_near(fobs, theta)
-            sd = s.frequency_sd * fobs + zeta * fobs
-            ll += float(np.sum(-0.5 * ((fobs - fp) / sd) ** 2 - np.log(sd)))
+            sd = s.frequency_sd * fobs
+            dens = np.exp(-0.5 * ((fobs - fp) / sd) ** 2) / (math.sqrt(2 * math.pi) * sd)
+            dens = np.where(np.isfinite(dens), dens, 0.0)
+            ll += float(np.sum(np.log((1.0 - s.label_noise) * dens
+                                      + s.label_noise * self._branch_density())))
             k += fobs.size
         if aobs.size:
             ap = np.exp(pred[k:k + aobs.size])
@@ -382,10 +396,15 @@ class CalibrationProblem:
             ll += float(np.sum(-0.5 * ((np.exp(aobs[ok]) - ap[ok]) / sd) ** 2 - np.log(sd)))
         return ll
 
-    def _zeta_near(self, fobs: np.ndarray, theta: np.ndarray | None) -> np.ndarray:
-        st = self.structure if theta is None else self.structure_at(theta)
-        j = np.argmin(np.abs(st.frequency_Hz[:3][None, :] - fobs[:, None]), axis=1)
-        return st.damping_ratio[j]
+    def _branch_density(self) -> np.ndarray:
+        """Density [1/Hz] of a chatter frequency that belongs to no predicted branch: uniform
+        over one branch spacing (the insert passing frequency) of each chatter cut."""
+        out = []
+        for o in self.observations:
+            if o.chatter and o.chatter_frequency_Hz is not None:
+                pr = self.processes[o.feed_mm_per_rev]
+                out.append(60.0 / (pr.n_inserts * o.speed_rpm))
+        return np.asarray(out, float)
 
     def prior_cov(self, with_pd: bool) -> np.ndarray:
         """Prior covariance of the log factors (:class:`LikelihoodSettings`)."""

@@ -20,9 +20,15 @@ displacement) with a measurement noise of :data:`AMPLITUDE_NOISE_REL` (5 %) rela
 so that the cuts and the verdicts are the same with and without them; a reading below the
 scale's resolution (0.1 um) is not reported. A chattering cut's
 amplitude is set by the chatter's own limit cycle (the tool leaving the cut), which the linear
-forced response does not predict, so chatter cuts carry none. Chatter frequencies are not
-made: the frequency of the semi-discretisation's critical eigenvalue is not a public result of
-the stability code, and the frequency-domain lobes' frequency belongs to a different limit.
+forced response does not predict, so chatter cuts carry none.
+
+Chatter frequencies (``chatter_frequency=True``): every cut with the verdict chatter carries
+the frequency of the truth's critical Floquet multiplier at the cut's speed and depth
+(:func:`~robobore.dynamics.semidiscretization.critical_multiplier`, the branch nearest the
+natural frequency of the mode that carries it: the spectrum's peak) with a relative
+measurement noise of :data:`FREQUENCY_NOISE_REL` (1 %), from a third random stream of the seed.
+A cut whose verdict was flipped to chatter reports the frequency of the truth's least-damped
+regenerative vibration at that cut (the same multiplier, inside the unit circle).
 Every observation and result made here is labelled SYNTHETIC.
 """
 
@@ -48,6 +54,8 @@ LABEL_NOISE = 0.1
 #: Measurement noise of the SYNTHETIC feed amplitudes: relative, and absolute [m].
 AMPLITUDE_NOISE_REL = 0.05
 AMPLITUDE_NOISE_ABS_M = 1e-7
+#: Relative measurement noise of the SYNTHETIC chatter frequencies.
+FREQUENCY_NOISE_REL = 0.01
 
 
 def truth_feed_amplitude(truth, process, speed_rpm: float, depth_m: float) -> float:
@@ -69,11 +77,20 @@ def truth_structure(structure):
                             log_k)
 
 
+def truth_chatter_frequency(truth, process, speed_rpm: float, depth_m: float) -> float:
+    """Chatter frequency [Hz] of the truth's critical Floquet multiplier at a cut (the branch
+    nearest the natural frequency of the mode that carries it)."""
+    from robobore.dynamics.semidiscretization import critical_multiplier
+
+    return critical_multiplier(truth, process, speed_rpm, depth_m)[1]
+
+
 def synthetic_observations(problem, speed_range: tuple[float, float], seed: int,
-                           feed_amplitude: bool = False
+                           feed_amplitude: bool = False, chatter_frequency: bool = False
                            ) -> tuple[list[Observation], np.ndarray, np.ndarray]:
     """SYNTHETIC cuts of the truth robot (module docstring): the observations (stable cuts
-    with their measured feed amplitude when ``feed_amplitude``), the held-out speeds and the
+    with their measured feed amplitude when ``feed_amplitude``, chatter cuts with their
+    measured chatter frequency when ``chatter_frequency``), the held-out speeds and the
     truth's critical depths there [m]."""
     rng = np.random.default_rng(seed)
     lo, hi = speed_range
@@ -99,6 +116,18 @@ def synthetic_observations(problem, speed_range: tuple[float, float], seed: int,
             a = a * (1.0 + AMPLITUDE_NOISE_REL * noise[i, 0]) + AMPLITUDE_NOISE_ABS_M * noise[i, 1]
             if a >= AMPLITUDE_NOISE_ABS_M:
                 obs[i] = replace(o, feed_amplitude_m=float(a))
+    if chatter_frequency:
+        from dataclasses import replace
+
+        rng3 = np.random.default_rng([seed, 2])
+        noise = rng3.standard_normal(N_CUTS)
+        for i, o in enumerate(obs):
+            if not o.chatter:
+                continue
+            f = truth_chatter_frequency(truth, problem.process, o.speed_rpm, o.depth_m)
+            if np.isfinite(f):
+                obs[i] = replace(o, chatter_frequency_Hz=float(f * (1.0 + FREQUENCY_NOISE_REL
+                                                                    * noise[i])))
     return obs, held, critical_depths(truth, problem.process, held)
 
 
@@ -107,7 +136,9 @@ class ValidationRun:
     """One seed: the fraction of held-out speeds whose corrected median critical depth is
     within 10 % of the truth, the 90 % band's coverage of the truth, the median relative error
     of the corrected and of the uncorrected model, labels flipped, the calibration's run time
-    and CPU time [s], the MAP factors, whether the stable cuts carried feed amplitudes."""
+    and CPU time [s], the MAP factors, whether the stable cuts carried feed amplitudes and the
+    chatter cuts chatter frequencies, and the share within 10 % the band itself forecasts
+    (:func:`within_10pct_share`)."""
 
     seed: int
     within_10pct: float
@@ -120,6 +151,8 @@ class ValidationRun:
     cpu_seconds: float
     factors: dict[str, float]
     feed_amplitude: bool = False
+    chatter_frequency: bool = False
+    expected_within_10pct: float = float("nan")
 
     def to_dict(self) -> dict[str, Any]:
         return {"seed": self.seed, "within_10pct": self.within_10pct,
@@ -130,14 +163,17 @@ class ValidationRun:
                 "flipped_labels": self.flipped, "seconds": self.seconds,
                 "cpu_seconds": self.cpu_seconds,
                 "factors": self.factors, "feed_amplitude": self.feed_amplitude,
-                "kind": "SYNTHETIC"}
+                "chatter_frequency": self.chatter_frequency,
+                "expected_within_10pct": self.expected_within_10pct, "kind": "SYNTHETIC"}
 
 
 def validation_case(config: Any, seed: int,
                     speed_range: tuple[float, float] = (200.0, 3000.0),
                     settings: LikelihoodSettings | None = None,
-                    feed_amplitude: bool = False) -> dict[str, Any]:
-    """The SYNTHETIC cuts of ``seed`` (with feed amplitudes when ``feed_amplitude``) and
+                    feed_amplitude: bool = False,
+                    chatter_frequency: bool = False) -> dict[str, Any]:
+    """The SYNTHETIC cuts of ``seed`` (with feed amplitudes when ``feed_amplitude``, chatter
+    frequencies when ``chatter_frequency``) and
     their calibration: ``observations``, ``held_out``
     speeds, the ``truth``'s critical depths there [m], the ``calibration`` (band at the
     held-out speeds), ``flipped`` labels, its wall and CPU ``seconds``."""
@@ -145,7 +181,8 @@ def validation_case(config: Any, seed: int,
 
     cfg, _ = load_dynamics_config(config) if not hasattr(config, "equivalent") else (config, 0)
     problem = build_problem(cfg, [Observation(1, 1000.0, 1e-3, False)], settings)
-    obs, held, truth = synthetic_observations(problem, speed_range, seed, feed_amplitude)
+    obs, held, truth = synthetic_observations(problem, speed_range, seed, feed_amplitude,
+                                              chatter_frequency)
     a_t = critical_depths(truth_structure(problem.structure), problem.process,
                           np.array([o.speed_rpm for o in obs]))
     flipped = sum(int(o.chatter != (o.depth_m > a)) for o, a in zip(obs, a_t, strict=True))
@@ -156,28 +193,46 @@ def validation_case(config: Any, seed: int,
             "flipped": flipped, "seconds": dt, "cpu_seconds": cpu}
 
 
+def within_10pct_share(log_sd: np.ndarray) -> np.ndarray:
+    """The probability, per speed, that the truth lies within 10 % of the band's median when
+    the truth is distributed as the band says (Gaussian in ``ln a_crit`` with ``log_sd``): the
+    share of held-out speeds within 10 % that the band itself forecasts. A band as wide as the
+    information in the cuts allows forecasts fewer speeds within 10 % than all of them."""
+    from scipy.stats import norm
+
+    sd = np.asarray(log_sd, float)
+    with np.errstate(divide="ignore"):
+        p = norm.cdf(np.log(1.1) / sd) - norm.cdf(np.log(0.9) / sd)
+    return np.where(sd > 0, p, 1.0)
+
+
 def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (200.0, 3000.0),
                   settings: LikelihoodSettings | None = None,
-                  feed_amplitude: bool = False) -> ValidationRun:
+                  feed_amplitude: bool = False,
+                  chatter_frequency: bool = False) -> ValidationRun:
     """Make the SYNTHETIC cuts of ``seed``, calibrate on them, compare at the held-out
     speeds (:func:`validation_case`)."""
-    c = validation_case(config, seed, speed_range, settings, feed_amplitude)
+    c = validation_case(config, seed, speed_range, settings, feed_amplitude, chatter_frequency)
     cal, truth = c["calibration"], c["truth"]
     b = cal.band
     err_c = np.abs(b.median_m / truth - 1.0)
     err_u = np.abs(cal.nominal_m / truth - 1.0)
     cover = (b.lower_m <= truth) & (truth <= b.upper_m)
     factors = {r["name"]: r["value"] for r in cal.parameters()}
+    expected = float(np.mean(within_10pct_share(b.log_sd)))
     return ValidationRun(seed, float(np.mean(err_c <= 0.1)), float(np.mean(cover)),
                          float(np.median(err_c)), float(np.median(err_u)),
                          float(np.mean(err_u <= 0.1)), int(c["flipped"]), c["seconds"],
-                         c["cpu_seconds"], factors, feed_amplitude)
+                         c["cpu_seconds"], factors, feed_amplitude, chatter_frequency,
+                         expected)
 
 
 __all__ = ["truth_structure", "synthetic_observations", "validate_seed", "validation_case", "ValidationRun",
            "TRUTH_DAMPING_FACTOR", "TRUTH_STIFFNESS_FACTOR", "TRUTH_STIFFNESS_AXIS", "N_CUTS",
            "N_HELD_OUT", "LABEL_NOISE", "write_example_observations", "truth_feed_amplitude",
-           "AMPLITUDE_NOISE_REL", "AMPLITUDE_NOISE_ABS_M"]
+           "AMPLITUDE_NOISE_REL", "AMPLITUDE_NOISE_ABS_M", "FREQUENCY_NOISE_REL",
+           "within_10pct_share",
+           "truth_chatter_frequency"]
 
 
 def write_example_observations(path: Any, config: Any, seed: int = 0) -> Any:

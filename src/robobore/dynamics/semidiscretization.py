@@ -1419,10 +1419,123 @@ def _narrow(rho, lo: float, r_lo: float, hi: float, r_hi: float, tol: float,
     return math.exp(0.5 * (x0 + x1))
 
 
+def _dominant_pair(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m: int):
+    """The monodromy's eigenvalue of largest modulus (complex) and the modal displacements
+    ``q`` (m, complex) of its eigenvector; ``None`` when a product overflows."""
+    n = 2 * m + r * m
+
+    def dense():
+        U = np.empty((n, n))
+        _propagate(Phi, P0, P1, r, m, np.eye(n), U)
+        if not np.all(np.isfinite(U)):
+            return None
+        try:
+            ev, X = np.linalg.eig(U)
+        except np.linalg.LinAlgError:
+            return None
+        i = int(np.argmax(np.abs(ev)))
+        return complex(ev[i]), X[:m, i]
+
+    if n <= DENSE_EIG_MAX:
+        return dense()
+    v = np.random.default_rng(12345).standard_normal(n)
+    v /= np.linalg.norm(v)
+    K = min(n - 1, ARNOLDI_VECTORS)
+    V = np.empty((K + 1, n))
+    H = np.empty((K + 1, K))
+    work = (np.empty((2 * r, m)), np.empty(2 * m), np.empty(2 * m), np.empty(n))
+    for _ in range(ARNOLDI_RESTARTS):
+        k = _arnoldi(Phi, P0, P1, r, m, v, V, H, *work)
+        if k < 0:
+            return None
+        try:
+            ev, Y = np.linalg.eig(H[:k, :k])
+        except np.linalg.LinAlgError:
+            return dense()
+        i = int(np.argmax(np.abs(ev)))
+        lam = abs(ev[i])
+        y = Y[:, i] / np.linalg.norm(Y[:, i])
+        resid = abs(H[k, k - 1] * y[k - 1]) if k == K else 0.0
+        if resid <= ARNOLDI_TOL * max(lam, 1e-300):
+            return complex(ev[i]), (V[:k].T @ y)[:m]
+        v = V[:k].T @ (y.real + y.imag)
+        nv = float(np.linalg.norm(v))
+        if not (nv > 0.0 and math.isfinite(nv)):
+            return dense()
+        v /= nv
+    return dense()
+
+
+def critical_multiplier(structure: ToolPointStructure, process: CuttingProcess,
+                        speed_rpm: float, depth_m: float, steps: int = 0,
+                        include_process_stiffness: bool = True,
+                        about_deflected: bool = True,
+                        near_Hz: float | None = None) -> tuple[complex, float, int]:
+    """The monodromy's critical (largest-modulus) Floquet multiplier ``mu`` at one speed and
+    depth, the chatter frequency [Hz] it gives, and the structural mode that carries it.
+
+    A multiplier ``mu = |mu| exp(i phi)`` over the delay ``T`` (one insert period) is the
+    vibration ``exp(i (phi + 2 pi k) t / T)`` for every integer ``k``: the frequencies
+    ``|phi / (2 pi) + k| / T``, one delay's harmonic apart (Insperger & Stepan 2011,
+    *Semi-Discretization for Time-Delay Systems*, ch. 3). The spectrum shows the branch the
+    structure amplifies: the one nearest the natural frequency of the mode with the largest
+    share of the eigenvector's modal strain energy (``k_j |q_j|^2``), or the one nearest
+    ``near_Hz`` where that is given (a measured chatter frequency, for comparing with it).
+    Returns ``(mu, frequency_Hz, mode)``; ``(nan, nan, -1)`` when the step matrices overflow
+    (far beyond the limit). ``steps`` per delay (0: :func:`auto_steps`); no Richardson
+    extrapolation (the phase converges faster than the modulus is needed)."""
+    steps = steps or auto_steps(structure, process, speed_rpm)
+    m = structure.n_modes
+    with np.errstate(over="ignore", invalid="ignore"), blas_thread_limit(1):
+        pr = process.at_depth(depth_m) if process.depth_dependent else process
+        tau = 60.0 / (pr.n_inserts * speed_rpm)
+        dt = tau / steps
+        constant = (not pr.rotating) or pr.n_inserts == 0
+        n_th = 1 if constant else steps
+        rp = np.zeros((1, 3))
+        weighted = False
+        if about_deflected:
+            parts = _deflection_parts(structure, pr, speed_rpm)
+            if parts is not None:
+                rp, r0 = parts
+                if r0 is not None and depth_m > 0.0:
+                    rp = rp + r0 / depth_m
+                weighted = True
+        core = np.einsum("e,ei,ej->ij", pr.width_per_depth, pr.shear, pr.normal)
+        vec = (np.einsum("e,e,ei->i", pr.width_per_depth, pr.h0, pr.shear)
+               + np.einsum("e,ei->i", pr.edge_per_depth, pr.edge))
+        L = np.empty((n_th, 2 * m, 2 * m))
+        W = np.empty((n_th, m, m))
+        _step_coefficients(bool(pr.rotating), int(pr.n_inserts), float(dt), float(speed_rpm),
+                           core, vec, np.asarray(pr.depth_direction, float),
+                           np.ascontiguousarray(structure.directions, dtype=float),
+                           1.0 / np.asarray(structure.modal_mass, float),
+                           np.asarray(structure.omega, float),
+                           np.asarray(structure.damping_ratio, float),
+                           np.ascontiguousarray(rp), weighted, float(depth_m),
+                           bool(include_process_stiffness), L, W)
+        Phi = np.empty_like(L)
+        P0, P1 = np.empty((n_th, 2 * m, m)), np.empty((n_th, 2 * m, m))
+        if not _delay_matrices(L, W, float(dt), float(pr.overlap * depth_m), Phi, P0, P1):
+            return complex("nan"), math.nan, -1
+        pair = _dominant_pair(Phi, P0, P1, int(steps), int(m))
+    if pair is None:
+        return complex("nan"), math.nan, -1
+    mu, q = pair
+    energy = np.asarray(structure.stiffness_N_per_m, float) * np.abs(q) ** 2
+    mode = int(np.argmax(energy))
+    target = float(structure.frequency_Hz[mode]) if near_Hz is None else float(near_Hz)
+    base = math.atan2(mu.imag, mu.real) / (2.0 * math.pi)  # in (-1/2, 1/2]
+    k0 = math.floor(target * tau)
+    cands = [abs(s * base + k) / tau for k in range(k0 - 1, k0 + 3) for s in (1.0, -1.0)]
+    f = min(cands, key=lambda c: abs(c - target))
+    return mu, float(f), mode
+
+
 __all__ = ["DEPTH_SCAN_HI_M", "DEPTH_SCAN_DECADES", "DEPTH_SCAN_RATIO", "DENSE_EIG_MAX",
            "blas_thread_limit", "depth_scan_grid", "auto_steps", "deflected_depth_weights",
            "monodromy_spectral_radius", "critical_depth_semidiscretization",
            "interrupted_below",
            "chatter_free_window", "chatter_free_windows", "CONTINUATION_STEP",
            "CONTINUATION_SLOPE", "CONTINUATION_MAX_STEP", "CONTINUATION_SECANT_STEPS",
-           "RICHARDSON_MIN_STEPS", "DEFLECTION_SAMPLES"]
+           "RICHARDSON_MIN_STEPS", "DEFLECTION_SAMPLES", "critical_multiplier"]
