@@ -143,4 +143,9 @@ def boring_runner(condition: dict[str, Any], context: dict[str, Any]) -> Any:
     return ds
 
 
+#: imported once by the server the sweep's process pool forks its workers from
+_PRELOAD = ("numpy", "xarray", "robobore.dynamics.api", "robobore.dynamics.timedomain",
+            "robobore.dynamics.chatter")
+boring_runner.preload_modules = _PRELOAD  # type: ignore[attr-defined]
+
 __all__ = ["boring_runner", "SYSTEMS"]
