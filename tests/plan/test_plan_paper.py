@@ -53,3 +53,22 @@ def test_posture_section_reports_an_error():
     rep = Report("t")
     add_posture_section(rep, {"error": "robot 'x' has no inertial data"})
     assert any("no inertial data" in part for part in rep._parts)
+
+
+def test_posture_plan_in_a_process_of_its_own_is_the_same():
+    """The study runs the posture plan in a forked process beside the lobes (workers > 0):
+    the same result as in the study's own process (its wall time aside)."""
+    from robobore.study.paper import _PosturePlan
+
+    cfg, raw, path = load_paper_config(None)
+    stiff = identify_stiffness(cfg, path)
+    modes = identify_modes(cfg, path)
+    coeffs = json.loads((path.parent / cfg.coefficients.file).read_text())
+    side = _PosturePlan(cfg, path, stiff, modes, coeffs, parallel=True)
+    assert side.fut is not None  # submitted to the process pool
+    here = _PosturePlan(cfg, path, stiff, modes, coeffs, parallel=False).result()
+    there = side.result()
+    assert "error" not in there, there.get("error")
+    here.pop("wall_time_s")
+    there.pop("wall_time_s")
+    assert there == here

@@ -1,6 +1,7 @@
-"""Sweeps: serial and Dask runs give the same stored results; failures are recorded and
-do not stop the others; a second run recomputes only what is missing or failed; a sweep
-runs on a Dask scheduler started separately on loopback."""
+"""Sweeps: serial, Dask and process-pool runs give the same stored results; failures
+(a dead pool worker too) are recorded and do not stop the others; a second run recomputes
+only what is missing or failed; a sweep runs on a Dask scheduler started separately on
+loopback."""
 
 from __future__ import annotations
 
@@ -42,6 +43,53 @@ def test_serial_and_dask_threads_store_identical_results(tmp_path):
     idx = json.loads((tmp_path / "dask" / "index.json").read_text())
     assert idx["counts"] == {"done": 12, "failed": 0, "pending": 0}
     assert len((tmp_path / "dask" / "summary.csv").read_text().splitlines()) == 13
+
+
+def test_process_pool_stores_the_serial_results_and_records_failures(tmp_path):
+    marks = tmp_path / "marks"
+    cfg = write_sweep_toml(tmp_path / "c.toml", runner_options=(
+        f'marker_dir = "{marks}"\nfail_speeds_rpm = [400]'))
+    plan = plan_from_file(cfg)
+    a = run_sweep(plan, tmp_path / "serial", workers=0)
+    b = run_sweep(plan, tmp_path / "pool", workers=2, pool="processes")
+    assert b.mode == "local process pool, 2 worker(s)"
+    assert (a.computed, a.failed) == (b.computed, b.failed) == (8, 4)
+    sa, sb = ResultsStore(tmp_path / "serial"), ResultsStore(tmp_path / "pool")
+    assert sa.done_keys() == sb.done_keys()
+    for key in sa.done_keys():
+        da, db = sa.load(key), sb.load(key)
+        np.testing.assert_array_equal(da["z_um"].values, db["z_um"].values)
+        assert sa.read_record(key).summary == sb.read_record(key).summary
+    for i in plan.items:
+        if i.condition["speed_rpm"] == 400:
+            assert "asked to fail at 400" in sb.failure(i.key)["error"]
+    assert sum(_markers(marks).values()) == 24
+
+
+def _dies_at_400(condition, context):
+    import os
+
+    from robobore.study.demo import demo_runner
+
+    if condition["speed_rpm"] == 400:
+        os._exit(3)
+    return demo_runner(condition, context)
+
+
+def test_a_dead_pool_worker_is_a_recorded_failure_not_a_crash(tmp_path):
+    plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(200, 400),
+                                           feeds=(0.1,), depths=(0.05,)))
+    out = run_sweep(plan, tmp_path / "s", workers=1, pool="processes", runner=_dies_at_400)
+    assert out.computed + out.failed == len(plan.items) == 2 and out.failed >= 1
+    assert all("worker process of the sweep pool died" in f["error"] for f in out.failures)
+    again = run_sweep(plan, tmp_path / "s", workers=0)
+    assert again.computed == out.failed and again.pending == 0
+
+
+def test_unknown_pool_is_a_clear_error(tmp_path):
+    plan = plan_from_file(write_sweep_toml(tmp_path / "c.toml", speeds=(200,), feeds=(0.1,)))
+    with pytest.raises(ConfigError, match="unknown sweep pool"):
+        run_sweep(plan, tmp_path / "s", workers=1, pool="threads")
 
 
 def test_progress_is_reported_through_the_callback(tmp_path):

@@ -404,7 +404,8 @@ def workspace_map(result: PostureResult, progress: Any = None) -> dict[str, Any]
             cand = enumerate_candidates(inp.robot, pt, inp.bore_axis, inp.tcp_m, rot,
                                         inp.cfg.plan.singularity_margin, inp.x_hint)
             if cand.q_rad.shape[0]:
-                ev = evaluate(model, inp.robot, cand, process, A0, inp.cfg)
+                ev = evaluate(model, inp.robot, cand, process, A0, inp.cfg,
+                              criterion_only=True)
                 c = criterion_values(inp.cfg.plan.criterion, ev["stiffness_N_per_m"],
                                      ev["critical_depth_m"])
                 best[iy, ix] = float(np.max(c))

@@ -59,15 +59,19 @@ CRITERION_UNITS = {"critical_depth": "mm", "stiffness_x": "N/m", "stiffness_y": 
 
 
 def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndarray,
-             cfg: PlanConfig, progress: Any = None, mode_share: float = 1e-3
-             ) -> dict[str, np.ndarray]:
+             cfg: PlanConfig, progress: Any = None, mode_share: float = 1e-3,
+             criterion_only: bool = False) -> dict[str, np.ndarray]:
     """Stiffness, modes, critical depth (frequency-domain screen) and the steady feed
     amplitude per candidate (chunks of 512); ``mode_share``: the feed amplitude's structure
     leaves out modes below that share of the tool-point flexibility.
 
     ``critical_depth_m`` is the limit at the ``[cutting]`` speed (the speed the cut runs at:
     the value candidates are ranked by); ``critical_depth_range_min_m`` the lowest point of
-    the envelope over the ``[lobes]`` speed range, at ``critical_speed_rpm``."""
+    the envelope over the ``[lobes]`` speed range, at ``critical_speed_rpm``.
+
+    ``criterion_only``: only what :func:`criterion_values` needs (modes, stiffness, and for
+    the ``critical_depth`` criterion ``critical_depth_m`` and ``chatter_frequency_Hz``); the
+    range minimum, its speed and the feed amplitude are NaN."""
     from robobore.plan.chatter import critical_depth_range
 
     n = cand.q_rad.shape[0]
@@ -77,22 +81,29 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
            "chatter_frequency_Hz": np.empty(n), "critical_speed_rpm": np.empty(n),
            "critical_depth_range_min_m": np.empty(n), "feed_amplitude_m": np.empty(n)}
     n_cut = float(cfg.cutting.speed_rpm)
+    need_depth = not criterion_only or cfg.plan.criterion == "critical_depth"
+    if criterion_only:
+        for name in ("critical_depth_m", "chatter_frequency_Hz", "critical_speed_rpm",
+                     "critical_depth_range_min_m", "feed_amplitude_m"):
+            out[name].fill(np.nan)
     for s in range(0, n, 512):
         e = min(n, s + 512)
         pm = model.modes(cand.q_rad[s:e])
         out["frequency_Hz"][s:e] = pm.frequency_Hz
         out["damping_ratio"][s:e] = pm.damping_ratio
         out["stiffness_N_per_m"][s:e] = pm.directional_stiffness
-        b, fch, nch = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
-                                           cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm,
-                                           process.n_inserts)
-        out["critical_depth_range_min_m"][s:e] = b
-        out["critical_speed_rpm"][s:e] = nch
-        b, fch, _ = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0, n_cut,
-                                         n_cut, process.n_inserts)
-        out["critical_depth_m"][s:e] = b
-        out["chatter_frequency_Hz"][s:e] = fch
-        for k in range(e - s):
+        if not criterion_only:
+            b, fch, nch = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
+                                               cfg.lobes.speed_min_rpm,
+                                               cfg.lobes.speed_max_rpm, process.n_inserts)
+            out["critical_depth_range_min_m"][s:e] = b
+            out["critical_speed_rpm"][s:e] = nch
+        if need_depth:
+            b, fch, _ = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
+                                             n_cut, n_cut, process.n_inserts)
+            out["critical_depth_m"][s:e] = b
+            out["chatter_frequency_Hz"][s:e] = fch
+        for k in range(e - s if not criterion_only else 0):
             out["feed_amplitude_m"][s + k] = steady_feed_amplitude(
                 pm.structure(k, mode_share), process, cfg.cutting.depth_mm * 1e-3,
                 cfg.cutting.speed_rpm)

@@ -295,8 +295,8 @@ def paper_cmd(
     out: Path = typer.Option(Path("paper-results"), "--out", help="Output folder."),
     fast: bool = typer.Option(False, "--fast", help="Use the stored force calibration "
                               "([coefficients] file) instead of running the FE calibration."),
-    workers: int = typer.Option(2, "--workers", min=0, help="Dask worker processes for the "
-                                "sweep and FE processes (0 = serial, no Dask)."),
+    workers: int = typer.Option(2, "--workers", min=0, help="Worker processes for the "
+                                "sweep (a forked process pool) and FE processes (0 = serial)."),
     allow_failures: bool = ALLOW_FAILURES_OPTION,
     as_json: bool = JSON_OPTION,
 ) -> None:
