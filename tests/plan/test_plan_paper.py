@@ -68,6 +68,7 @@ def test_posture_plan_in_a_process_of_its_own_is_the_same():
     assert side.fut is not None  # submitted to the process pool
     here = _PosturePlan(cfg, path, stiff, modes, coeffs, parallel=False).result()
     there = side.result()
+    assert side.computed_in == "side process"  # not the fallback in this process
     assert "error" not in there, there.get("error")
     here.pop("wall_time_s")
     there.pop("wall_time_s")

@@ -423,6 +423,9 @@ class _PosturePlan:
                  modes: dict[str, Any], coeffs: dict[str, Any], parallel: bool) -> None:
         self.args = (cfg, cfg_path, stiff, modes, coeffs, model_coefficients(cfg, coeffs))
         self.ex = self.fut = None
+        #: where the plan was computed: "side process", "this process", or a warning that
+        #: the side process died and the plan was computed again here
+        self.computed_in = ""
         if parallel:
             import multiprocessing as mp
             from concurrent.futures import ProcessPoolExecutor
@@ -439,11 +442,16 @@ class _PosturePlan:
 
         if self.fut is not None:
             try:
-                return self.fut.result()
-            except BrokenProcessPool:
-                pass
+                plan = self.fut.result()
+                self.computed_in = "side process"
+                return plan
+            except BrokenProcessPool as exc:
+                self.computed_in = (f"posture plan: its side process died ({exc}); computed "
+                                    "again in the study's process")
             finally:
                 self.ex.shutdown()
+        else:
+            self.computed_in = "this process"
         return paper_posture_plan(*self.args)
 
 
@@ -577,7 +585,8 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
                              "with_foot": eq["with_foot"].table()},
         "coefficients": cset["coefficients"], "coefficient_set": cset,
         "warnings": cset["warnings"] + [w for w in outcome.warnings
-                                        if w.startswith("coefficients")],
+                                        if w.startswith("coefficients")]
+        + ([posture.computed_in] if posture.computed_in.startswith("posture plan") else []),
         "coefficients_mode": coeffs.get("mode"),
         "comparison": None if cmp is None else {"groups": cmp.groups,
                                                 "agreement": cmp.agreement},
