@@ -90,7 +90,8 @@ from robobore.material import johnson_cook as jc
 __all__ = [
     "conduction_pass3", "element_update3", "node_update3", "run_chunk3", "sum_energies3",
     "contact_total3", "run_chunk3_ale", "run_chunk3_heat", "run_chunk3_ale_heat", "RUN_CHUNK3",
-    "run_chunk3_for", "renew_inertia_factors_py", "renew_inertia_factors",
+    "run_chunk3_for", "renew_inertia_factors_py", "renew_inertia_factors", "energy_arrays3",
+    "ENERGY_FIELDS3",
 ]
 
 
@@ -186,14 +187,25 @@ _energy_totals3 = njit(sum_energies3_py)
 
 
 @njit(cache=True)
-def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
-    """:data:`sum_energies3_py` of these arrays."""
-    _energy_totals3((mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork), en)
+def sum_energies3(es, en):
+    """:data:`sum_energies3_py` of the arrays ``es`` (:func:`energy_arrays3`) into ``en``."""
+    _energy_totals3(es, en)
+
+
+def energy_arrays3(st):
+    """The arrays ``es`` of :data:`sum_energies3_py` of a 3D state ``st`` (any object with
+    them as attributes: :class:`~robobore.cutting.fe.engine.state3d.FEState3`), by name."""
+    return tuple(getattr(st, f) for f in ENERGY_FIELDS3)
+
+
+#: the state's arrays ``es`` of :data:`sum_energies3_py`, in its order
+ENERGY_FIELDS3 = ("mass", "vx", "vy", "vz", "ie", "plast", "hge", "alive", "fric", "pen",
+                  "ero_ke", "nwork")
 
 
 @njit(inline="always")
 def _energy_arrays3(s):
-    # the arrays ``es`` of sum_energies3_py in the chunk loop's state ``s``
+    # the arrays ``es`` of sum_energies3_py in the chunk loop's state ``s`` (ENERGY_FIELDS3)
     return (s.mass, s.vx, s.vy, s.vz, s.ie, s.plast, s.hge, s.alive, s.fric, s.pen, s.ero_ke,
             s.nwork)
 
