@@ -79,8 +79,9 @@ def main() -> None:
                         (off_x, 0.0, 0.0))
 
     def run_targets(a, aflt):
-        toolframe3d_targets(a["x"], a["y"], a["z"], xn, yn, zn, x0, y0, z0, acls, aflt, off_x,
-                            0.0, 0.25, prm, off_x, 0.0, 0.0, scratch)
+        ale = ToolFrameAle3(x0=x0, y0=y0, z0=z0, acls=acls, aflt=aflt, scratch=scratch)
+        toolframe3d_targets(a["x"], a["y"], a["z"], xn, yn, zn, ale, prm, (off_x, 0.0, 0.25),
+                            (off_x, 0.0, 0.0))
 
     def run_remap(a, aflt):
         remap3d(*groups(a), rho_s, 293.15, 0)

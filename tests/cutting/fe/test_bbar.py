@@ -24,6 +24,7 @@ from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.chunk_loop import Phases
+from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.quad import bbar
 from robobore.cutting.fe.quad import element as q_element
@@ -57,10 +58,7 @@ def _kernel_stiffness(mat: Material, nodes=QUAD) -> np.ndarray:
         (st.vx if j % 2 == 0 else st.vy)[j // 2] = v
         st.x += dt * st.vx
         st.y += dt * st.vy
-        bbar.element_update_bbar(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
-                              st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg,
-                              st.gps, st.area0, st.ie, st.fex, st.fey, st.dte, st.plast,
-                              st.rate, st.mat, st.prm, dt, layout.ERODE_NONE)
+        bbar.element_update_bbar(*groups_of(st)[:4], st.gps, st.mat, st.prm, dt, layout.ERODE_NONE)
         f = np.column_stack([st.fex[0], st.fey[0]]).ravel()
         Kmat[:, j] = f / (v * dt)
     return Kmat
@@ -134,10 +132,7 @@ def test_only_rigid_body_modes_have_zero_energy():
         (st.vx if j % 2 == 0 else st.vy)[j // 2] = 1e-3
         st.x += 1e-12 * st.vx
         st.y += 1e-12 * st.vy
-        q_element.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
-                         st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg, st.qhx,
-                         st.qhy, st.area0, st.ie, st.hge, st.fex, st.fey, st.dte, st.plast,
-                         st.rate, st.mat, st.prm, 1e-12, layout.ERODE_NONE)
+        q_element.element_update(*groups_of(st)[:4], st.mat, st.prm, 1e-12, layout.ERODE_NONE)
         cols.append(np.column_stack([st.fex[0], st.fey[0]]).ravel() / 1e-15)
     K1 = np.array(cols).T
     ev1 = np.linalg.eigvalsh(0.5 * (K1 + K1.T))
@@ -176,10 +171,7 @@ def test_homogeneous_flow_follows_the_flow_curve(kind):
         t0 = st.temp[0]
         st.x += dt * vx
         st.y += dt * vy
-        bbar.element_update_bbar(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
-                              st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg,
-                              st.gps, st.area0, st.ie, st.fex, st.fey, st.dte, st.plast,
-                              st.rate, st.mat, st.prm, dt, layout.ERODE_NONE)
+        bbar.element_update_bbar(*groups_of(st)[:4], st.gps, st.mat, st.prm, dt, layout.ERODE_NONE)
         s = st.gps[0]
         q = np.sqrt(1.5 * (s[:, 0] ** 2 + s[:, 1] ** 2 + s[:, 2] ** 2 + 2 * s[:, 3] ** 2))
         out.append((q.min(), q.max(), st.eps_p[0], st.rate[0], t0, st.pres[0]))

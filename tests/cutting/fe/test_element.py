@@ -18,6 +18,7 @@ from conftest import elastic_tc4, strip_mesh
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.chunk_loop import Phases
+from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.engine.state2d import default_prm, make_state
 from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import NumericalError
@@ -44,10 +45,7 @@ def _drive_one_element(velocity, total_strain_measure, n_steps=4000, dt=2e-9, si
         st.vy[:] = vy
         st.x += dt * vx
         st.y += dt * vy
-        q_element.element_update(st.conn, st.x, st.y, st.vx, st.vy, st.alive, st.layer, st.sdx,
-                                 st.sdy, st.sdz, st.sdxy, st.pres, st.eps_p, st.temp, st.dmg,
-                                 st.qhx, st.qhy, st.area0, st.ie, st.hge, st.fex, st.fey, st.dte,
-                                 st.plast, st.rate, st.mat, st.prm, dt, layout.ERODE_NONE)
+        q_element.element_update(*groups_of(st)[:4], st.mat, st.prm, dt, layout.ERODE_NONE)
         q = math.sqrt(1.5 * (st.sdx[0] ** 2 + st.sdy[0] ** 2 + st.sdz[0] ** 2
                              + 2 * st.sdxy[0] ** 2))
         out.append((total_strain_measure(st), q, st.eps_p[0], st.rate[0], st.temp[0],

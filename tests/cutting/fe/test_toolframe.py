@@ -27,6 +27,7 @@ from robobore.cutting.fe.ale.rezone import (
 from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import layout
+from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal, simulate_orthogonal
 from robobore.cutting.fe.physics.tool_contact import tool_gap_py
 from robobore.errors import ConfigError
@@ -85,10 +86,8 @@ def _pass(st, off):
     rho_s = st.mat[15] * st.prm[layout.P_MS]
     tg = (st.prm[layout.P_ALE_X0] + off, st.prm[layout.P_TCY], st.prm[layout.P_NRX],
           st.prm[layout.P_NRY], st.prm[layout.P_NFX], st.prm[layout.P_NFY], st.prm[layout.P_R])
-    return rezone(st.x, st.y, st.vx, st.vy, st.mass, st.conn, st.alive, st.ptr, st.nel,
-                  st.enbr, st.snodes, st.xn, st.yn, st.buf, st.sdx, st.sdy, st.sdz, st.sdxy,
-                  st.pres, st.eps_p, st.temp, st.dmg, st.qhx, st.qhy, st.area0, rho_s, 0.2,
-                  st.x0, st.y0, st.vbuf, tg, st.acls, st.aflt, st.bflag, 293.0, off)
+    nodes, quads, state, _, _, ale = groups_of(st)
+    return rezone(nodes, quads, state, ale, rho_s, 0.2, tg, 293.0, off)
 
 
 def test_remap_open_boundaries_balance_mass():

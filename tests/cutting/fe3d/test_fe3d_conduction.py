@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.ale.groups3d import groups3_of
 from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
@@ -42,8 +43,14 @@ def _bar(nx: int, le: float, twin_row: int | None = None):
 
 
 def _conduct(st, dt_th):
-    conduct3(st.conn, st.x, st.y, st.z, st.alive, st.enbr, st.pairs, st.vol0, st.temp, st.tbuf,
-             KCOND, RCP, dt_th)
+    nodes, cells, elems, _, contact = groups3_of(st)
+    conduct3(nodes, cells, elems, contact, st.tbuf, KCOND, RCP, dt_th)
+
+
+def _heat_groups(st):
+    # the groups of tool_heat3 before theat: nodes, ncorner, cells, elems, contact
+    nodes, cells, elems, _, contact = groups3_of(st)
+    return nodes, st.ncorner, cells, elems, contact
 
 
 def _heat(st) -> float:
@@ -136,21 +143,18 @@ def test_frictional_heat_and_contact_with_the_cold_insert():
     # frictional heat only
     st.fric[mid] = 1e-6  # J
     q0 = _heat(st)
-    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
-               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, 0.0, 0.5, 293.0, 1e-7)
+    tool_heat3(*_heat_groups(st), st.theat, RCP, 0.0, 0.5, 293.0, 1e-7)
     assert _heat(st) - q0 == pytest.approx(0.5e-6, rel=1e-12)
     # the second pass books only new dissipation
     q1 = _heat(st)
-    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
-               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, 0.0, 0.5, 293.0, 1e-7)
+    tool_heat3(*_heat_groups(st), st.theat, RCP, 0.0, 0.5, 293.0, 1e-7)
     assert _heat(st) == pytest.approx(q1, rel=1e-15)
     # contact: the whole top face touches a 293 K insert, the block at 800 K
     st.temp[:] = 800.0
     st.cf[top, 1] = -1.0
     hc, dt = 1e5, 1e-9
     q2 = _heat(st)
-    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
-               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, hc, 0.0, 293.0, dt)
+    tool_heat3(*_heat_groups(st), st.theat, RCP, hc, 0.0, 293.0, dt)
     area = (2 * le) ** 2  # every top-face node in contact: the whole face exchanges (the
     # side faces touch along an edge only: no area)
     assert q2 - _heat(st) == pytest.approx(hc * area * (800.0 - 293.0) * dt, rel=1e-12)
@@ -160,8 +164,7 @@ def test_frictional_heat_and_contact_with_the_cold_insert():
     st.cf[corner, 1] = 0.0
     st.temp[:] = 800.0
     q3 = _heat(st)
-    tool_heat3(st.conn, st.x, st.y, st.z, st.ptr, st.nel, st.ncorner, st.alive, st.enbr,
-               st.pairs, st.vol0, st.cf, st.fric, st.temp, st.theat, RCP, hc, 0.0, 293.0, dt)
+    tool_heat3(*_heat_groups(st), st.theat, RCP, hc, 0.0, 293.0, dt)
     area = 3.5 * le * le
     assert q3 - _heat(st) == pytest.approx(hc * area * (800.0 - 293.0) * dt, rel=1e-12)
     assert n_all == st.x.size

@@ -13,8 +13,10 @@ import math
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.ale.groups3d import groups3_of
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine import layout
+from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.engine.state3d import (
     advance3,
     box_mesh,
@@ -40,9 +42,9 @@ def _distorted_cube(rng):
 
 
 def _one_update(st, dt=1e-30):
-    K3.element_update3(st.conn, st.x, st.y, st.z, st.vx, st.vy, st.vz, st.alive, st.layer,
-                       st.sd, st.pres, st.eps_p, st.temp, st.dmg, st.qh, st.vol0, st.ie, st.hge,
-                       st.fe, st.dte, st.plast, st.rate, st.mat, st.prm, dt, layout3d.ERODE_NONE)
+    nodes, cells, elems, out, _ = groups3_of(st)
+    K3.element_update3(nodes, cells, st.layer, elems, out, st.mat, st.prm, dt,
+                       layout3d.ERODE_NONE)
 
 
 def test_volume_derivative_matches_numerical():
@@ -270,10 +272,7 @@ def test_hourglass_resistance_matches_2d_quad_in_plane_strain(hgs, hgv):
     p2[layout.P_HGS], p2[layout.P_HGV], p2[layout.P_BV1], p2[layout.P_BV2] = hgs, hgv, 0.0, 0.0
     s2 = make_state(nodes2, np.array([[0, 1, 2, 3]]), np.zeros(4, bool), mat, prm=p2)
     s2.vx[:] = v0 * np.sign(s2.x - 0.5 * a) * np.sign(s2.y - 0.5 * a)
-    q_element.element_update(s2.conn, s2.x, s2.y, s2.vx, s2.vy, s2.alive, s2.layer, s2.sdx, s2.sdy,
-                     s2.sdz, s2.sdxy, s2.pres, s2.eps_p, s2.temp, s2.dmg, s2.qhx, s2.qhy,
-                     s2.area0, s2.ie, s2.hge, s2.fex, s2.fey, s2.dte, s2.plast, s2.rate,
-                     s2.mat, s2.prm, dt, layout.ERODE_NONE)
+    q_element.element_update(*groups_of(s2)[:4], s2.mat, s2.prm, dt, layout.ERODE_NONE)
     for k in range(4):
         # the cube's two nodes above the quad's node k (z = 0 and z = a), per unit thickness
         sel = (np.abs(st.x - nodes2[k, 0]) < 1e-12) & (np.abs(st.y - nodes2[k, 1]) < 1e-12)

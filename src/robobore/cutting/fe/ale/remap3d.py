@@ -68,7 +68,7 @@ __all__ = [
     "VEL_TAYLOR", "dv_py", "hex_volume_py", "hex_volume", "face_corner_py", "swept_face_py",
     "swept_face", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
     "rz3_taylor_py", "rz3_taylor", "rz3_write_py", "rz3_write", "rz3_node_mass_py",
-    "rz3_node_mass", "remap3d", "remap3d_loops", "remap3d_py", "remap3d_inputs", "remap3d_groups",
+    "rz3_node_mass", "remap3d", "remap3d_py", "remap3d_inputs", "remap3d_groups",
     "remap3d_outputs", "element_volumes3",
 ]
 
@@ -468,7 +468,7 @@ def rz3_node_mass_py(n, ptr, nel, alive, vol0, rho_s, msf, mass):
 rz3_node_mass = njit(cache=True, inline="always")(rz3_node_mass_py)
 
 
-@njit(cache=True)
+@njit(parallel=True, cache=True)
 def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     """One remap pass from the nodes' ``x, y, z`` to the new positions ``work.xn, yn, zn``
     (then copied into ``x, y, z``): element state, reference volumes, nodal velocities and
@@ -481,25 +481,36 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     :data:`VEL_MOMENTUM` or :data:`VEL_TAYLOR`. Returns the number of nodes whose velocity
     was remapped. Allocates nothing.
 
-    The groups are unpacked here, in sequential code, and the parallel loops
-    (:func:`remap3d_loops`, called from here only) take the arrays one by one: with the
-    arrays read from named tuples inside a ``parallel=True`` function, numba's parallel
-    loops do not give the remap's results (the pressures, velocities and masses of
-    ``tests/cutting/fe3d/test_remap3d.py`` differ; the same source compiled without
-    ``parallel`` is exact)."""
-    return remap3d_loops(nodes.x, nodes.y, nodes.z, work.xn, work.yn, work.zn, nodes.vx,
-                         nodes.vy, nodes.vz, nodes.mass, nodes.fixed, cells.conn, cells.alive,
-                         nodes.ptr, nodes.nel, cells.fnbr, cells.bflag, elems.sd, elems.pres,
-                         elems.eps_p, elems.temp, elems.dmg, elems.qh, elems.vol0, rho_s,
-                         elems.msf, t_room, vel_mode, work.buf, work.vbuf)
-
-
-@njit(parallel=True, cache=True)
-def remap3d_loops(x, y, z, xn, yn, zn, vx, vy, vz, mass, fixed, conn, alive, ptr, nel, fnbr,
-                  bflag, sd, pres, eps_p, temp, dmg, qh, vol0, rho_s, msf, t_room, vel_mode,
-                  buf, vbuf):
-    """The parallel loops of :func:`remap3d` (the arrays of its groups, in this order; called
-    from :func:`remap3d` only)."""
+    The parallel loops read the groups' arrays as locals, each bound by its own statement
+    before them (:mod:`robobore.cutting.fe.ale.groups3d`: a ``prange`` body's writes into an
+    array reached through a tuple are dropped)."""
+    x = nodes.x
+    y = nodes.y
+    z = nodes.z
+    vx = nodes.vx
+    vy = nodes.vy
+    vz = nodes.vz
+    mass = nodes.mass
+    fixed = nodes.fixed
+    ptr = nodes.ptr
+    nel = nodes.nel
+    conn = cells.conn
+    alive = cells.alive
+    fnbr = cells.fnbr
+    bflag = cells.bflag
+    sd = elems.sd
+    pres = elems.pres
+    eps_p = elems.eps_p
+    temp = elems.temp
+    dmg = elems.dmg
+    qh = elems.qh
+    vol0 = elems.vol0
+    msf = elems.msf
+    xn = work.xn
+    yn = work.yn
+    zn = work.zn
+    buf = work.buf
+    vbuf = work.vbuf
     nn = x.shape[0]
     ne = conn.shape[0]
     for e in prange(ne):

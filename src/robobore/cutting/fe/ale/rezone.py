@@ -267,25 +267,59 @@ def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scrat
 
 
 @njit(parallel=True, cache=True)
-def rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx, sdy,
-           sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s, max_move, x0, y0, vbuf,
-           tg, acls, aflt, bflag, t_room, off):
+def rezone(nodes, quads, state, ale, rho_s, max_move, tg, t_room, off):
     """One tool-frame ALE pass: relocation + remap (see module docstring).
 
-    ``acls``, ``aflt`` the node classes and data (:func:`toolframe_targets`), ``x0``, ``y0``
-    the nodes' places in the tool frame at the start, ``off`` the tool's x travel since the
-    start [m], ``tg`` the tool geometry (tool edge centre x, y, rake and flank normals, edge
-    radius); ``snodes`` are the nodes whose velocity is remapped (all but the rigid ones).
-    ``bflag`` (n_elem, 4): flux type of each outline edge (BF_*): virgin material at
-    ``t_room`` [K] flows in through BF_VIRGIN edges, material leaves through BF_VIRGIN and
-    BF_OPEN edges (and comes back through BF_OPEN ones with the element's own state).
-    ``xn``, ``yn`` (n_nodes,) and ``buf`` (n_elem, N_RZ_FIELDS) are work arrays, ``vbuf``
-    (n_nodes, 2) scratch for the velocity increments (all computed from the old velocities
-    before any is applied). Returns the number of nodes moved.
+    The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2), ``quads``
+    (Quads2), ``state`` (QuadState2), ``ale`` (Ale2); ``rho_s`` the mass-scaled density
+    [kg/m^3], ``max_move`` the largest node move of a pass [m].
+    ``ale.acls``, ``ale.aflt`` the node classes and data (:func:`toolframe_targets`),
+    ``ale.x0``, ``ale.y0`` the nodes' places in the tool frame at the start, ``off`` the
+    tool's x travel since the start [m], ``tg`` the tool geometry (tool edge centre x, y, rake
+    and flank normals, edge radius); ``ale.snodes`` are the nodes whose velocity is remapped
+    (all but the rigid ones). ``ale.bflag`` (n_elem, 4): flux type of each outline edge
+    (BF_*): virgin material at ``t_room`` [K] flows in through BF_VIRGIN edges, material
+    leaves through BF_VIRGIN and BF_OPEN edges (and comes back through BF_OPEN ones with the
+    element's own state). ``ale.xn``, ``ale.yn`` (n_nodes,) and ``ale.buf`` (n_elem,
+    N_RZ_FIELDS) are work arrays, ``ale.vbuf`` (n_nodes, 2) scratch for the velocity
+    increments (all computed from the old velocities before any is applied). Returns the
+    number of nodes moved.
 
     The passes are the scalar functions :func:`rz_flux_py`, :func:`rz_velocity_py`,
     :func:`rz_write_py` and :func:`rz_node_mass_py` (and the tool-frame ones), which the
     GPU engine runs in the same order (:mod:`robobore.cutting.fe.engine.gpu.backend2d`)."""
+    # the prange bodies read flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    vx = nodes.vx
+    vy = nodes.vy
+    mass = nodes.mass
+    ptr = nodes.ptr
+    nel = nodes.nel
+    conn = quads.conn
+    alive = quads.alive
+    area0 = quads.area0
+    sdx = state.sdx
+    sdy = state.sdy
+    sdz = state.sdz
+    sdxy = state.sdxy
+    pres = state.pres
+    eps_p = state.eps_p
+    temp = state.temp
+    dmg = state.dmg
+    qhx = state.qhx
+    qhy = state.qhy
+    enbr = ale.enbr
+    bflag = ale.bflag
+    snodes = ale.snodes
+    x0 = ale.x0
+    y0 = ale.y0
+    acls = ale.acls
+    aflt = ale.aflt
+    xn = ale.xn
+    yn = ale.yn
+    buf = ale.buf
+    vbuf = ale.vbuf
     nn = x.shape[0]
     ne = conn.shape[0]
     for n in prange(nn):

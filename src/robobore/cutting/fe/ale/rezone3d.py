@@ -89,7 +89,7 @@ from robobore.cutting.fe.hex.scalar3d import insert_gap3
 
 __all__ = ["OFF_NMIN2", "keep_py", "off_insert_py", "off_insert", "tf_place_plane_py",
            "tf_place_plane", "place3_py", "place3", "tf_face3_py", "tf_face3",
-           "toolframe3d_targets", "toolframe3d_targets_loops", "rezone3d", "toolframe3d_ale_data",
+           "toolframe3d_targets", "rezone3d", "toolframe3d_ale_data",
            "toolframe3d_targets_py", "rezone3d_py"]
 
 #: the least squared in-plane part of the insert normal the "off tool" push divides by
@@ -180,11 +180,22 @@ def tf_face3_py(n, xn, yn, x0, y0, acls, aflt, off):
 tf_face3 = njit(cache=True, inline="always")(tf_face3_py)
 
 
-def toolframe3d_targets_loops(x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z,
-                              max_move, prm, cx, cy, cz, scratch):
-    """New node positions ``xn, yn, zn`` of the z-sliced tool-frame mesh (module docstring);
-    ``aflt[:, 4:6]`` (the in-plane mesh displacement) updated, ``scratch`` (n, >= 2) work.
-    Allocates nothing."""
+@njit(parallel=True, cache=True)
+def toolframe3d_targets(x, y, z, xn, yn, zn, ale, prm, travel, tip):
+    """New node positions ``xn, yn, zn`` of the z-sliced tool-frame mesh (module docstring)
+    from the current ``x, y, z``; ``ale`` the
+    :class:`~robobore.cutting.fe.ale.groups3d.ToolFrameAle3` (``aflt[:, 4:6]``, the in-plane
+    mesh displacement, updated; ``scratch`` (n, >= 2) work), ``prm`` the engine's parameter
+    vector, ``travel`` and ``tip`` as in :func:`rezone3d`. Allocates nothing."""
+    # the prange bodies read flat locals, one bound per statement (ale.groups3d)
+    x0 = ale.x0
+    y0 = ale.y0
+    z0 = ale.z0
+    acls = ale.acls
+    aflt = ale.aflt
+    scratch = ale.scratch
+    off_x, off_z, max_move = travel
+    cx, cy, cz = tip
     nn = x.shape[0]
     tool = prm[P_TOOL] > 0.5
     # 1. z into the planes; rigid nodes, surface chains and the chain ends in the planes
@@ -205,10 +216,6 @@ def toolframe3d_targets_loops(x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x
         tf_interior(n, x, y, xn, yn, x0, y0, acls, aflt, off_x, max_move)
 
 
-#: the placement's loops compiled on their own (called by :func:`rezone3d`)
-toolframe3d_targets = njit(parallel=True, cache=True)(toolframe3d_targets_loops)
-
-
 @njit(cache=True)
 def rezone3d(nodes, cells, elems, work, ale, rho_s, t_room, vel_mode, prm, travel, tip):
     """One tool-frame ALE pass of the 3D engine: the placement (:func:`toolframe3d_targets`)
@@ -222,12 +229,8 @@ def rezone3d(nodes, cells, elems, work, ale, rho_s, t_room, vel_mode, prm, trave
     engine's parameter vector and ``tip`` = ``(cx, cy, cz)`` the insert tip's current
     position (the "off tool" correction). Returns the number of nodes whose velocity was
     remapped. Allocates nothing."""
-    off_x, off_z, max_move = travel
-    cx, cy, cz = tip
-    # the parallel placement takes the arrays one by one (see remap3d)
-    toolframe3d_targets(nodes.x, nodes.y, nodes.z, work.xn, work.yn, work.zn, ale.x0, ale.y0,
-                        ale.z0, ale.acls, ale.aflt, off_x, off_z, max_move, prm, cx, cy, cz,
-                        ale.scratch)
+    toolframe3d_targets(nodes.x, nodes.y, nodes.z, work.xn, work.yn, work.zn, ale, prm,
+                        travel, tip)
     return remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode)
 
 
@@ -247,11 +250,13 @@ def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarr
         prm = np.zeros(N_PRM)
     n = nodes.shape[0]
     xn, yn, zn = np.empty(n), np.empty(n), np.empty(n)
+    ale = ToolFrameAle3(x0=places[:, 0].copy(), y0=places[:, 1].copy(), z0=places[:, 2].copy(),
+                        acls=np.ascontiguousarray(acls, np.int64), aflt=aflt,
+                        scratch=np.zeros((n, 3)))
     toolframe3d_targets(nodes[:, 0].copy(), nodes[:, 1].copy(), nodes[:, 2].copy(), xn, yn, zn,
-                        places[:, 0].copy(), places[:, 1].copy(), places[:, 2].copy(),
-                        np.ascontiguousarray(acls, np.int64), aflt, float(off_x), float(off_z),
-                        float(max_move), np.ascontiguousarray(prm, np.float64),
-                        float(tip[0]), float(tip[1]), float(tip[2]), np.zeros((n, 3)))
+                        ale, np.ascontiguousarray(prm, np.float64),
+                        (float(off_x), float(off_z), float(max_move)),
+                        (float(tip[0]), float(tip[1]), float(tip[2])))
     return np.stack([xn, yn, zn], axis=1)
 
 

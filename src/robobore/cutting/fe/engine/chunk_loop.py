@@ -35,6 +35,14 @@ from typing import Any, Literal
 from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
+from robobore.cutting.fe.engine.groups2d import (
+    ale_of,
+    contact_of,
+    nodes_of,
+    out_of,
+    quads_of,
+    state_of,
+)
 from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
 from robobore.cutting.fe.engine.layout import (
     P_ALE_X0,
@@ -135,9 +143,7 @@ def _nodes(s, kin, dt, split):
     # tool face
     cx, cy, tvx, tvy = kin
     x, y, cfx, cfy, prm = s.x, s.y, s.cfx, s.cfy, s.prm
-    ncont = node_update(x, y, s.vx, s.vy, s.mass, s.fixed, s.ptr, s.nel, s.ncorner, s.alive,
-                        s.area0, s.fex, s.fey, cfx, cfy, s.fric, s.pen, s.ndead, s.ero_ke,
-                        s.nwork, cx, cy, tvx, tvy, prm, dt, s.twin, s.tied, s.vslip)
+    ncont = node_update(nodes_of(s), quads_of(s), out_of(s), contact_of(s), kin, prm, dt)
     fwx, fwy = contact_total(cfx, cfy)
     contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
                   split)
@@ -152,36 +158,25 @@ def _tool_step(s, fx, fy, fz, dt):
 @njit(inline="always")
 def _remesh(s, step):
     # the tool-frame ALE pass every prm[P_RZ_EVERY] steps
-    (x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx, sdy,
-     sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, x0, y0, vbuf, acls, aflt, bflag,
-     mat, prm) = (
-        s.x, s.y, s.vx, s.vy, s.mass, s.conn, s.alive, s.ptr, s.nel, s.enbr, s.snodes,
-        s.xn, s.yn, s.buf, s.sdx, s.sdy, s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.qhx,
-        s.qhy, s.area0, s.x0, s.y0, s.vbuf, s.acls, s.aflt, s.bflag, s.mat, s.prm)
+    mat, prm = s.mat, s.prm
     rho_s = mat[jc.RHO] * prm[P_MS]
-    if step % int(prm[P_RZ_EVERY]) == 0 and snodes.shape[0] > 0:
-        rezone(x, y, vx, vy, mass, conn, alive, ptr, nel, enbr, snodes, xn, yn, buf, sdx,
-               sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0, rho_s,
-               prm[P_RZ_MAXMOVE], x0, y0, vbuf, tool_geometry(prm), acls, aflt, bflag,
-               mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
+    if step % int(prm[P_RZ_EVERY]) == 0 and s.snodes.shape[0] > 0:
+        rezone(nodes_of(s), quads_of(s), state_of(s), ale_of(s), rho_s, prm[P_RZ_MAXMOVE],
+               tool_geometry(prm), mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
 
 
 @njit(inline="always")
 def _elements_q4r(s, dt):
     # the one-point quad with hourglass control
-    return element_update(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy, s.sdz,
-                          s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.qhx, s.qhy, s.area0, s.ie,
-                          s.hge, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat, s.prm, dt,
+    return element_update(nodes_of(s), quads_of(s), state_of(s), out_of(s), s.mat, s.prm, dt,
                           int(s.prm[P_EROSION]))
 
 
 @njit(inline="always")
 def _elements_bbar(s, dt):
     # the B-bar quad
-    return element_update_bbar(s.conn, s.x, s.y, s.vx, s.vy, s.alive, s.layer, s.sdx, s.sdy,
-                               s.sdz, s.sdxy, s.pres, s.eps_p, s.temp, s.dmg, s.gps, s.area0,
-                               s.ie, s.fex, s.fey, s.dte, s.plast, s.rate, s.mat, s.prm, dt,
-                               int(s.prm[P_EROSION]))
+    return element_update_bbar(nodes_of(s), quads_of(s), state_of(s), out_of(s), s.gps, s.mat,
+                               s.prm, dt, int(s.prm[P_EROSION]))
 
 
 @njit(inline="always")

@@ -41,7 +41,15 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
-from robobore.cutting.fe.ale.groups3d import Cells3, ElementState3, Nodes3, RemapWork3, ToolFrameAle3
+from robobore.cutting.fe.ale.groups3d import (
+    Cells3,
+    Contact3,
+    ElementOut3,
+    ElementState3,
+    Nodes3,
+    RemapWork3,
+    ToolFrameAle3,
+)
 from robobore.cutting.fe.ale.rezone3d import rezone3d
 from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
 from robobore.cutting.fe.engine.step_loop import make_chunk_loop
@@ -82,27 +90,93 @@ from robobore.material import johnson_cook as jc
 __all__ = [
     "conduction_pass3", "element_update3", "node_update3", "run_chunk3", "sum_energies3",
     "contact_total3", "run_chunk3_ale", "run_chunk3_heat", "run_chunk3_ale_heat", "RUN_CHUNK3",
-    "run_chunk3_for", "renew_inertia_factors_py", "renew_inertia_factors",
+    "run_chunk3_for", "renew_inertia_factors_py", "renew_inertia_factors", "energy_arrays3",
+    "ENERGY_FIELDS3",
 ]
 
 
 @njit(parallel=True, cache=True)
-def element_update3(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh, vol0,
-                    ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion):
-    """:func:`hex.element.hex_element_py` over all elements (parallel)."""
+def element_update3(nodes, cells, layer, elems, out, mat, prm, dt, erosion):
+    """:func:`hex.element.hex_element_py` over all elements (parallel). The groups of
+    :mod:`robobore.cutting.fe.ale.groups3d`: ``nodes`` (Nodes3), ``cells`` (Cells3: ``conn``,
+    ``alive``), ``elems`` (ElementState3), ``out`` (ElementOut3); ``layer`` (e,) the
+    separation-layer flags, ``mat`` the material vector, ``prm`` the parameter vector, ``dt``
+    the step [s], ``erosion`` the erosion mode."""
+    # the prange body reads flat locals, one bound per statement (ale.groups3d)
+    x = nodes.x
+    y = nodes.y
+    z = nodes.z
+    vx = nodes.vx
+    vy = nodes.vy
+    vz = nodes.vz
+    conn = cells.conn
+    alive = cells.alive
+    sd = elems.sd
+    pres = elems.pres
+    eps_p = elems.eps_p
+    temp = elems.temp
+    dmg = elems.dmg
+    qh = elems.qh
+    vol0 = elems.vol0
+    ie = out.ie
+    hge = out.hge
+    fe = out.fe
+    dte = out.dte
+    plast = out.plast
+    rate = out.rate
     for e in prange(conn.shape[0]):
         hex_element(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dmg, qh,
                     vol0, ie, hge, fe, dte, plast, rate, mat, prm, dt, erosion)
 
 
 @njit(parallel=True, cache=True)
-def node_update3(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-                 pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt, pairs):
-    """:func:`hex_node_py` over all nodes (parallel)."""
+def node_update3(nodes, ncorner, cells, elems, out, contact, prm, kin, dt):
+    """:func:`hex_node_py` over all nodes (parallel). The groups of
+    :mod:`robobore.cutting.fe.ale.groups3d`: ``nodes`` (Nodes3), ``cells`` (Cells3:
+    ``alive``), ``elems`` (ElementState3: ``vol0``), ``out`` (ElementOut3: ``fe``),
+    ``contact`` (Contact3); ``ncorner`` the node's corner in each element of its CSR list,
+    ``prm`` the parameter vector, ``kin`` = (edge centre x, y, z [m], tool velocity x, y, z
+    [m/s]), ``dt`` the step [s]."""
+    # the prange body reads flat locals, one bound per statement (ale.groups3d)
+    x = nodes.x
+    y = nodes.y
+    z = nodes.z
+    vx = nodes.vx
+    vy = nodes.vy
+    vz = nodes.vz
+    mass = nodes.mass
+    fixed = nodes.fixed
+    ptr = nodes.ptr
+    nel = nodes.nel
+    alive = cells.alive
+    vol0 = elems.vol0
+    fe = out.fe
+    cf = contact.cf
+    fric = contact.fric
+    pen = contact.pen
+    ndead = contact.ndead
+    ero_ke = contact.ero_ke
+    nwork = contact.nwork
+    pairs = contact.pairs
+    cx, cy, cz, tvx, tvy, tvz = kin
     for n in prange(x.shape[0]):
         hex_node(np.int64(n), x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0,
                  fe, cf, fric, pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, dt,
                  pairs)
+
+
+@njit(inline="always")
+def _groups3(s):
+    # the groups of robobore.cutting.fe.ale.groups3d of the chunk loop's state ``s``
+    nodes = Nodes3(x=s.x, y=s.y, z=s.z, vx=s.vx, vy=s.vy, vz=s.vz, mass=s.mass,
+                   fixed=s.fixed, ptr=s.ptr, nel=s.nel)
+    cells = Cells3(conn=s.conn, alive=s.alive, fnbr=s.enbr, bflag=s.bflag)
+    elems = ElementState3(sd=s.sd, pres=s.pres, eps_p=s.eps_p, temp=s.temp, dmg=s.dmg,
+                          qh=s.qh, vol0=s.vol0, msf=s.msf)
+    out = ElementOut3(ie=s.ie, hge=s.hge, fe=s.fe, dte=s.dte, plast=s.plast, rate=s.rate)
+    contact = Contact3(cf=s.cf, fric=s.fric, pen=s.pen, ndead=s.ndead, ero_ke=s.ero_ke,
+                       nwork=s.nwork, pairs=s.pairs)
+    return nodes, cells, elems, out, contact
 
 
 #: the energy totals (:func:`robobore.cutting.fe.engine.history.make_energy_totals` in 3D) of
@@ -113,14 +187,25 @@ _energy_totals3 = njit(sum_energies3_py)
 
 
 @njit(cache=True)
-def sum_energies3(mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork, en):
-    """:data:`sum_energies3_py` of these arrays."""
-    _energy_totals3((mass, vx, vy, vz, ie, plast, hge, alive, fric, pen, ero_ke, nwork), en)
+def sum_energies3(es, en):
+    """:data:`sum_energies3_py` of the arrays ``es`` (:func:`energy_arrays3`) into ``en``."""
+    _energy_totals3(es, en)
+
+
+def energy_arrays3(st):
+    """The arrays ``es`` of :data:`sum_energies3_py` of a 3D state ``st`` (any object with
+    them as attributes: :class:`~robobore.cutting.fe.engine.state3d.FEState3`), by name."""
+    return tuple(getattr(st, f) for f in ENERGY_FIELDS3)
+
+
+#: the state's arrays ``es`` of :data:`sum_energies3_py`, in its order
+ENERGY_FIELDS3 = ("mass", "vx", "vy", "vz", "ie", "plast", "hge", "alive", "fric", "pen",
+                  "ero_ke", "nwork")
 
 
 @njit(inline="always")
 def _energy_arrays3(s):
-    # the arrays ``es`` of sum_energies3_py in the chunk loop's state ``s``
+    # the arrays ``es`` of sum_energies3_py in the chunk loop's state ``s`` (ENERGY_FIELDS3)
     return (s.mass, s.vx, s.vy, s.vz, s.ie, s.plast, s.hge, s.alive, s.fric, s.pen, s.ero_ke,
             s.nwork)
 
@@ -162,16 +247,16 @@ def contact_total3(cf):
 
 
 @njit(cache=True)
-def conduction_pass3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
-                     tbuf, theat, mat, prm, t_end_step):
+def conduction_pass3(nodes, ncorner, cells, elems, contact, tbuf, theat, mat, prm, t_end_step):
     """Conduction and the thermal contact with the insert over the time since the last pass,
-    ``t_end_step - prm[P_COND_T]`` [s], which then moves to ``t_end_step``."""
+    ``t_end_step - prm[P_COND_T]`` [s], which then moves to ``t_end_step``; the groups and
+    ``tbuf``, ``theat`` as in :func:`robobore.cutting.fe.physics.thermal3d.tool_heat3`."""
     dt_th = t_end_step - prm[P_COND_T]
     rcp = mat[jc.RHO] * mat[jc.CP]
-    conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[jc.KCOND], rcp, dt_th)
+    conduct3(nodes, cells, elems, contact, tbuf, mat[jc.KCOND], rcp, dt_th)
     if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-        tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
-                   theat, rcp, prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
+        tool_heat3(nodes, ncorner, cells, elems, contact, theat, rcp, prm[P_HC], prm[P_FHEAT],
+                   prm[P_TTOOL], dt_th)
     prm[P_COND_T] = t_end_step
 
 
@@ -189,10 +274,8 @@ ChunkState3 = namedtuple("ChunkState3", CHUNK_ARGS3)
 @njit(inline="always")
 def _nodes3(s, kin, dt, split):
     # node update and contact, then the contact-force total in the fixed lane order
-    cx, cy, cz, tvx, tvy, tvz = kin
-    node_update3(s.x, s.y, s.z, s.vx, s.vy, s.vz, s.mass, s.fixed, s.ptr, s.nel, s.ncorner,
-                 s.alive, s.vol0, s.fe, s.cf, s.fric, s.pen, s.ndead, s.ero_ke, s.nwork, s.prm,
-                 cx, cy, cz, tvx, tvy, tvz, dt, s.pairs)
+    nodes, cells, elems, out, contact = _groups3(s)
+    node_update3(nodes, s.ncorner, cells, elems, out, contact, s.prm, kin, dt)
     return contact_total3(s.cf)
 
 
@@ -206,9 +289,8 @@ def _elements3(s, dt):
     # the element update, then its smallest stable step and an inverted element
     prm = s.prm
     conn, dte, alive = s.conn, s.dte, s.alive
-    element_update3(conn, s.x, s.y, s.z, s.vx, s.vy, s.vz, alive, s.layer, s.sd, s.pres,
-                    s.eps_p, s.temp, s.dmg, s.qh, s.vol0, s.ie, s.hge, s.fe, dte, s.plast,
-                    s.rate, s.mat, prm, dt, int(prm[P_EROSION]))
+    nodes, cells, elems, out, _contact = _groups3(s)
+    element_update3(nodes, cells, s.layer, elems, out, s.mat, prm, dt, int(prm[P_EROSION]))
     dtmin = 1e30
     bad = -1
     for e in range(conn.shape[0]):
@@ -238,9 +320,9 @@ def _elements3_ale(s, dt):
 def _heat3(s, step, t, dt):
     # every prm[P_COND_EVERY] (>= 1) steps: conduction and the thermal contact
     if is_conduction_step(step, s.prm):
-        conduction_pass3(s.conn, s.x, s.y, s.z, s.ptr, s.nel, s.ncorner, s.alive, s.enbr,
-                         s.pairs, s.vol0, s.cf, s.fric, s.temp, s.tbuf, s.theat, s.mat, s.prm,
-                         t + dt)
+        nodes, cells, elems, _out, contact = _groups3(s)
+        conduction_pass3(nodes, s.ncorner, cells, elems, contact, s.tbuf, s.theat, s.mat,
+                         s.prm, t + dt)
 
 
 def renew_inertia_factors_py(msf, dte, alive, dt_target):
@@ -270,11 +352,7 @@ def _remesh3(s, step):
         if prm[P_MSF_DT] > 0.0 and s.msf.shape[0] > 0:
             renew_inertia_factors(s.msf, s.dte, s.alive, prm[P_MSF_DT])
         cx, cy, cz, _vx, _vy, _vz = tool_kinematics(s.tool, prm)
-        nodes = Nodes3(x=s.x, y=s.y, z=s.z, vx=s.vx, vy=s.vy, vz=s.vz, mass=s.mass,
-                       fixed=s.fixed, ptr=s.ptr, nel=s.nel)
-        cells = Cells3(conn=s.conn, alive=s.alive, fnbr=s.enbr, bflag=s.bflag)
-        elems = ElementState3(sd=s.sd, pres=s.pres, eps_p=s.eps_p, temp=s.temp, dmg=s.dmg,
-                              qh=s.qh, vol0=s.vol0, msf=s.msf)
+        nodes, cells, elems, _out, _contact = _groups3(s)
         work = RemapWork3(xn=s.xn, yn=s.yn, zn=s.zn, buf=s.buf, vbuf=s.vbuf)
         ale = ToolFrameAle3(x0=s.x0, y0=s.y0, z0=s.z0, acls=s.acls, aflt=s.aflt,
                             scratch=s.scratch)

@@ -16,6 +16,7 @@ from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
 from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
+from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import ConfigError
 from robobore.material import Material
@@ -300,12 +301,12 @@ def parting_edges(conn: np.ndarray, twin: np.ndarray | None) -> np.ndarray:
 
 def init_forces(st: FEState) -> float:
     """Element forces and stable step of the current configuration (no stress update)."""
-    q_element.element_update(st.conn, st.x, st.y, st.vx * 0.0, st.vy * 0.0, st.alive, st.layer,
-                     st.sdx.copy(), st.sdy.copy(), st.sdz.copy(), st.sdxy.copy(),
-                     st.pres.copy(), st.eps_p.copy(), st.temp.copy(), st.dmg.copy(),
-                     st.qhx.copy(), st.qhy.copy(), st.area0, st.ie.copy(), st.hge.copy(),
-                     st.fex, st.fey, st.dte, st.plast.copy(), st.rate.copy(), st.mat, st.prm,
-                     1e-30, layout.ERODE_NONE)
+    copies = {f: getattr(st, f).copy() for f in ("sdx", "sdy", "sdz", "sdxy", "pres", "eps_p",
+                                                   "temp", "dmg", "qhx", "qhy", "ie", "hge",
+                                                   "plast", "rate")}
+    nodes, quads, state, out, _, _ = groups_of(st, vx=st.vx * 0.0, vy=st.vy * 0.0, **copies)
+    q_element.element_update(nodes, quads, state, out, st.mat, st.prm, 1e-30,
+                             layout.ERODE_NONE)
     dt = st.prm[layout.P_CFL] * float(np.min(st.dte))
     st.clock[1] = dt
     if st.prm[layout.P_DTMIN] <= 0:

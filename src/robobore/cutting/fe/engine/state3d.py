@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from robobore.cutting.fe.ale.groups3d import groups3_of
 from robobore.cutting.fe.ale.remap3d import N_RZ3
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine import layout
@@ -306,11 +307,13 @@ def element_steps3(st: FEState3) -> np.ndarray:
     rest (the element update's own estimate, without the inertia factors; the state is not
     changed)."""
     dte = np.zeros_like(st.dte)
-    K3.element_update3(st.conn, st.x, st.y, st.z, st.vx * 0.0, st.vy * 0.0, st.vz * 0.0,
-                       st.alive.copy(), st.layer, st.sd.copy(), st.pres.copy(), st.eps_p.copy(),
-                       st.temp.copy(), st.dmg.copy(), st.qh.copy(), st.vol0, st.ie.copy(),
-                       st.hge.copy(), np.zeros_like(st.fe), dte, st.plast.copy(),
-                       st.rate.copy(), st.mat, st.prm, 1e-30, layout3d.ERODE_NONE)
+    copies = {f: getattr(st, f).copy() for f in ("alive", "sd", "pres", "eps_p", "temp", "dmg",
+                                                   "qh", "ie", "hge", "plast", "rate")}
+    nodes, cells, elems, out, _ = groups3_of(st, vx=st.vx * 0.0, vy=st.vy * 0.0,
+                                             vz=st.vz * 0.0, fe=np.zeros_like(st.fe), dte=dte,
+                                             **copies)
+    K3.element_update3(nodes, cells, st.layer, elems, out, st.mat, st.prm, 1e-30,
+                       layout3d.ERODE_NONE)
     return dte
 
 

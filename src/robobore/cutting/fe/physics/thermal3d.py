@@ -293,9 +293,24 @@ DEVICE_FUNCTIONS = (
 
 
 @njit(parallel=True, cache=True)
-def conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th):
+def conduct3(nodes, cells, elems, contact, tbuf, kcond, rcp, dt_th):
     """Conduction between live elements over ``dt_th`` [s] (three passes over the elements:
-    centroids, new temperatures into ``tbuf[:, 3]``, copy). ``tbuf`` (e, 4) is scratch."""
+    centroids, new temperatures into ``tbuf[:, 3]``, copy). The groups of
+    :mod:`robobore.cutting.fe.ale.groups3d`: ``nodes`` (Nodes3: ``x, y, z``), ``cells``
+    (Cells3: ``conn``, ``alive``, ``fnbr`` the face neighbours ``enbr`` of this module),
+    ``elems`` (ElementState3: ``vol0``, ``temp``), ``contact`` (Contact3: ``pairs``);
+    ``tbuf`` (e, 4) scratch, ``kcond`` the conductivity [W/(m K)], ``rcp`` the volumetric
+    heat capacity [J/(m^3 K)]."""
+    # the prange bodies read flat locals, one bound per statement (ale.groups3d)
+    x = nodes.x
+    y = nodes.y
+    z = nodes.z
+    conn = cells.conn
+    alive = cells.alive
+    enbr = cells.fnbr
+    vol0 = elems.vol0
+    temp = elems.temp
+    pairs = contact.pairs
     ne = conn.shape[0]
     for e in prange(ne):
         hex_centroid3(e, conn, x, y, z, tbuf)
@@ -306,10 +321,28 @@ def conduct3(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt
 
 
 @njit(parallel=True, cache=True)
-def tool_heat3(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric, temp,
-               theat, rcp, hc, eta, t_tool, dt_th):
+def tool_heat3(nodes, ncorner, cells, elems, contact, theat, rcp, hc, eta, t_tool, dt_th):
     """Thermal contact with the insert over ``dt_th`` [s] (after :func:`conduct3`): node by
-    node, then into the elements. Heat is conserved between nodes and elements."""
+    node, then into the elements. Heat is conserved between nodes and elements. The groups as
+    in :func:`conduct3` (``nodes.ptr``, ``nodes.nel`` and ``ncorner`` the node-to-element
+    lists; ``contact.cf``, ``contact.fric`` the contact forces and frictional work), ``theat``
+    (n, 3) the nodes' heat data, ``rcp`` [J/(m^3 K)], ``hc`` the contact conductance
+    [W/(m^2 K)], ``eta`` the share of the frictional heat into the workpiece, ``t_tool`` the
+    insert's temperature [K]."""
+    # the prange bodies read flat locals, one bound per statement (ale.groups3d)
+    x = nodes.x
+    y = nodes.y
+    z = nodes.z
+    ptr = nodes.ptr
+    nel = nodes.nel
+    conn = cells.conn
+    alive = cells.alive
+    enbr = cells.fnbr
+    vol0 = elems.vol0
+    temp = elems.temp
+    cf = contact.cf
+    fric = contact.fric
+    pairs = contact.pairs
     for n in prange(x.shape[0]):
         tool_heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
                         fric, temp, theat, rcp, hc, eta, t_tool, dt_th)

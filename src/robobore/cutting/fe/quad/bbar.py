@@ -241,11 +241,33 @@ quad_bbar = njit(cache=True, inline="always")(quad_bbar_py)
 
 
 @njit(parallel=True, cache=True)
-def element_update_bbar(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
-                        temp, dmg, gps, area0, ie, fex, fey, dte, plast, rate, mat, prm, dt,
-                        erosion):
-    """:func:`quad_bbar_py` over all elements (parallel); returns ``(dtmin, bad)`` as
-    :func:`element_update`."""
+def element_update_bbar(nodes, quads, state, out, gps, mat, prm, dt, erosion):
+    """:func:`quad_bbar_py` over all elements (parallel); the groups and the result as
+    :func:`robobore.cutting.fe.quad.element.element_update` (``state.qhx``/``qhy`` and
+    ``out.hge`` unused), ``gps`` the B-bar element's Gauss-point state."""
+    # the prange body reads flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    vx = nodes.vx
+    vy = nodes.vy
+    conn = quads.conn
+    layer = quads.layer
+    alive = quads.alive
+    area0 = quads.area0
+    sdx = state.sdx
+    sdy = state.sdy
+    sdz = state.sdz
+    sdxy = state.sdxy
+    pres = state.pres
+    eps_p = state.eps_p
+    temp = state.temp
+    dmg = state.dmg
+    ie = out.ie
+    fex = out.fex
+    fey = out.fey
+    dte = out.dte
+    plast = out.plast
+    rate = out.rate
     ne = conn.shape[0]
     dtmin = 1e30
     bad = -1

@@ -313,11 +313,12 @@ quad_element = njit(cache=False, inline="always")(quad_element_py)
 
 
 @njit(parallel=True, cache=True)
-def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp,
-                   dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, dt,
-                   erosion):
+def element_update(nodes, quads, state, out, mat, prm, dt, erosion):
     """Stress update and element nodal forces at the new configuration.
 
+    The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2), ``quads``
+    (Quads2), ``state`` (QuadState2), ``out`` (QuadOut2); ``mat`` the material vector,
+    ``prm`` the parameter vector, ``dt`` the step [s], ``erosion`` the erosion mode.
     Returns ``(dtmin, bad)``: the smallest element stable step [s] (1e30 when no element is
     alive) and the largest index of an inverted element (-1: none).
     Writes ``fex``/``fey`` (n_elem, 4) internal nodal forces [N/m], ``dte`` (n_elem,) the
@@ -325,6 +326,27 @@ def element_update(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, 
     ``plast`` plastic work per element [J/m], ``hge`` hourglass work [J/m]. Erodes
     elements (``alive`` = 0 damage, -1 distortion).
     """
+    # the prange body reads flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    vx = nodes.vx
+    vy = nodes.vy
+    conn = quads.conn
+    layer = quads.layer
+    alive = quads.alive
+    area0 = quads.area0
+    sdx = state.sdx
+    sdy = state.sdy
+    sdz = state.sdz
+    sdxy = state.sdxy
+    pres = state.pres
+    eps_p = state.eps_p
+    temp = state.temp
+    dmg = state.dmg
+    qhx = state.qhx
+    qhy = state.qhy
+    ie, hge, fex, fey, dte, plast, rate = (out.ie, out.hge, out.fex, out.fey, out.dte,
+                                           out.plast, out.rate)
     ne = conn.shape[0]
     dtmin = 1e30
     bad = -1

@@ -212,14 +212,41 @@ quad_node = njit(cache=False, inline="always")(quad_node_py)
 
 
 @njit(parallel=True, cache=True)
-def node_update(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey,
-                cfx, cfy, fric, pen, ndead, ero_ke, nwork, tool_cx, tool_cy, tool_vx, tool_vy,
-                prm, dt, twin, tied, vslip):
+def node_update(nodes, quads, out, contact, kin, prm, dt):
     """:func:`quad_node_py` over all nodes (parallel).
 
+    The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2), ``quads``
+    (Quads2: ``alive``, ``area0`` read), ``out`` (QuadOut2: the element forces ``fex``,
+    ``fey``), ``contact`` (Contact2); ``kin`` = (edge centre x, y [m], tool velocity x, y
+    [m/s]), ``prm`` the parameter vector, ``dt`` the step [s].
     Returns the number of nodes in contact; their contact forces are in ``cfx``/``cfy``
     (summed in a fixed order by :func:`contact_total`).
     """
+    # the prange body reads flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    vx = nodes.vx
+    vy = nodes.vy
+    mass = nodes.mass
+    fixed = nodes.fixed
+    ptr = nodes.ptr
+    nel = nodes.nel
+    ncorner = nodes.ncorner
+    alive = quads.alive
+    area0 = quads.area0
+    fex = out.fex
+    fey = out.fey
+    cfx = contact.cfx
+    cfy = contact.cfy
+    fric = contact.fric
+    pen = contact.pen
+    ndead = contact.ndead
+    ero_ke = contact.ero_ke
+    nwork = contact.nwork
+    twin = contact.twin
+    tied = contact.tied
+    vslip = contact.vslip
+    tool_cx, tool_cy, tool_vx, tool_vy = kin
     ncont = 0
     for n in prange(x.shape[0]):
         _fcx, _fcy, touched = quad_node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive,

@@ -155,6 +155,5 @@ def _copy_back(st, g) -> None:
     for name in _MUTABLE:
         getattr(st, name)[...] = g[name].copy_to_host()
     ext = float(st.en[layout.E_EXT])
-    K3.sum_energies3(st.mass, st.vx, st.vy, st.vz, st.ie, st.plast, st.hge, st.alive, st.fric,
-                     st.pen, st.ero_ke, st.nwork, st.en)
+    K3.sum_energies3(K3.energy_arrays3(st), st.en)
     st.en[layout.E_EXT] = ext
