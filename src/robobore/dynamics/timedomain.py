@@ -589,9 +589,11 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
         raise NumericalError("the simulation produced non-finite values (unstable integration)")
     t = np.arange(n_steps) * dt
-    th_all = 2 * np.pi * (np.arange(n_steps) % Ns) / Ns
-    a_r = acc[:, 0] * np.cos(th_all) + acc[:, 1] * np.sin(th_all)
-    a_t = -acc[:, 0] * np.sin(th_all) + acc[:, 1] * np.cos(th_all)
+    th_rev = 2 * np.pi * np.arange(Ns) / Ns  # the insert's angle, the same every revolution
+    c_rev, s_rev = np.cos(th_rev), np.sin(th_rev)
+    ax, ay = acc[:, 0].reshape(revs, Ns), acc[:, 1].reshape(revs, Ns)
+    a_r = (ax * c_rev + ay * s_rev).ravel()
+    a_t = (-ax * s_rev + ay * c_rev).ravel()
     zr = X[:, 2].reshape(revs, Ns)
     feed_amp = 0.5 * (zr.max(axis=1) - zr.min(axis=1))
     ds_out = xr.Dataset(
