@@ -73,8 +73,7 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
 
     ``Lc`` is one (n, n) matrix or a stack (k, n, n); the result has the same leading shape.
     Reference implementation (scipy's Pade expm of the augmented 3n x 3n matrix); the
-    monodromy uses :func:`_step_matrices_modal`; tests compare both compiled kernels with
-    this one."""
+    monodromy uses :func:`_step_matrices_modal`, which a test holds to this one."""
     n = Lc.shape[-1]
     H = np.zeros(Lc.shape[:-2] + (3 * n, 3 * n))
     H[..., :n, :n] = Lc
@@ -82,17 +81,6 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
     H[..., n:2 * n, 2 * n:] = np.eye(n)
     E = expm(H * dt)
     return E[..., :n, :n], E[..., :n, n:2 * n], E[..., :n, 2 * n:]
-
-
-@nb.njit(cache=True)
-def _matmul_into(A, B, out):  # pragma: no cover - numba
-    n = A.shape[0]
-    for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for k in range(n):
-                acc += A[i, k] * B[k, j]
-            out[i, j] = acc
 
 
 @nb.njit(cache=True)
@@ -139,104 +127,21 @@ def _balance(L):  # pragma: no cover - numba
 
 
 @nb.njit(cache=True)
-def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+def _step_matrices_modal(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n) of the modal
+    system matrices of :func:`_step_coefficients` (``L = [[0, I], [K, C]]``, ``C`` diagonal),
+    in place; ``G0`` and ``G1`` only their last ``m`` columns (k, 2m, m), the ones the delayed
+    term multiplies.
 
     The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
-    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
-    whose norm is of the order of the modes' angular frequencies rather than their squares,
-    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
-    (:func:`_step_matrices_taylor` on ``L'``)."""
-    k_n, n, _ = L.shape
-    d = _balance(L)
-    Lb = np.empty_like(L)
-    for q in range(k_n):
-        for i in range(n):
-            for j in range(n):
-                Lb[q, i, j] = L[q, i, j] * d[j] / d[i]
-    _step_matrices_taylor(Lb, dt, Phi, G0, G1)
-    for q in range(k_n):
-        for i in range(n):
-            for j in range(n):
-                sc = d[i] / d[j]
-                Phi[q, i, j] *= sc
-                G0[q, i, j] *= sc
-                G1[q, i, j] *= sc
-
-
-@nb.njit(cache=True)
-def _step_matrices_taylor(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
-
-    Taylor series on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2``, of the lowest degree (at
-    most 16) whose first omitted term is below 1e-17 relative, then ``s`` doublings: ``Phi(2h) = Phi^2``,
-    ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the integral at h)."""
-    k_n, n, _ = L.shape
-    T = np.empty((n, n))
-    A = np.empty((n, n))
-    W1 = np.empty((n, n))
-    W2 = np.empty((n, n))
-    W3 = np.empty((n, n))
-    for q in range(k_n):
-        nrm = 0.0
-        for j in range(n):
-            c = 0.0
-            for i in range(n):
-                c += abs(L[q, i, j])
-            nrm = max(nrm, c)
-        nrm *= dt
-        s = 0
-        if nrm > 0.5:
-            s = int(math.ceil(math.log2(nrm / 0.5)))
-        h = dt / 2.0**s
-        for i in range(n):
-            for j in range(n):
-                A[i, j] = L[q, i, j] * h
-                T[i, j] = 1.0 if i == j else 0.0  # (A)^m / m! accumulated as T
-                Phi[q, i, j] = T[i, j]
-                G0[q, i, j] = T[i, j] * h
-                G1[q, i, j] = T[i, j] * h * h * 0.5
-        nh = nrm / 2.0**s  # ||L h||_1 <= 1/2
-        deg = 16
-        term = nh
-        for j in range(1, 17):  # term = nh^(j+1) / (j+1)!
-            term *= nh / (j + 1)
-            if term < 1e-17:
-                deg = j
-                break
-        for m in range(1, deg + 1):
-            _matmul_into(T, A, W1)  # T <- T A / m  (= A^m / m!)
-            for i in range(n):
-                for j in range(n):
-                    T[i, j] = W1[i, j] / m
-            c0 = h / (m + 1)                  # A^m/(m+1)! = (A^m/m!) / (m+1)
-            c1 = h * h / ((m + 1) * (m + 2))  # A^m/(m+2)! = (A^m/m!) / ((m+1)(m+2))
-            for i in range(n):
-                for j in range(n):
-                    Phi[q, i, j] += T[i, j]
-                    G0[q, i, j] += c0 * T[i, j]
-                    G1[q, i, j] += c1 * T[i, j]
-        for _ in range(s):
-            _matmul_into(Phi[q], G1[q], W1)
-            _matmul_into(Phi[q], G0[q], W2)
-            _matmul_into(Phi[q], Phi[q], W3)
-            for i in range(n):
-                for j in range(n):
-                    G1[q, i, j] = W1[i, j] + h * G0[q, i, j] + G1[q, i, j]
-                    G0[q, i, j] = W2[i, j] + G0[q, i, j]
-                    Phi[q, i, j] = W3[i, j]
-            h *= 2.0
-
-
-@nb.njit(cache=True)
-def _step_matrices_modal(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """:func:`_step_matrices_batch` for the modal system matrices of :func:`_step_coefficients`
-    (``L = [[0, I], [K, C]]``, ``C`` diagonal), ``G0`` and ``G1`` only their last ``m``
-    columns (k, 2m, m), the ones the delayed term multiplies.
-
-    The same balancing, Taylor degree and doublings; each Taylor product ``T A`` uses the
-    blocks of ``A = L' h`` (a diagonal upper right and lower right, a full lower left), which
-    the balancing keeps."""
+    point; :func:`_balance`): ``L' = D^-1 L D``, whose norm is of the order of the modes'
+    angular frequencies rather than their squares, so that few doublings are needed. Then a
+    Taylor series on ``h = dt / 2^s`` with ``||L' h||_1 <= 1/2``, of the lowest degree (at
+    most 16) whose first omitted term is below 1e-17 relative, and ``s`` doublings:
+    ``Phi(2h) = Phi^2``, ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the
+    integral at h); finally ``Phi = D Phi' D^-1`` and likewise both Gammas. Each Taylor
+    product ``T A`` uses the blocks of ``A = L' h`` (a diagonal upper right and lower right, a
+    full lower left), which the balancing keeps."""
     k_n, n, _ = L.shape
     m = n // 2
     d = _balance(L)
