@@ -274,140 +274,15 @@ def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
 
 def _deflection_parts_uncached(structure, process, speed_rpm):
     """:func:`~robobore.dynamics.timedomain.nominal_cut_deflection` at
-    :data:`DEFLECTION_SAMPLES` samples per revolution, by :func:`_deflection_kernel` (the
-    same orbit of the same map, its step matrices and forces formed in the kernel from the
-    process's three-vectors)."""
-    N = int(process.n_inserts)
-    Ns = int(math.ceil(DEFLECTION_SAMPLES / N) * N)
-    Phi, Gam = _zoh(structure, 60.0 / (float(speed_rpm) * Ns))
-    vec = ((process.width_per_depth * process.h0) @ process.shear
-           + process.edge_per_depth @ process.edge)
-    fixed = process.edge_fixed_m @ process.edge
-    out = np.empty((Ns, 3, 2))
-    if not _deflection_kernel(Phi, Gam, np.ascontiguousarray(structure.directions, dtype=float),
-                              np.asarray(process.depth_direction, float), vec, fixed, N,
-                              30.0 / (float(speed_rpm) * Ns), out):
+    :data:`DEFLECTION_SAMPLES` samples per revolution, ``r_0`` None where the process has no
+    depth-independent edge length."""
+    from robobore.dynamics.timedomain import nominal_cut_deflection
+
+    parts = nominal_cut_deflection(structure, process, speed_rpm, DEFLECTION_SAMPLES)
+    if parts is None:
         return None
-    r1 = np.ascontiguousarray(out[:, :, 0])
-    return (r1, np.ascontiguousarray(out[:, :, 1])) if np.any(process.edge_fixed_m) else (
-        r1, None)
-
-
-_ZOH: dict = {}
-
-
-def _zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~robobore.dynamics.timedomain.modal_zoh`, kept per structure (keyed by its
-    values) and step."""
-    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
-           structure.stiffness_N_per_m.tobytes(), float(dt))
-    hit = _ZOH.get(key)
-    if hit is not None:
-        return hit
-    from robobore.dynamics.timedomain import modal_zoh
-
-    out = modal_zoh(structure, dt)
-    if len(_ZOH) > 4096:
-        _ZOH.clear()
-    _ZOH[key] = out
-    return out
-
-
-@nb.njit(cache=True)
-def _deflection_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, out):  # pragma: no cover - numba
-    """Steady nominal-cut tool-point displacement per unit depth and of the depth-independent
-    edge force, ``out`` (Ns, 3, 2), at the step starts ``2 pi i / Ns``: the periodic orbit of
-    the time-domain map on the nominal chip (``robobore.dynamics.timedomain._orbit_kernel``:
-    per mode ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))``, the Ns steps composed,
-    ``x_0 = T x_0 + c``, solved). At the step midpoint ``theta_i`` and insert ``p``
-    (``theta_i + 2 pi p / N``, basis ``B_p``): the depth-modulation stiffness
-    ``Pm_i = sum_p u_p v_p^T`` with ``u_p = D B_p^T vec``, ``v_p = D B_p^T dd``, and the load
-    cases ``Fm_i = sum_p D B_p^T (vec, fixed)``. A step is the per-mode ``Phi`` plus one
-    rank-one term per insert, ``(Gam u_p)(v_p, half_dt v_p)^T``, and is applied as such.
-    False when ``I - T`` is singular (no orbit)."""
-    Ns = out.shape[0]
-    m = D.shape[0]
-    n = 2 * m
-    U = np.zeros((Ns, N, m))
-    Vv = np.zeros((Ns, N, m))
-    Fm = np.zeros((Ns, m, 2))
-    two_pi = 2.0 * math.pi
-    for i in range(Ns):
-        th = two_pi * (i + 0.5) / Ns
-        for p in range(N):
-            tp = th + two_pi * p / N
-            c_, s_ = math.cos(tp), math.sin(tp)
-            # B^T x = x_t e_t + x_r e_r + x_z e_z, e_t = (-s, c, 0), e_r = (c, s, 0)
-            fv0, fv1, fv2 = -s_ * vec[0] + c_ * vec[1], c_ * vec[0] + s_ * vec[1], vec[2]
-            ff0, ff1, ff2 = (-s_ * fixed[0] + c_ * fixed[1], c_ * fixed[0] + s_ * fixed[1],
-                             fixed[2])
-            fe0, fe1, fe2 = -s_ * dd[0] + c_ * dd[1], c_ * dd[0] + s_ * dd[1], dd[2]
-            for j in range(m):
-                u = D[j, 0] * fv0 + D[j, 1] * fv1 + D[j, 2] * fv2
-                U[i, p, j] = u
-                Vv[i, p, j] = D[j, 0] * fe0 + D[j, 1] * fe1 + D[j, 2] * fe2
-                Fm[i, j, 0] += u
-                Fm[i, j, 1] += D[j, 0] * ff0 + D[j, 1] * ff1 + D[j, 2] * ff2
-    # X <- A X + b (X: T (n, n) with b = 0, or c (n, 2) with b = Gam Fm_i)
-    T = np.eye(n)
-    T2 = np.empty((n, n))
-    c = np.zeros((n, 2))
-    c2 = np.empty((n, 2))
-    bt = np.empty(n)
-    bc = np.empty(2)
-    for i in range(Ns):
-        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, T, T2, True, bt)
-        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, c, c2, False, bc)
-        T, T2 = T2, T
-        c, c2 = c2, c
-    M = np.eye(n) - T
-    if abs(np.linalg.det(M)) < 1e-300:
-        return False
-    x = np.ascontiguousarray(np.linalg.solve(M, c))
-    x2 = np.empty((n, 2))
-    for i in range(Ns):
-        for o in range(3):
-            for kk in range(2):
-                acc = 0.0
-                for j in range(m):
-                    acc += x[j, kk] * D[j, o]
-                out[i, o, kk] = acc
-        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, x, x2, False, bc)
-        x, x2 = x2, x
-    return True
-
-
-@nb.njit(cache=True)
-def _orbit_step(Phi, Gam, U, Vv, Fm_i, half_dt, X, Y, homogeneous, w):  # pragma: no cover
-    """``Y = A X`` (``homogeneous``) or ``Y = A X + b`` for one step of
-    :func:`_deflection_kernel`: ``A = blockdiag_j Phi_j + sum_p (Gam u_p)(v_p, half_dt v_p)^T``
-    in the state order ``(q_1..q_m, q'_1..q'_m)``, ``b = Gam Fm_i``; ``w`` (X's columns) is
-    work space."""
-    m = Phi.shape[0]
-    ncol = X.shape[1]
-    for j in range(m):
-        for col in range(ncol):
-            x0 = X[j, col]
-            x1 = X[m + j, col]
-            Y[j, col] = Phi[j, 0, 0] * x0 + Phi[j, 0, 1] * x1
-            Y[m + j, col] = Phi[j, 1, 0] * x0 + Phi[j, 1, 1] * x1
-    for p in range(U.shape[0]):
-        for col in range(ncol):
-            acc = 0.0
-            for k in range(m):
-                acc += Vv[p, k] * (X[k, col] + half_dt * X[m + k, col])
-            w[col] = acc
-        for j in range(m):
-            g0 = Gam[j, 0] * U[p, j]
-            g1 = Gam[j, 1] * U[p, j]
-            for col in range(ncol):
-                Y[j, col] += g0 * w[col]
-                Y[m + j, col] += g1 * w[col]
-    if not homogeneous:
-        for j in range(m):
-            for col in range(ncol):
-                Y[j, col] += Gam[j, 0] * Fm_i[j, col]
-                Y[m + j, col] += Gam[j, 1] * Fm_i[j, col]
+    r1, r0 = parts
+    return (r1, r0) if np.any(process.edge_fixed_m) else (r1, None)
 
 
 def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,
