@@ -104,7 +104,8 @@ def test_deflection_without_trailing_edge_has_no_fixed_part(structure):
 
 def _process_from_edge_elements(ins, c, depth_m, feed_m, trailing):
     """The process arrays of :func:`boring_process` formed from
-    :func:`robobore.cutting.geometry.edge_elements` (the reference the compiled pass follows)."""
+    :func:`robobore.cutting.geometry.edge_elements` with numpy (the coefficients, chip widths
+    above the minimum chip thickness and trailing-side edge lengths)."""
     from robobore.cutting.geometry import edge_elements
 
     el = edge_elements(ins, depth_m, feed_m / ins.n_inserts, 24, trailing_edge=trailing,
@@ -128,7 +129,7 @@ def _process_from_edge_elements(ins, c, depth_m, feed_m, trailing):
 @pytest.mark.parametrize("trailing", [True, False])
 def test_process_elements_are_the_edge_elements(kappa_deg, end_deg, feed_m, trailing):
     """Depths inside the nose and beyond it, feeds whose trailing contact ends on the arc and
-    on the straight minor edge, 1 and 3 inserts: the same elements as edge_elements."""
+    on the straight minor edge, 1 and 3 inserts: the process arrays formed from edge_elements."""
     c = ti64_coefficients()
     for n_ins in (1, 3):
         ins = BoringInsert(nose_radius_m=0.4e-3, approach_angle_deg=kappa_deg,
@@ -140,6 +141,17 @@ def test_process_elements_are_the_edge_elements(kappa_deg, end_deg, feed_m, trai
                 got = getattr(pr, name)
                 assert got.shape == v.shape, name
                 assert np.abs(got - v).max() <= 1e-13 * max(np.abs(v).max(), 1e-300), name
+
+
+def test_process_without_minimum_chip_thickness_keeps_the_trailing_side_chipless():
+    """With no minimum chip thickness every leading element carries a chip width, and the
+    rubbing-only trailing elements (h = 0) still none."""
+    ins = BoringInsert(nose_radius_m=0.8e-3, approach_angle_deg=75.0)
+    pr = boring_process(ins, ti64_coefficients(), 1e-3, 0.2e-3, min_chip_thickness_m=0.0)
+    tr = pr.edge_fixed_m > 0
+    assert tr.sum() >= 1 and np.all(pr.width_per_depth[tr] == 0.0)
+    assert np.all(pr.width_per_depth[~tr] == pr.edge_per_depth[~tr])
+    assert np.all(pr.edge_per_depth[tr] == 0.0)
 
 
 def test_process_at_depth_keeps_the_geometry_and_label():
