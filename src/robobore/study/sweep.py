@@ -1,4 +1,4 @@
-"""Run a runner over many conditions with Dask, storing each result as it finishes.
+"""Run a runner over many conditions (Dask or a process pool), storing each result as it finishes.
 
 A *runner* is a picklable, importable function ``runner(condition: dict, context: dict)
 -> xarray.Dataset`` (condition: :class:`~robobore.study.conditions.Condition` as a dict;
@@ -14,7 +14,9 @@ Execution (:func:`run_sweep`):
 * conditions already in the store are skipped; missing and failed ones are (re)computed;
 * a local Dask cluster (``workers`` processes, one thread each; or threads in this process
   with ``processes=False``) is started unless a scheduler address is given, and closed at
-  the end; ``workers=0`` runs in this process without Dask (debugging, profiling);
+  the end; ``pool="processes"`` runs the conditions on ``workers`` processes forked from a
+  forkserver that has imported the runner once instead (:func:`_run_pool`); ``workers=0``
+  runs in this process without Dask (debugging, profiling);
 * results are collected with ``as_completed`` and written by the client at once, one
   netCDF file per condition, atomically; a failing condition (runner exception, a result
   that breaks the summary contract, a lost worker) is recorded with its error and
