@@ -569,68 +569,125 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     ``insert_profile``: optional :class:`robobore.cutting.geometry.BoringInsert` used to draw
     the machined bore profile along the feed (nose geometry + the tool's radial and axial
     position at each pass). Without it the surface record is the chip-normal displacement.
+    The run is a :class:`TimeDomainRun` (which can be continued).
     """
-    settings.check()
-    process = process.at_depth(settings.depth_m)  # the chip geometry at the simulated depth
-    N = int(process.n_inserts)
-    Ns = settings.samples_per_rev or auto_samples_per_rev(structure, settings.speed_rpm, N)
-    Ns = int(math.ceil(Ns / N) * N)
-    n_steps = int(settings.revolutions) * Ns
-    from robobore.io.memory import check_timedomain
+    return TimeDomainRun(structure, process, settings, insert_profile).dataset()
 
-    check_timedomain(int(settings.revolutions), Ns, N)  # before the arrays are allocated
-    dt = 60.0 / (settings.speed_rpm * Ns)
-    Phi, Gam = modal_zoh(structure, dt)
-    theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # directions at the step midpoints
-    basis = np.ascontiguousarray(process.basis(theta))
-    a = settings.depth_m
-    w = process.width_per_depth * a
-    ds = process.edge_per_depth * a
-    inv_depth = 1.0 / a if np.any(process.depth_direction) else 0.0
-    m = structure.n_modes
-    spp = Ns // N
-    r_forced = None
-    if settings.start == "periodic":
-        q, qd, sr, r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
-        pert = settings.perturbation_m
-        if pert is None:
-            pert = 0.01 * float(np.max(process.h0))
-        q = q + pert
-    else:
-        q = np.zeros(m)
-        qd = np.zeros(m)
-        sr = np.zeros((Ns, 3))
-    limit = settings.divergence_limit_m
-    if limit is None:
-        if r_forced is None:
-            r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)[3]
-        limit = DIVERGENCE_FLOOR_M + DIVERGENCE_FORCED_FACTOR * float(np.abs(r_forced).max())
-    tlast = np.full(Ns, -spp, dtype=np.int64)
-    F = np.empty((n_steps, 3))
-    X = np.empty((n_steps, 3))
-    acc = np.empty((n_steps, 3))
-    area = np.empty((n_steps, N))
-    n_done = _simulate_kernel(n_steps, Ns, N, Phi, Gam,
-                              np.ascontiguousarray(structure.directions), basis, process.h0, w,
-                              ds, np.ascontiguousarray(process.edge_fixed_m, dtype=np.float64),
-                              process.normal, process.shear, process.edge,
-                              process.depth_direction, inv_depth, process.overlap,
-                              structure.omega, structure.damping_ratio,
-                              1.0 / structure.modal_mass, 0.5 * dt, q, qd, sr, tlast, F, X, acc,
-                              area, float(limit))
-    diverged = n_done < n_steps
-    revs = int(settings.revolutions)
-    if diverged:
-        revs = n_done // Ns  # keep the whole revolutions before the divergence
-        if revs < 1:
-            raise NumericalError(
-                f"the tool-point displacement exceeded {limit * 1e3:.3g} mm"
-                f" within the first revolution (t = {n_done * dt:.4g} s): the cut diverges at "
-                "once; check the structure (stiffness, mass) and the cutting coefficients")
+
+class TimeDomainRun:
+    """A time-domain run (:func:`simulate`) that can be continued: :meth:`extend` integrates
+    more revolutions from where the run stopped (the modal state, the surface left at each
+    angle and when it was cut), so that a run of ``R`` revolutions extended by ``R'`` is the
+    run of ``R + R'`` revolutions, digit for digit, at the cost of the ``R'`` new ones.
+    :meth:`dataset` is the Dataset of the revolutions integrated so far."""
+
+    def __init__(self, structure: ToolPointStructure, process: CuttingProcess,
+                 settings: SimulationSettings, insert_profile=None) -> None:
+        settings.check()
+        process = process.at_depth(settings.depth_m)  # the chip geometry at the depth
+        N = int(process.n_inserts)
+        Ns = settings.samples_per_rev or auto_samples_per_rev(structure, settings.speed_rpm, N)
+        Ns = int(math.ceil(Ns / N) * N)
+        self.structure, self.process, self.insert_profile = structure, process, insert_profile
+        self.settings, self.N, self.Ns = settings, N, Ns
+        self.dt = 60.0 / (settings.speed_rpm * Ns)
+        self.Phi, self.Gam = modal_zoh(structure, self.dt)
+        theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # directions at the step midpoints
+        self.basis = np.ascontiguousarray(process.basis(theta))
+        a = settings.depth_m
+        m = structure.n_modes
+        r_forced = None
+        if settings.start == "periodic":
+            q, qd, sr, r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
+            pert = settings.perturbation_m
+            if pert is None:
+                pert = 0.01 * float(np.max(process.h0))
+            q = q + pert
+        else:
+            q = np.zeros(m)
+            qd = np.zeros(m)
+            sr = np.zeros((Ns, 3))
+        limit = settings.divergence_limit_m
+        if limit is None:
+            if r_forced is None:
+                r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)[3]
+            limit = DIVERGENCE_FLOOR_M + DIVERGENCE_FORCED_FACTOR * float(np.abs(r_forced).max())
+        self.limit = float(limit)
+        self.q, self.qd, self.sr = q, qd, sr
+        self.tlast = np.full(Ns, -(Ns // N), dtype=np.int64)  # step of the last cut, per angle
+        self.n_steps = 0  # steps integrated
+        self.n_done = 0  # steps done before a divergence (= n_steps without one)
+        self.revolutions = 0  # revolutions asked for
+        self.F = np.empty((0, 3))
+        self.X = np.empty((0, 3))
+        self.acc = np.empty((0, 3))
+        self.area = np.empty((0, N))
+        self.extend(int(settings.revolutions))
+
+    @property
+    def diverged(self) -> bool:
+        return self.n_done < self.n_steps
+
+    def extend(self, revolutions: int) -> None:
+        """Integrate ``revolutions`` more (nothing once the run has diverged)."""
+        from robobore.io.memory import check_timedomain
+
+        if self.diverged:
+            return
+        Ns, N, st, pr = self.Ns, self.N, self.structure, self.process
+        total = self.revolutions + int(revolutions)
+        check_timedomain(total, Ns, N)  # before the arrays are allocated
+        n = int(revolutions) * Ns
+        F = np.empty((n, 3))
+        X = np.empty((n, 3))
+        acc = np.empty((n, 3))
+        area = np.empty((n, N))
+        a = self.settings.depth_m
+        tl = self.tlast - self.n_steps  # the kernel counts steps from 0
+        inv_depth = 1.0 / a if np.any(pr.depth_direction) else 0.0
+        done = _simulate_kernel(n, Ns, N, self.Phi, self.Gam, np.ascontiguousarray(st.directions),
+                                self.basis, pr.h0, pr.width_per_depth * a, pr.edge_per_depth * a,
+                                np.ascontiguousarray(pr.edge_fixed_m, dtype=np.float64),
+                                pr.normal, pr.shear, pr.edge, pr.depth_direction, inv_depth,
+                                pr.overlap, st.omega, st.damping_ratio, 1.0 / st.modal_mass,
+                                0.5 * self.dt, self.q, self.qd, self.sr, tl, F, X, acc, area,
+                                self.limit)
+        self.tlast = tl + self.n_steps
+        self.n_done = self.n_steps + int(done)
+        self.n_steps += n
+        self.revolutions = total
+        parts = [(self.F, F), (self.X, X), (self.acc, acc), (self.area, area)]
+        self.F, self.X, self.acc, self.area = (
+            new[:done] if old.shape[0] == 0 else np.concatenate([old, new[:done]])
+            for old, new in parts)
+
+    def dataset(self) -> xr.Dataset:
+        """The Dataset of the run so far (:func:`simulate`)."""
+        Ns, n_done, limit = self.Ns, self.n_done, self.limit
+        revs = self.revolutions
+        if self.diverged:
+            revs = n_done // Ns  # keep the whole revolutions before the divergence
+            if revs < 1:
+                raise NumericalError(
+                    f"the tool-point displacement exceeded {limit * 1e3:.3g} mm"
+                    f" within the first revolution (t = {n_done * self.dt:.4g} s): the cut "
+                    "diverges at once; check the structure (stiffness, mass) and the cutting "
+                    "coefficients")
         n_steps = revs * Ns
-        F, X, acc, area = F[:n_steps], X[:n_steps], acc[:n_steps], area[:n_steps]
-    if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
-        raise NumericalError("the simulation produced non-finite values (unstable integration)")
+        F, X = self.F[:n_steps], self.X[:n_steps]
+        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
+            raise NumericalError("the simulation produced non-finite values (unstable "
+                                 "integration)")
+        return _run_dataset(self, F, X, self.acc[:n_steps], self.area[:n_steps], revs, n_steps)
+
+
+def _run_dataset(run: TimeDomainRun, F: np.ndarray, X: np.ndarray, acc: np.ndarray,
+                 area: np.ndarray, revs: int, n_steps: int) -> xr.Dataset:
+    """The Dataset of ``run``'s first ``revs`` whole revolutions (:func:`simulate`)."""
+    settings, process, Ns, N, dt = run.settings, run.process, run.Ns, run.N, run.dt
+    insert_profile = run.insert_profile
+    a = settings.depth_m
+    diverged, n_done, limit = run.diverged, run.n_done, run.limit
     t = np.arange(n_steps) * dt
     th_rev = 2 * np.pi * np.arange(Ns) / Ns  # the insert's angle, the same every revolution
     c_rev, s_rev = np.cos(th_rev), np.sin(th_rev)
@@ -660,7 +717,7 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
         attrs={"speed_rpm": settings.speed_rpm, "depth_m": a, "revolutions": revs,
                "samples_per_rev": Ns, "n_inserts": N, "dt_s": dt, "overlap": process.overlap,
                "feed_per_rev_m": process.feed_per_rev_m, "process": process.label,
-               "diverged": int(diverged), "revolutions_requested": int(settings.revolutions),
+               "diverged": int(diverged), "revolutions_requested": int(run.revolutions),
                "diverged_at_s": n_done * dt if diverged else math.nan,
                "divergence_limit_m": float(limit),
                "frame": "boring frame: x horizontal, y vertical, z feed (bore axis)"},
@@ -769,6 +826,6 @@ def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, 
     }
 
 
-__all__ = ["simulate", "SimulationSettings", "DIVERGENCE_FLOOR_M", "DIVERGENCE_FORCED_FACTOR", "modal_zoh", "auto_samples_per_rev",
+__all__ = ["simulate", "TimeDomainRun", "SimulationSettings", "DIVERGENCE_FLOOR_M", "DIVERGENCE_FORCED_FACTOR", "modal_zoh", "auto_samples_per_rev",
            "periodic_start", "forced_response", "periodic_orbit", "nominal_cut_deflection",
            "surface_profile", "roughness", "summarize", "FORM_DEGREE"]
