@@ -583,3 +583,28 @@ def test_study_pool_gives_the_serial_study(small_run, tmp_path):
     assert pa == pb
     assert [w for w in pooled["warnings"] if not w.startswith("posture plan")] == \
         [w for w in serial["warnings"] if not w.startswith("posture plan")]
+
+
+def test_paper_and_compare_outputs_hold_no_contradiction(small_run):
+    """paper_summary.json (with its comparison, lobe check and posture plan) and every
+    condition's record hold no contradictory verdicts (robobore.io.consistency)."""
+    from robobore.io.consistency import contradictions
+    from robobore.study.store import ResultsStore
+
+    res, out, _ = small_run
+    assert contradictions(res) == []
+    assert res["comparison"] is not None and contradictions(res["comparison"]) == []
+    store = ResultsStore(out / "sweep")
+    for key in store.done_keys():
+        ds = store.load(key)
+        rec = {"chatter": bool(int(ds["chatter"])),
+               "stable": None if "stable" not in ds else bool(int(ds["stable"])),
+               "tool_leaves_cut": bool(int(ds["tool_leaves_cut"])),
+               "tool_left_cut_fraction": float(ds.attrs["tool_left_cut_fraction"]),
+               "surface_finish": None if "surface_finish_ok" not in ds else (
+                   "ok" if int(ds["surface_finish_ok"]) else "rough"),
+               "chatter_frequency_Hz": (None if ds.attrs["chatter_frequency_Hz"] < 0
+                                        else float(ds.attrs["chatter_frequency_Hz"])),
+               "diverged": bool(int(ds.attrs.get("diverged", 0))),
+               "reasons": ds.attrs["reasons"]}
+        assert contradictions(rec, key) == []
