@@ -262,7 +262,7 @@ def test_rotating_bar_semidiscretization_vs_time_domain():
     """Rotating boring bar (time-periodic directions) on a stiff, machine-tool-like structure
     where the static deflection is a negligible part of the depth: the semi-discretised
     (Floquet) critical depth separates decaying (0.9 x) from growing (1.1 x) simulations."""
-    from robobore.cutting.forces import ti64_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
     from robobore.dynamics.stability import critical_depth_semidiscretization
 
     st = ToolPointStructure.from_modes([

@@ -25,8 +25,8 @@ from robobore.cutting.fe.config.spec import (
     SlidingSpeedFriction,
     ToolFrame,
     WorkpieceFrame,
-    build_spec,
 )
+from robobore.cutting.fe.config.spec_build import build_spec
 from robobore.cutting.fe.engine import chunk_loop as CL
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state2d import default_prm
@@ -184,8 +184,8 @@ def test_the_boring_spec_and_its_slots():
         HexElement,
         ToolFrame3D,
         WorkpieceFrame3D,
-        build_boring_spec,
     )
+    from robobore.cutting.fe.config.spec_build import build_boring_spec
     from robobore.cutting.fe.engine.state3d import default_prm3
     from robobore.cutting.fe.hex import layout3d
 

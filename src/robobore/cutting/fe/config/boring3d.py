@@ -12,7 +12,7 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from robobore.cutting.fe.config.orthogonal import ContactSection as ContactSection2D
+from robobore.cutting.fe.config.contact import ContactSection as ContactSection2D
 from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.cutting.geometry import BoringInsert
@@ -59,7 +59,7 @@ class CutSection(Strict):
 
 class ContactSection(ContactSection2D):
     """The 2D engine's ``[contact]``
-    (:class:`robobore.cutting.fe.config.orthogonal.ContactSection`): the same keys, values and
+    (:class:`robobore.cutting.fe.config.contact.ContactSection`): the same keys, values and
     defaults -- ``friction`` a bundled friction law (default ``rech2013_calibrated``: the Rech
     et al. 2013 table x 1.5 read at each contact node's filtered sliding speed, no shear cap),
     "table" or a constant Coulomb coefficient; ``friction_velocity``, ``friction_table_*``,
@@ -229,7 +229,7 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
                           field="cut.bore_diameter_mm", value=cfg.cut.bore_diameter_mm,
                           expected=f">= 20 x cut.cut_length_mm = "
                           f"{20 * cfg.cut.cut_length_mm:g} mm")
-    from robobore.cutting.fe.config.spec import build_boring_spec
+    from robobore.cutting.fe.config.spec_build import build_boring_spec
     from robobore.cutting.fe.mesh.memory import check_fe3d
 
     # the model choices: a key the chosen variants have no place for is an error at load

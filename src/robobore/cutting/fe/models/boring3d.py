@@ -223,13 +223,16 @@ def compare_with_mechanistic(result: BoringFEResult,
                              coefficients: str | Path | None = None) -> dict[str, Any]:
     """FE rotating-frame forces vs the mechanistic boring model at the same condition.
 
-    ``coefficients``: a coefficients file (:func:`robobore.cutting.forces.load_coefficients`)
-    -- e.g. the FE-calibrated one -- or None for the default TC4 coefficients
-    (:func:`robobore.cutting.forces.ti64_coefficients` at the run's cutting speed).
+    ``coefficients``: a coefficients file
+    (:func:`robobore.cutting.coefficient_files.load_coefficients`) -- e.g. the FE-calibrated
+    one -- or None for the default TC4 coefficients
+    (:func:`robobore.cutting.coefficient_sets.ti64_coefficients` at the run's cutting speed).
     Returns per component (tangential, radial, feed) the FE and model forces [N] and the
     relative difference (FE - model) / |model|.
     """
-    from robobore.cutting.forces import boring_forces, load_coefficients, ti64_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
+    from robobore.cutting.forces import boring_forces
 
     s = result.setup
     coef = (ti64_coefficients(s.vc * 60.0) if coefficients is None

@@ -33,13 +33,8 @@ from robobore.cutting.fe.config.engine_settings import (
     apply_numerics,
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
-from robobore.cutting.fe.config.spec import (
-    HexElement,
-    ModelSpec,
-    WorkpieceFrame,
-    WorkpieceFrame3D,
-    build_spec,
-)
+from robobore.cutting.fe.config.spec import HexElement, ModelSpec, WorkpieceFrame, WorkpieceFrame3D
+from robobore.cutting.fe.config.spec_build import build_spec
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import energy_error
 from robobore.cutting.fe.engine.state3d import (

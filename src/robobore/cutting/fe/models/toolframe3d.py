@@ -30,11 +30,12 @@ checked from the start of the run).
 from __future__ import annotations
 
 import math
+
 import numpy as np
 
-from robobore.cutting.fe.ale.remap3d import FACES_OUT
+from robobore.cutting.fe.ale.hexvolume3d import FACES_OUT
 from robobore.cutting.fe.config.boring3d import BoringFEConfig
-from robobore.cutting.fe.config.spec import build_boring_spec
+from robobore.cutting.fe.config.spec_build import build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import FEState3, element_steps3, make_state3
 from robobore.cutting.fe.hex import layout3d, scalar3d

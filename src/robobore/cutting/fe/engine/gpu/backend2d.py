@@ -60,7 +60,8 @@ from typing import Any
 
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.engine import layout
-from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, RunState, kernels2
+from robobore.cutting.fe.engine.gpu.kernels2d import kernels2
+from robobore.cutting.fe.engine.gpu.runstate2d import N_RED, RUN_ARRAYS, RunState
 from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
 from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
