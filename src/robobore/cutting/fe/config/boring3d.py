@@ -13,6 +13,7 @@ from typing import Any, Literal
 from pydantic import Field, field_validator, model_validator
 
 from robobore.cutting.fe.config.contact import ContactSection as ContactSection2D
+from robobore.cutting.fe.config.frame import Frame
 from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.cutting.geometry import BoringInsert
@@ -102,7 +103,7 @@ class MeshSection(Strict):
     #: (``depth_factor``, ``side_margin_um``, ``ahead_mm``, ``separation``,
     #: ``separation_height_um``, ``chip_rows``, ``solver.erosion``,
     #: ``solver.separation_gate_um``, ``solver.erode_time_step_fraction``) are an error
-    frame: Literal["workpiece", "tool"] = "tool"
+    frame: Frame = Frame.TOOL
     #: tool frame: element round the edge [um] (None: element_size_um / 4, the 2D model's)
     edge_element_um: float | None = Field(default=None, gt=0.0)
     #: tool frame: largest step between slices along the feed [um] (None: element_size_um)
@@ -222,7 +223,7 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
         raise ConfigError("edge radius not smaller than the nose radius", file=source,
                           field="insert.edge_radius_um", value=cfg.insert.edge_radius_um,
                           expected=f"< {cfg.insert.nose_radius_mm * 1e3:g} um")
-    if cfg.mesh.frame == "tool":
+    if cfg.mesh.frame.is_tool:
         _check_tool_frame(cfg, source)
     if cfg.cut.bore_diameter_mm < 20 * cfg.cut.cut_length_mm:
         raise ConfigError("bore too small for the locally flat wall model", file=source,

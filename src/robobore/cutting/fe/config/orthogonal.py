@@ -22,6 +22,7 @@ from pydantic import (
 )
 
 from robobore.cutting.fe.config.contact import ContactSection
+from robobore.cutting.fe.config.frame import Frame
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
@@ -109,7 +110,7 @@ class MeshSection(Strict):
     #: "tool", ``cut.length_mm`` is the tool's travel, ``edge_element_um`` the element
     #: round the edge (default element_size_um / 4), and the separation keys are an error
     #: (a key the chosen model has no place for is refused: robobore.cutting.fe.config.spec)
-    frame: Literal["workpiece", "tool"] = "tool"
+    frame: Frame = Frame.TOOL
     #: tool frame: chip thickness / h of the pre-shaped chip the run starts from (the
     #: chip's shape then follows from the flow)
     initial_chip_ratio: float = Field(default=1.6, ge=1.0, le=5.0)
@@ -283,7 +284,7 @@ def check_config(cfg: FEConfig, source: str | None = None) -> FEConfig:
                           expected=f"a height in um at most uncut_chip_thickness_um - "
                           f"element_size_um = {h - le:.4g} um (one element row of chip)")
     ee = cfg.mesh.edge_element_um
-    if cfg.mesh.frame == "tool":
+    if cfg.mesh.frame.is_tool:
         return _check_tool_frame(cfg, source)
     if ee is not None:
         if cfg.mesh.separation != "node_split":

@@ -142,7 +142,7 @@ def build_spec(cfg: Any, material: Material, source: str | None = None) -> Model
     workpiece_mesh_keys = ("mesh.fine_depth_factor", "mesh.height_factor", "mesh.grading",
                            "mesh.ahead_mm")
     hourglass = ("solver.hourglass_viscous", "solver.hourglass_stiffness")
-    if cfg.mesh.frame == "tool":
+    if cfg.mesh.frame.is_tool:
         keys.exclude("tool", "mesh.separation", "mesh.separation_layer",
                      "mesh.separation_height_um", "mesh.edge_band_um", *workpiece_mesh_keys,
                      "solver.element",
@@ -222,7 +222,7 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
     tool_keys = ("mesh.edge_element_um", "mesh.slice_spacing_um", "mesh.t_min_um",
                  "mesh.margin_slices", "mesh.initial_chip_ratio", "solver.ale_interval",
                  "solver.thin_element_mass_scaling")
-    if cfg.mesh.frame == "tool":
+    if cfg.mesh.frame.is_tool:
         keys.exclude("tool3d", "mesh.depth_factor", "mesh.side_margin_um", "mesh.ahead_mm",
                      "mesh.separation", "mesh.separation_height_um", "mesh.chip_rows",
                      "solver.erosion", "solver.separation_gate_um",

@@ -123,7 +123,7 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
         mesh = build_toolframe3d_mesh(ins, ap, f, sizes)
     except ValueError as exc:
         raise ConfigError(f"no tool-frame mesh for this insert and cut: {exc}", file=source,
-                          field="mesh.frame", value=m.frame,
+                          field="mesh.frame", value=m.frame.value,
                           expected="an engaged edge that contains the nose tip and a chip that "
                           "stays below the nose's centre in every slice (the tool frame's "
                           "domain, docs/fe3d.md: with the paper's insert, 0.4 mm nose, ap up "
