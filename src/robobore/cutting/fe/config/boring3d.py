@@ -14,7 +14,7 @@ from pydantic import Field, field_validator, model_validator
 
 from robobore.cutting.fe.config.contact import ContactSection as ContactSection2D
 from robobore.cutting.fe.config.frame import Frame
-from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
+from robobore.cutting.fe.config.orthogonal import MaterialSection, ParameterSetConfig
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
@@ -179,7 +179,7 @@ class ToolSupportSection(Strict):
                                       strict=True)]
 
 
-class BoringFEConfig(Strict):
+class BoringFEConfig(ParameterSetConfig):
     #: the 2D engine's switch (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`):
     #: "calibrated" (default) -- friction law "rech2013_calibrated" and the material file's
     #: hardening hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;
@@ -193,13 +193,6 @@ class BoringFEConfig(Strict):
     mesh: MeshSection
     solver: SolverSection = SolverSection()
     tool_support: ToolSupportSection | None = None
-
-    @model_validator(mode="before")
-    @classmethod
-    def _parameter_set(cls, data: Any) -> Any:
-        # the 2D config's rule: the friction law and hardening of ``parameters`` where the
-        # keys are not given
-        return apply_parameter_set(data) if isinstance(data, dict) else data
 
     def friction_law(self) -> str:
         """The friction law in words (:meth:`ContactSection.law_description`)."""

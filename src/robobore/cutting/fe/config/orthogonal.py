@@ -200,7 +200,7 @@ def auto_mass_scaling(cutting_speed_m_per_min: float) -> float:
     return max(1.0, 100.0 * (30.0 / cutting_speed_m_per_min) ** 2)
 
 
-def apply_parameter_set(data: dict[str, Any]) -> dict[str, Any]:
+def _apply_parameter_set(data: dict[str, Any]) -> dict[str, Any]:
     """A raw config dict with the friction law and the hardening of its ``parameters`` set
     ("calibrated", the default, or "a_priori") filled in where ``contact.friction`` and
     ``material.hardening_strain_limit`` are not given (the 2D and the 3D boring configs)."""
@@ -214,7 +214,18 @@ def apply_parameter_set(data: dict[str, Any]) -> dict[str, Any]:
     return data
 
 
-class FEConfig(Strict):
+class ParameterSetConfig(Strict):
+    """The base of the FE configs (2D orthogonal, 3D boring): before validation, the friction
+    law and the hardening of the config's ``parameters`` set are filled in where
+    ``contact.friction`` and ``material.hardening_strain_limit`` are not given."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _parameter_set(cls, data: Any) -> Any:
+        return _apply_parameter_set(data) if isinstance(data, dict) else data
+
+
+class FEConfig(ParameterSetConfig):
     #: "calibrated" (default): the validated model's CALIBRATED choices -- friction law
     #: "rech2013_calibrated" and the material file's hardening hold; "a_priori": the
     #: source's values, nothing chosen against measured forces -- friction law "rech2013"
@@ -236,7 +247,7 @@ class FEConfig(Strict):
             return data
         if not isinstance(data.get("solver", {}), BaseModel):
             data = {**data, "solver": dict(data.get("solver", {}))}
-        return apply_parameter_set(data)
+        return _apply_parameter_set(data)
 
     @model_validator(mode="after")
     def _mass_scaling(self) -> FEConfig:
