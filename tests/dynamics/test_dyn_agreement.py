@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from robobore.dynamics.crosscheck import check_cut, random_cut, run_agrees
+from robobore.errors import NumericalError
 
 
 @pytest.mark.slow
@@ -75,8 +76,14 @@ def test_simulate_boring_never_contradicts_itself(seed, fac):
     cut = random_cut(np.random.default_rng(seed))
     _, ac = chatter_free_window(cut.structure, cut.process(), cut.speed_rpm)
     a = min(0.05, fac * ac) if 0 < ac < math.inf else 0.05e-3
-    ds = simulate(cut.structure, cut.process(a), SimulationSettings(cut.speed_rpm, a, 40),
-                  cut.insert)
+    try:
+        ds = simulate(cut.structure, cut.process(a), SimulationSettings(cut.speed_rpm, a, 40),
+                      cut.insert)
+    except NumericalError as exc:
+        # a run that diverges within its first revolution is an error, not a verdict; it is
+        # right only above the lobes' limit (no chatter-free depth here: ac = 0)
+        assert "diverges at once" in str(exc) and a > ac, (a, ac, str(exc))
+        return
     for tol in (None, 1.6e-6):
         v = classify(ds, ra_tolerance_m=tol)
         diverged = bool(ds.attrs["diverged"])

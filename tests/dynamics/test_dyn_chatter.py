@@ -200,3 +200,19 @@ def test_amplitude_growth_ignores_the_entry_transient_and_beats():
                          0.2 * (transient + decaying)])
     ag = amplitude_growth(X, ns, ns)
     assert ag["radial"] < 1 and ag["feed"] < 1
+
+
+def test_regenerative_pass_is_the_delay_difference():
+    """The compiled pass shared by the chatter measures is r(t) - r(t - tau) by definition:
+    its norm, feed and radial parts and max |r| equal numpy's, bit for bit."""
+    from robobore.dynamics.chatter import regenerative
+
+    X = np.random.default_rng(3).normal(size=(1000, 3)) * 1e-5
+    s = 37
+    r = regenerative(X, s)
+    D = X[s:] - X[:-s]
+    assert np.array_equal(r.d, np.linalg.norm(D, axis=1))
+    assert np.array_equal(r.feed, np.abs(D[:, 2]))
+    assert np.array_equal(r.radial, np.linalg.norm(D[:, :2], axis=1))
+    assert r.xmax == np.abs(X).max()
+    assert regenerative(X[:10], s).d.shape == (0,)

@@ -1,6 +1,6 @@
 """The set-up of the semi-discretisation at a trial depth (the steady deflection and the
-process at that depth) equals the general routines it stands in for: the time domain's
-nominal-cut orbit and the process rebuilt from the chip geometry."""
+process at that depth): the nominal-cut orbit against the dense composition of the
+time-domain map's steps, the process against the chip geometry's edge elements."""
 
 from __future__ import annotations
 
@@ -30,17 +30,67 @@ def structure():
     return ToolPointStructure.from_modes(MODES)
 
 
+def _dense_orbit(structure, pr, speed, Ns, depths):
+    """Reference: the nominal-chip orbit of the time-domain map with each step's full
+    (2m, 2m) matrix from ``process_stiffness`` and the nominal force at each depth from the
+    process arrays, the Ns steps composed densely; displacements (Ns, 3) per depth."""
+    from robobore.dynamics.timedomain import modal_zoh
+
+    m = structure.n_modes
+    dt = 60.0 / (speed * Ns)
+    Phi, Gam = modal_zoh(structure, dt)
+    D = structure.directions
+    theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns
+    Pm = np.einsum("jo,noi,ki->njk", D, pr.process_stiffness(theta), D)
+    A0 = np.zeros((2 * m, 2 * m))
+    for j in range(m):
+        A0[np.ix_([j, m + j], [j, m + j])] = Phi[j]
+    G = np.zeros((2 * m, m))
+    G[np.arange(m), np.arange(m)] = Gam[:, 0]
+    G[m + np.arange(m), np.arange(m)] = Gam[:, 1]
+    S = np.hstack([np.eye(m), 0.5 * dt * np.eye(m)])  # q + half_dt q'
+    out = []
+    for a in depths:
+        f0 = ((pr.width_per_depth * a * pr.h0) @ pr.shear
+              + (pr.edge_per_depth * a + pr.edge_fixed_m) @ pr.edge)
+        F = np.zeros((Ns, 3))
+        for p in range(pr.n_inserts):
+            F += np.einsum("nki,k->ni", pr.basis(theta + 2 * np.pi * p / pr.n_inserts), f0)
+        As = [A0 + G @ Pm[i] @ S for i in range(Ns)]
+        bs = [G @ (D @ F[i]) for i in range(Ns)]
+        T, c = np.eye(2 * m), np.zeros(2 * m)
+        for A, b in zip(As, bs, strict=True):
+            T, c = A @ T, A @ c + b
+        x = np.linalg.solve(np.eye(2 * m) - T, c)
+        r = np.empty((Ns, 3))
+        for i in range(Ns):
+            r[i] = x[:m] @ D
+            x = As[i] @ x + bs[i]
+        out.append(r)
+    return out
+
+
 @pytest.mark.parametrize("n_inserts", [1, 2, 3])
 @pytest.mark.parametrize("depth_m", [0.2e-3, 0.7e-3, 3.0e-3])
-def test_deflection_kernel_is_the_time_domain_orbit(structure, n_inserts, depth_m):
+def test_nominal_cut_orbit_is_the_dense_map_orbit(structure, n_inserts, depth_m):
+    """The compiled orbit (rank-one steps) equals the orbit of the dense step matrices, through
+    the time domain's nominal_cut_deflection and periodic_orbit and the lobes' steady
+    deflection."""
+    from robobore.dynamics.timedomain import periodic_orbit
+
     ins = BoringInsert(nose_radius_m=0.4e-3, approach_angle_deg=75.0, n_inserts=n_inserts)
     pr = boring_process(ins, ti64_coefficients(), depth_m, 0.15e-3)
+    Ns = int(np.ceil(sd.DEFLECTION_SAMPLES / n_inserts) * n_inserts)
     for speed in (150.0, 433.0, 1100.0):
+        ref_a, ref1, ref0 = _dense_orbit(structure, pr, speed, Ns, (depth_m, 1.0, 0.0))
+        ref1 = ref1 - ref0
         r1, r0 = nominal_cut_deflection(structure, pr, speed, sd.DEFLECTION_SAMPLES)
         q1, q0 = sd._deflection_parts_uncached(structure, pr, speed)
-        assert q1.shape == r1.shape and q0.shape == r0.shape
-        assert np.abs(q1 - r1).max() <= 1e-11 * np.abs(r1).max()
-        assert np.abs(q0 - r0).max() <= 1e-11 * np.abs(r0).max()
+        for got, ref in ((r1, ref1), (r0, ref0), (q1, ref1), (q0, ref0)):
+            assert got.shape == ref.shape
+            assert np.abs(got - ref).max() <= 1e-11 * np.abs(ref).max()
+        r_t = periodic_orbit(structure, pr, Ns, depth_m, speed)[3]
+        assert np.abs(r_t - ref_a).max() <= 1e-11 * np.abs(ref_a).max()
 
 
 def test_deflection_without_trailing_edge_has_no_fixed_part(structure):
@@ -54,7 +104,8 @@ def test_deflection_without_trailing_edge_has_no_fixed_part(structure):
 
 def _process_from_edge_elements(ins, c, depth_m, feed_m, trailing):
     """The process arrays of :func:`boring_process` formed from
-    :func:`robobore.cutting.geometry.edge_elements` (the reference the compiled pass follows)."""
+    :func:`robobore.cutting.geometry.edge_elements` with numpy (the coefficients, chip widths
+    above the minimum chip thickness and trailing-side edge lengths)."""
     from robobore.cutting.geometry import edge_elements
 
     el = edge_elements(ins, depth_m, feed_m / ins.n_inserts, 24, trailing_edge=trailing,
@@ -78,7 +129,7 @@ def _process_from_edge_elements(ins, c, depth_m, feed_m, trailing):
 @pytest.mark.parametrize("trailing", [True, False])
 def test_process_elements_are_the_edge_elements(kappa_deg, end_deg, feed_m, trailing):
     """Depths inside the nose and beyond it, feeds whose trailing contact ends on the arc and
-    on the straight minor edge, 1 and 3 inserts: the same elements as edge_elements."""
+    on the straight minor edge, 1 and 3 inserts: the process arrays formed from edge_elements."""
     c = ti64_coefficients()
     for n_ins in (1, 3):
         ins = BoringInsert(nose_radius_m=0.4e-3, approach_angle_deg=kappa_deg,
@@ -90,6 +141,17 @@ def test_process_elements_are_the_edge_elements(kappa_deg, end_deg, feed_m, trai
                 got = getattr(pr, name)
                 assert got.shape == v.shape, name
                 assert np.abs(got - v).max() <= 1e-13 * max(np.abs(v).max(), 1e-300), name
+
+
+def test_process_without_minimum_chip_thickness_keeps_the_trailing_side_chipless():
+    """With no minimum chip thickness every leading element carries a chip width, and the
+    rubbing-only trailing elements (h = 0) still none."""
+    ins = BoringInsert(nose_radius_m=0.8e-3, approach_angle_deg=75.0)
+    pr = boring_process(ins, ti64_coefficients(), 1e-3, 0.2e-3, min_chip_thickness_m=0.0)
+    tr = pr.edge_fixed_m > 0
+    assert tr.sum() >= 1 and np.all(pr.width_per_depth[tr] == 0.0)
+    assert np.all(pr.width_per_depth[~tr] == pr.edge_per_depth[~tr])
+    assert np.all(pr.edge_per_depth[tr] == 0.0)
 
 
 def test_process_at_depth_keeps_the_geometry_and_label():

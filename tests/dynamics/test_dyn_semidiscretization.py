@@ -204,21 +204,6 @@ def test_model_given_twice_is_refused(tmp_path):
     assert r.exit_code == 2 and "given twice" in r.output
 
 
-@pytest.mark.parametrize("scale", [0.1, 3.0, 100.0, 1.0e4])
-def test_step_matrices_batch_equal_the_augmented_exponential(scale):
-    """The numba Taylor/doubling step matrices equal scipy's expm of the augmented matrix
-    (Van Loan) to 1e-12 relative, from small to large ``||L dt||``."""
-    from robobore.dynamics.semidiscretization import _step_matrices, _step_matrices_batch
-
-    rng = np.random.default_rng(7)
-    L = rng.standard_normal((20, 6, 6)) * scale
-    ref = _step_matrices(L, 1e-3)
-    out = [np.empty_like(L) for _ in range(3)]
-    _step_matrices_batch(L, 1e-3, *out)
-    for a, b in zip(ref, out, strict=True):
-        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a))
-
-
 def test_arpack_and_dense_spectral_radius_agree():
     """Large monodromy matrices go to ARPACK: the spectral radius equals the dense one."""
     from robobore.dynamics import semidiscretization as S

@@ -302,3 +302,27 @@ def test_robot_boring_semidiscretization_vs_time_domain(speed):
         # the simulated cut's growth per revolution is the lobes' spectral radius
         assert v.chatter is chatter and v.chatter_decided
         assert v.floquet_multiplier == pytest.approx(rho, abs=2e-3)
+
+
+@pytest.mark.parametrize("depth_mm", [0.3, 3.0])
+def test_a_continued_run_is_the_longer_run_digit_for_digit(depth_mm):
+    """TimeDomainRun.extend continues from the modal state, the surface and when each angle
+    was cut: R revolutions extended by R are the 2R-revolution run, every sample equal (a
+    decaying and a diverging cut)."""
+    from robobore.cutting.forces import ti64_coefficients
+    from robobore.dynamics.timedomain import SimulationSettings, TimeDomainRun, simulate
+
+    st = ToolPointStructure.from_modes([
+        {"frequency_Hz": 40.0, "damping_ratio": 0.03, "stiffness_N_per_m": 2e6,
+         "direction": [1, 0, 0]},
+        {"frequency_Hz": 55.0, "damping_ratio": 0.02, "stiffness_N_per_m": 3e6,
+         "direction": [0, 1, 0]}])
+    pr = boring_process(BoringInsert(), ti64_coefficients(30.0), depth_mm * 1e-3, 0.15e-3)
+    s1 = SimulationSettings(600.0, depth_mm * 1e-3, 12, 240)
+    run = TimeDomainRun(st, pr, s1)
+    run.extend(12)
+    cont = run.dataset()
+    full = simulate(st, pr, SimulationSettings(600.0, depth_mm * 1e-3, 24, 240))
+    assert cont.attrs == full.attrs
+    for name in full.data_vars:
+        assert np.array_equal(cont[name].values, full[name].values, equal_nan=True), name

@@ -263,3 +263,22 @@ def test_link_bending_model_consistent_and_optional():
     assert np.all(np.diag(pm.compliance[0]) > np.diag(p0.compliance[0]))
     with pytest.raises(InputError):
         PoseModel(rb, S.TRUTH_JOINT_K, S.TRUTH_JOINT_C, link_bending=(LinkBending(2, (-1, 0)),))
+
+
+def test_several_speed_ranges_in_one_pass_are_each_range_alone():
+    """critical_depth_ranges (one pass over the frequency grid for several speed ranges) gives
+    each range's critical_depth_range, digit for digit, a one-speed range included."""
+    from robobore.plan.chatter import critical_depth_range, critical_depth_ranges
+
+    rng = np.random.default_rng(5)
+    f = rng.uniform(5, 60, (40, 6))
+    z = rng.uniform(0.01, 0.06, (40, 6))
+    u = rng.normal(size=(40, 6, 3)) * 1e-3
+    A0 = rng.normal(size=(3, 3)) * 1e9
+    ranges = [(300.0, 300.0), (150.0, 1500.0), (1000.0, 3000.0)]
+    b, fch, n = critical_depth_ranges(f, z, u, A0, ranges)
+    for q, (lo, hi) in enumerate(ranges):
+        b1, f1, n1 = critical_depth_range(f, z, u, A0, lo, hi)
+        assert np.array_equal(b[:, q], b1) and np.isfinite(b1).any()
+        assert np.array_equal(fch[:, q], f1, equal_nan=True)
+        assert np.array_equal(n[:, q], n1, equal_nan=True)

@@ -561,3 +561,26 @@ def test_report_figures_units_legends_and_log_scale(small_run):
     assert any("= 0" in t.get_text() for t in trends.legends[0].get_texts())
     for fig in figs:
         plt.close(fig)
+
+
+def test_study_pool_gives_the_serial_study(small_run, tmp_path):
+    """With workers the posture plan, the lobes and the conditions run on the study pool
+    (the main job's route); the summary is the serial study's, up to the run's own records
+    (wall times, where it ran) and the last digits of the lobes (BLAS in other processes)."""
+    serial, _, cfg = small_run
+    pooled = pp.run_paper(cfg, tmp_path / "pooled", fast=True, workers=2).to_dict()
+    assert pooled["sweep"]["mode"].startswith("local process pool")
+    drop = ("timings_s", "wall_time_s", "out", "report", "sweep", "workers", "warnings",
+            "lobe_consistency", "posture_plan")
+    assert {k: v for k, v in pooled.items() if k not in drop} == \
+        {k: v for k, v in serial.items() if k not in drop}
+    a, b = pooled["lobe_consistency"], serial["lobe_consistency"]
+    assert [c["consistent"] for c in a["conditions"]] == [c["consistent"] for c in b["conditions"]]
+    np.testing.assert_allclose([c["critical_depth_mm"] for c in a["conditions"]],
+                               [c["critical_depth_mm"] for c in b["conditions"]], rtol=1e-9)
+    pa, pb = dict(pooled["posture_plan"]), dict(serial["posture_plan"])
+    pa.pop("wall_time_s", None)
+    pb.pop("wall_time_s", None)
+    assert pa == pb
+    assert [w for w in pooled["warnings"] if not w.startswith("posture plan")] == \
+        [w for w in serial["warnings"] if not w.startswith("posture plan")]

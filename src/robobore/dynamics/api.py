@@ -107,7 +107,8 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
     """
     from robobore.dynamics.chatter import AMPLITUDE_RESOLUTION_M, classify, resolved
-    from robobore.dynamics.timedomain import SimulationSettings, simulate, summarize
+    from robobore.dynamics.timedomain import (SimulationSettings, TimeDomainRun, simulate,
+                                              summarize)
 
     cfg, raw, src = _config(config, source, equivalent)
     if feed_mm_per_rev is not None:
@@ -154,24 +155,27 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     tol = cfg.simulation.ra_tolerance_um
     ins = cfg.insert.to_insert() if cfg.is_boring else None
     extend = revolutions is None and cfg.simulation.extend_undecided
-    ds, v = None, None
-    run_revs = int(revs)
+    run = None
     while True:
         try:
-            ds = simulate(st, pr, SimulationSettings(float(n), a * 1e-3, run_revs, int(nspr)),
-                          ins)
+            if run is None:
+                run = TimeDomainRun(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs),
+                                                               int(nspr)), ins)
+            else:  # continued: the run of twice the revolutions, paying only the new ones
+                run.extend(run.revolutions)
         except ConfigError as exc:  # a settings error (size guard): name the config file
             if exc.file is None and src is not None:
                 raise ConfigError(exc.message, file=src, field=exc.field, value=exc.value,
                                   expected=exc.expected) from None
             raise
+        ds = run.dataset()
         v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
         # near the stability limit the growth per pitch is within its uncertainty of 1:
         # lengthen the run (up to UNDECIDED_MAX_FACTOR x) before saying so
-        if v.chatter_decided or not extend or run_revs >= UNDECIDED_MAX_FACTOR * int(revs):
+        if v.chatter_decided or not extend or \
+                run.revolutions >= UNDECIDED_MAX_FACTOR * int(revs):
             break
-        run_revs *= 2
-    revs = run_revs
+    revs = run_revs = run.revolutions
     # where the tool leaves the cut the force is not smooth in the displacement and the
     # verdict can depend on where the steps fall: the same run at twice the samples per
     # revolution must agree, or the verdict is undecided (said, with both verdicts)

@@ -52,36 +52,79 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import xarray as xr
+from numba import njit
 
 
-def vibration_growth(displacement: np.ndarray, samples_per_delay: int) -> float:
+class Regenerative(NamedTuple):
+    """The regenerative displacement ``r(t) - r(t - tau)`` of a run, once: its norm ``d``,
+    feed (z) part ``feed`` (absolute) and radial (x, y) part ``radial`` (norms), each
+    (n_samples - samples_per_delay,) [m], and ``xmax`` = max ``|displacement|`` [m]."""
+
+    d: np.ndarray
+    feed: np.ndarray
+    radial: np.ndarray
+    xmax: float
+
+
+@njit(cache=True)
+def _regenerative_kernel(X, s, d, feed, radial):  # pragma: no cover - numba
+    xmax = 0.0
+    for i in range(X.shape[0]):
+        for c in range(3):
+            a = abs(X[i, c])
+            if a > xmax:
+                xmax = a
+    for i in range(X.shape[0] - s):
+        ex = X[i + s, 0] - X[i, 0]
+        ey = X[i + s, 1] - X[i, 1]
+        ez = X[i + s, 2] - X[i, 2]
+        exy = ex * ex + ey * ey
+        d[i] = math.sqrt(exy + ez * ez)
+        feed[i] = abs(ez)
+        radial[i] = math.sqrt(exy)
+    return xmax
+
+
+def regenerative(displacement: np.ndarray, samples_per_delay: int) -> Regenerative:
+    """:class:`Regenerative` of ``displacement`` (n_samples, 3) [m] over one delay of
+    ``samples_per_delay`` samples (one compiled pass shared by the chatter measures)."""
+    X = np.ascontiguousarray(displacement, dtype=float)
+    s = int(samples_per_delay)
+    n = max(X.shape[0] - s, 0)
+    d, feed, radial = np.empty(n), np.empty(n), np.empty(n)
+    xmax = float(_regenerative_kernel(X, s, d, feed, radial)) if X.size else 0.0
+    return Regenerative(d, feed, radial, xmax)
+
+
+def vibration_growth(displacement: np.ndarray, samples_per_delay: int,
+                     regen: Regenerative | None = None) -> float:
     """Growth of the envelope of ``|r(t) - r(t - tau)|``: its maximum over the last delay
     period over the smallest per-delay maximum of the first half of the run.
 
     Measured from the quietest point of the first half, not from the first delay, so that
     the decay of the entry transient does not hide growth that follows it, and vibration
     that grew and then saturated (the tool leaving the cut) still reads as grown.
-    ``displacement``: (n_samples, 3) [m]. Returns 0 when the last envelope is at round-off
+    ``displacement``: (n_samples, 3) [m]; ``regen``: its :func:`regenerative` when already
+    computed. Returns 0 when the last envelope is at round-off
     level (:data:`ROUNDOFF`), i.e. the motion repeats every delay.
     """
-    X = np.asarray(displacement, float)
     s = int(samples_per_delay)
-    if X.shape[0] < 3 * s:
+    if np.shape(displacement)[0] < 3 * s:
         return math.nan
-    d = np.linalg.norm(X[s:] - X[:-s], axis=1)
-    return _growth(d, s, X)
+    r = regen if regen is not None else regenerative(displacement, s)
+    return _growth(r.d, s, r.xmax)
 
 
-def _growth(d: np.ndarray, period: int, X: np.ndarray) -> float:
+def _growth(d: np.ndarray, period: int, xmax: float) -> float:
     """Last period's maximum of ``d`` over the smallest period maximum of the first half."""
     n = d.shape[0] // period
     peaks = d[:n * period].reshape(n, period).max(axis=1)
     first_half = peaks[:max(1, n // 2)]
-    return _ratio(float(first_half.min()), float(d[-period:].max()), X)
+    return _ratio(float(first_half.min()), float(d[-period:].max()), xmax)
 
 
 #: Relative floor of the regenerative displacement: below ``ROUNDOFF x max |displacement|``
@@ -89,8 +132,8 @@ def _growth(d: np.ndarray, period: int, X: np.ndarray) -> float:
 ROUNDOFF = 1e-9
 
 
-def _ratio(first: float, last: float, X: np.ndarray) -> float:
-    floor = ROUNDOFF * float(np.abs(X).max()) if X.size else 0.0
+def _ratio(first: float, last: float, xmax: float) -> float:
+    floor = ROUNDOFF * xmax
     if last <= floor:
         return 0.0
     return float(last / max(first, floor)) if max(first, floor) > 0 else math.inf
@@ -116,7 +159,8 @@ def resolved(amplitude_m: float) -> bool:
 
 def floquet_multiplier(displacement: np.ndarray, samples_per_delay: int,
                        tail_fraction: float = 0.5, min_delays: int = 6,
-                       linear_limit_m: float | None = None) -> tuple[float, float, int]:
+                       linear_limit_m: float | None = None,
+                       regen: Regenerative | None = None) -> tuple[float, float, int]:
     """Growth per delay of the regenerative displacement: ``(rho, se_ln_rho, delays)``.
 
     ``d(t) = |r(t) - r(t - tau)|`` (``tau`` = ``samples_per_delay`` samples) decays or grows as
@@ -135,15 +179,14 @@ def floquet_multiplier(displacement: np.ndarray, samples_per_delay: int,
     modulation and the chip thickness are no longer small perturbations and its growth slows
     down); the run is then fitted only up to the first delay whose maximum exceeds the limit
     (the last ``tail_fraction`` of those delays), so that the estimate is the linear cut's
-    multiplier."""
-    X = np.asarray(displacement, float)
+    multiplier. ``regen``: the :func:`regenerative` displacement when already computed."""
     s = int(samples_per_delay)
-    n = X.shape[0] // s - 1
+    n = np.shape(displacement)[0] // s - 1
     if n < min_delays + 1:
         return math.nan, math.nan, 0
-    d = np.linalg.norm(X[s:(n + 1) * s] - X[:n * s], axis=1)
-    pk = d.reshape(n, s).max(axis=1)
-    floor = FLOQUET_FLOOR * float(np.abs(X).max()) if X.size else 0.0
+    r = regen if regen is not None else regenerative(displacement, s)
+    pk = r.d[:n * s].reshape(n, s).max(axis=1)
+    floor = FLOQUET_FLOOR * r.xmax
     if linear_limit_m is not None and linear_limit_m > 0.0:
         over = np.nonzero(pk > linear_limit_m)[0]
         if over.size and over[0] >= min_delays + 1:
@@ -197,24 +240,24 @@ def harmonic_analysis(signal: np.ndarray, fs: float, tooth_freq: float,
 
 
 def amplitude_growth(displacement: np.ndarray, samples_per_rev: int,
-                     samples_per_delay: int) -> dict[str, float]:
+                     samples_per_delay: int, regen: Regenerative | None = None
+                     ) -> dict[str, float]:
     """Growth of the per-revolution amplitude of the regenerative displacement.
 
     ``max |r(t) - r(t - tau)|`` per revolution for the feed (Z) and radial (X, Y) parts of
     ``displacement`` (n_samples, 3) [m]: the last revolution's over the smallest of the first
     half of the run (as :func:`vibration_growth`). Returns ``{"feed", "radial"}``; NaN with
-    fewer than 3 revolutions, 0 when the last amplitude is at round-off level.
+    fewer than 3 revolutions, 0 when the last amplitude is at round-off level. ``regen``:
+    the :func:`regenerative` displacement when already computed.
     """
-    X = np.asarray(displacement, float)
     ns, s = int(samples_per_rev), int(samples_per_delay)
-    revs = X.shape[0] // ns
+    revs = np.shape(displacement)[0] // ns
     if revs < 3:
         return {"feed": math.nan, "radial": math.nan}
-    D = X[s:revs * ns] - X[:revs * ns - s]
-    out = {}
-    for name, d in (("feed", np.abs(D[:, 2])), ("radial", np.linalg.norm(D[:, :2], axis=1))):
-        out[name] = _growth(d, ns, X)
-    return out
+    r = regen if regen is not None else regenerative(displacement, s)
+    m = revs * ns - s
+    return {"feed": _growth(r.feed[:m], ns, r.xmax),
+            "radial": _growth(r.radial[:m], ns, r.xmax)}
 
 
 @dataclass(frozen=True)
@@ -257,12 +300,12 @@ class ChatterVerdict:
         return d
 
 
-def _regenerative_tail(X: np.ndarray, samples_per_delay: int) -> float:
+def _regenerative_tail(regen: Regenerative, samples_per_delay: int) -> float:
     """Largest regenerative displacement ``|r(t) - r(t - tau)|`` over the last delay [m]."""
     s = int(samples_per_delay)
-    if X.shape[0] < 2 * s:
+    if regen.d.shape[0] < s:
         return math.inf
-    return float(np.linalg.norm(X[-s:] - X[-2 * s:-s], axis=1).max())
+    return float(regen.d[-s:].max())
 
 
 def _chip_scale(ds: xr.Dataset, depth: float, n_inserts: int) -> float:
@@ -280,8 +323,9 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
     N = int(ds.attrs["n_inserts"])
     spd = Ns // N
     X = ds["displacement"].values
-    g = vibration_growth(X, spd)
-    ag = amplitude_growth(X, Ns, spd)
+    regen = regenerative(X, spd)
+    g = vibration_growth(X, spd, regen)
+    ag = amplitude_growth(X, Ns, spd, regen)
     fs = 1.0 / float(ds.attrs["dt_s"])
     tooth = float(ds.attrs["speed_rpm"]) / 60.0 * N
     n0 = int(X.shape[0] * (1 - tail_fraction))
@@ -299,7 +343,7 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
              and amp > growth_limit)
     depth = float(ds.attrs.get("depth_m", math.nan))
     rho, se, _ = floquet_multiplier(X, spd, linear_limit_m=(
-        LINEAR_FRACTION * depth if math.isfinite(depth) and depth > 0 else None))
+        LINEAR_FRACTION * depth if math.isfinite(depth) and depth > 0 else None), regen=regen)
     decided = True
     cause = None
     left_cause = None
@@ -309,7 +353,7 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
         reasons.append(f"chatter: vibration diverged (tool-point displacement above "
                        f"{float(ds.attrs['divergence_limit_m']) * 1e3:.3g} mm at "
                        f"t = {float(ds.attrs['diverged_at_s']):.4g} s)")
-    elif left > 0 and (tail := _regenerative_tail(X, spd)) < AMPLITUDE_RESOLUTION_M:
+    elif left > 0 and (tail := _regenerative_tail(regen, spd)) < AMPLITUDE_RESOLUTION_M:
         # the tool leaves the cut, but the motion repeats every insert pitch to below the
         # amplitude resolution: a bounded forced vibration that interrupts the cut, not
         # chatter (growth ratios of sub-resolution values are not findings)
@@ -374,6 +418,6 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
                           rho, se, decided, cause, left_cause if left > 0 else None)
 
 
-__all__ = ["vibration_growth", "amplitude_growth", "harmonic_analysis", "classify",
+__all__ = ["vibration_growth", "regenerative", "Regenerative", "amplitude_growth", "harmonic_analysis", "classify",
            "ChatterVerdict", "floquet_multiplier", "resolved", "FLOQUET_FLOOR",
            "DECISION_SIGMAS", "DECISION_FLOOR", "AMPLITUDE_RESOLUTION_M", "LINEAR_FRACTION"]

@@ -51,7 +51,7 @@ import numba as nb
 import numpy as np
 
 from robobore.cutting.forces import CuttingCoefficients
-from robobore.cutting.geometry import BoringInsert, trailing_intersection
+from robobore.cutting.geometry import BoringInsert, edge_elements
 from robobore.errors import ConfigError
 
 
@@ -265,42 +265,21 @@ def _boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dep
     of the same insert, coefficients, feed and options (:meth:`CuttingProcess.at_depth`).
 
     The elements are those of :func:`robobore.cutting.geometry.edge_elements` (with
-    ``exact_area=False``), computed by :func:`_process_arrays` in one compiled pass: the same
-    element boundaries, 16-point Gauss-Legendre chip areas and trailing-side nodes."""
+    ``exact_area=False``, 16-point Gauss-Legendre chip areas); :func:`_process_arrays` forms
+    the process arrays from them in one compiled pass."""
     fz = feed_per_rev_m / insert.n_inserts
-    _check_range("depth_m", depth_m, 0.05, "m")
-    _check_range("feed_m", fz, 0.01, "m")
-    if int(n_elements) != n_elements or n_elements < 1:
-        raise ConfigError("need at least one element", field="n_elements", value=n_elements,
-                          expected="an integer >= 1")
-    n = int(n_elements)
-    r, k, ke = insert.nose_radius_m, insert.kappa, insert.kappa_end
-    d_arc = r * (1 - math.cos(k))  # arc length of the leading edge down to the depth
-    s_end = (r * math.acos(1 - depth_m / r) if depth_m <= d_arc
-             else r * k + (depth_m - d_arc) / math.sin(k))
-    s_i, n_str, n_arc = 0.0, 0, 0
-    if trailing_edge:  # arc length (< 0) of the trailing contact's end
-        z = -trailing_intersection(insert, depth_m, fz)
-        s_i = (-r * math.asin(min(z / r, 1.0)) if z <= r * math.sin(ke)
-               else -(r * ke + (z - r * math.sin(ke)) / math.cos(ke)))
-        n_t = max(1, round(n * (-s_i) / s_end))
-        s_corner = -r * ke
-        if s_i < s_corner:
-            L_str, L_arc = s_corner - s_i, -s_corner
-            n_str = max(1, round(n_t * L_str / (L_str + L_arc)))
-            n_arc = max(1, n_t - n_str)
-        else:
-            n_arc = n_t
-    E = n + n_str + n_arc
+    # edge_elements refuses a depth, feed per insert or element count out of range by name
+    el = edge_elements(insert, depth_m, fz, n_elements, trailing_edge=trailing_edge,
+                       exact_area=False)
+    E = el.n
     hmin = 0.25 * insert.edge_radius_m if min_chip_thickness_m is None else min_chip_thickness_m
     c = coefficients
-    h0, wpd, epd, efix = np.empty(E), np.empty(E), np.empty(E), np.empty(E)
+    wpd, epd, efix = np.empty(E), np.empty(E), np.empty(E)
     normal, shear, edge = np.empty((E, 3)), np.empty((E, 3)), np.empty((E, 3))
-    xg, wg = _GAUSS_16
-    _process_arrays(r, k, ke, math.isclose(k, math.pi / 2), float(depth_m), float(fz), n,
-                    float(s_end), float(s_i), n_str, n_arc, float(hmin),
-                    np.array([c.Ktc, c.Krc, c.Kfc, c.Kte, c.Kre, c.Kfe], float), xg, wg,
-                    h0, wpd, epd, efix, normal, shear, edge)
+    _process_arrays(el.kappa, el.h, el.db, el.dS, el.n_trailing, float(depth_m), float(hmin),
+                    np.array([c.Ktc, c.Krc, c.Kfc, c.Kte, c.Kre, c.Kfe], float),
+                    wpd, epd, efix, normal, shear, edge)
+    h0 = el.h
     if label is None:
         label = (f"boring bar, {insert.n_inserts} insert(s), nose {insert.nose_radius_m * 1e3:g} "
                  f"mm, kappa_r {insert.approach_angle_deg:g} deg")
@@ -317,106 +296,24 @@ def _boring_process(insert: BoringInsert, coefficients: CuttingCoefficients, dep
         label=label, edge_fixed_m=efix, geometry=geometry)
 
 
-#: 16-point Gauss-Legendre nodes and weights on [-1, 1] (the chip areas of edge_elements)
-_GAUSS_16 = np.polynomial.legendre.leggauss(16)
-
-
-def _check_range(name: str, value: float, hi: float, unit: str) -> None:
-    """``value`` in ``(0, hi]`` or a :class:`~robobore.errors.ConfigError` naming it."""
-    if not (math.isfinite(value) and 0.0 < value <= hi):
-        raise ConfigError("out of range", field=name, value=value,
-                          expected=f"a value in (0.0, {hi}] {unit}")
-
-
-@nb.njit(cache=True, inline="always")
-def _edge_point(s, r, k, ke):  # pragma: no cover - numba
-    """Drop [m] and local approach angle [rad] of the edge point at arc length ``s``
-    (:meth:`robobore.cutting.geometry.BoringInsert.point`)."""
-    if s >= -r * ke and s <= r * k:
-        psi = s / r
-        return r * (1 - math.cos(psi)), psi
-    if s > r * k:
-        t = s - r * k
-        return r * (1 - math.cos(k)) + t * math.sin(k), k
-    t = -s - r * ke
-    return r * (1 - math.cos(ke)) + t * math.sin(ke), -ke
-
-
-@nb.njit(cache=True, inline="always")
-def _profile_width(d, r, k, ke, k90):  # pragma: no cover - numba
-    """Width of the tool profile at drop ``d`` [m] (as ``_width_at_drop`` of
-    :mod:`robobore.cutting.geometry`)."""
-    x = r - min(d, 2 * r)
-    circ = math.sqrt(max(r * r - x * x, 0.0))
-    d_lead, d_trail = r * (1 - math.cos(k)), r * (1 - math.cos(ke))
-    if d <= d_lead:
-        b = circ
-    elif k90:
-        b = r
-    else:
-        b = r * math.sin(k) + (d - d_lead) / math.tan(k)
-    if d <= d_trail:
-        a = -circ
-    else:
-        a = -(r * math.sin(ke) + (d - d_trail) / math.tan(ke))
-    return b - a
-
-
 @nb.njit(cache=True)
-def _process_arrays(r, k, ke, k90, depth, fz, n, s_end, s_i, n_str, n_arc, hmin, K, xg, wg,
-                    h0, wpd, epd, efix, normal, shear, edge):  # pragma: no cover - numba
-    """Element arrays of :func:`_boring_process`, in place, trailing elements first.
-
-    Leading side (``edge_elements``): ``n`` elements of equal arc length from the tip to
-    ``s_end`` (where the edge reaches the pre-bore surface), each with the chip area between
-    its radial levels ``integral min(f, w(d)) dd`` (Gauss-Legendre ``xg``, ``wg``) and
-    ``h = area / dS``; trailing side: from ``s_i`` to the tip, ``n_str`` elements on the
-    straight minor edge and ``n_arc`` on the arc (the corner a node). ``K``: Ktc, Krc, Kfc,
-    Kte, Kre, Kfe."""
-    nt = n_str + n_arc
-    s_corner = -r * ke
-    # trailing nodes: numpy.linspace's i * step + start, the last node set to the stop
-    for j in range(nt):
-        if j < n_str:
-            st = (s_corner - s_i) / n_str
-            a0 = j * st + s_i
-            a1 = s_corner if j + 1 == n_str else (j + 1) * st + s_i
+def _process_arrays(kl, h, db, dS, n_trailing, depth, hmin, K, wpd, epd, efix, normal, shear,
+                    edge):  # pragma: no cover - numba
+    """Process arrays of :func:`_boring_process` from the edge elements (local approach angle
+    ``kl``, chip thickness ``h`` and width ``db``, edge length ``dS``; the first
+    ``n_trailing`` rub only), in place: per unit depth chip widths (0 below ``hmin``) and edge
+    lengths, the trailing side's edge lengths as depth-independent ``efix``, and each
+    element's coefficients (:func:`_element_coefficients`). ``K``: Ktc, Krc, Kfc, Kte, Kre,
+    Kfe."""
+    for j in range(kl.size):
+        wpd[j] = db[j] / depth if h[j] >= hmin else 0.0
+        if j < n_trailing:
+            epd[j] = 0.0
+            efix[j] = dS[j]
         else:
-            i = j - n_str
-            if n_str > 0:
-                st = (0.0 - s_corner) / n_arc
-                a0 = s_corner if i == 0 else i * st + s_corner
-                a1 = 0.0 if i + 1 == n_arc else (i + 1) * st + s_corner
-            else:
-                st = (0.0 - s_i) / n_arc
-                a0 = i * st + s_i
-                a1 = 0.0 if i + 1 == n_arc else (i + 1) * st + s_i
-        _, kl = _edge_point(0.5 * (a1 + a0), r, k, ke)
-        h0[j] = 0.0
-        wpd[j] = 0.0
-        epd[j] = 0.0
-        efix[j] = a1 - a0
-        _element_coefficients(kl, K, normal[j], shear[j], edge[j])
-    step = s_end / n
-    e0 = 0.0
-    d0 = min(_edge_point(0.0, r, k, ke)[0], depth)
-    for i in range(n):
-        e1 = s_end if i + 1 == n else (i + 1) * step + 0.0
-        d1 = depth if i + 1 == n else min(_edge_point(e1, r, k, ke)[0], depth)
-        dS = e1 - e0
-        _, kl = _edge_point(0.5 * (e1 + e0), r, k, ke)
-        acc = 0.0
-        for q in range(xg.size):
-            dq = 0.5 * (d0 + d1) + 0.5 * (d1 - d0) * xg[q]
-            acc += min(fz, _profile_width(dq, r, k, ke, k90)) * wg[q]
-        h = (0.5 * (d1 - d0)) * acc / dS
-        j = nt + i
-        h0[j] = h
-        wpd[j] = dS / depth if h >= hmin else 0.0
-        epd[j] = dS / depth
-        efix[j] = 0.0
-        _element_coefficients(kl, K, normal[j], shear[j], edge[j])
-        e0, d0 = e1, d1
+            epd[j] = dS[j] / depth
+            efix[j] = 0.0
+        _element_coefficients(kl[j], K, normal[j], shear[j], edge[j])
 
 
 @nb.njit(cache=True, inline="always")

@@ -73,8 +73,7 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
 
     ``Lc`` is one (n, n) matrix or a stack (k, n, n); the result has the same leading shape.
     Reference implementation (scipy's Pade expm of the augmented 3n x 3n matrix); the
-    monodromy uses :func:`_step_matrices_modal`; tests compare both compiled kernels with
-    this one."""
+    monodromy uses :func:`_step_matrices_modal`, which a test holds to this one."""
     n = Lc.shape[-1]
     H = np.zeros(Lc.shape[:-2] + (3 * n, 3 * n))
     H[..., :n, :n] = Lc
@@ -82,17 +81,6 @@ def _step_matrices(Lc: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, n
     H[..., n:2 * n, 2 * n:] = np.eye(n)
     E = expm(H * dt)
     return E[..., :n, :n], E[..., :n, n:2 * n], E[..., :n, 2 * n:]
-
-
-@nb.njit(cache=True)
-def _matmul_into(A, B, out):  # pragma: no cover - numba
-    n = A.shape[0]
-    for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for k in range(n):
-                acc += A[i, k] * B[k, j]
-            out[i, j] = acc
 
 
 @nb.njit(cache=True)
@@ -139,104 +127,21 @@ def _balance(L):  # pragma: no cover - numba
 
 
 @nb.njit(cache=True)
-def _step_matrices_batch(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
+def _step_matrices_modal(L, dt, Phi, G0, G1):  # pragma: no cover - numba
+    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n) of the modal
+    system matrices of :func:`_step_coefficients` (``L = [[0, I], [K, C]]``, ``C`` diagonal),
+    in place; ``G0`` and ``G1`` only their last ``m`` columns (k, 2m, m), the ones the delayed
+    term multiplies.
 
     The stack is balanced first by one diagonal similarity of powers of 2 (exact in floating
-    point; Parlett & Reinsch 1969, on the sum of the matrices' moduli): ``L' = D^-1 L D``,
-    whose norm is of the order of the modes' angular frequencies rather than their squares,
-    so that few doublings are needed; then ``Phi = D Phi' D^-1`` and likewise both Gammas
-    (:func:`_step_matrices_taylor` on ``L'``)."""
-    k_n, n, _ = L.shape
-    d = _balance(L)
-    Lb = np.empty_like(L)
-    for q in range(k_n):
-        for i in range(n):
-            for j in range(n):
-                Lb[q, i, j] = L[q, i, j] * d[j] / d[i]
-    _step_matrices_taylor(Lb, dt, Phi, G0, G1)
-    for q in range(k_n):
-        for i in range(n):
-            for j in range(n):
-                sc = d[i] / d[j]
-                Phi[q, i, j] *= sc
-                G0[q, i, j] *= sc
-                G1[q, i, j] *= sc
-
-
-@nb.njit(cache=True)
-def _step_matrices_taylor(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """Phi, Gamma0, Gamma1 of :func:`_step_matrices` for a stack ``L`` (k, n, n), in place.
-
-    Taylor series on ``h = dt / 2^s`` with ``||L h||_1 <= 1/2``, of the lowest degree (at
-    most 16) whose first omitted term is below 1e-17 relative, then ``s`` doublings: ``Phi(2h) = Phi^2``,
-    ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the integral at h)."""
-    k_n, n, _ = L.shape
-    T = np.empty((n, n))
-    A = np.empty((n, n))
-    W1 = np.empty((n, n))
-    W2 = np.empty((n, n))
-    W3 = np.empty((n, n))
-    for q in range(k_n):
-        nrm = 0.0
-        for j in range(n):
-            c = 0.0
-            for i in range(n):
-                c += abs(L[q, i, j])
-            nrm = max(nrm, c)
-        nrm *= dt
-        s = 0
-        if nrm > 0.5:
-            s = int(math.ceil(math.log2(nrm / 0.5)))
-        h = dt / 2.0**s
-        for i in range(n):
-            for j in range(n):
-                A[i, j] = L[q, i, j] * h
-                T[i, j] = 1.0 if i == j else 0.0  # (A)^m / m! accumulated as T
-                Phi[q, i, j] = T[i, j]
-                G0[q, i, j] = T[i, j] * h
-                G1[q, i, j] = T[i, j] * h * h * 0.5
-        nh = nrm / 2.0**s  # ||L h||_1 <= 1/2
-        deg = 16
-        term = nh
-        for j in range(1, 17):  # term = nh^(j+1) / (j+1)!
-            term *= nh / (j + 1)
-            if term < 1e-17:
-                deg = j
-                break
-        for m in range(1, deg + 1):
-            _matmul_into(T, A, W1)  # T <- T A / m  (= A^m / m!)
-            for i in range(n):
-                for j in range(n):
-                    T[i, j] = W1[i, j] / m
-            c0 = h / (m + 1)                  # A^m/(m+1)! = (A^m/m!) / (m+1)
-            c1 = h * h / ((m + 1) * (m + 2))  # A^m/(m+2)! = (A^m/m!) / ((m+1)(m+2))
-            for i in range(n):
-                for j in range(n):
-                    Phi[q, i, j] += T[i, j]
-                    G0[q, i, j] += c0 * T[i, j]
-                    G1[q, i, j] += c1 * T[i, j]
-        for _ in range(s):
-            _matmul_into(Phi[q], G1[q], W1)
-            _matmul_into(Phi[q], G0[q], W2)
-            _matmul_into(Phi[q], Phi[q], W3)
-            for i in range(n):
-                for j in range(n):
-                    G1[q, i, j] = W1[i, j] + h * G0[q, i, j] + G1[q, i, j]
-                    G0[q, i, j] = W2[i, j] + G0[q, i, j]
-                    Phi[q, i, j] = W3[i, j]
-            h *= 2.0
-
-
-@nb.njit(cache=True)
-def _step_matrices_modal(L, dt, Phi, G0, G1):  # pragma: no cover - numba
-    """:func:`_step_matrices_batch` for the modal system matrices of :func:`_step_coefficients`
-    (``L = [[0, I], [K, C]]``, ``C`` diagonal), ``G0`` and ``G1`` only their last ``m``
-    columns (k, 2m, m), the ones the delayed term multiplies.
-
-    The same balancing, Taylor degree and doublings; each Taylor product ``T A`` uses the
-    blocks of ``A = L' h`` (a diagonal upper right and lower right, a full lower left), which
-    the balancing keeps."""
+    point; :func:`_balance`): ``L' = D^-1 L D``, whose norm is of the order of the modes'
+    angular frequencies rather than their squares, so that few doublings are needed. Then a
+    Taylor series on ``h = dt / 2^s`` with ``||L' h||_1 <= 1/2``, of the lowest degree (at
+    most 16) whose first omitted term is below 1e-17 relative, and ``s`` doublings:
+    ``Phi(2h) = Phi^2``, ``G0(2h) = Phi G0 + G0``, ``G1(2h) = Phi G1 + h G0 + G1`` (split the
+    integral at h); finally ``Phi = D Phi' D^-1`` and likewise both Gammas. Each Taylor
+    product ``T A`` uses the blocks of ``A = L' h`` (a diagonal upper right and lower right, a
+    full lower left), which the balancing keeps."""
     k_n, n, _ = L.shape
     m = n // 2
     d = _balance(L)
@@ -369,140 +274,15 @@ def _deflection_parts(structure: ToolPointStructure, process: CuttingProcess,
 
 def _deflection_parts_uncached(structure, process, speed_rpm):
     """:func:`~robobore.dynamics.timedomain.nominal_cut_deflection` at
-    :data:`DEFLECTION_SAMPLES` samples per revolution, by :func:`_deflection_kernel` (the
-    same orbit of the same map, its step matrices and forces formed in the kernel from the
-    process's three-vectors)."""
-    N = int(process.n_inserts)
-    Ns = int(math.ceil(DEFLECTION_SAMPLES / N) * N)
-    Phi, Gam = _zoh(structure, 60.0 / (float(speed_rpm) * Ns))
-    vec = ((process.width_per_depth * process.h0) @ process.shear
-           + process.edge_per_depth @ process.edge)
-    fixed = process.edge_fixed_m @ process.edge
-    out = np.empty((Ns, 3, 2))
-    if not _deflection_kernel(Phi, Gam, np.ascontiguousarray(structure.directions, dtype=float),
-                              np.asarray(process.depth_direction, float), vec, fixed, N,
-                              30.0 / (float(speed_rpm) * Ns), out):
+    :data:`DEFLECTION_SAMPLES` samples per revolution, ``r_0`` None where the process has no
+    depth-independent edge length."""
+    from robobore.dynamics.timedomain import nominal_cut_deflection
+
+    parts = nominal_cut_deflection(structure, process, speed_rpm, DEFLECTION_SAMPLES)
+    if parts is None:
         return None
-    r1 = np.ascontiguousarray(out[:, :, 0])
-    return (r1, np.ascontiguousarray(out[:, :, 1])) if np.any(process.edge_fixed_m) else (
-        r1, None)
-
-
-_ZOH: dict = {}
-
-
-def _zoh(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~robobore.dynamics.timedomain.modal_zoh`, kept per structure (keyed by its
-    values) and step."""
-    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
-           structure.stiffness_N_per_m.tobytes(), float(dt))
-    hit = _ZOH.get(key)
-    if hit is not None:
-        return hit
-    from robobore.dynamics.timedomain import modal_zoh
-
-    out = modal_zoh(structure, dt)
-    if len(_ZOH) > 4096:
-        _ZOH.clear()
-    _ZOH[key] = out
-    return out
-
-
-@nb.njit(cache=True)
-def _deflection_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, out):  # pragma: no cover - numba
-    """Steady nominal-cut tool-point displacement per unit depth and of the depth-independent
-    edge force, ``out`` (Ns, 3, 2), at the step starts ``2 pi i / Ns``: the periodic orbit of
-    the time-domain map on the nominal chip (``robobore.dynamics.timedomain._orbit_kernel``:
-    per mode ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))``, the Ns steps composed,
-    ``x_0 = T x_0 + c``, solved). At the step midpoint ``theta_i`` and insert ``p``
-    (``theta_i + 2 pi p / N``, basis ``B_p``): the depth-modulation stiffness
-    ``Pm_i = sum_p u_p v_p^T`` with ``u_p = D B_p^T vec``, ``v_p = D B_p^T dd``, and the load
-    cases ``Fm_i = sum_p D B_p^T (vec, fixed)``. A step is the per-mode ``Phi`` plus one
-    rank-one term per insert, ``(Gam u_p)(v_p, half_dt v_p)^T``, and is applied as such.
-    False when ``I - T`` is singular (no orbit)."""
-    Ns = out.shape[0]
-    m = D.shape[0]
-    n = 2 * m
-    U = np.zeros((Ns, N, m))
-    Vv = np.zeros((Ns, N, m))
-    Fm = np.zeros((Ns, m, 2))
-    two_pi = 2.0 * math.pi
-    for i in range(Ns):
-        th = two_pi * (i + 0.5) / Ns
-        for p in range(N):
-            tp = th + two_pi * p / N
-            c_, s_ = math.cos(tp), math.sin(tp)
-            # B^T x = x_t e_t + x_r e_r + x_z e_z, e_t = (-s, c, 0), e_r = (c, s, 0)
-            fv0, fv1, fv2 = -s_ * vec[0] + c_ * vec[1], c_ * vec[0] + s_ * vec[1], vec[2]
-            ff0, ff1, ff2 = (-s_ * fixed[0] + c_ * fixed[1], c_ * fixed[0] + s_ * fixed[1],
-                             fixed[2])
-            fe0, fe1, fe2 = -s_ * dd[0] + c_ * dd[1], c_ * dd[0] + s_ * dd[1], dd[2]
-            for j in range(m):
-                u = D[j, 0] * fv0 + D[j, 1] * fv1 + D[j, 2] * fv2
-                U[i, p, j] = u
-                Vv[i, p, j] = D[j, 0] * fe0 + D[j, 1] * fe1 + D[j, 2] * fe2
-                Fm[i, j, 0] += u
-                Fm[i, j, 1] += D[j, 0] * ff0 + D[j, 1] * ff1 + D[j, 2] * ff2
-    # X <- A X + b (X: T (n, n) with b = 0, or c (n, 2) with b = Gam Fm_i)
-    T = np.eye(n)
-    T2 = np.empty((n, n))
-    c = np.zeros((n, 2))
-    c2 = np.empty((n, 2))
-    bt = np.empty(n)
-    bc = np.empty(2)
-    for i in range(Ns):
-        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, T, T2, True, bt)
-        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, c, c2, False, bc)
-        T, T2 = T2, T
-        c, c2 = c2, c
-    M = np.eye(n) - T
-    if abs(np.linalg.det(M)) < 1e-300:
-        return False
-    x = np.ascontiguousarray(np.linalg.solve(M, c))
-    x2 = np.empty((n, 2))
-    for i in range(Ns):
-        for o in range(3):
-            for kk in range(2):
-                acc = 0.0
-                for j in range(m):
-                    acc += x[j, kk] * D[j, o]
-                out[i, o, kk] = acc
-        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, x, x2, False, bc)
-        x, x2 = x2, x
-    return True
-
-
-@nb.njit(cache=True)
-def _orbit_step(Phi, Gam, U, Vv, Fm_i, half_dt, X, Y, homogeneous, w):  # pragma: no cover
-    """``Y = A X`` (``homogeneous``) or ``Y = A X + b`` for one step of
-    :func:`_deflection_kernel`: ``A = blockdiag_j Phi_j + sum_p (Gam u_p)(v_p, half_dt v_p)^T``
-    in the state order ``(q_1..q_m, q'_1..q'_m)``, ``b = Gam Fm_i``; ``w`` (X's columns) is
-    work space."""
-    m = Phi.shape[0]
-    ncol = X.shape[1]
-    for j in range(m):
-        for col in range(ncol):
-            x0 = X[j, col]
-            x1 = X[m + j, col]
-            Y[j, col] = Phi[j, 0, 0] * x0 + Phi[j, 0, 1] * x1
-            Y[m + j, col] = Phi[j, 1, 0] * x0 + Phi[j, 1, 1] * x1
-    for p in range(U.shape[0]):
-        for col in range(ncol):
-            acc = 0.0
-            for k in range(m):
-                acc += Vv[p, k] * (X[k, col] + half_dt * X[m + k, col])
-            w[col] = acc
-        for j in range(m):
-            g0 = Gam[j, 0] * U[p, j]
-            g1 = Gam[j, 1] * U[p, j]
-            for col in range(ncol):
-                Y[j, col] += g0 * w[col]
-                Y[m + j, col] += g1 * w[col]
-    if not homogeneous:
-        for j in range(m):
-            for col in range(ncol):
-                Y[j, col] += Gam[j, 0] * Fm_i[j, col]
-                Y[m + j, col] += Gam[j, 1] * Fm_i[j, col]
+    r1, r0 = parts
+    return (r1, r0) if np.any(process.edge_fixed_m) else (r1, None)
 
 
 def _deflected_weights(parts, process: CuttingProcess, theta: np.ndarray,

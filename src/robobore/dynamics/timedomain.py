@@ -344,73 +344,97 @@ def periodic_start(structure: ToolPointStructure, process: CuttingProcess, Ns: i
 
 
 @nb.njit(cache=True)
-def _step_map(Phi, Gam, Pm_i, Fm_i, half_dt, A, b):  # pragma: no cover - numba
-    """One step of the nominal-chip map (see :func:`_orbit_kernel`) into ``A`` (2m, 2m) and
-    ``b`` (2m, K)."""
-    m = Phi.shape[0]
-    A[:, :] = 0.0
-    for j in range(m):
-        A[j, j] = Phi[j, 0, 0]
-        A[j, m + j] = Phi[j, 0, 1]
-        A[m + j, j] = Phi[j, 1, 0]
-        A[m + j, m + j] = Phi[j, 1, 1]
-        for k in range(m):
-            A[j, k] += Gam[j, 0] * Pm_i[j, k]
-            A[j, m + k] += Gam[j, 0] * Pm_i[j, k] * half_dt
-            A[m + j, k] += Gam[j, 1] * Pm_i[j, k]
-            A[m + j, m + k] += Gam[j, 1] * Pm_i[j, k] * half_dt
-        for c in range(Fm_i.shape[1]):
-            b[j, c] = Gam[j, 0] * Fm_i[j, c]
-            b[m + j, c] = Gam[j, 1] * Fm_i[j, c]
-
-
-@nb.njit(cache=True)
-def _orbit_kernel(Phi, Gam, Pm, Fm, half_dt, X_out):  # pragma: no cover - numba
+def _orbit_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, X_out):  # pragma: no cover - numba
     """Periodic orbits of the discrete map of :func:`_simulate_kernel` on the nominal chip.
 
-    Step ``i``: ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))`` per mode (``Pm``: the
-    depth-modulation stiffness in modal coordinates, (Ns, m, m); ``Fm``: the nominal modal
-    forces, (Ns, m, K), K load cases); the state ``x = (q, q')`` (2m). Composes the Ns steps
-    into ``x_Ns = T x_0 + c``, solves ``x_0 = T x_0 + c`` and writes the orbits' states at the
-    step starts into ``X_out`` (Ns, 2m, K). Returns False when ``I - T`` is singular."""
-    Ns, m, K = Fm.shape
+    Step ``i``: ``x+ = Phi x + Gam (Fm_i + Pm_i (q + half_dt q'))`` per mode, the state
+    ``x = (q_1..q_m, q'_1..q'_m)`` (2m). At the step midpoint ``theta_i = 2 pi (i + 1/2) / Ns``
+    and insert ``p`` (``theta_i + 2 pi p / N``, basis ``B_p``): the depth-modulation stiffness
+    in modal coordinates ``Pm_i = sum_p u_p v_p^T`` with ``u_p = D B_p^T vec``,
+    ``v_p = D B_p^T dd``, and two load cases ``Fm_i = sum_p D B_p^T (vec, fixed)`` (the
+    nominal force per unit depth and the depth-independent edge force). A step is the per-mode
+    ``Phi`` plus one rank-one term per insert, ``(Gam u_p)(v_p, half_dt v_p)^T``, and is applied
+    as such (:func:`_orbit_step`). Composes the Ns steps into ``x_Ns = T x_0 + c``, solves
+    ``x_0 = T x_0 + c`` and writes both orbits' states at the step starts into ``X_out``
+    (2, Ns, 2m), load case first. Returns False when ``I - T`` is singular (no orbit)."""
+    Ns = X_out.shape[1]
+    m = D.shape[0]
     n = 2 * m
-    T = np.eye(n)
-    T2 = np.empty((n, n))
-    c = np.zeros((n, K))
-    c2 = np.empty((n, K))
-    A = np.zeros((n, n))
-    b = np.zeros((n, K))
-    for i in range(Ns):  # T <- A T, c <- A c + b, without allocation
-        _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
-        for r in range(n):
-            for j in range(n):
-                acc = 0.0
-                for k in range(n):
-                    acc += A[r, k] * T[k, j]
-                T2[r, j] = acc
-            for j in range(K):
-                acc = b[r, j]
-                for k in range(n):
-                    acc += A[r, k] * c[k, j]
-                c2[r, j] = acc
-        T, T2 = T2, T
-        c, c2 = c2, c
+    U = np.zeros((Ns, N, m))
+    Vv = np.zeros((Ns, N, m))
+    Fm = np.zeros((Ns, m, 2))
+    two_pi = 2.0 * math.pi
+    for i in range(Ns):
+        th = two_pi * (i + 0.5) / Ns
+        for p in range(N):
+            tp = th + two_pi * p / N
+            c_, s_ = math.cos(tp), math.sin(tp)
+            # B^T x = x_t e_t + x_r e_r + x_z e_z, e_t = (-s, c, 0), e_r = (c, s, 0)
+            fv0, fv1, fv2 = -s_ * vec[0] + c_ * vec[1], c_ * vec[0] + s_ * vec[1], vec[2]
+            ff0, ff1, ff2 = (-s_ * fixed[0] + c_ * fixed[1], c_ * fixed[0] + s_ * fixed[1],
+                             fixed[2])
+            fe0, fe1, fe2 = -s_ * dd[0] + c_ * dd[1], c_ * dd[0] + s_ * dd[1], dd[2]
+            for j in range(m):
+                u = D[j, 0] * fv0 + D[j, 1] * fv1 + D[j, 2] * fv2
+                U[i, p, j] = u
+                Vv[i, p, j] = D[j, 0] * fe0 + D[j, 1] * fe1 + D[j, 2] * fe2
+                Fm[i, j, 0] += u
+                Fm[i, j, 1] += D[j, 0] * ff0 + D[j, 1] * ff1 + D[j, 2] * ff2
+    # Z = [T | c] <- A Z + [0 | Gam Fm_i] (T (n, n), c (n, 2))
+    Z = np.zeros((n, n + 2))
+    for r in range(n):
+        Z[r, r] = 1.0
+    Z2 = np.empty((n, n + 2))
+    w = np.empty(n + 2)
+    for i in range(Ns):
+        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, Z, Z2, n, w)
+        Z, Z2 = Z2, Z
+    T = np.ascontiguousarray(Z[:, :n])
+    c = np.ascontiguousarray(Z[:, n:])
     M = np.eye(n) - T
     if abs(np.linalg.det(M)) < 1e-300:
         return False
     x = np.ascontiguousarray(np.linalg.solve(M, c))
+    x2 = np.empty((n, 2))
     for i in range(Ns):
-        X_out[i] = x
-        _step_map(Phi, Gam, Pm[i], Fm[i], half_dt, A, b)
         for r in range(n):
-            for j in range(K):
-                acc = b[r, j]
-                for k in range(n):
-                    acc += A[r, k] * x[k, j]
-                c2[r, j] = acc
-        x[:, :] = c2
+            X_out[0, i, r] = x[r, 0]
+            X_out[1, i, r] = x[r, 1]
+        _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, x, x2, 0, w)
+        x, x2 = x2, x
     return True
+
+
+@nb.njit(cache=True)
+def _orbit_step(Phi, Gam, U, Vv, Fm_i, half_dt, X, Y, c0, w):  # pragma: no cover - numba
+    """``Y = A X + [0 | b]`` for one step of :func:`_orbit_kernel`:
+    ``A = blockdiag_j Phi_j + sum_p (Gam u_p)(v_p, half_dt v_p)^T`` in the state order
+    ``(q_1..q_m, q'_1..q'_m)``, ``b = Gam Fm_i`` added to X's columns from ``c0`` on (column
+    ``c0 + k`` takes load case ``k``); ``w`` (at least X's columns) is work space."""
+    m = Phi.shape[0]
+    ncol = X.shape[1]
+    for j in range(m):
+        for col in range(ncol):
+            x0 = X[j, col]
+            x1 = X[m + j, col]
+            Y[j, col] = Phi[j, 0, 0] * x0 + Phi[j, 0, 1] * x1
+            Y[m + j, col] = Phi[j, 1, 0] * x0 + Phi[j, 1, 1] * x1
+    for p in range(U.shape[0]):
+        for col in range(ncol):
+            acc = 0.0
+            for k in range(m):
+                acc += Vv[p, k] * (X[k, col] + half_dt * X[m + k, col])
+            w[col] = acc
+        for j in range(m):
+            g0 = Gam[j, 0] * U[p, j]
+            g1 = Gam[j, 1] * U[p, j]
+            for col in range(ncol):
+                Y[j, col] += g0 * w[col]
+                Y[m + j, col] += g1 * w[col]
+    for j in range(m):
+        for col in range(c0, ncol):
+            Y[j, col] += Gam[j, 0] * Fm_i[j, col - c0]
+            Y[m + j, col] += Gam[j, 1] * Fm_i[j, col - c0]
 
 
 def periodic_orbit(structure: ToolPointStructure, process: CuttingProcess, Ns: int,
@@ -425,10 +449,10 @@ def periodic_orbit(structure: ToolPointStructure, process: CuttingProcess, Ns: i
     exactly (the Ns steps composed, ``x_0 = T x_0 + c``). Returns ``(q0, qd0, sr, r_t)`` as
     :func:`_periodic_state`; ``None`` when the process has no depth modulation (the harmonic
     solution is then exact) or the orbit does not exist (``I - T`` singular)."""
-    orbits = _orbits(structure, process, Ns, speed_rpm, (depth_m,))
+    orbits = _orbits(structure, process, Ns, speed_rpm)
     if orbits is None:
         return None
-    X = orbits[:, :, 0]
+    X = depth_m * orbits[0] + orbits[1]
     m = structure.n_modes
     dt = 60.0 / (speed_rpm * Ns)
     D = structure.directions
@@ -439,23 +463,43 @@ def periodic_orbit(structure: ToolPointStructure, process: CuttingProcess, Ns: i
     return X[0, :m].copy(), X[0, m:].copy(), np.ascontiguousarray(sr), q_t @ D
 
 
-def _orbits(structure: ToolPointStructure, process: CuttingProcess, Ns: int, speed_rpm: float,
-            depths: tuple[float, ...]) -> np.ndarray | None:
-    """States (Ns, 2m, K) of the nominal-chip orbits at the depths ``depths`` (a depth of 0:
-    the depth-independent edge force alone); None without depth modulation or orbit."""
+def _orbits(structure: ToolPointStructure, process: CuttingProcess, Ns: int,
+            speed_rpm: float) -> np.ndarray | None:
+    """States (2, Ns, 2m) of the nominal-chip orbit at the step starts, per unit depth
+    (``X[0]``) and of the depth-independent edge force alone (``X[1]``): the orbit at depth
+    ``a`` is ``a X[0] + X[1]`` (the map is linear, its matrix independent of the depth). None
+    without depth modulation or orbit."""
     if not process.rotating or not np.any(process.depth_direction):
         return None
     dt = 60.0 / (speed_rpm * Ns)
-    Phi, Gam = modal_zoh(structure, dt)
-    theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # the kernel's directions (midpoints)
-    D = structure.directions
-    Pm = np.einsum("jo,noi,ki->njk", D, process.process_stiffness(theta), D)
-    Fm = np.stack([_nominal_force(process, theta, a) @ D.T for a in depths], axis=-1)
-    X = np.empty((Ns, 2 * structure.n_modes, len(depths)))
-    if not _orbit_kernel(Phi, Gam, np.ascontiguousarray(Pm), np.ascontiguousarray(Fm),
-                         0.5 * dt, X):
+    Phi, Gam = _zoh_kept(structure, dt)
+    vec = ((process.width_per_depth * process.h0) @ process.shear
+           + process.edge_per_depth @ process.edge)
+    fixed = process.edge_fixed_m @ process.edge
+    X = np.empty((2, Ns, 2 * structure.n_modes))
+    if not _orbit_kernel(Phi, Gam, np.ascontiguousarray(structure.directions, dtype=float),
+                         np.asarray(process.depth_direction, float), vec, fixed,
+                         int(process.n_inserts), 0.5 * dt, X):
         return None
     return X
+
+
+_ZOH: dict = {}
+
+
+def _zoh_kept(structure: ToolPointStructure, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`modal_zoh`, kept per structure (keyed by its values) and step (the lobes ask for
+    the orbit at every trial depth of a speed, each at the same step)."""
+    key = (structure.frequency_Hz.tobytes(), structure.damping_ratio.tobytes(),
+           structure.stiffness_N_per_m.tobytes(), float(dt))
+    hit = _ZOH.get(key)
+    if hit is not None:
+        return hit
+    out = modal_zoh(structure, dt)
+    if len(_ZOH) > 4096:
+        _ZOH.clear()
+    _ZOH[key] = out
+    return out
 
 
 def nominal_cut_deflection(structure: ToolPointStructure, process: CuttingProcess,
@@ -468,12 +512,11 @@ def nominal_cut_deflection(structure: ToolPointStructure, process: CuttingProces
     included); None for a process without depth modulation."""
     N = int(process.n_inserts)
     Ns = int(math.ceil(samples_per_rev / N) * N)
-    X = _orbits(structure, process, Ns, speed_rpm, (1.0, 0.0))
+    X = _orbits(structure, process, Ns, speed_rpm)
     if X is None:
         return None
-    r = np.einsum("nmk,mo->nok", X[:, :structure.n_modes, :], structure.directions)
-    r0 = r[:, :, 1]
-    return r[:, :, 0] - r0, r0
+    m = structure.n_modes
+    return X[0, :, :m] @ structure.directions, X[1, :, :m] @ structure.directions
 
 
 def _nominal_force(process: CuttingProcess, theta: np.ndarray, depth_m: float) -> np.ndarray:
@@ -526,72 +569,131 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
     ``insert_profile``: optional :class:`robobore.cutting.geometry.BoringInsert` used to draw
     the machined bore profile along the feed (nose geometry + the tool's radial and axial
     position at each pass). Without it the surface record is the chip-normal displacement.
+    The run is a :class:`TimeDomainRun` (which can be continued).
     """
-    settings.check()
-    process = process.at_depth(settings.depth_m)  # the chip geometry at the simulated depth
-    N = int(process.n_inserts)
-    Ns = settings.samples_per_rev or auto_samples_per_rev(structure, settings.speed_rpm, N)
-    Ns = int(math.ceil(Ns / N) * N)
-    n_steps = int(settings.revolutions) * Ns
-    from robobore.io.memory import check_timedomain
+    return TimeDomainRun(structure, process, settings, insert_profile).dataset()
 
-    check_timedomain(int(settings.revolutions), Ns, N)  # before the arrays are allocated
-    dt = 60.0 / (settings.speed_rpm * Ns)
-    Phi, Gam = modal_zoh(structure, dt)
-    theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # directions at the step midpoints
-    basis = np.ascontiguousarray(process.basis(theta))
-    a = settings.depth_m
-    w = process.width_per_depth * a
-    ds = process.edge_per_depth * a
-    inv_depth = 1.0 / a if np.any(process.depth_direction) else 0.0
-    m = structure.n_modes
-    spp = Ns // N
-    r_forced = None
-    if settings.start == "periodic":
-        q, qd, sr, r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
-        pert = settings.perturbation_m
-        if pert is None:
-            pert = 0.01 * float(np.max(process.h0))
-        q = q + pert
-    else:
-        q = np.zeros(m)
-        qd = np.zeros(m)
-        sr = np.zeros((Ns, 3))
-    limit = settings.divergence_limit_m
-    if limit is None:
-        if r_forced is None:
-            r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)[3]
-        limit = DIVERGENCE_FLOOR_M + DIVERGENCE_FORCED_FACTOR * float(np.abs(r_forced).max())
-    tlast = np.full(Ns, -spp, dtype=np.int64)
-    F = np.empty((n_steps, 3))
-    X = np.empty((n_steps, 3))
-    acc = np.empty((n_steps, 3))
-    area = np.empty((n_steps, N))
-    n_done = _simulate_kernel(n_steps, Ns, N, Phi, Gam,
-                              np.ascontiguousarray(structure.directions), basis, process.h0, w,
-                              ds, np.ascontiguousarray(process.edge_fixed_m, dtype=np.float64),
-                              process.normal, process.shear, process.edge,
-                              process.depth_direction, inv_depth, process.overlap,
-                              structure.omega, structure.damping_ratio,
-                              1.0 / structure.modal_mass, 0.5 * dt, q, qd, sr, tlast, F, X, acc,
-                              area, float(limit))
-    diverged = n_done < n_steps
-    revs = int(settings.revolutions)
-    if diverged:
-        revs = n_done // Ns  # keep the whole revolutions before the divergence
-        if revs < 1:
-            raise NumericalError(
-                f"the tool-point displacement exceeded {limit * 1e3:.3g} mm"
-                f" within the first revolution (t = {n_done * dt:.4g} s): the cut diverges at "
-                "once; check the structure (stiffness, mass) and the cutting coefficients")
+
+class TimeDomainRun:
+    """A time-domain run (:func:`simulate`) that can be continued: :meth:`extend` integrates
+    more revolutions from where the run stopped (the modal state, the surface left at each
+    angle and when it was cut), so that a run of ``R`` revolutions extended by ``R'`` is the
+    run of ``R + R'`` revolutions, digit for digit, at the cost of the ``R'`` new ones.
+    :meth:`dataset` is the Dataset of the revolutions integrated so far."""
+
+    def __init__(self, structure: ToolPointStructure, process: CuttingProcess,
+                 settings: SimulationSettings, insert_profile=None) -> None:
+        settings.check()
+        process = process.at_depth(settings.depth_m)  # the chip geometry at the depth
+        N = int(process.n_inserts)
+        Ns = settings.samples_per_rev or auto_samples_per_rev(structure, settings.speed_rpm, N)
+        Ns = int(math.ceil(Ns / N) * N)
+        self.structure, self.process, self.insert_profile = structure, process, insert_profile
+        self.settings, self.N, self.Ns = settings, N, Ns
+        self.dt = 60.0 / (settings.speed_rpm * Ns)
+        self.Phi, self.Gam = modal_zoh(structure, self.dt)
+        theta = 2 * np.pi * (np.arange(Ns) + 0.5) / Ns  # directions at the step midpoints
+        self.basis = np.ascontiguousarray(process.basis(theta))
+        a = settings.depth_m
+        m = structure.n_modes
+        r_forced = None
+        if settings.start == "periodic":
+            q, qd, sr, r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)
+            pert = settings.perturbation_m
+            if pert is None:
+                pert = 0.01 * float(np.max(process.h0))
+            q = q + pert
+        else:
+            q = np.zeros(m)
+            qd = np.zeros(m)
+            sr = np.zeros((Ns, 3))
+        limit = settings.divergence_limit_m
+        if limit is None:
+            if r_forced is None:
+                r_forced = _periodic_state(structure, process, Ns, a, settings.speed_rpm)[3]
+            limit = DIVERGENCE_FLOOR_M + DIVERGENCE_FORCED_FACTOR * float(np.abs(r_forced).max())
+        self.limit = float(limit)
+        self.q, self.qd, self.sr = q, qd, sr
+        self.tlast = np.full(Ns, -(Ns // N), dtype=np.int64)  # step of the last cut, per angle
+        self.n_steps = 0  # steps integrated
+        self.n_done = 0  # steps done before a divergence (= n_steps without one)
+        self.revolutions = 0  # revolutions asked for
+        self.F = np.empty((0, 3))
+        self.X = np.empty((0, 3))
+        self.acc = np.empty((0, 3))
+        self.area = np.empty((0, N))
+        self.extend(int(settings.revolutions))
+
+    @property
+    def diverged(self) -> bool:
+        return self.n_done < self.n_steps
+
+    def extend(self, revolutions: int) -> None:
+        """Integrate ``revolutions`` more (nothing once the run has diverged)."""
+        from robobore.io.memory import check_timedomain
+
+        if self.diverged:
+            return
+        Ns, N, st, pr = self.Ns, self.N, self.structure, self.process
+        total = self.revolutions + int(revolutions)
+        check_timedomain(total, Ns, N)  # before the arrays are allocated
+        n = int(revolutions) * Ns
+        F = np.empty((n, 3))
+        X = np.empty((n, 3))
+        acc = np.empty((n, 3))
+        area = np.empty((n, N))
+        a = self.settings.depth_m
+        tl = self.tlast - self.n_steps  # the kernel counts steps from 0
+        inv_depth = 1.0 / a if np.any(pr.depth_direction) else 0.0
+        done = _simulate_kernel(n, Ns, N, self.Phi, self.Gam, np.ascontiguousarray(st.directions),
+                                self.basis, pr.h0, pr.width_per_depth * a, pr.edge_per_depth * a,
+                                np.ascontiguousarray(pr.edge_fixed_m, dtype=np.float64),
+                                pr.normal, pr.shear, pr.edge, pr.depth_direction, inv_depth,
+                                pr.overlap, st.omega, st.damping_ratio, 1.0 / st.modal_mass,
+                                0.5 * self.dt, self.q, self.qd, self.sr, tl, F, X, acc, area,
+                                self.limit)
+        self.tlast = tl + self.n_steps
+        self.n_done = self.n_steps + int(done)
+        self.n_steps += n
+        self.revolutions = total
+        parts = [(self.F, F), (self.X, X), (self.acc, acc), (self.area, area)]
+        self.F, self.X, self.acc, self.area = (
+            new[:done] if old.shape[0] == 0 else np.concatenate([old, new[:done]])
+            for old, new in parts)
+
+    def dataset(self) -> xr.Dataset:
+        """The Dataset of the run so far (:func:`simulate`)."""
+        Ns, n_done, limit = self.Ns, self.n_done, self.limit
+        revs = self.revolutions
+        if self.diverged:
+            revs = n_done // Ns  # keep the whole revolutions before the divergence
+            if revs < 1:
+                raise NumericalError(
+                    f"the tool-point displacement exceeded {limit * 1e3:.3g} mm"
+                    f" within the first revolution (t = {n_done * self.dt:.4g} s): the cut "
+                    "diverges at once; check the structure (stiffness, mass) and the cutting "
+                    "coefficients")
         n_steps = revs * Ns
-        F, X, acc, area = F[:n_steps], X[:n_steps], acc[:n_steps], area[:n_steps]
-    if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
-        raise NumericalError("the simulation produced non-finite values (unstable integration)")
+        F, X = self.F[:n_steps], self.X[:n_steps]
+        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
+            raise NumericalError("the simulation produced non-finite values (unstable "
+                                 "integration)")
+        return _run_dataset(self, F, X, self.acc[:n_steps], self.area[:n_steps], revs, n_steps)
+
+
+def _run_dataset(run: TimeDomainRun, F: np.ndarray, X: np.ndarray, acc: np.ndarray,
+                 area: np.ndarray, revs: int, n_steps: int) -> xr.Dataset:
+    """The Dataset of ``run``'s first ``revs`` whole revolutions (:func:`simulate`)."""
+    settings, process, Ns, N, dt = run.settings, run.process, run.Ns, run.N, run.dt
+    insert_profile = run.insert_profile
+    a = settings.depth_m
+    diverged, n_done, limit = run.diverged, run.n_done, run.limit
     t = np.arange(n_steps) * dt
-    th_all = 2 * np.pi * (np.arange(n_steps) % Ns) / Ns
-    a_r = acc[:, 0] * np.cos(th_all) + acc[:, 1] * np.sin(th_all)
-    a_t = -acc[:, 0] * np.sin(th_all) + acc[:, 1] * np.cos(th_all)
+    th_rev = 2 * np.pi * np.arange(Ns) / Ns  # the insert's angle, the same every revolution
+    c_rev, s_rev = np.cos(th_rev), np.sin(th_rev)
+    ax, ay = acc[:, 0].reshape(revs, Ns), acc[:, 1].reshape(revs, Ns)
+    a_r = (ax * c_rev + ay * s_rev).ravel()
+    a_t = (-ax * s_rev + ay * c_rev).ravel()
     zr = X[:, 2].reshape(revs, Ns)
     feed_amp = 0.5 * (zr.max(axis=1) - zr.min(axis=1))
     ds_out = xr.Dataset(
@@ -615,7 +717,7 @@ def simulate(structure: ToolPointStructure, process: CuttingProcess,
         attrs={"speed_rpm": settings.speed_rpm, "depth_m": a, "revolutions": revs,
                "samples_per_rev": Ns, "n_inserts": N, "dt_s": dt, "overlap": process.overlap,
                "feed_per_rev_m": process.feed_per_rev_m, "process": process.label,
-               "diverged": int(diverged), "revolutions_requested": int(settings.revolutions),
+               "diverged": int(diverged), "revolutions_requested": int(run.revolutions),
                "diverged_at_s": n_done * dt if diverged else math.nan,
                "divergence_limit_m": float(limit),
                "frame": "boring frame: x horizontal, y vertical, z feed (bore axis)"},
@@ -724,6 +826,6 @@ def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, 
     }
 
 
-__all__ = ["simulate", "SimulationSettings", "DIVERGENCE_FLOOR_M", "DIVERGENCE_FORCED_FACTOR", "modal_zoh", "auto_samples_per_rev",
+__all__ = ["simulate", "TimeDomainRun", "SimulationSettings", "DIVERGENCE_FLOOR_M", "DIVERGENCE_FORCED_FACTOR", "modal_zoh", "auto_samples_per_rev",
            "periodic_start", "forced_response", "periodic_orbit", "nominal_cut_deflection",
            "surface_profile", "roughness", "summarize", "FORM_DEGREE"]

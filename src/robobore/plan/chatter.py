@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit, prange
@@ -64,11 +65,66 @@ def _cubic_roots(a, b, c, out):  # pragma: no cover - numba
         out[r] = x
 
 
+@njit(cache=True)
+def _lobe_check(lam, lp, first, w, wprev, n_min, n_max, n_ins, best):  # pragma: no cover
+    """The lowest lobe depth that the eigenvalue ``lam`` at the grid frequency ``w`` (and the
+    same branch ``lp`` at the previous point ``wprev``, unless ``first``) gives inside the
+    speed range ``[n_min, n_max]``, if below ``best``: ``(depth, w, speed)``; ``(inf, nan,
+    nan)`` when none is."""
+    two_pi = 2.0 * math.pi
+    out_b = np.inf
+    out_w = np.nan
+    out_n = np.nan
+    lo = 60.0 * w / (n_ins * n_max)
+    hi = 60.0 * w / (n_ins * n_min)
+    b = -1.0 / (2.0 * lam.real)
+    eps = (math.pi + 2.0 * math.atan2(lam.imag, lam.real)) % two_pi
+    if b < best:
+        kk = math.ceil((lo - eps) / two_pi)
+        if kk < 0:
+            kk = 0
+        ph = eps + two_pi * kk
+        if ph <= hi and ph > 0.0:
+            best = b
+            out_b = b
+            out_w = w
+            out_n = 60.0 * w / (n_ins * ph)
+    # range ends: a lobe crossing n_min or n_max between this and the previous point of the
+    # branch (linear interpolation, as the stability module does)
+    if first or not lp.real < 0.0:
+        return out_b, out_w, out_n
+    b0 = -1.0 / (2.0 * lp.real)
+    e0 = (math.pi + 2.0 * math.atan2(lp.imag, lp.real)) % two_pi
+    if abs(eps - e0) > math.pi or min(b0, b) >= best:
+        return out_b, out_w, out_n
+    for side in range(2):
+        nb = n_min if side == 0 else n_max
+        tau = 60.0 / (n_ins * nb)
+        p0 = (wprev * tau - e0) / two_pi
+        p1 = (w * tau - eps) / two_pi
+        jlo = math.ceil(min(p0, p1))
+        if jlo < 0:
+            jlo = 0
+        j = jlo
+        while j <= max(p0, p1):
+            t = (j - p0) / (p1 - p0) if p1 != p0 else 0.0
+            bb = b0 + t * (b - b0)
+            if bb < best:
+                best = bb
+                out_b = bb
+                out_w = wprev + t * (w - wprev)
+                out_n = nb
+            j += 1
+    return out_b, out_w, out_n
+
+
 @njit(cache=True, parallel=True)
-def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, out_b, out_f,
+def _critical_kernel(f_hz, zeta, u, v, ranges, n_ins, n_global, n_local, out_b, out_f,
                      out_n, roots, perms):  # pragma: no cover - numba
-    """f_hz, zeta (n, m); u, v (n, m, 3); out_b/out_f/out_n (n,); scratch roots (n, 3, 3)
+    """f_hz, zeta (n, m); u, v (n, m, 3); ranges (R, 2) speed ranges [r/min];
+    out_b/out_f/out_n (n, R), out_b filled with inf; scratch roots (n, 3, 3)
     (current, previous, reordered); perms (6, 3) the permutations of 3."""
+    n_ranges = ranges.shape[0]
     n = f_hz.shape[0]
     m = f_hz.shape[1]
     two_pi = 2.0 * math.pi
@@ -80,9 +136,6 @@ def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, o
                 fmin = f_hz[k, j]
             if f_hz[k, j] > fmax:
                 fmax = f_hz[k, j]
-        best = np.inf
-        bw = np.nan
-        bn = np.nan
         wprev = 0.0
         npts = n_global + m * n_local
         for i in range(npts):
@@ -142,55 +195,23 @@ def _critical_kernel(f_hz, zeta, u, v, n_min, n_max, n_ins, n_global, n_local, o
                     roots[k, 2, r] = roots[k, 0, perms[bp, r]]
                 for r in range(3):
                     roots[k, 0, r] = roots[k, 2, r]
-            lo = 60.0 * w / (n_ins * n_max)
-            hi = 60.0 * w / (n_ins * n_min)
             for r in range(3):
                 lam = roots[k, 0, r]
                 if not lam.real < 0.0:
                     continue
-                b = -1.0 / (2.0 * lam.real)
-                eps = (math.pi + 2.0 * math.atan2(lam.imag, lam.real)) % two_pi
-                if b < best:
-                    kk = math.ceil((lo - eps) / two_pi)
-                    if kk < 0:
-                        kk = 0
-                    ph = eps + two_pi * kk
-                    if ph <= hi and ph > 0.0:
-                        best = b
-                        bw = w
-                        bn = 60.0 * w / (n_ins * ph)
-                # range ends: a lobe crossing n_min or n_max between this and the previous
-                # point of the branch (linear interpolation, as the stability module does)
                 lp = roots[k, 1, r]
-                if first or not lp.real < 0.0:
-                    continue
-                b0 = -1.0 / (2.0 * lp.real)
-                e0 = (math.pi + 2.0 * math.atan2(lp.imag, lp.real)) % two_pi
-                if abs(eps - e0) > math.pi or min(b0, b) >= best:
-                    continue
-                for side in range(2):
-                    nb = n_min if side == 0 else n_max
-                    tau = 60.0 / (n_ins * nb)
-                    p0 = (wprev * tau - e0) / two_pi
-                    p1 = (w * tau - eps) / two_pi
-                    jlo = math.ceil(min(p0, p1))
-                    if jlo < 0:
-                        jlo = 0
-                    j = jlo
-                    while j <= max(p0, p1):
-                        t = (j - p0) / (p1 - p0) if p1 != p0 else 0.0
-                        bb = b0 + t * (b - b0)
-                        if bb < best:
-                            best = bb
-                            bw = wprev + t * (w - wprev)
-                            bn = nb
-                        j += 1
+                for q in range(n_ranges):
+                    b, f, sp = _lobe_check(lam, lp, first, w, wprev, ranges[q, 0],
+                                           ranges[q, 1], n_ins, out_b[k, q])
+                    if b < out_b[k, q]:
+                        out_b[k, q] = b
+                        out_f[k, q] = f
+                        out_n[k, q] = sp
             for r in range(3):
                 roots[k, 1, r] = roots[k, 0, r]
             wprev = w
-        out_b[k] = best
-        out_f[k] = bw / two_pi
-        out_n[k] = bn
+        for q in range(n_ranges):
+            out_f[k, q] = out_f[k, q] / two_pi
 
 
 _critical_kernel_serial = njit(cache=True)(_critical_kernel.py_func)
@@ -208,18 +229,34 @@ def critical_depth_range(frequency_Hz: np.ndarray, damping_ratio: np.ndarray, u:
     Returns (depth_m, chatter_frequency_Hz, speed_rpm) where the envelope is lowest, (n,) each;
     ``inf`` depth when no lobe falls in the range.
     """
+    b, f, n = critical_depth_ranges(frequency_Hz, damping_ratio, u, A0,
+                                    [(speed_min_rpm, speed_max_rpm)], n_inserts,
+                                    n_global=n_global, n_local=n_local)
+    return b[:, 0], f[:, 0], n[:, 0]
+
+
+def critical_depth_ranges(frequency_Hz: np.ndarray, damping_ratio: np.ndarray, u: np.ndarray,
+                          A0: np.ndarray, ranges: Any, n_inserts: int = 1, *,
+                          n_global: int = 400, n_local: int = 161
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`critical_depth_range` over several speed ranges ``ranges`` ((R, 2) [r/min]; a
+    range of one speed gives the limit at that speed) in one pass over the frequency grid (the
+    eigenvalues are the same for every range): (depth_m, chatter_frequency_Hz, speed_rpm), each
+    (n, R)."""
     f = np.ascontiguousarray(np.atleast_2d(frequency_Hz), dtype=float)
     z = np.ascontiguousarray(np.atleast_2d(damping_ratio), dtype=float)
     uu = np.ascontiguousarray(np.asarray(u, float).reshape(f.shape + (3,)))
     v = np.ascontiguousarray(np.einsum("ba,nmb->nma", np.asarray(A0, float), uu))
+    rg = np.ascontiguousarray(np.asarray(ranges, float).reshape(-1, 2))
     n = f.shape[0]
-    ob, of, on = np.empty(n), np.empty(n), np.empty(n)
+    shape = (n, rg.shape[0])
+    ob, of, on = np.full(shape, np.inf), np.full(shape, np.nan), np.full(shape, np.nan)
     roots = np.zeros((n, 3, 3), dtype=np.complex128)
     perms = np.array([[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]])
     kern = _critical_kernel if n >= 16 else _critical_kernel_serial
-    kern(f, z, uu, v, float(speed_min_rpm), float(speed_max_rpm), float(n_inserts),
-         int(n_global), int(n_local), ob, of, on, roots, perms)
+    kern(f, z, uu, v, rg, float(n_inserts), int(n_global), int(n_local), ob, of, on, roots,
+         perms)
     return ob, of, on
 
 
-__all__ = ["critical_depth_range"]
+__all__ = ["critical_depth_range", "critical_depth_ranges"]

@@ -72,7 +72,7 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
     ``criterion_only``: only what :func:`criterion_values` needs (modes, stiffness, and for
     the ``critical_depth`` criterion ``critical_depth_m`` and ``chatter_frequency_Hz``); the
     range minimum, its speed and the feed amplitude are NaN."""
-    from robobore.plan.chatter import critical_depth_range
+    from robobore.plan.chatter import critical_depth_ranges
 
     n = cand.q_rad.shape[0]
     nj = model.n_dof
@@ -92,17 +92,19 @@ def evaluate(model: Any, robot: Any, cand: Candidates, process: Any, A0: np.ndar
         out["frequency_Hz"][s:e] = pm.frequency_Hz
         out["damping_ratio"][s:e] = pm.damping_ratio
         out["stiffness_N_per_m"][s:e] = pm.directional_stiffness
-        if not criterion_only:
-            b, fch, nch = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
-                                               cfg.lobes.speed_min_rpm,
-                                               cfg.lobes.speed_max_rpm, process.n_inserts)
-            out["critical_depth_range_min_m"][s:e] = b
-            out["critical_speed_rpm"][s:e] = nch
+        # the limit at the cut's speed and (not criterion_only) the range's lowest point, in
+        # one pass over the frequency grid
+        ranges = [(n_cut, n_cut)] * need_depth + [
+            (cfg.lobes.speed_min_rpm, cfg.lobes.speed_max_rpm)] * (not criterion_only)
+        if ranges:
+            b, fch, nch = critical_depth_ranges(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
+                                                ranges, process.n_inserts)
         if need_depth:
-            b, fch, _ = critical_depth_range(pm.frequency_Hz, pm.damping_ratio, pm.u, A0,
-                                             n_cut, n_cut, process.n_inserts)
-            out["critical_depth_m"][s:e] = b
-            out["chatter_frequency_Hz"][s:e] = fch
+            out["critical_depth_m"][s:e] = b[:, 0]
+            out["chatter_frequency_Hz"][s:e] = fch[:, 0]
+        if not criterion_only:
+            out["critical_depth_range_min_m"][s:e] = b[:, -1]
+            out["critical_speed_rpm"][s:e] = nch[:, -1]
         for k in range(e - s if not criterion_only else 0):
             out["feed_amplitude_m"][s + k] = steady_feed_amplitude(
                 pm.structure(k, mode_share), process, cfg.cutting.depth_mm * 1e-3,

@@ -13,12 +13,18 @@ Pipeline (:func:`run_paper`), on the bundled SYNTHETIC example data by default
    (``paper_config.model_coefficients``: the measured TC4 default unless ``[coefficients]
    material = "TC4-FE"`` chooses the calibration);
 5. the sweep of the paper's kind of conditions (one factor at a time around the paper's
-   Fig. 7 condition) for the robot at P = 0 and 0.3 MPa and for a stiff machine tool, on a
-   local process pool (``run_sweep(..., pool="processes")``)
-   with a resumable results store under ``OUT/sweep``;
-6. stability lobes (robot without and with the foot) at the base feed;
+   Fig. 7 condition) for the robot at P = 0 and 0.3 MPa and for a stiff machine tool, with a
+   resumable results store under ``OUT/sweep``;
+6. stability lobes (robot without and with the foot) at the base feed, and the posture plan
+   (:func:`robobore.plan.paper.paper_posture_plan`);
 7. comparison with the (SYNTHETIC) measured CSV and the paper's qualitative checks;
 8. the report (``paper_report``), ``results.nc`` and ``paper_summary.json`` in OUT.
+
+With ``workers`` (default 2) one process pool, forked from a server that imports the runner
+and the planner once, is started with the study; the posture plan, the two lobe diagrams and
+the sweep's conditions are submitted to it in that order (longest first) while this process
+draws the modal figures and records the results; ``workers=0`` runs everything here. The
+results are the same either way.
 
 The config file (TOML) is documented in ``docs/paper.md`` and in the bundled example; its
 model and reader are :mod:`robobore.study.paper_config`, the checks of step 7
@@ -258,25 +264,35 @@ def build_plan(cfg: PaperConfig, robot_model: dict[str, Any],
     return plan, meta
 
 
-def compute_lobes(cfg: PaperConfig, robot_model: dict[str, Any]) -> dict[str, Any]:
-    """Stability lobes (robot without / with the foot) at the base feed."""
+def lobe_cases(cfg: PaperConfig) -> list[tuple[str, float]]:
+    """The (label, foot pressure [MPa]) of the study's two lobe diagrams: without and with
+    the foot."""
+    return [("P = 0", 0.0), (f"P = {cfg.pressure_foot.pressure_MPa:g} MPa",
+                             cfg.pressure_foot.pressure_MPa)]
+
+
+def lobes_at_pressure(cfg: PaperConfig, robot_model: dict[str, Any],
+                      pressure_MPa: float) -> dict[str, Any]:
+    """The stability lobes of the robot at one foot pressure (0: no foot) at the base feed,
+    as lists (one entry of :func:`compute_lobes`)."""
     from robobore.dynamics.api import lobes
 
-    out = {}
-    for label, p in (("P = 0", 0.0), (f"P = {cfg.pressure_foot.pressure_MPa:g} MPa",
-                                      cfg.pressure_foot.pressure_MPa)):
-        dyn = json.loads(json.dumps(robot_model["dynamics"]))
-        if p == 0.0:
-            dyn["equivalent"].pop("pressure_foot", None)
-        dyn["cutting"] = {"speed_rpm": float(cfg.study.base["speed_rpm"]),
-                          "feed_mm_per_rev": float(cfg.study.base["feed_mm_per_rev"]),
-                          "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
-        dyn["speed_rpm"] = {"min": cfg.lobes.speed_min_rpm, "max": cfg.lobes.speed_max_rpm,
-                            "count": cfg.lobes.count}
-        d = lobes(dyn, method=cfg.lobes.method).to_dict()
-        out[label] = {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
-                      for k, v in d.items()}
-    return out
+    dyn = json.loads(json.dumps(robot_model["dynamics"]))
+    if pressure_MPa == 0.0:
+        dyn["equivalent"].pop("pressure_foot", None)
+    dyn["cutting"] = {"speed_rpm": float(cfg.study.base["speed_rpm"]),
+                      "feed_mm_per_rev": float(cfg.study.base["feed_mm_per_rev"]),
+                      "depth_mm": float(cfg.study.base["depth_of_cut_mm"])}
+    dyn["speed_rpm"] = {"min": cfg.lobes.speed_min_rpm, "max": cfg.lobes.speed_max_rpm,
+                        "count": cfg.lobes.count}
+    d = lobes(dyn, method=cfg.lobes.method).to_dict()
+    return {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v)
+            for k, v in d.items()}
+
+
+def compute_lobes(cfg: PaperConfig, robot_model: dict[str, Any]) -> dict[str, Any]:
+    """Stability lobes (robot without / with the foot) at the base feed, by label."""
+    return {label: lobes_at_pressure(cfg, robot_model, p) for label, p in lobe_cases(cfg)}
 
 
 #: Rule of the lobes-vs-verdicts check: a condition more than this fraction above the
@@ -418,26 +434,61 @@ def _stage(progress: Callable[[str, int, int], None] | None, task: str,
     return advance
 
 
+def _pool_ready() -> bool:
+    """A task the study pool runs first on each worker: it starts the workers (forked from
+    the server that has imported the runner and the planner) while this process identifies
+    the robot."""
+    return True
+
+
+class _StudyPool:
+    """The study's ``workers`` processes, forked from one forkserver that imports the boring
+    runner's modules and the posture planner once (:func:`robobore.study.sweep.pool_preload`);
+    started at the beginning of the study so that the imports overlap the identification.
+    The posture plan, the two lobe diagrams and the sweep's conditions are submitted to it in
+    that order (longest first); results do not depend on which worker computes what."""
+
+    def __init__(self, workers: int) -> None:
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor
+
+        from robobore.study.runners import boring_runner
+        from robobore.study.sweep import pool_preload
+
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload([*pool_preload(boring_runner), "robobore.plan.paper",
+                                    "robobore.dynamics.api", __name__])
+        self.ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+        for _ in range(workers):
+            self.ex.submit(_pool_ready)
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
+        return self.ex.submit(fn, *args)
+
+    def close(self) -> None:
+        self.ex.shutdown(wait=True, cancel_futures=True)
+
+
 class _PosturePlan:
-    """:func:`robobore.plan.paper.paper_posture_plan` of the study, computed in a process
-    forked from the multiprocessing server (``parallel``) or in this one when asked for;
-    the same result either way (a pool that breaks falls back to this process)."""
+    """:func:`robobore.plan.paper.paper_posture_plan` of the study, computed on a worker of
+    the study pool (``pool``; ``parallel=True`` without one: a pool of its own) or in this
+    process; the same result either way (a pool that breaks falls back to this process)."""
 
     def __init__(self, cfg: PaperConfig, cfg_path: Path, stiff: dict[str, Any],
-                 modes: dict[str, Any], coeffs: dict[str, Any], parallel: bool) -> None:
+                 modes: dict[str, Any], coeffs: dict[str, Any], parallel: bool,
+                 pool: _StudyPool | None = None) -> None:
+        from robobore.plan.paper import paper_posture_plan
+
         self.args = (cfg, cfg_path, stiff, modes, coeffs, model_coefficients(cfg, coeffs))
-        self.ex = self.fut = None
+        self.own = None
+        self.fut = None
         #: where the plan was computed: "side process", "this process", or a warning that
         #: the side process died and the plan was computed again here
         self.computed_in = ""
-        if parallel:
-            import multiprocessing as mp
-            from concurrent.futures import ProcessPoolExecutor
-
-            from robobore.plan.paper import paper_posture_plan
-
-            self.ex = ProcessPoolExecutor(1, mp_context=mp.get_context("forkserver"))
-            self.fut = self.ex.submit(paper_posture_plan, *self.args)
+        if parallel and pool is None:
+            pool = self.own = _StudyPool(1)
+        if pool is not None:
+            self.fut = pool.submit(paper_posture_plan, *self.args)
 
     def result(self) -> dict[str, Any]:
         from concurrent.futures.process import BrokenProcessPool
@@ -453,10 +504,25 @@ class _PosturePlan:
                 self.computed_in = (f"posture plan: its side process died ({exc}); computed "
                                     "again in the study's process")
             finally:
-                self.ex.shutdown()
+                if self.own is not None:
+                    self.own.close()
         else:
             self.computed_in = "this process"
         return paper_posture_plan(*self.args)
+
+
+def _lobes_result(cfg: PaperConfig, robot_model: dict[str, Any],
+                  futures: list[tuple[str, float, Any]]) -> dict[str, Any]:
+    """The lobe diagrams submitted to the study pool (computed here if the pool broke)."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    out = {}
+    for label, p, fut in futures:
+        try:
+            out[label] = fut.result()
+        except BrokenProcessPool:
+            out[label] = lobes_at_pressure(cfg, robot_model, p)
+    return out
 
 
 def run_paper(config: str | Path | None = None, out: str | Path = "paper-results", *,
@@ -470,12 +536,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     in order: "identify robot and modes", "FE force calibration" (not with ``fast``),
     "sweep <name>" (:func:`robobore.study.sweep.run_sweep`), "lobes, comparison, report".
     """
-    from robobore import __version__
-    from robobore.io.results import write_json, write_netcdf
-    from robobore.study.compare import compare, read_measured_csv
-    from robobore.study.paper_report import build_report
-    from robobore.study.store import ResultsStore
-    from robobore.study.sweep import run_sweep
+    from robobore.study.compare import read_measured_csv
 
     t0 = time.perf_counter()
     cfg, raw, cfg_path = load_paper_config(config)
@@ -485,6 +546,28 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
         read_measured_csv(_resolve(cfg_path, cfg.measured.file))
     nw = workers if workers is not None else 2
     timings: dict[str, float] = {}
+    pool = _StudyPool(nw) if nw > 0 else None  # its workers start while the robot is identified
+    try:
+        return _run_stages(cfg, raw, cfg_path, outdir, fast=fast, nw=nw, pool=pool,
+                           progress=progress, browser_check=browser_check, timings=timings,
+                           t0=t0)
+    finally:
+        if pool is not None:
+            pool.close()
+
+
+def _run_stages(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, outdir: Path, *,
+                fast: bool, nw: int, pool: _StudyPool | None,
+                progress: Callable[[str, int, int], None] | None, browser_check: bool,
+                timings: dict[str, float], t0: float) -> PaperSummary:
+    """The stages of :func:`run_paper` after the config is read (``pool``: the study pool,
+    None for a serial run)."""
+    from robobore import __version__
+    from robobore.io.results import write_json, write_netcdf
+    from robobore.study.compare import compare, read_measured_csv
+    from robobore.study.paper_report import build_report, modal_figure_pngs
+    from robobore.study.store import ResultsStore
+    from robobore.study.sweep import run_sweep
 
     def lap(name: str, t: float) -> None:
         timings[name] = time.perf_counter() - t
@@ -514,6 +597,13 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     mt_model = dynamics_model(cfg, eq, coeffs, "machine_tool") if cfg.study.machine_tool \
         else None
     plan, meta = build_plan(cfg, robot_model, mt_model)
+    # the posture plan and the lobes need only the identification and the force set: they go
+    # to the study pool first (the longest tasks first), the sweep's conditions after them
+    posture = _PosturePlan(cfg, cfg_path, stiff, modes, coeffs, parallel=False, pool=pool)
+    lobe_futures = ([(label, p, pool.submit(lobes_at_pressure, cfg, robot_model, p))
+                     for label, p in lobe_cases(cfg)] if pool is not None else [])
+    an = modes.get("analysis")
+    modal_pngs = None if an is None or pool is None else modal_figure_pngs(an)
     t = time.perf_counter()
     store = ResultsStore(outdir / "sweep")
     from dataclasses import replace as _replace
@@ -522,7 +612,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     # a process pool forked from one server that imports the runner once: on 2 cores it
     # takes about half the CPU time of a Dask local cluster for the same results
     outcome = run_sweep(plan, store, workers=nw, processes=nw > 0, progress=progress,
-                        pool="processes")
+                        pool="processes", executor=None if pool is None else pool.ex)
     lap("sweep", t)
     rows = []
     for m in meta:
@@ -535,11 +625,9 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
             r["error"] = f.get("error", "not computed")
         rows.append(r)
     advance = _stage(progress, "lobes, comparison, report", 3)
-    # the posture plan needs only the identification and the force set: with workers it runs
-    # in a process of its own beside the lobes and the comparison (2 cores: both busy)
-    posture = _PosturePlan(cfg, cfg_path, stiff, modes, coeffs, parallel=nw > 0)
     t = time.perf_counter()
-    lob = compute_lobes(cfg, robot_model)
+    lob = (_lobes_result(cfg, robot_model, lobe_futures) if lobe_futures
+           else compute_lobes(cfg, robot_model))
     from robobore.study.paper_calibration import paper_calibration
 
     calib = paper_calibration(cfg, cfg_path, robot_model, outdir)  # None without observations
@@ -602,7 +690,7 @@ def run_paper(config: str | Path | None = None, out: str | Path = "paper-results
     }
     rep = build_report(cfg, cfg_path, stiff=stiff, modes=modes, eq=eq, coeffs=coeffs,
                        rows=rows, store=store, lobes=lob, cmp=cmp, checks=checks,
-                       summary=summary)
+                       summary=summary, modal_pngs=modal_pngs)
     rep.write(outdir / "report.html")
     lap("report", t)
     if browser_check:

@@ -76,24 +76,27 @@ def _mode_rows(modes: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def _modal_figures(rep: Report, an: Any) -> None:
-    """Stabilisation diagram and the driving-point FRF fit of the hammer test's first input."""
+def modal_figure_pngs(an: Any) -> list[tuple[bytes, str]]:
+    """(PNG, caption) of the stabilisation diagram and of the FRF fit of each hammer input's
+    driving point: the report's modal figures (drawn by the study while its pool computes)."""
     import tempfile
 
     from robobore.modal.plots import plot_frf_fit, plot_stabilisation
 
+    out = []
     with tempfile.TemporaryDirectory() as tmp:
         p = plot_stabilisation(an, Path(tmp) / "stab.png")
-        rep.add_image_png(p.read_bytes(), "Stabilisation diagram of the hammer test (pLSCF "
-                          "model order against frequency, symbols by stability status) over "
-                          "the CMIF; dashed lines: the selected modes.")
+        out.append((p.read_bytes(), "Stabilisation diagram of the hammer test (pLSCF model "
+                    "order against frequency, symbols by stability status) over the CMIF; "
+                    "dashed lines: the selected modes."))
         d = an.data
         for j in range(d.n_inputs):
             o = j if j < d.n_outputs else 0
             p = plot_frf_fit(an, Path(tmp) / f"frf{j}.png", o, j)
-            rep.add_image_png(p.read_bytes(), f"Measured FRF {d.output_names[o]} / "
-                              f"{d.input_names[j]} and the identified modal model (LSFD "
-                              "synthesis).")
+            out.append((p.read_bytes(), f"Measured FRF {d.output_names[o]} / "
+                        f"{d.input_names[j]} and the identified modal model (LSFD "
+                        "synthesis)."))
+    return out
 
 
 def _eq_rows(eq: dict[str, Any]) -> list[dict[str, Any]]:
@@ -233,8 +236,10 @@ def coefficient_set_section(rep: Report, cset: dict[str, Any], warnings: list[st
 def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict[str, Any],
                  eq: dict[str, Any], coeffs: dict[str, Any], rows: list[dict[str, Any]],
                  store: Any, lobes: dict[str, Any], cmp: Any, checks: list[dict[str, Any]],
-                 summary: dict[str, Any]) -> Report:
-    """The paper report (see module doc)."""
+                 summary: dict[str, Any],
+                 modal_pngs: list[tuple[bytes, str]] | None = None) -> Report:
+    """The paper report (see module doc); ``modal_pngs``: the modal figures of
+    :func:`modal_figure_pngs` when already drawn (drawn here otherwise)."""
     plt = pyplot()
     base = {k: float(v) for k, v in cfg.study.base.items()}
     syn = stiff.get("synthetic") or modes.get("synthetic")
@@ -300,7 +305,8 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
                   "the driving point of the mode's direction)")
     an = modes.get("analysis")
     if an is not None:
-        _modal_figures(rep, an)
+        for png, caption in (modal_pngs if modal_pngs is not None else modal_figure_pngs(an)):
+            rep.add_image_png(png, caption)
 
     rep.add_section("Equivalent model")
     rep.add_text("Paper eq. 1-3: per direction k from the robot stiffness, f_n and zeta from the "
@@ -526,4 +532,4 @@ def build_report(cfg: Any, cfg_path: Path, *, stiff: dict[str, Any], modes: dict
     return rep
 
 
-__all__ = ["build_report", "coefficient_set_section", "force_model_fe_text", "force_model_validation"]
+__all__ = ["build_report", "modal_figure_pngs", "coefficient_set_section", "force_model_fe_text", "force_model_validation"]

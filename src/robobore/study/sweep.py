@@ -1,4 +1,4 @@
-"""Run a runner over many conditions with Dask, storing each result as it finishes.
+"""Run a runner over many conditions (Dask or a process pool), storing each result as it finishes.
 
 A *runner* is a picklable, importable function ``runner(condition: dict, context: dict)
 -> xarray.Dataset`` (condition: :class:`~robobore.study.conditions.Condition` as a dict;
@@ -14,7 +14,9 @@ Execution (:func:`run_sweep`):
 * conditions already in the store are skipped; missing and failed ones are (re)computed;
 * a local Dask cluster (``workers`` processes, one thread each; or threads in this process
   with ``processes=False``) is started unless a scheduler address is given, and closed at
-  the end; ``workers=0`` runs in this process without Dask (debugging, profiling);
+  the end; ``pool="processes"`` runs the conditions on ``workers`` processes forked from a
+  forkserver that has imported the runner once instead (:func:`_run_pool`); ``workers=0``
+  runs in this process without Dask (debugging, profiling);
 * results are collected with ``as_completed`` and written by the client at once, one
   netCDF file per condition, atomically; a failing condition (runner exception, a result
   that breaks the summary contract, a lost worker) is recorded with its error and
@@ -245,6 +247,7 @@ def run_sweep(
     index_every_s: float = 2.0,
     connect_timeout_s: float = 15.0,
     pool: str = "dask",
+    executor: Any = None,
 ) -> SweepOutcome:
     """Run the pending conditions of ``plan`` and store each result as it finishes.
 
@@ -254,8 +257,10 @@ def run_sweep(
     ``pool="processes"`` (no scheduler, ``processes``): ``workers`` processes forked from a
     server that has imported the runner's module once (:func:`_run_pool`), instead of a
     Dask cluster whose workers each start an interpreter and import everything; same
-    results, less start-up work. ``runner`` overrides the plan's runner spec (a picklable
-    function). The store is
+    results, less start-up work. ``executor``: with ``pool="processes"``, an open
+    ``concurrent.futures`` process pool to submit the conditions to instead of starting one
+    (it is left open; a study that runs other work on the same workers passes it).
+    ``runner`` overrides the plan's runner spec (a picklable function). The store is
     locked for the duration (:meth:`ResultsStore.lock`). ``progress(task, done, total)``, if
     given, is called with ``task = "sweep <name>"`` once before the first condition (done 0)
     and after each condition that finishes, ``total`` being the conditions to compute.
@@ -270,7 +275,8 @@ def run_sweep(
     with store.lock():
         return _run_locked(plan, store, fn, scheduler=scheduler, workers=workers,
                            processes=processes, progress=progress, index_every_s=index_every_s,
-                           connect_timeout_s=connect_timeout_s, pool=pool)
+                           connect_timeout_s=connect_timeout_s, pool=pool,
+                           executor=executor)
 
 
 #: Local executors of :func:`run_sweep`: a Dask local cluster, or a forked process pool.
@@ -280,7 +286,8 @@ POOLS = ("dask", "processes")
 def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: str | None,
                 workers: int | None, processes: bool,
                 progress: Callable[[str, int, int], None] | None, index_every_s: float,
-                connect_timeout_s: float, pool: str = "dask") -> SweepOutcome:
+                connect_timeout_s: float, pool: str = "dask",
+                executor: Any = None) -> SweepOutcome:
     import warnings
 
     store.cleanup_partial()  # safe: the lock says no other sweep is writing here
@@ -319,7 +326,7 @@ def _run_locked(plan: SweepPlan, store: ResultsStore, fn: Runner, *, scheduler: 
             for item in todo:
                 rec.record(item, execute(fn, item.condition, item.context))
         elif scheduler is None and pool == "processes" and processes:
-            _run_pool(fn, todo, rec, workers=workers or _default_workers())
+            _run_pool(fn, todo, rec, workers=workers or _default_workers(), executor=executor)
         else:
             _run_dask(fn, todo, rec, scheduler=scheduler,
                       workers=workers or _default_workers(), processes=processes,
@@ -446,22 +453,41 @@ def _run_dask(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, scheduler: s
             cluster.close(timeout=10)
 
 
-def _run_pool(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, workers: int) -> None:
+def pool_preload(fn: Runner) -> list[str]:
+    """The modules the forkserver of a sweep's process pool imports before it forks the
+    workers: this module, the runner's and those its ``preload_modules`` attribute names."""
+    return [__name__, getattr(fn, "__module__", __name__), *getattr(fn, "preload_modules", ())]
+
+
+def _run_pool(fn: Runner, todo: list[SweepItem], rec: _Recorder, *, workers: int,
+              executor: Any = None) -> None:
     """The conditions on ``workers`` processes of a ``concurrent.futures`` pool whose
     processes are forked from a server that imported the runner's module and the modules it
     names in its ``preload_modules`` attribute (numpy, xarray, the numba kernels' modules)
     once; results are recorded as they finish. A
     worker that dies breaks the pool: the conditions not finished then are recorded as
-    failures (run the sweep again to retry them)."""
+    failures (run the sweep again to retry them). ``executor``: an open pool to use instead
+    (left open)."""
+    import contextlib
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
-    ctx = mp.get_context("forkserver")
-    ctx.set_forkserver_preload([__name__, getattr(fn, "__module__", __name__),
-                                *getattr(fn, "preload_modules", ())])
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx) as ex:
-        by_future = {ex.submit(execute, fn, i.condition, i.context): i for i in todo}
+    if executor is None:
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(pool_preload(fn))
+        pool_cm: Any = ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx)
+    else:
+        pool_cm = contextlib.nullcontext(executor)
+    with pool_cm as ex:
+        by_future = {}
+        for i in todo:
+            try:
+                by_future[ex.submit(execute, fn, i.condition, i.context)] = i
+            except BrokenProcessPool:  # a shared pool broken by other work
+                rec.record(i, {"ok": False, "error": "the sweep's process pool is broken (a "
+                               "worker died); run the sweep again to retry this condition",
+                               "traceback": traceback.format_exc()})
         for fut in as_completed(by_future):
             item = by_future.pop(fut)
             try:
