@@ -309,7 +309,7 @@ def test_a_continued_run_is_the_longer_run_digit_for_digit(depth_mm):
     """TimeDomainRun.extend continues from the modal state, the surface and when each angle
     was cut: R revolutions extended by R are the 2R-revolution run, every sample equal (a
     decaying and a diverging cut)."""
-    from robobore.cutting.forces import ti64_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
     from robobore.dynamics.timedomain import SimulationSettings, TimeDomainRun, simulate
 
     st = ToolPointStructure.from_modes([
