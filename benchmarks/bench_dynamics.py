@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robobore.cutting.forces import ti64_coefficients
+from robobore.cutting.coefficient_sets import ti64_coefficients
 from robobore.cutting.geometry import BoringInsert
 from robobore.dynamics.process import boring_process, single_point_process
 from robobore.dynamics.stability import lobes_frequency_domain

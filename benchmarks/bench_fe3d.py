@@ -131,7 +131,7 @@ def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None
         d["cut"]["cut_length_mm"] = cut_mm
         d["solver"]["mass_scaling"] = ms
         r = simulate_boring(parse_boring_config(d))
-        cmp_ = compare_with_mechanistic(r, coefficients)
+        cmp_ = compare_with_mechanistic(r, coefficients).to_dict()
         s = r.to_dict()
         row = {"element_size_um": le, "force_rotating_N": s["force_rotating_N"],
                "force_rotating_std_N": s["force_rotating_std_N"],

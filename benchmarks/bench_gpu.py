@@ -252,7 +252,7 @@ def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
                                          "hourglass_fraction", "n_elements", "steps",
                                          "wall_time_s", "element_updates_per_s",
                                          "eroded_damage", "eroded_distortion")}
-            by[dev]["comparison"] = compare_with_mechanistic(r, coefficients)
+            by[dev]["comparison"] = compare_with_mechanistic(r, coefficients).to_dict()
             print(f"paper3d {le} um {dev}: " + json.dumps(by[dev]), flush=True)
         row = {"element_size_um": le, "by_device": by}
         if "cpu" in by and "gpu" in by:

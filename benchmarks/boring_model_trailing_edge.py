@@ -33,7 +33,9 @@ FE_N = {"5 um": (16.51, -7.00, -1.57), "6.25 um": (16.85, -8.02, -1.72),
 
 
 def main() -> None:
-    from robobore.cutting.forces import boring_forces, load_coefficients, ti64_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
+    from robobore.cutting.forces import boring_forces
     from robobore.cutting.geometry import BoringInsert
     from robobore.io.config import load_toml
 

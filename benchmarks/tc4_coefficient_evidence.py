@@ -5,8 +5,9 @@ Pantale et al. (CIRP 2022; ``cutting/coefficients/ti64_orthogonal_cutting_forces
 15 deg, edge radius 20 um, h 40/60/80 um x vc 5/10/30 m/min, forces per mm of width). The
 paper's boring forces exist only as figures (no numbers). The two sets:
 
-* ``measured`` (``material = "TC4"``, :func:`robobore.cutting.forces.ti64_coefficients`): a
-  least-squares fit of those points per speed, interpolated in vc. Judged OUT OF SAMPLE here:
+* ``measured`` (``material = "TC4"``,
+  :func:`robobore.cutting.coefficient_sets.ti64_coefficients`): a least-squares fit of those
+  points per speed, interpolated in vc. Judged OUT OF SAMPLE here:
   leave one speed out (the set from the other two speeds predicts the left-out speed's three
   points) and leave one chip thickness out (per speed, the fit of the other two thicknesses
   predicts the third);
@@ -28,9 +29,9 @@ from importlib import resources
 import numpy as np
 
 
-
 def main() -> None:
-    from robobore.cutting.forces import DUCOBU_FILE, fit_linear_edge_model, load_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.coefficient_sets import DUCOBU_FILE, fit_linear_edge_model
 
     data = json.loads(DUCOBU_FILE.read_text())["measured"]
     hs = sorted(data["Fc"], key=float)

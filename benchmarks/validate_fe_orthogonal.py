@@ -54,7 +54,7 @@ def main() -> None:
 
     res = run_validation(base, read_measured(a.data), source=str(a.config),
                          points=None if a.points is None else parse_points(a.points),
-                         out_dir=out, device=a.device)
+                         out_dir=out, device=a.device).to_dict()
     for p in res["points"]:
         m, e = p["measured"], p["relative_error"]
         pct = {k: None if v is None else 100 * v for k, v in e.items()}

@@ -345,7 +345,7 @@ def test_config_foot_applies_to_a_model_without_one(chain):
 
 
 def test_process_takes_the_cutting_stage_objects(chain):
-    from robobore.cutting.forces import read_coefficients_file
+    from robobore.cutting.coefficient_files import read_coefficients_file
 
     em = chain["robot"]
     ref = api.stability_lobes({**_process(), "coefficients": api.bundled_fe_coefficients()}, em,

@@ -87,7 +87,7 @@ def _measured(p: Path):
 
 
 def _coefficients(p: Path):
-    from robobore.cutting.forces import load_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
 
     load_coefficients(p)
 

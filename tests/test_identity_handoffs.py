@@ -434,8 +434,17 @@ def test_fe_validate_announces_its_default_store_and_records_the_identity(tmp_pa
     meas = shared if shared.is_file() else (
         REPO / "src" / "robobore" / "cutting" / "coefficients" /
         "ti64_orthogonal_cutting_forces.json")
+    from robobore.cutting.fe.models.results import (
+        PerQuantity,
+        ValidationResult,
+        ValidationSummary,
+    )
+
+    none = PerQuantity(None, None, None)
     monkeypatch.setattr("robobore.cutting.fe.models.validate.run_validation",
-                        lambda *a, **k: {"points": [], "summary": {}})
+                        lambda *a, **k: ValidationResult(
+                            points=(), summary=ValidationSummary(none, none, none),
+                            config="<stub>", device="cpu", out_dir=None))
     monkeypatch.chdir(tmp_path)
     r = runner.invoke(app, ["fe", "validate", str(EX / "fe_orthogonal.toml"), "--measured",
                             str(meas), "--json"])

@@ -188,7 +188,7 @@ def test_campaign_forces_in_kn_refused(tmp_path):
 
 
 def test_coefficients_in_n_per_mm2_refused(tmp_path):
-    from robobore.cutting.forces import load_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
 
     d = json.loads((DATA / "paper_example" / "tc4_fe_coefficients.json").read_text())
     d["coefficients"]["Ktc_N_per_m2"] /= 1e6
@@ -263,7 +263,8 @@ def test_no_bundled_config_is_rejected(path):
 
 
 def test_no_bundled_or_shared_data_file_is_rejected():
-    from robobore.cutting.forces import load_coefficients, ti64_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
     from robobore.modal.example import example_path
     from robobore.modal.io import load_input
     from robobore.robot.campaign_io import read_campaign

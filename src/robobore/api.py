@@ -256,9 +256,9 @@ def stiffness_at_pose(joint_stiffness: Any, joints_deg: Any = PAPER_POSTURE_DEG,
     against the robot the stiffness was identified for (another robot: ``ConfigError``
     naming both); None: the stiffness's own robot (a warning says so when it is not the
     default robot), else the default."""
-    from robobore.robot.stiffness import joint_stiffness_arg, stiffness_at
-
     import numpy as np
+
+    from robobore.robot.stiffness import joint_stiffness_arg, stiffness_at
 
     joint_stiffness_arg(joint_stiffness)
     rb = _robot_arg(robot, joint_stiffness)
@@ -389,7 +389,8 @@ def cutting_coefficients(cutting_speed_m_per_min: float | None = None,
     """Cutting coefficients at a cutting speed [m/min] -> ``CuttingCoefficients`` (SI): of a
     coefficients file, or (None) the default measured TC4 set at that speed (30 m/min, the
     fastest measured, when no speed is given)."""
-    from robobore.cutting.forces import load_coefficients, ti64_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
 
     v = _number_arg(cutting_speed_m_per_min, "cutting_speed_m_per_min", "m/min")
     path = _path_arg(path, "path")

@@ -4,7 +4,7 @@ References: ordinary least squares with standard errors ``cov = s^2 (A^T A)^-1``
 ``s^2 = RSS/(n-2)`` (e.g. Montgomery & Runger, *Applied Statistics and Probability for
 Engineers*, ch. 11); the linear edge-force model ``F = Ke + Kc h`` (Altintas,
 *Manufacturing Automation*, 2nd ed., ch. 2); orthogonal-to-oblique transformation (Budak,
-Altintas & Armarego 1996) as implemented in ``cutting/forces.py``.
+Altintas & Armarego 1996) as implemented in ``cutting/coefficient_sets.py``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 from robobore.cutting import calibrate as cal
 from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
-from robobore.cutting.forces import load_coefficients
+from robobore.cutting.coefficient_files import load_coefficients
 from robobore.errors import ConfigError
 from robobore.io.cache import ResultCache
 from robobore.study.paper_config import PaperConfig, example_config_path, example_dir
@@ -83,7 +83,7 @@ def _fake_records(cfg, kc=1.6e9, ke=30e3, kfc=0.4e9, kfe=40e3):
 
 def test_calibrate_file_round_trip(tmp_path):
     """Coefficients fitted from known forces are recovered, and the written file is loaded
-    by cutting.forces.load_coefficients with the same values and an FE provenance."""
+    by cutting.coefficient_files.load_coefficients with the same values and an FE provenance."""
     cfg = _cfg()
     data = cal.calibrate(cfg, _fake_records(cfg))
     c = data["coefficients"]

@@ -20,12 +20,13 @@ import pytest
 from robobore.cutting import calibrate as cal
 from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
+from robobore.cutting.coefficient_files import load_coefficients
+from robobore.cutting.coefficient_sets import DUCOBU_FILE
 from robobore.cutting.fe.models.validate import (
     bundled_validation_path,
     load_validation_record,
     read_measured,
 )
-from robobore.cutting.forces import DUCOBU_FILE, load_coefficients
 from robobore.io.config import load_toml
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fe_orthogonal.toml"

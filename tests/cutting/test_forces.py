@@ -8,16 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.forces import (
-    CuttingCoefficients,
-    boring_forces,
+from robobore.cutting.coefficient_files import load_coefficients
+from robobore.cutting.coefficient_sets import (
+    DUCOBU_FILE,
     ducobu_fits,
-    element_forces,
-    load_coefficients,
     orthogonal_parameters_from_data,
     orthogonal_to_oblique,
     ti64_coefficients,
 )
+from robobore.cutting.forces import CuttingCoefficients, boring_forces, element_forces
 from robobore.cutting.geometry import BoringInsert, edge_elements
 from robobore.errors import ConfigError
 
@@ -27,7 +26,7 @@ def test_ducobu_fit_reproduces_data():
     every point (reading accuracy 0.5 N/mm; scatter of the measurement)."""
     fits = ducobu_fits()
     k = fits[30.0]
-    data = json.load(open(__import__("robobore.cutting.forces", fromlist=["x"]).DUCOBU_FILE))
+    data = json.loads(DUCOBU_FILE.read_text())
     for h in ("40", "60", "80"):
         pred = (k["Kte"] + k["Ktc"] * float(h) * 1e-6) / 1e3
         assert pred == pytest.approx(data["measured"]["Fc"][h]["30"], abs=3.0)

@@ -16,13 +16,13 @@ from pathlib import Path
 
 import pytest
 
-from robobore.cutting.forces import (
-    CuttingCoefficients,
+from robobore.cutting.coefficient_files import (
     coefficients_at_speed,
     inline_coefficients,
     load_coefficients,
     read_coefficients_file,
 )
+from robobore.cutting.forces import CuttingCoefficients
 from robobore.errors import ConfigError
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from robobore import api
 from robobore.cli import app
-from robobore.cutting import forces
+from robobore.cutting import coefficient_files, coefficient_sets
 from robobore.dynamics.api import lobes, run_boring
 from robobore.dynamics.config import DynamicsConfig, build_coefficients
 from robobore.io.config import validate_model
@@ -46,21 +46,21 @@ def test_api_default_is_the_cli_default():
         vc = math.pi * 0.04 * n
         cfg = load(_cfg(api.bundled_coefficients(), n))
         got = build_coefficients(cfg)
-        ref = forces.ti64_coefficients(vc)
+        ref = coefficient_sets.ti64_coefficients(vc)
         assert (got.Ktc, got.Kfc, got.Kte, got.Kfe) == (ref.Ktc, ref.Kfc, ref.Kte, ref.Kfe)
         assert api.cutting_coefficients(vc) == ref
     # a config without [coefficients] gets the same set
     no = _cfg(None)
     del no["coefficients"]
     cfg = load(no)
-    assert build_coefficients(cfg) == forces.ti64_coefficients(math.pi * 0.04 * 300.0)
+    assert build_coefficients(cfg) == coefficient_sets.ti64_coefficients(math.pi * 0.04 * 300.0)
 
 
 def test_fe_set_is_opt_in_and_named():
     assert api.bundled_fe_coefficients() == {"material": "TC4-FE"}
     cfg = load(_cfg(api.bundled_fe_coefficients()))
     fe = build_coefficients(cfg)
-    stored = forces.load_coefficients(forces.TC4_FE_FILE)
+    stored = coefficient_files.load_coefficients(coefficient_sets.TC4_FE_FILE)
     assert (fe.Ktc, fe.Kfc, fe.Kte, fe.Kfe) == (stored.Ktc, stored.Kfc, stored.Kte, stored.Kfe)
     assert "FE-calibrated" in fe.provenance
     assert fe.chip_thickness_range_m == pytest.approx((60e-6, 90e-6))
@@ -72,14 +72,15 @@ def test_fe_set_is_opt_in_and_named():
 
 def test_speed_outside_the_calibrated_range_is_said():
     # the FE set: calibrated at 37.7 m/min only; 300 r/min on a 40 mm bore is 37.699 m/min
-    at = forces.coefficients_at_speed(json.loads(forces.TC4_FE_FILE.read_text()), 37.699)
+    fe_set = json.loads(coefficient_sets.TC4_FE_FILE.read_text())
+    at = coefficient_files.coefficients_at_speed(fe_set, 37.699)
     assert at.warnings == ()
-    off = forces.coefficients_at_speed(json.loads(forces.TC4_FE_FILE.read_text()), 18.85)
+    off = coefficient_files.coefficients_at_speed(fe_set, 18.85)
     assert len(off.warnings) == 1 and "outside the calibrated speed 37.7 m/min" in \
         off.warnings[0]
     # the measured set: 5-30 m/min
-    assert forces.ti64_coefficients(20.0).warnings == ()
-    assert "outside the measured 5-30" in forces.ti64_coefficients(37.7).warnings[0]
+    assert coefficient_sets.ti64_coefficients(20.0).warnings == ()
+    assert "outside the measured 5-30" in coefficient_sets.ti64_coefficients(37.7).warnings[0]
 
 
 @pytest.mark.parametrize("coefficients", [{"material": "TC4"}, {"material": "TC4-FE"}])
@@ -138,19 +139,19 @@ def test_measured_set_predicts_real_forces_better_than_the_fe_set():
     measured set fitted WITHOUT a chip thickness predicts it within 6.5 % (Fc) / 9.5 % (Ff);
     the FE set (rake 7 deg, 37.7 m/min) misses the feed force by up to 19.9 % (mean 9.4 %
     against the measured set's 3.2 % out of sample)."""
-    data = json.loads(forces.DUCOBU_FILE.read_text())["measured"]
+    data = json.loads(coefficient_sets.DUCOBU_FILE.read_text())["measured"]
     hs = sorted(data["Fc"], key=float)
     vs = sorted(data["Fc"][hs[0]], key=float)
     h = np.array([float(x) for x in hs]) * 1e-6
-    fe = forces.load_coefficients(forces.TC4_FE_FILE)
+    fe = coefficient_files.load_coefficients(coefficient_sets.TC4_FE_FILE)
     loto_c, loto_f, fe_f = [], [], []
     for v in vs:
         Fc = np.array([data["Fc"][x][v] for x in hs]) * 1e3
         Ff = np.array([data["Ff"][x][v] for x in hs]) * 1e3
         for i in range(h.size):
             k = [j for j in range(h.size) if j != i]
-            kc, ke = forces.fit_linear_edge_model(h[k], Fc[k])
-            kf, kfe = forces.fit_linear_edge_model(h[k], Ff[k])
+            kc, ke = coefficient_sets.fit_linear_edge_model(h[k], Fc[k])
+            kf, kfe = coefficient_sets.fit_linear_edge_model(h[k], Ff[k])
             loto_c.append(abs((ke + kc * h[i]) / Fc[i] - 1))
             loto_f.append(abs((kfe + kf * h[i]) / Ff[i] - 1))
             fe_f.append(abs((fe.Kfe + fe.Kfc * h[i]) / Ff[i] - 1))
@@ -162,8 +163,8 @@ def test_measured_set_predicts_real_forces_better_than_the_fe_set():
 def test_a_coefficients_file_content_passed_inline_keeps_its_domain():
     """The studies (paper, sweep) pass a calibration inline (``inline_coefficients``): its
     ``grid`` goes with it, so their per-condition runs carry the same warnings as the file."""
-    content = forces.read_coefficients_file(forces.TC4_FE_FILE)
-    inline = forces.inline_coefficients(content)
+    content = coefficient_files.read_coefficients_file(coefficient_sets.TC4_FE_FILE)
+    inline = coefficient_files.inline_coefficients(content)
     assert inline["grid"]["cutting_speed_m_per_min"] == [37.7]
     for n in (150.0, 300.0):
         by_file = run_boring(_cfg({"material": "TC4-FE"}, n, feed=0.5)).warnings

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robobore.cutting.forces import ti64_coefficients
+from robobore.cutting.coefficient_sets import ti64_coefficients
 from robobore.cutting.geometry import BoringInsert
 from robobore.dynamics import semidiscretization as sd
 from robobore.dynamics.process import boring_process

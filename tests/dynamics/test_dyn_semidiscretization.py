@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from robobore.cli import app
-from robobore.cutting.forces import ti64_coefficients
+from robobore.cutting.coefficient_sets import ti64_coefficients
 from robobore.cutting.geometry import BoringInsert
 from robobore.dynamics.process import boring_process, single_point_process
 from robobore.dynamics.stability import (

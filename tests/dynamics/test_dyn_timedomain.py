@@ -262,7 +262,7 @@ def test_rotating_bar_semidiscretization_vs_time_domain():
     """Rotating boring bar (time-periodic directions) on a stiff, machine-tool-like structure
     where the static deflection is a negligible part of the depth: the semi-discretised
     (Floquet) critical depth separates decaying (0.9 x) from growing (1.1 x) simulations."""
-    from robobore.cutting.forces import ti64_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
     from robobore.dynamics.stability import critical_depth_semidiscretization
 
     st = ToolPointStructure.from_modes([
@@ -309,7 +309,7 @@ def test_a_continued_run_is_the_longer_run_digit_for_digit(depth_mm):
     """TimeDomainRun.extend continues from the modal state, the surface and when each angle
     was cut: R revolutions extended by R are the 2R-revolution run, every sample equal (a
     decaying and a diverging cut)."""
-    from robobore.cutting.forces import ti64_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
     from robobore.dynamics.timedomain import SimulationSettings, TimeDomainRun, simulate
 
     st = ToolPointStructure.from_modes([

@@ -156,12 +156,12 @@ def test_ik_all_branches_verified_by_fk(rb):
 def paper_process():
     from importlib import resources
 
-    from robobore.cutting import forces
+    from robobore.cutting import coefficient_files
     from robobore.cutting.geometry import BoringInsert
     from robobore.dynamics.process import boring_process
 
-    co = forces.load_coefficients(str(resources.files("robobore") / "data" / "paper_example"
-                                      / "tc4_fe_coefficients.json"))
+    co = coefficient_files.load_coefficients(str(resources.files("robobore") / "data"
+                                                 / "paper_example" / "tc4_fe_coefficients.json"))
     ins = BoringInsert(0.4e-3, 90.0, 5.0, 7.0, 0.0, 7.0, 20e-6, 1)
     return boring_process(ins, co, 0.05e-3, 0.15e-3)
 

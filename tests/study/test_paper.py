@@ -70,7 +70,8 @@ def test_boring_runner_uses_the_coefficients():
     force amplitudes equal the static mechanistic forces of ``cutting.forces.boring_forces``
     with the same coefficients (within 1 %, the time-domain sampling of the max/min), and
     doubling every coefficient doubles them (within 1 %)."""
-    from robobore.cutting.forces import boring_forces, load_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.forces import boring_forces
 
     stored = json.loads((EX / "tc4_fe_coefficients.json").read_text())["coefficients"]
     cond = {"speed_rpm": 300.0, "feed_mm_per_rev": 0.15, "depth_of_cut_mm": 0.1,
@@ -372,7 +373,7 @@ def test_paper_fast_small_run_outputs(small_run):
     base_w = [w for w in s["warnings"] if "(the base condition)" in w]
     assert len(base_w) == 1 and "37.7 m/min outside the measured 5-30 m/min" in base_w[0]
     assert "800 r/min" in " ".join(s["warnings"])
-    from robobore.cutting.forces import ti64_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
 
     assert cs["coefficients"]["Ktc_N_per_m2"] == pytest.approx(ti64_coefficients(37.7).Ktc)
     html = (out / "report.html").read_text()

@@ -12,8 +12,9 @@ is fitted by ordinary least squares over all grid points (the pooled set, ``coef
 and per cutting speed (``per_speed_fits``). Standard errors come from the residuals:
 ``cov = s^2 (A^T A)^-1``, ``s^2 = RSS / (n - 2)``. With two or more speeds the boring model
 uses the per-speed fits interpolated linearly in ln(vc) at its cutting speed (held outside the
-calibrated speeds; :func:`robobore.cutting.forces.coefficients_at_speed`), unless the user
-forces the pooled set (``speed_dependent = false``). :func:`mechanistic_check` measures how
+calibrated speeds;
+:func:`robobore.cutting.coefficient_files.coefficients_at_speed`), unless the user forces
+the pooled set (``speed_dependent = false``). :func:`mechanistic_check` measures how
 well that reproduces the FE points and measured forces, with leave-one-speed-out
 cross-validation.
 
@@ -25,12 +26,12 @@ Orthogonal -> insert: the FE tests use the insert's own rake angle and edge radi
 zero-inclination insert the orthogonal coefficients apply unchanged to each edge element
 (the thrust acts normal to the local edge, as in ``cutting/forces.py``) and ``Krc = Kre = 0``.
 For an inclined insert the shearing coefficients go through the orthogonal-to-oblique
-transformation (:func:`robobore.cutting.forces.orthogonal_to_oblique`) with the shear stress,
-shear angle and friction angle of the orthogonal fit (:func:`orthogonal_parameters_from_data`;
-shear angle from the FE chip ratio when the FE gives one, else Merchant's
-``phi = pi/4 - (beta - alpha)/2``).
+transformation (:func:`robobore.cutting.coefficient_sets.orthogonal_to_oblique`) with the
+shear stress, shear angle and friction angle of the orthogonal fit
+(:func:`robobore.cutting.coefficient_sets.orthogonal_parameters_from_data`; shear angle from
+the FE chip ratio when the FE gives one, else Merchant's ``phi = pi/4 - (beta - alpha)/2``).
 
-The saved file (JSON) is read by :func:`robobore.cutting.forces.load_coefficients`: the
+The saved file (JSON) is read by :func:`robobore.cutting.coefficient_files.load_coefficients`: the
 ``coefficients`` table holds the ``CuttingCoefficients`` keys; the other tables hold the
 provenance (material, insert, FE settings, grid, version, FE forces, fit residuals).
 """
@@ -92,11 +93,11 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
     """Fit the coefficients to FE records (:func:`run_grid`) and build the file's content."""
     from robobore import __version__
     from robobore.cutting import fe
-    from robobore.cutting.forces import (
-        CuttingCoefficients,
+    from robobore.cutting.coefficient_sets import (
         orthogonal_parameters_from_data,
         orthogonal_to_oblique,
     )
+    from robobore.cutting.forces import CuttingCoefficients
 
     h = np.array([r["h_um"] for r in records]) * 1e-6
     fc = np.array([r["Fc_N_per_m"] for r in records])
@@ -128,7 +129,7 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
         beta = rake + math.atan2(kfc, ktc)
         phi = math.pi / 4 - (beta - rake) / 2
         tau = (ktc * math.cos(phi) - kfc * math.sin(phi)) * math.sin(phi)
-        from robobore.cutting.forces import OrthogonalParameters
+        from robobore.cutting.coefficient_sets import OrthogonalParameters
 
         op = OrthogonalParameters(tau, phi, beta, rake)
         phi_src = "Merchant phi = pi/4 - (beta - alpha)/2 (FE chip ratio not available)"
@@ -159,8 +160,8 @@ def calibrate(cfg: CalibrationConfig, records: list[dict[str, Any]]) -> dict[str
         prov += "; FE tests outside the model's validated domain: " + "; ".join(
             model["outside_validation"])
     if len(per_speed) >= 2:
-        # the boring model uses the per-speed fits (forces.coefficients_at_speed): they are
-        # the fits to check; the pooled set's miss matters with speed_dependent = false
+        # the boring model uses the per-speed fits (coefficient_files.coefficients_at_speed):
+        # they are the fits to check; the pooled set's miss matters with speed_dependent = false
         warnings = per_speed_warnings
         miss = max(fit_c["max_rel_residual"], fit_f["max_rel_residual"])
         if miss > FIT_TOLERANCE:
@@ -284,9 +285,9 @@ def mechanistic_orthogonal_forces(data: dict[str, Any], h_um: float, vc_m_per_mi
                                   speed_dependent: bool = True) -> tuple[float, float]:
     """Orthogonal forces (Fc, Ff) [N/m of width] of a coefficients-file content at uncut chip
     thickness ``h_um`` and cutting speed ``vc_m_per_min``: the coefficients at vc through the
-    boring model's own path (:func:`robobore.cutting.forces.coefficients_at_speed`), then
+    boring model's own path (:func:`robobore.cutting.coefficient_files.coefficients_at_speed`), then
     ``Fc = Kte + Ktc h``, ``Ff = Kfe + Kfc h`` (a zero-inclination insert)."""
-    from robobore.cutting.forces import coefficients_at_speed
+    from robobore.cutting.coefficient_files import coefficients_at_speed
 
     c = coefficients_at_speed(data, vc_m_per_min, speed_dependent=speed_dependent)
     h = h_um * 1e-6

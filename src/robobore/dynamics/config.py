@@ -234,7 +234,7 @@ class CoefficientsCfg(StrictModel):
     Kre_N_per_m: float | None = None
     Kfe_N_per_m: float | None = None
     provenance: str = "config file"
-    #: a calibration's per-speed fits (``robobore.cutting.forces.read_per_speed_fits``:
+    #: a calibration's per-speed fits (``robobore.cutting.coefficient_files.read_per_speed_fits``:
     #: "<vc m/min>" -> {Ktc_N_per_m2, Kte_N_per_m, Kfc_N_per_m2, Kfe_N_per_m}), inline with
     #: the K values; from a ``file`` they are read from the file
     per_speed_fits: dict[str, Any] | None = None
@@ -243,7 +243,8 @@ class CoefficientsCfg(StrictModel):
     speed_dependent: bool = True
     #: the calibration's grid (``uncut_chip_thickness_um``, ``cutting_speed_m_per_min``), inline
     #: with the K values: the domain the set's warnings are judged on
-    #: (``robobore.cutting.forces.calibrated_domain``); from a ``file`` it is read from the file
+    #: (``robobore.cutting.coefficient_files.calibrated_domain``); from a ``file`` it is read
+    #: from the file
     grid: dict[str, list[float]] | None = None
 
     @model_validator(mode="after")
@@ -262,7 +263,7 @@ class CoefficientsCfg(StrictModel):
             raise ValueError("speed_dependent = false applies to calibrated coefficients (file "
                              "or inline per_speed_fits); the measured TC4 default is always "
                              "interpolated at the cutting speed")
-        from robobore.cutting.forces import TC4_FE_NAMES, TC4_NAMES
+        from robobore.cutting.coefficient_sets import TC4_FE_NAMES, TC4_NAMES
 
         if self.material is not None and self.material.upper() not in TC4_NAMES + TC4_FE_NAMES:
             raise ValueError(f"unknown material {self.material!r}; expected 'TC4' (Ti-6Al-4V, "
@@ -476,24 +477,24 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
     ``[coefficients]`` section); the paper example's FE-calibrated set with
     ``material = "TC4-FE"`` (opt-in; warned outside its 37.7 m/min); a calibration (file, or inline values with
     ``per_speed_fits``) with fits at several speeds evaluated at vc
-    (:func:`robobore.cutting.forces.coefficients_at_speed`; ``speed_dependent = false``: the
-    pooled set); inline values as given."""
-    from robobore.cutting import forces
+    (:func:`robobore.cutting.coefficient_files.coefficients_at_speed`;
+    ``speed_dependent = false``: the pooled set); inline values as given."""
+    from robobore.cutting import coefficient_files, coefficient_sets
 
     c = cfg.coefficients
     vc = cutting_speed_m_per_min(cfg)
     if (c is not None and c.material is not None and c.file is None
-            and c.material.upper() in forces.TC4_FE_NAMES):
-        return forces.tc4_fe_coefficients(vc)
+            and c.material.upper() in coefficient_sets.TC4_FE_NAMES):
+        return coefficient_sets.tc4_fe_coefficients(vc)
     if c is None or (c.material is not None and c.file is None):
         if c is not None and c.oblique:
-            return forces.ti64_oblique_coefficients(cfg.insert.to_insert(),
-                                                    30.0 if vc is None else vc)
-        return forces.ti64_coefficients(vc)
+            return coefficient_sets.ti64_oblique_coefficients(cfg.insert.to_insert(),
+                                                              30.0 if vc is None else vc)
+        return coefficient_sets.ti64_coefficients(vc)
     if c.file is not None:
         cf = resolve_config_path(c.file, source, "coefficients.file", what="coefficients file")
-        coef = forces.load_coefficients(cf, vc, speed_dependent=c.speed_dependent)
-        return forces.check_coefficients_identity(
+        coef = coefficient_files.load_coefficients(cf, vc, speed_dependent=c.speed_dependent)
+        return coefficient_files.check_coefficients_identity(
             coef, cf, material=c.material, insert=cfg.insert,
             material_by=f"coefficients.material of {source or 'the config'}",
             insert_by=f"[insert] of {source or 'the config'}")
@@ -504,7 +505,7 @@ def build_coefficients(cfg: DynamicsConfig, source: str | None = None):
         data["per_speed_fits"] = c.per_speed_fits
     if c.grid is not None:
         data["grid"] = c.grid
-    return forces.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
+    return coefficient_files.coefficients_at_speed(data, vc, speed_dependent=c.speed_dependent,
                                         source=source)
 
 

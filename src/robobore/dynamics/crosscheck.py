@@ -28,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.forces import CuttingCoefficients, ti64_coefficients
+from robobore.cutting.coefficient_sets import ti64_coefficients
+from robobore.cutting.forces import CuttingCoefficients
 from robobore.cutting.geometry import BoringInsert
 from robobore.dynamics.process import CuttingProcess, boring_process
 from robobore.dynamics.structure import ToolPointStructure
@@ -187,7 +188,7 @@ def check_cut(cut: CrossCheckCut, factors: tuple[float, ...] = (0.8, 1.25),
         interrupted_below,
         monodromy_spectral_radius,
     )
-    from robobore.dynamics.timedomain import SimulationSettings, simulate, auto_samples_per_rev
+    from robobore.dynamics.timedomain import SimulationSettings, auto_samples_per_rev, simulate
 
     pr = cut.process() if process is None else process
     if process is None:

@@ -93,13 +93,15 @@ def with_coefficients(raw: dict[str, Any]) -> dict[str, Any]:
     """``raw`` with a ``coefficients`` entry given as the cutting stage's result turned into
     the ``[coefficients]`` table: a :class:`~robobore.cutting.forces.CuttingCoefficients`
     (its values, used as given at every speed) or a coefficients-file content (the output of
-    ``robobore calibrate forces``, :func:`~robobore.cutting.forces.read_coefficients_file`:
-    :func:`~robobore.cutting.forces.inline_coefficients`, per-speed fits included). A table
-    of the section's own keys is left as it is."""
+    ``robobore calibrate forces``,
+    :func:`~robobore.cutting.coefficient_files.read_coefficients_file`:
+    :func:`~robobore.cutting.coefficient_files.inline_coefficients`, per-speed fits included). A
+    table of the section's own keys is left as it is."""
     c = raw.get("coefficients")
     if c is None or (isinstance(c, dict) and not isinstance(c.get("coefficients"), dict)):
         return raw
-    from robobore.cutting.forces import CuttingCoefficients, inline_coefficients
+    from robobore.cutting.coefficient_files import inline_coefficients
+    from robobore.cutting.forces import CuttingCoefficients
 
     if isinstance(c, CuttingCoefficients):
         return {**raw, "coefficients": c.to_dict()}

@@ -34,7 +34,7 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
     made (for instance a robot without inertial data), so the report says why. The plan's
     ``[coefficients]`` table is ``coefficients`` (the study's set), or the coefficients-file
     content ``coeffs`` inline when it is None."""
-    from robobore.cutting.forces import inline_coefficients
+    from robobore.cutting.coefficient_files import inline_coefficients
     from robobore.plan.config import PlanConfig, PlanInputs
     from robobore.plan.posture import run_plan, workspace_map
     from robobore.robot.kinematics import fk, get_robot

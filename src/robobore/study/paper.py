@@ -47,8 +47,12 @@ import numpy as np
 from robobore.dynamics.config import PressureFootCfg
 from robobore.errors import ConfigError
 from robobore.study.paper_checks import qualitative_checks
-from robobore.study.paper_config import (PaperConfig, coefficient_set, load_paper_config,
-                                         model_coefficients)
+from robobore.study.paper_config import (
+    PaperConfig,
+    coefficient_set,
+    load_paper_config,
+    model_coefficients,
+)
 from robobore.study.results import PaperSummary
 
 RUNNER = "boring"
@@ -154,7 +158,7 @@ def load_or_calibrate(cfg: PaperConfig, raw: dict[str, Any], cfg_path: Path, fas
             raise ConfigError("stored coefficients file not found", file=str(cfg_path),
                               field="coefficients.file", value=str(p),
                               expected="a JSON file written by 'robobore calibrate forces'")
-        from robobore.cutting.forces import read_coefficients_file
+        from robobore.cutting.coefficient_files import read_coefficients_file
 
         data = read_coefficients_file(p)  # clear errors for a corrupt file; ranges checked
         from robobore.io.identity import check_insert, check_material, cut_identity_of

@@ -89,7 +89,7 @@ class MaterialSection(StrictModel):
 
 class CoefficientsSection(StrictModel):
     #: the set the boring model (sweep, lobes, posture plan) uses: "TC4" the measured default
-    #: (robobore.cutting.forces.ti64_coefficients, 5-30 m/min, h 40-80 um); "TC4-FE" the
+    #: (robobore.cutting.coefficient_sets.ti64_coefficients, 5-30 m/min, h 40-80 um); "TC4-FE" the
     #: force calibration of this config (``file`` with --fast, the FE runs of [calibration]
     #: otherwise), also the way to use a coefficients file of one's own
     material: str = "TC4"
@@ -97,13 +97,13 @@ class CoefficientsSection(StrictModel):
     #: force-model section with --fast, and the set used with material = "TC4-FE"
     file: str
     #: per-speed fits at two or more speeds evaluated at each condition's cutting speed
-    #: (robobore.cutting.forces.coefficients_at_speed); false: the pooled set
+    #: (robobore.cutting.coefficient_files.coefficients_at_speed); false: the pooled set
     speed_dependent: bool = True
 
     @field_validator("material")
     @classmethod
     def _material(cls, v: str) -> str:
-        from robobore.cutting.forces import TC4_FE_NAMES, TC4_NAMES
+        from robobore.cutting.coefficient_sets import TC4_FE_NAMES, TC4_NAMES
 
         if v.upper() not in TC4_NAMES + TC4_FE_NAMES:
             raise ValueError(f"unknown coefficient set {v!r}; expected 'TC4' (the measured "
@@ -113,7 +113,7 @@ class CoefficientsSection(StrictModel):
 
     def uses_calibration(self) -> bool:
         """True when the boring model uses this config's force calibration ("TC4-FE")."""
-        from robobore.cutting.forces import TC4_FE_NAMES
+        from robobore.cutting.coefficient_sets import TC4_FE_NAMES
 
         return self.material.upper() in TC4_FE_NAMES
 
@@ -145,7 +145,7 @@ def model_coefficients(cfg: PaperConfig, calibration: dict[str, Any]) -> dict[st
     check, posture plan): ``{"material": "TC4"}`` (the measured default, interpolated at each
     condition's cutting speed) or, with ``material = "TC4-FE"``, the force calibration
     ``calibration`` (a coefficients-file content) inline, with its grid and per-speed fits."""
-    from robobore.cutting.forces import inline_coefficients
+    from robobore.cutting.coefficient_files import inline_coefficients
 
     if cfg.coefficients.uses_calibration():
         return inline_coefficients(calibration, cfg.coefficients.speed_dependent)
@@ -160,16 +160,16 @@ def coefficient_set(cfg: PaperConfig, calibration: dict[str, Any],
     and ``warnings``: the set's own warning at each study speed outside its calibrated
     speeds (the base condition's first). The per-condition warnings (chip thickness
     included) are the sweep's."""
-    from robobore.cutting import forces
+    from robobore.cutting import coefficient_files, coefficient_sets
 
     if cfg.coefficients.uses_calibration():
-        h, v = forces.calibrated_domain(calibration)
+        h, v = coefficient_files.calibrated_domain(calibration)
         name = "TC4-FE"
         desc = ("this config's force calibration (FE-calibrated, opt-in: [coefficients] "
                 f"material = \"TC4-FE\"; {mode or 'calibration'})")
     else:
-        fits = sorted(forces.ducobu_fits())
-        h, v = forces.TI64_CHIP_THICKNESS_M, (fits[0], fits[-1])
+        fits = sorted(coefficient_sets.ducobu_fits())
+        h, v = coefficient_sets.TI64_CHIP_THICKNESS_M, (fits[0], fits[-1])
         name = "TC4"
         desc = ("the measured TC4 default (least-squares fit of measured orthogonal forces, "
                 "Ducobu et al., CIRP 2022), interpolated at each condition's cutting speed; "
@@ -180,9 +180,9 @@ def coefficient_set(cfg: PaperConfig, calibration: dict[str, Any],
     base_c = None
     for n in speeds:  # the base condition's speed first
         vc = math.pi * cfg.bore.diameter_mm * 1e-3 * n
-        c = (forces.coefficients_at_speed(calibration, vc,
+        c = (coefficient_files.coefficients_at_speed(calibration, vc,
                                           speed_dependent=cfg.coefficients.speed_dependent)
-             if cfg.coefficients.uses_calibration() else forces.ti64_coefficients(vc))
+             if cfg.coefficients.uses_calibration() else coefficient_sets.ti64_coefficients(vc))
         base_c = c if base_c is None else base_c
         warnings += [f"coefficient set {name} at {n:g} r/min"
                      + (" (the base condition)" if n == n_base else "") + f": {w}"

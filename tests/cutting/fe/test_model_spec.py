@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.config.frame import Frame
 from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
 from robobore.cutting.fe.config.spec import (
     Adiabatic,
@@ -25,8 +26,8 @@ from robobore.cutting.fe.config.spec import (
     SlidingSpeedFriction,
     ToolFrame,
     WorkpieceFrame,
-    build_spec,
 )
+from robobore.cutting.fe.config.spec_build import build_spec
 from robobore.cutting.fe.engine import chunk_loop as CL
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state2d import default_prm
@@ -71,6 +72,18 @@ def test_the_bundled_configs_choose_their_variants():
     assert b.frame.element == BBarQuad()
     with pytest.raises(dataclasses.FrozenInstanceError):
         b.frame = s.frame  # type: ignore[misc]
+
+
+def test_the_config_holds_the_frame_typed():
+    """``[mesh] frame`` is a :class:`Frame` read through ``is_tool``; its TOML/JSON value, its
+    equality with the string and the message of an unknown frame are those of the string."""
+    tool, work = parse_config(_base("tool")), parse_config(_base("workpiece"))
+    assert tool.mesh.frame is Frame.TOOL and tool.mesh.frame.is_tool
+    assert work.mesh.frame is Frame.WORKPIECE and not work.mesh.frame.is_tool
+    assert tool.mesh.frame == "tool" and work.model_dump(mode="json")["mesh"]["frame"] == \
+        "workpiece"
+    with pytest.raises(ConfigError, match="Input should be 'workpiece' or 'tool'"):
+        parse_config(_base("sideways"))
 
 
 def test_the_spec_chooses_the_compiled_step():
@@ -184,8 +197,8 @@ def test_the_boring_spec_and_its_slots():
         HexElement,
         ToolFrame3D,
         WorkpieceFrame3D,
-        build_boring_spec,
     )
+    from robobore.cutting.fe.config.spec_build import build_boring_spec
     from robobore.cutting.fe.engine.state3d import default_prm3
     from robobore.cutting.fe.hex import layout3d
 

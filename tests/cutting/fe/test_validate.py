@@ -18,6 +18,7 @@ from typer.testing import CliRunner
 
 from robobore.cli import app
 from robobore.cutting.fe.models import validate as V
+from robobore.cutting.fe.models.results import PerQuantity
 from robobore.errors import ConfigError, DataError
 
 TINY = """\
@@ -226,7 +227,7 @@ def test_interrupted_validation_resumes(tmp_path):
         return simulate_orthogonal(cfg, **kw)
 
     res = V.run_validation(base, meas, out_dir=out, simulate=counting)
-    assert len(ran) == 2 and sum(p["reused"] for p in res["points"]) == 1
+    assert len(ran) == 2 and sum(p.reused for p in res.points) == 1
     # another config (here the element round the edge) does not reuse the stored points
     base2 = {**base, "mesh": {**base["mesh"], "edge_element_um": 10.0}}
     ran.clear()
@@ -242,9 +243,20 @@ def test_points_option_runs_a_prediction(tmp_path):
     base = tomllib.loads(TINY)
     meas = V.read_measured(_files(tmp_path)[1])
     res = V.run_validation(base, meas, points=[(60.0, 20.0)], simulate=simulate_orthogonal)
-    (p,) = res["points"]
-    assert p["cutting_speed_m_per_min"] == 20.0 and p["cutting_force_N_per_mm"] > 0
-    assert p["relative_error"] == {"cutting_force": None, "feed_force": None,
-                                   "chip_ratio": None}
-    assert res["summary"]["max_abs_error"]["cutting_force"] is None
-    assert math.isfinite(p["feed_force_N_per_mm"])
+    (p,) = res.points
+    assert p.cutting_speed_m_per_min == 20.0 and p.cutting_force_N_per_mm > 0
+    assert p.relative_error == PerQuantity(cutting_force=None, feed_force=None,
+                                           chip_ratio=None)
+    assert res.summary.max_abs_error.cutting_force is None
+    assert math.isfinite(p.feed_force_N_per_mm)
+    # the JSON of the typed result
+    d = res.to_dict()
+    assert list(d) == ["points", "summary", "config", "device", "out_dir"]
+    assert d["points"][0]["relative_error"] == {"cutting_force": None, "feed_force": None,
+                                                "chip_ratio": None}
+    assert d["points"][0]["measured"] == {"cutting_force_N_per_mm": None,
+                                          "feed_force_N_per_mm": None, "chip_ratio": None}
+    none = {"cutting_force": None, "feed_force": None, "chip_ratio": None}
+    assert d["summary"] == {"max_abs_error": none, "mean_abs_error": none,
+                            "n_measured": {"cutting_force": 0, "feed_force": 0,
+                                           "chip_ratio": 0}}

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.config.orthogonal import FRICTION_TABLE_MU, load_fe_config, parse_config
+from robobore.cutting.fe.config.contact import FRICTION_TABLE_MU
+from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal
 from robobore.cutting.fe.models.validate import point_config

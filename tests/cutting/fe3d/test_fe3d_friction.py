@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.config.contact import ContactSection
 from robobore.cutting.fe.config.engine_settings import apply_friction_settings
-from robobore.cutting.fe.config.orthogonal import ContactSection
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state2d import default_prm
 from robobore.cutting.fe.engine.state3d import box_mesh, default_prm3, make_state3

@@ -42,11 +42,12 @@ SCRIPT = textwrap.dedent("""
         # the default friction law (rech2013_calibrated: the table read at each contact
         # node's filtered sliding speed) at the block's cutting speed prm[P_VC] = 5 m/s, and
         # heat conduction with the thermal contact every 3 steps (20 passes)
-        from robobore.cutting.fe.config.orthogonal import ContactSection, SolverSection
+        from robobore.cutting.fe.config.contact import ContactSection
         from robobore.cutting.fe.config.engine_settings import (
             apply_friction_settings,
             apply_thermal_settings,
         )
+        from robobore.cutting.fe.config.orthogonal import SolverSection
         from robobore.material import load_material
         s = bench.small3d(n_samples=40)
         apply_friction_settings(s.prm, ContactSection(), s.prm[L3.P_VC] * 60.0, L3)

@@ -15,16 +15,14 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.ale.groups3d import Cells3, ElementState3, Nodes3, RemapWork3
-from robobore.cutting.fe.ale.remap import BF_OPEN, BF_VIRGIN, rz_flux_py, rz_velocity_py
-from robobore.cutting.fe.ale.remap3d import (
+from robobore.cutting.fe.ale.hexvolume3d import (
     FACES_OUT,
-    VEL_MOMENTUM,
-    VEL_TAYLOR,
     element_volumes3,
     hex_volume_py,
-    remap3d_py,
     swept_face_py,
 )
+from robobore.cutting.fe.ale.remap import BF_OPEN, BF_VIRGIN, rz_flux_py, rz_velocity_py
+from robobore.cutting.fe.ale.remap3d import VEL_MOMENTUM, VEL_TAYLOR, remap3d_py
 from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.engine.state3d import box_mesh, hex_volumes
 from robobore.cutting.fe.physics.thermal3d import HEX_FACES

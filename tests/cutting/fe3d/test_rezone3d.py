@@ -20,8 +20,8 @@ import math
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.ale.hexvolume3d import FACES_OUT, element_volumes3, swept_face_py
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_VIRGIN
-from robobore.cutting.fe.ale.remap3d import FACES_OUT, element_volumes3, swept_face_py
 from robobore.cutting.fe.ale.rezone import (
     TF_CHAIN,
     TF_FACE,

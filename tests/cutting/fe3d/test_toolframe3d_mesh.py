@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.ale.hexvolume3d import FACES_OUT
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
-from robobore.cutting.fe.ale.remap3d import FACES_OUT
 from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 from robobore.cutting.fe.engine.state3d import HEX_SIGNS
 from robobore.cutting.fe.hex.scalar3d import insert_gap3_py

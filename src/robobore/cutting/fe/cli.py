@@ -202,7 +202,7 @@ def run_validate_cli(config, measured, as_json, points, out, plot, device="cpu")
                      f"{out.resolve()} (no --out given)", soft_wrap=True, highlight=False)
     with fraction_progress("FE validation", enabled=not as_json) as prog:
         result = run_validation(base, meas, source=str(config), points=pts, out_dir=out,
-                                device=device, progress=prog)
+                                device=device, progress=prog).to_dict()
     result["measured_file"] = str(measured)
     from robobore.io.identity import fe_identity
 

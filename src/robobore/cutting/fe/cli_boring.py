@@ -123,7 +123,7 @@ def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
     with fraction_progress("FE boring (3D)", enabled=not as_json) as prog:
         res = simulate_boring(cfg, source=str(config), progress=prog, device=device)
     result = res.to_dict()
-    result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients)
+    result["mechanistic_comparison"] = compare_with_mechanistic(res, coefficients).to_dict()
     result["warnings"] = boring_warnings(cfg, res.summary) + notes
     result["identity"] = fe_identity("fe boring", cfg, str(config))
     if vtk is not None:

@@ -30,7 +30,7 @@ Nodes3 = namedtuple("Nodes3", "x y z vx vy vz mass fixed ptr nel")
 
 #: the hexahedra: ``conn`` (e, 8) int64, ``alive`` (e,) int64 (1 live, 0 / -1 eroded),
 #: ``fnbr`` (e, 6) int64 face neighbours (-1: outline), ``bflag`` (e, 6) int64 the outline
-#: faces' flux types (``remap3d.FACES_OUT``...; (0, 6): closed)
+#: faces' flux types (``hexvolume3d.FACES_OUT``...; (0, 6): closed)
 Cells3 = namedtuple("Cells3", "conn alive fnbr bflag")
 
 #: the element state the remap transports: deviatoric stress ``sd`` (e, 6) [Pa], pressure

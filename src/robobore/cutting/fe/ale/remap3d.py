@@ -46,12 +46,8 @@ The passes are scalar functions of one element or node (``*_py`` originals, ``nj
 versions without the suffix), read only what the previous pass wrote and allocate nothing,
 so the CPU chunk loop calls them from ``prange`` loops (:func:`remap3d`) and a GPU kernel
 can compile the same source. :func:`remap3d_py` is the allocating wrapper for tests and
-scripts.
-
-Face numbering: face ``f`` of an element has the node set of
-:data:`robobore.cutting.fe.physics.thermal3d.HEX_FACES` ``[f]`` (so the neighbour table of
-:func:`robobore.cutting.fe.physics.thermal3d.face_neighbours` serves as ``fnbr``), taken in
-the cyclic order of :data:`FACES_OUT` whose right-hand normal points out of the element.
+scripts. The volumes (hexahedra, swept faces, the face numbering) are in
+:mod:`robobore.cutting.fe.ale.hexvolume3d`.
 """
 # ruff: noqa: E501
 
@@ -61,24 +57,21 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.cutting.fe.ale.groups3d import Cells3, ElementState3, Nodes3, RemapWork3
-from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
+from robobore.cutting.fe.ale.hexvolume3d import (
+    corner_gradient,
+    elem_volume,
+    element_volumes3,
+    swept_face,
+)
+from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_VIRGIN
 
 __all__ = [
-    "BF_CLOSED", "BF_OPEN", "BF_VIRGIN", "FACES_OUT", "N_RZ3", "N_INTENSIVE3", "VEL_MOMENTUM",
-    "VEL_TAYLOR", "dv_py", "hex_volume_py", "hex_volume", "face_corner_py", "swept_face_py",
-    "swept_face", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
+    "N_RZ3", "N_INTENSIVE3", "VEL_MOMENTUM", "VEL_TAYLOR", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
     "rz3_taylor_py", "rz3_taylor", "rz3_write_py", "rz3_write", "rz3_node_mass_py",
     "rz3_node_mass", "remap3d", "remap3d_py", "remap3d_inputs", "remap3d_groups",
-    "remap3d_outputs", "element_volumes3",
+    "remap3d_outputs",
 ]
 
-#: corners of each face, cyclic with the right-hand normal pointing out of the element; the
-#: node sets (and the face numbers) of ``thermal3d.HEX_FACES``: xi = -1, xi = +1, eta = -1,
-#: eta = +1, zeta = -1, zeta = +1
-FACES_OUT = np.array([(0, 4, 7, 3), (1, 2, 6, 5), (0, 1, 5, 4), (3, 7, 6, 2), (0, 3, 2, 1),
-                      (4, 5, 6, 7)], np.int64)
-_CODES = tuple(int(sum(int(c) << (3 * (3 - j)) for j, c in enumerate(f))) for f in FACES_OUT)
-_C0, _C1, _C2, _C3, _C4, _C5 = _CODES
 #: remapped intensive element fields (volume-weighted averages): sd (6), pres, eps_p, temp,
 #: dmg, qh (12); then in ``buf``: the new reference volume, the new momentum / rho_s (3),
 #: the old momentum / rho_s (3)
@@ -91,116 +84,6 @@ N_RZ3 = N_INTENSIVE3 + 7
 VEL_MOMENTUM, VEL_TAYLOR = 0, 1
 
 
-def face_corner_py(f, j):
-    """Corner (0-7) number ``j`` (0-3) of face ``f`` (0-5) of :data:`FACES_OUT`."""
-    if f == 0:
-        code = _C0
-    elif f == 1:
-        code = _C1
-    elif f == 2:
-        code = _C2
-    elif f == 3:
-        code = _C3
-    elif f == 4:
-        code = _C4
-    else:
-        code = _C5
-    return (code >> (3 * (3 - j))) & 7
-
-
-def dv_py(c, p0, p1, p2, p3, p4, p5, p6, p7, q0, q1, q2, q3, q4, q5, q6, q7):
-    """``dV/dx_c`` of a trilinear hexahedron's volume with respect to corner ``c``'s x, given
-    the corners' y (``p``) and z (``q``); cyclic: ``dV/dy_c = dv(c, z, x)``, ``dV/dz_c =
-    dv(c, x, y)`` (Flanagan & Belytschko 1981, eq. 79: the coefficients of
-    :func:`robobore.cutting.fe.hex.element.hex_element_py`)."""
-    if c == 0:
-        return (p1*(-q2-q3+q4+q5) + p2*(q1-q3) + p3*(q1+q2-q4-q7) + p4*(-q1+q3-q5+q7) + p5*(-q1+q4) + p7*(q3-q4)) / 12.0
-    elif c == 1:
-        return (p0*(q2+q3-q4-q5) + p2*(-q0-q3+q5+q6) + p3*(-q0+q2) + p4*(q0-q5) + p5*(q0-q2+q4-q6) + p6*(-q2+q5)) / 12.0
-    elif c == 2:
-        return (p0*(-q1+q3) + p1*(q0+q3-q5-q6) + p3*(-q0-q1+q6+q7) + p5*(q1-q6) + p6*(q1-q3+q5-q7) + p7*(-q3+q6)) / 12.0
-    elif c == 3:
-        return (p0*(-q1-q2+q4+q7) + p1*(q0-q2) + p2*(q0+q1-q6-q7) + p4*(-q0+q7) + p6*(q2-q7) + p7*(-q0+q2-q4+q6)) / 12.0
-    elif c == 4:
-        return (p0*(q1-q3+q5-q7) + p1*(-q0+q5) + p3*(q0-q7) + p5*(-q0-q1+q6+q7) + p6*(-q5+q7) + p7*(q0+q3-q5-q6)) / 12.0
-    elif c == 5:
-        return (p0*(q1-q4) + p1*(-q0+q2-q4+q6) + p2*(-q1+q6) + p4*(q0+q1-q6-q7) + p6*(-q1-q2+q4+q7) + p7*(q4-q6)) / 12.0
-    elif c == 6:
-        return (p1*(q2-q5) + p2*(-q1+q3-q5+q7) + p3*(-q2+q7) + p4*(q5-q7) + p5*(q1+q2-q4-q7) + p7*(-q2-q3+q4+q5)) / 12.0
-    return (p0*(-q3+q4) + p2*(q3-q6) + p3*(q0-q2+q4-q6) + p4*(-q0-q3+q5+q6) + p5*(-q4+q6) + p6*(q2+q3-q4-q5)) / 12.0
-
-
-dv = njit(cache=True, inline="always")(dv_py)
-
-
-def hex_volume_py(x0, x1, x2, x3, x4, x5, x6, x7, y0, y1, y2, y3, y4, y5, y6, y7,
-                  z0, z1, z2, z3, z4, z5, z6, z7):
-    """Signed volume of the trilinear hexahedron with corners 0-7 in VTK order (positive for
-    the node order of :mod:`robobore.cutting.fe.hex.element`): ``sum_I x_I dV/dx_I`` with the
-    element's volume derivatives (:func:`dv_py`), exact for any trilinear hexahedron;
-    evaluated in coordinates relative to corner 0."""
-    x1 -= x0
-    x2 -= x0
-    x3 -= x0
-    x4 -= x0
-    x5 -= x0
-    x6 -= x0
-    x7 -= x0
-    y1 -= y0
-    y2 -= y0
-    y3 -= y0
-    y4 -= y0
-    y5 -= y0
-    y6 -= y0
-    y7 -= y0
-    z1 -= z0
-    z2 -= z0
-    z3 -= z0
-    z4 -= z0
-    z5 -= z0
-    z6 -= z0
-    z7 -= z0
-    v = 0.0
-    for c in range(1, 8):
-        xc = x1 if c == 1 else x2 if c == 2 else x3 if c == 3 else x4 if c == 4 else \
-            x5 if c == 5 else x6 if c == 6 else x7
-        v += xc * dv(c, 0.0, y1, y2, y3, y4, y5, y6, y7, 0.0, z1, z2, z3, z4, z5, z6, z7)
-    return v
-
-
-hex_volume = njit(cache=True, inline="always")(hex_volume_py)
-
-
-def swept_face_py(e, f, conn, x, y, z, xn, yn, zn):
-    """Volume swept outward by face ``f`` of element ``e`` moving from ``x, y, z`` to
-    ``xn, yn, zn`` (the trilinear hexahedron old face -> new face, see the module
-    docstring); negative when the face moves into the element."""
-    a = conn[e, face_corner(f, 0)]
-    b = conn[e, face_corner(f, 1)]
-    c = conn[e, face_corner(f, 2)]
-    d = conn[e, face_corner(f, 3)]
-    if (x[a] == xn[a] and y[a] == yn[a] and z[a] == zn[a] and x[b] == xn[b] and y[b] == yn[b]
-            and z[b] == zn[b] and x[c] == xn[c] and y[c] == yn[c] and z[c] == zn[c]
-            and x[d] == xn[d] and y[d] == yn[d] and z[d] == zn[d]):
-        return 0.0  # a face that does not move sweeps nothing (not a round-off residue)
-    return hex_volume(x[a], x[b], x[c], x[d], xn[a], xn[b], xn[c], xn[d],
-                      y[a], y[b], y[c], y[d], yn[a], yn[b], yn[c], yn[d],
-                      z[a], z[b], z[c], z[d], zn[a], zn[b], zn[c], zn[d])
-
-
-face_corner = njit(cache=True, inline="always")(face_corner_py)
-swept_face = njit(cache=True, inline="always")(swept_face_py)
-
-
-def _elem_volume_py(e, conn, x, y, z):
-    i0, i1, i2, i3 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
-    i4, i5, i6, i7 = conn[e, 4], conn[e, 5], conn[e, 6], conn[e, 7]
-    return hex_volume(x[i0], x[i1], x[i2], x[i3], x[i4], x[i5], x[i6], x[i7],
-                      y[i0], y[i1], y[i2], y[i3], y[i4], y[i5], y[i6], y[i7],
-                      z[i0], z[i1], z[i2], z[i3], z[i4], z[i5], z[i6], z[i7])
-
-
-_elem_volume = njit(cache=True, inline="always")(_elem_volume_py)
 
 
 def _gather_py(e, w, u, sd, pres, eps_p, temp, dmg, qh, buf):
@@ -246,7 +129,7 @@ def rz3_flux_py(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, bu
         buf[e, f] = 0.0
     if alive[e] != 1:
         return
-    v_old = _elem_volume(e, conn, x, y, z)
+    v_old = elem_volume(e, conn, x, y, z)
     v_new = v_old
     _gather(e, v_old, e, sd, pres, eps_p, temp, dmg, qh, buf)
     m_new = vol0[e]
@@ -284,7 +167,7 @@ def rz3_flux_py(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, bu
             if sw <= 0.0:
                 u = np.int64(e)
         _gather(e, sw, u, sd, pres, eps_p, temp, dmg, qh, buf)
-        dm = sw * vol0[u] / _elem_volume(u, conn, x, y, z)
+        dm = sw * vol0[u] / elem_volume(u, conn, x, y, z)
         m_new += dm
         px += dm * _mean_velocity(u, 0, conn, vx, vy, vz)
         py += dm * _mean_velocity(u, 1, conn, vx, vy, vz)
@@ -381,10 +264,10 @@ def rz3_taylor_py(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive, fix
         e = nel[q]
         if alive[e] != 1:
             continue
-        vol = _elem_volume(e, conn, x, y, z)
+        vol = elem_volume(e, conn, x, y, z)
         for c in range(8):
             m = conn[e, c]
-            bx, by, bz = _corner_gradient(e, c, conn, x, y, z)
+            bx, by, bz = corner_gradient(e, c, conn, x, y, z)
             bx /= vol
             by /= vol
             bz /= vol
@@ -411,28 +294,6 @@ def rz3_taylor_py(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive, fix
     return 1
 
 
-def _corner_gradient_py(e, c, conn, x, y, z):
-    """``dV/dx_c`` (3 components) of hexahedron ``e``'s volume with respect to its corner
-    ``c`` (:func:`dv_py`, in coordinates relative to corner 0)."""
-    i0 = conn[e, 0]
-    ox = x[i0]
-    oy = y[i0]
-    oz = z[i0]
-    i1, i2, i3 = conn[e, 1], conn[e, 2], conn[e, 3]
-    i4, i5, i6, i7 = conn[e, 4], conn[e, 5], conn[e, 6], conn[e, 7]
-    x1, x2, x3, x4 = x[i1] - ox, x[i2] - ox, x[i3] - ox, x[i4] - ox
-    x5, x6, x7 = x[i5] - ox, x[i6] - ox, x[i7] - ox
-    y1, y2, y3, y4 = y[i1] - oy, y[i2] - oy, y[i3] - oy, y[i4] - oy
-    y5, y6, y7 = y[i5] - oy, y[i6] - oy, y[i7] - oy
-    z1, z2, z3, z4 = z[i1] - oz, z[i2] - oz, z[i3] - oz, z[i4] - oz
-    z5, z6, z7 = z[i5] - oz, z[i6] - oz, z[i7] - oz
-    gx = dv(c, 0.0, y1, y2, y3, y4, y5, y6, y7, 0.0, z1, z2, z3, z4, z5, z6, z7)
-    gy = dv(c, 0.0, z1, z2, z3, z4, z5, z6, z7, 0.0, x1, x2, x3, x4, x5, x6, x7)
-    gz = dv(c, 0.0, x1, x2, x3, x4, x5, x6, x7, 0.0, y1, y2, y3, y4, y5, y6, y7)
-    return gx, gy, gz
-
-
-_corner_gradient = njit(cache=True, inline="always")(_corner_gradient_py)
 rz3_taylor = njit(cache=True, inline="always")(rz3_taylor_py)
 
 
@@ -538,22 +399,6 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
         rz3_node_mass(n, ptr, nel, alive, vol0, rho_s, msf, mass)
     return moved
 
-
-@njit(cache=True)
-def _volumes(conn, x, y, z, out):
-    for e in range(conn.shape[0]):
-        out[e] = _elem_volume(e, conn, x, y, z)
-
-
-def element_volumes3(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
-    """Volumes (e,) [m^3] of the hexahedra ``conn`` (e, 8) over ``nodes`` (n, 3), by
-    :func:`hex_volume_py` (equal to :func:`robobore.cutting.fe.engine.state3d.hex_volumes`
-    to round-off)."""
-    nodes = np.ascontiguousarray(nodes, np.float64)
-    out = np.empty(conn.shape[0])
-    _volumes(np.ascontiguousarray(conn, np.int64), nodes[:, 0].copy(), nodes[:, 1].copy(),
-             nodes[:, 2].copy(), out)
-    return out
 
 
 def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,

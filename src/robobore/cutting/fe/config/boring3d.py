@@ -12,8 +12,9 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from robobore.cutting.fe.config.orthogonal import ContactSection as ContactSection2D
-from robobore.cutting.fe.config.orthogonal import MaterialSection, apply_parameter_set
+from robobore.cutting.fe.config.contact import ContactSection as ContactSection2D
+from robobore.cutting.fe.config.frame import Frame
+from robobore.cutting.fe.config.orthogonal import MaterialSection, ParameterSetConfig
 from robobore.cutting.fe.config.solver import SolverSettings, Strict
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
@@ -59,7 +60,7 @@ class CutSection(Strict):
 
 class ContactSection(ContactSection2D):
     """The 2D engine's ``[contact]``
-    (:class:`robobore.cutting.fe.config.orthogonal.ContactSection`): the same keys, values and
+    (:class:`robobore.cutting.fe.config.contact.ContactSection`): the same keys, values and
     defaults -- ``friction`` a bundled friction law (default ``rech2013_calibrated``: the Rech
     et al. 2013 table x 1.5 read at each contact node's filtered sliding speed, no shear cap),
     "table" or a constant Coulomb coefficient; ``friction_velocity``, ``friction_table_*``,
@@ -102,7 +103,7 @@ class MeshSection(Strict):
     #: (``depth_factor``, ``side_margin_um``, ``ahead_mm``, ``separation``,
     #: ``separation_height_um``, ``chip_rows``, ``solver.erosion``,
     #: ``solver.separation_gate_um``, ``solver.erode_time_step_fraction``) are an error
-    frame: Literal["workpiece", "tool"] = "tool"
+    frame: Frame = Frame.TOOL
     #: tool frame: element round the edge [um] (None: element_size_um / 4, the 2D model's)
     edge_element_um: float | None = Field(default=None, gt=0.0)
     #: tool frame: largest step between slices along the feed [um] (None: element_size_um)
@@ -178,7 +179,7 @@ class ToolSupportSection(Strict):
                                       strict=True)]
 
 
-class BoringFEConfig(Strict):
+class BoringFEConfig(ParameterSetConfig):
     #: the 2D engine's switch (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`):
     #: "calibrated" (default) -- friction law "rech2013_calibrated" and the material file's
     #: hardening hold (TC4: plastic strain 0.6), the validated 2D model's CALIBRATED choices;
@@ -192,13 +193,6 @@ class BoringFEConfig(Strict):
     mesh: MeshSection
     solver: SolverSection = SolverSection()
     tool_support: ToolSupportSection | None = None
-
-    @model_validator(mode="before")
-    @classmethod
-    def _parameter_set(cls, data: Any) -> Any:
-        # the 2D config's rule: the friction law and hardening of ``parameters`` where the
-        # keys are not given
-        return apply_parameter_set(data) if isinstance(data, dict) else data
 
     def friction_law(self) -> str:
         """The friction law in words (:meth:`ContactSection.law_description`)."""
@@ -222,14 +216,14 @@ def parse_boring_config(data: dict[str, Any], source: str | None = None) -> Bori
         raise ConfigError("edge radius not smaller than the nose radius", file=source,
                           field="insert.edge_radius_um", value=cfg.insert.edge_radius_um,
                           expected=f"< {cfg.insert.nose_radius_mm * 1e3:g} um")
-    if cfg.mesh.frame == "tool":
+    if cfg.mesh.frame.is_tool:
         _check_tool_frame(cfg, source)
     if cfg.cut.bore_diameter_mm < 20 * cfg.cut.cut_length_mm:
         raise ConfigError("bore too small for the locally flat wall model", file=source,
                           field="cut.bore_diameter_mm", value=cfg.cut.bore_diameter_mm,
                           expected=f">= 20 x cut.cut_length_mm = "
                           f"{20 * cfg.cut.cut_length_mm:g} mm")
-    from robobore.cutting.fe.config.spec import build_boring_spec
+    from robobore.cutting.fe.config.spec_build import build_boring_spec
     from robobore.cutting.fe.mesh.memory import check_fe3d
 
     # the model choices: a key the chosen variants have no place for is an error at load

@@ -14,12 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe.config.spec import (
-    friction_spec,
-    thermal_spec,
-    write_friction,
-    write_thermal,
-)
+from robobore.cutting.fe.config.spec import write_friction, write_thermal
+from robobore.cutting.fe.config.spec_build import friction_spec, thermal_spec
 from robobore.material import Material
 
 

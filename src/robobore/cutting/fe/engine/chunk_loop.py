@@ -68,7 +68,7 @@ from robobore.cutting.fe.engine.layout import (
     T_GX,
     T_UX,
 )
-from robobore.cutting.fe.engine.step_loop import make_chunk_loop, no_remesh_py
+from robobore.cutting.fe.engine.step_loop import StepPhases, make_chunk_loop, no_remesh_py
 from robobore.cutting.fe.physics.thermal2d import (
     conduct,
     parting_conduct,
@@ -210,10 +210,10 @@ _no_remesh = njit(inline="always")(no_remesh_py)
 def _bind(name, elements, remesh, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 2D phases
     return make_chunk_loop(name=name, state=ChunkState, n_split=ENGINE2["N_SPLIT"],
-                           energy_arrays=_energy_arrays, kinematics=tool_kinematics,
-                           nodes=_nodes, tool_step=_tool_step, remesh=remesh,
-                           elements=elements, heat=heat, end_step=_end_step,
-                           energy_totals=_energy_totals)
+                           energy_arrays=_energy_arrays, energy_totals=_energy_totals,
+                           phases=StepPhases(kinematics=tool_kinematics, nodes=_nodes,
+                                             tool_step=_tool_step, elements=elements,
+                                             heat=heat, end_step=_end_step, remesh=remesh))
 
 
 @dataclass(frozen=True)

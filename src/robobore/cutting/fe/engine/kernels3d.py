@@ -52,7 +52,7 @@ from robobore.cutting.fe.ale.groups3d import (
 )
 from robobore.cutting.fe.ale.rezone3d import rezone3d
 from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
-from robobore.cutting.fe.engine.step_loop import make_chunk_loop
+from robobore.cutting.fe.engine.step_loop import StepPhases, make_chunk_loop
 from robobore.cutting.fe.hex.element import hex_element
 from robobore.cutting.fe.hex.layout3d import (
     P_ALE_X0,
@@ -370,10 +370,11 @@ def _no_heat3(s, step, t, dt):
 def _bind3(name, remesh, elements, heat):
     # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases
     return make_chunk_loop(name=name, state=ChunkState3, n_split=ENGINE3["N_SPLIT"],
-                           energy_arrays=_energy_arrays3, kinematics=tool_kinematics,
-                           nodes=_nodes3, tool_step=_tool_step3, remesh=remesh,
-                           elements=elements, heat=heat, end_step=_end_step3,
-                           energy_totals=_energy_totals3, totals_at_chunk_end=True)
+                           energy_arrays=_energy_arrays3, energy_totals=_energy_totals3,
+                           phases=StepPhases(kinematics=tool_kinematics, nodes=_nodes3,
+                                             tool_step=_tool_step3, elements=elements,
+                                             heat=heat, end_step=_end_step3, remesh=remesh),
+                           totals_at_chunk_end=True)
 
 
 # the step loop of robobore.cutting.fe.engine.step_loop bound to the 3D phases, one per

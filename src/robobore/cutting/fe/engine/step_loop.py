@@ -38,12 +38,15 @@ a change to this module needs the cache files cleared (``*.nbi``, ``*.nbc``).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 from numba import njit
 
 from robobore.cutting.fe.engine.layout import E_EXT, I_STEP
 
-__all__ = ["make_chunk_loop", "no_remesh_py"]
+__all__ = ["StepPhases", "make_chunk_loop", "no_remesh_py"]
 
 
 def no_remesh_py(s, step):
@@ -54,9 +57,29 @@ def no_remesh_py(s, step):
 _no_remesh = njit(inline="always")(no_remesh_py)
 
 
-def make_chunk_loop(*, name: str, state, n_split: int, energy_arrays, kinematics, nodes,
-                    tool_step, elements, heat, end_step, energy_totals, remesh=None,
-                    totals_at_chunk_end: bool = False):
+@dataclass(frozen=True)
+class StepPhases:
+    """The phases of one engine's step (the module docstring's steps 1-6), each compiled with
+    ``njit(inline="always")``."""
+
+    #: ``kinematics(tool, prm)``: the tool's motion for the node update
+    kinematics: Any
+    #: ``nodes(s, kin, dt, split) -> (fx, fy, fz, ncont)``: the node update with the contact
+    nodes: Any
+    #: ``tool_step(s, fx, fy, fz, dt)``: the tool support's step, returns the external work
+    tool_step: Any
+    #: ``elements(s, dt) -> (dtmin, bad)``: the element update
+    elements: Any
+    #: ``heat(s, step, t, dt)``: the conduction pass (a no-op when adiabatic)
+    heat: Any
+    #: the engine's end of step (:func:`robobore.cutting.fe.engine.history.make_end_step`)
+    end_step: Any
+    #: ``remesh(s, step)``: the ALE pass; None: none (:func:`no_remesh_py`)
+    remesh: Any = None
+
+
+def make_chunk_loop(*, name: str, state, n_split: int, energy_arrays, energy_totals,
+                    phases: StepPhases, totals_at_chunk_end: bool = False):
     """The chunk loop of the module docstring for one engine, compiled with ``numba.njit``
     (not cached: the engines call it from their own cached functions).
 
@@ -66,14 +89,18 @@ def make_chunk_loop(*, name: str, state, n_split: int, energy_arrays, kinematics
     in another process and both loaded from numba's cache into one, could resolve to one
     machine code; ``state``: the namedtuple class of the state arrays (the order of
     ``kernel_args()``); ``n_split``: the length of the force-by-face buffer (the engine's
-    ``N_SPLIT``); ``energy_arrays(s)``: the arrays of ``energy_totals(es, en)``;
-    ``end_step``: the engine's
-    :func:`robobore.cutting.fe.engine.history.make_end_step`; ``remesh``: None for none
-    (:func:`no_remesh_py`); ``totals_at_chunk_end``: sum the energy totals after a chunk that
-    ran to its end; the phases as in the module docstring, each already compiled with
-    ``njit(inline="always")``.
+    ``N_SPLIT``); ``energy_arrays(s)``: the arrays of ``energy_totals(es, en)``; ``phases``:
+    the engine's :class:`StepPhases`; ``totals_at_chunk_end``: sum the energy totals after a
+    chunk that ran to its end.
     """
-    remesh = _no_remesh if remesh is None else remesh
+    # the phases as plain names of the closure: the compiled loop calls them directly
+    kinematics = phases.kinematics
+    nodes = phases.nodes
+    tool_step = phases.tool_step
+    elements = phases.elements
+    heat = phases.heat
+    end_step = phases.end_step
+    remesh = _no_remesh if phases.remesh is None else phases.remesh
 
     def chunk_loop(n_steps, *a):
         s = state(*a)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from robobore.cutting.fe.config.frame import Frame
 from robobore.io.memory import available_memory_bytes, check_memory
 
 __all__ = ["FE2D_BYTES_PER_ELEMENT", "FE3D_BYTES_PER_ELEMENT", "fe2d_elements",
@@ -35,7 +36,7 @@ def fe2d_elements(cfg: Any) -> float:
     """Element count of a 2D FE config (:class:`robobore.cutting.fe.config.orthogonal.FEConfig`)
     on its frame: :func:`toolframe2d_elements` or :func:`workpiece2d_elements` (the choice of
     the config check, before the model is chosen)."""
-    if getattr(cfg.mesh, "frame", "workpiece") == "tool":
+    if Frame(getattr(cfg.mesh, "frame", Frame.WORKPIECE)).is_tool:
         return toolframe2d_elements(cfg)
     return workpiece2d_elements(cfg)
 
@@ -84,7 +85,7 @@ def fe3d_elements(cfg: Any) -> float:
     """Element count of a 3D boring FE config (:class:`BoringFEConfig`) on its frame:
     :func:`toolframe3d_elements` (``mesh.frame = "tool"``) or :func:`workpiece3d_elements`
     (the choice of the config check, before the model is chosen)."""
-    if getattr(cfg.mesh, "frame", "workpiece") == "tool":
+    if Frame(getattr(cfg.mesh, "frame", Frame.WORKPIECE)).is_tool:
         return toolframe3d_elements(cfg)
     return workpiece3d_elements(cfg)
 

@@ -75,7 +75,7 @@ margin slice block A's top row is a free-surface chain. Every hexahedron face ca
 kind (:data:`FK_INTERIOR` ... :data:`FK_CHIP_SIDE`) and the remap's flux flag
 (``BF_VIRGIN`` on the inflow face, ``BF_OPEN`` on the outflow faces and the chip's sides,
 :mod:`robobore.cutting.fe.ale.remap3d`), in the face numbering of
-:data:`robobore.cutting.fe.ale.remap3d.FACES_OUT`.
+:data:`robobore.cutting.fe.ale.hexvolume3d.FACES_OUT`.
 
 **The ALE pass** on this mesh is :func:`robobore.cutting.fe.ale.rezone3d.rezone3d` (nodes
 kept in their planes, the 2D tool-frame placement in each plane, the 3D insert's "off tool"
@@ -152,7 +152,7 @@ class ToolFrameMesh3D(MeshSizes):
     2D class's neighbours within the slice (global indices, -1 pad: see
     :class:`robobore.cutting.fe.ale.toolframe.ToolFrameMesh`); ``elem_slice`` (e,) the lower
     slice of each hexahedron; ``fkind`` (e, 6) face kinds (``FK_*``) and ``bflag`` (e, 6)
-    the remap's flux flags, faces numbered as ``remap3d.FACES_OUT``; ``rigid`` (n,) the
+    the remap's flux flags, faces numbered as ``hexvolume3d.FACES_OUT``; ``rigid`` (n,) the
     inflow face and bottom; ``z_slices`` (k,) [m], ``engaged`` (k,) slices with a chip block;
     ``t`` (k,) true vertical uncut thickness, ``t_mesh`` (k,) the clamped one; ``h2`` (k,)
     the normal-section thickness each slice was built for; ``reference`` the 2D mesh of the

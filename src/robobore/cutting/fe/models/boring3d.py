@@ -57,7 +57,9 @@ from robobore.cutting.fe.models.choose import choose_boring
 from robobore.cutting.fe.models.results import (
     XYZ,
     BoringSummary,
+    ComponentComparison,
     Energies3D,
+    MechanisticComparison,
     RotatingForce,
     ToolSupport3D,
 )
@@ -220,30 +222,36 @@ def simulate_boring(cfg: BoringFEConfig, *, source: str | None = None,
 
 # ----------------------------------------------------------------------------- comparison
 def compare_with_mechanistic(result: BoringFEResult,
-                             coefficients: str | Path | None = None) -> dict[str, Any]:
+                             coefficients: str | Path | None = None) -> MechanisticComparison:
     """FE rotating-frame forces vs the mechanistic boring model at the same condition.
 
-    ``coefficients``: a coefficients file (:func:`robobore.cutting.forces.load_coefficients`)
-    -- e.g. the FE-calibrated one -- or None for the default TC4 coefficients
-    (:func:`robobore.cutting.forces.ti64_coefficients` at the run's cutting speed).
+    ``coefficients``: a coefficients file
+    (:func:`robobore.cutting.coefficient_files.load_coefficients`) -- e.g. the FE-calibrated
+    one -- or None for the default TC4 coefficients
+    (:func:`robobore.cutting.coefficient_sets.ti64_coefficients` at the run's cutting speed).
     Returns per component (tangential, radial, feed) the FE and model forces [N] and the
-    relative difference (FE - model) / |model|.
+    relative difference (FE - model) / |model|, with the coefficients' provenance
+    (:class:`~robobore.cutting.fe.models.results.MechanisticComparison`).
     """
-    from robobore.cutting.forces import boring_forces, load_coefficients, ti64_coefficients
+    from robobore.cutting.coefficient_files import load_coefficients
+    from robobore.cutting.coefficient_sets import ti64_coefficients
+    from robobore.cutting.forces import boring_forces
 
     s = result.setup
     coef = (ti64_coefficients(s.vc * 60.0) if coefficients is None
             else load_coefficients(coefficients, s.vc * 60.0))
     mech = boring_forces(s.insert, s.ap, s.f, coef)
     fe = result.summary.force_rotating_N.to_dict()
-    out: dict[str, Any] = {"coefficients": coef.provenance if hasattr(coef, "provenance")
-                           else str(coefficients)}
+    parts = {}
     for comp, key in (("tangential", "tangential_N"), ("radial", "radial_N"),
                       ("feed", "feed_N")):
         m = float(mech[key])
-        out[comp] = {"fe_N": fe[comp], "model_N": m,
-                     "relative_difference": (fe[comp] - m) / abs(m) if m != 0 else math.nan}
-    return out
+        parts[comp] = ComponentComparison(
+            fe_N=fe[comp], model_N=m,
+            relative_difference=(fe[comp] - m) / abs(m) if m != 0 else math.nan)
+    return MechanisticComparison(
+        coefficients=coef.provenance if hasattr(coef, "provenance") else str(coefficients),
+        **parts)
 
 
 # ------------------------------------------------------------------------------------ VTK

@@ -14,7 +14,8 @@ import numpy as np
 
 from robobore.cutting.fe.config.boring3d import BoringFEConfig
 from robobore.cutting.fe.config.engine_settings import apply_numerics
-from robobore.cutting.fe.config.spec import ModelSpec, build_boring_spec
+from robobore.cutting.fe.config.spec import ModelSpec
+from robobore.cutting.fe.config.spec_build import build_boring_spec
 from robobore.cutting.fe.engine.state3d import FEState3, default_prm3, make_state3
 from robobore.cutting.fe.hex import layout3d
 from robobore.cutting.fe.mesh.boring3d import build_boring_mesh

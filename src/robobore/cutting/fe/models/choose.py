@@ -174,7 +174,7 @@ def choose_orthogonal(cfg: FEConfig, device: str = "cpu",
 
         check_gpu_supported(cfg.solver.element, source)
         require_gpu()
-    cls = Orthogonal2DTool if cfg.mesh.frame == "tool" else Orthogonal2DWork
+    cls = Orthogonal2DTool if cfg.mesh.frame.is_tool else Orthogonal2DWork
     return cls(cfg=cfg, device=device, loop=_gpu2d if device == "gpu" else _cpu2d)
 
 
@@ -294,7 +294,7 @@ def choose_boring(cfg: BoringFEConfig, device: str = "cpu",
     GPU with the tool frame (its ALE pass runs on the CPU only) or a GPU that is not
     there."""
     check_device(device, source)
-    tool = cfg.mesh.frame == "tool"
+    tool = cfg.mesh.frame.is_tool
     if device == "gpu":
         if tool:
             raise ConfigError(

@@ -16,7 +16,8 @@ import numpy as np
 from robobore.cutting.fe.ale.rezone import TF_RIGID
 from robobore.cutting.fe.config.engine_settings import apply_numerics
 from robobore.cutting.fe.config.orthogonal import FEConfig
-from robobore.cutting.fe.config.spec import ModelSpec, build_spec
+from robobore.cutting.fe.config.spec import ModelSpec
+from robobore.cutting.fe.config.spec_build import build_spec
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import energy_check, energy_error
 from robobore.cutting.fe.engine.chunk_loop import phases_of

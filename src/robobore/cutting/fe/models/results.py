@@ -1,4 +1,5 @@
-"""Typed summaries of the FE runs: the orthogonal 2D run, the 3D boring run and the 3D slab.
+"""Typed summaries of the FE runs: the orthogonal 2D run, the 3D boring run and the 3D slab;
+the 3D run against the mechanistic model; the validation against measured forces.
 
 Each summary is a frozen dataclass whose fields are documented one by one (``#:`` above the
 field, in the unit its name carries); ``to_dict()`` gives the JSON the CLI writes
@@ -15,7 +16,9 @@ from typing import Any
 
 __all__ = ["RotatingForce", "XYZ", "FaceForce", "FaceForces", "Energies3D",
            "ToolSupport2D", "OrthogonalSummary", "ToolFrameMeshSummary", "ToolSupport3D",
-           "BoringSummary", "SlabSummary"]
+           "BoringSummary", "SlabSummary", "ComponentComparison", "MechanisticComparison",
+           "PerQuantity", "MeasuredValues", "ValidationPoint", "ValidationSummary",
+           "ValidationResult"]
 
 
 def _plain(v: Any) -> Any:
@@ -361,3 +364,116 @@ class SlabSummary(_Record):
     steps: int
     #: the stable time step at the end
     final_time_step_s: float
+
+
+@dataclass(frozen=True)
+class ComponentComparison(_Record):
+    """One rotating-frame component of the FE force against the mechanistic model [N]."""
+
+    #: the FE run's mean force
+    fe_N: float
+    #: the mechanistic boring model's force at the same condition
+    model_N: float
+    #: (FE - model) / |model| (nan where the model's force is 0)
+    relative_difference: float
+
+
+@dataclass(frozen=True)
+class MechanisticComparison(_Record):
+    """The FE boring forces against the mechanistic model
+    (:func:`robobore.cutting.fe.models.boring3d.compare_with_mechanistic`); ``to_dict()`` is
+    the ``mechanistic_comparison`` of ``robobore fe boring --json``."""
+
+    #: the provenance of the mechanistic model's cutting coefficients
+    coefficients: str
+    #: against the cutting velocity
+    tangential: ComponentComparison
+    #: along e_r, positive outwards
+    radial: ComponentComparison
+    #: along +Z, the feed
+    feed: ComponentComparison
+
+
+@dataclass(frozen=True)
+class PerQuantity(_Record):
+    """One value per validated quantity (a relative error ``simulated / measured - 1``, a
+    statistic of them or a count; None where there is none)."""
+
+    #: of the cutting force
+    cutting_force: float | int | None
+    #: of the feed (thrust) force
+    feed_force: float | int | None
+    #: of the chip ratio (chip thickness / uncut chip thickness)
+    chip_ratio: float | int | None
+
+
+@dataclass(frozen=True)
+class MeasuredValues(_Record):
+    """The measured values of a validation point (None: not measured)."""
+
+    #: cutting force per mm of width [N/mm]
+    cutting_force_N_per_mm: float | None
+    #: feed (thrust) force per mm of width [N/mm]
+    feed_force_N_per_mm: float | None
+    #: chip thickness / uncut chip thickness
+    chip_ratio: float | None
+
+
+@dataclass(frozen=True)
+class ValidationPoint(_Record):
+    """One point of an FE validation: the simulated values against the measured ones."""
+
+    #: uncut chip thickness [um]
+    uncut_chip_thickness_um: float
+    #: cutting speed [m/min]
+    cutting_speed_m_per_min: float
+    #: simulated cutting force per mm of width [N/mm] (None: not finite)
+    cutting_force_N_per_mm: float | None
+    #: simulated feed force per mm of width [N/mm] (None: not finite)
+    feed_force_N_per_mm: float | None
+    #: simulated chip ratio (None: not measured in the run)
+    chip_ratio: float | None
+    #: simulated / measured - 1 per quantity (None: no measured value)
+    relative_error: PerQuantity
+    #: the measured values
+    measured: MeasuredValues
+    #: relative energy-balance error of the run
+    energy_error: float | None
+    #: wall time of the run [s] (of the run that stored a reused result)
+    wall_time_s: float | None
+    #: element updates per second of the run
+    element_updates_per_s: float | None
+    #: the result was read from the results folder, not run again
+    reused: bool
+    #: the stored result's file (None: no results folder)
+    file: str | None
+
+
+@dataclass(frozen=True)
+class ValidationSummary(_Record):
+    """The errors of a validation over its points, per quantity."""
+
+    #: largest |relative error| (None: no point measured)
+    max_abs_error: PerQuantity
+    #: mean |relative error| (None: no point measured)
+    mean_abs_error: PerQuantity
+    #: number of points with a measured value
+    n_measured: PerQuantity
+
+
+@dataclass(frozen=True)
+class ValidationResult(_Record):
+    """An FE validation run (:func:`robobore.cutting.fe.models.validate.run_validation`);
+    ``to_dict()`` is the ``--json`` of ``robobore fe validate`` (docs/fe.md) before the
+    command adds the measured file and the identity."""
+
+    #: the points, in the order run
+    points: tuple[ValidationPoint, ...]
+    #: the errors over the points
+    summary: ValidationSummary
+    #: the base config's name
+    config: str
+    #: the device the points ran on
+    device: str
+    #: the results folder (None: none)
+    out_dir: str | None

@@ -33,13 +33,8 @@ from robobore.cutting.fe.config.engine_settings import (
     apply_numerics,
 )
 from robobore.cutting.fe.config.orthogonal import FEConfig
-from robobore.cutting.fe.config.spec import (
-    HexElement,
-    ModelSpec,
-    WorkpieceFrame,
-    WorkpieceFrame3D,
-    build_spec,
-)
+from robobore.cutting.fe.config.spec import HexElement, ModelSpec, WorkpieceFrame, WorkpieceFrame3D
+from robobore.cutting.fe.config.spec_build import build_spec
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import energy_error
 from robobore.cutting.fe.engine.state3d import (
@@ -74,7 +69,7 @@ def setup_slab3(cfg: FEConfig, *, n_z: int = 2, depth_factor: float = 1.5,
     """3D plane-strain slab of the 2D config ``cfg`` (workpiece frame, node splitting only)."""
     if choose_orthogonal(cfg).tool_frame:
         raise ConfigError("the 3D slab cross-check is a workpiece-frame model",
-                          field="mesh.frame", value=cfg.mesh.frame, expected='"workpiece"')
+                          field="mesh.frame", value=cfg.mesh.frame.value, expected='"workpiece"')
     if cfg.mesh.separation != "node_split":
         raise ConfigError("the 3D slab cross-check needs node splitting",
                           field="mesh.separation", value=cfg.mesh.separation,
@@ -160,7 +155,7 @@ def setup_slab3_toolframe(cfg: FEConfig, *, n_z: int = 2) -> SlabSetup:
 
     if not choose_orthogonal(cfg).tool_frame:
         raise ConfigError("the tool-frame slab needs the 2D tool-frame model",
-                          field="mesh.frame", value=cfg.mesh.frame, expected='"tool"')
+                          field="mesh.frame", value=cfg.mesh.frame.value, expected='"tool"')
     setup2 = setup_orthogonal(cfg)
     spec2 = setup2.spec
     assert spec2 is not None and isinstance(spec2.frame, ToolFrame)

@@ -30,11 +30,12 @@ checked from the start of the run).
 from __future__ import annotations
 
 import math
+
 import numpy as np
 
-from robobore.cutting.fe.ale.remap3d import FACES_OUT
+from robobore.cutting.fe.ale.hexvolume3d import FACES_OUT
 from robobore.cutting.fe.config.boring3d import BoringFEConfig
-from robobore.cutting.fe.config.spec import build_boring_spec
+from robobore.cutting.fe.config.spec_build import build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import FEState3, element_steps3, make_state3
 from robobore.cutting.fe.hex import layout3d, scalar3d
@@ -122,7 +123,7 @@ def setup_boring_toolframe(cfg: BoringFEConfig, source: str | None = None):
         mesh = build_toolframe3d_mesh(ins, ap, f, sizes)
     except ValueError as exc:
         raise ConfigError(f"no tool-frame mesh for this insert and cut: {exc}", file=source,
-                          field="mesh.frame", value=m.frame,
+                          field="mesh.frame", value=m.frame.value,
                           expected="an engaged edge that contains the nose tip and a chip that "
                           "stays below the nose's centre in every slice (the tool frame's "
                           "domain, docs/fe3d.md: with the paper's insert, 0.4 mm nose, ap up "

@@ -38,6 +38,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from robobore.cutting.fe.models.results import (
+    MeasuredValues,
+    PerQuantity,
+    ValidationPoint,
+    ValidationResult,
+    ValidationSummary,
+)
 from robobore.errors import ConfigError, DataError
 from robobore.io.readers import load_json
 
@@ -234,13 +241,15 @@ def run_validation(base: dict[str, Any], measured: list[MeasuredPoint], *,
                    source: str = "<config>", points: list[tuple[float, float]] | None = None,
                    out_dir: str | Path | None = None, device: str = "cpu",
                    progress: Callable[[float], None] | None = None,
-                   simulate: Callable[..., Any] | None = None) -> dict[str, Any]:
+                   simulate: Callable[..., Any] | None = None) -> ValidationResult:
     """Run ``base`` at every measured point (or at ``points``, measured or not) and compare.
 
     Every point's config is built and checked before the first run. With ``out_dir``, each
     point's result is written there atomically and reused on a rerun with the same point
-    config. ``progress(fraction of all points done)``. Returns ``{"points", "summary"}``
-    (the ``--json`` contract, docs/fe.md) plus ``config``, ``out_dir`` and per-point extras.
+    config. ``progress(fraction of all points done)``. Returns a
+    :class:`~robobore.cutting.fe.models.results.ValidationResult`: the points and their
+    summary (``to_dict()``: the ``--json`` contract, docs/fe.md) plus the config's name, the
+    device and the results folder.
     """
     from robobore import __version__
     from robobore.cutting.fe import FE_ENGINE_REVISION
@@ -311,8 +320,8 @@ def run_validation(base: dict[str, Any], measured: list[MeasuredPoint], *,
             progress((i + 1) / n)
         rows.append(_row(pl.point, stored["result"], cached,
                          None if pl.path is None else str(pl.path)))
-    return {"points": rows, "summary": summarize(rows), "config": source,
-            "device": device, "out_dir": None if out is None else str(out)}
+    return ValidationResult(points=tuple(rows), summary=_summarize(rows), config=source,
+                            device=device, out_dir=None if out is None else str(out))
 
 
 def _load_stored(path: Path | None, inputs: dict[str, Any]) -> dict[str, Any] | None:
@@ -330,36 +339,38 @@ def _load_stored(path: Path | None, inputs: dict[str, Any]) -> dict[str, Any] | 
     return d
 
 
-def _row(m: MeasuredPoint, r: dict[str, Any], cached: bool, file: str | None) -> dict[str, Any]:
+def _row(m: MeasuredPoint, r: dict[str, Any], cached: bool, file: str | None
+         ) -> ValidationPoint:
     sim = {q: r.get(QUANTITIES[q][0]) for q in QUANTITIES}
     meas = {q: getattr(m, q) for q in QUANTITIES}
-    return {
-        "uncut_chip_thickness_um": m.h_um,
-        "cutting_speed_m_per_min": m.vc_m_per_min,
-        "cutting_force_N_per_mm": sim["Fc"],
-        "feed_force_N_per_mm": sim["Ff"],
-        "chip_ratio": sim["chip_ratio"],
-        "relative_error": {QUANTITIES[q][1]: _rel(sim[q], meas[q]) for q in QUANTITIES},
-        "measured": {QUANTITIES[q][0]: meas[q] for q in QUANTITIES},
-        "energy_error": r.get("energy_error"),
-        "wall_time_s": r.get("wall_time_s"),
-        "element_updates_per_s": r.get("element_updates_per_s"),
-        "reused": cached,
-        "file": file,
-    }
+    return ValidationPoint(
+        uncut_chip_thickness_um=m.h_um,
+        cutting_speed_m_per_min=m.vc_m_per_min,
+        cutting_force_N_per_mm=sim["Fc"],
+        feed_force_N_per_mm=sim["Ff"],
+        chip_ratio=sim["chip_ratio"],
+        relative_error=PerQuantity(**{QUANTITIES[q][1]: _rel(sim[q], meas[q])
+                                      for q in QUANTITIES}),
+        measured=MeasuredValues(**{QUANTITIES[q][0]: meas[q] for q in QUANTITIES}),
+        energy_error=r.get("energy_error"),
+        wall_time_s=r.get("wall_time_s"),
+        element_updates_per_s=r.get("element_updates_per_s"),
+        reused=cached,
+        file=file,
+    )
 
 
-def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
+def _summarize(rows: list[ValidationPoint]) -> ValidationSummary:
     """Max and mean absolute relative error per quantity (None where no point has one)."""
     out: dict[str, dict[str, Any]] = {"max_abs_error": {}, "mean_abs_error": {},
                                       "n_measured": {}}
     for _, key, _ in QUANTITIES.values():
-        errs = [abs(r["relative_error"][key]) for r in rows
-                if r["relative_error"][key] is not None]
+        errs = [abs(getattr(r.relative_error, key)) for r in rows
+                if getattr(r.relative_error, key) is not None]
         out["max_abs_error"][key] = max(errs) if errs else None
         out["mean_abs_error"][key] = sum(errs) / len(errs) if errs else None
         out["n_measured"][key] = len(errs)
-    return out
+    return ValidationSummary(**{k: PerQuantity(**v) for k, v in out.items()})
 
 
 #: the bundled validation record of the default model: the ``--json`` output of
@@ -402,5 +413,5 @@ def load_validation_record(path: str | Path) -> dict[str, Any]:
 
 
 __all__ = ["MeasuredPoint", "read_measured", "parse_points", "point_config", "run_validation",
-           "summarize", "QUANTITIES", "BUNDLED_RECORD", "bundled_validation_path",
+           "QUANTITIES", "BUNDLED_RECORD", "bundled_validation_path",
            "load_validation_record"]

@@ -60,8 +60,9 @@ from typing import Any
 
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.engine import layout
-from robobore.cutting.fe.engine.gpu.kernels2d import N_RED, RUN_ARRAYS, RunState, kernels2
-from robobore.cutting.fe.engine.gpu.shared import blocks, drive_gpu, require_gpu
+from robobore.cutting.fe.engine.gpu.kernels2d import kernels2
+from robobore.cutting.fe.engine.gpu.runstate2d import N_RED, RUN_ARRAYS, RunState
+from robobore.cutting.fe.engine.gpu.shared import GpuEngine, blocks, drive_gpu, require_gpu
 from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
 
@@ -170,11 +171,11 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                        g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"], g["nwork"])
         tick("finish")
 
-    return drive_gpu(st, t_end, names=_ARRAYS, p_tend=layout.P_TEND, n_red=N_RED, k_run=k_run,
-                     run_state=RunState, run_extra=[erosion, cond_every, int(theat), rz_every],
-                     launch_step=launch_step, copy_back=_copy_back, label="simulation (GPU)",
-                     chunk_steps=chunk_steps, progress=progress, check=check, profile=profile,
-                     persistent=persistent)
+    engine = GpuEngine(names=_ARRAYS, p_tend=layout.P_TEND, n_red=N_RED, k_run=k_run,
+                       run_state=RunState, run_extra=[erosion, cond_every, int(theat), rz_every],
+                       launch_step=launch_step, copy_back=_copy_back, label="simulation (GPU)")
+    return drive_gpu(st, t_end, engine, chunk_steps=chunk_steps, progress=progress,
+                     check=check, profile=profile, persistent=persistent)
 
 
 def _ale_launches(g: dict, ale: tuple, gn: int, ge: int, gs: int) -> None:

@@ -37,6 +37,7 @@ from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, RUN_ARRAYS, RunState
 from robobore.cutting.fe.engine.gpu.shared import (
     MAX_BLOCK,
     THREADS,
+    GpuEngine,
     bind_cuda,
     blocks,
     chunk_list_py,
@@ -137,10 +138,11 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
                        g["en"], dred)
         tick("finish")
 
-    return drive_gpu(st, t_end, names=_RUN_ARGS, p_tend=layout3d.P_TEND, n_red=N_RED, k_run=k_run,
-                     run_state=RunState3, run_extra=[erosion], launch_step=launch_step,
-                     copy_back=_copy_back, label="3D simulation (GPU)", chunk_steps=chunk_steps,
-                     progress=progress, check=check, profile=profile, persistent=persistent)
+    engine = GpuEngine(names=_RUN_ARGS, p_tend=layout3d.P_TEND, n_red=N_RED, k_run=k_run,
+                       run_state=RunState3, run_extra=[erosion], launch_step=launch_step,
+                       copy_back=_copy_back, label="3D simulation (GPU)")
+    return drive_gpu(st, t_end, engine, chunk_steps=chunk_steps, progress=progress,
+                     check=check, profile=profile, persistent=persistent)
 
 
 #: the state arrays on the device, in the persistent kernel's state RunState3 (then erosion)

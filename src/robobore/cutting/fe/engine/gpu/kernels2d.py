@@ -5,7 +5,8 @@ engine (their device versions: :func:`robobore.cutting.fe.engine.gpu.device2d.de
 elements, the heat-conduction kernels, step end, the tool-frame ALE passes) and the
 persistent kernel ``k_run`` that runs a whole chunk of steps in one cooperative launch (the
 step loop of :func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel` with the 2D
-phases, on the state :data:`RunState`), for one
+phases, on the state
+:data:`robobore.cutting.fe.engine.gpu.runstate2d.RunState`), for one
 :class:`~robobore.cutting.fe.engine.chunk_loop.Phases` -- the CPU loop's model choice: the
 ALE phase only in the tool frame, the heat phase only with conduction, compiled in; the host
 driver is :func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`, whose docstring
@@ -15,7 +16,6 @@ describes the step's phases.
 from __future__ import annotations
 
 import functools
-from collections import namedtuple
 
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
@@ -25,31 +25,12 @@ from robobore.cutting.fe.engine.gpu.persistent import (
     R_DTMIN,
     persistent_kernel,
 )
+from robobore.cutting.fe.engine.gpu.runstate2d import R_FX, R_FY, R_NC, R_SPLIT
 from robobore.cutting.fe.engine.gpu.shared import bind_cuda
 from robobore.cutting.fe.quad import node_contact
 
-__all__ = ["kernels2", "RUN_ARRAYS", "RunState", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_NC",
-           "R_SPLIT", "N_RED"]
+__all__ = ["kernels2"]
 
-# reduction slots on the device (engine.gpu.persistent's R_DTMIN, R_BAD, then the two sums of
-# its contact-force total; the number of contact nodes, counted by atomic add)
-R_FX, R_FY, R_NC = 2, 3, 4
-#: the contact force by tool face (kernels.contact_split): rake x, y, edge arc x, y, flank x, y
-R_SPLIT = 5
-N_RED = 11
-
-#: FEState arrays used by the kernels (copied to the device), in the order of the persistent
-#: kernel's state
-RUN_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
-              "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx",
-              "qhy", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy",
-              "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
-              "clock", "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair",
-              "vslip", "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
-#: the persistent kernel's state: the arrays, then the erosion mode, the conduction interval
-#: [steps] (read with conduction only), 1 with the thermal contact, the ALE interval [steps]
-#: (read in the tool frame only)
-RunState = namedtuple("RunState", RUN_ARRAYS + ("erosion", "cond_every", "theat", "rz_every"))
 
 #: the numba.cuda module, bound on first use (a module global, so that numba's simulator can
 #: substitute its own inside the kernels)

@@ -3,7 +3,7 @@
 :func:`persistent_kernel` builds ``k_run(n_steps, a, red, cflag, clist)``, which runs
 ``n_steps`` whole time steps in one cooperative launch, from one dimension's device
 functions (its phases). ``a`` is the engine's state, a namedtuple of the state arrays and
-then its scalar settings (``RunState`` of :mod:`robobore.cutting.fe.engine.gpu.kernels2d`,
+then its scalar settings (``RunState`` of :mod:`robobore.cutting.fe.engine.gpu.runstate2d`,
 ``RunState3`` of :mod:`robobore.cutting.fe.engine.gpu.kernels3d`; both name ``x``, ``conn``,
 ``ist``, ``clock``, ``tool`` and ``prm``), ``red`` the reduction slots
 (:data:`R_DTMIN`, :data:`R_BAD`, then the contact-force sums from :data:`R_SUMS`), ``cflag``

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -21,7 +23,7 @@ from robobore.errors import ConfigError
 
 __all__ = ["THREADS", "MAX_BLOCK", "simulator_enabled", "cuda_available", "require_gpu",
            "jc_device_functions", "bind_cuda", "chunk_list_py", "persistent_run", "cooperative",
-           "profile_ticker", "blocks", "drive_gpu"]
+           "profile_ticker", "blocks", "GpuEngine", "drive_gpu"]
 
 #: threads per block of the GPU engines' launches
 THREADS = 128
@@ -200,43 +202,68 @@ def blocks(n: int) -> int:
     return max(1, (n + THREADS - 1) // THREADS)
 
 
-def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: int, k_run,
-              run_state, run_extra: list, launch_step: Callable, copy_back: Callable, label: str,
-              chunk_steps: int, progress: Callable[[float], None] | None,
-              check: Callable | None, profile: dict[str, float] | None,
-              persistent: bool | None) -> int:
+@dataclass(frozen=True)
+class GpuEngine:
+    """What :func:`drive_gpu` runs: one GPU engine's state on the device and its kernels."""
+
+    #: the state's arrays copied to the device, in the persistent kernel's order
+    names: tuple[str, ...]
+    #: the parameter slot of the end time
+    p_tend: int
+    #: the number of reduction slots of the kernels
+    n_red: int
+    #: the persistent kernel (:func:`robobore.cutting.fe.engine.gpu.persistent.persistent_kernel`)
+    k_run: Any
+    #: the namedtuple class of the persistent kernel's state: the arrays, then ``run_extra``
+    run_state: Any
+    #: the state's scalar settings after the arrays
+    run_extra: list
+    #: ``launch_step(g, dred, step, tick)``: one step as one launch per kernel
+    launch_step: Callable
+    #: ``copy_back(st, g)``: the device arrays back into the host state
+    copy_back: Callable
+    #: the run's name in an instability message
+    label: str
+
+
+def drive_gpu(st, t_end: float, engine: GpuEngine, *, chunk_steps: int,
+              progress: Callable[[float], None] | None, check: Callable | None,
+              profile: dict[str, float] | None, persistent: bool | None) -> int:
     """The host driver of both GPU engines
     (:func:`robobore.cutting.fe.engine.gpu.backend2d.advance_gpu`,
     :func:`robobore.cutting.fe.engine.gpu.backend3d.advance3_gpu`): the state's arrays
-    ``names`` to the device, then chunks of ``chunk_steps`` steps until ``t_end`` [s] or a stop
-    status; returns the number of steps taken.
+    ``engine.names`` to the device, then chunks of ``chunk_steps`` steps until ``t_end`` [s]
+    or a stop status; returns the number of steps taken.
 
-    A chunk is one cooperative launch of the persistent kernel ``k_run`` (arguments: the
-    state ``run_state(*arrays, *run_extra)``, a namedtuple, the ``n_red`` reduction slots of
-    the kernels, the smallest stable step in slot 0 and the inverted element in slot 1; see
-    :func:`persistent_run`), or ``launch_step(g, dred, step, tick)`` once per step (``g`` the
-    device arrays by name, ``step`` the step's number, ``tick`` the :func:`profile_ticker`).
-    After each chunk the step counter and clock come back (the whole state, by
-    ``copy_back(st, g)``, when ``check`` is given, at the end and on a stop); an instability
-    status raises :func:`robobore.cutting.fe.status.instability_error` labelled ``label``.
+    A chunk is one cooperative launch of the persistent kernel ``engine.k_run`` (arguments:
+    the state ``run_state(*arrays, *run_extra)``, a namedtuple, the ``n_red`` reduction slots
+    of the kernels, the smallest stable step in slot 0 and the inverted element in slot 1;
+    see :func:`persistent_run`), or ``launch_step(g, dred, step, tick)`` once per step (``g``
+    the device arrays by name, ``step`` the step's number, ``tick`` the
+    :func:`profile_ticker`). After each chunk the step counter and clock come back (the whole
+    state, by ``copy_back(st, g)``, when ``check`` is given, at the end and on a stop); an
+    instability status raises :func:`robobore.cutting.fe.status.instability_error` labelled
+    ``engine.label``.
     """
+    names, launch_step, copy_back = engine.names, engine.launch_step, engine.copy_back
     from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.status import STATUS_TEXT, instability_error
 
     require_gpu()
     _cuda = bind_cuda()
-    st.prm[p_tend] = t_end
+    st.prm[engine.p_tend] = t_end
     st.ist[layout.I_STATUS] = layout.STATUS_OK
     g = {name: _cuda.to_device(np.ascontiguousarray(getattr(st, name))) for name in names}
-    red = np.zeros(n_red)
+    red = np.zeros(engine.n_red)
     red[0] = 1e30  # no stable step yet (R_DTMIN)
     red[1] = -1.0  # no inverted element (R_BAD)
     dred = _cuda.to_device(red)
     t_start = st.time
     step0 = int(st.ist[layout.I_STEP])
     tick = profile_ticker(profile)
-    run = persistent_run(k_run, run_state(*[g[name] for name in names], *run_extra), dred,
-                         st.x.shape[0], profile, persistent)
+    run = persistent_run(engine.k_run,
+                         engine.run_state(*[g[name] for name in names], *engine.run_extra),
+                         dred, st.x.shape[0], profile, persistent)
     while True:
         if run is not None:
             run(chunk_steps)
@@ -252,7 +279,7 @@ def drive_gpu(st, t_end: float, *, names: tuple[str, ...], p_tend: int, n_red: i
         if status in STATUS_TEXT or status == layout.STATUS_DONE or check is not None:
             copy_back(st, g)
         if status in STATUS_TEXT:
-            raise instability_error(st, label, "a smaller solver.cfl, a larger "
+            raise instability_error(st, engine.label, "a smaller solver.cfl, a larger "
                                     "mesh.element_size_um or less mass scaling")
         if progress is not None:
             progress(min(1.0, (st.time - t_start) / max(t_end - t_start, 1e-300)))
