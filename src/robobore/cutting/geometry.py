@@ -45,8 +45,9 @@ leading side, so those *trailing* elements carry no chip (``h = db = 0``) but th
 whole engaged edge (Kaymakci et al. 2012: edge forces integrated from the intersection with the
 previous pass to the depth-of-cut end).
 
-The edge profile (:func:`_edge_point`), the profile width (:func:`_profile_width`) and the
-elements (:func:`_element_pass`) are compiled scalar functions: :meth:`BoringInsert.point`,
+The edge profile (``edge_point``), the profile width (``profile_width``) and the
+elements (``element_pass``) are compiled scalar functions
+(:mod:`robobore.cutting.edge_kernels`): :meth:`BoringInsert.point`,
 the areas by radial levels and :func:`edge_elements` call them, and the boring process of the
 dynamics (:func:`robobore.dynamics.process.boring_process`) is built from :func:`edge_elements`.
 """
@@ -58,9 +59,9 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-import numba as nb
 import numpy as np
 
+from robobore.cutting.edge_kernels import edge_points, element_pass, profile_widths
 from robobore.errors import ConfigError
 from robobore.io.sections import (
     CLEARANCE_MAX_DEG,
@@ -167,14 +168,14 @@ class BoringInsert:
 
         Returns ``(zeta, drop, kappa_local, curvature)``: position [m], local approach angle
         [rad] (positive on the major side, negative on the minor side) and curvature [1/m]
-        (:func:`_edge_point`: nose arc ``-r kappa' <= s <= r kappa``, the straight major edge
+        (``edge_kernels.edge_point``: nose arc ``-r kappa' <= s <= r kappa``, the straight major edge
         beyond ``r kappa``, the straight minor edge beyond ``-r kappa'``).
         """
         s = np.asarray(s, float)
         r, k, ke = self.nose_radius_m, self.kappa, self.kappa_end
         flat = np.ascontiguousarray(s).reshape(-1)
         zeta, drop, kl = np.empty_like(flat), np.empty_like(flat), np.empty_like(flat)
-        _edge_points(flat, r, k, ke, zeta, drop, kl)
+        edge_points(flat, r, k, ke, zeta, drop, kl)
         curv = np.where((s >= -r * ke) & (s <= r * k), 1.0 / r, 0.0)
         return zeta.reshape(s.shape), drop.reshape(s.shape), kl.reshape(s.shape), curv
 
@@ -350,74 +351,13 @@ def _bisect(fun, lo: np.ndarray, hi: np.ndarray, iters: int = 60) -> np.ndarray:
 
 def _width_at_drop(insert: BoringInsert, d: np.ndarray) -> np.ndarray:
     """Width ``w(d) = b(d) - a(d)`` [m] of the tool profile at drop ``d`` [m]
-    (:func:`_profile_width`)."""
+    (``edge_kernels.profile_width``)."""
     d = np.asarray(d, float)
     flat = np.ascontiguousarray(d).reshape(-1)
     out = np.empty_like(flat)
-    _profile_widths(flat, insert.nose_radius_m, insert.kappa, insert.kappa_end,
+    profile_widths(flat, insert.nose_radius_m, insert.kappa, insert.kappa_end,
                     math.isclose(insert.kappa, math.pi / 2), out)
     return out.reshape(d.shape)
-
-
-@nb.njit(cache=True, inline="always")
-def _edge_point(s, r, k, ke):  # pragma: no cover - numba
-    """``(zeta, drop, kappa_local)`` of the edge point at arc length ``s`` [m] from the tip
-    (nose radius ``r``, approach angle ``k``, end-edge angle ``ke``): the nose arc
-    (``psi = s / r``, ``zeta = r sin psi``, ``drop = r (1 - cos psi)``) for
-    ``-r ke <= s <= r k``, the straight major edge at ``k`` beyond it, the straight minor edge
-    at ``-ke`` behind it."""
-    if s >= -r * ke and s <= r * k:
-        psi = s / r
-        return r * math.sin(psi), r * (1 - math.cos(psi)), psi
-    if s > r * k:
-        t = s - r * k
-        return r * math.sin(k) + t * math.cos(k), r * (1 - math.cos(k)) + t * math.sin(k), k
-    t = -s - r * ke
-    return (-r * math.sin(ke) - t * math.cos(ke), r * (1 - math.cos(ke)) + t * math.sin(ke),
-            -ke)
-
-
-@nb.njit(cache=True)
-def _edge_points(s, r, k, ke, zeta, drop, kl):  # pragma: no cover - numba
-    for i in range(s.size):
-        zeta[i], drop[i], kl[i] = _edge_point(s[i], r, k, ke)
-
-
-@nb.njit(cache=True, inline="always")
-def _width_constants(r, k, ke):  # pragma: no cover - numba
-    """The constants of :func:`_profile_width` for nose radius ``r``, approach angle ``k`` and
-    end-edge angle ``ke``: the drops where the arc meets the major and the minor edge, and
-    each straight edge's offset and slope."""
-    return (r * (1 - math.cos(k)), r * (1 - math.cos(ke)), r * math.sin(k), math.tan(k),
-            r * math.sin(ke), math.tan(ke))
-
-
-@nb.njit(cache=True, inline="always")
-def _profile_width(d, r, d_lead, d_trail, rsk, tk, rske, tke, k90):  # pragma: no cover
-    """Width ``b(d) - a(d)`` [m] of the tool profile at drop ``d`` [m] (the insert's constants
-    from :func:`_width_constants`): the leading side ``b`` on the arc up to ``d_lead``, then on
-    the major edge (``r`` for a 90 deg edge, ``k90``); the trailing side ``a`` on the arc up
-    to ``d_trail``, then on the minor edge."""
-    x = r - min(d, 2 * r)
-    circ = math.sqrt(max(r * r - x * x, 0.0))
-    if d <= d_lead:
-        b = circ
-    elif k90:
-        b = r
-    else:
-        b = rsk + (d - d_lead) / tk
-    if d <= d_trail:
-        a = -circ
-    else:
-        a = -(rske + (d - d_trail) / tke)
-    return b - a
-
-
-@nb.njit(cache=True)
-def _profile_widths(d, r, k, ke, k90, out):  # pragma: no cover - numba
-    d_lead, d_trail, rsk, tk, rske, tke = _width_constants(r, k, ke)
-    for i in range(d.size):
-        out[i] = _profile_width(d[i], r, d_lead, d_trail, rsk, tk, rske, tke, k90)
 
 
 def trailing_intersection(insert: BoringInsert, depth_m: float, feed_m: float) -> float:
@@ -475,71 +415,6 @@ def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     return np.polynomial.legendre.leggauss(n)
 
 
-@nb.njit(cache=True)
-def _element_pass(r, k, ke, k90, depth, fz, n, s_end, s_i, n_str, n_arc, xg, wg, s, zeta, drop,
-                  kl, h, db, dS):  # pragma: no cover - numba
-    """The elements of :func:`edge_elements` into ``s, zeta, drop, kl, h, db, dS`` (each
-    ``(n_str + n_arc + n,)``), trailing elements first.
-
-    Trailing side: from ``s_i`` to the tip, ``n_str`` elements of equal length on the straight
-    minor edge and ``n_arc`` on the arc (the corner ``-r ke`` a node; without a straight part
-    ``n_arc`` from ``s_i``), ``h = db = 0``. Leading side: ``n`` elements of equal arc length
-    from the tip to ``s_end`` (where the edge reaches the pre-bore surface); the radial levels
-    of an element's ends are its ends' drops (capped at the depth, the last one the depth), its
-    chip area ``integral min(f, w(d)) dd`` between them (Gauss-Legendre ``xg``, ``wg`` on
-    [-1, 1]), ``h = area / dS``, ``db = dS``. The nodes are numpy.linspace's
-    (``i * step + start``, the last node the stop); element centres and local angles are those
-    of :func:`_edge_point` at the centre. Returns ``sum(h db)`` over the leading side, the
-    elements' chip area."""
-    nt = n_str + n_arc
-    s_corner = -r * ke
-    for j in range(nt):
-        if j < n_str:
-            st = (s_corner - s_i) / n_str
-            a0 = j * st + s_i
-            a1 = s_corner if j + 1 == n_str else (j + 1) * st + s_i
-        else:
-            i = j - n_str
-            if n_str > 0:
-                st = (0.0 - s_corner) / n_arc
-                a0 = s_corner if i == 0 else i * st + s_corner
-                a1 = 0.0 if i + 1 == n_arc else (i + 1) * st + s_corner
-            else:
-                st = (0.0 - s_i) / n_arc
-                a0 = i * st + s_i
-                a1 = 0.0 if i + 1 == n_arc else (i + 1) * st + s_i
-        sc = 0.5 * (a1 + a0)
-        s[j] = sc
-        zeta[j], drop[j], kl[j] = _edge_point(sc, r, k, ke)
-        h[j] = 0.0
-        db[j] = 0.0
-        dS[j] = a1 - a0
-    d_lead, d_trail, rsk, tk, rske, tke = _width_constants(r, k, ke)
-    step = s_end / n
-    area = 0.0
-    e0 = 0.0
-    d0 = min(_edge_point(0.0, r, k, ke)[1], depth)
-    for i in range(n):
-        e1 = s_end if i + 1 == n else (i + 1) * step + 0.0
-        d1 = depth if i + 1 == n else min(_edge_point(e1, r, k, ke)[1], depth)
-        ds = e1 - e0
-        sc = 0.5 * (e1 + e0)
-        j = nt + i
-        s[j] = sc
-        zeta[j], drop[j], kl[j] = _edge_point(sc, r, k, ke)
-        acc = 0.0
-        for q in range(xg.size):
-            dq = 0.5 * (d0 + d1) + 0.5 * (d1 - d0) * xg[q]
-            w = _profile_width(dq, r, d_lead, d_trail, rsk, tk, rske, tke, k90)
-            acc += min(fz, w) * wg[q]
-        h[j] = (0.5 * (d1 - d0)) * acc / ds
-        db[j] = ds
-        dS[j] = ds
-        area += h[j] * ds
-        e0, d0 = e1, d1
-    return area
-
-
 def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
                   n_elements: int = 40, n_quad: int = 16, trailing_edge: bool = True,
                   n_trailing: int | None = None, exact_area: bool = True) -> EdgeElements:
@@ -583,12 +458,13 @@ def edge_elements(insert: BoringInsert, depth_m: float, feed_m: float,
         n_str, n_arc = _trailing_split(insert, s_i, int(n_trailing or n_auto))
     n_tr = n_str + n_arc
     E = n + n_tr
-    s, zeta, drop, kl, h, db, dS = (np.empty(E) for _ in range(7))
-    xg, wg = _gauss_legendre(int(n_quad))
+    out = np.empty((7, E))
+    quad = np.ascontiguousarray(np.vstack(_gauss_legendre(int(n_quad))))
     r, k = insert.nose_radius_m, insert.kappa
-    area_elements = _element_pass(r, k, insert.kappa_end, math.isclose(k, math.pi / 2),
-                                  float(depth_m), float(feed_m), n, float(s_end), float(s_i),
-                                  n_str, n_arc, xg, wg, s, zeta, drop, kl, h, db, dS)
+    area_elements = element_pass((r, k, insert.kappa_end, math.isclose(k, math.pi / 2)),
+                                  float(depth_m), float(feed_m), float(s_end), float(s_i),
+                                  (n, n_str, n_arc), quad, out)
+    s, zeta, drop, kl, h, db, dS = out
     area = chip_area(insert, depth_m, feed_m) if exact_area else area_elements
     return EdgeElements(s=s, zeta=zeta, drop=drop, kappa=kl, h=h, db=db, dS=dS,
                         area=area, area_elements=area_elements, depth_m=float(depth_m),

@@ -9,10 +9,10 @@ _SCRIPT = Path(__file__).parents[3] / "benchmarks" / "fe_code_counts.py"
 
 #: ceilings: the counts in the source as it is; lower them when a change lowers a count
 CEILINGS = {
-    "functions_over_12_params": 34,
+    "functions_over_12_params": 33,
     "globals_update_rebind": 0,
     "frame_device_string_sites": 0,
-    "modules_over_500_lines": 1,
+    "modules_over_500_lines": 0,
     "dict_any_returns_fe": 2,
 }
 
