@@ -128,6 +128,20 @@ def thermal_spec(solver: Any, contact: Any, material: Material) -> Adiabatic | C
                       tool_temperature_K=float(material.T_room if tt is None else tt))
 
 
+#: The keys that the heat conduction reads (and that an adiabatic run leaves unused).
+THERMAL_KEYS = ("solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
+                "contact.friction_heat_fraction", "contact.tool_temperature_K")
+
+
+def _thermal_keys(keys: _Keys, heat_conduction: bool) -> None:
+    """Mark the thermal keys read (with heat conduction) or excluded as "adiabatic"."""
+    if heat_conduction:
+        for key in THERMAL_KEYS:
+            keys.get(key)
+    else:
+        keys.exclude("adiabatic", *THERMAL_KEYS)
+
+
 def build_spec(cfg: Any, material: Material, source: str | None = None) -> ModelSpec:
     """The :class:`ModelSpec` of a validated orthogonal FE config ``cfg`` (``material``: the
     config's material as loaded, whose ``hardening_strain_limit`` is the hold in force).
@@ -182,14 +196,7 @@ def build_spec(cfg: Any, material: Material, source: str | None = None) -> Model
                                erode_time_step_fraction=float(
                                    keys.get("solver.erode_time_step_fraction")))
     friction = friction_spec(cfg.contact, cfg.cut.cutting_speed_m_per_min)
-    if cfg.solver.heat_conduction:
-        for key in ("solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
-                    "contact.friction_heat_fraction", "contact.tool_temperature_K"):
-            keys.get(key)
-    else:
-        keys.exclude("adiabatic", "solver.conduction_interval",
-                     "contact.thermal_conductance_W_per_m2K", "contact.friction_heat_fraction",
-                     "contact.tool_temperature_K")
+    _thermal_keys(keys, cfg.solver.heat_conduction)
     thermal = thermal_spec(cfg.solver, cfg.contact, material)
     limit = material.hardening_strain_limit
     hardening: PlainHardening | HardeningHold = (
@@ -243,14 +250,7 @@ def build_boring_spec(cfg: Any, material: Material, vc_m_per_min: float,
             keys.exclude("erosion_layer", "mesh.separation_height_um", "mesh.chip_rows",
                          "solver.separation_gate_um")
             sep = EdgePathLayer()
-    if cfg.solver.heat_conduction:
-        for key in ("solver.conduction_interval", "contact.thermal_conductance_W_per_m2K",
-                    "contact.friction_heat_fraction", "contact.tool_temperature_K"):
-            keys.get(key)
-    else:
-        keys.exclude("adiabatic", "solver.conduction_interval",
-                     "contact.thermal_conductance_W_per_m2K", "contact.friction_heat_fraction",
-                     "contact.tool_temperature_K")
+    _thermal_keys(keys, cfg.solver.heat_conduction)
     s = cfg.solver
     limit = material.hardening_strain_limit
     keys.check(source)
