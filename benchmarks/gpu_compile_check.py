@@ -7,6 +7,10 @@ it (a side virtual environment is fine)::
 
     pip install -e . "numba-cuda" nvidia-cuda-nvcc-cu12 nvidia-cuda-nvrtc-cu12
 
+No environment variable is needed: numba-cuda finds libnvvm in the nvidia-cuda-nvcc wheel,
+and this script runs that wheel's ``ptxas``. ``benchmarks/gpu_compile_check.sh`` builds such an
+environment once (outside the checkout) and runs this script.
+
 Usage::
 
     python benchmarks/gpu_compile_check.py [--cc 9.0]
@@ -59,7 +63,7 @@ def _ptxas() -> str | None:
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("--cc", default="9.0", help="compute capability, e.g. 9.0 (H100)")
     a = ap.parse_args()
     cc = tuple(int(v) for v in a.cc.split("."))
