@@ -741,6 +741,29 @@ class TimeDomainRun:
                             self._area[:n_steps], revs, n_steps)
 
 
+@nb.njit(cache=True)
+def _rotating_frame(acc, X, c_rev, s_rev, a_rot, feed_amp):  # pragma: no cover - compiled
+    """Per revolution of ``Ns = c_rev.size`` samples: the acceleration on the insert's radial
+    and tangential directions (``a_rot``: ``ax c + ay s``, ``-ax s + ay c``) and the half
+    peak-to-peak feed (z) displacement (``feed_amp``)."""
+    Ns = c_rev.shape[0]
+    for r in range(feed_amp.shape[0]):
+        zmax = X[r * Ns, 2]
+        zmin = zmax
+        for k in range(Ns):
+            i = r * Ns + k
+            ax = acc[i, 0]
+            ay = acc[i, 1]
+            a_rot[i, 0] = ax * c_rev[k] + ay * s_rev[k]
+            a_rot[i, 1] = -ax * s_rev[k] + ay * c_rev[k]
+            z = X[i, 2]
+            if z > zmax:
+                zmax = z
+            if z < zmin:
+                zmin = z
+        feed_amp[r] = 0.5 * (zmax - zmin)
+
+
 def _run_dataset(run: TimeDomainRun, F: np.ndarray, X: np.ndarray, acc: np.ndarray,
                  area: np.ndarray, revs: int, n_steps: int) -> xr.Dataset:
     """The Dataset of ``run``'s first ``revs`` whole revolutions (:func:`simulate`)."""
@@ -751,18 +774,16 @@ def _run_dataset(run: TimeDomainRun, F: np.ndarray, X: np.ndarray, acc: np.ndarr
     t = np.arange(n_steps) * dt
     th_rev = 2 * np.pi * np.arange(Ns) / Ns  # the insert's angle, the same every revolution
     c_rev, s_rev = np.cos(th_rev), np.sin(th_rev)
-    ax, ay = acc[:, 0].reshape(revs, Ns), acc[:, 1].reshape(revs, Ns)
-    a_r = (ax * c_rev + ay * s_rev).ravel()
-    a_t = (-ax * s_rev + ay * c_rev).ravel()
-    zr = X[:, 2].reshape(revs, Ns)
-    feed_amp = 0.5 * (zr.max(axis=1) - zr.min(axis=1))
+    a_rot = np.empty((n_steps, 2))
+    feed_amp = np.empty(revs)
+    _rotating_frame(acc, X, c_rev, s_rev, a_rot, feed_amp)
     ds_out = xr.Dataset(
         {
             "force": (("time", "axis"), F, {"units": "N", "long_name": "force on the tool"}),
             "displacement": (("time", "axis"), X, {"units": "m",
                                                    "long_name": "tool-point displacement"}),
             "acceleration": (("time", "axis"), acc, {"units": "m/s^2"}),
-            "rotational_acceleration": (("time", "rot_axis"), np.column_stack([a_r, a_t]), {
+            "rotational_acceleration": (("time", "rot_axis"), a_rot, {
                 "units": "m/s^2",
                 "long_name": "tool-point acceleration on the rotating insert's radial and "
                              "tangential directions (no centripetal term)"}),
