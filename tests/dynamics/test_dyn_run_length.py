@@ -182,3 +182,14 @@ def test_the_rotating_frame_and_feed_amplitude_are_the_array_formulas():
     assert np.array_equal(rot[:, 1], (-ax * np.sin(th) + ay * np.cos(th)).ravel())
     z = ds["displacement"].values[:, 2].reshape(revs, Ns)
     assert np.array_equal(ds["feed_amplitude"].values, 0.5 * (z.max(axis=1) - z.min(axis=1)))
+
+
+@pytest.mark.parametrize("cols", [1, 2, 3, 26])
+def test_column_means_are_numpy_s_digit_for_digit(cols):
+    from robobore.dynamics.timedomain import column_means
+
+    rng = np.random.default_rng(44)
+    for n in (1, 7, 1000, 57528):
+        x = rng.standard_normal((n, cols)) * 1e-6 + rng.standard_normal(cols)
+        for y in (x, x[n // 3:], x[:, :1], np.asfortranarray(x)):
+            assert np.array_equal(column_means(y), y.mean(axis=0))

@@ -50,6 +50,7 @@ ratios of such values are not findings.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -57,6 +58,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import xarray as xr
 from numba import njit
+
+from robobore.dynamics.timedomain import column_means
 
 
 class Regenerative(NamedTuple):
@@ -212,6 +215,14 @@ def floquet_multiplier(displacement: np.ndarray, samples_per_delay: int,
     return math.exp(slope), se, int(use.size)
 
 
+@functools.lru_cache(maxsize=8)
+def _hanning(n: int) -> np.ndarray:
+    """``np.hanning(n)``, kept for the lengths in use (read-only)."""
+    w = np.hanning(n)
+    w.flags.writeable = False
+    return w
+
+
 def harmonic_analysis(signal: np.ndarray, fs: float, tooth_freq: float,
                       band_rel: float = 0.02) -> tuple[float, float]:
     """Non-harmonic energy ratio and the largest non-harmonic peak frequency [Hz].
@@ -222,9 +233,9 @@ def harmonic_analysis(signal: np.ndarray, fs: float, tooth_freq: float,
     x = np.asarray(signal, float)
     if x.ndim == 1:
         x = x[:, None]
-    x = x - x.mean(axis=0)
+    x = x - column_means(x)
     n = x.shape[0]
-    win = np.hanning(n)[:, None]
+    win = _hanning(n)[:, None]
     P = (np.abs(np.fft.rfft(x * win, axis=0)) ** 2).sum(axis=1)
     f = np.fft.rfftfreq(n, 1.0 / fs)
     df = f[1] - f[0]
