@@ -10,7 +10,8 @@
    with the config's own sampling and run length) of examples/boring_paper.toml at the
    ``CONDITIONS``, this tree against another checkout's ``src`` in subprocesses, alternated
    ``--pairs`` times; prints the median wall time of each tree, the samples per revolution
-   and revolutions each chose, and the ratio of the medians (the trees share the load).
+   and revolutions each chose, and the ratio of the medians (the trees share the load), of the
+   wall time and of the process's CPU time (less sensitive to other work on the cores).
 
 Run: python benchmarks/bench_dynamics.py [--reference-tree ../ref] [--pairs 3]
 (note the machine load, `uptime`, with the figures)
@@ -70,11 +71,12 @@ cfg, conds = sys.argv[1], json.loads(sys.argv[2])
 run_boring(cfg, speed_rpm=conds[0][0], depth_mm=conds[0][1], revolutions=5)  # compile / warm
 out = []
 for n, a in conds:
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     s = run_boring(cfg, speed_rpm=n, depth_mm=a)
     s = s.to_dict() if hasattr(s, "to_dict") else s  # a reference tree may return the dict
-    dt = time.perf_counter() - t
-    out.append({"speed_rpm": n, "depth_mm": a, "wall_s": dt, "chatter": s.get("chatter"),
+    dt, dc = time.perf_counter() - t, time.process_time() - c
+    out.append({"speed_rpm": n, "depth_mm": a, "wall_s": dt, "cpu_s": dc,
+                "chatter": s.get("chatter"),
                 "samples_per_rev": s.get("samples_per_rev"),
                 "revolutions": s.get("revolutions_simulated", s.get("revolutions"))})
 print("RESULT" + json.dumps(out))
@@ -104,14 +106,19 @@ def paired_timedomain(ref: Path, pairs: int) -> None:
     for i, (n, a) in enumerate(CONDITIONS):
         m = statistics.median(run[i]["wall_s"] for run in mine)
         r = statistics.median(run[i]["wall_s"] for run in theirs)
+        cm = statistics.median(run[i]["cpu_s"] for run in mine)
+        cr = statistics.median(run[i]["cpu_s"] for run in theirs)
         print(f"  {n:6.0f} r/min {a:.2f} mm: this tree {m:.2f} s "
               f"({mine[0][i]['samples_per_rev']} samples/rev x {mine[0][i]['revolutions']} rev,"
               f" chatter {mine[0][i]['chatter']}), reference {r:.2f} s "
               f"({theirs[0][i]['samples_per_rev']} x {theirs[0][i]['revolutions']}, chatter "
-              f"{theirs[0][i]['chatter']}); this/reference {m / r:.2f}")
+              f"{theirs[0][i]['chatter']}); this/reference {m / r:.2f} (CPU time {cm / cr:.2f})")
+    cpu_m = statistics.median(sum(r["cpu_s"] for r in run) for run in mine)
+    cpu_r = statistics.median(sum(r["cpu_s"] for r in run) for run in theirs)
     print(f"  all: this tree {statistics.median(tot_m):.2f} s, reference "
           f"{statistics.median(tot_r):.2f} s; this/reference "
-          f"{statistics.median(tot_m) / statistics.median(tot_r):.2f}")
+          f"{statistics.median(tot_m) / statistics.median(tot_r):.2f} (CPU time "
+          f"{cpu_m / cpu_r:.2f})")
 
 
 def main() -> None:

@@ -106,9 +106,9 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     ``pressure_MPa`` (boring configs with an ``[equivalent]`` section) replaces the pressure
     foot: 0 removes it, a positive value sets ``pressure_MPa`` keeping the other foot keys.
     """
-    from robobore.dynamics.chatter import AMPLITUDE_RESOLUTION_M, classify, resolved
-    from robobore.dynamics.timedomain import (SimulationSettings, TimeDomainRun, simulate,
-                                              summarize)
+    from robobore.dynamics.chatter import (AMPLITUDE_RESOLUTION_M, chatter_decision, classify,
+                                           resolved)
+    from robobore.dynamics.timedomain import SimulationSettings, TimeDomainRun, summarize
 
     cfg, raw, src = _config(config, source, equivalent)
     if feed_mm_per_rev is not None:
@@ -155,12 +155,20 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     tol = cfg.simulation.ra_tolerance_um
     ins = cfg.insert.to_insert() if cfg.is_boring else None
     extend = revolutions is None and cfg.simulation.extend_undecided
+
+    def decision(r: TimeDomainRun):  # the chatter verdict of a run (classify's), no Dataset
+        X, area = r.record()
+        return chatter_decision(X, area, r.Ns, r.N, r.settings.depth_m,
+                                r.process.feed_per_rev_m, r.diverged)
+
     run = None
     while True:
         try:
             if run is None:
                 run = TimeDomainRun(st, pr, SimulationSettings(float(n), a * 1e-3, int(revs),
-                                                               int(nspr)), ins)
+                                                               int(nspr)), ins,
+                                    reserve_revolutions=UNDECIDED_MAX_FACTOR * int(revs)
+                                    if extend else None)
             else:  # continued: the run of twice the revolutions, paying only the new ones
                 run.extend(run.revolutions)
         except ConfigError as exc:  # a settings error (size guard): name the config file
@@ -168,13 +176,13 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
                 raise ConfigError(exc.message, file=src, field=exc.field, value=exc.value,
                                   expected=exc.expected) from None
             raise
-        ds = run.dataset()
-        v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
         # near the stability limit the growth per pitch is within its uncertainty of 1:
         # lengthen the run (up to UNDECIDED_MAX_FACTOR x) before saying so
-        if v.chatter_decided or not extend or \
-                run.revolutions >= UNDECIDED_MAX_FACTOR * int(revs):
+        if not extend or run.revolutions >= UNDECIDED_MAX_FACTOR * int(revs) or \
+                decision(run).decided:
             break
+    ds = run.dataset()
+    v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
     revs = run_revs = run.revolutions
     # where the tool leaves the cut the force is not smooth in the displacement and the
     # verdict can depend on where the steps fall: the same run at twice the samples per
@@ -182,10 +190,9 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
     sampling_check = None
     if v.tool_leaves_cut and not int(ds.attrs["diverged"]):
         spr2 = 2 * int(ds.attrs["samples_per_rev"])
-        try:
-            v2 = classify(simulate(st, pr, SimulationSettings(float(n), a * 1e-3, run_revs,
-                                                              spr2), ins),
-                          ra_tolerance_m=None if tol is None else tol * 1e-6)
+        try:  # only its chatter verdict is compared
+            v2 = decision(TimeDomainRun(st, pr, SimulationSettings(float(n), a * 1e-3,
+                                                                   run_revs, spr2), ins))
         except ConfigError:  # the doubled run is over the size guard: no check
             v2 = None
         if v2 is not None:

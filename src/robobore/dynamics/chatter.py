@@ -50,6 +50,7 @@ ratios of such values are not findings.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -57,6 +58,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import xarray as xr
 from numba import njit
+
+from robobore.dynamics.timedomain import column_means
 
 
 class Regenerative(NamedTuple):
@@ -212,6 +215,14 @@ def floquet_multiplier(displacement: np.ndarray, samples_per_delay: int,
     return math.exp(slope), se, int(use.size)
 
 
+@functools.lru_cache(maxsize=8)
+def _hanning(n: int) -> np.ndarray:
+    """``np.hanning(n)``, kept for the lengths in use (read-only)."""
+    w = np.hanning(n)
+    w.flags.writeable = False
+    return w
+
+
 def harmonic_analysis(signal: np.ndarray, fs: float, tooth_freq: float,
                       band_rel: float = 0.02) -> tuple[float, float]:
     """Non-harmonic energy ratio and the largest non-harmonic peak frequency [Hz].
@@ -222,9 +233,9 @@ def harmonic_analysis(signal: np.ndarray, fs: float, tooth_freq: float,
     x = np.asarray(signal, float)
     if x.ndim == 1:
         x = x[:, None]
-    x = x - x.mean(axis=0)
+    x = x - column_means(x)
     n = x.shape[0]
-    win = np.hanning(n)[:, None]
+    win = _hanning(n)[:, None]
     P = (np.abs(np.fft.rfft(x * win, axis=0)) ** 2).sum(axis=1)
     f = np.fft.rfftfreq(n, 1.0 / fs)
     df = f[1] - f[0]
@@ -308,24 +319,113 @@ def _regenerative_tail(regen: Regenerative, samples_per_delay: int) -> float:
     return float(regen.d[-s:].max())
 
 
-def _chip_scale(ds: xr.Dataset, depth: float, n_inserts: int) -> float:
+def _chip_scale(feed_per_rev_m: float, depth: float, n_inserts: int) -> float:
     """The size of the chip [m]: the feed per insert, or the depth where it is smaller."""
-    fz = float(ds.attrs.get("feed_per_rev_m", math.nan)) / max(int(n_inserts), 1)
+    fz = float(feed_per_rev_m) / max(int(n_inserts), 1)
     vals = [v for v in (fz, depth) if math.isfinite(v) and v > 0]
     return min(vals) if vals else math.inf
+
+
+class ChatterDecision(NamedTuple):
+    """The chatter verdict of a record (:func:`chatter_decision`), and the measures behind it.
+
+    ``rule`` names what decided it: ``"diverged"``, ``"repeats every pitch"`` (the tool leaves
+    the cut in a motion that repeats to below resolution), ``"grown out of the cut"``,
+    ``"too short"`` (no multiplier: fewer than 7 pitches) or ``"multiplier"``.
+    ``tail``: the largest regenerative displacement over the last pitch [m] (NaN when the
+    tool stays in the cut). ``left_cause``: None when the tool stays in the cut."""
+
+    chatter: bool
+    decided: bool
+    cause: str | None
+    left_cause: str | None
+    rule: str
+    floquet_multiplier: float
+    floquet_multiplier_se: float
+    vibration_growth: float
+    feed_amplitude_growth: float
+    radial_amplitude_growth: float
+    tool_left_cut_fraction: float
+    tail: float
+
+
+def chatter_decision(displacement: np.ndarray, chip_area: np.ndarray, samples_per_rev: int,
+                     n_inserts: int, depth_m: float = math.nan,
+                     feed_per_rev_m: float = math.nan, diverged: bool = False,
+                     growth_limit: float = 1.0, tail_fraction: float = 0.3
+                     ) -> ChatterDecision:
+    """The chatter verdict (``chatter``, ``decided`` and their cause) of a record: the
+    tool-point ``displacement`` (n_samples, 3) [m] and ``chip_area`` (n_samples, n_inserts)
+    [m^2] of whole revolutions of ``samples_per_rev`` samples; :func:`classify` gives the same
+    verdict on the record's Dataset (it adds the spectrum, the surface and the reasons).
+    ``diverged``: the run stopped at the divergence limit (chatter)."""
+    Ns = int(samples_per_rev)
+    N = int(n_inserts)
+    spd = Ns // N
+    X = displacement
+    regen = regenerative(X, spd)
+    g = vibration_growth(X, spd, regen)
+    ag = amplitude_growth(X, Ns, spd, regen)
+    n0 = int(X.shape[0] * (1 - tail_fraction))
+    left = float(np.mean(chip_area[n0:] <= 0))
+    amp = max((v for v in ag.values() if math.isfinite(v)), default=math.nan)
+    grows = (math.isfinite(g) and g > growth_limit and math.isfinite(amp)
+             and amp > growth_limit)
+    depth = float(depth_m)
+    rho, se, _ = floquet_multiplier(X, spd, linear_limit_m=(
+        LINEAR_FRACTION * depth if math.isfinite(depth) and depth > 0 else None), regen=regen)
+    tail = _regenerative_tail(regen, spd) if left > 0 else math.nan
+    decided = True
+    cause = None
+    left_cause = None
+    if diverged:
+        chatter, cause, rule = True, "diverged", "diverged"
+    elif left > 0 and tail < AMPLITUDE_RESOLUTION_M:
+        # the tool leaves the cut, but the motion repeats every insert pitch to below the
+        # amplitude resolution: a bounded forced vibration that interrupts the cut, not
+        # chatter (growth ratios of sub-resolution values are not findings)
+        chatter, left_cause, rule = False, "forced vibration", "repeats every pitch"
+    elif left > 0 and grows and tail > LINEAR_FRACTION * _chip_scale(feed_per_rev_m, depth, N):
+        # regenerative vibration grown out of the linear range takes the tool out of the cut:
+        # the regenerative displacement is a fraction of the chip thickness (the feed per
+        # insert sets it; the depth where it is smaller) -- a forced vibration that
+        # interrupts the cut leaves it orders of magnitude below
+        chatter, cause, left_cause = True, "tool leaves the cut", "regenerative vibration"
+        rule = "grown out of the cut"
+    elif not math.isfinite(rho):
+        chatter, decided, rule = grows, False, "too short"
+        if left > 0:
+            left_cause = "undecided"
+    else:
+        ln = math.log(rho) if rho > 0 else -math.inf
+        decided = abs(ln) > max(DECISION_SIGMAS * se, DECISION_FLOOR)
+        chatter = rho > 1.0
+        rule = "multiplier"
+        if left > 0:
+            left_cause = ("undecided" if not decided else
+                          "regenerative vibration" if chatter else "forced vibration")
+        if chatter:
+            cause = "regenerative"
+    return ChatterDecision(bool(chatter), bool(decided), cause,
+                           left_cause if left > 0 else None, rule, rho, se, g, ag["feed"],
+                           ag["radial"], left, tail)
 
 
 def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | None = None,
              tail_fraction: float = 0.3) -> ChatterVerdict:
     """The verdicts on a simulation Dataset (:func:`~robobore.dynamics.timedomain.simulate`);
-    see the module docstring. ``reasons`` lists, for each verdict that flags the cut, why."""
+    see the module docstring. ``reasons`` lists, for each verdict that flags the cut, why.
+    The chatter verdict is :func:`chatter_decision`'s on the Dataset's record."""
     Ns = int(ds.attrs["samples_per_rev"])
     N = int(ds.attrs["n_inserts"])
-    spd = Ns // N
     X = ds["displacement"].values
-    regen = regenerative(X, spd)
-    g = vibration_growth(X, spd, regen)
-    ag = amplitude_growth(X, Ns, spd, regen)
+    diverged = bool(int(ds.attrs.get("diverged", 0)))
+    dec = chatter_decision(X, ds["chip_area"].values, Ns, N,
+                           float(ds.attrs.get("depth_m", math.nan)),
+                           float(ds.attrs.get("feed_per_rev_m", math.nan)), diverged,
+                           growth_limit, tail_fraction)
+    g, rho, se, left = (dec.vibration_growth, dec.floquet_multiplier,
+                        dec.floquet_multiplier_se, dec.tool_left_cut_fraction)
     fs = 1.0 / float(ds.attrs["dt_s"])
     tooth = float(ds.attrs["speed_rpm"]) / 60.0 * N
     n0 = int(X.shape[0] * (1 - tail_fraction))
@@ -335,62 +435,31 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
     slope = float(ds.attrs.get("form_slope_um_per_mm", math.nan))
     has_tol = ra_tolerance_m is not None and math.isfinite(ra)
     r_ok = True if not has_tol else ra <= ra_tolerance_m
-    area = ds["chip_area"].values
-    left = float(np.mean(area[n0:] <= 0))
-    diverged = bool(int(ds.attrs.get("diverged", 0)))
-    amp = max((v for v in ag.values() if math.isfinite(v)), default=math.nan)
-    grows = (math.isfinite(g) and g > growth_limit and math.isfinite(amp)
-             and amp > growth_limit)
-    depth = float(ds.attrs.get("depth_m", math.nan))
-    rho, se, _ = floquet_multiplier(X, spd, linear_limit_m=(
-        LINEAR_FRACTION * depth if math.isfinite(depth) and depth > 0 else None), regen=regen)
-    decided = True
-    cause = None
-    left_cause = None
+    chatter, decided = dec.chatter, dec.decided
     reasons = []
-    if diverged:
-        chatter, cause = True, "diverged"
+    if dec.rule == "diverged":
         reasons.append(f"chatter: vibration diverged (tool-point displacement above "
                        f"{float(ds.attrs['divergence_limit_m']) * 1e3:.3g} mm at "
                        f"t = {float(ds.attrs['diverged_at_s']):.4g} s)")
-    elif left > 0 and (tail := _regenerative_tail(regen, spd)) < AMPLITUDE_RESOLUTION_M:
-        # the tool leaves the cut, but the motion repeats every insert pitch to below the
-        # amplitude resolution: a bounded forced vibration that interrupts the cut, not
-        # chatter (growth ratios of sub-resolution values are not findings)
-        chatter, left_cause = False, "forced vibration"
+    elif dec.rule == "repeats every pitch":
         reasons.append(f"no chatter: the forced vibration takes the tool out of the cut and "
                        f"the motion repeats every insert pitch (regenerative displacement "
-                       f"{tail * 1e9:.2g} nm, below the "
+                       f"{dec.tail * 1e9:.2g} nm, below the "
                        f"{AMPLITUDE_RESOLUTION_M * 1e9:g} nm resolution)")
-    elif left > 0 and grows and tail > LINEAR_FRACTION * _chip_scale(
-            ds, depth, N):
-        # regenerative vibration grown out of the linear range takes the tool out of the cut:
-        # the regenerative displacement is a fraction of the chip thickness (the feed per
-        # insert sets it; the depth where it is smaller) -- a forced vibration that
-        # interrupts the cut leaves it orders of magnitude below
-        chatter, cause, left_cause = True, "tool leaves the cut", "regenerative vibration"
+    elif dec.rule == "grown out of the cut":
         reasons.append(f"chatter: vibration grows and the tool leaves the cut (nonlinear: "
                        f"regenerative envelope x{g:.3g}, feed amplitude "
-                       f"x{ag['feed']:.3g}, radial x{ag['radial']:.3g}) at {fpk:.4g} Hz")
-    elif not math.isfinite(rho):
-        chatter, decided = grows, False
-        if left > 0:
-            left_cause = "undecided"
+                       f"x{dec.feed_amplitude_growth:.3g}, radial "
+                       f"x{dec.radial_amplitude_growth:.3g}) at {fpk:.4g} Hz")
+    elif dec.rule == "too short":
         reasons.append("undecided: the run is too short for a growth estimate (fewer than 7 "
                        "insert pitches); lengthen [simulation] revolutions")
     else:
-        ln = math.log(rho) if rho > 0 else -math.inf
-        decided = abs(ln) > max(DECISION_SIGMAS * se, DECISION_FLOOR)
-        chatter = rho > 1.0
-        if left > 0:
-            left_cause = ("undecided" if not decided else
-                          "regenerative vibration" if chatter else "forced vibration")
-            if decided and not chatter:
-                reasons.append(f"no chatter: the forced vibration takes the tool out of the "
-                               f"cut; the regenerative vibration decays x{rho:.4g} per insert "
-                               f"pitch (+-{se:.2g} in ln)")
+        if left > 0 and decided and not chatter:
+            reasons.append(f"no chatter: the forced vibration takes the tool out of the "
+                           f"cut; the regenerative vibration decays x{rho:.4g} per insert "
+                           f"pitch (+-{se:.2g} in ln)")
         if chatter:
-            cause = "regenerative"
             reasons.append(f"chatter: vibration grows x{rho:.4g} per insert pitch (Floquet "
                            f"multiplier of the simulated cut, +-{se:.2g} in ln) at "
                            f"{fpk:.4g} Hz")
@@ -413,11 +482,12 @@ def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | 
         reasons.append("paper's criterion not judged: no Ra tolerance "
                        "([simulation] ra_tolerance_um)")
     freq = fpk if (chatter and not diverged and math.isfinite(fpk) and fpk > 0) else None
-    return ChatterVerdict(chatter, finish, left > 0, paper_stable, g, ag["feed"], ag["radial"],
-                          ratio, freq, fpk, ra, rz, slope, r_ok, left, tuple(reasons),
-                          rho, se, decided, cause, left_cause if left > 0 else None)
+    return ChatterVerdict(chatter, finish, left > 0, paper_stable, g, dec.feed_amplitude_growth,
+                          dec.radial_amplitude_growth, ratio, freq, fpk, ra, rz, slope, r_ok,
+                          left, tuple(reasons), rho, se, decided, dec.cause, dec.left_cause)
 
 
 __all__ = ["vibration_growth", "regenerative", "Regenerative", "amplitude_growth", "harmonic_analysis", "classify",
+           "chatter_decision", "ChatterDecision",
            "ChatterVerdict", "floquet_multiplier", "resolved", "FLOQUET_FLOOR",
            "DECISION_SIGMAS", "DECISION_FLOOR", "AMPLITUDE_RESOLUTION_M", "LINEAR_FRACTION"]

@@ -579,10 +579,16 @@ class TimeDomainRun:
     more revolutions from where the run stopped (the modal state, the surface left at each
     angle and when it was cut), so that a run of ``R`` revolutions extended by ``R'`` is the
     run of ``R + R'`` revolutions, digit for digit, at the cost of the ``R'`` new ones.
-    :meth:`dataset` is the Dataset of the revolutions integrated so far."""
+    :meth:`dataset` is the Dataset of the revolutions integrated so far, :meth:`record` their
+    displacement and chip area alone.
+
+    ``reserve_revolutions``: the length the run may be extended to; the records are allocated
+    for it at once (where the memory guard accepts a run of that length; else as the run
+    grows), so that extending up to it writes in place."""
 
     def __init__(self, structure: ToolPointStructure, process: CuttingProcess,
-                 settings: SimulationSettings, insert_profile=None) -> None:
+                 settings: SimulationSettings, insert_profile=None,
+                 reserve_revolutions: int | None = None) -> None:
         settings.check()
         process = process.at_depth(settings.depth_m)  # the chip geometry at the depth
         N = int(process.n_inserts)
@@ -618,11 +624,55 @@ class TimeDomainRun:
         self.n_steps = 0  # steps integrated
         self.n_done = 0  # steps done before a divergence (= n_steps without one)
         self.revolutions = 0  # revolutions asked for
-        self.F = np.empty((0, 3))
-        self.X = np.empty((0, 3))
-        self.acc = np.empty((0, 3))
-        self.area = np.empty((0, N))
+        self.reserve_revolutions = int(reserve_revolutions or 0)
+        # the records (force, displacement, acceleration, chip area), rows [:n_done] filled
+        self._F = np.empty((0, 3))
+        self._X = np.empty((0, 3))
+        self._acc = np.empty((0, 3))
+        self._area = np.empty((0, N))
         self.extend(int(settings.revolutions))
+
+    @property
+    def room_steps(self) -> int:
+        """Steps the records have room for (the reserve, or the steps asked for)."""
+        return int(self._F.shape[0])
+
+    @property
+    def F(self) -> np.ndarray:
+        return self._F[:self.n_done]
+
+    @property
+    def X(self) -> np.ndarray:
+        return self._X[:self.n_done]
+
+    @property
+    def acc(self) -> np.ndarray:
+        return self._acc[:self.n_done]
+
+    @property
+    def area(self) -> np.ndarray:
+        return self._area[:self.n_done]
+
+    def _room(self, total: int) -> None:
+        """Records with room for ``total`` revolutions (the reserve where it is longer and
+        the memory guard accepts it), the steps done so far kept."""
+        from robobore.io.memory import check_timedomain
+
+        Ns, N = self.Ns, self.N
+        rows = total * Ns
+        if rows <= self._F.shape[0]:
+            return
+        if self.reserve_revolutions > total:
+            try:
+                check_timedomain(self.reserve_revolutions, Ns, N)
+                rows = self.reserve_revolutions * Ns
+            except ConfigError:
+                pass  # room for this length only; a longer one reallocates
+        done = self.n_done
+        for name, width in (("_F", 3), ("_X", 3), ("_acc", 3), ("_area", N)):
+            new = np.empty((rows, width))
+            new[:done] = getattr(self, name)[:done]
+            setattr(self, name, new)
 
     @property
     def diverged(self) -> bool:
@@ -638,10 +688,10 @@ class TimeDomainRun:
         total = self.revolutions + int(revolutions)
         check_timedomain(total, Ns, N)  # before the arrays are allocated
         n = int(revolutions) * Ns
-        F = np.empty((n, 3))
-        X = np.empty((n, 3))
-        acc = np.empty((n, 3))
-        area = np.empty((n, N))
+        self._room(total)
+        i0 = self.n_steps  # = n_done: the run has not diverged
+        F, X = self._F[i0:i0 + n], self._X[i0:i0 + n]
+        acc, area = self._acc[i0:i0 + n], self._area[i0:i0 + n]
         a = self.settings.depth_m
         tl = self.tlast - self.n_steps  # the kernel counts steps from 0
         inv_depth = 1.0 / a if np.any(pr.depth_direction) else 0.0
@@ -656,13 +706,10 @@ class TimeDomainRun:
         self.n_done = self.n_steps + int(done)
         self.n_steps += n
         self.revolutions = total
-        parts = [(self.F, F), (self.X, X), (self.acc, acc), (self.area, area)]
-        self.F, self.X, self.acc, self.area = (
-            new[:done] if old.shape[0] == 0 else np.concatenate([old, new[:done]])
-            for old, new in parts)
 
-    def dataset(self) -> xr.Dataset:
-        """The Dataset of the run so far (:func:`simulate`)."""
+    def _whole_steps(self) -> tuple[int, int]:
+        """The whole revolutions of the run so far (those before a divergence) and their
+        steps; NumericalError where there is none or the record is not finite."""
         Ns, n_done, limit = self.Ns, self.n_done, self.limit
         revs = self.revolutions
         if self.diverged:
@@ -674,11 +721,47 @@ class TimeDomainRun:
                     "diverges at once; check the structure (stiffness, mass) and the cutting "
                     "coefficients")
         n_steps = revs * Ns
-        F, X = self.F[:n_steps], self.X[:n_steps]
+        F, X = self._F[:n_steps], self._X[:n_steps]
         if not (np.all(np.isfinite(X)) and np.all(np.isfinite(F))):
             raise NumericalError("the simulation produced non-finite values (unstable "
                                  "integration)")
-        return _run_dataset(self, F, X, self.acc[:n_steps], self.area[:n_steps], revs, n_steps)
+        return revs, n_steps
+
+    def record(self) -> tuple[np.ndarray, np.ndarray]:
+        """The tool-point displacement (n, 3) [m] and chip area (n, n_inserts) [m^2] of the
+        run so far, the Dataset's ``displacement`` and ``chip_area`` (:meth:`dataset`, with
+        its errors) without building it."""
+        n_steps = self._whole_steps()[1]
+        return self._X[:n_steps], self._area[:n_steps]
+
+    def dataset(self) -> xr.Dataset:
+        """The Dataset of the run so far (:func:`simulate`)."""
+        revs, n_steps = self._whole_steps()
+        return _run_dataset(self, self._F[:n_steps], self._X[:n_steps], self._acc[:n_steps],
+                            self._area[:n_steps], revs, n_steps)
+
+
+@nb.njit(cache=True)
+def _rotating_frame(acc, X, c_rev, s_rev, a_rot, feed_amp):  # pragma: no cover - compiled
+    """Per revolution of ``Ns = c_rev.size`` samples: the acceleration on the insert's radial
+    and tangential directions (``a_rot``: ``ax c + ay s``, ``-ax s + ay c``) and the half
+    peak-to-peak feed (z) displacement (``feed_amp``)."""
+    Ns = c_rev.shape[0]
+    for r in range(feed_amp.shape[0]):
+        zmax = X[r * Ns, 2]
+        zmin = zmax
+        for k in range(Ns):
+            i = r * Ns + k
+            ax = acc[i, 0]
+            ay = acc[i, 1]
+            a_rot[i, 0] = ax * c_rev[k] + ay * s_rev[k]
+            a_rot[i, 1] = -ax * s_rev[k] + ay * c_rev[k]
+            z = X[i, 2]
+            if z > zmax:
+                zmax = z
+            if z < zmin:
+                zmin = z
+        feed_amp[r] = 0.5 * (zmax - zmin)
 
 
 def _run_dataset(run: TimeDomainRun, F: np.ndarray, X: np.ndarray, acc: np.ndarray,
@@ -691,18 +774,16 @@ def _run_dataset(run: TimeDomainRun, F: np.ndarray, X: np.ndarray, acc: np.ndarr
     t = np.arange(n_steps) * dt
     th_rev = 2 * np.pi * np.arange(Ns) / Ns  # the insert's angle, the same every revolution
     c_rev, s_rev = np.cos(th_rev), np.sin(th_rev)
-    ax, ay = acc[:, 0].reshape(revs, Ns), acc[:, 1].reshape(revs, Ns)
-    a_r = (ax * c_rev + ay * s_rev).ravel()
-    a_t = (-ax * s_rev + ay * c_rev).ravel()
-    zr = X[:, 2].reshape(revs, Ns)
-    feed_amp = 0.5 * (zr.max(axis=1) - zr.min(axis=1))
+    a_rot = np.empty((n_steps, 2))
+    feed_amp = np.empty(revs)
+    _rotating_frame(acc, X, c_rev, s_rev, a_rot, feed_amp)
     ds_out = xr.Dataset(
         {
             "force": (("time", "axis"), F, {"units": "N", "long_name": "force on the tool"}),
             "displacement": (("time", "axis"), X, {"units": "m",
                                                    "long_name": "tool-point displacement"}),
             "acceleration": (("time", "axis"), acc, {"units": "m/s^2"}),
-            "rotational_acceleration": (("time", "rot_axis"), np.column_stack([a_r, a_t]), {
+            "rotational_acceleration": (("time", "rot_axis"), a_rot, {
                 "units": "m/s^2",
                 "long_name": "tool-point acceleration on the rotating insert's radial and "
                              "tangential directions (no centripetal term)"}),
@@ -810,6 +891,25 @@ def surface_profile(X: np.ndarray, area: np.ndarray, Ns: int, N: int, process: C
     return z, height, ra, rz
 
 
+@nb.njit(cache=True)
+def _column_sums(x):  # pragma: no cover - compiled
+    out = np.zeros(x.shape[1])
+    for i in range(x.shape[0]):
+        for j in range(x.shape[1]):
+            out[j] += x[i, j]
+    return out
+
+
+def column_means(x: np.ndarray) -> np.ndarray:
+    """``x.mean(axis=0)`` of a (n, c) array, digit for digit. A C-ordered array of several
+    columns and rows is summed row after row (the order numpy reduces its first axis in) in
+    one compiled pass and divided by ``n``; any other is numpy's mean."""
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 2 or x.shape[0] < 1 or x.shape[1] < 2 or not x.flags.c_contiguous:
+        return x.mean(axis=0)
+    return _column_sums(x) / x.shape[0]
+
+
 def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, Any]:
     """Mean and amplitude (half peak-to-peak) of the forces over the last revolutions [N],
     mean feed-direction amplitude [m]."""
@@ -818,14 +918,16 @@ def summarize(ds: xr.Dataset, skip_revolutions: int | None = None) -> dict[str, 
     k0 = revs // 2 if skip_revolutions is None else min(skip_revolutions, revs - 1)
     F = ds["force"].values[k0 * Ns:]
     fa = ds["feed_amplitude"].values[k0:]
+    # extremes per column (a strided pass each: faster than along the rows, the same values)
+    fmax = np.array([F[:, c].max() for c in range(F.shape[1])])
+    fmin = np.array([F[:, c].min() for c in range(F.shape[1])])
     return {
-        "force_mean_N": dict(zip("xyz", F.mean(axis=0).tolist(), strict=True)),
-        "force_amplitude_N": dict(zip("xyz", (0.5 * (F.max(axis=0) - F.min(axis=0))).tolist(),
-                                      strict=True)),
+        "force_mean_N": dict(zip("xyz", column_means(F).tolist(), strict=True)),
+        "force_amplitude_N": dict(zip("xyz", (0.5 * (fmax - fmin)).tolist(), strict=True)),
         "feed_amplitude_m": float(fa.mean()),
     }
 
 
 __all__ = ["simulate", "TimeDomainRun", "SimulationSettings", "DIVERGENCE_FLOOR_M", "DIVERGENCE_FORCED_FACTOR", "modal_zoh", "auto_samples_per_rev",
            "periodic_start", "forced_response", "periodic_orbit", "nominal_cut_deflection",
-           "surface_profile", "roughness", "summarize", "FORM_DEGREE"]
+           "surface_profile", "roughness", "summarize", "column_means", "FORM_DEGREE"]
