@@ -16,10 +16,11 @@ and CPU time on 12 observations (goal: under 1 min on 2 cores).
 
 Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_calibrate.py [--seeds 10] [--first 0]
      [--observed verdicts|frequency|amplitude|frequency+amplitude|both] [--json FILE]
-     [--plot DIR] [--design stratified|sequential]
+     [--plot DIR] [--design stratified|sequential] [--criterion mean|point]
 
 ``--design sequential``: the first 4 cuts stratified over quarters of the range, then 8 cuts
-proposed one at a time from the posterior of the cuts so far (robobore.dynamics.design); the
+proposed one at a time from the posterior of the cuts so far (robobore.dynamics.design,
+``--criterion``); the
 wall and CPU time of the design's 8 calibrations is printed beside the last one's.
 """
 
@@ -54,6 +55,10 @@ def main() -> None:
     ap.add_argument("--design", choices=("stratified", "sequential"), default="stratified",
                     help="the cuts' design: stratified (one per twelfth of the range) or "
                          "sequential (4 stratified, 8 proposed from the posterior)")
+    ap.add_argument("--criterion", choices=("mean", "point"), default="mean",
+                    help="the sequential design's criterion (robobore.dynamics.design): mean "
+                         "marginal information over the speeds, or the verdict's information "
+                         "at the cut's speed")
     ap.add_argument("--json", default=None, help="write the per-seed results here")
     ap.add_argument("--plot", default=None, help="write the first seed's band figure here")
     args = ap.parse_args()
@@ -74,7 +79,7 @@ def run_config(cfg, args, amp: bool, freq: bool = False) -> list[dict]:
              (True, True): "verdicts + chatter frequency + feed amplitude"}[(amp, freq)]
     if args.plot:
         case = validation_case(cfg, args.first, feed_amplitude=amp, chatter_frequency=freq,
-                               design=args.design)
+                               design=args.design, criterion=args.criterion)
         from robobore.dynamics.plots import plot_band
 
         cal = case["calibration"]
@@ -90,7 +95,8 @@ def run_config(cfg, args, amp: bool, freq: bool = False) -> list[dict]:
         pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
         critical_depths(truth_structure(pb.structure), pb.process, np.array([1e3]))
     runs = []
-    print(f"SYNTHETIC calibration validation ({label}; {args.design} design), {args.config}, NUMBA_NUM_THREADS="
+    print(f"SYNTHETIC calibration validation ({label}; {args.design} design"
+          f"{', criterion ' + args.criterion if args.design == 'sequential' else ''}), {args.config}, NUMBA_NUM_THREADS="
           f"{os.environ.get('NUMBA_NUM_THREADS', '-')}, {os.cpu_count()} CPUs, load average "
           f"{os.getloadavg()[0]:.1f}")
     print(f"{'seed':>4} {'within10%':>9} {'forecast':>8} {'cover90':>8} {'err corr':>8} "
@@ -98,7 +104,7 @@ def run_config(cfg, args, amp: bool, freq: bool = False) -> list[dict]:
           f"{'design cpu':>10}")
     for seed in range(args.first, args.first + args.seeds):
         r = validate_seed(cfg, seed, feed_amplitude=amp, chatter_frequency=freq,
-                          design=args.design)
+                          design=args.design, criterion=args.criterion)
         runs.append(r)
         print(f"{seed:4d} {r.within_10pct:9.2f} {r.expected_within_10pct:8.2f} "
               f"{r.coverage_90:8.2f} "

@@ -20,11 +20,12 @@ EXAMPLE = ROOT / "examples" / "boring_paper.toml"
 runner = CliRunner()
 
 
-def _band(speeds, median_m, log_sd) -> LobeBand:
+def _band(speeds, median_m, log_sd, sensitivity=None) -> LobeBand:
     speeds, med, sd = (np.asarray(x, float) for x in (speeds, median_m, log_sd))
     depth = np.geomspace(1e-4, 1e-2, 5)
     return LobeBand(speeds, med, med * np.exp(-Z90 * sd), med * np.exp(Z90 * sd), sd, depth,
-                    np.zeros((speeds.size, depth.size)), "test", ("a",), 1)
+                    np.zeros((speeds.size, depth.size)), "test", ("a",), 1,
+                    sensitivity=sensitivity)
 
 
 def test_information_rises_with_the_spread_and_peaks_at_the_median():
@@ -49,7 +50,12 @@ def test_proposal_lands_at_the_widest_speed_at_the_median_depth():
     sd = np.full(7, 0.05)
     sd[4] = 0.6
     (c,) = propose_cuts(_band(speeds, med, sd))
+    assert c.criterion == "point"  # a band without sensitivity
     assert c.speed_rpm == speeds[4]
+    S = np.diag(sd)  # each speed on its own axis: the mean criterion lands there too
+    (m,) = propose_cuts(_band(speeds, med, sd, S), criterion="mean")
+    assert (m.criterion, m.speed_rpm, m.depth_m) == ("mean", speeds[4], med[4])
+    assert m.mean_information_bits > 0
     assert c.depth_m == med[4]
     assert c.p_chatter == pytest.approx(0.5)
     assert c.log_sd == pytest.approx(0.6)
@@ -77,6 +83,27 @@ def test_several_proposals_spread_and_skip_speeds_without_a_limit():
         propose_cuts(_band(speeds, med, sd), 0)
 
 
+def test_mean_criterion_prefers_what_the_speeds_share():
+    """A shared axis (all speeds) and a local one (one speed, the widest): the verdict's own
+    information picks the widest speed, the mean information a speed that measures the shared
+    axis; greedy picks update the covariance, so each adds less."""
+    speeds = np.linspace(500.0, 2000.0, 7)
+    med = np.full(7, 1e-3)
+    S = np.zeros((7, 2))
+    S[:, 0] = 0.3
+    S[4, 1] = 0.35
+    sd = np.sqrt((S ** 2).sum(axis=1))
+    band = _band(speeds, med, sd, S)
+    assert propose_cuts(band, criterion="point")[0].speed_rpm == speeds[4]
+    cuts = propose_cuts(band, 3)
+    assert cuts[0].speed_rpm != speeds[4]
+    bits = [c.mean_information_bits for c in cuts]
+    assert bits[0] > bits[1] > bits[2] > 0
+    assert len({c.speed_rpm for c in cuts}) == 3
+    with pytest.raises(ConfigError, match="criterion"):
+        propose_cuts(band, criterion="widest")
+
+
 def test_calibrate_cli_proposes_cuts_at_the_band(tmp_path):
     from robobore.dynamics.calibrate import Observation, write_observations_csv
 
@@ -98,7 +125,10 @@ def test_calibrate_cli_proposes_cuts_at_the_band(tmp_path):
         assert c["depth_mm"] == pytest.approx(b["critical_depth_p50_mm"][i], rel=1e-12)
         assert c["p_chatter"] == pytest.approx(0.5)
         assert set(c) >= {"speed_rpm", "depth_mm", "p_chatter", "why"}
-    assert cuts[0]["critical_depth_log_sd"] == pytest.approx(sd.max())
+    assert all(c["criterion"] == "mean" for c in cuts)
+    assert cuts[0]["speed_rpm"] != cuts[1]["speed_rpm"]
+    assert cuts[0]["mean_information_bits"] > cuts[1]["mean_information_bits"] > 0
+    assert cuts[0]["critical_depth_log_sd"] <= sd.max()
     r2 = runner.invoke(app, args)
     assert r2.exit_code == 0, r2.output
     assert "proposed cut 1" in r2.output and "proposed cut 2" in r2.output

@@ -15,7 +15,8 @@ Held-out speeds: 24 speeds drawn uniformly over the range with the same seed.
 Sequential design (:func:`sequential_observations`, ``design="sequential"``): the first
 :data:`N_FIRST_CUTS` (4) cuts stratified as above over quarters of the range (the seed's
 first speed positions, depth factors and flips), then one cut at a time at the speed and
-depth :func:`~robobore.dynamics.design.propose_cuts` proposes from the calibration on the cuts
+depth :func:`~robobore.dynamics.design.propose_cuts` proposes (criterion ``"mean"`` unless
+told) from the calibration on the cuts
 so far (its band at :data:`N_CANDIDATES` (28) candidate speeds, the centres of equal slices of
 the range), labelled by the truth with the flip of the seed's draw for that cut; 12 cuts in
 all. The seed's random streams are drawn as for the stratified design, so the held-out speeds,
@@ -175,11 +176,12 @@ def candidate_speeds(speed_range: tuple[float, float] = (200.0, 3000.0),
 def sequential_observations(config: Any, problem, speed_range: tuple[float, float], seed: int,
                             settings: LikelihoodSettings | None = None,
                             feed_amplitude: bool = False, chatter_frequency: bool = False,
-                            progress: Any = None
+                            progress: Any = None, criterion: str = "mean"
                             ) -> tuple[list[Observation], np.ndarray, np.ndarray, list]:
     """SYNTHETIC cuts of the sequential design (module docstring): :data:`N_FIRST_CUTS`
     stratified cuts (one speed per slice, the depths and flips of the seed's first draws),
-    then one cut at a time proposed by :func:`~robobore.dynamics.design.propose_cuts` from the
+    then one cut at a time proposed by :func:`~robobore.dynamics.design.propose_cuts` (its
+    ``criterion``) from the
     calibration on the cuts so far (band at :func:`candidate_speeds`), labelled by the truth
     with the flip of the seed's draw for that cut. Returns the cuts, the held-out speeds (the
     stratified design's of the same seed), the truth's critical depths there [m] and the
@@ -198,7 +200,7 @@ def sequential_observations(config: Any, problem, speed_range: tuple[float, floa
     proposals = []
     for i in range(N_FIRST_CUTS, N_CUTS):
         cal = calibrate(config, obs, settings, speeds=grid)
-        cut = propose_cuts(cal, 1)[0]
+        cut = propose_cuts(cal, 1, criterion=criterion)[0]
         proposals.append(cut)
         a = float(critical_depths(truth, pr, np.array([cut.speed_rpm]))[0])
         new = Observation(i + 1, cut.speed_rpm, cut.depth_m, bool((cut.depth_m > a) != flip[i]))
@@ -217,7 +219,8 @@ class ValidationRun:
     chatter cuts chatter frequencies, the share within 10 % the band itself forecasts
     (:func:`within_10pct_share`), the design of the cuts (``stratified`` or ``sequential``)
     and the wall and CPU time [s] of the sequential design's calibrations before the last
-    (0 for the stratified design), and the cuts (speed [r/min], depth [mm], chatter)."""
+    (0 for the stratified design), the cuts (speed [r/min], depth [mm], chatter) and the
+    sequential design's criterion."""
 
     seed: int
     within_10pct: float
@@ -236,6 +239,7 @@ class ValidationRun:
     design_seconds: float = 0.0
     design_cpu_seconds: float = 0.0
     cuts: tuple = ()
+    criterion: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         return {"seed": self.seed, "within_10pct": self.within_10pct,
@@ -250,7 +254,8 @@ class ValidationRun:
                 "expected_within_10pct": self.expected_within_10pct, "design": self.design,
                 "design_seconds": self.design_seconds,
                 "design_cpu_seconds": self.design_cpu_seconds,
-                "cuts": [list(c) for c in self.cuts], "kind": "SYNTHETIC"}
+                "cuts": [list(c) for c in self.cuts], "criterion": self.criterion,
+                "kind": "SYNTHETIC"}
 
 
 #: The designs of the cuts :func:`validation_case` makes.
@@ -262,10 +267,11 @@ def validation_case(config: Any, seed: int,
                     settings: LikelihoodSettings | None = None,
                     feed_amplitude: bool = False,
                     chatter_frequency: bool = False,
-                    design: str = "stratified") -> dict[str, Any]:
+                    design: str = "stratified", criterion: str = "mean") -> dict[str, Any]:
     """The SYNTHETIC cuts of ``seed`` (with feed amplitudes when ``feed_amplitude``, chatter
     frequencies when ``chatter_frequency``; ``design`` ``stratified``:
-    :func:`synthetic_observations`, ``sequential``: :func:`sequential_observations`) and
+    :func:`synthetic_observations`, ``sequential``: :func:`sequential_observations` with the
+    design ``criterion``) and
     their calibration: ``observations``, ``held_out``
     speeds, the ``truth``'s critical depths there [m], the ``calibration`` (band at the
     held-out speeds), ``flipped`` labels, its wall and CPU ``seconds``, the ``proposals`` and
@@ -284,7 +290,8 @@ def validation_case(config: Any, seed: int,
                                                   chatter_frequency)
     else:
         obs, held, truth, proposals = sequential_observations(
-            cfg, problem, speed_range, seed, settings, feed_amplitude, chatter_frequency)
+            cfg, problem, speed_range, seed, settings, feed_amplitude, chatter_frequency,
+            criterion=criterion)
     d_wall, d_cpu = time.perf_counter() - t0, time.process_time() - c0
     a_t = critical_depths(truth_structure(problem.structure), problem.process,
                           np.array([o.speed_rpm for o in obs]))
@@ -315,11 +322,12 @@ def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (20
                   settings: LikelihoodSettings | None = None,
                   feed_amplitude: bool = False,
                   chatter_frequency: bool = False,
-                  design: str = "stratified") -> ValidationRun:
-    """Make the SYNTHETIC cuts of ``seed`` (``design``: :data:`DESIGNS`), calibrate on them,
+                  design: str = "stratified", criterion: str = "mean") -> ValidationRun:
+    """Make the SYNTHETIC cuts of ``seed`` (``design``: :data:`DESIGNS`; ``criterion``: the
+    sequential design's, :data:`~robobore.dynamics.design.CRITERIA`), calibrate on them,
     compare at the held-out speeds (:func:`validation_case`)."""
     c = validation_case(config, seed, speed_range, settings, feed_amplitude, chatter_frequency,
-                        design)
+                        design, criterion)
     cal, truth = c["calibration"], c["truth"]
     b = cal.band
     err_c = np.abs(b.median_m / truth - 1.0)
@@ -333,7 +341,8 @@ def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (20
                          c["cpu_seconds"], factors, feed_amplitude, chatter_frequency,
                          expected, design, *c["design_seconds"],
                          tuple((o.speed_rpm, o.depth_m * 1e3, o.chatter)
-                               for o in c["observations"]))
+                               for o in c["observations"]),
+                         criterion if design == "sequential" else "")
 
 
 __all__ = ["truth_structure", "synthetic_observations", "validate_seed", "validation_case", "ValidationRun",
