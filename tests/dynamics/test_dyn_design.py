@@ -148,8 +148,8 @@ def test_sequential_design_proposes_from_the_posterior(monkeypatch):
 
     cfg, _ = load_dynamics_config(EXAMPLE)
     pb = build_problem(cfg, [Observation(1, 1000.0, 1e-3, False)])
-    _, held_s, truth_s = cs.synthetic_observations(pb, (200.0, 3000.0), 3)
     monkeypatch.setattr(cs, "N_CUTS", 5)
+    _, held_s, truth_s = cs.synthetic_observations(pb, (200.0, 3000.0), 3)
     obs, held, truth, props = cs.sequential_observations(cfg, pb, (200.0, 3000.0), 3)
     assert np.array_equal(held, held_s) and np.allclose(truth, truth_s)
     assert len(obs) == 5 and len(props) == 1
