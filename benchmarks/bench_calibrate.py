@@ -95,8 +95,9 @@ def run_config(cfg, args, amp: bool, freq: bool = False) -> list[dict]:
         pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
         critical_depths(truth_structure(pb.structure), pb.process, np.array([1e3]))
     runs = []
-    print(f"SYNTHETIC calibration validation ({label}; {args.design} design"
-          f"{', criterion ' + args.criterion if args.design == 'sequential' else ''}), {args.config}, NUMBA_NUM_THREADS="
+    crit = f", criterion {args.criterion}" if args.design == "sequential" else ""
+    print(f"SYNTHETIC calibration validation ({label}; {args.design} design{crit}), "
+          f"{args.config}, NUMBA_NUM_THREADS="
           f"{os.environ.get('NUMBA_NUM_THREADS', '-')}, {os.cpu_count()} CPUs, load average "
           f"{os.getloadavg()[0]:.1f}")
     print(f"{'seed':>4} {'within10%':>9} {'forecast':>8} {'cover90':>8} {'err corr':>8} "

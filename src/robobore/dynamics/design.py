@@ -203,9 +203,9 @@ def propose_cuts(source: LobeBand | Any, n: int = 1, label_noise: float | None =
             cov = cov - np.outer(c, c) / (cov[i, i] + 1.0 / max(float(fisher[i]), 1e-300))
         else:
             i = int(np.argmax(np.where(free, info, -np.inf)))
+            apart = f" at least {spacing:.0f} r/min from the cuts proposed before it" if out else ""
             why = (f"largest expected information of a verdict among the candidate speeds"
-                   f"{' at least %.0f r/min from the cuts proposed before it' % spacing if out else ''}"
-                   f": {info[i]:.3f} bit (critical depth log sd {sd[i]:.3f}, 90 % band "
+                   f"{apart}: {info[i]:.3f} bit (critical depth log sd {sd[i]:.3f}, 90 % band "
                    f"{band.lower_m[i] * 1e3:.3g}-{band.upper_m[i] * 1e3:.3g} mm); depth at the "
                    f"band's median, where P(chatter) = {p50[i]:.2f}")
             mean_bits = float("nan")
