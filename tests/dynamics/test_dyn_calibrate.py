@@ -165,6 +165,11 @@ def test_modal_band_collapses_to_nominal_and_widens_with_the_intervals(example):
     assert np.all(b2.lower_m <= b2.median_m) and np.all(b2.median_m <= b2.upper_m)
     # the probability of chatter rises with the depth at every speed
     assert np.all(np.diff(b2.p_chatter, axis=1) >= 0)
+    # the secants along the principal axes carry the band's variance (and nothing without one)
+    assert b0.sensitivity.shape == (3, 0)
+    assert b2.sensitivity.shape == (3, (b2.evaluations - 1) // 2)
+    np.testing.assert_allclose(np.sqrt((b2.sensitivity ** 2).sum(axis=1)), b2.log_sd,
+                               rtol=1e-12)
 
 
 # --------------------------------------------------------------------------- calibration

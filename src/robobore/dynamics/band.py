@@ -73,7 +73,10 @@ class LobeBand:
     ``log_sd`` (n,) of the critical depth; ``depth_m`` (d,) and ``p_chatter`` (n, d);
     ``source`` (what the uncertainty is: "observations" or "modal intervals");
     ``parameters`` (names of the uncertain parameters); ``evaluations`` (lobe curves
-    computed)."""
+    computed); ``sensitivity`` (n, k): the secant ``(g_j+ - g_j-) / 2`` of ``ln a_crit``
+    along each of the covariance's ``k`` principal axes one standard deviation wide, so that
+    ``sensitivity @ sensitivity.T`` is the linearised covariance of ``ln a_crit`` between the
+    speeds (``log_sd`` the root of its diagonal); None where not known."""
 
     speed_rpm: np.ndarray
     median_m: np.ndarray
@@ -87,6 +90,7 @@ class LobeBand:
     evaluations: int
     method: str = ("linearised sensitivity along the covariance's principal axes "
                    "(central secants at +-1 sd), Gaussian in ln a_crit")
+    sensitivity: np.ndarray | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"source": self.source, "method": self.method,
@@ -142,6 +146,7 @@ def lobe_band(curve: Callable[[np.ndarray, np.ndarray | None], np.ndarray],
     lam, U = np.linalg.eigh(0.5 * (cov + cov.T))
     var = np.zeros_like(g0)
     n_eval = 1
+    cols = []
     scale = max(float(lam.max(initial=0.0)), 0.0)
     for j in range(lam.size):
         if not (lam[j] > 1e-12 * max(scale, 1e-300) and lam[j] > 1e-18):
@@ -150,6 +155,7 @@ def lobe_band(curve: Callable[[np.ndarray, np.ndarray | None], np.ndarray],
         gp = np.log(clipped(curve(theta0 + step, g0c)))
         gm = np.log(clipped(curve(theta0 - step, g0c)))
         var += (0.5 * (gp - gm)) ** 2
+        cols.append(0.5 * (gp - gm))
         n_eval += 2
         if progress is not None:
             progress(2)
@@ -161,7 +167,8 @@ def lobe_band(curve: Callable[[np.ndarray, np.ndarray | None], np.ndarray],
     step_map = (la >= g0[:, None]).astype(float)
     p = np.where(sd[:, None] > 0, norm.cdf(np.nan_to_num(z)), step_map)
     return LobeBand(np.asarray(speeds, float), g0c, np.exp(g0 - Z90 * sd),
-                    np.exp(g0 + Z90 * sd), sd, depth, p, source, tuple(names), n_eval)
+                    np.exp(g0 + Z90 * sd), sd, depth, p, source, tuple(names), n_eval,
+                    sensitivity=np.column_stack(cols) if cols else np.zeros((g0.size, 0)))
 
 
 # --------------------------------------------------------------------------- modal intervals

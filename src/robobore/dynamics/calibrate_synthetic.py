@@ -12,6 +12,16 @@ brackets the limit within a factor 1.35 either side); the label is the truth's v
 above its semi-discretisation linear limit) flipped with probability 0.1 (label noise).
 Held-out speeds: 24 speeds drawn uniformly over the range with the same seed.
 
+Sequential design (:func:`sequential_observations`, ``design="sequential"``): the first
+:data:`N_FIRST_CUTS` (4) cuts stratified as above over quarters of the range (the seed's
+first speed positions, depth factors and flips), then one cut at a time at the speed and
+depth :func:`~robobore.dynamics.design.propose_cuts` proposes (criterion ``"mean"`` unless
+told) from the calibration on the cuts
+so far (its band at :data:`N_CANDIDATES` (28) candidate speeds, the centres of equal slices of
+the range), labelled by the truth with the flip of the seed's draw for that cut; 12 cuts in
+all. The seed's random streams are drawn as for the stratified design, so the held-out speeds,
+the flips and the measurement noises per cut index are the same.
+
 Feed amplitudes (``feed_amplitude=True``): every stable cut carries the feed amplitude a
 grating scale measures, the truth's steady periodic orbit at the cut
 (:func:`~robobore.dynamics.timedomain.nominal_cut_deflection`, half peak-to-peak of the feed
@@ -42,6 +52,7 @@ import numpy as np
 
 from robobore.dynamics.band import critical_depths, scaled_structure
 from robobore.dynamics.calibrate import LikelihoodSettings, Observation, build_problem, calibrate
+from robobore.errors import ConfigError
 
 #: The truth robot: damping factor of every direction, and one direction's stiffness factor.
 TRUTH_DAMPING_FACTOR = 0.6
@@ -56,6 +67,9 @@ AMPLITUDE_NOISE_REL = 0.05
 AMPLITUDE_NOISE_ABS_M = 1e-7
 #: Relative measurement noise of the SYNTHETIC chatter frequencies.
 FREQUENCY_NOISE_REL = 0.01
+#: Sequential design: stratified cuts before the first proposal, and candidate speeds.
+N_FIRST_CUTS = 4
+N_CANDIDATES = 28
 
 
 def truth_feed_amplitude(truth, process, speed_rpm: float, depth_m: float) -> float:
@@ -85,6 +99,53 @@ def truth_chatter_frequency(truth, process, speed_rpm: float, depth_m: float) ->
     return critical_multiplier(truth, process, speed_rpm, depth_m)[1]
 
 
+def _measured(obs: list[Observation], truth, process, seed: int, feed_amplitude: bool,
+              chatter_frequency: bool, first: int = 0) -> list[Observation]:
+    """The cuts with what they carry besides the verdict (module docstring): ``obs[j]`` is cut
+    ``first + j`` of the seed and takes that draw of its amplitude and frequency noise
+    streams."""
+    from dataclasses import replace
+
+    obs = list(obs)
+    if feed_amplitude:
+        rng2 = np.random.default_rng([seed, 1])
+        noise = rng2.standard_normal((N_CUTS, 2))
+        for i, o in enumerate(obs):
+            if o.chatter:
+                continue
+            a = truth_feed_amplitude(truth, process, o.speed_rpm, o.depth_m)
+            a = (a * (1.0 + AMPLITUDE_NOISE_REL * noise[first + i, 0])
+                 + AMPLITUDE_NOISE_ABS_M * noise[first + i, 1])
+            if a >= AMPLITUDE_NOISE_ABS_M:
+                obs[i] = replace(o, feed_amplitude_m=float(a))
+    if chatter_frequency:
+        rng3 = np.random.default_rng([seed, 2])
+        noise = rng3.standard_normal(N_CUTS)
+        for i, o in enumerate(obs):
+            if not o.chatter:
+                continue
+            f = truth_chatter_frequency(truth, process, o.speed_rpm, o.depth_m)
+            if np.isfinite(f):
+                obs[i] = replace(o, chatter_frequency_Hz=float(f * (1.0 + FREQUENCY_NOISE_REL
+                                                                    * noise[first + i])))
+    return obs
+
+
+def _draws(seed: int, speed_range: tuple[float, float], n_slices: int):
+    """The seed's draws in their order: speeds (one per slice of ``n_slices``, from the first
+    ``n_slices`` of :data:`N_CUTS` uniform positions), depth factors, label flips, held-out
+    speeds."""
+    rng = np.random.default_rng(seed)
+    lo, hi = speed_range
+    pos = rng.uniform(0, 1, N_CUTS)
+    edges = np.linspace(lo, hi, n_slices + 1)
+    speeds = edges[:-1] + pos[:n_slices] * np.diff(edges)
+    factor = np.exp(rng.uniform(-DEPTH_SPREAD_LN, DEPTH_SPREAD_LN, N_CUTS))
+    flip = rng.uniform(0, 1, N_CUTS) < LABEL_NOISE
+    held = np.sort(rng.uniform(lo, hi, N_HELD_OUT))
+    return speeds, factor, flip, held
+
+
 def synthetic_observations(problem, speed_range: tuple[float, float], seed: int,
                            feed_amplitude: bool = False, chatter_frequency: bool = False
                            ) -> tuple[list[Observation], np.ndarray, np.ndarray]:
@@ -92,43 +153,61 @@ def synthetic_observations(problem, speed_range: tuple[float, float], seed: int,
     with their measured feed amplitude when ``feed_amplitude``, chatter cuts with their
     measured chatter frequency when ``chatter_frequency``), the held-out speeds and the
     truth's critical depths there [m]."""
-    rng = np.random.default_rng(seed)
-    lo, hi = speed_range
-    edges = np.linspace(lo, hi, N_CUTS + 1)
-    speeds = edges[:-1] + rng.uniform(0, 1, N_CUTS) * np.diff(edges)
+    speeds, factor, flip, held = _draws(seed, speed_range, N_CUTS)
     truth = truth_structure(problem.structure)
     a_t = critical_depths(truth, problem.process, speeds)
-    depth = a_t * np.exp(rng.uniform(-DEPTH_SPREAD_LN, DEPTH_SPREAD_LN, N_CUTS))
+    depth = a_t * factor
     chatter = depth > a_t
-    flip = rng.uniform(0, 1, N_CUTS) < LABEL_NOISE
     obs = [Observation(i + 1, float(n), float(a), bool(c != f))
            for i, (n, a, c, f) in enumerate(zip(speeds, depth, chatter, flip, strict=True))]
-    held = np.sort(rng.uniform(lo, hi, N_HELD_OUT))
-    if feed_amplitude:
-        from dataclasses import replace
-
-        rng2 = np.random.default_rng([seed, 1])
-        noise = rng2.standard_normal((N_CUTS, 2))
-        for i, o in enumerate(obs):
-            if o.chatter:
-                continue
-            a = truth_feed_amplitude(truth, problem.process, o.speed_rpm, o.depth_m)
-            a = a * (1.0 + AMPLITUDE_NOISE_REL * noise[i, 0]) + AMPLITUDE_NOISE_ABS_M * noise[i, 1]
-            if a >= AMPLITUDE_NOISE_ABS_M:
-                obs[i] = replace(o, feed_amplitude_m=float(a))
-    if chatter_frequency:
-        from dataclasses import replace
-
-        rng3 = np.random.default_rng([seed, 2])
-        noise = rng3.standard_normal(N_CUTS)
-        for i, o in enumerate(obs):
-            if not o.chatter:
-                continue
-            f = truth_chatter_frequency(truth, problem.process, o.speed_rpm, o.depth_m)
-            if np.isfinite(f):
-                obs[i] = replace(o, chatter_frequency_Hz=float(f * (1.0 + FREQUENCY_NOISE_REL
-                                                                    * noise[i])))
+    obs = _measured(obs, truth, problem.process, seed, feed_amplitude, chatter_frequency)
     return obs, held, critical_depths(truth, problem.process, held)
+
+
+def candidate_speeds(speed_range: tuple[float, float] = (200.0, 3000.0),
+                     count: int = N_CANDIDATES) -> np.ndarray:
+    """The sequential design's candidate speeds [r/min]: the centres of ``count`` equal slices
+    of the range (a fixed grid; the held-out speeds are drawn uniformly, apart from it)."""
+    lo, hi = speed_range
+    edges = np.linspace(lo, hi, count + 1)
+    return 0.5 * (edges[:-1] + edges[1:])
+
+
+def sequential_observations(config: Any, problem, speed_range: tuple[float, float], seed: int,
+                            settings: LikelihoodSettings | None = None,
+                            feed_amplitude: bool = False, chatter_frequency: bool = False,
+                            progress: Any = None, criterion: str = "mean"
+                            ) -> tuple[list[Observation], np.ndarray, np.ndarray, list]:
+    """SYNTHETIC cuts of the sequential design (module docstring): :data:`N_FIRST_CUTS`
+    stratified cuts (one speed per slice, the depths and flips of the seed's first draws),
+    then one cut at a time proposed by :func:`~robobore.dynamics.design.propose_cuts` (its
+    ``criterion``) from the
+    calibration on the cuts so far (band at :func:`candidate_speeds`), labelled by the truth
+    with the flip of the seed's draw for that cut. Returns the cuts, the held-out speeds (the
+    stratified design's of the same seed), the truth's critical depths there [m] and the
+    proposals."""
+    from robobore.dynamics.design import propose_cuts
+
+    speeds, factor, flip, held = _draws(seed, speed_range, N_FIRST_CUTS)
+    truth = truth_structure(problem.structure)
+    pr = problem.process
+    a_t = critical_depths(truth, pr, speeds)
+    obs = [Observation(i + 1, float(n), float(a * k), bool((a * k > a) != f))
+           for i, (n, a, k, f) in enumerate(zip(speeds, a_t, factor[:N_FIRST_CUTS],
+                                                 flip[:N_FIRST_CUTS], strict=True))]
+    obs = _measured(obs, truth, pr, seed, feed_amplitude, chatter_frequency)
+    grid = candidate_speeds(speed_range)
+    proposals = []
+    for i in range(N_FIRST_CUTS, N_CUTS):
+        cal = calibrate(config, obs, settings, speeds=grid)
+        cut = propose_cuts(cal, 1, criterion=criterion)[0]
+        proposals.append(cut)
+        a = float(critical_depths(truth, pr, np.array([cut.speed_rpm]))[0])
+        new = Observation(i + 1, cut.speed_rpm, cut.depth_m, bool((cut.depth_m > a) != flip[i]))
+        obs = obs + _measured([new], truth, pr, seed, feed_amplitude, chatter_frequency, i)
+        if progress is not None:
+            progress(i + 1)
+    return obs, held, critical_depths(truth, pr, held), proposals
 
 
 @dataclass(frozen=True)
@@ -137,8 +216,11 @@ class ValidationRun:
     within 10 % of the truth, the 90 % band's coverage of the truth, the median relative error
     of the corrected and of the uncorrected model, labels flipped, the calibration's run time
     and CPU time [s], the MAP factors, whether the stable cuts carried feed amplitudes and the
-    chatter cuts chatter frequencies, and the share within 10 % the band itself forecasts
-    (:func:`within_10pct_share`)."""
+    chatter cuts chatter frequencies, the share within 10 % the band itself forecasts
+    (:func:`within_10pct_share`), the design of the cuts (``stratified`` or ``sequential``)
+    and the wall and CPU time [s] of the sequential design's calibrations before the last
+    (0 for the stratified design), the cuts (speed [r/min], depth [mm], chatter) and the
+    sequential design's criterion."""
 
     seed: int
     within_10pct: float
@@ -153,6 +235,11 @@ class ValidationRun:
     feed_amplitude: bool = False
     chatter_frequency: bool = False
     expected_within_10pct: float = float("nan")
+    design: str = "stratified"
+    design_seconds: float = 0.0
+    design_cpu_seconds: float = 0.0
+    cuts: tuple = ()
+    criterion: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         return {"seed": self.seed, "within_10pct": self.within_10pct,
@@ -164,33 +251,58 @@ class ValidationRun:
                 "cpu_seconds": self.cpu_seconds,
                 "factors": self.factors, "feed_amplitude": self.feed_amplitude,
                 "chatter_frequency": self.chatter_frequency,
-                "expected_within_10pct": self.expected_within_10pct, "kind": "SYNTHETIC"}
+                "expected_within_10pct": self.expected_within_10pct, "design": self.design,
+                "design_seconds": self.design_seconds,
+                "design_cpu_seconds": self.design_cpu_seconds,
+                "cuts": [list(c) for c in self.cuts], "criterion": self.criterion,
+                "kind": "SYNTHETIC"}
+
+
+#: The designs of the cuts :func:`validation_case` makes.
+DESIGNS = ("stratified", "sequential")
 
 
 def validation_case(config: Any, seed: int,
                     speed_range: tuple[float, float] = (200.0, 3000.0),
                     settings: LikelihoodSettings | None = None,
                     feed_amplitude: bool = False,
-                    chatter_frequency: bool = False) -> dict[str, Any]:
+                    chatter_frequency: bool = False,
+                    design: str = "stratified", criterion: str = "mean") -> dict[str, Any]:
     """The SYNTHETIC cuts of ``seed`` (with feed amplitudes when ``feed_amplitude``, chatter
-    frequencies when ``chatter_frequency``) and
+    frequencies when ``chatter_frequency``; ``design`` ``stratified``:
+    :func:`synthetic_observations`, ``sequential``: :func:`sequential_observations` with the
+    design ``criterion``) and
     their calibration: ``observations``, ``held_out``
     speeds, the ``truth``'s critical depths there [m], the ``calibration`` (band at the
-    held-out speeds), ``flipped`` labels, its wall and CPU ``seconds``."""
+    held-out speeds), ``flipped`` labels, its wall and CPU ``seconds``, the ``proposals`` and
+    the wall and CPU ``design_seconds`` of the sequential design."""
     from robobore.dynamics.config import load_dynamics_config
 
+    if design not in DESIGNS:
+        raise ConfigError("unknown design of the cuts", field="design", value=design,
+                          expected=" or ".join(DESIGNS))
     cfg, _ = load_dynamics_config(config) if not hasattr(config, "equivalent") else (config, 0)
     problem = build_problem(cfg, [Observation(1, 1000.0, 1e-3, False)], settings)
-    obs, held, truth = synthetic_observations(problem, speed_range, seed, feed_amplitude,
-                                              chatter_frequency)
+    t0, c0 = time.perf_counter(), time.process_time()
+    proposals: list = []
+    if design == "stratified":
+        obs, held, truth = synthetic_observations(problem, speed_range, seed, feed_amplitude,
+                                                  chatter_frequency)
+    else:
+        obs, held, truth, proposals = sequential_observations(
+            cfg, problem, speed_range, seed, settings, feed_amplitude, chatter_frequency,
+            criterion=criterion)
+    d_wall, d_cpu = time.perf_counter() - t0, time.process_time() - c0
     a_t = critical_depths(truth_structure(problem.structure), problem.process,
                           np.array([o.speed_rpm for o in obs]))
     flipped = sum(int(o.chatter != (o.depth_m > a)) for o, a in zip(obs, a_t, strict=True))
     t0, c0 = time.perf_counter(), time.process_time()
     cal = calibrate(cfg, obs, settings, speeds=held)
     dt, cpu = time.perf_counter() - t0, time.process_time() - c0
+    seq = design == "sequential"
     return {"observations": obs, "held_out": held, "truth": truth, "calibration": cal,
-            "flipped": flipped, "seconds": dt, "cpu_seconds": cpu}
+            "flipped": flipped, "seconds": dt, "cpu_seconds": cpu, "proposals": proposals,
+            "design_seconds": (d_wall if seq else 0.0, d_cpu if seq else 0.0)}
 
 
 def within_10pct_share(log_sd: np.ndarray) -> np.ndarray:
@@ -209,10 +321,13 @@ def within_10pct_share(log_sd: np.ndarray) -> np.ndarray:
 def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (200.0, 3000.0),
                   settings: LikelihoodSettings | None = None,
                   feed_amplitude: bool = False,
-                  chatter_frequency: bool = False) -> ValidationRun:
-    """Make the SYNTHETIC cuts of ``seed``, calibrate on them, compare at the held-out
-    speeds (:func:`validation_case`)."""
-    c = validation_case(config, seed, speed_range, settings, feed_amplitude, chatter_frequency)
+                  chatter_frequency: bool = False,
+                  design: str = "stratified", criterion: str = "mean") -> ValidationRun:
+    """Make the SYNTHETIC cuts of ``seed`` (``design``: :data:`DESIGNS`; ``criterion``: the
+    sequential design's, :data:`~robobore.dynamics.design.CRITERIA`), calibrate on them,
+    compare at the held-out speeds (:func:`validation_case`)."""
+    c = validation_case(config, seed, speed_range, settings, feed_amplitude, chatter_frequency,
+                        design, criterion)
     cal, truth = c["calibration"], c["truth"]
     b = cal.band
     err_c = np.abs(b.median_m / truth - 1.0)
@@ -224,14 +339,18 @@ def validate_seed(config: Any, seed: int, speed_range: tuple[float, float] = (20
                          float(np.median(err_c)), float(np.median(err_u)),
                          float(np.mean(err_u <= 0.1)), int(c["flipped"]), c["seconds"],
                          c["cpu_seconds"], factors, feed_amplitude, chatter_frequency,
-                         expected)
+                         expected, design, *c["design_seconds"],
+                         tuple((o.speed_rpm, o.depth_m * 1e3, o.chatter)
+                               for o in c["observations"]),
+                         criterion if design == "sequential" else "")
 
 
 __all__ = ["truth_structure", "synthetic_observations", "validate_seed", "validation_case", "ValidationRun",
            "TRUTH_DAMPING_FACTOR", "TRUTH_STIFFNESS_FACTOR", "TRUTH_STIFFNESS_AXIS", "N_CUTS",
            "N_HELD_OUT", "LABEL_NOISE", "write_example_observations", "truth_feed_amplitude",
            "AMPLITUDE_NOISE_REL", "AMPLITUDE_NOISE_ABS_M", "FREQUENCY_NOISE_REL",
-           "within_10pct_share",
+           "within_10pct_share", "sequential_observations", "candidate_speeds", "DESIGNS",
+           "N_FIRST_CUTS", "N_CANDIDATES",
            "truth_chatter_frequency"]
 
 

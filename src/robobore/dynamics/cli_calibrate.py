@@ -47,6 +47,10 @@ def calibrate_dynamics_cmd(
         None, "--out", help="Write calibration.json, calibration.nc and equivalent_corrected."
                             "json (an equivalent model `lobes --equivalent-file` takes) here."),
     plot: Path | None = typer.Option(None, "--plot", help="Write calibration_lobes.png here."),
+    propose: int = typer.Option(
+        0, "--propose", help="Propose this many next test cuts (speed, depth) where the "
+                             "posterior is least sure of the critical depth "
+                             "(robobore.dynamics.design; among the band's --speeds)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Correct the robot's equivalent model by observed cuts; lobes with a confidence band."""
@@ -61,6 +65,9 @@ def calibrate_dynamics_cmd(
     if not 2 <= speeds <= 2000:
         raise ConfigError("band speeds out of range", field="--speeds", value=speeds,
                           expected="2 .. 2000 speeds")
+    if not 0 <= propose <= 100:
+        raise ConfigError("number of proposed cuts out of range", field="--propose",
+                          value=propose, expected="0 .. 100 cuts")
     cfg, raw = load_dynamics_config(config)
     obs_file = observations_path(cfg, config, observations)
     obs = read_observations(obs_file)
@@ -78,6 +85,10 @@ def calibrate_dynamics_cmd(
     result["kind"] = result["kind"] + (" (SYNTHETIC observations)"
                                        if "SYNTHETIC" in obs_file.read_text(
                                            errors="replace")[:2000] else "")
+    if propose:
+        from robobore.dynamics.design import propose_cuts
+
+        result["proposed_cuts"] = [c.to_dict() for c in propose_cuts(cal, propose)]
     if out is not None:
         from robobore.io.results import write_json, write_netcdf
 
@@ -120,6 +131,11 @@ def calibrate_dynamics_cmd(
         nom = np.asarray(r["nominal_critical_depth_mm"])
         nom = nom[nom > DEPTH_FLOOR_M * 1e3 * (1 + 1e-9)]
         rows.append(("lowest nominal critical depth (mm)", fmt(nom.min()) if nom.size else "-"))
+        for k, c in enumerate(r.get("proposed_cuts", []), start=1):
+            rows.append((f"proposed cut {k}",
+                         f"{fmt(c['speed_rpm'])} r/min, {fmt(c['depth_mm'])} mm (P(chatter) "
+                         f"{c['p_chatter']:.2f}, {c['expected_information_bits']:.2f} bit): "
+                         + c["why"]))
         rows.append(("run time (s)", fmt(r["seconds"])))
         for f in r.get("files", []):
             rows.append(("written", f))
