@@ -178,11 +178,14 @@ def run_boring(config: str | Path | dict[str, Any] | DynamicsConfig,
             raise
         # near the stability limit the growth per pitch is within its uncertainty of 1:
         # lengthen the run (up to UNDECIDED_MAX_FACTOR x) before saying so
-        if not extend or run.revolutions >= UNDECIDED_MAX_FACTOR * int(revs) or \
-                decision(run).decided:
+        dec = None  # the decision on the run's final length, where it was made here
+        if not extend or run.revolutions >= UNDECIDED_MAX_FACTOR * int(revs):
+            break
+        dec = decision(run)
+        if dec.decided:
             break
     ds = run.dataset()
-    v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6)
+    v = classify(ds, ra_tolerance_m=None if tol is None else tol * 1e-6, decision=dec)
     revs = run_revs = run.revolutions
     # where the tool leaves the cut the force is not smooth in the displacement and the
     # verdict can depend on where the steps fall: the same run at twice the samples per

@@ -412,18 +412,21 @@ def chatter_decision(displacement: np.ndarray, chip_area: np.ndarray, samples_pe
 
 
 def classify(ds: xr.Dataset, growth_limit: float = 1.0, ra_tolerance_m: float | None = None,
-             tail_fraction: float = 0.3) -> ChatterVerdict:
+             tail_fraction: float = 0.3, decision: ChatterDecision | None = None
+             ) -> ChatterVerdict:
     """The verdicts on a simulation Dataset (:func:`~robobore.dynamics.timedomain.simulate`);
     see the module docstring. ``reasons`` lists, for each verdict that flags the cut, why.
-    The chatter verdict is :func:`chatter_decision`'s on the Dataset's record."""
+    The chatter verdict is :func:`chatter_decision`'s on the Dataset's record; ``decision``:
+    that decision when the caller has already made it (on the same record, with the same
+    ``growth_limit`` and ``tail_fraction``)."""
     Ns = int(ds.attrs["samples_per_rev"])
     N = int(ds.attrs["n_inserts"])
     X = ds["displacement"].values
     diverged = bool(int(ds.attrs.get("diverged", 0)))
-    dec = chatter_decision(X, ds["chip_area"].values, Ns, N,
-                           float(ds.attrs.get("depth_m", math.nan)),
-                           float(ds.attrs.get("feed_per_rev_m", math.nan)), diverged,
-                           growth_limit, tail_fraction)
+    dec = decision if decision is not None else chatter_decision(
+        X, ds["chip_area"].values, Ns, N, float(ds.attrs.get("depth_m", math.nan)),
+        float(ds.attrs.get("feed_per_rev_m", math.nan)), diverged, growth_limit,
+        tail_fraction)
     g, rho, se, left = (dec.vibration_growth, dec.floquet_multiplier,
                         dec.floquet_multiplier_se, dec.tool_left_cut_fraction)
     fs = 1.0 / float(ds.attrs["dt_s"])
