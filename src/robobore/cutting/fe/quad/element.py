@@ -155,12 +155,10 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
     ``quad_step``, ``damage_erosion`` given (the CPU's compiled functions here, a GPU
     engine's device functions in its port)"""
 
-    def quad_element_py(e, nodes, quads, state, out, mat, prm, dt, erosion):
+    def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                        temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
+                        prm, dt, erosion):
         """Stress update and nodal forces of quad ``e`` (one element, scalar code).
-
-        The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2), ``quads``
-        (Quads2), ``state`` (QuadState2), ``out`` (QuadOut2); ``mat`` the material vector,
-        ``prm`` the parameter vector, ``dt`` the step [s], ``erosion`` the erosion mode.
 
         The whole per-element update of :func:`element_update`: kinematics at the new
         configuration, Jaumann rotation, elastic trial, Johnson-Cook radial return, adiabatic
@@ -174,31 +172,6 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
         was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
         """
-        x = nodes.x
-        y = nodes.y
-        vx = nodes.vx
-        vy = nodes.vy
-        conn = quads.conn
-        layer = quads.layer
-        alive = quads.alive
-        area0 = quads.area0
-        sdx = state.sdx
-        sdy = state.sdy
-        sdz = state.sdz
-        sdxy = state.sdxy
-        pres = state.pres
-        eps_p = state.eps_p
-        temp = state.temp
-        dmg = state.dmg
-        qhx = state.qhx
-        qhy = state.qhy
-        ie = out.ie
-        hge = out.hge
-        fex = out.fex
-        fey = out.fey
-        dte = out.dte
-        plast = out.plast
-        rate = out.rate
         if alive[e] != 1:
             quad_retire(e, fex, fey, dte)
             return 1e30, False
@@ -336,7 +309,7 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
 quad_element_py = make_quad_element(radial_return, jc_damage_increment, quad_retire,
                                     quad_area_corners, quad_distorted, quad_bvectors,
                                     quad_step, damage_erosion)
-quad_element = njit(cache=False)(quad_element_py)
+quad_element = njit(cache=False, inline="always")(quad_element_py)
 
 
 @njit(parallel=True, cache=True)
@@ -353,13 +326,34 @@ def element_update(nodes, quads, state, out, mat, prm, dt, erosion):
     ``plast`` plastic work per element [J/m], ``hge`` hourglass work [J/m]. Erodes
     elements (``alive`` = 0 damage, -1 distortion).
     """
-    # the prange body passes the groups to quad_element, which numba compiles apart (not
-    # inlined) and which reads their arrays (engine.groups2d)
-    ne = quads.conn.shape[0]
+    # the prange body reads flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    vx = nodes.vx
+    vy = nodes.vy
+    conn = quads.conn
+    layer = quads.layer
+    alive = quads.alive
+    area0 = quads.area0
+    sdx = state.sdx
+    sdy = state.sdy
+    sdz = state.sdz
+    sdxy = state.sdxy
+    pres = state.pres
+    eps_p = state.eps_p
+    temp = state.temp
+    dmg = state.dmg
+    qhx = state.qhx
+    qhy = state.qhy
+    ie, hge, fex, fey, dte, plast, rate = (out.ie, out.hge, out.fex, out.fey, out.dte,
+                                           out.plast, out.rate)
+    ne = conn.shape[0]
     dtmin = 1e30
     bad = -1
     for e in prange(ne):
-        d, inv = quad_element(e, nodes, quads, state, out, mat, prm, dt, erosion)
+        d, inv = quad_element(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
+                              eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
+                              rate, mat, prm, dt, erosion)
         dtmin = min(dtmin, d)
         if inv:
             bad = max(bad, e)

@@ -56,12 +56,10 @@ Not ported: the B-bar element is refused with a ConfigError.
 from __future__ import annotations
 
 from collections.abc import Callable
-from types import SimpleNamespace
 from typing import Any
 
 from robobore.cutting.fe.ale import rezone as RZ
 from robobore.cutting.fe.engine import layout
-from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.engine.gpu.kernels2d import kernels2
 from robobore.cutting.fe.engine.gpu.runstate2d import N_RED, RUN_ARRAYS, RunState
 from robobore.cutting.fe.engine.gpu.shared import GpuEngine, blocks, drive_gpu, require_gpu
@@ -143,7 +141,11 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
         if phases.tool_frame and step % rz_every == 0:
             _ale_launches(g, ale, gn, ge, gs)
             tick("ale")
-        k_elems[ge, _THREADS](*groups_of(SimpleNamespace(**g))[:4], g["mat"], g["prm"],
+        k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
+                              g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
+                              g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
+                              g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
+                              g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
                               g["clock"], erosion, g["ist"], dred)
         tick("elements")
         if phases.conduction and step % cond_every == 0:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import functools
 
-from robobore.cutting.fe.engine import groups2d, layout
+from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
 from robobore.cutting.fe.engine.gpu.persistent import (
@@ -59,10 +59,6 @@ def kernels2(phases: Phases):
         f.csplit, f.tool_geometry, f.tplace, f.tfacep, f.tsweep, f.tscopy, f.tinter, f.rflux,
         f.rvel, f.rwrite, f.rmass, f.SWEEPS, f.elem, f.node, f.kin, f.tstep, f.cent, f.cond,
         f.pedge, f.thnode, f.thelem, f.end_step, f.lsum)
-    # the groups of engine.groups2d from the persistent kernel's state, by field name
-    dev = cuda.jit(device=True)
-    nodes_of, quads_of = dev(groups2d.nodes_of.py_func), dev(groups2d.quads_of.py_func)
-    state_of, out_of = dev(groups2d.state_of.py_func), dev(groups2d.out_of.py_func)
     LANES = node_contact.N_SUM_LANES
     float64 = _float64
     CONDUCTION = phases.conduction
@@ -232,12 +228,15 @@ def kernels2(phases: Phases):
         red[R_BAD] = -1.0
 
     @cuda.jit
-    def k_elems(nodes, quads, state, out, mat, prm, clock, erosion, ist, red):
-        # the groups of engine.groups2d (Nodes2, Quads2, QuadState2, QuadOut2)
+    def k_elems(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm,
+                qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, clock, erosion,
+                ist, red):
         e = cuda.grid(1)
-        if e >= quads.conn.shape[0] or ist[I_STATUS] != ST_OK:
+        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
             return
-        d, inv = elem(e, nodes, quads, state, out, mat, prm, clock[1], erosion)
+        d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
+                      temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm,
+                      clock[1], erosion)
         cuda.atomic.min(red, R_DTMIN, d)
         if inv:
             cuda.atomic.max(red, R_BAD, float(e))
@@ -417,8 +416,11 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def elem_phase(e, a, dt, red):
-        d, inv = elem(e, nodes_of(a), quads_of(a), state_of(a), out_of(a), a.mat, a.prm, dt,
-                      a.erosion)
+        d, inv = elem(e, a.conn, a.x, a.y, a.vx, a.vy, a.alive, a.layer,
+                      a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p,
+                      a.temp, a.dmg, a.qhx, a.qhy, a.area0, a.ie, a.hge,
+                      a.fex, a.fey, a.dte, a.plast, a.rate, a.mat, a.prm,
+                      dt, a.erosion)
         cuda.atomic.min(red, R_DTMIN, d)
         if inv:
             cuda.atomic.max(red, R_BAD, float(e))
