@@ -59,7 +59,7 @@ def _state2(n_hist=3, sample_dt=1.0, t_end=10.0):
 def _end(s, dt, fx=0.0, ncont=0, split=None, bad=-1, dtmin=1.0):
     split = np.zeros(6) if split is None else split
     s["clock"][1] = dt
-    return CL._end_step(dt, bad, dtmin, fx, 0.0, 0.0, ncont, split, s["ist"], s["clock"],
+    return CL._end_step(dt, (dtmin, bad), (fx, 0.0, 0.0, ncont), split, s["ist"], s["clock"],
                         s["prm"], s["tool"], s["en"], s["hacc"], s["hist"], s["es"])
 
 
@@ -119,7 +119,7 @@ def test_the_3d_engine_counts_a_step_stopped_by_an_inverted_element():
     hist = np.full((2, scalar3d.N_HIST), np.nan)
     es = tuple(np.zeros(1) for _ in range(7)) + (np.ones(1, np.int8),) + tuple(
         np.zeros(1) for _ in range(4))
-    ok = K3._end_step3(0.1, 2, 1.0, 0.0, 0.0, 0.0, 0, np.zeros(1), ist, clock, prm,
+    ok = K3._end_step3(0.1, (1.0, 2), (0.0, 0.0, 0.0, 0), np.zeros(1), ist, clock, prm,
                        np.zeros(scalar3d.N_TOOL), np.zeros(layout.N_EN),
                        np.zeros(scalar3d.N_HIST), hist, es)
     assert not ok and ist[layout.I_STATUS] == layout.STATUS_INVERTED and ist[layout.I_BADELEM] == 2

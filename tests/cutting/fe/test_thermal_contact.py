@@ -18,6 +18,7 @@ from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_driver import advance
 from robobore.cutting.fe.engine.chunk_loop import Phases
+from robobore.cutting.fe.engine.groups2d import groups_of
 from robobore.cutting.fe.engine.state2d import default_prm, make_state, parting_edges
 from robobore.cutting.fe.mesh.orthogonal import _split_nodes
 from robobore.cutting.fe.models.orthogonal import setup_orthogonal
@@ -104,8 +105,9 @@ def _heat(st):
 
 
 def _tool_heat(st, hc, eta, t_tool, dt):
-    thermal2d.tool_heat(st.conn, st.x, st.y, st.ptr, st.nel, st.ncorner, st.alive, st.enbr, st.cfx,
-                st.cfy, st.fric, st.fheat, st.temp, st.tbuf, st.tcq, RCP, hc, eta, t_tool, dt)
+    nodes, quads, state, _out, contact, _ale = groups_of(st)
+    thermal2d.tool_heat(nodes, quads, state, contact, st.enbr, st.fheat, st.tbuf, st.tcq, RCP,
+                        (hc, eta, t_tool, dt))
 
 
 def test_frictional_heat_goes_into_the_workpiece_once():

@@ -192,9 +192,8 @@ def _heat(s, step, t, dt):
             parting_conduct(s.ppair, x, y, alive, s.tied, temp, tbuf, mat[jc.KCOND], rcp,
                             prm[P_COND_ACC])
         if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-            tool_heat(conn, x, y, s.ptr, s.nel, s.ncorner, alive, enbr, s.cfx, s.cfy,
-                      s.fric, s.fheat, temp, tbuf, s.tcq, rcp, prm[P_HC], prm[P_FHEAT],
-                      prm[P_TTOOL], prm[P_COND_ACC])
+            tool_heat(nodes_of(s), quads_of(s), state_of(s), contact_of(s), enbr, s.fheat, tbuf,
+                      s.tcq, rcp, (prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC]))
         prm[P_COND_ACC] = 0.0
 
 

@@ -19,7 +19,11 @@ loop then reads correctly and writes nothing. The parallel passes therefore take
 and bind their arrays one statement each; the per-element and per-node functions the body
 inlines take those locals one by one (measured with numba 0.68.1: the bound groups run as
 fast as flat arguments, one thread and two; ``tests/cutting/fe/test_groups2d.py`` checks that
-a parallel pass so written writes every array).
+a parallel pass so written writes every array). A per-element function that takes the groups
+and is compiled apart (``njit`` without ``inline="always"``, called from the body with the
+groups) keeps the writes, but runs the 2D contract case at 0.62-0.63 of the inlined flat form
+(paired, one thread: ``benchmarks/measured/fe_before_after/
+quad_element_groups_apart_2d_paired.txt``).
 
 Shapes: ``n`` nodes, ``e`` quads.
 """

@@ -147,8 +147,8 @@ def make_energy_totals(ndim: int, name: str):
 
 
 def make_end_step(dev, engine: dict, tool_columns, energy_totals):
-    """The end of a step of one engine, ``end_step(dt, bad, dtmin, fx, fy, fz, ncont, split,
-    ist, clock, prm, tool, en, hacc, hist, es)`` with its ``sample_history``, compiled with
+    """The end of a step of one engine, ``end_step(dt, (dtmin, bad), (fx, fy, fz, ncont),
+    split, ist, clock, prm, tool, en, hacc, hist, es)`` with its ``sample_history``, compiled with
     ``dev`` (``numba.njit``, ``njit(inline="always")`` or ``numba.cuda.jit(device=True)``).
 
     ``engine`` holds the values of :data:`ENGINE_NAMES` (the module docstring);
@@ -205,13 +205,13 @@ def make_end_step(dev, engine: dict, tool_columns, energy_totals):
         ist[I_SAMPLE] = k + 1
         return True
 
-    def end_step(dt, bad, dtmin, fx, fy, fz, ncont, split, ist, clock, prm, tool, en, hacc,
-                 hist, es):
+    def end_step(dt, elements, contact, split, ist, clock, prm, tool, en, hacc, hist, es):
         """The end of a step of length ``dt`` [s] (``clock`` = [t, dt, t_acc]); True: go on.
 
-        ``bad``: an inverted element (-1: none); ``dtmin``: the smallest stable step of the
-        elements [s] (1e30: none left); ``fx, fy, fz``: the contact-force total (``fz`` = 0
-        in 2D); ``ncont``: the number of contact nodes; ``split``: the force by tool face
+        ``elements`` = ``(dtmin, bad)``, the element pass's result: the smallest stable step
+        of the elements [s] (1e30: none left) and an inverted element (-1: none);
+        ``contact`` = ``(fx, fy, fz, ncont)``, the node pass's: the contact-force total
+        (``fz`` = 0 in 2D) and the number of contact nodes; ``split``: the force by tool face
         (``N_SPLIT`` values); ``es``: the state arrays of ``energy_totals``. Moves
         ``clock[0]`` and ``ist[I_STEP]`` on, then stops (False, with ``ist[I_STATUS]``) on an
         inverted element, no element, non-finite forces or step, a step below
@@ -220,6 +220,8 @@ def make_end_step(dev, engine: dict, tool_columns, energy_totals):
         to ``hacc`` and ``dt`` to ``clock[2]``, and writes a history row
         (``sample_history``) when the time passes the end of the current sample interval.
         """
+        dtmin, bad = elements
+        fx, fy, fz, ncont = contact
         t = clock[0] + dt
         if COUNT_STOPPED_STEP:
             clock[0] = t

@@ -112,14 +112,15 @@ def make_chunk_loop(*, name: str, state, n_split: int, energy_arrays, energy_tot
             step = ist[I_STEP]
             t = clock[0]
             dt = clock[1]
-            fx, fy, fz, ncont = nodes(s, kinematics(tool, prm), dt, split)
+            contact = nodes(s, kinematics(tool, prm), dt, split)
+            fx, fy, fz, _ncont = contact
             en[E_EXT] += tool_step(s, fx, fy, fz, dt)
             remesh(s, step)
-            dtmin, bad = elements(s, dt)
+            elems = elements(s, dt)
             heat(s, step, t, dt)
             taken += 1
-            if not end_step(dt, bad, dtmin, fx, fy, fz, ncont, split, ist, clock,
-                            prm, tool, en, s.hacc, s.hist, es):
+            if not end_step(dt, elems, contact, split, ist, clock, prm, tool, en, s.hacc,
+                            s.hist, es):
                 return taken
         if totals_at_chunk_end:
             energy_totals(es, en)

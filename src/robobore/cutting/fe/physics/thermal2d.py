@@ -189,12 +189,35 @@ def parting_conduct(ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
 
 
 @njit(parallel=True, cache=True)
-def tool_heat(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp, tbuf,
-              tcq, rcp, hc, eta, t_tool, dt_th):
-    """Thermal contact with the tool over ``dt_th`` [s] (after :func:`conduct`): frictional
-    heat and the interface conductance, node by node (:func:`tool_heat_node_py`), then into
-    the elements (:func:`tool_heat_elem_py`). Heat is conserved between nodes and
-    elements."""
+def tool_heat(nodes, quads, state, contact, enbr, fheat, tbuf, tcq, rcp, interface):
+    """Thermal contact with the tool (after :func:`conduct`): frictional heat and the interface
+    conductance, node by node (:func:`tool_heat_node_py`), then into the elements
+    (:func:`tool_heat_elem_py`). Heat is conserved between nodes and elements.
+
+    The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2: ``x``, ``y``,
+    the CSR ``ptr``, ``nel``, ``ncorner``), ``quads`` (Quads2: ``conn``, ``alive``), ``state``
+    (QuadState2: ``temp``), ``contact`` (Contact2: ``cfx``, ``cfy``, ``fric``); ``enbr``
+    (e, 4) the edge neighbours, ``fheat`` (n,) the frictional work already turned into heat
+    [J/m], ``tbuf`` the centroids and areas of :func:`conduct`, ``tcq`` (e,) work, ``rcp``
+    rho c_p [J/(m^3 K)]; ``interface`` = (conductance hc [W/(m^2 K)], heat fraction eta, tool
+    temperature [K], time ``dt_th`` [s]).
+    """
+    # the prange bodies read flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    ptr = nodes.ptr
+    nel = nodes.nel
+    ncorner = nodes.ncorner
+    conn = quads.conn
+    alive = quads.alive
+    temp = state.temp
+    cfx = contact.cfx
+    cfy = contact.cfy
+    fric = contact.fric
+    hc = interface[0]
+    eta = interface[1]
+    t_tool = interface[2]
+    dt_th = interface[3]
     for n in prange(x.shape[0]):
         tool_heat_node(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
                        temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th)

@@ -299,7 +299,7 @@ def kernels2(phases: Phases):
         # the step end (one thread): history.make_end_step's end_step on the step's reductions
         nc = red[R_NC]
         red[R_NC] = 0.0  # the force total is rewritten by k_contact_sum every step
-        end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], 0.0, nc,
+        end_step(clock[1], (red[R_DTMIN], int(red[R_BAD])), (red[R_FX], red[R_FY], 0.0, nc),
                  red[R_SPLIT:], ist, clock, prm, tool, en, hacc, hist, es)
 
     @cuda.jit

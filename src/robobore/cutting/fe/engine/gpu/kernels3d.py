@@ -229,8 +229,9 @@ def kernels3(conduction: bool):
     def finish(tool, prm, clock, ist, hacc, hist, en, red):
         # the step end (one thread): history.make_end_step's end_step on the step's reductions (no
         # per-sample energy totals: the host sums them from the copied-back state)
-        end_step(clock[1], int(red[R_BAD]), red[R_DTMIN], red[R_FX], red[R_FY], red[R_FZ],
-                 red[R_NC], red, ist, clock, prm, tool, en, hacc, hist, ())
+        end_step(clock[1], (red[R_DTMIN], int(red[R_BAD])),
+                 (red[R_FX], red[R_FY], red[R_FZ], red[R_NC]), red, ist, clock, prm, tool, en,
+                 hacc, hist, ())
 
     @cuda.jit
     def k_finish(tool, prm, clock, ist, hacc, hist, en, red):
