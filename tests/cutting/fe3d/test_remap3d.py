@@ -99,9 +99,9 @@ def test_hex_volume_is_translation_invariant_far_from_the_origin():
     rng = np.random.default_rng(5)
     p = rng.uniform(0, H, (8, 3)) + np.array([[0, 0, 0], [H, 0, 0], [H, H, 0], [0, H, 0],
                                               [0, 0, H], [H, 0, H], [H, H, H], [0, H, H]])
-    v0 = hex_volume_py(*p[:, 0], *p[:, 1], *p[:, 2])
+    v0 = hex_volume_py(tuple(p[:, 0]), tuple(p[:, 1]), tuple(p[:, 2]))
     q = p + np.array([5e-3, -3e-3, 7e-3])
-    v1 = hex_volume_py(*q[:, 0], *q[:, 1], *q[:, 2])
+    v1 = hex_volume_py(tuple(q[:, 0]), tuple(q[:, 1]), tuple(q[:, 2]))
     assert v1 == pytest.approx(v0, rel=1e-13)
 
 

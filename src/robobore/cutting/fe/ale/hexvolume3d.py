@@ -58,11 +58,13 @@ def face_corner_py(f, j):
     return (code >> (3 * (3 - j))) & 7
 
 
-def dv_py(c, p0, p1, p2, p3, p4, p5, p6, p7, q0, q1, q2, q3, q4, q5, q6, q7):
+def dv_py(c, p, q):
     """``dV/dx_c`` of a trilinear hexahedron's volume with respect to corner ``c``'s x, given
-    the corners' y (``p``) and z (``q``); cyclic: ``dV/dy_c = dv(c, z, x)``, ``dV/dz_c =
-    dv(c, x, y)`` (Flanagan & Belytschko 1981, eq. 79: the coefficients of
-    :func:`robobore.cutting.fe.hex.element.hex_element_py`)."""
+    the corners' y (``p``) and z (``q``), each a tuple of the 8 corners' coordinates; cyclic:
+    ``dV/dy_c = dv(c, z, x)``, ``dV/dz_c = dv(c, x, y)`` (Flanagan & Belytschko 1981, eq. 79:
+    the coefficients of :func:`robobore.cutting.fe.hex.element.hex_element_py`)."""
+    p0, p1, p2, p3, p4, p5, p6, p7 = p
+    q0, q1, q2, q3, q4, q5, q6, q7 = q
     if c == 0:
         return (p1*(-q2-q3+q4+q5) + p2*(q1-q3) + p3*(q1+q2-q4-q7) + p4*(-q1+q3-q5+q7) + p5*(-q1+q4) + p7*(q3-q4)) / 12.0
     elif c == 1:
@@ -83,38 +85,27 @@ def dv_py(c, p0, p1, p2, p3, p4, p5, p6, p7, q0, q1, q2, q3, q4, q5, q6, q7):
 dv = njit(cache=True, inline="always")(dv_py)
 
 
-def hex_volume_py(x0, x1, x2, x3, x4, x5, x6, x7, y0, y1, y2, y3, y4, y5, y6, y7,
-                  z0, z1, z2, z3, z4, z5, z6, z7):
+def _relative_py(a):
+    # the 8 corners' coordinates relative to corner 0 (corner 0 itself: 0)
+    a0 = a[0]
+    return (0.0, a[1] - a0, a[2] - a0, a[3] - a0, a[4] - a0, a[5] - a0, a[6] - a0, a[7] - a0)
+
+
+_relative = njit(cache=True, inline="always")(_relative_py)
+
+
+def hex_volume_py(x, y, z):
     """Signed volume of the trilinear hexahedron with corners 0-7 in VTK order (positive for
-    the node order of :mod:`robobore.cutting.fe.hex.element`): ``sum_I x_I dV/dx_I`` with the
-    element's volume derivatives (:func:`dv_py`), exact for any trilinear hexahedron;
-    evaluated in coordinates relative to corner 0."""
-    x1 -= x0
-    x2 -= x0
-    x3 -= x0
-    x4 -= x0
-    x5 -= x0
-    x6 -= x0
-    x7 -= x0
-    y1 -= y0
-    y2 -= y0
-    y3 -= y0
-    y4 -= y0
-    y5 -= y0
-    y6 -= y0
-    y7 -= y0
-    z1 -= z0
-    z2 -= z0
-    z3 -= z0
-    z4 -= z0
-    z5 -= z0
-    z6 -= z0
-    z7 -= z0
+    the node order of :mod:`robobore.cutting.fe.hex.element`), given the tuples ``x, y, z``
+    of the 8 corners' coordinates: ``sum_I x_I dV/dx_I`` with the element's volume
+    derivatives (:func:`dv_py`), exact for any trilinear hexahedron; evaluated in coordinates
+    relative to corner 0."""
+    xr = _relative(x)
+    yr = _relative(y)
+    zr = _relative(z)
     v = 0.0
     for c in range(1, 8):
-        xc = x1 if c == 1 else x2 if c == 2 else x3 if c == 3 else x4 if c == 4 else \
-            x5 if c == 5 else x6 if c == 6 else x7
-        v += xc * dv(c, 0.0, y1, y2, y3, y4, y5, y6, y7, 0.0, z1, z2, z3, z4, z5, z6, z7)
+        v += xr[c] * dv(c, yr, zr)
     return v
 
 
@@ -133,9 +124,9 @@ def swept_face_py(e, f, conn, x, y, z, xn, yn, zn):
             and z[b] == zn[b] and x[c] == xn[c] and y[c] == yn[c] and z[c] == zn[c]
             and x[d] == xn[d] and y[d] == yn[d] and z[d] == zn[d]):
         return 0.0  # a face that does not move sweeps nothing (not a round-off residue)
-    return hex_volume(x[a], x[b], x[c], x[d], xn[a], xn[b], xn[c], xn[d],
-                      y[a], y[b], y[c], y[d], yn[a], yn[b], yn[c], yn[d],
-                      z[a], z[b], z[c], z[d], zn[a], zn[b], zn[c], zn[d])
+    return hex_volume((x[a], x[b], x[c], x[d], xn[a], xn[b], xn[c], xn[d]),
+                      (y[a], y[b], y[c], y[d], yn[a], yn[b], yn[c], yn[d]),
+                      (z[a], z[b], z[c], z[d], zn[a], zn[b], zn[c], zn[d]))
 
 
 face_corner = njit(cache=True, inline="always")(face_corner_py)
@@ -146,9 +137,9 @@ def elem_volume_py(e, conn, x, y, z):
     """Signed volume of hexahedron ``e`` of ``conn`` over the nodes ``x, y, z``."""
     i0, i1, i2, i3 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
     i4, i5, i6, i7 = conn[e, 4], conn[e, 5], conn[e, 6], conn[e, 7]
-    return hex_volume(x[i0], x[i1], x[i2], x[i3], x[i4], x[i5], x[i6], x[i7],
-                      y[i0], y[i1], y[i2], y[i3], y[i4], y[i5], y[i6], y[i7],
-                      z[i0], z[i1], z[i2], z[i3], z[i4], z[i5], z[i6], z[i7])
+    return hex_volume((x[i0], x[i1], x[i2], x[i3], x[i4], x[i5], x[i6], x[i7]),
+                      (y[i0], y[i1], y[i2], y[i3], y[i4], y[i5], y[i6], y[i7]),
+                      (z[i0], z[i1], z[i2], z[i3], z[i4], z[i5], z[i6], z[i7]))
 
 
 elem_volume = njit(cache=True, inline="always")(elem_volume_py)
@@ -157,21 +148,14 @@ elem_volume = njit(cache=True, inline="always")(elem_volume_py)
 def corner_gradient_py(e, c, conn, x, y, z):
     """``dV/dx_c`` (3 components) of hexahedron ``e``'s volume with respect to its corner
     ``c`` (:func:`dv_py`, in coordinates relative to corner 0)."""
-    i0 = conn[e, 0]
-    ox = x[i0]
-    oy = y[i0]
-    oz = z[i0]
-    i1, i2, i3 = conn[e, 1], conn[e, 2], conn[e, 3]
+    i0, i1, i2, i3 = conn[e, 0], conn[e, 1], conn[e, 2], conn[e, 3]
     i4, i5, i6, i7 = conn[e, 4], conn[e, 5], conn[e, 6], conn[e, 7]
-    x1, x2, x3, x4 = x[i1] - ox, x[i2] - ox, x[i3] - ox, x[i4] - ox
-    x5, x6, x7 = x[i5] - ox, x[i6] - ox, x[i7] - ox
-    y1, y2, y3, y4 = y[i1] - oy, y[i2] - oy, y[i3] - oy, y[i4] - oy
-    y5, y6, y7 = y[i5] - oy, y[i6] - oy, y[i7] - oy
-    z1, z2, z3, z4 = z[i1] - oz, z[i2] - oz, z[i3] - oz, z[i4] - oz
-    z5, z6, z7 = z[i5] - oz, z[i6] - oz, z[i7] - oz
-    gx = dv(c, 0.0, y1, y2, y3, y4, y5, y6, y7, 0.0, z1, z2, z3, z4, z5, z6, z7)
-    gy = dv(c, 0.0, z1, z2, z3, z4, z5, z6, z7, 0.0, x1, x2, x3, x4, x5, x6, x7)
-    gz = dv(c, 0.0, x1, x2, x3, x4, x5, x6, x7, 0.0, y1, y2, y3, y4, y5, y6, y7)
+    xr = _relative((x[i0], x[i1], x[i2], x[i3], x[i4], x[i5], x[i6], x[i7]))
+    yr = _relative((y[i0], y[i1], y[i2], y[i3], y[i4], y[i5], y[i6], y[i7]))
+    zr = _relative((z[i0], z[i1], z[i2], z[i3], z[i4], z[i5], z[i6], z[i7]))
+    gx = dv(c, yr, zr)
+    gy = dv(c, zr, xr)
+    gz = dv(c, xr, yr)
     return gx, gy, gz
 
 
