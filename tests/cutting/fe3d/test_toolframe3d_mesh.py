@@ -15,7 +15,7 @@ import pytest
 
 from robobore.cutting.fe.ale.hexvolume3d import FACES_OUT
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_OPEN, BF_VIRGIN
-from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
+from robobore.cutting.fe.ale.toolframe import ToolFrameExtent, build_toolframe_mesh
 from robobore.cutting.fe.engine.state3d import HEX_SIGNS
 from robobore.cutting.fe.hex.scalar3d import insert_gap3_py
 from robobore.cutting.fe.mesh.toolframe3d import (
@@ -83,12 +83,14 @@ def test_the_nose_tip_slice_is_the_2d_mesh(mesh):
     k0 = int(np.flatnonzero(mesh.z_slices == 0.0)[0])
     h0 = float(uncut_thickness(INSERT, AP, F, np.array([0.0]))[0])
     p = mesh.plan
-    kw = dict(element_size=LE, edge_size=LE / 4, chip_ratio=1.6, behind=p.x_out,
-              depth=-mesh.y_bottom, chip_length=p.chip_length)
+    ext = dict(behind=p.x_out, depth=-mesh.y_bottom, chip_length=p.chip_length)
+    kw = dict(element_size=LE, edge_size=LE / 4, chip_ratio=1.6)
     r, rake, clr = 20e-6, math.radians(7.0), math.radians(7.0)
-    probe = build_toolframe_mesh(h0, r, rake, clr, ahead=60e-6, **kw)
+    probe = build_toolframe_mesh(h0, r, rake, clr, extent=ToolFrameExtent(ahead=60e-6, **ext),
+                                 **kw)
     root = probe.nodes[:, 0].min() + 60e-6
-    m2 = build_toolframe_mesh(h0, r, rake, clr, ahead=root - p.x_in, **kw)
+    m2 = build_toolframe_mesh(h0, r, rake, clr,
+                              extent=ToolFrameExtent(ahead=root - p.x_in, **ext), **kw)
     sel = mesh.node_slice == k0
     local = mesh.node_local[sel]
     p3 = mesh.nodes[sel]

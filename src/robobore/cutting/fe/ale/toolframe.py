@@ -163,22 +163,42 @@ def free_surface_join(x_in: float, R: np.ndarray, Ot: np.ndarray, S: np.ndarray,
     return poly, cum, None
 
 
+@dataclass(frozen=True)
+class ToolFrameExtent:
+    """The tool-frame mesh's extents [m] (None: the default, a function of the uncut chip
+    thickness ``h`` and the initial chip thickness ``tc``): ``ahead`` the distance of the
+    inflow face ahead of the chip's root (default max(1.5 h, 60 um)), ``behind`` of the back
+    face behind the edge centre (max(2 h, 120 um)), ``depth`` of the bottom below the cut line
+    (max(2.5 h, 120 um)), ``chip_length`` of the chip's top face from the rake face's start
+    (max(1.5 tc, 80 um): a few contact lengths; a longer free chip curls and leaves its top
+    face at a grazing angle)."""
+
+    ahead: float | None = None
+    behind: float | None = None
+    depth: float | None = None
+    chip_length: float | None = None
+
+    def resolved(self, h: float, tc: float) -> tuple[float, float, float, float]:
+        """``(ahead, behind, depth, chip_length)`` [m], the defaults filled in."""
+        return (max(1.5 * h, 60e-6) if self.ahead is None else self.ahead,
+                max(2.0 * h, 120e-6) if self.behind is None else self.behind,
+                max(2.5 * h, 120e-6) if self.depth is None else self.depth,
+                max(1.5 * tc, 80e-6) if self.chip_length is None else self.chip_length)
+
+
 def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
                          element_size: float, edge_size: float, chip_ratio: float = 1.6,
-                         join_height: float | None = None, ahead: float | None = None,
-                         behind: float | None = None, depth: float | None = None,
-                         chip_length: float | None = None, ratio: float = 1.15) -> ToolFrameMesh:
+                         join_height: float | None = None,
+                         extent: ToolFrameExtent = ToolFrameExtent(),
+                         ratio: float = 1.15) -> ToolFrameMesh:
     """Build the two-block tool-frame mesh (SI units; angles in rad).
 
     ``h`` uncut chip thickness, ``r`` edge radius (> 0), ``element_size`` the largest element,
     ``edge_size`` the element round the edge; ``chip_ratio`` the initial chip thickness / h;
     ``join_height`` the height of the blocks' join point on the edge arc above the tool's
     lowest point (default min(r, h) / 2: a mesh choice, not a separation criterion -- the material
-    divides wherever its flow does); ``ahead`` the distance of the inflow face ahead of the
-    chip's root, ``behind`` of the back face behind the edge centre, ``depth`` of the bottom
-    below the cut line, ``chip_length`` of the chip's top face from the rake face's start
-    (default 1.5 chip thicknesses: a few contact lengths; a longer free chip curls and
-    leaves its top face at a grazing angle).
+    divides wherever its flow does); ``extent`` the inflow, back, bottom and chip-top faces'
+    places (:class:`ToolFrameExtent`); ``ratio`` the grading ratio of neighbouring elements.
     """
     if r <= 0.0:
         raise ValueError("the tool-frame mesh needs an edge radius > 0")
@@ -189,10 +209,7 @@ def build_toolframe_mesh(h: float, r: float, rake: float, clearance: float, *,
         raise ValueError("join height must lie on the lower front quarter of the edge arc "
                          "and at most 3/4 h above the cut line")
     tc = chip_ratio * h
-    ahead = max(1.5 * h, 60e-6) if ahead is None else ahead
-    behind = max(2.0 * h, 120e-6) if behind is None else behind
-    depth = max(2.5 * h, 120e-6) if depth is None else depth
-    chip_length = max(1.5 * tc, 80e-6) if chip_length is None else chip_length
+    ahead, behind, depth, chip_length = extent.resolved(h, tc)
     _, _, cx, cy, nr, tr, T, th_s, S, th_t, R = key_points(h, r, rake, chip_ratio, hj)
     if R[0] >= S[0] - h:
         raise ValueError("chip ratio too small for this rake angle and edge radius")
@@ -402,4 +419,4 @@ def measure_chip_toolframe(st, mesh: ToolFrameMesh, h: float, rake: float,
     return geo, (vc / vm if vm > 0.0 else math.nan), int(face.size)
 
 
-__all__ = ["ToolFrameMesh", "build_toolframe_mesh", "measure_chip_toolframe"]
+__all__ = ["ToolFrameMesh", "ToolFrameExtent", "build_toolframe_mesh", "measure_chip_toolframe"]

@@ -13,7 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe.ale.toolframe import ToolFrameMesh, build_toolframe_mesh, key_points
+from robobore.cutting.fe.ale.toolframe import (
+    ToolFrameExtent,
+    ToolFrameMesh,
+    build_toolframe_mesh,
+    key_points,
+)
 from robobore.cutting.fe.mesh.toolframe3d_section import (
     SectionPlan,
     s_of_y,
@@ -143,8 +148,9 @@ def slice_layout(insert: BoringInsert, ap: float, f: float,
                         depth=depth, chip_length=chip_length)
     ref = build_toolframe_mesh(h_ref, r, rake, clr, element_size=coarse, edge_size=fine,
                                chip_ratio=sizes.chip_ratio,
-                               ahead=key_points(h_ref, r, rake, sizes.chip_ratio)[10][0] - x_in,
-                               behind=x_out, depth=depth, chip_length=chip_length,
+                               extent=ToolFrameExtent(
+                                   ahead=key_points(h_ref, r, rake, sizes.chip_ratio)[10][0]
+                                   - x_in, behind=x_out, depth=depth, chip_length=chip_length),
                                ratio=sizes.ratio)
     ref_nodes, blk = section_nodes(plan, h_ref, depth)
     if ref_nodes.shape != ref.nodes.shape or not np.allclose(ref_nodes, ref.nodes, rtol=0.0,

@@ -88,7 +88,7 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
     cm = cfg.mesh
     tool_frame = choose_orthogonal(cfg, source=source).tool_frame
     if tool_frame:
-        from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
+        from robobore.cutting.fe.ale.toolframe import ToolFrameExtent, build_toolframe_mesh
 
         ee = (cm.element_size_um / 4.0 if cm.edge_element_um is None else cm.edge_element_um)
         try:
@@ -96,8 +96,10 @@ def setup_orthogonal(cfg: FEConfig, source: str | None = None) -> CuttingSetup:
                 h, r, rake, clr, element_size=le, edge_size=ee * 1e-6,
                 chip_ratio=cm.initial_chip_ratio,
                 join_height=_m_or_none(cm.join_height_um),
-                chip_length=_m_or_none(cm.chip_length_um), depth=_m_or_none(cm.depth_um),
-                ahead=_m_or_none(cm.inflow_length_um), behind=_m_or_none(cm.back_length_um))
+                extent=ToolFrameExtent(ahead=_m_or_none(cm.inflow_length_um),
+                                       behind=_m_or_none(cm.back_length_um),
+                                       depth=_m_or_none(cm.depth_um),
+                                       chip_length=_m_or_none(cm.chip_length_um)))
         except ValueError as exc:
             raise ConfigError(str(exc), file=source, field="mesh.initial_chip_ratio",
                               value=cm.initial_chip_ratio,
