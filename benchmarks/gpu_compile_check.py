@@ -114,6 +114,13 @@ def main() -> int:
     for conduction in (True, False):
         name = f"3D k_run ({'conduction' if conduction else 'adiabatic'})"
         cases[name] = (gpu._kernels(conduction)[-1], run3)
+    # the 3D launch-per-kernel path's kernels (with conduction: all of them), each on the state
+    # ``a`` and, where it takes them, the reductions ``red``
+    k3 = gpu._kernels(True)
+    for kern in tuple(k3[:5]) + tuple(k3[5]):
+        names = inspect.signature(kern.py_func).parameters
+        args = [np.zeros(gpu.N_RED) if n == "red" else run3[1] for n in names]
+        cases[f"3D {kern.py_func.__name__}"] = (kern, args)
     # the 2D persistent kernel of each GPU model choice (the tool frame and conduction, each
     # on or off), compiled for the tool-frame state's argument types
     run2 = [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS],
@@ -126,13 +133,11 @@ def main() -> int:
             name = (f"2D k_run ({'tool' if tool_frame else 'workpiece'} frame, "
                     f"{'conduction' if conduction else 'adiabatic'})")
             cases[name] = (gpu2d._kernels(ph)[-2], run2)
-    # the launch-per-kernel path's contact total (with the split by face) and ALE kernels,
-    # their arguments by name from the tool-frame state
-    alias = {"dm": "dmg"}
-    for kern in (k2[1],) + tuple(k2[-1]):
+    # the launch-per-kernel path's kernels (the tool frame with conduction: all of them), each
+    # on the state ``a`` and, where it takes them, the reductions ``red``
+    for kern in tuple(k2[:-2]) + tuple(k2[-1]):
         names = inspect.signature(kern.py_func).parameters
-        args = [np.zeros(gpu2d.N_RED) if n == "red"
-                else np.ascontiguousarray(getattr(st2, alias.get(n, n))) for n in names]
+        args = [np.zeros(gpu2d.N_RED) if n == "red" else run2[1] for n in names]
         cases[f"2D {kern.py_func.__name__}"] = (kern, args)
     ptxas = _ptxas()
     rc = 0

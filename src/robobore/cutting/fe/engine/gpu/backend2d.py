@@ -47,8 +47,9 @@ the 3D engine is :mod:`robobore.cutting.fe.engine.gpu.shared`, whose
 :func:`~robobore.cutting.fe.engine.gpu.shared.drive_gpu` is the host driver of both engines;
 this module hands it the 2D state, the kernels and the launch-per-kernel step.
 
-Kernel parameters: the persistent kernel takes the whole state, 3944 bytes of CUDA's classic
-4096-byte limit (checked by a test with numba's data model).
+Kernel parameters: every kernel takes the whole state (the launch-per-kernel kernels also the
+reductions), 3944 bytes of CUDA's classic 4096-byte limit (checked by a test with numba's data
+model).
 
 Not ported: the B-bar element is refused with a ConfigError.
 """
@@ -123,52 +124,33 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
     gp, gs = blocks(npair), blocks(int(st.snodes.shape[0]))
     theat = st.prm[layout.P_HC] > 0.0 or st.prm[layout.P_FHEAT] > 0.0
 
-    def launch_step(g, dred, step, tick):
-        # one step as one launch per phase (the persistent kernel's phases); conduction
-        # where ist[I_STEP] % cond_every == 0, as on the CPU
+    def launch_step(a, dred, step, tick):
+        # one step as one launch per phase (the persistent kernel's phases) on the state
+        # RunState a; conduction where ist[I_STEP] % cond_every == 0, as on the CPU
         tick(None)
-        k_nodes[gn, _THREADS](g["x"], g["y"], g["vx"], g["vy"], g["mass"], g["fixed"],
-                              g["ptr"], g["nel"], g["ncorner"], g["alive"], g["area0"],
-                              g["fex"], g["fey"], g["cfx"], g["cfy"], g["fric"], g["pen"],
-                              g["ndead"], g["ero_ke"], g["nwork"], g["prm"], g["tool"],
-                              g["clock"], g["ist"], g["twin"], g["tied"], g["vslip"], dred)
+        k_nodes[gn, _THREADS](a, dred)
         tick("nodes")
-        k_contact_sum[1, node_contact.N_SUM_LANES](g["cfx"], g["cfy"], g["x"], g["y"], g["tool"],
-                                        g["prm"], dred)
+        k_contact_sum[1, node_contact.N_SUM_LANES](a, dred)
         tick("contact_sum")
-        k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+        k_tool[1, 1](a, dred)
         tick("tool")
         if phases.tool_frame and step % rz_every == 0:
-            _ale_launches(g, ale, gn, ge, gs)
+            _ale_launches(a, ale, gn, ge, gs)
             tick("ale")
-        k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["vx"], g["vy"], g["alive"],
-                              g["layer"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
-                              g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"],
-                              g["qhy"], g["area0"], g["ie"], g["hge"], g["fex"], g["fey"],
-                              g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
-                              g["clock"], erosion, g["ist"], dred)
+        k_elems[ge, _THREADS](a, dred)
         tick("elements")
         if phases.conduction and step % cond_every == 0:
-            k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["tbuf"], g["ist"])
-            k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["alive"], g["enbr"],
-                                    g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
-            k_conduct_end[ge, _THREADS](g["temp"], g["tbuf"], g["prm"], g["ist"])
+            k_centroids[ge, _THREADS](a)
+            k_conduct[ge, _THREADS](a)
+            k_conduct_end[ge, _THREADS](a)
             if npair > 0:
-                k_parting[gp, _THREADS](g["ppair"], g["x"], g["y"], g["alive"], g["tied"],
-                                        g["temp"], g["tbuf"], g["mat"], g["prm"], g["ist"])
+                k_parting[gp, _THREADS](a)
             if theat:
-                k_theat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["ptr"], g["nel"],
-                                            g["ncorner"], g["alive"], g["enbr"], g["cfx"],
-                                            g["cfy"], g["fric"], g["fheat"], g["temp"],
-                                            g["tbuf"], g["tcq"], g["mat"], g["prm"],
-                                            g["ist"])
-                k_theat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["tcq"],
-                                            g["mat"], g["ist"])
-            k_conduct_reset[1, 1](g["prm"], g["ist"])
+                k_theat_nodes[gn, _THREADS](a)
+                k_theat_elems[ge, _THREADS](a)
+            k_conduct_reset[1, 1](a)
             tick("conduction")
-        k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
-                       g["en"], dred, g["mass"], g["vx"], g["vy"], g["ie"], g["plast"],
-                       g["hge"], g["alive"], g["fric"], g["pen"], g["ero_ke"], g["nwork"])
+        k_finish[1, 1](a, dred)
         tick("finish")
 
     engine = GpuEngine(names=_ARRAYS, p_tend=layout.P_TEND, n_red=N_RED, k_run=k_run,
@@ -178,33 +160,24 @@ def advance_gpu(st: Any, t_end: float, *, chunk_steps: int = 2000,
                      check=check, profile=profile, persistent=persistent)
 
 
-def _ale_launches(g: dict, ale: tuple, gn: int, ge: int, gs: int) -> None:
-    """One tool-frame ALE pass as one launch per phase (the persistent kernel's phases)."""
+def _ale_launches(a: Any, ale: tuple, gn: int, ge: int, gs: int) -> None:
+    """One tool-frame ALE pass as one launch per phase (the persistent kernel's phases) on the
+    state RunState ``a``."""
     (k_ale_place, k_ale_face, k_ale_sweep, k_ale_sweep_copy, k_ale_interior, k_ale_flux,
      k_ale_velocity, k_ale_apply, k_ale_write, k_ale_nodes, k_ale_mass) = ale
     T = _THREADS
-    k_ale_place[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["x0"], g["y0"], g["acls"],
-                       g["aflt"], g["prm"], g["ist"])
-    k_ale_face[gn, T](g["xn"], g["yn"], g["x0"], g["y0"], g["acls"], g["aflt"], g["prm"],
-                      g["ist"])
+    k_ale_place[gn, T](a)
+    k_ale_face[gn, T](a)
     for _ in range(RZ.TF_SWEEPS):
-        k_ale_sweep[gn, T](g["acls"], g["aflt"], g["vbuf"], g["ist"])
-        k_ale_sweep_copy[gn, T](g["acls"], g["aflt"], g["vbuf"], g["ist"])
-    k_ale_interior[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["x0"], g["y0"], g["acls"],
-                          g["aflt"], g["prm"], g["ist"])
-    k_ale_flux[ge, T](g["conn"], g["x"], g["y"], g["xn"], g["yn"], g["alive"], g["enbr"],
-                      g["bflag"], g["buf"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"], g["pres"],
-                      g["eps_p"], g["temp"], g["dmg"], g["qhx"], g["qhy"], g["area0"],
-                      g["mat"], g["ist"])
-    k_ale_velocity[gs, T](g["snodes"], g["x"], g["y"], g["xn"], g["yn"], g["vx"], g["vy"],
-                          g["ptr"], g["nel"], g["conn"], g["vbuf"], g["ist"])
-    k_ale_apply[gs, T](g["snodes"], g["vx"], g["vy"], g["vbuf"], g["ist"])
-    k_ale_write[ge, T](g["alive"], g["buf"], g["sdx"], g["sdy"], g["sdz"], g["sdxy"],
-                       g["pres"], g["eps_p"], g["temp"], g["dmg"], g["qhx"], g["qhy"],
-                       g["area0"], g["ist"])
-    k_ale_nodes[gn, T](g["x"], g["y"], g["xn"], g["yn"], g["ist"])
-    k_ale_mass[gn, T](g["ptr"], g["nel"], g["area0"], g["mass"], g["mat"], g["prm"],
-                      g["ist"])
+        k_ale_sweep[gn, T](a)
+        k_ale_sweep_copy[gn, T](a)
+    k_ale_interior[gn, T](a)
+    k_ale_flux[ge, T](a)
+    k_ale_velocity[gs, T](a)
+    k_ale_apply[gs, T](a)
+    k_ale_write[ge, T](a)
+    k_ale_nodes[gn, T](a)
+    k_ale_mass[gn, T](a)
 
 
 def _copy_back(st: Any, g: dict) -> None:

@@ -99,43 +99,28 @@ def advance3_gpu(st, t_end: float, *, chunk_steps: int = 500,
     erosion = int(st.prm[layout3d.P_EROSION])
     heat = st.prm[layout3d.P_HC] > 0.0 or st.prm[layout3d.P_FHEAT] > 0.0
 
-    def launch_step(g, dred, step, tick):
-        # one step as one launch per phase (the persistent kernel's phases)
+    def launch_step(a, dred, step, tick):
+        # one step as one launch per phase (the persistent kernel's phases) on the state
+        # RunState3 a
         tick(None)
-        k_nodes[gn, _THREADS](g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"], g["mass"],
-                              g["fixed"], g["ptr"], g["nel"], g["ncorner"], g["alive"],
-                              g["vol0"], g["fe"], g["cf"], g["fric"], g["pen"], g["ndead"],
-                              g["ero_ke"], g["nwork"], g["prm"], g["tool"], g["clock"],
-                              g["ist"], dred, g["pairs"])
+        k_nodes[gn, _THREADS](a, dred)
         tick("nodes")
-        k_contact_sum[1, node_contact.N_SUM_LANES](g["cf"], dred)
+        k_contact_sum[1, node_contact.N_SUM_LANES](a, dred)
         tick("contact_sum")
-        k_tool[1, 1](g["tool"], g["prm"], g["en"], g["clock"], g["ist"], dred)
+        k_tool[1, 1](a, dred)
         tick("tool")
-        k_elems[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["vx"], g["vy"], g["vz"],
-                              g["alive"], g["layer"], g["sd"], g["pres"], g["eps_p"],
-                              g["temp"], g["dmg"], g["qh"], g["vol0"], g["ie"], g["hge"],
-                              g["fe"], g["dte"], g["plast"], g["rate"], g["mat"], g["prm"],
-                              g["clock"], erosion, g["ist"], dred)
+        k_elems[ge, _THREADS](a, dred)
         tick("elements")
         if conduction and scalar3d.is_conduction_step_py(step, st.prm):
-            k_centroids[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["tbuf"], g["ist"])
-            k_conduct[ge, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["alive"], g["enbr"],
-                                    g["pairs"], g["vol0"], g["temp"], g["tbuf"], g["mat"],
-                                    g["prm"], g["clock"], g["ist"])
-            k_copy_temp[ge, _THREADS](g["temp"], g["tbuf"], g["ist"])
+            k_centroids[ge, _THREADS](a)
+            k_conduct[ge, _THREADS](a)
+            k_copy_temp[ge, _THREADS](a)
             if heat:
-                k_heat_nodes[gn, _THREADS](g["conn"], g["x"], g["y"], g["z"], g["ptr"],
-                                           g["nel"], g["ncorner"], g["alive"], g["enbr"],
-                                           g["pairs"], g["vol0"], g["cf"], g["fric"],
-                                           g["temp"], g["theat"], g["mat"], g["prm"],
-                                           g["clock"], g["ist"])
-                k_heat_elems[ge, _THREADS](g["conn"], g["alive"], g["temp"], g["theat"],
-                                           g["mat"], g["ist"])
-            k_cond_done[1, 1](g["prm"], g["clock"], g["ist"])
+                k_heat_nodes[gn, _THREADS](a)
+                k_heat_elems[ge, _THREADS](a)
+            k_cond_done[1, 1](a)
             tick("conduction")
-        k_finish[1, 1](g["tool"], g["prm"], g["clock"], g["ist"], g["hacc"], g["hist"],
-                       g["en"], dred)
+        k_finish[1, 1](a, dred)
         tick("finish")
 
     engine = GpuEngine(names=_RUN_ARGS, p_tend=layout3d.P_TEND, n_red=N_RED, k_run=k_run,

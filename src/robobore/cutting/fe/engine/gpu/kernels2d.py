@@ -97,203 +97,6 @@ def kernels2(phases: Phases):
         for j in range(6):
             red[R_SPLIT + j] = 0.0
 
-    @cuda.jit
-    def k_nodes(x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0, fex, fey, cfx, cfy,
-                fric, pen, ndead, ero_ke, nwork, prm, tool, clock, ist, twin, tied, vslip, red):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        cx, cy, tvx, tvy = kin(tool, prm)
-        fcx, fcy, touched = node(n, x, y, vx, vy, mass, fixed, ptr, nel, ncorner, alive, area0,
-                                 fex, fey, cfx, cfy, fric, pen, ndead, ero_ke, nwork, cx, cy,
-                                 tvx, tvy, prm, clock[1], twin, tied, vslip)
-        if touched:
-            cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
-
-    @cuda.jit
-    def k_contact_sum(cfx, cfy, x, y, tool, prm, red):
-        # the CPU's fixed-order total (kernels.contact_total): one thread per lane, then
-        # the lanes in order by thread 0 -- the same bits on both devices; then the split by
-        # tool face over every node in order (the persistent kernel visits only the chunks
-        # holding a contact node)
-        t = cuda.threadIdx.x
-        px = cuda.shared.array(LANES, float64)
-        py = cuda.shared.array(LANES, float64)
-        px[t] = lsum(cfx, t, LANES)
-        py[t] = lsum(cfy, t, LANES)
-        cuda.syncthreads()
-        if t == 0:
-            lanes_total(px, py, red)
-            cx, cy, tvx, tvy = kin(tool, prm)
-            split_reset(red)
-            for n in range(x.shape[0]):
-                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
-
-    @cuda.jit
-    def k_ale_place(x, y, xn, yn, x0, y0, acls, aflt, prm, ist):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        xn[n] = x[n]
-        yn[n] = y[n]
-        tplace(n, x, y, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0],
-               prm[P_RZ_MAXMOVE], tool_geometry(prm))
-
-    @cuda.jit
-    def k_ale_face(xn, yn, x0, y0, acls, aflt, prm, ist):
-        n = cuda.grid(1)
-        if n >= xn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        tfacep(n, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0])
-
-    @cuda.jit
-    def k_ale_sweep(acls, aflt, vbuf, ist):
-        n = cuda.grid(1)
-        if n >= acls.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        tsweep(n, acls, aflt, vbuf)
-
-    @cuda.jit
-    def k_ale_sweep_copy(acls, aflt, vbuf, ist):
-        n = cuda.grid(1)
-        if n >= acls.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        tscopy(n, acls, aflt, vbuf)
-
-    @cuda.jit
-    def k_ale_interior(x, y, xn, yn, x0, y0, acls, aflt, prm, ist):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        tinter(n, x, y, xn, yn, x0, y0, acls, aflt, prm[P_TCX] - prm[P_ALE_X0],
-               prm[P_RZ_MAXMOVE])
-
-    @cuda.jit
-    def k_ale_flux(conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-                   eps_p, temp, dm, qhx, qhy, area0, mat, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-              eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
-
-    @cuda.jit
-    def k_ale_velocity(snodes, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf, ist):
-        k = cuda.grid(1)
-        if k >= snodes.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
-
-    @cuda.jit
-    def k_ale_apply(snodes, vx, vy, vbuf, ist):
-        k = cuda.grid(1)
-        if k >= snodes.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        n = snodes[k]
-        vx[n] += vbuf[n, 0]
-        vy[n] += vbuf[n, 1]
-
-    @cuda.jit
-    def k_ale_write(alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0,
-                    ist):
-        e = cuda.grid(1)
-        if e >= alive.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        rwrite(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0)
-
-    @cuda.jit
-    def k_ale_nodes(x, y, xn, yn, ist):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        x[n] = xn[n]
-        y[n] = yn[n]
-
-    @cuda.jit
-    def k_ale_mass(ptr, nel, area0, mass, mat, prm, ist):
-        n = cuda.grid(1)
-        if n >= mass.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        rmass(n, ptr, nel, area0, mat[RHO] * prm[P_MS], mass)
-
-    @cuda.jit
-    def k_tool(tool, prm, en, clock, ist, red):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
-        dt = clock[1]
-        en[E_EXT] += tstep(tool, prm, red[R_FX], red[R_FY], dt)
-        if CONDUCTION:
-            prm[P_COND_ACC] += dt
-        red[R_DTMIN] = 1e30
-        red[R_BAD] = -1.0
-
-    @cuda.jit
-    def k_elems(conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm,
-                qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm, clock, erosion,
-                ist, red):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        d, inv = elem(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
-                      temp, dm, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat, prm,
-                      clock[1], erosion)
-        cuda.atomic.min(red, R_DTMIN, d)
-        if inv:
-            cuda.atomic.max(red, R_BAD, float(e))
-
-    @cuda.jit
-    def k_centroids(conn, x, y, tbuf, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        cent(e, conn, x, y, tbuf)
-
-    @cuda.jit
-    def k_conduct(conn, x, y, alive, enbr, temp, tbuf, mat, prm, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
-             prm[P_COND_ACC])
-
-    @cuda.jit
-    def k_conduct_end(temp, tbuf, prm, ist):
-        e = cuda.grid(1)
-        if e >= temp.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        temp[e] = tbuf[e, 3]
-
-    @cuda.jit
-    def k_parting(ppair, x, y, alive, tied, temp, tbuf, mat, prm, ist):
-        i = cuda.grid(1)
-        if i >= ppair.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        pedge(i, ppair, x, y, alive, tied, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
-              prm[P_COND_ACC])
-
-    @cuda.jit
-    def k_theat_nodes(conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp,
-                      tbuf, tcq, mat, prm, ist):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        thnode(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat, temp,
-               tbuf, tcq, mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
-               prm[P_COND_ACC])
-
-    @cuda.jit
-    def k_theat_elems(conn, alive, temp, tcq, mat, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
-
-    @cuda.jit
-    def k_conduct_reset(prm, ist):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
-        prm[P_COND_ACC] = 0.0
-
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red, es):
         # the step end (one thread): history.make_end_step's end_step on the step's reductions
@@ -302,13 +105,37 @@ def kernels2(phases: Phases):
         end_step(clock[1], (red[R_DTMIN], int(red[R_BAD])), (red[R_FX], red[R_FY], 0.0, nc),
                  red[R_SPLIT:], ist, clock, prm, tool, en, hacc, hist, es)
 
-    @cuda.jit
-    def k_finish(tool, prm, clock, ist, hacc, hist, en, red, mass, vx, vy, ie, plast, hge,
-                 alive, fric, pen, ero_ke, nwork):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
-        finish(tool, prm, clock, ist, hacc, hist, en, red,
-               (mass, vx, vy, vx, ie, plast, hge, alive, fric, pen, ero_ke, nwork))
+    # one item of a pass on the state RunState ``a``, for the persistent and launch paths
+
+    @cuda.jit(device=True)
+    def flux_item(e, a):
+        rflux(e, a.conn, a.x, a.y, a.xn, a.yn, a.alive, a.enbr, a.bflag, a.buf, a.sdx,
+              a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
+              a.qhx, a.qhy, a.area0, a.mat[TROOM])
+
+    @cuda.jit(device=True)
+    def write_item(e, a):
+        rwrite(e, a.alive, a.buf, a.sdx, a.sdy, a.sdz, a.sdxy, a.pres,
+               a.eps_p, a.temp, a.dmg, a.qhx, a.qhy, a.area0)
+
+    @cuda.jit(device=True)
+    def conduct_item(e, a):
+        mat = a.mat
+        cond(e, a.conn, a.x, a.y, a.alive, a.enbr, a.temp, a.tbuf, mat[KCOND],
+             mat[RHO] * mat[CP], a.prm[P_COND_ACC])
+
+    @cuda.jit(device=True)
+    def parting_item(i, a):
+        mat = a.mat
+        pedge(i, a.ppair, a.x, a.y, a.alive, a.tied, a.temp, a.tbuf, mat[KCOND],
+              mat[RHO] * mat[CP], a.prm[P_COND_ACC])
+
+    @cuda.jit(device=True)
+    def theat_item(n, a):
+        mat, prm = a.mat, a.prm
+        thnode(n, a.conn, a.x, a.y, a.ptr, a.nel, a.ncorner, a.alive, a.enbr, a.cfx,
+               a.cfy, a.fric, a.fheat, a.temp, a.tbuf, a.tcq, mat[RHO] * mat[CP],
+               prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
 
     # the persistent kernel's phases (engine.gpu.persistent), on the state RunState
 
@@ -365,7 +192,7 @@ def kernels2(phases: Phases):
             return
         x, y, xn, yn, x0, y0 = a.x, a.y, a.xn, a.yn, a.x0, a.y0
         vx, vy, acls, aflt, vbuf = a.vx, a.vy, a.acls, a.aflt, a.vbuf
-        conn, alive, ptr, nel, area0 = a.conn, a.alive, a.ptr, a.nel, a.area0
+        conn, ptr, nel, area0 = a.conn, a.ptr, a.nel, a.area0
         snodes, prm, mat = a.snodes, a.prm, a.mat
         nn = x.shape[0]
         ne = conn.shape[0]
@@ -392,9 +219,7 @@ def kernels2(phases: Phases):
             tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
         grid.sync()
         for e in range(tid, ne, nthr):
-            rflux(e, conn, x, y, xn, yn, alive, a.enbr, a.bflag, a.buf, a.sdx,
-                  a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
-                  a.qhx, a.qhy, area0, mat[TROOM])
+            flux_item(e, a)
         for k in range(tid, nsn, nthr):
             rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
         grid.sync()
@@ -403,8 +228,7 @@ def kernels2(phases: Phases):
             vx[n] += vbuf[n, 0]
             vy[n] += vbuf[n, 1]
         for e in range(tid, ne, nthr):
-            rwrite(e, alive, a.buf, a.sdx, a.sdy, a.sdz, a.sdxy, a.pres,
-                   a.eps_p, a.temp, a.dmg, a.qhx, a.qhy, area0)
+            write_item(e, a)
         for n in range(tid, nn, nthr):
             x[n] = xn[n]
             y[n] = yn[n]
@@ -431,7 +255,7 @@ def kernels2(phases: Phases):
         # launch path separated by barriers
         if step % a.cond_every != 0:
             return
-        conn, x, y, alive, enbr = a.conn, a.x, a.y, a.alive, a.enbr
+        conn, x, y, alive = a.conn, a.x, a.y, a.alive
         temp, tbuf, mat, prm = a.temp, a.tbuf, a.mat, a.prm
         ppair = a.ppair
         ne = conn.shape[0]
@@ -440,23 +264,19 @@ def kernels2(phases: Phases):
             cent(e, conn, x, y, tbuf)
         grid.sync()
         for e in range(tid, ne, nthr):
-            cond(e, conn, x, y, alive, enbr, temp, tbuf, mat[KCOND], mat[RHO] * mat[CP],
-                 prm[P_COND_ACC])
+            conduct_item(e, a)
         grid.sync()
         for e in range(tid, ne, nthr):
             temp[e] = tbuf[e, 3]
         grid.sync()
         if npair > 0:
             for i in range(tid, npair, nthr):
-                pedge(i, ppair, x, y, alive, a.tied, temp, tbuf, mat[KCOND],
-                      mat[RHO] * mat[CP], prm[P_COND_ACC])
+                parting_item(i, a)
             grid.sync()
         if a.theat != 0:
             tcq = a.tcq
             for n in range(tid, x.shape[0], nthr):
-                thnode(n, conn, x, y, a.ptr, a.nel, a.ncorner, alive, enbr, a.cfx,
-                       a.cfy, a.fric, a.fheat, temp, tbuf, tcq, mat[RHO] * mat[CP],
-                       prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
+                theat_item(n, a)
             grid.sync()
             for e in range(tid, ne, nthr):
                 thelem(e, conn, alive, temp, tcq, mat[RHO] * mat[CP])
@@ -474,6 +294,195 @@ def kernels2(phases: Phases):
         finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red,
                (a.mass, a.vx, a.vy, a.vx, a.ie, a.plast, a.hge,
                 a.alive, a.fric, a.pen, a.ero_ke, a.nwork))
+
+    # the launch-per-kernel path (no cooperative launch, or a per-kernel profile): one kernel
+    # per pass on the state RunState ``a`` (and the reductions ``red``), as the phases per item
+
+    @cuda.jit
+    def k_nodes(a, red):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        node_phase(n, a, kin(a.tool, a.prm), a.clock[1], red)
+
+    @cuda.jit
+    def k_contact_sum(a, red):
+        # the CPU's fixed-order total (kernels.contact_total): one thread per lane, then
+        # the lanes in order by thread 0 -- the same bits on both devices; then the split by
+        # tool face over every node in order (the persistent kernel visits only the chunks
+        # holding a contact node)
+        x, y, cfx, cfy, prm = a.x, a.y, a.cfx, a.cfy, a.prm
+        t = cuda.threadIdx.x
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        px[t] = lsum(cfx, t, LANES)
+        py[t] = lsum(cfy, t, LANES)
+        cuda.syncthreads()
+        if t == 0:
+            lanes_total(px, py, red)
+            cx, cy, tvx, tvy = kin(a.tool, prm)
+            split_reset(red)
+            for n in range(x.shape[0]):
+                split_add(n, x, y, cfx, cfy, cx, cy, prm, red)
+
+    @cuda.jit
+    def k_ale_place(a):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        x, y, xn, yn, prm = a.x, a.y, a.xn, a.yn, a.prm
+        xn[n] = x[n]
+        yn[n] = y[n]
+        tplace(n, x, y, xn, yn, a.x0, a.y0, a.acls, a.aflt, prm[P_TCX] - prm[P_ALE_X0],
+               prm[P_RZ_MAXMOVE], tool_geometry(prm))
+
+    @cuda.jit
+    def k_ale_face(a):
+        n = cuda.grid(1)
+        if n >= a.xn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        prm = a.prm
+        tfacep(n, a.xn, a.yn, a.x0, a.y0, a.acls, a.aflt, prm[P_TCX] - prm[P_ALE_X0])
+
+    @cuda.jit
+    def k_ale_sweep(a):
+        n = cuda.grid(1)
+        if n >= a.acls.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        tsweep(n, a.acls, a.aflt, a.vbuf)
+
+    @cuda.jit
+    def k_ale_sweep_copy(a):
+        n = cuda.grid(1)
+        if n >= a.acls.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        tscopy(n, a.acls, a.aflt, a.vbuf)
+
+    @cuda.jit
+    def k_ale_interior(a):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        prm = a.prm
+        tinter(n, a.x, a.y, a.xn, a.yn, a.x0, a.y0, a.acls, a.aflt,
+               prm[P_TCX] - prm[P_ALE_X0], prm[P_RZ_MAXMOVE])
+
+    @cuda.jit
+    def k_ale_flux(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        flux_item(e, a)
+
+    @cuda.jit
+    def k_ale_velocity(a):
+        k = cuda.grid(1)
+        if k >= a.snodes.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        rvel(a.snodes[k], a.x, a.y, a.xn, a.yn, a.vx, a.vy, a.ptr, a.nel, a.conn, a.vbuf)
+
+    @cuda.jit
+    def k_ale_apply(a):
+        k = cuda.grid(1)
+        if k >= a.snodes.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        n = a.snodes[k]
+        a.vx[n] += a.vbuf[n, 0]
+        a.vy[n] += a.vbuf[n, 1]
+
+    @cuda.jit
+    def k_ale_write(a):
+        e = cuda.grid(1)
+        if e >= a.alive.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        write_item(e, a)
+
+    @cuda.jit
+    def k_ale_nodes(a):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        a.x[n] = a.xn[n]
+        a.y[n] = a.yn[n]
+
+    @cuda.jit
+    def k_ale_mass(a):
+        n = cuda.grid(1)
+        if n >= a.mass.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        rmass(n, a.ptr, a.nel, a.area0, a.mat[RHO] * a.prm[P_MS], a.mass)
+
+    @cuda.jit
+    def k_tool(a, red):
+        if cuda.grid(1) != 0 or a.ist[I_STATUS] != ST_OK:
+            return
+        prm = a.prm
+        dt = a.clock[1]
+        a.en[E_EXT] += tstep(a.tool, prm, red[R_FX], red[R_FY], dt)
+        if CONDUCTION:
+            prm[P_COND_ACC] += dt
+        red[R_DTMIN] = 1e30
+        red[R_BAD] = -1.0
+
+    @cuda.jit
+    def k_elems(a, red):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        elem_phase(e, a, a.clock[1], red)
+
+    @cuda.jit
+    def k_centroids(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        cent(e, a.conn, a.x, a.y, a.tbuf)
+
+    @cuda.jit
+    def k_conduct(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        conduct_item(e, a)
+
+    @cuda.jit
+    def k_conduct_end(a):
+        e = cuda.grid(1)
+        if e >= a.temp.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        a.temp[e] = a.tbuf[e, 3]
+
+    @cuda.jit
+    def k_parting(a):
+        i = cuda.grid(1)
+        if i >= a.ppair.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        parting_item(i, a)
+
+    @cuda.jit
+    def k_theat_nodes(a):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        theat_item(n, a)
+
+    @cuda.jit
+    def k_theat_elems(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        mat = a.mat
+        thelem(e, a.conn, a.alive, a.temp, a.tcq, mat[RHO] * mat[CP])
+
+    @cuda.jit
+    def k_conduct_reset(a):
+        if cuda.grid(1) == 0 and a.ist[I_STATUS] == ST_OK:
+            a.prm[P_COND_ACC] = 0.0
+
+    @cuda.jit
+    def k_finish(a, red):
+        if cuda.grid(1) == 0 and a.ist[I_STATUS] == ST_OK:
+            finish_phase(a, red)
 
     # the tool step writes the new edge centre into prm[P_TCX], prm[P_TCY], which the
     # elements' gated erosion and the ALE pass read: a barrier after the tool

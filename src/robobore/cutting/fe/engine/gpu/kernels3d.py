@@ -130,101 +130,6 @@ def kernels3(conduction: bool):
         red[R_NC] = sn
         return sx, sy, sz
 
-    @cuda.jit
-    def k_nodes(x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-                pen, ndead, ero_ke, nwork, prm, tool, clock, ist, red, pairs):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        cx, cy, cz, tvx, tvy, tvz = kin(tool, prm)
-        node(n, x, y, z, vx, vy, vz, mass, fixed, ptr, nel, ncorner, alive, vol0, fe, cf, fric,
-             pen, ndead, ero_ke, nwork, prm, cx, cy, cz, tvx, tvy, tvz, clock[1], pairs)
-
-    @cuda.jit
-    def k_contact_sum(cf, red):
-        # the CPU's fixed-order total (kernels3d.contact_total3): one thread per lane, then
-        # the lanes in order by thread 0 -- reproducible bit for bit
-        t = cuda.threadIdx.x
-        px = cuda.shared.array(LANES, float64)
-        py = cuda.shared.array(LANES, float64)
-        pz = cuda.shared.array(LANES, float64)
-        pn = cuda.shared.array(LANES, float64)
-        a, b, c, k = lsum3(cf, t, LANES)
-        px[t] = a
-        py[t] = b
-        pz[t] = c
-        pn[t] = k
-        cuda.syncthreads()
-        if t == 0:
-            lanes_total(px, py, pz, pn, red)
-
-    @cuda.jit
-    def k_tool(tool, prm, en, clock, ist, red):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
-        en[E_EXT] += tstep(tool, prm, red[R_FX], red[R_FY], red[R_FZ], clock[1])
-        red[R_DTMIN] = 1e30
-        red[R_BAD] = -1.0
-
-    @cuda.jit
-    def k_elems(conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dm, qh, vol0,
-                ie, hge, fe, dte, plast, rate, mat, prm, clock, erosion, ist, red):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        elem(e, conn, x, y, z, vx, vy, vz, alive, layer, sd, pres, eps_p, temp, dm, qh, vol0,
-             ie, hge, fe, dte, plast, rate, mat, prm, clock[1], erosion)
-        cuda.atomic.min(red, R_DTMIN, dte[e])
-        if alive[e] == -2:
-            red[R_BAD] = e
-
-    @cuda.jit
-    def k_centroids(conn, x, y, z, tbuf, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        centroid3(e, conn, x, y, z, tbuf)
-
-    @cuda.jit
-    def k_conduct(conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat, prm, clock, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        dt_th = clock[0] + clock[1] - prm[P_COND_T]
-        conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[KCOND],
-                 mat[RHO] * mat[CP], dt_th)
-
-    @cuda.jit
-    def k_copy_temp(temp, tbuf, ist):
-        e = cuda.grid(1)
-        if e >= temp.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        temp[e] = tbuf[e, 3]
-
-    @cuda.jit
-    def k_heat_nodes(conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
-                     temp, theat, mat, prm, clock, ist):
-        n = cuda.grid(1)
-        if n >= x.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        dt_th = clock[0] + clock[1] - prm[P_COND_T]
-        heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
-                   temp, theat, mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL],
-                   dt_th)
-
-    @cuda.jit
-    def k_heat_elems(conn, alive, temp, theat, mat, ist):
-        e = cuda.grid(1)
-        if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
-            return
-        heat_elem3(e, conn, alive, temp, theat, mat[RHO] * mat[CP])
-
-    @cuda.jit
-    def k_cond_done(prm, clock, ist):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
-        prm[P_COND_T] = clock[0] + clock[1]
-
     @cuda.jit(device=True)
     def finish(tool, prm, clock, ist, hacc, hist, en, red):
         # the step end (one thread): history.make_end_step's end_step on the step's reductions (no
@@ -233,11 +138,22 @@ def kernels3(conduction: bool):
                  (red[R_FX], red[R_FY], red[R_FZ], red[R_NC]), red, ist, clock, prm, tool, en,
                  hacc, hist, ())
 
-    @cuda.jit
-    def k_finish(tool, prm, clock, ist, hacc, hist, en, red):
-        if cuda.grid(1) != 0 or ist[I_STATUS] != ST_OK:
-            return
-        finish(tool, prm, clock, ist, hacc, hist, en, red)
+    # one item of a conduction pass on the state RunState3 ``a`` (``dt_th`` the time since the
+    # last pass [s]): shared by the persistent kernel's heat phase and the launch-per-kernel
+    # path
+
+    @cuda.jit(device=True)
+    def conduct_item(e, a, dt_th):
+        mat = a.mat
+        conduct3(e, a.conn, a.x, a.y, a.z, a.alive, a.enbr, a.pairs, a.vol0, a.temp, a.tbuf,
+                 mat[KCOND], mat[RHO] * mat[CP], dt_th)
+
+    @cuda.jit(device=True)
+    def heat_node_item(n, a, dt_th):
+        mat, prm = a.mat, a.prm
+        heat_node3(n, a.conn, a.x, a.y, a.z, a.ptr, a.nel, a.ncorner, a.alive, a.enbr,
+                   a.pairs, a.vol0, a.cf, a.fric, a.temp, a.theat, mat[RHO] * mat[CP],
+                   prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
 
     # the persistent kernel's phases (engine.gpu.persistent), on the state RunState3
 
@@ -299,8 +215,7 @@ def kernels3(conduction: bool):
         if not is_cond(step, prm):
             return
         conn, x, y, z, alive = a.conn, a.x, a.y, a.z, a.alive
-        enbr, pairs, vol0, temp, tbuf = a.enbr, a.pairs, a.vol0, a.temp, a.tbuf
-        mat = a.mat
+        temp, tbuf, mat = a.temp, a.tbuf, a.mat
         ne = conn.shape[0]
         dt_th = clock[0] + dt - prm[P_COND_T]
         rcp = mat[RHO] * mat[CP]
@@ -308,17 +223,14 @@ def kernels3(conduction: bool):
             centroid3(e, conn, x, y, z, tbuf)
         grid.sync()
         for e in range(tid, ne, nthr):
-            conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, mat[KCOND], rcp,
-                     dt_th)
+            conduct_item(e, a, dt_th)
         grid.sync()
         for e in range(tid, ne, nthr):
             temp[e] = tbuf[e, 3]
         grid.sync()
         if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
             for n in range(tid, x.shape[0], nthr):
-                heat_node3(n, conn, x, y, z, a.ptr, a.nel, a.ncorner, alive, enbr,
-                           pairs, vol0, a.cf, a.fric, temp, a.theat, rcp, prm[P_HC],
-                           prm[P_FHEAT], prm[P_TTOOL], dt_th)
+                heat_node_item(n, a, dt_th)
             grid.sync()
             for e in range(tid, ne, nthr):
                 heat_elem3(e, conn, alive, temp, a.theat, rcp)
@@ -329,6 +241,100 @@ def kernels3(conduction: bool):
     @cuda.jit(device=True)
     def finish_phase(a, red):
         finish(a.tool, a.prm, a.clock, a.ist, a.hacc, a.hist, a.en, red)
+
+    # the launch-per-kernel path (no cooperative launch, or a per-kernel profile): one kernel
+    # per pass on the state RunState3 ``a`` (and the reductions ``red``), as the phases per item
+
+    @cuda.jit
+    def k_nodes(a, red):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        node_phase(n, a, kin(a.tool, a.prm), a.clock[1], red)
+
+    @cuda.jit
+    def k_contact_sum(a, red):
+        # the CPU's fixed-order total (kernels3d.contact_total3): one thread per lane, then
+        # the lanes in order by thread 0 -- reproducible bit for bit
+        t = cuda.threadIdx.x
+        px = cuda.shared.array(LANES, float64)
+        py = cuda.shared.array(LANES, float64)
+        pz = cuda.shared.array(LANES, float64)
+        pn = cuda.shared.array(LANES, float64)
+        sa, sb, sc, sk = lsum3(a.cf, t, LANES)
+        px[t] = sa
+        py[t] = sb
+        pz[t] = sc
+        pn[t] = sk
+        cuda.syncthreads()
+        if t == 0:
+            lanes_total(px, py, pz, pn, red)
+
+    @cuda.jit
+    def k_tool(a, red):
+        if cuda.grid(1) != 0 or a.ist[I_STATUS] != ST_OK:
+            return
+        a.en[E_EXT] += tstep(a.tool, a.prm, red[R_FX], red[R_FY], red[R_FZ], a.clock[1])
+        red[R_DTMIN] = 1e30
+        red[R_BAD] = -1.0
+
+    @cuda.jit
+    def k_elems(a, red):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        elem_phase(e, a, a.clock[1], red)
+
+    @cuda.jit
+    def k_centroids(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        centroid3(e, a.conn, a.x, a.y, a.z, a.tbuf)
+
+    @cuda.jit
+    def k_conduct(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        clock = a.clock
+        conduct_item(e, a, clock[0] + clock[1] - a.prm[P_COND_T])
+
+    @cuda.jit
+    def k_copy_temp(a):
+        e = cuda.grid(1)
+        if e >= a.temp.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        a.temp[e] = a.tbuf[e, 3]
+
+    @cuda.jit
+    def k_heat_nodes(a):
+        n = cuda.grid(1)
+        if n >= a.x.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        clock = a.clock
+        heat_node_item(n, a, clock[0] + clock[1] - a.prm[P_COND_T])
+
+    @cuda.jit
+    def k_heat_elems(a):
+        e = cuda.grid(1)
+        if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
+            return
+        mat = a.mat
+        heat_elem3(e, a.conn, a.alive, a.temp, a.theat, mat[RHO] * mat[CP])
+
+    @cuda.jit
+    def k_cond_done(a):
+        if cuda.grid(1) != 0 or a.ist[I_STATUS] != ST_OK:
+            return
+        clock = a.clock
+        a.prm[P_COND_T] = clock[0] + clock[1]
+
+    @cuda.jit
+    def k_finish(a, red):
+        if cuda.grid(1) != 0 or a.ist[I_STATUS] != ST_OK:
+            return
+        finish_phase(a, red)
 
     # the elements do not read the tool or the contact forces: no barrier after the tool
     k_run = persistent_kernel(n_sums=4, kinematics=kin, node=node_phase,

@@ -218,7 +218,8 @@ class GpuEngine:
     run_state: Any
     #: the state's scalar settings after the arrays
     run_extra: list
-    #: ``launch_step(g, dred, step, tick)``: one step as one launch per kernel
+    #: ``launch_step(state, dred, step, tick)``: one step as one launch per kernel on the state
+    #: ``run_state(*arrays, *run_extra)`` (the persistent kernel's argument)
     launch_step: Callable
     #: ``copy_back(st, g)``: the device arrays back into the host state
     copy_back: Callable
@@ -238,8 +239,8 @@ def drive_gpu(st, t_end: float, engine: GpuEngine, *, chunk_steps: int,
     A chunk is one cooperative launch of the persistent kernel ``engine.k_run`` (arguments:
     the state ``run_state(*arrays, *run_extra)``, a namedtuple, the ``n_red`` reduction slots
     of the kernels, the smallest stable step in slot 0 and the inverted element in slot 1;
-    see :func:`persistent_run`), or ``launch_step(g, dred, step, tick)`` once per step (``g``
-    the device arrays by name, ``step`` the step's number, ``tick`` the
+    see :func:`persistent_run`), or ``launch_step(state, dred, step, tick)`` once per step
+    (``state`` the same namedtuple of the device arrays, ``step`` the step's number, ``tick`` the
     :func:`profile_ticker`). After each chunk the step counter and clock come back (the whole
     state, by ``copy_back(st, g)``, when ``check`` is given, at the end and on a stop); an
     instability status raises :func:`robobore.cutting.fe.status.instability_error` labelled
@@ -261,9 +262,8 @@ def drive_gpu(st, t_end: float, engine: GpuEngine, *, chunk_steps: int,
     t_start = st.time
     step0 = int(st.ist[layout.I_STEP])
     tick = profile_ticker(profile)
-    run = persistent_run(engine.k_run,
-                         engine.run_state(*[g[name] for name in names], *engine.run_extra),
-                         dred, st.x.shape[0], profile, persistent)
+    state = engine.run_state(*[g[name] for name in names], *engine.run_extra)
+    run = persistent_run(engine.k_run, state, dred, st.x.shape[0], profile, persistent)
     while True:
         if run is not None:
             run(chunk_steps)
@@ -272,7 +272,7 @@ def drive_gpu(st, t_end: float, engine: GpuEngine, *, chunk_steps: int,
             # knows the step number; once the status changes the launches return at once
             step = int(st.ist[layout.I_STEP])
             for i in range(chunk_steps):
-                launch_step(g, dred, step + i, tick)
+                launch_step(state, dred, step + i, tick)
         for name in ("ist", "clock"):
             getattr(st, name)[...] = g[name].copy_to_host()
         status = int(st.ist[layout.I_STATUS])
