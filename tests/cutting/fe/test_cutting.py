@@ -146,7 +146,7 @@ def test_contact_split_classifies_by_face():
         x[i], y[i] = px, py
         cfx[i], cfy[i] = 1.0 + i, 10.0 * (1.0 + i)
     out = np.zeros(6)
-    contact_split(cfx, cfy, x, y, 0.0, 0.0, nrx, nry, nfx, nfy, out)
+    contact_split(cfx, cfy, x, y, (0.0, 0.0, nrx, nry, nfx, nfy), out)
     want = np.zeros(6)
     for i, (_, _, k) in enumerate(pts):
         want[2 * k] -= cfx[i]

@@ -145,7 +145,7 @@ def _nodes(s, kin, dt, split):
     x, y, cfx, cfy, prm = s.x, s.y, s.cfx, s.cfy, s.prm
     ncont = node_update(nodes_of(s), quads_of(s), out_of(s), contact_of(s), kin, prm, dt)
     fwx, fwy = contact_total(cfx, cfy)
-    contact_split(cfx, cfy, x, y, cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY],
+    contact_split(cfx, cfy, x, y, (cx, cy, prm[P_NRX], prm[P_NRY], prm[P_NFX], prm[P_NFY]),
                   split)
     return fwx, fwy, 0.0, ncont
 

@@ -292,16 +292,18 @@ def make_contact_split_node(tool_face):
     """:func:`contact_split_node_py` with its callees ``tool_face`` given (the CPU's
     compiled functions here, a GPU engine's device functions in its port)."""
 
-    def contact_split_node_py(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, o):
+    def contact_split_node_py(i, cfx, cfy, x, y, faces, out, o):
         """Node ``i``'s contact force on the tool added to its face's pair in ``out[o:o + 6]``
         = [Fx, Fy] of the rake face, the edge arc and the flank [N/m]. A node belongs to the
-        face that gives its gap (:func:`robobore.cutting.fe.physics.tool_contact.tool_face_py`).
-        Called in increasing node order by one thread on both devices (:func:`contact_split`, the
-        GPU's block 0), so the sums have the same bits."""
+        face that gives its gap (:func:`robobore.cutting.fe.physics.tool_contact.tool_face_py`);
+        ``faces`` = (edge centre x, y [m], rake normal x, y, flank normal x, y). Called in
+        increasing node order by one thread on both devices (:func:`contact_split`, the GPU's
+        block 0), so the sums have the same bits."""
         fx = cfx[i]
         fy = cfy[i]
         if fx == 0.0 and fy == 0.0:
             return
+        cx, cy, nrx, nry, nfx, nfy = faces
         k = tool_face(x[i] - cx, y[i] - cy, nrx, nry, nfx, nfy)
         out[o + 2 * k] -= fx
         out[o + 2 * k + 1] -= fy
@@ -323,10 +325,11 @@ tool_geometry = njit(cache=True, inline="always")(tool_geometry_py)
 
 
 @njit(cache=True)
-def contact_split(cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out):
+def contact_split(cfx, cfy, x, y, faces, out):
     """Contact force on the tool by face into ``out`` = [Fx, Fy] of the rake face, the edge
-    arc and the flank [N/m] (serial, fixed order: :func:`contact_split_node_py`)."""
+    arc and the flank [N/m] (serial, fixed order: :func:`contact_split_node_py`; ``faces`` as
+    there)."""
     for j in range(6):
         out[j] = 0.0
     for i in range(cfx.shape[0]):
-        contact_split_node(i, cfx, cfy, x, y, cx, cy, nrx, nry, nfx, nfy, out, 0)
+        contact_split_node(i, cfx, cfy, x, y, faces, out, 0)
