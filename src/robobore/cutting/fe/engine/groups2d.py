@@ -23,7 +23,9 @@ a parallel pass so written writes every array). A per-element function that take
 and is compiled apart (``njit`` without ``inline="always"``, called from the body with the
 groups) keeps the writes, but runs the 2D contract case at 0.62-0.63 of the inlined flat form
 (paired, one thread: ``benchmarks/measured/fe_before_after/
-quad_element_groups_apart_2d_paired.txt``).
+quad_element_groups_apart_2d_paired.txt``), and called once per task of 256 elements (a serial
+loop compiled apart, the ``prange`` over the tasks) at 0.83-0.85
+(``quad_element_chunked_2d_paired.txt``).
 
 Shapes: ``n`` nodes, ``e`` quads.
 """
