@@ -286,3 +286,30 @@ def test_radius_above_one_where_the_cut_is_interrupted_leaves_the_window_above(t
                           cfg.insert.to_insert()))
     assert v.chatter_decided and not v.chatter and not v.tool_leaves_cut
     assert rho < 1.0 and abs(v.floquet_multiplier - rho) < 5e-3
+
+
+def test_critical_depth_does_not_depend_on_what_ran_before():
+    """A limit is a function of its arguments: the Arnoldi warm starts live within one search
+    (semidiscretization._search_scope), so a search after others of the same monodromy
+    dimension (another robot, other speeds) returns the same digits as the first one."""
+    from robobore.dynamics import semidiscretization as sd
+    from robobore.dynamics.band import critical_depths
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.dynamics.config import load_dynamics_config
+
+    root = Path(__file__).resolve().parents[2]
+    cfg, _ = load_dynamics_config(root / "examples" / "boring_paper.toml")
+    pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
+    st, pr = pb.structure, pb.process
+    speeds = np.array([700.0, 1250.0, 2300.0])
+    assert sd.auto_steps(st, pr, 700.0) * 3 + 6 > sd.DENSE_EIG_MAX  # the Arnoldi path
+    first = critical_depths(st, pr, speeds)
+    other = pb.structure_at(np.array([-0.5, -0.3, -0.4, 0.25, -0.1, 0.05]))
+    critical_depths(other, pr, speeds[::-1])  # leaves eigenvectors of the same dimensions
+    critical_depths(other, pr, speeds + 37.0)
+    again = critical_depths(st, pr, speeds)
+    assert np.array_equal(first, again), (first, again)
+    assert sd._WARM_STARTS.get() is None  # nothing kept once the searches end
+    rho = sd.monodromy_spectral_radius(st, pr, 1250.0, float(first[1]))
+    critical_depths(other, pr, speeds)
+    assert sd.monodromy_spectral_radius(st, pr, 1250.0, float(first[1])) == rho
