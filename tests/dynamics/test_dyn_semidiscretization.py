@@ -313,3 +313,23 @@ def test_critical_depth_does_not_depend_on_what_ran_before():
     rho = sd.monodromy_spectral_radius(st, pr, 1250.0, float(first[1]))
     critical_depths(other, pr, speeds)
     assert sd.monodromy_spectral_radius(st, pr, 1250.0, float(first[1])) == rho
+
+
+def test_a_structure_whose_nominal_cut_map_overflows_gives_a_limit_not_an_error():
+    """A band secant far along a wide posterior axis (SYNTHETIC sequential seed 8: x stiffness
+    x e^-12, x damping x e^-17) meets a structure whose one-revolution map of the nominal cut
+    overflows at a deep trial depth: no steady orbit, and the search goes on."""
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.dynamics.config import load_dynamics_config
+    from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
+    from robobore.dynamics.timedomain import nominal_cut_deflection
+
+    root = Path(__file__).resolve().parents[2]
+    cfg, _ = load_dynamics_config(root / "examples" / "boring_paper.toml")
+    pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
+    st = pb.structure_at(np.array([-16.825, -0.617, -0.538, -12.308, -0.148, -0.159]))
+    deep = pb.process.at_depth(0.02)
+    assert nominal_cut_deflection(st, deep, 1250.0) is None
+    assert nominal_cut_deflection(st, pb.process.at_depth(1e-3), 1250.0) is not None
+    a = critical_depth_semidiscretization(st, pb.process, 1250.0, guess_m=0.02)
+    assert math.isfinite(a) and 0.0 <= a < 0.02
