@@ -104,6 +104,75 @@ def test_mean_criterion_prefers_what_the_speeds_share():
         propose_cuts(band, criterion="widest")
 
 
+def test_proposed_depth_is_capped_by_the_range_and_the_config():
+    """A median deeper than the cut can be (a lobe's peak): the proposal sits at the smaller of
+    the depth-of-cut range's top (robobore.io.ranges) and the config's largest depth, says
+    which bound, and carries P(chatter) and information of the capped depth."""
+    from robobore.dynamics.design import depth_cap
+    from robobore.io.ranges import RANGES
+
+    top = RANGES["depth_mm"].hi * 1e-3
+    speeds = np.linspace(500.0, 2000.0, 4)
+    med = np.array([1.0, 1.5 * top * 1e3, 2.0, 1.0]) * 1e-3  # 30 mm: under the scan's top
+    sd = np.array([0.05, 0.6, 0.05, 0.05])
+    band = _band(speeds, med, sd)
+    (c,) = propose_cuts(band)
+    assert c.speed_rpm == speeds[1]
+    assert c.depth_m == pytest.approx(top) and c.median_depth_m == pytest.approx(med[1])
+    assert "robobore.io.ranges" in c.depth_capped_by and "capped" in c.why
+    off = np.log(top / med[1])
+    assert c.p_chatter == pytest.approx(float(predictive_p_chatter(0.6, off, 0.1, 0.1)))
+    assert c.p_chatter < 0.5
+    assert c.information_bits == pytest.approx(float(expected_information(0.6, off, 0.1,
+                                                                          0.1)[0]))
+    # the config's limit binds where it is the smaller one, and only where the median is deeper
+    cuts = propose_cuts(band, 4, max_depth_m=1.2e-3, min_spacing_rpm=0.0)
+    by = {k.speed_rpm: k for k in cuts}
+    for n, m in zip(speeds, med, strict=True):
+        k = by[n]
+        assert k.depth_m == pytest.approx(min(m, 1.2e-3))
+        assert (k.depth_capped_by is not None) == (m > 1.2e-3)
+    d = by[speeds[2]].to_dict()
+    assert d["depth_mm"] == pytest.approx(1.2) and d["band_median_depth_mm"] == pytest.approx(2.0)
+    assert d["depth_capped_by"] == "[calibration] max_depth_mm = 1.2 mm"
+    assert by[speeds[0]].to_dict()["depth_capped_by"] is None
+    # a config limit above the range's top: the range binds
+    assert depth_cap(2 * top) == depth_cap(None)
+    with pytest.raises(ConfigError, match="max_depth_mm"):
+        depth_cap(-1e-3)
+
+
+def test_calibrate_cli_caps_proposals_at_the_config_depth(tmp_path):
+    from robobore.dynamics.calibrate import Observation, write_observations_csv
+
+    obs = [Observation(i + 1, n, a * 1e-3, c) for i, (n, a, c) in enumerate(
+        [(400, 0.2, False), (400, 3.0, True), (1200, 2.0, False), (1200, 15.0, True)])]
+    csv = write_observations_csv(tmp_path / "cuts.csv", obs, "SYNTHETIC")
+    cfg = tmp_path / "capped.toml"
+    cfg.write_text(EXAMPLE.read_text() + "\n[calibration]\nmax_depth_mm = 0.1\n")
+    args = ["calibrate", "dynamics", str(cfg), "--observations", str(csv), "--speeds", "5",
+            "--no-process-damping", "--propose", "2"]
+    r = runner.invoke(app, args + ["--json"])
+    assert r.exit_code == 0, r.output
+    cuts = json.loads(r.stdout)["proposed_cuts"]
+    assert len(cuts) == 2
+    for c in cuts:
+        assert c["band_median_depth_mm"] > 0.1  # the medians are deeper than the limit
+        assert c["depth_mm"] == pytest.approx(0.1)
+        assert c["depth_capped_by"] == "[calibration] max_depth_mm = 0.1 mm"
+        assert "capped at 0.1 mm" in c["why"]
+        assert c["p_chatter"] < 0.5
+    r2 = runner.invoke(app, args)
+    assert r2.exit_code == 0, r2.output
+    assert "capped" in r2.output
+    bad = tmp_path / "bad.toml"
+    bad.write_text(EXAMPLE.read_text() + "\n[calibration]\nmax_depth_mm = 500.0\n")
+    r3 = runner.invoke(app, ["calibrate", "dynamics", str(bad), "--observations", str(csv),
+                             "--propose", "1"])
+    assert r3.exit_code != 0
+    assert "max_depth_mm" in r3.output and "500" in r3.output and "mm" in r3.output
+
+
 def test_calibrate_cli_proposes_cuts_at_the_band(tmp_path):
     from robobore.dynamics.calibrate import Observation, write_observations_csv
 

@@ -286,3 +286,50 @@ def test_radius_above_one_where_the_cut_is_interrupted_leaves_the_window_above(t
                           cfg.insert.to_insert()))
     assert v.chatter_decided and not v.chatter and not v.tool_leaves_cut
     assert rho < 1.0 and abs(v.floquet_multiplier - rho) < 5e-3
+
+
+def test_critical_depth_does_not_depend_on_what_ran_before():
+    """A limit is a function of its arguments: the Arnoldi warm starts live within one search
+    (semidiscretization._search_scope), so a search after others of the same monodromy
+    dimension (another robot, other speeds) returns the same digits as the first one."""
+    from robobore.dynamics import semidiscretization as sd
+    from robobore.dynamics.band import critical_depths
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.dynamics.config import load_dynamics_config
+
+    root = Path(__file__).resolve().parents[2]
+    cfg, _ = load_dynamics_config(root / "examples" / "boring_paper.toml")
+    pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
+    st, pr = pb.structure, pb.process
+    speeds = np.array([700.0, 1250.0, 2300.0])
+    assert sd.auto_steps(st, pr, 700.0) * 3 + 6 > sd.DENSE_EIG_MAX  # the Arnoldi path
+    first = critical_depths(st, pr, speeds)
+    other = pb.structure_at(np.array([-0.5, -0.3, -0.4, 0.25, -0.1, 0.05]))
+    critical_depths(other, pr, speeds[::-1])  # leaves eigenvectors of the same dimensions
+    critical_depths(other, pr, speeds + 37.0)
+    again = critical_depths(st, pr, speeds)
+    assert np.array_equal(first, again), (first, again)
+    assert sd._WARM_STARTS.get() is None  # nothing kept once the searches end
+    rho = sd.monodromy_spectral_radius(st, pr, 1250.0, float(first[1]))
+    critical_depths(other, pr, speeds)
+    assert sd.monodromy_spectral_radius(st, pr, 1250.0, float(first[1])) == rho
+
+
+def test_a_structure_whose_nominal_cut_map_overflows_gives_a_limit_not_an_error():
+    """A band secant far along a wide posterior axis (SYNTHETIC sequential seed 8: x stiffness
+    x e^-12, x damping x e^-17) meets a structure whose one-revolution map of the nominal cut
+    overflows at a deep trial depth: no steady orbit, and the search goes on."""
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.dynamics.config import load_dynamics_config
+    from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
+    from robobore.dynamics.timedomain import nominal_cut_deflection
+
+    root = Path(__file__).resolve().parents[2]
+    cfg, _ = load_dynamics_config(root / "examples" / "boring_paper.toml")
+    pb = build_problem(cfg, [Observation(1, 1e3, 1e-3, False)])
+    st = pb.structure_at(np.array([-16.825, -0.617, -0.538, -12.308, -0.148, -0.159]))
+    deep = pb.process.at_depth(0.02)
+    assert nominal_cut_deflection(st, deep, 1250.0) is None
+    assert nominal_cut_deflection(st, pb.process.at_depth(1e-3), 1250.0) is not None
+    a = critical_depth_semidiscretization(st, pb.process, 1250.0, guess_m=0.02)
+    assert math.isfinite(a) and 0.0 <= a < 0.02

@@ -50,7 +50,8 @@ def calibrate_dynamics_cmd(
     propose: int = typer.Option(
         0, "--propose", help="Propose this many next test cuts (speed, depth) where the "
                              "posterior is least sure of the critical depth "
-                             "(robobore.dynamics.design; among the band's --speeds)."),
+                             "(robobore.dynamics.design; among the band's --speeds), no deeper "
+                             "than [calibration] max_depth_mm and the depth-of-cut range."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Correct the robot's equivalent model by observed cuts; lobes with a confidence band."""
@@ -88,7 +89,10 @@ def calibrate_dynamics_cmd(
     if propose:
         from robobore.dynamics.design import propose_cuts
 
-        result["proposed_cuts"] = [c.to_dict() for c in propose_cuts(cal, propose)]
+        cap = None if cfg.calibration is None or cfg.calibration.max_depth_mm is None else (
+            cfg.calibration.max_depth_mm * 1e-3)
+        result["proposed_cuts"] = [c.to_dict() for c in propose_cuts(cal, propose,
+                                                                     max_depth_m=cap)]
     if out is not None:
         from robobore.io.results import write_json, write_netcdf
 

@@ -305,10 +305,13 @@ class ModelFilesCfg(StrictModel):
 
 class CalibrationCfg(StrictModel):
     """``[calibration]``: the observed cuts of ``calibrate dynamics`` (a CSV, relative to the
-    TOML) and the verdicts' label-noise rate."""
+    TOML), the verdicts' label-noise rate and the largest depth of cut a proposed test cut may
+    have (what the insert's cutting edge, the machine and the part allow; range:
+    robobore.io.ranges ``depth_mm``, which also caps a proposal without it)."""
 
     observations: str | None = None
     label_noise: float | None = Field(None, ge=0, lt=0.5)
+    max_depth_mm: float | None = Field(None, gt=0)  # range: robobore.io.ranges
 
 
 class DynamicsConfig(StrictModel):

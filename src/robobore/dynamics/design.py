@@ -39,6 +39,14 @@ points of interest of ``"mean"``. A speed whose median lies at the bottom or at 
 the depth scan (unstable at vanishing depth, or stable up to the scan's top) is not proposed:
 a cut there does not bracket a limit. A band without ``sensitivity`` takes ``"point"``. The
 truth is never used: the proposal depends on the band alone.
+
+A proposed depth is never deeper than the cut can be: the depth-of-cut range of
+:mod:`robobore.io.ranges` (``depth_mm``, the one definition of a plausible depth) and, when
+given, the config's ``[calibration] max_depth_mm`` (what the insert, the machine and the part
+allow), whichever is smaller (:func:`depth_cap`). Where the band's median is deeper, the cut is
+at the cap; its ``p_chatter`` and ``information_bits`` are those of the capped depth, its
+``why`` and ``depth_capped_by`` say which limit bound. The choice of the speed stays that of
+the median depth.
 """
 
 from __future__ import annotations
@@ -53,6 +61,7 @@ from scipy.stats import norm
 from robobore.dynamics.band import DEPTH_FLOOR_M, LobeBand
 from robobore.dynamics.semidiscretization import DEPTH_SCAN_HI_M
 from robobore.errors import ConfigError
+from robobore.io.ranges import RANGES
 
 #: Default smallest distance between two cuts proposed together, as a share of the
 #: candidates' speed span.
@@ -68,7 +77,9 @@ class ProposedCut:
     """A proposed test cut: speed [r/min], depth [m], the predicted probability of chatter,
     the band's ``log_sd`` there, the expected information of its verdict about the critical
     depth at its speed [bit], why, the criterion that chose it and, for ``"mean"``, its mean
-    information over the band's speeds [bit]."""
+    information over the band's speeds [bit]. ``depth_capped_by``: the limit that set the depth
+    below the band's median (:func:`depth_cap`), None where the depth is the median;
+    ``median_depth_m``: the band's median there."""
 
     speed_rpm: float
     depth_m: float
@@ -78,9 +89,13 @@ class ProposedCut:
     why: str
     criterion: str = "point"
     mean_information_bits: float = float("nan")
+    depth_capped_by: str | None = None
+    median_depth_m: float = float("nan")
 
     def to_dict(self) -> dict[str, Any]:
         return {"speed_rpm": self.speed_rpm, "depth_mm": self.depth_m * 1e3,
+                "depth_capped_by": self.depth_capped_by,
+                "band_median_depth_mm": self.median_depth_m * 1e3,
                 "p_chatter": self.p_chatter, "critical_depth_log_sd": self.log_sd,
                 "expected_information_bits": self.information_bits,
                 "mean_information_bits": None if math.isnan(self.mean_information_bits)
@@ -145,16 +160,36 @@ def mean_information(cov: np.ndarray, fisher: np.ndarray) -> np.ndarray:
     return gain.mean(axis=0) if var.size else np.zeros(0)
 
 
+def depth_cap(max_depth_m: float | None = None) -> tuple[float, str]:
+    """The deepest cut [m] a proposal may have and the limit that sets it, in words: the top
+    of the depth-of-cut range of :mod:`robobore.io.ranges` or ``max_depth_m`` (the config's
+    ``[calibration] max_depth_mm``), whichever is smaller."""
+    r = RANGES["depth_mm"]
+    cap = (r.hi * 1e-3, f"the depth-of-cut range of robobore.io.ranges ({r.bounds()})")
+    if max_depth_m is None:
+        return cap
+    m = float(max_depth_m)
+    if not (math.isfinite(m) and m > 0.0):
+        raise ConfigError("largest depth of a proposed cut must be positive",
+                          field="calibration.max_depth_mm", value=m * 1e3,
+                          expected=f"{r.bounds()}")
+    if m < cap[0]:
+        return m, f"[calibration] max_depth_mm = {m * 1e3:g} mm"
+    return cap
+
+
 def propose_cuts(source: LobeBand | Any, n: int = 1, label_noise: float | None = None,
                  verdict_spread: float | None = None, min_spacing_rpm: float | None = None,
-                 criterion: str = "mean") -> list[ProposedCut]:
+                 criterion: str = "mean", max_depth_m: float | None = None
+                 ) -> list[ProposedCut]:
     """The ``n`` next test cuts (module docstring) from a
     :class:`~robobore.dynamics.calibrate.Calibration` (its band and likelihood settings) or a
     :class:`~robobore.dynamics.band.LobeBand` (with ``label_noise`` and ``verdict_spread``,
     default 0.1 each). Candidates: the band's speeds. ``criterion``: ``"mean"`` or
     ``"point"``. ``min_spacing_rpm`` (``"point"``): the smallest distance between two
-    proposed cuts (default :data:`MIN_SPACING_SHARE` of the candidates' span). Fewer than
-    ``n`` cuts come back when no candidate is left."""
+    proposed cuts (default :data:`MIN_SPACING_SHARE` of the candidates' span).
+    ``max_depth_m``: the config's largest depth of a test cut (:func:`depth_cap`; the range's
+    top always applies). Fewer than ``n`` cuts come back when no candidate is left."""
     band = source if isinstance(source, LobeBand) else source.band
     settings = getattr(source, "settings", None)
     eps = label_noise if label_noise is not None else (
@@ -175,6 +210,7 @@ def propose_cuts(source: LobeBand | Any, n: int = 1, label_noise: float | None =
     if spacing < 0:
         raise ConfigError("proposal spacing must not be negative", field="min_spacing_rpm",
                           value=spacing, expected=">= 0 r/min")
+    cap_m, cap_by = depth_cap(max_depth_m)
     med = np.asarray(band.median_m, float)
     inside = (med > DEPTH_FLOOR_M * (1 + 1e-9)) & (med < DEPTH_SCAN_HI_M * (1 - 1e-9))
     sd = np.asarray(band.log_sd, float).copy()
@@ -209,8 +245,17 @@ def propose_cuts(source: LobeBand | Any, n: int = 1, label_noise: float | None =
                    f"{band.lower_m[i] * 1e3:.3g}-{band.upper_m[i] * 1e3:.3g} mm); depth at the "
                    f"band's median, where P(chatter) = {p50[i]:.2f}")
             mean_bits = float("nan")
-        out.append(ProposedCut(float(speeds[i]), float(med[i]), float(p50[i]), float(sd[i]),
-                               float(info[i]), why, criterion, mean_bits))
+        depth, p_ch, bits, capped = float(med[i]), float(p50[i]), float(info[i]), None
+        if depth > cap_m:
+            off = math.log(cap_m / depth)
+            depth, capped = cap_m, cap_by
+            p_ch = float(predictive_p_chatter(sd[i], off, eps, s))
+            bits = float(expected_information(sd[i], off, eps, s)[0])
+            why += (f"; the median {med[i] * 1e3:.3g} mm is deeper than the cut can be: depth "
+                    f"capped at {cap_m * 1e3:.3g} mm by {cap_by}, where P(chatter) = "
+                    f"{p_ch:.2f} and the verdict's information is {bits:.3f} bit")
+        out.append(ProposedCut(float(speeds[i]), depth, p_ch, float(sd[i]), bits, why,
+                               criterion, mean_bits, capped, float(med[i])))
         if cov is not None:
             free[i] = False
         else:
@@ -218,6 +263,6 @@ def propose_cuts(source: LobeBand | Any, n: int = 1, label_noise: float | None =
     return out
 
 
-__all__ = ["ProposedCut", "propose_cuts", "expected_information", "predictive_p_chatter",
+__all__ = ["ProposedCut", "propose_cuts", "depth_cap", "expected_information", "predictive_p_chatter",
            "verdict_fisher", "mean_information", "CRITERIA",
            "MIN_SPACING_SHARE", "QUADRATURE_NODES"]

@@ -22,6 +22,7 @@ from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.structure import ToolPointStructure
 
 from contextlib import contextmanager, nullcontext
+from contextvars import ContextVar
 
 try:  # a single BLAS thread: the many mid-size eigenproblems are slower multi-threaded
     from threadpoolctl import ThreadpoolController
@@ -426,16 +427,17 @@ def _above_interruption(structure, process, speed_rpm, depth_hi_m, steps, tol,
                  about_deflected)
         return r if r == r else math.inf  # NaN counts as unstable
 
-    r_prev = rho(hi)
-    if r_prev >= 1.0:
-        return lo, 0.0
-    prev = hi
-    for a1 in grid[k + 1:]:
-        r1 = rho(float(a1))
-        if r1 >= 1.0:
-            return lo, _narrow(rho, prev, r_prev, float(a1), r1, tol)
-        prev, r_prev = float(a1), r1
-    return lo, math.inf
+    with _search_scope():
+        r_prev = rho(hi)
+        if r_prev >= 1.0:
+            return lo, 0.0
+        prev = hi
+        for a1 in grid[k + 1:]:
+            r1 = rho(float(a1))
+            if r1 >= 1.0:
+                return lo, _narrow(rho, prev, r_prev, float(a1), r1, tol)
+            prev, r_prev = float(a1), r1
+        return lo, math.inf
 
 
 def chatter_free_windows(structure: ToolPointStructure, process: CuttingProcess,
@@ -547,12 +549,15 @@ def _spectral_radius(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m:
 
     if n <= DENSE_EIG_MAX:
         return dense()
-    rnd = _START_VECTORS.get(("random", n))
+    rnd = _START_VECTORS.get(n)
     if rnd is None:
         rnd = np.random.default_rng(12345).standard_normal(n)  # deterministic start vector
         rnd /= np.linalg.norm(rnd)
-        _START_VECTORS[("random", n)] = rnd
-    warm = _START_VECTORS.get(("warm", n))
+        if len(_START_VECTORS) > 64:
+            _START_VECTORS.clear()
+        _START_VECTORS[n] = rnd
+    search = _WARM_STARTS.get()
+    warm = None if search is None else search.get(n)
     v = rnd.copy() if warm is None else (1.0 - ARNOLDI_RANDOM_SHARE) * warm + (
         ARNOLDI_RANDOM_SHARE * rnd)
     K = min(n - 1, ARNOLDI_VECTORS)
@@ -577,9 +582,8 @@ def _spectral_radius(Phi: np.ndarray, P0: np.ndarray, P1: np.ndarray, r: int, m:
         v /= nv
         resid = abs(H[k, k - 1] * y[k - 1]) if k == K else 0.0
         if resid <= ARNOLDI_TOL * max(lam, 1e-300):
-            if len(_START_VECTORS) > 64:
-                _START_VECTORS.clear()
-            _START_VECTORS[("warm", n)] = v
+            if search is not None:
+                search[n] = v
             return float(lam)
     return dense()
 
@@ -659,10 +663,29 @@ ARNOLDI_RESTARTS = 30
 #: Relative residual of the dominant Ritz pair at which the Arnoldi iteration stops.
 ARNOLDI_TOL = 1e-10
 #: Share of the fixed random vector in the Arnoldi start vector; the rest is the dominant
-#: eigenvector of the last monodromy of the same dimension (a neighbouring depth or speed),
-#: so that the iteration starts near the answer yet sees every direction.
+#: eigenvector of the last monodromy of the same dimension in the same critical-depth search
+#: (a neighbouring depth at one speed, :func:`_search_scope`), so that the iteration starts
+#: near the answer yet sees every direction. Outside a search, and for the first radius of
+#: each search, the fixed random vector alone.
 ARNOLDI_RANDOM_SHARE = 0.3
+#: The fixed random start vector per dimension (a function of the dimension alone).
 _START_VECTORS: dict = {}
+#: The warm start vectors of the critical-depth search in progress (dimension -> vector), or
+#: None outside one. Held per search, never across searches: a limit depends on its
+#: arguments alone, not on what the process computed before it.
+_WARM_STARTS: ContextVar[dict | None] = ContextVar("robobore_arnoldi_warm_starts",
+                                                   default=None)
+
+
+@contextmanager
+def _search_scope():
+    """A fresh set of Arnoldi warm starts for one critical-depth search (the searches nested
+    in it get their own), dropped when it ends."""
+    token = _WARM_STARTS.set({})
+    try:
+        yield
+    finally:
+        _WARM_STARTS.reset(token)
 
 
 def monodromy_spectral_radius(structure: ToolPointStructure, process: CuttingProcess,
@@ -1002,7 +1025,7 @@ def _critical_depth(structure, process, speed_rpm, depth_hi_m, steps, tol,
                  about_deflected, parts, known)
         return r if r == r else math.inf  # NaN counts as unstable
 
-    with blas_thread_limit(1):
+    with blas_thread_limit(1), _search_scope():
         if guess_m is not None and 0.0 < guess_m < depth_hi_m:
             return _continue(rho, guess_m, depth_hi_m, tol, decades, ratio, slope)
         return _scan(rho, depth_hi_m, tol, decades, ratio), None

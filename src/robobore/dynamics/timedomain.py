@@ -356,7 +356,9 @@ def _orbit_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, X_out):  # pragma: no
     ``Phi`` plus one rank-one term per insert, ``(Gam u_p)(v_p, half_dt v_p)^T``, and is applied
     as such (:func:`_orbit_step`). Composes the Ns steps into ``x_Ns = T x_0 + c``, solves
     ``x_0 = T x_0 + c`` and writes both orbits' states at the step starts into ``X_out``
-    (2, Ns, 2m), load case first. Returns False when ``I - T`` is singular (no orbit)."""
+    (2, Ns, 2m), load case first. Returns False when ``I - T`` is singular or the composed
+    map is not finite (it overflows over one revolution: a structure far softer than any
+    robot's, as a band secant many standard deviations wide meets): no orbit."""
     Ns = X_out.shape[1]
     m = D.shape[0]
     n = 2 * m
@@ -389,6 +391,10 @@ def _orbit_kernel(Phi, Gam, D, dd, vec, fixed, N, half_dt, X_out):  # pragma: no
     for i in range(Ns):
         _orbit_step(Phi, Gam, U[i], Vv[i], Fm[i], half_dt, Z, Z2, n, w)
         Z, Z2 = Z2, Z
+    for r in range(n):
+        for col in range(n + 2):
+            if not math.isfinite(Z[r, col]):  # the composed map overflowed: no orbit
+                return False
     T = np.ascontiguousarray(Z[:, :n])
     c = np.ascontiguousarray(Z[:, n:])
     M = np.eye(n) - T
@@ -448,7 +454,8 @@ def periodic_orbit(structure: ToolPointStructure, process: CuttingProcess, Ns: i
     midpoints, integrated as :func:`simulate` integrates it. Its periodic orbit is solved
     exactly (the Ns steps composed, ``x_0 = T x_0 + c``). Returns ``(q0, qd0, sr, r_t)`` as
     :func:`_periodic_state`; ``None`` when the process has no depth modulation (the harmonic
-    solution is then exact) or the orbit does not exist (``I - T`` singular)."""
+    solution is then exact) or the orbit does not exist (``I - T`` singular, or the map
+    overflowing over one revolution)."""
     orbits = _orbits(structure, process, Ns, speed_rpm)
     if orbits is None:
         return None

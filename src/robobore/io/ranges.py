@@ -244,7 +244,7 @@ BY_NAME: dict[str, str] = {
     "cond_limit": "condition_limit", "edge_radius_um": "edge_radius_um",
     "sample_rate_Hz": "sample_rate_Hz",
     "record_duration_s": "record_s", "sigma_um": "noise_um",
-    "depth_mm": "depth_mm", "depth_of_cut_mm": "depth_mm",
+    "depth_mm": "depth_mm", "depth_of_cut_mm": "depth_mm", "max_depth_mm": "depth_mm",
     "feed_mm_per_rev": "feed_mm_per_rev", "speed_rpm": "speed_rpm",
     "coherence": "coherence", "mpc": "ratio",
     "damping_ratio": "damping_ratio", "contact_damping_ratio": "damping_ratio",
