@@ -90,7 +90,7 @@ from robobore.cutting.fe.hex.scalar3d import insert_gap3
 __all__ = ["OFF_NMIN2", "keep_py", "off_insert_py", "off_insert", "tf_place_plane_py",
            "tf_place_plane", "place3_py", "place3", "tf_face3_py", "tf_face3",
            "toolframe3d_targets", "rezone3d", "toolframe3d_ale_data",
-           "toolframe3d_targets_py", "rezone3d_py"]
+           "toolframe3d_targets_py", "rezone3d_py", "REMAP3D_OPTIONS"]
 
 #: the least squared in-plane part of the insert normal the "off tool" push divides by
 OFF_NMIN2 = 0.25
@@ -134,18 +134,24 @@ def off_insert_py(px, py, pz, qx, qy, qz, prm, cx, cy, cz):
 off_insert = njit(cache=True, inline="always")(off_insert_py)
 
 
-def place3_py(n, x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm,
-              cx, cy, cz, tool):
+def place3_py(n, x, y, z, xn, yn, zn, ale, travel, prm, tip, tool):
     """First pass, node ``n``: z into its plane; a rigid node, a surface-chain node or a
     chain end on an outflow line placed in the plane (:func:`tf_place_plane_py`), the
     surface nodes then kept out of the insert (:func:`off_insert_py`, when ``tool``); other
-    classes keep their old x, y for now. Reads the old positions only."""
+    classes keep their old x, y for now. Reads the old positions ``x, y, z`` and the
+    :class:`~robobore.cutting.fe.ale.groups3d.ToolFrameAle3` ``ale`` (its places at the start,
+    ``acls``, ``aflt``) only; writes ``xn, yn, zn`` (flat: a ``prange`` body's writes through a
+    tuple are dropped, :mod:`robobore.cutting.fe.ale.groups3d`). ``travel`` =
+    ``(off_x, off_z, max_move)`` and ``tip`` = ``(cx, cy, cz)`` as in :func:`rezone3d`."""
+    off_x, off_z, max_move = travel
+    acls = ale.acls
     xn[n] = x[n]
     yn[n] = y[n]
-    zn[n] = z0[n] + off_z
-    tf_place_plane(n, x, y, xn, yn, x0, y0, acls, aflt, off_x, max_move, prm)
+    zn[n] = ale.z0[n] + off_z
+    tf_place_plane(n, x, y, xn, yn, ale.x0, ale.y0, acls, ale.aflt, off_x, max_move, prm)
     c = acls[n, 0]
     if tool and (c == TF_CHAIN or c == TF_LINE):
+        cx, cy, cz = tip
         tx, ty = off_insert(x[n], y[n], z[n], xn[n], yn[n], zn[n], prm, cx, cy, cz)
         xn[n] = tx
         yn[n] = ty
@@ -190,18 +196,15 @@ def toolframe3d_targets(x, y, z, xn, yn, zn, ale, prm, travel, tip):
     # the prange bodies read flat locals, one bound per statement (ale.groups3d)
     x0 = ale.x0
     y0 = ale.y0
-    z0 = ale.z0
     acls = ale.acls
     aflt = ale.aflt
     scratch = ale.scratch
-    off_x, off_z, max_move = travel
-    cx, cy, cz = tip
+    off_x, _off_z, max_move = travel
     nn = x.shape[0]
     tool = prm[P_TOOL] > 0.5
     # 1. z into the planes; rigid nodes, surface chains and the chain ends in the planes
     for n in prange(nn):
-        place3(n, x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm,
-               cx, cy, cz, tool)
+        place3(n, x, y, z, xn, yn, zn, ale, travel, prm, tip, tool)
     # 2. outflow faces between their (now placed) ends; the boundary values of the mesh
     # displacement
     for n in prange(nn):
@@ -260,24 +263,39 @@ def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarr
     return np.stack([xn, yn, zn], axis=1)
 
 
+#: the keyword options of :func:`robobore.cutting.fe.ale.remap3d.remap3d_py` that
+#: :func:`rezone3d_py` passes on (the same meaning and defaults)
+REMAP3D_OPTIONS = ("vel", "fixed", "fnbr", "bflag", "alive", "rho_s", "t_room", "vel_mode")
+
+
 def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: np.ndarray,
-                aflt: np.ndarray, fields: dict, *, vel: np.ndarray | None = None,
-                fixed: np.ndarray | None = None, fnbr: np.ndarray | None = None,
-                bflag: np.ndarray | None = None, alive: np.ndarray | None = None,
-                rho_s: float = 1.0, t_room: float = 293.15, vel_mode: int = VEL_MOMENTUM,
-                off_x: float = 0.0, off_z: float = 0.0, max_move: float = 0.25,
+                aflt: np.ndarray, fields: dict, *,
+                travel: tuple[float, float, float] = (0.0, 0.0, 0.25),
                 prm: np.ndarray | None = None,
-                tip: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> dict:
+                tip: tuple[float, float, float] = (0.0, 0.0, 0.0), **remap) -> dict:
     """Allocating wrapper of :func:`rezone3d` for tests and scripts: ``nodes`` (n, 3) the
     current positions, ``places`` (n, 3) the places at the start, ``acls``/``aflt`` the
-    tool-frame data (``aflt`` updated in place), ``fields`` and the keyword arguments of
-    :func:`robobore.cutting.fe.ale.remap3d.remap3d_py` (same defaults), ``prm`` the 3D
-    engine's parameter vector (None: no insert), ``tip`` the insert tip's current position.
-    Returns the dict of :func:`~robobore.cutting.fe.ale.remap3d.remap3d_py`."""
+    tool-frame data (``aflt`` updated in place), ``fields`` as in
+    :func:`robobore.cutting.fe.ale.remap3d.remap3d_py`; ``travel`` = ``(off_x, off_z,
+    max_move)`` the insert's travel since the start [m] and the move limit (a fraction of the
+    local size), ``prm`` the 3D engine's parameter vector (None: no insert), ``tip`` the
+    insert tip's current position [m]; ``remap`` any of remap3d_py's keyword options
+    (:data:`REMAP3D_OPTIONS`: ``vel, fixed, fnbr, bflag, alive, rho_s, t_room, vel_mode``,
+    same defaults). Returns the dict of
+    :func:`~robobore.cutting.fe.ale.remap3d.remap3d_py`."""
     from robobore.cutting.fe.hex.layout3d import N_PRM
 
-    a = remap3d_inputs(nodes, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
-                       alive=alive, t_room=t_room)
+    unknown = sorted(set(remap) - set(REMAP3D_OPTIONS))
+    if unknown:
+        raise TypeError(f"rezone3d_py: unknown keyword option(s) {unknown}; expected "
+                        f"travel, prm, tip or one of {list(REMAP3D_OPTIONS)}")
+    if len(travel) != 3:
+        raise ValueError(f"rezone3d_py: travel = {travel!r}; expected (off_x [m], off_z [m], "
+                         "max_move [fraction of the local size])")
+    rho_s = float(remap.pop("rho_s", 1.0))
+    vel_mode = int(remap.pop("vel_mode", VEL_MOMENTUM))
+    t_room = float(remap.get("t_room", 293.15))
+    a = remap3d_inputs(nodes, conn, fields, **remap)
     places = np.ascontiguousarray(places, np.float64)
     if prm is None:
         prm = np.zeros(N_PRM)
@@ -285,9 +303,9 @@ def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: n
     ale = ToolFrameAle3(x0=places[:, 0].copy(), y0=places[:, 1].copy(), z0=places[:, 2].copy(),
                         acls=np.ascontiguousarray(acls, np.int64), aflt=aflt,
                         scratch=np.zeros((n, 3)))
-    moved = rezone3d(*remap3d_groups(a), ale, float(rho_s), float(t_room), int(vel_mode),
+    moved = rezone3d(*remap3d_groups(a), ale, rho_s, t_room, vel_mode,
                      np.ascontiguousarray(prm, np.float64),
-                     (float(off_x), float(off_z), float(max_move)),
+                     (float(travel[0]), float(travel[1]), float(travel[2])),
                      (float(tip[0]), float(tip[1]), float(tip[2])))
     return remap3d_outputs(a, moved)
 
