@@ -340,3 +340,60 @@ def test_runs_on_the_engine_state_and_keeps_its_lumped_masses():
     assert st.mass.sum() == pytest.approx(mass0.sum(), rel=1e-13)
     p1 = np.array([np.sum(st.mass * v) for v in (st.vx, st.vy, st.vz)])
     assert np.allclose(p1, p0, rtol=0.0, atol=1e-12 * np.sum(mass0 * np.abs(st.vx)))
+
+
+@pytest.mark.parametrize("vel_mode", [VEL_MOMENTUM, VEL_TAYLOR])
+def test_parallel_pass_writes_what_the_scalar_passes_write(vel_mode):
+    # remap3d's prange loops against its scalar passes called element by element and node by
+    # node from Python, on every array the pass writes: a write lost in a prange shows
+    from robobore.cutting.fe.ale import remap3d as R3
+    from robobore.cutting.fe.physics.thermal3d import face_neighbours
+
+    nodes, conn, _, _ = _box(jitter=0.2, seed=3)
+    ne, n = conn.shape[0], nodes.shape[0]
+    rng = np.random.default_rng(8)
+    new = nodes + rng.uniform(-0.2 * H, 0.2 * H, nodes.shape)  # the outline moves too
+    fnbr = face_neighbours(conn)
+    bflag = np.where(fnbr < 0, np.where(rng.uniform(size=fnbr.shape) < 0.5, BF_OPEN,
+                                        BF_VIRGIN), 0).astype(np.int64)
+    alive = np.ones(ne, np.int64)
+    alive[7] = 0
+    fields = {**_fields(ne, rng), "msf": rng.uniform(1.0, 3.0, ne)}
+    opts = {"vel": rng.normal(size=(n, 3)), "fixed": rng.integers(0, 8, n), "bflag": bflag,
+            "alive": alive, "t_room": 293.15}
+
+    def run(scalar):
+        a = R3.remap3d_inputs(nodes, conn, fields, **opts)
+        g = R3.remap3d_groups(a, new)
+        if not scalar:
+            return R3.remap3d(*g, RHO_S, 293.15, vel_mode), a
+        nd, cells, elems, work = g
+        xyz = (work.xn, work.yn, work.zn)
+        for e in range(ne):
+            R3.rz3_flux_py(e, nd, cells, elems, xyz, work.buf, 293.15)
+        moved = 0
+        for m in range(n):
+            if vel_mode == VEL_TAYLOR:
+                moved += R3.rz3_taylor_py(m, nd, cells, xyz, work.vbuf)
+            else:
+                moved += R3.rz3_momentum_py(m, nd, cells, elems, work.buf, work.vbuf)
+        for k, v in enumerate((nd.vx, nd.vy, nd.vz)):
+            v[:] = work.vbuf[:, k]
+        for e in range(ne):
+            R3.rz3_write_py(e, cells.alive, work.buf, elems.sd, elems.pres, elems.eps_p,
+                            elems.temp, elems.dmg, elems.qh, elems.vol0)
+        for v, w in zip((nd.x, nd.y, nd.z), xyz, strict=True):
+            v[:] = w
+        for m in range(n):
+            R3.rz3_node_mass_py(m, nd.ptr, nd.nel, cells.alive, elems.vol0, RHO_S, elems.msf,
+                                nd.mass)
+        return moved, a
+
+    (m_ref, ref), (m_par, par) = run(True), run(False)
+    start = R3.remap3d_inputs(nodes, conn, fields, **opts)
+    assert m_ref == m_par and m_ref > 0
+    for f in ("sd", "pres", "eps_p", "temp", "dmg", "qh", "vol0", "vx", "vy", "vz", "x",
+              "mass", "buf", "vbuf"):
+        assert np.any(ref[f] != start[f]), f  # the pass changed it
+    bad = [f for f in ref if not np.array_equal(ref[f], par[f])]
+    assert not bad, bad
