@@ -174,8 +174,8 @@ def kernels2(phases: Phases):
         e = cuda.grid(1)
         if e >= conn.shape[0] or ist[I_STATUS] != ST_OK:
             return
-        rflux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-              eps_p, temp, dm, qhx, qhy, area0, mat[TROOM])
+        rflux(e, conn, alive, (x, y), (xn, yn), enbr, bflag, buf,
+              (sdx, sdy, sdz, sdxy, pres, eps_p, temp, dm, qhx, qhy, area0), mat[TROOM])
 
     @cuda.jit
     def k_ale_velocity(snodes, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf, ist):
@@ -392,9 +392,9 @@ def kernels2(phases: Phases):
             tinter(n, x, y, xn, yn, x0, y0, acls, aflt, off, mm)
         grid.sync()
         for e in range(tid, ne, nthr):
-            rflux(e, conn, x, y, xn, yn, alive, a.enbr, a.bflag, a.buf, a.sdx,
-                  a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
-                  a.qhx, a.qhy, area0, mat[TROOM])
+            rflux(e, conn, alive, (x, y), (xn, yn), a.enbr, a.bflag, a.buf,
+                  (a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
+                   a.qhx, a.qhy, area0), mat[TROOM])
         for k in range(tid, nsn, nthr):
             rvel(snodes[k], x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
         grid.sync()
