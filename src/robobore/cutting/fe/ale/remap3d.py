@@ -84,6 +84,8 @@ N_RZ3 = N_INTENSIVE3 + 7
 VEL_MOMENTUM, VEL_TAYLOR = 0, 1
 
 
+
+
 def _gather_py(e, w, u, sd, pres, eps_p, temp, dmg, qh, buf):
     """``buf[e, :N_INTENSIVE3] += w * (fields of element u)``."""
     for k in range(6):
@@ -116,20 +118,13 @@ def _mean_velocity_py(u, k, conn, vx, vy, vz):
 _mean_velocity = njit(cache=True, inline="always")(_mean_velocity_py)
 
 
-def rz3_flux_py(e, nodes, cells, elems, new, buf, t_room):
-    """Donor-cell remap of element ``e`` (old geometry ``nodes.x, y, z`` -> new ``new`` =
-    ``(xn, yn, zn)``): its new intensive fields, reference volume and momentum into
-    ``buf[e]`` (layout: see :data:`N_RZ3`). Reads the old state only (``nodes`` a
-    :class:`Nodes3`, ``cells`` a :class:`Cells3`: ``fnbr`` (e, 6) the element across each
-    face (< 0: none), ``bflag`` (e, 6) the flux type of each outline face (``BF_*``; an
-    empty array: all closed); ``elems`` an :class:`ElementState3`), so all elements can run
-    at once; writes ``buf`` only (flat: a ``prange`` body's writes through a tuple are
-    dropped, :mod:`robobore.cutting.fe.ale.groups3d`)."""
-    x, y, z, vx, vy, vz = nodes.x, nodes.y, nodes.z, nodes.vx, nodes.vy, nodes.vz
-    xn, yn, zn = new
-    conn, alive, fnbr, bflag = cells.conn, cells.alive, cells.fnbr, cells.bflag
-    sd, pres, eps_p, temp, dmg = elems.sd, elems.pres, elems.eps_p, elems.temp, elems.dmg
-    qh, vol0 = elems.qh, elems.vol0
+def rz3_flux_py(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, buf, sd, pres,
+                eps_p, temp, dmg, qh, vol0, t_room):
+    """Donor-cell remap of element ``e`` (old geometry ``x, y, z`` -> new ``xn, yn, zn``):
+    its new intensive fields, reference volume and momentum into ``buf[e]`` (layout: see
+    :data:`N_RZ3`). Reads the old state only, so all elements can run at once. ``fnbr``
+    (e, 6) the element across each face (< 0: none); ``bflag`` (e, 6) the flux type of each
+    outline face (``BF_*``; an empty array: all closed)."""
     for f in range(N_RZ3):
         buf[e, f] = 0.0
     if alive[e] != 1:
@@ -200,16 +195,13 @@ def factor_py(msf, e):
 _factor = njit(cache=True, inline="always")(factor_py)
 
 
-def rz3_momentum_py(n, nodes, cells, elems, buf, vbuf):
+def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf):
     """:data:`VEL_MOMENTUM`, node ``n``: its new velocity into ``vbuf[n]`` (after
     :func:`rz3_flux_py` of every element, before :func:`rz3_write_py`): old nodal momentum
     plus an eighth of each of its elements' momentum change, over the new lumped mass (all
     per unit mass-scaled density; each element's share times its inertia factor ``msf[e]``,
     which stays with the element as the material moves through it). Fixed components keep
-    their values. Reads ``nodes`` (:class:`Nodes3`), ``cells.alive``, ``elems.vol0, msf`` and
-    ``buf``; writes ``vbuf`` only. Returns 1 when the velocity changes."""
-    ptr, nel, vx, vy, vz, fixed = nodes.ptr, nodes.nel, nodes.vx, nodes.vy, nodes.vz, nodes.fixed
-    alive, vol0, msf = cells.alive, elems.vol0, elems.msf
+    their values. Returns 1 when the velocity changes."""
     m_old = 0.0
     m_new = 0.0
     dpx = 0.0
@@ -244,17 +236,12 @@ def rz3_momentum_py(n, nodes, cells, elems, buf, vbuf):
 rz3_momentum = njit(cache=True, inline="always")(rz3_momentum_py)
 
 
-def rz3_taylor_py(n, nodes, cells, new, vbuf):
+def rz3_taylor_py(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive, fixed, vbuf):
     """:data:`VEL_TAYLOR`, node ``n``: its new velocity into ``vbuf[n]``: the old one plus
     the mean old velocity gradient of its live elements (the mean gradient
-    ``b_I = dV/dx_I / V`` of each) times the node's move from ``nodes.x, y, z`` to ``new`` =
-    ``(xn, yn, zn)``, the 2D engine's :func:`robobore.cutting.fe.ale.remap.rz_velocity_py`
-    in 3D. Reads ``nodes`` (:class:`Nodes3`), ``cells.conn, alive`` and ``new``; writes
-    ``vbuf`` only. Returns 1 when the node moves."""
-    x, y, z, vx, vy, vz = nodes.x, nodes.y, nodes.z, nodes.vx, nodes.vy, nodes.vz
-    ptr, nel, fixed = nodes.ptr, nodes.nel, nodes.fixed
-    xn, yn, zn = new
-    conn, alive = cells.conn, cells.alive
+    ``b_I = dV/dx_I / V`` of each) times the node's move, the 2D engine's
+    :func:`robobore.cutting.fe.ale.remap.rz_velocity_py` in 3D. Returns 1 when the node
+    moves."""
     vbuf[n, 0] = vx[n]
     vbuf[n, 1] = vy[n]
     vbuf[n, 2] = vz[n]
@@ -365,10 +352,13 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     vy = nodes.vy
     vz = nodes.vz
     mass = nodes.mass
+    fixed = nodes.fixed
     ptr = nodes.ptr
     nel = nodes.nel
     conn = cells.conn
     alive = cells.alive
+    fnbr = cells.fnbr
+    bflag = cells.bflag
     sd = elems.sd
     pres = elems.pres
     eps_p = elems.eps_p
@@ -384,16 +374,17 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     vbuf = work.vbuf
     nn = x.shape[0]
     ne = conn.shape[0]
-    new = (xn, yn, zn)
     for e in prange(ne):
-        rz3_flux(e, nodes, cells, elems, new, buf, t_room)
+        rz3_flux(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, buf, sd, pres,
+                 eps_p, temp, dmg, qh, vol0, t_room)
     moved = 0
     if vel_mode == VEL_TAYLOR:
         for n in prange(nn):
-            moved += rz3_taylor(n, nodes, cells, new, vbuf)
+            moved += rz3_taylor(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive,
+                                fixed, vbuf)
     else:
         for n in prange(nn):
-            moved += rz3_momentum(n, nodes, cells, elems, buf, vbuf)
+            moved += rz3_momentum(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf)
     for n in prange(nn):
         vx[n] = vbuf[n, 0]
         vy[n] = vbuf[n, 1]
@@ -407,6 +398,7 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     for n in prange(nn):
         rz3_node_mass(n, ptr, nel, alive, vol0, rho_s, msf, mass)
     return moved
+
 
 
 def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,

@@ -134,24 +134,18 @@ def off_insert_py(px, py, pz, qx, qy, qz, prm, cx, cy, cz):
 off_insert = njit(cache=True, inline="always")(off_insert_py)
 
 
-def place3_py(n, x, y, z, xn, yn, zn, ale, travel, prm, tip, tool):
+def place3_py(n, x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm,
+              cx, cy, cz, tool):
     """First pass, node ``n``: z into its plane; a rigid node, a surface-chain node or a
     chain end on an outflow line placed in the plane (:func:`tf_place_plane_py`), the
     surface nodes then kept out of the insert (:func:`off_insert_py`, when ``tool``); other
-    classes keep their old x, y for now. Reads the old positions ``x, y, z`` and the
-    :class:`~robobore.cutting.fe.ale.groups3d.ToolFrameAle3` ``ale`` (its places at the start,
-    ``acls``, ``aflt``) only; writes ``xn, yn, zn`` (flat: a ``prange`` body's writes through a
-    tuple are dropped, :mod:`robobore.cutting.fe.ale.groups3d`). ``travel`` =
-    ``(off_x, off_z, max_move)`` and ``tip`` = ``(cx, cy, cz)`` as in :func:`rezone3d`."""
-    off_x, off_z, max_move = travel
-    acls = ale.acls
+    classes keep their old x, y for now. Reads the old positions only."""
     xn[n] = x[n]
     yn[n] = y[n]
-    zn[n] = ale.z0[n] + off_z
-    tf_place_plane(n, x, y, xn, yn, ale.x0, ale.y0, acls, ale.aflt, off_x, max_move, prm)
+    zn[n] = z0[n] + off_z
+    tf_place_plane(n, x, y, xn, yn, x0, y0, acls, aflt, off_x, max_move, prm)
     c = acls[n, 0]
     if tool and (c == TF_CHAIN or c == TF_LINE):
-        cx, cy, cz = tip
         tx, ty = off_insert(x[n], y[n], z[n], xn[n], yn[n], zn[n], prm, cx, cy, cz)
         xn[n] = tx
         yn[n] = ty
@@ -196,15 +190,18 @@ def toolframe3d_targets(x, y, z, xn, yn, zn, ale, prm, travel, tip):
     # the prange bodies read flat locals, one bound per statement (ale.groups3d)
     x0 = ale.x0
     y0 = ale.y0
+    z0 = ale.z0
     acls = ale.acls
     aflt = ale.aflt
     scratch = ale.scratch
-    off_x, _off_z, max_move = travel
+    off_x, off_z, max_move = travel
+    cx, cy, cz = tip
     nn = x.shape[0]
     tool = prm[P_TOOL] > 0.5
     # 1. z into the planes; rigid nodes, surface chains and the chain ends in the planes
     for n in prange(nn):
-        place3(n, x, y, z, xn, yn, zn, ale, travel, prm, tip, tool)
+        place3(n, x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm,
+               cx, cy, cz, tool)
     # 2. outflow faces between their (now placed) ends; the boundary values of the mesh
     # displacement
     for n in prange(nn):
