@@ -62,8 +62,8 @@ def _remap(x, y, xn, yn, vx, vy, conn, ptr, nel, interior, f, area0, mass):
     buf = np.zeros((ne, N_RZ_FIELDS))
     vbuf = np.zeros((x.size, 2))
     for e in range(ne):
-        rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, np.zeros((0, 4), np.int64), buf, *f,
-                   area0, 293.0)
+        rz_flux_py(e, conn, alive, (x, y), (xn, yn), enbr, np.zeros((0, 4), np.int64), buf,
+                   (*f, area0), 293.0)
     moved = sum(rz_velocity_py(n, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
                 for n in interior)
     vx[interior] += vbuf[interior, 0]

@@ -257,9 +257,9 @@ def test_extruded_mesh_equals_the_2d_remap_times_the_thickness():
     xn, yn = new2[:, 0].copy(), new2[:, 1].copy()
     alive = np.ones(ne, np.int64)
     for e in range(ne):
-        rz_flux_py(e, conn2, x, y, xn, yn, alive, enbr, np.zeros((0, 4), np.int64), buf2,
-                   f2["sdx"], f2["sdy"], f2["sdz"], f2["sdxy"], f2["pres"], f2["eps_p"],
-                   f2["temp"], f2["dmg"], f2["qhx"], f2["qhy"], area0, 293.15)
+        rz_flux_py(e, conn2, alive, (x, y), (xn, yn), enbr, np.zeros((0, 4), np.int64), buf2,
+                   (f2["sdx"], f2["sdy"], f2["sdz"], f2["sdxy"], f2["pres"], f2["eps_p"],
+                    f2["temp"], f2["dmg"], f2["qhx"], f2["qhy"], area0), 293.15)
     # 3D, the same fields in every layer
     sd = np.zeros((ne, 6))
     sd[:, 0], sd[:, 1], sd[:, 2], sd[:, 3] = f2["sdx"], f2["sdy"], f2["sdz"], f2["sdxy"]

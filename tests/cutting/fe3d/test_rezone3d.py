@@ -424,8 +424,8 @@ end slices are a tenth of the shortest edge apart) and an insert travel of
     assert np.all(v_old > 0.0)
     off_x = 0.5e-6
     r = rezone3d_py(cur, paper.nodes, paper.conn, acls, aflt, {"vol0": v_old},
-                    bflag=None if closed else paper.bflag, rho_s=RHO_S, off_x=off_x,
-                    prm=_prm(INSERT), tip=(off_x, 0.0, 0.0))
+                    bflag=None if closed else paper.bflag, rho_s=RHO_S,
+                    travel=(off_x, 0.0, 0.25), prm=_prm(INSERT), tip=(off_x, 0.0, 0.0))
     v_new = element_volumes3(r["nodes"], paper.conn)
     assert np.all(v_new > 0.0)
     assert np.array_equal(r["nodes"][:, 2], paper.nodes[:, 2])
@@ -469,7 +469,16 @@ def test_insert_travel_through_material_at_rest_balances_mass(paper):
     assert flux_out < 0.0  # the outflow faces follow the insert: material leaves
     v_old = element_volumes3(old, conn)
     r = rezone3d_py(old, old, conn, acls, aflt, {"vol0": v_old}, bflag=paper.bflag,
-                    rho_s=RHO_S, off_x=off_x, prm=prm, tip=tip)
+                    rho_s=RHO_S, travel=(off_x, 0.0, 0.25), prm=prm, tip=tip)
     assert np.array_equal(r["nodes"], new)
     assert abs(r["vol0"].sum() - (v_old.sum() + flux_in + flux_out)) <= 1e-12 * v_old.sum()
     assert np.all(r["vol0"] > 0.0)
+
+
+def test_rezone3d_py_names_a_wrong_option(paper):
+    # an option rezone3d_py neither takes nor passes on to remap3d_py is named in the error
+    acls, aflt = toolframe3d_ale_data(paper)
+    with pytest.raises(TypeError, match="off_x"):
+        rezone3d_py(paper.nodes, paper.nodes, paper.conn, acls, aflt, {}, off_x=1e-6)
+    with pytest.raises(ValueError, match="travel"):
+        rezone3d_py(paper.nodes, paper.nodes, paper.conn, acls, aflt, {}, travel=(0.0, 0.0))

@@ -19,7 +19,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-N_RZ_FIELDS = 11
+#: the element fields the remap transports, in the order of its work array's columns
+#: (``buf[:, k]``) and of ``rz_flux_py``'s ``fields`` tuple
+RZ_FIELDS = ("sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy", "area0")
+N_RZ_FIELDS = len(RZ_FIELDS)
 #: flux through an element edge on the outline (``bflag``): none, virgin material flowing
 #: in (inflow face), open (outflow; a backflow brings the element's own state)
 BF_CLOSED, BF_VIRGIN, BF_OPEN = 0, 1, 2
@@ -39,11 +42,17 @@ def make_rz_flux(swept):
     """:func:`rz_flux_py` with its callees ``swept`` given (the CPU's compiled functions
     here, a GPU engine's device functions in its port)."""
 
-    def rz_flux_py(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-                   eps_p, temp, dmg, qhx, qhy, area0, t_room):
-        """Donor-cell remap of element ``e`` (old geometry ``x``, ``y`` -> new ``xn``, ``yn``):
-        its new intensive fields and reference area into ``buf[e]`` (see :func:`rezone`).
-        Reads the old state only, so all elements can run at once."""
+    def rz_flux_py(e, conn, alive, old, new, enbr, bflag, buf, fields, t_room):
+        """Donor-cell remap of element ``e`` (old geometry ``old`` = ``(x, y)`` -> new
+        ``new`` = ``(xn, yn)``): its new intensive fields and reference area into ``buf[e]``
+        (see :func:`rezone`). ``fields`` = ``(sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg,
+        qhx, qhy, area0)`` the element state (:data:`RZ_FIELDS`, the order of ``buf``'s
+        columns). Reads the old state only, so all elements can run at once; writes ``buf``
+        only (flat: a ``prange`` body's writes through a tuple are dropped,
+        :mod:`robobore.cutting.fe.engine.groups2d`)."""
+        x, y = old
+        xn, yn = new
+        sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0 = fields
         for f in range(N_RZ_FIELDS):
             buf[e, f] = 0.0
         if alive[e] != 1:

@@ -328,9 +328,11 @@ def rezone(nodes, quads, state, ale, rho_s, max_move, tg, t_room, off):
     # 1. new positions of movable nodes
     toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, vbuf)
     # 2. element fluxes into buf (old geometry x, y -> new geometry xn, yn)
+    old = (x, y)
+    new = (xn, yn)
+    fields = (sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0)
     for e in prange(ne):
-        rz_flux(e, conn, x, y, xn, yn, alive, enbr, bflag, buf, sdx, sdy, sdz, sdxy, pres,
-                eps_p, temp, dmg, qhx, qhy, area0, t_room)
+        rz_flux(e, conn, alive, old, new, enbr, bflag, buf, fields, t_room)
     # 3. nodal velocity: first-order Taylor with the mean old gradient of adjacent elements
     moved = 0
     for k in prange(snodes.shape[0]):

@@ -90,7 +90,7 @@ from robobore.cutting.fe.hex.scalar3d import insert_gap3
 __all__ = ["OFF_NMIN2", "keep_py", "off_insert_py", "off_insert", "tf_place_plane_py",
            "tf_place_plane", "place3_py", "place3", "tf_face3_py", "tf_face3",
            "toolframe3d_targets", "rezone3d", "toolframe3d_ale_data",
-           "toolframe3d_targets_py", "rezone3d_py"]
+           "toolframe3d_targets_py", "rezone3d_py", "REMAP3D_OPTIONS"]
 
 #: the least squared in-plane part of the insert normal the "off tool" push divides by
 OFF_NMIN2 = 0.25
@@ -260,24 +260,39 @@ def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarr
     return np.stack([xn, yn, zn], axis=1)
 
 
+#: the keyword options of :func:`robobore.cutting.fe.ale.remap3d.remap3d_py` that
+#: :func:`rezone3d_py` passes on (the same meaning and defaults)
+REMAP3D_OPTIONS = ("vel", "fixed", "fnbr", "bflag", "alive", "rho_s", "t_room", "vel_mode")
+
+
 def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: np.ndarray,
-                aflt: np.ndarray, fields: dict, *, vel: np.ndarray | None = None,
-                fixed: np.ndarray | None = None, fnbr: np.ndarray | None = None,
-                bflag: np.ndarray | None = None, alive: np.ndarray | None = None,
-                rho_s: float = 1.0, t_room: float = 293.15, vel_mode: int = VEL_MOMENTUM,
-                off_x: float = 0.0, off_z: float = 0.0, max_move: float = 0.25,
+                aflt: np.ndarray, fields: dict, *,
+                travel: tuple[float, float, float] = (0.0, 0.0, 0.25),
                 prm: np.ndarray | None = None,
-                tip: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> dict:
+                tip: tuple[float, float, float] = (0.0, 0.0, 0.0), **remap) -> dict:
     """Allocating wrapper of :func:`rezone3d` for tests and scripts: ``nodes`` (n, 3) the
     current positions, ``places`` (n, 3) the places at the start, ``acls``/``aflt`` the
-    tool-frame data (``aflt`` updated in place), ``fields`` and the keyword arguments of
-    :func:`robobore.cutting.fe.ale.remap3d.remap3d_py` (same defaults), ``prm`` the 3D
-    engine's parameter vector (None: no insert), ``tip`` the insert tip's current position.
-    Returns the dict of :func:`~robobore.cutting.fe.ale.remap3d.remap3d_py`."""
+    tool-frame data (``aflt`` updated in place), ``fields`` as in
+    :func:`robobore.cutting.fe.ale.remap3d.remap3d_py`; ``travel`` = ``(off_x, off_z,
+    max_move)`` the insert's travel since the start [m] and the move limit (a fraction of the
+    local size), ``prm`` the 3D engine's parameter vector (None: no insert), ``tip`` the
+    insert tip's current position [m]; ``remap`` any of remap3d_py's keyword options
+    (:data:`REMAP3D_OPTIONS`: ``vel, fixed, fnbr, bflag, alive, rho_s, t_room, vel_mode``,
+    same defaults). Returns the dict of
+    :func:`~robobore.cutting.fe.ale.remap3d.remap3d_py`."""
     from robobore.cutting.fe.hex.layout3d import N_PRM
 
-    a = remap3d_inputs(nodes, conn, fields, vel=vel, fixed=fixed, fnbr=fnbr, bflag=bflag,
-                       alive=alive, t_room=t_room)
+    unknown = sorted(set(remap) - set(REMAP3D_OPTIONS))
+    if unknown:
+        raise TypeError(f"rezone3d_py: unknown keyword option(s) {unknown}; expected "
+                        f"travel, prm, tip or one of {list(REMAP3D_OPTIONS)}")
+    if len(travel) != 3:
+        raise ValueError(f"rezone3d_py: travel = {travel!r}; expected (off_x [m], off_z [m], "
+                         "max_move [fraction of the local size])")
+    rho_s = float(remap.pop("rho_s", 1.0))
+    vel_mode = int(remap.pop("vel_mode", VEL_MOMENTUM))
+    t_room = float(remap.get("t_room", 293.15))
+    a = remap3d_inputs(nodes, conn, fields, **remap)
     places = np.ascontiguousarray(places, np.float64)
     if prm is None:
         prm = np.zeros(N_PRM)
@@ -285,9 +300,9 @@ def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: n
     ale = ToolFrameAle3(x0=places[:, 0].copy(), y0=places[:, 1].copy(), z0=places[:, 2].copy(),
                         acls=np.ascontiguousarray(acls, np.int64), aflt=aflt,
                         scratch=np.zeros((n, 3)))
-    moved = rezone3d(*remap3d_groups(a), ale, float(rho_s), float(t_room), int(vel_mode),
+    moved = rezone3d(*remap3d_groups(a), ale, rho_s, t_room, vel_mode,
                      np.ascontiguousarray(prm, np.float64),
-                     (float(off_x), float(off_z), float(max_move)),
+                     (float(travel[0]), float(travel[1]), float(travel[2])),
                      (float(tip[0]), float(tip[1]), float(tip[2])))
     return remap3d_outputs(a, moved)
 

@@ -109,9 +109,9 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def flux_item(e, a):
-        rflux(e, a.conn, a.x, a.y, a.xn, a.yn, a.alive, a.enbr, a.bflag, a.buf, a.sdx,
-              a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg,
-              a.qhx, a.qhy, a.area0, a.mat[TROOM])
+        rflux(e, a.conn, a.alive, (a.x, a.y), (a.xn, a.yn), a.enbr, a.bflag, a.buf,
+              (a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg, a.qhx, a.qhy,
+               a.area0), a.mat[TROOM])
 
     @cuda.jit(device=True)
     def write_item(e, a):
