@@ -25,7 +25,9 @@ groups) keeps the writes, but runs the 2D contract case at 0.62-0.63 of the inli
 (paired, one thread: ``benchmarks/measured/fe_before_after/
 quad_element_groups_apart_2d_paired.txt``), and called once per task of 256 elements (a serial
 loop compiled apart, the ``prange`` over the tasks) at 0.83-0.85
-(``quad_element_chunked_2d_paired.txt``).
+(``quad_element_chunked_2d_paired.txt``). Reading the groups by field name inside an inlined
+per-node function keeps the writes but costs about 3 % in the thermal contact pass
+(``tool_heat_node_groups_2d_paired.txt``).
 
 Shapes: ``n`` nodes, ``e`` quads.
 """

@@ -107,17 +107,9 @@ def parting_edge_py(i, ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
     temp[eb] -= q / (rcp * ab)
 
 
-def tool_heat_node_py(n, nodes, quads, state, contact, enbr, tbuf, fheat, tcq, rcp, interface):
+def tool_heat_node_py(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
+                      temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th):
     """Heat [J/m] node ``n`` exchanges with the tool since the last call, into ``tcq[n]``.
-
-    Reads ``nodes`` (``x``, ``y``, the CSR ``ptr``, ``nel``, ``ncorner``), ``quads``
-    (``conn``, ``alive``), ``state`` (``temp``) and ``contact`` (``cfx``, ``cfy``, ``fric``)
-    by field name (the groups of :mod:`robobore.cutting.fe.engine.groups2d`, or any
-    named tuple with those fields: the GPU's state), the edge neighbours ``enbr`` and the
-    centroids and areas ``tbuf``; writes ``fheat`` and ``tcq`` only (a parallel pass's writes
-    go to arrays it holds directly: :mod:`robobore.cutting.fe.engine.groups2d`). ``rcp`` rho
-    c_p [J/(m^3 K)], ``interface`` = (conductance hc [W/(m^2 K)], heat fraction eta, tool
-    temperature [K], time ``dt_th`` [s]).
 
     The node takes ``eta`` of the frictional dissipation booked on it since the last call
     (``fric - fheat``; the rest heats the tool). A node in contact (non-zero contact force)
@@ -128,18 +120,6 @@ def tool_heat_node_py(n, nodes, quads, state, contact, enbr, tbuf, fheat, tcq, r
     (stability, as in :func:`quad_conduct_py`). ``tcq[n]`` = (heat, area of the node's live
     elements). Needs the areas in ``tbuf[:, 2]``.
     """
-    x = nodes.x
-    y = nodes.y
-    ptr = nodes.ptr
-    nel = nodes.nel
-    ncorner = nodes.ncorner
-    conn = quads.conn
-    alive = quads.alive
-    temp = state.temp
-    cfx = contact.cfx
-    cfy = contact.cfy
-    fric = contact.fric
-    hc, eta, t_tool, dt_th = interface
     q = eta * (fric[n] - fheat[n])
     fheat[n] = fric[n]
     touching = hc > 0.0 and (cfx[n] != 0.0 or cfy[n] != 0.0)
@@ -222,12 +202,24 @@ def tool_heat(nodes, quads, state, contact, enbr, fheat, tbuf, tcq, rcp, interfa
     rho c_p [J/(m^3 K)]; ``interface`` = (conductance hc [W/(m^2 K)], heat fraction eta, tool
     temperature [K], time ``dt_th`` [s]).
     """
-    # the groups are only read in the prange bodies; the arrays written (fheat, tcq, temp)
-    # are bound flat, one per statement (engine.groups2d)
+    # the prange bodies read flat locals, one bound per statement (engine.groups2d)
+    x = nodes.x
+    y = nodes.y
+    ptr = nodes.ptr
+    nel = nodes.nel
+    ncorner = nodes.ncorner
     conn = quads.conn
     alive = quads.alive
     temp = state.temp
-    for n in prange(nodes.x.shape[0]):
-        tool_heat_node(n, nodes, quads, state, contact, enbr, tbuf, fheat, tcq, rcp, interface)
+    cfx = contact.cfx
+    cfy = contact.cfy
+    fric = contact.fric
+    hc = interface[0]
+    eta = interface[1]
+    t_tool = interface[2]
+    dt_th = interface[3]
+    for n in prange(x.shape[0]):
+        tool_heat_node(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
+                       temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th)
     for e in prange(conn.shape[0]):
         tool_heat_elem(e, conn, alive, temp, tcq, rcp)

@@ -133,9 +133,9 @@ def kernels2(phases: Phases):
     @cuda.jit(device=True)
     def theat_item(n, a):
         mat, prm = a.mat, a.prm
-        # the state holds the fields of the CPU's groups by the same names
-        thnode(n, a, a, a, a, a.enbr, a.tbuf, a.fheat, a.tcq, mat[RHO] * mat[CP],
-               (prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC]))
+        thnode(n, a.conn, a.x, a.y, a.ptr, a.nel, a.ncorner, a.alive, a.enbr, a.cfx,
+               a.cfy, a.fric, a.fheat, a.temp, a.tbuf, a.tcq, mat[RHO] * mat[CP],
+               prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
 
     # the persistent kernel's phases (engine.gpu.persistent), on the state RunState
 
