@@ -50,6 +50,7 @@ versions of ``make_tf_place``'s ``limit`` and of ``off_insert_py``'s ``insert_ga
 
 from __future__ import annotations
 
+import inspect
 import math
 
 import numpy as np
@@ -63,6 +64,7 @@ from robobore.cutting.fe.ale.remap3d import (
     remap3d_groups,
     remap3d_inputs,
     remap3d_outputs,
+    remap3d_py,
 )
 from robobore.cutting.fe.ale.rezone import (
     TF_CHAIN,
@@ -261,8 +263,9 @@ def toolframe3d_targets_py(nodes: np.ndarray, places: np.ndarray, acls: np.ndarr
 
 
 #: the keyword options of :func:`robobore.cutting.fe.ale.remap3d.remap3d_py` that
-#: :func:`rezone3d_py` passes on (the same meaning and defaults)
-REMAP3D_OPTIONS = ("vel", "fixed", "fnbr", "bflag", "alive", "rho_s", "t_room", "vel_mode")
+#: :func:`rezone3d_py` passes on (the same meaning and defaults), read from its signature
+REMAP3D_OPTIONS = tuple(name for name, p in inspect.signature(remap3d_py).parameters.items()
+                        if p.kind is inspect.Parameter.KEYWORD_ONLY)
 
 
 def rezone3d_py(nodes: np.ndarray, places: np.ndarray, conn: np.ndarray, acls: np.ndarray,
