@@ -118,13 +118,23 @@ def _mean_velocity_py(u, k, conn, vx, vy, vz):
 _mean_velocity = njit(cache=True, inline="always")(_mean_velocity_py)
 
 
-def rz3_flux_py(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, buf, sd, pres,
-                eps_p, temp, dmg, qh, vol0, t_room):
+def rz3_flux_py(e, conn, pos, posn, vel, alive, fnbr, bflag, buf, fields, t_room):
     """Donor-cell remap of element ``e`` (old geometry ``x, y, z`` -> new ``xn, yn, zn``):
     its new intensive fields, reference volume and momentum into ``buf[e]`` (layout: see
     :data:`N_RZ3`). Reads the old state only, so all elements can run at once. ``fnbr``
     (e, 6) the element across each face (< 0: none); ``bflag`` (e, 6) the flux type of each
-    outline face (``BF_*``; an empty array: all closed)."""
+    outline face (``BF_*``; an empty array: all closed).
+
+    Read-only groups (tuples): ``pos`` = ``(x, y, z)`` and ``posn`` = ``(xn, yn, zn)`` the old
+    and new node positions (n,) [m], ``vel`` = ``(vx, vy, vz)`` the velocities (n,) [m/s],
+    ``fields`` = ``(sd, pres, eps_p, temp, dmg, qh, vol0)`` the element state (the arrays of
+    :class:`~robobore.cutting.fe.ale.groups3d.ElementState3`); ``t_room`` the virgin
+    material's temperature [K]. Writes ``buf[e]`` only (read-only tuples built at the
+    call: :mod:`robobore.cutting.fe.ale.groups3d`)."""
+    x, y, z = pos
+    xn, yn, zn = posn
+    vx, vy, vz = vel
+    sd, pres, eps_p, temp, dmg, qh, vol0 = fields
     for f in range(N_RZ3):
         buf[e, f] = 0.0
     if alive[e] != 1:
@@ -195,13 +205,18 @@ def factor_py(msf, e):
 _factor = njit(cache=True, inline="always")(factor_py)
 
 
-def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf):
+def rz3_momentum_py(n, csr, conn, alive, vol0, msf, buf, vel, fixed, vbuf):
     """:data:`VEL_MOMENTUM`, node ``n``: its new velocity into ``vbuf[n]`` (after
     :func:`rz3_flux_py` of every element, before :func:`rz3_write_py`): old nodal momentum
     plus an eighth of each of its elements' momentum change, over the new lumped mass (all
     per unit mass-scaled density; each element's share times its inertia factor ``msf[e]``,
     which stays with the element as the material moves through it). Fixed components keep
-    their values. Returns 1 when the velocity changes."""
+    their values. Returns 1 when the velocity changes.
+
+    Read-only groups (tuples): ``csr`` = ``(ptr, nel)`` the node-to-element lists, ``vel`` =
+    ``(vx, vy, vz)`` the old velocities (n,) [m/s]."""
+    ptr, nel = csr
+    vx, vy, vz = vel
     m_old = 0.0
     m_new = 0.0
     dpx = 0.0
@@ -236,12 +251,20 @@ def rz3_momentum_py(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed,
 rz3_momentum = njit(cache=True, inline="always")(rz3_momentum_py)
 
 
-def rz3_taylor_py(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive, fixed, vbuf):
+def rz3_taylor_py(n, pos, posn, vel, csr, conn, alive, fixed, vbuf):
     """:data:`VEL_TAYLOR`, node ``n``: its new velocity into ``vbuf[n]``: the old one plus
     the mean old velocity gradient of its live elements (the mean gradient
     ``b_I = dV/dx_I / V`` of each) times the node's move, the 2D engine's
     :func:`robobore.cutting.fe.ale.remap.rz_velocity_py` in 3D. Returns 1 when the node
-    moves."""
+    moves.
+
+    Read-only groups (tuples): ``pos`` = ``(x, y, z)`` and ``posn`` = ``(xn, yn, zn)`` the old
+    and new positions (n,) [m], ``vel`` = ``(vx, vy, vz)`` the old velocities (n,) [m/s],
+    ``csr`` = ``(ptr, nel)`` the node-to-element lists."""
+    x, y, z = pos
+    xn, yn, zn = posn
+    vx, vy, vz = vel
+    ptr, nel = csr
     vbuf[n, 0] = vx[n]
     vbuf[n, 1] = vy[n]
     vbuf[n, 2] = vz[n]
@@ -375,16 +398,17 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     nn = x.shape[0]
     ne = conn.shape[0]
     for e in prange(ne):
-        rz3_flux(e, conn, x, y, z, xn, yn, zn, vx, vy, vz, alive, fnbr, bflag, buf, sd, pres,
-                 eps_p, temp, dmg, qh, vol0, t_room)
+        rz3_flux(e, conn, (x, y, z), (xn, yn, zn), (vx, vy, vz), alive, fnbr, bflag, buf,
+                 (sd, pres, eps_p, temp, dmg, qh, vol0), t_room)
     moved = 0
     if vel_mode == VEL_TAYLOR:
         for n in prange(nn):
-            moved += rz3_taylor(n, x, y, z, xn, yn, zn, vx, vy, vz, ptr, nel, conn, alive,
-                                fixed, vbuf)
+            moved += rz3_taylor(n, (x, y, z), (xn, yn, zn), (vx, vy, vz), (ptr, nel), conn,
+                                alive, fixed, vbuf)
     else:
         for n in prange(nn):
-            moved += rz3_momentum(n, ptr, nel, conn, alive, vol0, msf, buf, vx, vy, vz, fixed, vbuf)
+            moved += rz3_momentum(n, (ptr, nel), conn, alive, vol0, msf, buf, (vx, vy, vz),
+                                  fixed, vbuf)
     for n in prange(nn):
         vx[n] = vbuf[n, 0]
         vy[n] = vbuf[n, 1]

@@ -136,12 +136,21 @@ def off_insert_py(px, py, pz, qx, qy, qz, prm, cx, cy, cz):
 off_insert = njit(cache=True, inline="always")(off_insert_py)
 
 
-def place3_py(n, x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm,
-              cx, cy, cz, tool):
+def place3_py(n, pos, xn, yn, zn, start, travel, prm, tip, tool):
     """First pass, node ``n``: z into its plane; a rigid node, a surface-chain node or a
     chain end on an outflow line placed in the plane (:func:`tf_place_plane_py`), the
     surface nodes then kept out of the insert (:func:`off_insert_py`, when ``tool``); other
-    classes keep their old x, y for now. Reads the old positions only."""
+    classes keep their old x, y for now. Reads the old positions only.
+
+    Read-only groups (tuples): ``pos`` = ``(x, y, z)`` the old positions (n,) [m]; ``start``
+    = ``(x0, y0, z0, acls, aflt)`` the places at the start and the tool-frame data of
+    :func:`toolframe3d_ale_data`; ``travel`` = ``(off_x, off_z, max_move)`` and ``tip`` =
+    ``(cx, cy, cz)`` as in :func:`rezone3d`; ``prm`` the parameter vector. Writes ``xn, yn,
+    zn`` (n,) [m] at ``n``."""
+    x, y, z = pos
+    x0, y0, z0, acls, aflt = start
+    off_x, off_z, max_move = travel
+    cx, cy, cz = tip
     xn[n] = x[n]
     yn[n] = y[n]
     zn[n] = z0[n] + off_z
@@ -196,14 +205,13 @@ def toolframe3d_targets(x, y, z, xn, yn, zn, ale, prm, travel, tip):
     acls = ale.acls
     aflt = ale.aflt
     scratch = ale.scratch
-    off_x, off_z, max_move = travel
-    cx, cy, cz = tip
+    off_x = travel[0]
+    max_move = travel[2]
     nn = x.shape[0]
     tool = prm[P_TOOL] > 0.5
     # 1. z into the planes; rigid nodes, surface chains and the chain ends in the planes
     for n in prange(nn):
-        place3(n, x, y, z, xn, yn, zn, x0, y0, z0, acls, aflt, off_x, off_z, max_move, prm,
-               cx, cy, cz, tool)
+        place3(n, (x, y, z), xn, yn, zn, (x0, y0, z0, acls, aflt), travel, prm, tip, tool)
     # 2. outflow faces between their (now placed) ends; the boundary values of the mesh
     # displacement
     for n in prange(nn):
