@@ -13,14 +13,14 @@ from robobore.cutting.fe.quad.element import element_update, quad_element_py
 from robobore.cutting.fe.quad.node_contact import node_update, quad_node_py
 from robobore.material import load_material
 
-_GROUPS = (groups2d.Nodes2, groups2d.Quads2, groups2d.QuadState2, groups2d.QuadOut2,
-           groups2d.Contact2, groups2d.Ale2)
+_GROUPS = (groups2d.Nodes2, groups2d.Quads2, groups2d.QuadOut2, groups2d.Contact2,
+           groups2d.Ale2)
 
 
 @njit
 def _all_groups(s):
-    return (groups2d.nodes_of(s), groups2d.quads_of(s), groups2d.state_of(s),
-            groups2d.out_of(s), groups2d.contact_of(s), groups2d.ale_of(s))
+    return (groups2d.nodes_of(s), groups2d.quads_of(s), groups2d.out_of(s),
+            groups2d.contact_of(s), groups2d.ale_of(s))
 
 
 def _state():
@@ -49,18 +49,35 @@ def test_compiled_builders_take_each_field_by_name():
 def test_fields_name_distinct_state_arrays():
     fields = [f for g in _GROUPS for f in g._fields]
     assert len(fields) == len(set(fields))
-    assert set(fields) <= set(ChunkState._fields)
+    assert set(fields) | {"qs"} <= set(ChunkState._fields)
     st = _state()
-    ptrs = [_data(getattr(st, f))[0] for f in fields if getattr(st, f).size]
+    ptrs = [_data(getattr(st, f))[0] for f in fields + ["qs"] if getattr(st, f).size]
     assert len(ptrs) == len(set(ptrs))  # each field a distinct array of the state
+    assert not set(fields) & set(groups2d.QS_FIELDS)
+
+
+def test_element_state_rows_follow_the_field_list():
+    # each QS_* constant is the row of its field in QS_FIELDS, and the state's attribute of
+    # that name is that row of ``qs`` (a view: writing it writes ``qs``)
+    names = {getattr(groups2d, "QS_" + f.upper()): f for f in groups2d.QS_FIELDS}
+    assert sorted(names) == list(range(groups2d.N_QS)) == list(range(len(groups2d.QS_FIELDS)))
+    st = _state()
+    assert st.qs.shape == (groups2d.N_QS, st.conn.shape[0]) and st.qs.flags.c_contiguous
+    for k, f in names.items():
+        row = getattr(st, f)
+        assert row.base is st.qs and _data(row) == _data(st.qs[k]), f
+        row[:] = k + 1.0
+        assert np.all(st.qs[k] == k + 1.0), f
 
 
 def test_groups_of_reads_by_name_and_replaces():
     st = _state()
     vx = np.ones_like(st.vx)
-    nodes, quads, state, out, contact, ale = groups2d.groups_of(st, vx=vx)
+    nodes, quads, qs, out, contact, ale = groups2d.groups_of(st, vx=vx)
     assert nodes.vx is vx and nodes.x is st.x and quads.area0 is st.area0
-    assert state.qhy is st.qhy and out.fex is st.fex and contact.vslip is st.vslip
+    assert qs is st.qs and out.fex is st.fex and contact.vslip is st.vslip
+    qs2 = st.qs.copy()
+    assert groups2d.groups_of(st, qs=qs2)[2] is qs2
     assert ale.vbuf is st.vbuf
 
 
@@ -80,7 +97,8 @@ def _moving_state():
 
 
 def _arrays(st):
-    return {f: getattr(st, f).copy() for g in _GROUPS for f in g._fields}
+    fields = [f for g in _GROUPS for f in g._fields] + list(groups2d.QS_FIELDS)
+    return {f: getattr(st, f).copy() for f in fields}
 
 
 def test_parallel_passes_write_what_the_scalar_code_writes():
@@ -89,10 +107,9 @@ def test_parallel_passes_write_what_the_scalar_code_writes():
     ref, par = _moving_state(), _moving_state()
     dt = 1e-9
     for e in range(ref.conn.shape[0]):
-        quad_element_py(e, ref.conn, ref.x, ref.y, ref.vx, ref.vy, ref.alive, ref.layer,
-                        ref.sdx, ref.sdy, ref.sdz, ref.sdxy, ref.pres, ref.eps_p, ref.temp,
-                        ref.dmg, ref.qhx, ref.qhy, ref.area0, ref.ie, ref.hge, ref.fex, ref.fey,
-                        ref.dte, ref.plast, ref.rate, ref.mat, ref.prm, dt, layout.ERODE_NONE)
+        quad_element_py(e, (ref.conn, ref.layer, ref.area0, ref.x, ref.y, ref.vx, ref.vy),
+                        ref.alive, ref.qs, ref.ie, ref.hge, ref.fex, ref.fey, ref.dte, ref.plast,
+                        ref.rate, (ref.mat, ref.prm, dt, layout.ERODE_NONE))
     element_update(*groups2d.groups_of(par)[:4], par.mat, par.prm, dt, layout.ERODE_NONE)
     kin = (par.prm[layout.P_TCX], par.prm[layout.P_TCY], 0.0, 0.0)
     for n in range(ref.x.shape[0]):

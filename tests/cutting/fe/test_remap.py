@@ -63,13 +63,13 @@ def _remap(x, y, xn, yn, vx, vy, conn, ptr, nel, interior, f, area0, mass):
     vbuf = np.zeros((x.size, 2))
     for e in range(ne):
         rz_flux_py(e, conn, alive, (x, y), (xn, yn), enbr, np.zeros((0, 4), np.int64), buf,
-                   (*f, area0), 293.0)
+                   (f, area0), 293.0)
     moved = sum(rz_velocity_py(n, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf)
                 for n in interior)
     vx[interior] += vbuf[interior, 0]
     vy[interior] += vbuf[interior, 1]
     for e in range(ne):
-        rz_write_py(e, alive, buf, *f, area0)
+        rz_write_py(e, alive, buf, f, area0)
     x[:] = xn
     y[:] = yn
     for n in range(x.size):
@@ -78,8 +78,9 @@ def _remap(x, y, xn, yn, vx, vy, conn, ptr, nel, interior, f, area0, mass):
 
 
 def _fields(ne, rng):
-    """sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy: random but temp uniform."""
-    f = [rng.standard_normal(ne) for _ in range(10)]
+    """The element state (N_QS, e), rows sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy:
+    random but temp uniform."""
+    f = np.array([rng.standard_normal(ne) for _ in range(10)])
     f[6][:] = 500.0
     return f
 

@@ -24,6 +24,7 @@ from robobore.cutting.fe.ale.hexvolume3d import (
 from robobore.cutting.fe.ale.remap import BF_OPEN, BF_VIRGIN, rz_flux_py, rz_velocity_py
 from robobore.cutting.fe.ale.remap3d import VEL_MOMENTUM, VEL_TAYLOR, remap3d_py
 from robobore.cutting.fe.ale.stencils import edge_neighbours
+from robobore.cutting.fe.engine.groups2d import QS_FIELDS
 from robobore.cutting.fe.engine.state3d import box_mesh, hex_volumes
 from robobore.cutting.fe.physics.thermal3d import HEX_FACES
 
@@ -258,8 +259,7 @@ def test_extruded_mesh_equals_the_2d_remap_times_the_thickness():
     alive = np.ones(ne, np.int64)
     for e in range(ne):
         rz_flux_py(e, conn2, alive, (x, y), (xn, yn), enbr, np.zeros((0, 4), np.int64), buf2,
-                   (f2["sdx"], f2["sdy"], f2["sdz"], f2["sdxy"], f2["pres"], f2["eps_p"],
-                    f2["temp"], f2["dmg"], f2["qhx"], f2["qhy"], area0), 293.15)
+                   (np.array([f2[k] for k in QS_FIELDS]), area0), 293.15)
     # 3D, the same fields in every layer
     sd = np.zeros((ne, 6))
     sd[:, 0], sd[:, 1], sd[:, 2], sd[:, 3] = f2["sdx"], f2["sdy"], f2["sdz"], f2["sdxy"]

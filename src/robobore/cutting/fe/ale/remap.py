@@ -19,9 +19,24 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from robobore.cutting.fe.engine.groups2d import (
+    QS_DMG,
+    QS_EPS_P,
+    QS_FIELDS,
+    QS_PRES,
+    QS_QHX,
+    QS_QHY,
+    QS_SDX,
+    QS_SDXY,
+    QS_SDY,
+    QS_SDZ,
+    QS_TEMP,
+)
+
 #: the element fields the remap transports, in the order of its work array's columns
-#: (``buf[:, k]``) and of ``rz_flux_py``'s ``fields`` tuple
-RZ_FIELDS = ("sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx", "qhy", "area0")
+#: (``buf[:, k]``): the rows of the element state (``engine.groups2d.QS_FIELDS``), then the
+#: reference area
+RZ_FIELDS = QS_FIELDS + ("area0",)
 N_RZ_FIELDS = len(RZ_FIELDS)
 #: flux through an element edge on the outline (``bflag``): none, virgin material flowing
 #: in (inflow face), open (outflow; a backflow brings the element's own state)
@@ -45,14 +60,14 @@ def make_rz_flux(swept):
     def rz_flux_py(e, conn, alive, old, new, enbr, bflag, buf, fields, t_room):
         """Donor-cell remap of element ``e`` (old geometry ``old`` = ``(x, y)`` -> new
         ``new`` = ``(xn, yn)``): its new intensive fields and reference area into ``buf[e]``
-        (see :func:`rezone`). ``fields`` = ``(sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg,
-        qhx, qhy, area0)`` the element state (:data:`RZ_FIELDS`, the order of ``buf``'s
-        columns). Reads the old state only, so all elements can run at once; writes ``buf``
-        only (flat: a ``prange`` body's writes through a tuple are dropped,
+        (see :func:`rezone`). ``fields`` = ``(qs, area0)`` the element state (N_QS, e) and
+        the reference areas (:data:`RZ_FIELDS`, the order of ``buf``'s columns). Reads the
+        old state only, so all elements can run at once; writes ``buf`` only (flat: a
+        ``prange`` body's writes through a tuple are dropped,
         :mod:`robobore.cutting.fe.engine.groups2d`)."""
         x, y = old
         xn, yn = new
-        sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0 = fields
+        qs, area0 = fields
         for f in range(N_RZ_FIELDS):
             buf[e, f] = 0.0
         if alive[e] != 1:
@@ -64,16 +79,16 @@ def make_rz_flux(swept):
         # an eroded element carries no flux, so a boundary node that slides along a
         # curved surface neither creates nor destroys mass)
         a_new = a_old
-        c0 = sdx[e] * a_old
-        c1 = sdy[e] * a_old
-        c2 = sdz[e] * a_old
-        c3 = sdxy[e] * a_old
-        c4 = pres[e] * a_old
-        c5 = eps_p[e] * a_old
-        c6 = temp[e] * a_old
-        c7 = dmg[e] * a_old
-        c8 = qhx[e] * a_old
-        c9 = qhy[e] * a_old
+        c0 = qs[QS_SDX, e] * a_old
+        c1 = qs[QS_SDY, e] * a_old
+        c2 = qs[QS_SDZ, e] * a_old
+        c3 = qs[QS_SDXY, e] * a_old
+        c4 = qs[QS_PRES, e] * a_old
+        c5 = qs[QS_EPS_P, e] * a_old
+        c6 = qs[QS_TEMP, e] * a_old
+        c7 = qs[QS_DMG, e] * a_old
+        c8 = qs[QS_QHX, e] * a_old
+        c9 = qs[QS_QHY, e] * a_old
         c10 = area0[e]
         for kk in range(4):
             a = conn[e, kk]
@@ -102,16 +117,16 @@ def make_rz_flux(swept):
             iu1, iu2, iu3, iu4 = conn[u, 0], conn[u, 1], conn[u, 2], conn[u, 3]
             au = 0.5 * ((x[iu3] - x[iu1]) * (y[iu4] - y[iu2])
                         + (x[iu2] - x[iu4]) * (y[iu3] - y[iu1]))
-            c0 += sw * sdx[u]
-            c1 += sw * sdy[u]
-            c2 += sw * sdz[u]
-            c3 += sw * sdxy[u]
-            c4 += sw * pres[u]
-            c5 += sw * eps_p[u]
-            c6 += sw * temp[u]
-            c7 += sw * dmg[u]
-            c8 += sw * qhx[u]
-            c9 += sw * qhy[u]
+            c0 += sw * qs[QS_SDX, u]
+            c1 += sw * qs[QS_SDY, u]
+            c2 += sw * qs[QS_SDZ, u]
+            c3 += sw * qs[QS_SDXY, u]
+            c4 += sw * qs[QS_PRES, u]
+            c5 += sw * qs[QS_EPS_P, u]
+            c6 += sw * qs[QS_TEMP, u]
+            c7 += sw * qs[QS_DMG, u]
+            c8 += sw * qs[QS_QHX, u]
+            c9 += sw * qs[QS_QHY, u]
             c10 += sw * area0[u] / au
         inv = 1.0 / a_new
         buf[e, 0] = c0 * inv
@@ -168,20 +183,21 @@ def rz_velocity_py(n, x, y, xn, yn, vx, vy, ptr, nel, conn, vbuf):
     return 1
 
 
-def rz_write_py(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0):
-    """Live element ``e`` takes its remapped fields from ``buf[e]``."""
+def rz_write_py(e, alive, buf, qs, area0):
+    """Live element ``e`` takes its remapped fields from ``buf[e]``: the element state ``qs``
+    (N_QS, e) and the reference area ``area0`` (e,) [m^2]."""
     if alive[e] != 1:
         return
-    sdx[e] = buf[e, 0]
-    sdy[e] = buf[e, 1]
-    sdz[e] = buf[e, 2]
-    sdxy[e] = buf[e, 3]
-    pres[e] = buf[e, 4]
-    eps_p[e] = buf[e, 5]
-    temp[e] = buf[e, 6]
-    dmg[e] = buf[e, 7]
-    qhx[e] = buf[e, 8]
-    qhy[e] = buf[e, 9]
+    qs[QS_SDX, e] = buf[e, 0]
+    qs[QS_SDY, e] = buf[e, 1]
+    qs[QS_SDZ, e] = buf[e, 2]
+    qs[QS_SDXY, e] = buf[e, 3]
+    qs[QS_PRES, e] = buf[e, 4]
+    qs[QS_EPS_P, e] = buf[e, 5]
+    qs[QS_TEMP, e] = buf[e, 6]
+    qs[QS_DMG, e] = buf[e, 7]
+    qs[QS_QHX, e] = buf[e, 8]
+    qs[QS_QHY, e] = buf[e, 9]
     area0[e] = buf[e, 10]
 
 

@@ -267,12 +267,12 @@ def toolframe_targets(x, y, xn, yn, x0, y0, acls, aflt, off, max_move, tg, scrat
 
 
 @njit(parallel=True, cache=True)
-def rezone(nodes, quads, state, ale, rho_s, max_move, tg, t_room, off):
+def rezone(nodes, quads, qs, ale, rho_s, max_move, tg, t_room, off):
     """One tool-frame ALE pass: relocation + remap (see module docstring).
 
     The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2), ``quads``
-    (Quads2), ``state`` (QuadState2), ``ale`` (Ale2); ``rho_s`` the mass-scaled density
-    [kg/m^3], ``max_move`` the largest node move of a pass [m].
+    (Quads2), ``qs`` the element state (N_QS, e), ``ale`` (Ale2); ``rho_s`` the mass-scaled
+    density [kg/m^3], ``max_move`` the largest node move of a pass [m].
     ``ale.acls``, ``ale.aflt`` the node classes and data (:func:`toolframe_targets`),
     ``ale.x0``, ``ale.y0`` the nodes' places in the tool frame at the start, ``off`` the
     tool's x travel since the start [m], ``tg`` the tool geometry (tool edge centre x, y, rake
@@ -299,16 +299,6 @@ def rezone(nodes, quads, state, ale, rho_s, max_move, tg, t_room, off):
     conn = quads.conn
     alive = quads.alive
     area0 = quads.area0
-    sdx = state.sdx
-    sdy = state.sdy
-    sdz = state.sdz
-    sdxy = state.sdxy
-    pres = state.pres
-    eps_p = state.eps_p
-    temp = state.temp
-    dmg = state.dmg
-    qhx = state.qhx
-    qhy = state.qhy
     enbr = ale.enbr
     bflag = ale.bflag
     snodes = ale.snodes
@@ -330,7 +320,7 @@ def rezone(nodes, quads, state, ale, rho_s, max_move, tg, t_room, off):
     # 2. element fluxes into buf (old geometry x, y -> new geometry xn, yn)
     old = (x, y)
     new = (xn, yn)
-    fields = (sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0)
+    fields = (qs, area0)
     for e in prange(ne):
         rz_flux(e, conn, alive, old, new, enbr, bflag, buf, fields, t_room)
     # 3. nodal velocity: first-order Taylor with the mean old gradient of adjacent elements
@@ -343,7 +333,7 @@ def rezone(nodes, quads, state, ale, rho_s, max_move, tg, t_room, off):
         vy[n] += vbuf[n, 1]
     # 4. write back element fields and positions, recompute nodal masses
     for e in prange(ne):
-        rz_write(e, alive, buf, sdx, sdy, sdz, sdxy, pres, eps_p, temp, dmg, qhx, qhy, area0)
+        rz_write(e, alive, buf, qs, area0)
     for n in prange(nn):
         x[n] = xn[n]
         y[n] = yn[n]

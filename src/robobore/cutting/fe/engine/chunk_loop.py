@@ -36,12 +36,12 @@ from numba import njit
 
 from robobore.cutting.fe.ale.rezone import rezone
 from robobore.cutting.fe.engine.groups2d import (
+    QS_TEMP,
     ale_of,
     contact_of,
     nodes_of,
     out_of,
     quads_of,
-    state_of,
 )
 from robobore.cutting.fe.engine.history import make_end_step, make_energy_totals
 from robobore.cutting.fe.engine.layout import (
@@ -127,9 +127,8 @@ def _energy_arrays(s):
 
 #: the state arrays of the loop, in the order of ``FEState.kernel_args()``
 CHUNK_ARGS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
-              "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx",
-              "qhy", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy",
-              "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
+              "alive", "qs", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx",
+              "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
               "clock", "hacc", "hist", "enbr", "snodes", "xn", "yn", "buf", "twin",
               "tied", "tbuf", "gps", "fheat", "tcq", "ppair", "x0", "y0", "vbuf", "acls",
               "aflt", "bflag", "vslip")
@@ -161,21 +160,21 @@ def _remesh(s, step):
     mat, prm = s.mat, s.prm
     rho_s = mat[jc.RHO] * prm[P_MS]
     if step % int(prm[P_RZ_EVERY]) == 0 and s.snodes.shape[0] > 0:
-        rezone(nodes_of(s), quads_of(s), state_of(s), ale_of(s), rho_s, prm[P_RZ_MAXMOVE],
+        rezone(nodes_of(s), quads_of(s), s.qs, ale_of(s), rho_s, prm[P_RZ_MAXMOVE],
                tool_geometry(prm), mat[jc.TROOM], prm[P_TCX] - prm[P_ALE_X0])
 
 
 @njit(inline="always")
 def _elements_q4r(s, dt):
     # the one-point quad with hourglass control
-    return element_update(nodes_of(s), quads_of(s), state_of(s), out_of(s), s.mat, s.prm, dt,
+    return element_update(nodes_of(s), quads_of(s), s.qs, out_of(s), s.mat, s.prm, dt,
                           int(s.prm[P_EROSION]))
 
 
 @njit(inline="always")
 def _elements_bbar(s, dt):
     # the B-bar quad
-    return element_update_bbar(nodes_of(s), quads_of(s), state_of(s), out_of(s), s.gps, s.mat,
+    return element_update_bbar(nodes_of(s), quads_of(s), s.qs, out_of(s), s.gps, s.mat,
                                s.prm, dt, int(s.prm[P_EROSION]))
 
 
@@ -185,14 +184,15 @@ def _heat(s, step, t, dt):
     prm, mat = s.prm, s.mat
     prm[P_COND_ACC] += dt
     if step % int(prm[P_COND_EVERY]) == 0:
-        conn, x, y, alive, enbr, temp, tbuf = s.conn, s.x, s.y, s.alive, s.enbr, s.temp, s.tbuf
+        conn, x, y, alive, enbr, tbuf = s.conn, s.x, s.y, s.alive, s.enbr, s.tbuf
+        temp = s.qs[QS_TEMP]
         rcp = mat[jc.RHO] * mat[jc.CP]
         conduct(conn, x, y, alive, enbr, temp, tbuf, mat[jc.KCOND], rcp, prm[P_COND_ACC])
         if s.ppair.shape[0] > 0:
             parting_conduct(s.ppair, x, y, alive, s.tied, temp, tbuf, mat[jc.KCOND], rcp,
                             prm[P_COND_ACC])
         if prm[P_HC] > 0.0 or prm[P_FHEAT] > 0.0:
-            tool_heat(nodes_of(s), quads_of(s), state_of(s), contact_of(s), enbr, s.fheat, tbuf,
+            tool_heat(nodes_of(s), quads_of(s), s.qs, contact_of(s), enbr, s.fheat, tbuf,
                       s.tcq, rcp, (prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC]))
         prm[P_COND_ACC] = 0.0
 

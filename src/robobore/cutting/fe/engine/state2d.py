@@ -16,7 +16,20 @@ from robobore.cutting.fe.ale.remap import N_RZ_FIELDS
 from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
-from robobore.cutting.fe.engine.groups2d import groups_of
+from robobore.cutting.fe.engine.groups2d import (
+    QS_DMG,
+    QS_EPS_P,
+    QS_PRES,
+    QS_QHX,
+    QS_QHY,
+    QS_SDX,
+    QS_SDXY,
+    QS_SDY,
+    QS_SDZ,
+    QS_TEMP,
+    N_QS,
+    groups_of,
+)
 from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import ConfigError
 from robobore.material import Material
@@ -55,23 +68,13 @@ class FEState:
     layer: np.ndarray
     #: element state: 1 alive, 0 eroded by damage, -1 by distortion or time step, -2 inverted
     alive: np.ndarray
-    # --- element state (e,)
-    #: deviatoric stress xx, yy, zz, xy [Pa]
-    sdx: np.ndarray
-    sdy: np.ndarray
-    sdz: np.ndarray
-    sdxy: np.ndarray
-    #: pressure [Pa] (stress = deviatoric stress - pressure)
-    pres: np.ndarray
-    #: equivalent plastic strain
-    eps_p: np.ndarray
-    #: temperature [K]
-    temp: np.ndarray
-    #: Johnson-Cook damage (erodes at 1 where allowed)
-    dmg: np.ndarray
-    #: stored (co-rotated) hourglass stiffness force, x and y [N/m]
-    qhx: np.ndarray
-    qhy: np.ndarray
+    # --- element state
+    #: the element state (N_QS, e), a row per field of engine.groups2d.QS_FIELDS: deviatoric
+    #: stress xx, yy, zz, xy [Pa], pressure [Pa] (stress = deviatoric stress - pressure),
+    #: equivalent plastic strain, temperature [K], Johnson-Cook damage (erodes at 1 where
+    #: allowed), stored (co-rotated) hourglass stiffness force x and y [N/m]; read (and
+    #: written in place) by row as ``sdx`` ... ``qhy``
+    qs: np.ndarray
     #: reference area [m^2] = element mass / (scaled density)
     area0: np.ndarray
     # --- element energies and outputs (e,)
@@ -159,12 +162,61 @@ class FEState:
     #: element, tool frame, conduction (engine.chunk_loop.Phases; advance runs its loop)
     phases: Phases = field(default_factory=Phases)
 
+    # the rows of ``qs`` by name: views, written in place (``st.temp[:] = ...``)
+    @property
+    def sdx(self) -> np.ndarray:
+        """deviatoric stress xx (e,) [Pa]"""
+        return self.qs[QS_SDX]
+
+    @property
+    def sdy(self) -> np.ndarray:
+        """deviatoric stress yy (e,) [Pa]"""
+        return self.qs[QS_SDY]
+
+    @property
+    def sdz(self) -> np.ndarray:
+        """deviatoric stress zz (e,) [Pa]"""
+        return self.qs[QS_SDZ]
+
+    @property
+    def sdxy(self) -> np.ndarray:
+        """deviatoric stress xy (e,) [Pa]"""
+        return self.qs[QS_SDXY]
+
+    @property
+    def pres(self) -> np.ndarray:
+        """pressure (e,) [Pa]"""
+        return self.qs[QS_PRES]
+
+    @property
+    def eps_p(self) -> np.ndarray:
+        """equivalent plastic strain (e,)"""
+        return self.qs[QS_EPS_P]
+
+    @property
+    def temp(self) -> np.ndarray:
+        """temperature (e,) [K]"""
+        return self.qs[QS_TEMP]
+
+    @property
+    def dmg(self) -> np.ndarray:
+        """Johnson-Cook damage (e,)"""
+        return self.qs[QS_DMG]
+
+    @property
+    def qhx(self) -> np.ndarray:
+        """stored hourglass force x (e,) [N/m]"""
+        return self.qs[QS_QHX]
+
+    @property
+    def qhy(self) -> np.ndarray:
+        """stored hourglass force y (e,) [N/m]"""
+        return self.qs[QS_QHY]
+
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
-                self.ncorner, self.conn, self.layer, self.alive, self.sdx, self.sdy, self.sdz,
-                self.sdxy, self.pres, self.eps_p, self.temp, self.dmg, self.qhx, self.qhy,
-                self.area0, self.ie, self.hge, self.fex, self.fey, self.dte, self.plast,
-                self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
+                self.ncorner, self.conn, self.layer, self.alive, self.qs, self.area0, self.ie,
+                self.hge, self.fex, self.fey, self.dte, self.plast, self.rate, self.cfx, self.cfy, self.fric, self.pen, self.ndead, self.ero_ke,
                 self.nwork, self.mat, self.prm, self.tool, self.en, self.ist, self.clock,
                 self.hacc, self.hist, self.enbr, self.snodes, self.xn, self.yn,
                 self.buf, self.twin, self.tied, self.tbuf, self.gps, self.fheat, self.tcq,
@@ -248,14 +300,14 @@ def make_state(nodes: np.ndarray, conn: np.ndarray, fixed: np.ndarray, material:
     tool[layout.T_GX], tool[layout.T_GY] = tool_center
     z = np.zeros
     phases = Phases() if phases is None else phases
+    qs = z((N_QS, ne))
+    qs[QS_TEMP] = material.T_room
     st = FEState(
         x=xs, y=ys, vx=z(n), vy=z(n), mass=mass, fixed=np.asarray(fixed, dtype=np.bool_),
         ptr=ptr, nel=nel, ncorner=nco, conn=conn,
         layer=np.zeros(ne, np.bool_) if layer is None else np.asarray(layer, np.bool_),
-        alive=np.ones(ne, np.int64), sdx=z(ne), sdy=z(ne), sdz=z(ne), sdxy=z(ne), pres=z(ne),
-        eps_p=z(ne), temp=np.full(ne, material.T_room), dmg=z(ne), qhx=z(ne), qhy=z(ne),
-        area0=area.copy(), ie=z(ne), hge=z(ne), fex=z((ne, 4)), fey=z((ne, 4)),
-        dte=z(ne), plast=z(ne), rate=z(ne), cfx=z(n), cfy=z(n), fric=z(n), pen=z(n),
+        alive=np.ones(ne, np.int64), qs=qs, area0=area.copy(), ie=z(ne), hge=z(ne),
+        fex=z((ne, 4)), fey=z((ne, 4)), dte=z(ne), plast=z(ne), rate=z(ne), cfx=z(n), cfy=z(n), fric=z(n), pen=z(n),
         ndead=np.zeros(n, np.bool_), ero_ke=z(n), nwork=z(n), mat=mat, prm=prm, tool=tool,
         en=z(layout.N_EN), ist=np.zeros(layout.N_IST, np.int64), clock=z(3), hacc=z(layout.N_HIST),
         hist=np.full((max(1, n_samples), layout.N_HIST), np.nan), x0=xs.copy(), y0=ys.copy(),
@@ -301,12 +353,9 @@ def parting_edges(conn: np.ndarray, twin: np.ndarray | None) -> np.ndarray:
 
 def init_forces(st: FEState) -> float:
     """Element forces and stable step of the current configuration (no stress update)."""
-    copies = {f: getattr(st, f).copy() for f in ("sdx", "sdy", "sdz", "sdxy", "pres", "eps_p",
-                                                   "temp", "dmg", "qhx", "qhy", "ie", "hge",
-                                                   "plast", "rate")}
-    nodes, quads, state, out, _, _ = groups_of(st, vx=st.vx * 0.0, vy=st.vy * 0.0, **copies)
-    q_element.element_update(nodes, quads, state, out, st.mat, st.prm, 1e-30,
-                             layout.ERODE_NONE)
+    copies = {f: getattr(st, f).copy() for f in ("qs", "ie", "hge", "plast", "rate")}
+    nodes, quads, qs, out, _, _ = groups_of(st, vx=st.vx * 0.0, vy=st.vy * 0.0, **copies)
+    q_element.element_update(nodes, quads, qs, out, st.mat, st.prm, 1e-30, layout.ERODE_NONE)
     dt = st.prm[layout.P_CFL] * float(np.min(st.dte))
     st.clock[1] = dt
     if st.prm[layout.P_DTMIN] <= 0:

@@ -14,6 +14,8 @@ import math
 
 from numba import njit, prange
 
+from robobore.cutting.fe.engine.groups2d import QS_TEMP
+
 
 def quad_centroid_py(e, conn, x, y, tbuf):
     """Centroid x, y and area of quad ``e`` into ``tbuf[e, 0:3]`` (first pass of conduction)."""
@@ -189,17 +191,17 @@ def parting_conduct(ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
 
 
 @njit(parallel=True, cache=True)
-def tool_heat(nodes, quads, state, contact, enbr, fheat, tbuf, tcq, rcp, interface):
+def tool_heat(nodes, quads, qs, contact, enbr, fheat, tbuf, tcq, rcp, interface):
     """Thermal contact with the tool (after :func:`conduct`): frictional heat and the interface
     conductance, node by node (:func:`tool_heat_node_py`), then into the elements
     (:func:`tool_heat_elem_py`). Heat is conserved between nodes and elements.
 
     The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2: ``x``, ``y``,
-    the CSR ``ptr``, ``nel``, ``ncorner``), ``quads`` (Quads2: ``conn``, ``alive``), ``state``
-    (QuadState2: ``temp``), ``contact`` (Contact2: ``cfx``, ``cfy``, ``fric``); ``enbr``
-    (e, 4) the edge neighbours, ``fheat`` (n,) the frictional work already turned into heat
-    [J/m], ``tbuf`` the centroids and areas of :func:`conduct`, ``tcq`` (e,) work, ``rcp``
-    rho c_p [J/(m^3 K)]; ``interface`` = (conductance hc [W/(m^2 K)], heat fraction eta, tool
+    the CSR ``ptr``, ``nel``, ``ncorner``), ``quads`` (Quads2: ``conn``, ``alive``), ``qs``
+    (the element state: its row ``temp``), ``contact`` (Contact2: ``cfx``, ``cfy``,
+    ``fric``); ``enbr`` (e, 4) the edge neighbours, ``fheat`` (n,) the frictional work
+    already turned into heat [J/m], ``tbuf`` the centroids and areas of :func:`conduct`,
+    ``tcq`` (e,) work, ``rcp`` rho c_p [J/(m^3 K)]; ``interface`` = (conductance hc [W/(m^2 K)], heat fraction eta, tool
     temperature [K], time ``dt_th`` [s]).
     """
     # the prange bodies read flat locals, one bound per statement (engine.groups2d)
@@ -210,7 +212,7 @@ def tool_heat(nodes, quads, state, contact, enbr, fheat, tbuf, tcq, rcp, interfa
     ncorner = nodes.ncorner
     conn = quads.conn
     alive = quads.alive
-    temp = state.temp
+    temp = qs[QS_TEMP]
     cfx = contact.cfx
     cfy = contact.cfy
     fric = contact.fric

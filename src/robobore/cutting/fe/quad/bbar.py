@@ -11,6 +11,16 @@ import math
 
 from numba import njit, prange
 
+from robobore.cutting.fe.engine.groups2d import (
+    QS_DMG,
+    QS_EPS_P,
+    QS_PRES,
+    QS_SDX,
+    QS_SDXY,
+    QS_SDY,
+    QS_SDZ,
+    QS_TEMP,
+)
 from robobore.cutting.fe.engine.layout import (
     G_EPS,
     G_SX,
@@ -38,8 +48,7 @@ from robobore.cutting.fe.quad.element import (
 from robobore.material import johnson_cook as jc
 
 
-def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
-                 temp, dmg, gps, area0, ie, fex, fey, dte, plast, rate, mat, prm, dt, erosion):
+def quad_bbar_py(e, mesh, alive, qs, gps, ie, fex, fey, dte, plast, rate, law):
     """Fully integrated quad ``e`` with mean-dilatation B-bar (scalar code, allocates nothing).
 
     Four Gauss points (2x2) each carry their own deviatoric stress and plastic strain
@@ -50,14 +59,18 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     no hourglass mode at all: hourglass-shaped deformation strains the Gauss points, which
     resist it with the material's own (elastic or plastic) response. The temperature and the
     damage stay one per element (Gauss-point plastic work and damage increments are
-    area-weighted); ``sdx``, ``sdy``, ``sdz``, ``sdxy``, ``eps_p`` and ``rate`` receive the
-    area-weighted Gauss-point means (for the outputs, conduction and erosion).
+    area-weighted); the rows ``sdx``, ``sdy``, ``sdz``, ``sdxy``, ``eps_p`` of the element
+    state ``qs`` and ``rate`` receive the area-weighted Gauss-point means (for the outputs,
+    conduction and erosion). ``mesh`` and ``law`` as in
+    :func:`robobore.cutting.fe.quad.element.make_quad_element`'s ``quad_element_py``.
 
     Internal force ``f_I = sum_k detJ_k B_k^T sigma_k`` with ``sigma_k = s_k - p``: for a
     deviatoric ``s_k`` and an element-constant ``p`` this equals the B-bar force
     ``sum_k detJ_k Bbar_k^T sigma_k`` (Belytschko, Liu, Moran 2000, sec. 8.5). Stable step,
     bulk viscosity and erosion as :func:`quad_element_py`; returns ``(dte, inverted)``.
     """
+    conn, layer, area0, x, y, vx, vy = mesh
+    mat, prm, dt, erosion = law
     if alive[e] != 1:
         quad_retire(e, fex, fey, dte)
         return 1e30, False
@@ -89,7 +102,7 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     bx1, bx2, bx3, bx4, by1, by2, by3, by4 = quad_bvectors(x1, x2, x3, x4, y1, y2, y3, y4, A)
     trd = (u1 * bx1 + u2 * bx2 + u3 * bx3 + u4 * bx4
            + w1 * by1 + w2 * by2 + w3 * by3 + w4 * by4)
-    p_old = pres[e]
+    p_old = qs[QS_PRES, e]
     p_new = p_old - K * trd * dt
     bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
             + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
@@ -114,7 +127,7 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     wp_tot = 0.0
     dd = 0.0
     pw = 0.0
-    t_e = temp[e]
+    t_e = qs[QS_TEMP, e]
     therm = 1.0 - jc.homologous_temperature(t_e, tr_, tm_) ** m_
     for k in range(4):
         xi = -gq if (k == 0 or k == 3) else gq
@@ -219,21 +232,21 @@ def quad_bbar_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
     fey[e, 2] = f3y
     fey[e, 3] = f4y
     iw = 1.0 / wsum
-    sdx[e] = ssx * iw
-    sdy[e] = ssy * iw
-    sdz[e] = ssz * iw
-    sdxy[e] = ssxy * iw
-    eps_p[e] = seps * iw
+    qs[QS_SDX, e] = ssx * iw
+    qs[QS_SDY, e] = ssy * iw
+    qs[QS_SDZ, e] = ssz * iw
+    qs[QS_SDXY, e] = ssxy * iw
+    qs[QS_EPS_P, e] = seps * iw
     rate[e] = srate * iw
-    pres[e] = p_new
+    qs[QS_PRES, e] = p_new
     if wp_tot > 0.0:
         plast[e] += wp_tot
-        temp[e] += beta * wp_tot / (rcp * A)
-        dmg[e] += dd * iw
+        qs[QS_TEMP, e] += beta * wp_tot / (rcp * A)
+        qs[QS_DMG, e] += dd * iw
     ie[e] += dt * pw
     if dte_e < dt_erode:
         alive[e] = -1
-    damage_erosion(e, conn, x, y, alive, layer, dmg, prm, erosion)
+    damage_erosion(e, conn, x, y, alive, layer, qs[QS_DMG, e], prm, erosion)
     return dte_e, False
 
 
@@ -241,10 +254,10 @@ quad_bbar = njit(cache=True, inline="always")(quad_bbar_py)
 
 
 @njit(parallel=True, cache=True)
-def element_update_bbar(nodes, quads, state, out, gps, mat, prm, dt, erosion):
+def element_update_bbar(nodes, quads, qs, out, gps, mat, prm, dt, erosion):
     """:func:`quad_bbar_py` over all elements (parallel); the groups and the result as
-    :func:`robobore.cutting.fe.quad.element.element_update` (``state.qhx``/``qhy`` and
-    ``out.hge`` unused), ``gps`` the B-bar element's Gauss-point state."""
+    :func:`robobore.cutting.fe.quad.element.element_update` (the rows ``qhx``/``qhy`` of
+    ``qs`` and ``out.hge`` unused), ``gps`` the B-bar element's Gauss-point state."""
     # the prange body reads flat locals, one bound per statement (engine.groups2d)
     x = nodes.x
     y = nodes.y
@@ -254,14 +267,6 @@ def element_update_bbar(nodes, quads, state, out, gps, mat, prm, dt, erosion):
     layer = quads.layer
     alive = quads.alive
     area0 = quads.area0
-    sdx = state.sdx
-    sdy = state.sdy
-    sdz = state.sdz
-    sdxy = state.sdxy
-    pres = state.pres
-    eps_p = state.eps_p
-    temp = state.temp
-    dmg = state.dmg
     ie = out.ie
     fex = out.fex
     fey = out.fey
@@ -272,9 +277,8 @@ def element_update_bbar(nodes, quads, state, out, gps, mat, prm, dt, erosion):
     dtmin = 1e30
     bad = -1
     for e in prange(ne):
-        d, inv = quad_bbar(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
-                           eps_p, temp, dmg, gps, area0, ie, fex, fey, dte, plast, rate, mat,
-                           prm, dt, erosion)
+        d, inv = quad_bbar(e, (conn, layer, area0, x, y, vx, vy), alive, qs, gps, ie, fex, fey,
+                           dte, plast, rate, (mat, prm, dt, erosion))
         dtmin = min(dtmin, d)
         if inv:
             bad = max(bad, e)

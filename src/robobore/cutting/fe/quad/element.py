@@ -23,6 +23,18 @@ import math
 
 from numba import njit, prange
 
+from robobore.cutting.fe.engine.groups2d import (
+    QS_DMG,
+    QS_EPS_P,
+    QS_PRES,
+    QS_QHX,
+    QS_QHY,
+    QS_SDX,
+    QS_SDXY,
+    QS_SDY,
+    QS_SDZ,
+    QS_TEMP,
+)
 from robobore.cutting.fe.engine.layout import (
     ERODE_LAYER,
     P_BV1,
@@ -114,11 +126,11 @@ def make_damage_erosion(tool_gap):
     """:func:`damage_erosion_py` with its callees ``tool_gap`` given (the CPU's compiled
     functions here, a GPU engine's device functions in its port)."""
 
-    def damage_erosion_py(e, conn, x, y, alive, layer, dmg, prm, erosion):
-        """Erode quad ``e`` of the separation layer once its Johnson-Cook damage reached 1
+    def damage_erosion_py(e, conn, x, y, alive, layer, damage, prm, erosion):
+        """Erode quad ``e`` of the separation layer once its Johnson-Cook ``damage`` reached 1
         (``erosion`` = ERODE_LAYER; optionally only with a node within ``prm[P_GATE]`` of the
         tool)."""
-        if dmg[e] >= 1.0 and erosion == ERODE_LAYER and layer[e]:
+        if damage >= 1.0 and erosion == ERODE_LAYER and layer[e]:
             gate = prm[P_GATE]
             if gate < 0.0:
                 alive[e] = 0
@@ -155,10 +167,15 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
     ``quad_step``, ``damage_erosion`` given (the CPU's compiled functions here, a GPU
     engine's device functions in its port)"""
 
-    def quad_element_py(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres, eps_p,
-                        temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast, rate, mat,
-                        prm, dt, erosion):
+    def quad_element_py(e, mesh, alive, qs, ie, hge, fex, fey, dte, plast, rate, law):
         """Stress update and nodal forces of quad ``e`` (one element, scalar code).
+
+        Reads ``mesh`` = ``(conn, layer, area0, x, y, vx, vy)`` (the arrays of
+        :data:`~robobore.cutting.fe.engine.groups2d.Quads2` but ``alive``, then the nodes'
+        positions [m] and velocities [m/s]) and ``law`` = ``(mat, prm, dt, erosion)`` (the
+        material and parameter vectors, the step [s], the erosion mode); updates the element
+        state ``qs`` (:data:`~robobore.cutting.fe.engine.groups2d.QS_FIELDS` rows), ``alive``
+        and the outputs of :data:`~robobore.cutting.fe.engine.groups2d.QuadOut2` at ``e``.
 
         The whole per-element update of :func:`element_update`: kinematics at the new
         configuration, Jaumann rotation, elastic trial, Johnson-Cook radial return, adiabatic
@@ -172,6 +189,8 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
         was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
         """
+        conn, layer, area0, x, y, vx, vy = mesh
+        mat, prm, dt, erosion = law
         if alive[e] != 1:
             quad_retire(e, fex, fey, dte)
             return 1e30, False
@@ -212,14 +231,14 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         spin = 0.5 * (dvxdy - dvydx)
         trd = dxx + dyy
         # old total stress (for the midpoint stress power)
-        p_old = pres[e]
-        oxx = sdx[e] - p_old
-        oyy = sdy[e] - p_old
-        oxy = sdxy[e]
+        p_old = qs[QS_PRES, e]
+        oxx = qs[QS_SDX, e] - p_old
+        oyy = qs[QS_SDY, e] - p_old
+        oxy = qs[QS_SDXY, e]
         # Jaumann rotation of the deviatoric stress (zz unaffected in plane strain)
-        sx = sdx[e]
-        sy = sdy[e]
-        sxy = sdxy[e]
+        sx = qs[QS_SDX, e]
+        sy = qs[QS_SDY, e]
+        sxy = qs[QS_SDXY, e]
         rs = dt * spin
         sx_r = sx + 2.0 * rs * sxy
         sy_r = sy - 2.0 * rs * sxy
@@ -228,32 +247,33 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         tr3 = trd * dt / 3.0
         tx = sx_r + 2.0 * G * (dxx * dt - tr3)
         ty = sy_r + 2.0 * G * (dyy * dt - tr3)
-        tz = sdz[e] + 2.0 * G * (-tr3)
+        tz = qs[QS_SDZ, e] + 2.0 * G * (-tr3)
         txy = sxy_r + 2.0 * G * dxy * dt
         p_new = p_old - K * trd * dt
-        nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, eps_p[e], temp[e], dt,
-                                                       G, a_, b_, n_, c_, m_, e0, tr_, tm_, eh_)
+        nsx, nsy, nsz, nsxy, dep, syld = radial_return(tx, ty, tz, txy, qs[QS_EPS_P, e],
+                                                       qs[QS_TEMP, e], dt, G, a_, b_, n_, c_,
+                                                       m_, e0, tr_, tm_, eh_)
         if dep > 0.0:
-            eps_p[e] += dep
+            qs[QS_EPS_P, e] += dep
             rate[e] = dep / dt
             wp = syld * dep
             plast[e] += wp * A
-            temp[e] += beta * wp / rcp
+            qs[QS_TEMP, e] += beta * wp / rcp
             q = syld
             if q > 0.0:
                 triax = -p_new / q
             else:
                 triax = 0.0
-            dmg[e] += jc_damage_increment(dep, triax, dep / dt, temp[e], mat[jc.D1],
-                                          mat[jc.D2], mat[jc.D3], mat[jc.D4], mat[jc.D5],
-                                          e0, tr_, tm_)
+            qs[QS_DMG, e] += jc_damage_increment(dep, triax, dep / dt, qs[QS_TEMP, e],
+                                                 mat[jc.D1], mat[jc.D2], mat[jc.D3], mat[jc.D4],
+                                                 mat[jc.D5], e0, tr_, tm_)
         else:
             rate[e] = 0.0
-        sdx[e] = nsx
-        sdy[e] = nsy
-        sdz[e] = nsz
-        sdxy[e] = nsxy
-        pres[e] = p_new
+        qs[QS_SDX, e] = nsx
+        qs[QS_SDY, e] = nsy
+        qs[QS_SDZ, e] = nsz
+        qs[QS_SDXY, e] = nsxy
+        qs[QS_PRES, e] = p_new
         # bulk viscosity (compression only) and stable step
         bsum = (bx1 * bx1 + bx2 * bx2 + bx3 * bx3 + bx4 * bx4
                 + by1 * by1 + by2 * by2 + by3 * by3 + by4 * by4)
@@ -278,14 +298,14 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         qx = g1 * u1 + g2 * u2 + g3 * u3 + g4 * u4
         qy = g1 * w1 + g2 * w2 + g3 * w3 + g4 * w4
         # stiffness part: stored, co-rotated, rate-form
-        hsx = qhx[e]
-        hsy = qhy[e]
+        hsx = qs[QS_QHX, e]
+        hsy = qs[QS_QHY, e]
         hsx, hsy = hsx + rs * hsy, hsy - rs * hsx
         kh = hgs * G * A * bsum
         hsx += dt * kh * qx
         hsy += dt * kh * qy
-        qhx[e] = hsx
-        qhy[e] = hsy
+        qs[QS_QHX, e] = hsx
+        qs[QS_QHY, e] = hsy
         cv = 2.0 * hgv * rho_c * c * math.sqrt(A)
         Qx = hsx + cv * qx
         Qy = hsy + cv * qy
@@ -299,7 +319,7 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         fey[e, 2] = A * (nsxy * bx3 + fyy * by3) + Qy * g3
         fey[e, 3] = A * (nsxy * bx4 + fyy * by4) + Qy * g4
         # erosion by Johnson-Cook damage (in the layer optionally only at the tool's edge)
-        damage_erosion(e, conn, x, y, alive, layer, dmg, prm, erosion)
+        damage_erosion(e, conn, x, y, alive, layer, qs[QS_DMG, e], prm, erosion)
         return dte_e, False
 
     return quad_element_py
@@ -313,12 +333,12 @@ quad_element = njit(cache=False, inline="always")(quad_element_py)
 
 
 @njit(parallel=True, cache=True)
-def element_update(nodes, quads, state, out, mat, prm, dt, erosion):
+def element_update(nodes, quads, qs, out, mat, prm, dt, erosion):
     """Stress update and element nodal forces at the new configuration.
 
     The groups of :mod:`robobore.cutting.fe.engine.groups2d`: ``nodes`` (Nodes2), ``quads``
-    (Quads2), ``state`` (QuadState2), ``out`` (QuadOut2); ``mat`` the material vector,
-    ``prm`` the parameter vector, ``dt`` the step [s], ``erosion`` the erosion mode.
+    (Quads2), ``qs`` the element state (N_QS, e), ``out`` (QuadOut2); ``mat`` the material
+    vector, ``prm`` the parameter vector, ``dt`` the step [s], ``erosion`` the erosion mode.
     Returns ``(dtmin, bad)``: the smallest element stable step [s] (1e30 when no element is
     alive) and the largest index of an inverted element (-1: none).
     Writes ``fex``/``fey`` (n_elem, 4) internal nodal forces [N/m], ``dte`` (n_elem,) the
@@ -335,25 +355,14 @@ def element_update(nodes, quads, state, out, mat, prm, dt, erosion):
     layer = quads.layer
     alive = quads.alive
     area0 = quads.area0
-    sdx = state.sdx
-    sdy = state.sdy
-    sdz = state.sdz
-    sdxy = state.sdxy
-    pres = state.pres
-    eps_p = state.eps_p
-    temp = state.temp
-    dmg = state.dmg
-    qhx = state.qhx
-    qhy = state.qhy
     ie, hge, fex, fey, dte, plast, rate = (out.ie, out.hge, out.fex, out.fey, out.dte,
                                            out.plast, out.rate)
     ne = conn.shape[0]
     dtmin = 1e30
     bad = -1
     for e in prange(ne):
-        d, inv = quad_element(e, conn, x, y, vx, vy, alive, layer, sdx, sdy, sdz, sdxy, pres,
-                              eps_p, temp, dmg, qhx, qhy, area0, ie, hge, fex, fey, dte, plast,
-                              rate, mat, prm, dt, erosion)
+        d, inv = quad_element(e, (conn, layer, area0, x, y, vx, vy), alive, qs, ie, hge, fex,
+                              fey, dte, plast, rate, (mat, prm, dt, erosion))
         dtmin = min(dtmin, d)
         if inv:
             bad = max(bad, e)

@@ -85,9 +85,8 @@ def check_gpu_supported(element: str, source: str | None = None) -> None:
 #: RunState holds them, then its scalar settings)
 _ARRAYS = RUN_ARRAYS
 #: the arrays the kernels change (copied back to the host)
-_MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "sdx", "sdy", "sdz", "sdxy", "pres",
-            "eps_p", "temp", "dmg", "qhx", "qhy", "area0", "ie", "hge", "fex", "fey", "dte",
-            "plast", "rate", "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm",
+_MUTABLE = ("x", "y", "vx", "vy", "mass", "alive", "qs", "area0", "ie", "hge", "fex", "fey",
+            "dte", "plast", "rate", "cfx", "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "prm",
             "tool", "en", "ist", "clock", "hacc", "hist", "tied", "tbuf", "fheat", "tcq",
             "vslip", "xn", "yn", "buf", "vbuf", "aflt")
 

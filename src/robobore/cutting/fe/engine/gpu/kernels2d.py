@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import functools
 
-from robobore.cutting.fe.engine import layout
+from robobore.cutting.fe.engine import groups2d, layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.gpu.device2d import device_functions2
 from robobore.cutting.fe.engine.gpu.persistent import (
@@ -71,6 +71,7 @@ def kernels2(phases: Phases):
     P_ALE_X0, P_RZ_MAXMOVE, P_MS = layout.P_ALE_X0, layout.P_RZ_MAXMOVE, layout.P_MS
     E_EXT = layout.E_EXT
     KCOND, RHO, CP, TROOM = jc.KCOND, jc.RHO, jc.CP, jc.TROOM
+    QS_TEMP = groups2d.QS_TEMP
 
     @cuda.jit(device=True)
     def lanes_total(px, py, red):
@@ -110,31 +111,29 @@ def kernels2(phases: Phases):
     @cuda.jit(device=True)
     def flux_item(e, a):
         rflux(e, a.conn, a.alive, (a.x, a.y), (a.xn, a.yn), a.enbr, a.bflag, a.buf,
-              (a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p, a.temp, a.dmg, a.qhx, a.qhy,
-               a.area0), a.mat[TROOM])
+              (a.qs, a.area0), a.mat[TROOM])
 
     @cuda.jit(device=True)
     def write_item(e, a):
-        rwrite(e, a.alive, a.buf, a.sdx, a.sdy, a.sdz, a.sdxy, a.pres,
-               a.eps_p, a.temp, a.dmg, a.qhx, a.qhy, a.area0)
+        rwrite(e, a.alive, a.buf, a.qs, a.area0)
 
     @cuda.jit(device=True)
     def conduct_item(e, a):
         mat = a.mat
-        cond(e, a.conn, a.x, a.y, a.alive, a.enbr, a.temp, a.tbuf, mat[KCOND],
+        cond(e, a.conn, a.x, a.y, a.alive, a.enbr, a.qs[QS_TEMP], a.tbuf, mat[KCOND],
              mat[RHO] * mat[CP], a.prm[P_COND_ACC])
 
     @cuda.jit(device=True)
     def parting_item(i, a):
         mat = a.mat
-        pedge(i, a.ppair, a.x, a.y, a.alive, a.tied, a.temp, a.tbuf, mat[KCOND],
+        pedge(i, a.ppair, a.x, a.y, a.alive, a.tied, a.qs[QS_TEMP], a.tbuf, mat[KCOND],
               mat[RHO] * mat[CP], a.prm[P_COND_ACC])
 
     @cuda.jit(device=True)
     def theat_item(n, a):
         mat, prm = a.mat, a.prm
         thnode(n, a.conn, a.x, a.y, a.ptr, a.nel, a.ncorner, a.alive, a.enbr, a.cfx,
-               a.cfy, a.fric, a.fheat, a.temp, a.tbuf, a.tcq, mat[RHO] * mat[CP],
+               a.cfy, a.fric, a.fheat, a.qs[QS_TEMP], a.tbuf, a.tcq, mat[RHO] * mat[CP],
                prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
 
     # the persistent kernel's phases (engine.gpu.persistent), on the state RunState
@@ -240,11 +239,9 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def elem_phase(e, a, dt, red):
-        d, inv = elem(e, a.conn, a.x, a.y, a.vx, a.vy, a.alive, a.layer,
-                      a.sdx, a.sdy, a.sdz, a.sdxy, a.pres, a.eps_p,
-                      a.temp, a.dmg, a.qhx, a.qhy, a.area0, a.ie, a.hge,
-                      a.fex, a.fey, a.dte, a.plast, a.rate, a.mat, a.prm,
-                      dt, a.erosion)
+        d, inv = elem(e, (a.conn, a.layer, a.area0, a.x, a.y, a.vx, a.vy), a.alive, a.qs,
+                      a.ie, a.hge, a.fex, a.fey, a.dte, a.plast, a.rate,
+                      (a.mat, a.prm, dt, a.erosion))
         cuda.atomic.min(red, R_DTMIN, d)
         if inv:
             cuda.atomic.max(red, R_BAD, float(e))
@@ -256,7 +253,7 @@ def kernels2(phases: Phases):
         if step % a.cond_every != 0:
             return
         conn, x, y, alive = a.conn, a.x, a.y, a.alive
-        temp, tbuf, mat, prm = a.temp, a.tbuf, a.mat, a.prm
+        temp, tbuf, mat, prm = a.qs[QS_TEMP], a.tbuf, a.mat, a.prm
         ppair = a.ppair
         ne = conn.shape[0]
         npair = ppair.shape[0]
@@ -448,9 +445,9 @@ def kernels2(phases: Phases):
     @cuda.jit
     def k_conduct_end(a):
         e = cuda.grid(1)
-        if e >= a.temp.shape[0] or a.ist[I_STATUS] != ST_OK:
+        if e >= a.qs.shape[1] or a.ist[I_STATUS] != ST_OK:
             return
-        a.temp[e] = a.tbuf[e, 3]
+        a.qs[QS_TEMP, e] = a.tbuf[e, 3]
 
     @cuda.jit
     def k_parting(a):
@@ -472,7 +469,7 @@ def kernels2(phases: Phases):
         if e >= a.conn.shape[0] or a.ist[I_STATUS] != ST_OK:
             return
         mat = a.mat
-        thelem(e, a.conn, a.alive, a.temp, a.tcq, mat[RHO] * mat[CP])
+        thelem(e, a.conn, a.alive, a.qs[QS_TEMP], a.tcq, mat[RHO] * mat[CP])
 
     @cuda.jit
     def k_conduct_reset(a):

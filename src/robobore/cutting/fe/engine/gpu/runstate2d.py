@@ -21,9 +21,8 @@ N_RED = 11
 #: FEState arrays used by the kernels (copied to the device), in the order of the persistent
 #: kernel's state
 RUN_ARRAYS = ("x", "y", "vx", "vy", "mass", "fixed", "ptr", "nel", "ncorner", "conn", "layer",
-              "alive", "sdx", "sdy", "sdz", "sdxy", "pres", "eps_p", "temp", "dmg", "qhx",
-              "qhy", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx", "cfy",
-              "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
+              "alive", "qs", "area0", "ie", "hge", "fex", "fey", "dte", "plast", "rate", "cfx",
+              "cfy", "fric", "pen", "ndead", "ero_ke", "nwork", "mat", "prm", "tool", "en", "ist",
               "clock", "hacc", "hist", "enbr", "twin", "tied", "tbuf", "fheat", "tcq", "ppair",
               "vslip", "snodes", "x0", "y0", "xn", "yn", "buf", "vbuf", "acls", "aflt", "bflag")
 #: the persistent kernel's state: the arrays, then the erosion mode, the conduction interval
