@@ -45,8 +45,10 @@ faces (Benson 1992, "Computational methods in Lagrangian and Eulerian hydrocodes
 The passes are scalar functions of one element or node (``*_py`` originals, ``njit``
 versions without the suffix), read only what the previous pass wrote and allocate nothing,
 so the CPU chunk loop calls them from ``prange`` loops (:func:`remap3d`) and a GPU kernel
-can compile the same source. :func:`remap3d_py` is the allocating wrapper for tests and
-scripts. The volumes (hexahedra, swept faces, the face numbering) are in
+can compile the same source; the arrays a pass only reads come in tuples built at the call
+(``pos``, ``posn`` = old, new ``(x, y, z)`` [m]; ``vel`` [m/s]; ``csr`` = ``(ptr, nel)``;
+``fields`` = ``(sd, pres, eps_p, temp, dmg, qh, vol0)``: :mod:`~robobore.cutting.fe.ale.groups3d`).
+:func:`remap3d_py` is the allocating wrapper for tests and scripts. The volumes (hexahedra, swept faces, the face numbering) are in
 :mod:`robobore.cutting.fe.ale.hexvolume3d`.
 """
 # ruff: noqa: E501
@@ -66,11 +68,10 @@ from robobore.cutting.fe.ale.hexvolume3d import (
 from robobore.cutting.fe.ale.remap import BF_CLOSED, BF_VIRGIN
 
 __all__ = [
-    "N_RZ3", "N_INTENSIVE3", "VEL_MOMENTUM", "VEL_TAYLOR", "rz3_flux_py", "rz3_flux", "rz3_momentum_py", "rz3_momentum",
-    "rz3_taylor_py", "rz3_taylor", "rz3_write_py", "rz3_write", "rz3_node_mass_py",
-    "rz3_node_mass", "remap3d", "remap3d_py", "remap3d_inputs", "remap3d_groups",
-    "remap3d_outputs",
-]
+    "N_RZ3", "N_INTENSIVE3", "VEL_MOMENTUM", "VEL_TAYLOR", "rz3_flux_py", "rz3_flux",
+    "rz3_momentum_py", "rz3_momentum", "rz3_taylor_py", "rz3_taylor", "rz3_write_py",
+    "rz3_write", "rz3_node_mass_py", "rz3_node_mass", "remap3d", "remap3d_py",
+    "remap3d_inputs", "remap3d_groups", "remap3d_outputs"]
 
 #: remapped intensive element fields (volume-weighted averages): sd (6), pres, eps_p, temp,
 #: dmg, qh (12); then in ``buf``: the new reference volume, the new momentum / rho_s (3),
@@ -82,8 +83,6 @@ B_POLD = N_INTENSIVE3 + 4
 N_RZ3 = N_INTENSIVE3 + 7
 #: nodal velocity remap: conservative element-centred momentum, or the 2D Taylor step
 VEL_MOMENTUM, VEL_TAYLOR = 0, 1
-
-
 
 
 def _gather_py(e, w, u, sd, pres, eps_p, temp, dmg, qh, buf):
@@ -119,18 +118,11 @@ _mean_velocity = njit(cache=True, inline="always")(_mean_velocity_py)
 
 
 def rz3_flux_py(e, conn, pos, posn, vel, alive, fnbr, bflag, buf, fields, t_room):
-    """Donor-cell remap of element ``e`` (old geometry ``x, y, z`` -> new ``xn, yn, zn``):
-    its new intensive fields, reference volume and momentum into ``buf[e]`` (layout: see
-    :data:`N_RZ3`). Reads the old state only, so all elements can run at once. ``fnbr``
-    (e, 6) the element across each face (< 0: none); ``bflag`` (e, 6) the flux type of each
-    outline face (``BF_*``; an empty array: all closed).
-
-    Read-only groups (tuples): ``pos`` = ``(x, y, z)`` and ``posn`` = ``(xn, yn, zn)`` the old
-    and new node positions (n,) [m], ``vel`` = ``(vx, vy, vz)`` the velocities (n,) [m/s],
-    ``fields`` = ``(sd, pres, eps_p, temp, dmg, qh, vol0)`` the element state (the arrays of
-    :class:`~robobore.cutting.fe.ale.groups3d.ElementState3`); ``t_room`` the virgin
-    material's temperature [K]. Writes ``buf[e]`` only (read-only tuples built at the
-    call: :mod:`robobore.cutting.fe.ale.groups3d`)."""
+    """Donor-cell remap of element ``e`` (old geometry ``pos`` -> new ``posn``): its new
+    intensive fields, reference volume and momentum into ``buf[e]`` (layout: :data:`N_RZ3`).
+    Reads the old state only, so all elements can run at once. ``fnbr`` (e, 6) the element
+    across each face (< 0: none); ``bflag`` (e, 6) the flux type of each outline face
+    (``BF_*``; empty: all closed); ``t_room`` the virgin material's temperature [K]."""
     x, y, z = pos
     xn, yn, zn = posn
     vx, vy, vz = vel
@@ -211,10 +203,7 @@ def rz3_momentum_py(n, csr, conn, alive, vol0, msf, buf, vel, fixed, vbuf):
     plus an eighth of each of its elements' momentum change, over the new lumped mass (all
     per unit mass-scaled density; each element's share times its inertia factor ``msf[e]``,
     which stays with the element as the material moves through it). Fixed components keep
-    their values. Returns 1 when the velocity changes.
-
-    Read-only groups (tuples): ``csr`` = ``(ptr, nel)`` the node-to-element lists, ``vel`` =
-    ``(vx, vy, vz)`` the old velocities (n,) [m/s]."""
+    their values. Returns 1 when the velocity changes."""
     ptr, nel = csr
     vx, vy, vz = vel
     m_old = 0.0
@@ -256,11 +245,7 @@ def rz3_taylor_py(n, pos, posn, vel, csr, conn, alive, fixed, vbuf):
     the mean old velocity gradient of its live elements (the mean gradient
     ``b_I = dV/dx_I / V`` of each) times the node's move, the 2D engine's
     :func:`robobore.cutting.fe.ale.remap.rz_velocity_py` in 3D. Returns 1 when the node
-    moves.
-
-    Read-only groups (tuples): ``pos`` = ``(x, y, z)`` and ``posn`` = ``(xn, yn, zn)`` the old
-    and new positions (n,) [m], ``vel`` = ``(vx, vy, vz)`` the old velocities (n,) [m/s],
-    ``csr`` = ``(ptr, nel)`` the node-to-element lists."""
+    moves."""
     x, y, z = pos
     xn, yn, zn = posn
     vx, vy, vz = vel
@@ -422,7 +407,6 @@ def remap3d(nodes, cells, elems, work, rho_s, t_room, vel_mode):
     for n in prange(nn):
         rz3_node_mass(n, ptr, nel, alive, vol0, rho_s, msf, mass)
     return moved
-
 
 
 def remap3d_inputs(old: np.ndarray, conn: np.ndarray, fields: dict, *,
