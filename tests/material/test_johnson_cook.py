@@ -208,3 +208,50 @@ def test_hardening_strain_limit_from_files_and_configs(tmp_path):
     assert cfg.material.hardening_strain_limit == 1.0
     with pytest.raises(ConfigError, match="material.hardening_strain_limit"):
         parse_config({**base, "material": {"name": "TC4", "hardening_strain_limit": 0.0}})
+
+
+#: the compiled Johnson-Cook functions shared by the 2D, 3D and GPU engines
+_SHARED = ("homologous_temperature", "jc_athermal", "jc_flow_stress", "jc_failure_strain",
+           "jc_damage_increment", "jc_return", "radial_return")
+
+
+def test_shared_functions_set_their_own_floating_point_flags():
+    # numba compiles a callee with its caller's fastmath flags unless the callee sets them, and
+    # keeps (and caches on disk) that one compilation for every later caller: each shared
+    # function sets fastmath=False, so the 3D element's fastmath cannot leak into the 2D engine
+    for name in _SHARED:
+        assert getattr(jc, name).targetoptions.get("fastmath") is False, name
+
+
+_FAST_FIRST = """
+import sys
+from numba import njit
+from robobore.material import johnson_cook as jc
+args = (9.4e-08, 2.572, 997900000.0, 653100000.0, 0.45, 0.0198, 1.0, 0.6)
+if sys.argv[1] == "fast":
+    @njit(fastmath={"contract", "reassoc", "arcp", "nsz"})
+    def caller(a):
+        return jc.jc_athermal(*a) + jc.jc_return(1.2e9, 9.1e-08, 294.05, 1.07e-09, 4.2e10, 997900000.0,
+                                                653100000.0, 0.45, 0.0198, 0.7, 1.0, 293.0, 1873.0,
+                                                0.6)[1]
+    caller(args)
+print(repr(jc.jc_athermal(*args)), repr(jc.jc_return(1.2e9, 9.1e-08, 294.05, 1.07e-09, 4.2e10,
+      997900000.0, 653100000.0, 0.45, 0.0198, 0.7, 1.0, 293.0, 1873.0, 0.6)))
+"""
+
+
+def test_results_do_not_depend_on_a_fastmath_caller_compiled_first(tmp_path):
+    # a fresh numba cache each: a process that compiled a fastmath caller of the shared
+    # functions first (as the 3D element is) gets the digits of one that did not
+    import os
+    import subprocess
+    import sys
+
+    def run(mode, cache):
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / cache))
+        return subprocess.run([sys.executable, "-c", _FAST_FIRST, mode], env=env, check=True,
+                              capture_output=True, text=True).stdout
+
+    plain = run("plain", "a")
+    assert run("fast", "b") == plain
+    assert run("plain", "b") == plain  # after the fastmath caller's process wrote the cache

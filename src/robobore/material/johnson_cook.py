@@ -232,21 +232,25 @@ def make_radial_return(jc_return):
     return radial_return_py
 
 
-homologous_temperature = njit(cache=True)(homologous_temperature_py)
-jc_athermal = njit(cache=True)(jc_athermal_py)
-jc_flow_stress = njit(cache=True)(jc_flow_stress_py)
+# fastmath=False on each: numba compiles a callee that does not set its flags with its first
+# caller's (the 3D element's fastmath) and keeps, and caches, that one compilation for every
+# later caller; set, the shared law has the same digits in every engine whatever compiled first
+# (tests/material/test_johnson_cook.py)
+homologous_temperature = njit(cache=True, fastmath=False)(homologous_temperature_py)
+jc_athermal = njit(cache=True, fastmath=False)(jc_athermal_py)
+jc_flow_stress = njit(cache=True, fastmath=False)(jc_flow_stress_py)
 # a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
 jc_failure_strain_py = make_jc_failure_strain(homologous_temperature)
-jc_failure_strain = njit(cache=False)(jc_failure_strain_py)
+jc_failure_strain = njit(cache=False, fastmath=False)(jc_failure_strain_py)
 # a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
 jc_damage_increment_py = make_jc_damage_increment(jc_failure_strain)
-jc_damage_increment = njit(cache=False)(jc_damage_increment_py)
+jc_damage_increment = njit(cache=False, fastmath=False)(jc_damage_increment_py)
 # a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
 jc_return_py = make_jc_return(jc_athermal, homologous_temperature)
-jc_return = njit(cache=False)(jc_return_py)
+jc_return = njit(cache=False, fastmath=False)(jc_return_py)
 # a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
 radial_return_py = make_radial_return(jc_return)
-radial_return = njit(cache=False)(radial_return_py)
+radial_return = njit(cache=False, fastmath=False)(radial_return_py)
 
 
 __all__ = [

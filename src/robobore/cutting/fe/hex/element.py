@@ -450,7 +450,9 @@ def make_hex_element(jc_return, jc_damage_increment):
 
 
 #: CPU version. ``fastmath`` without the no-NaN/no-Inf flags (FMA contraction, reassociation,
-#: reciprocal approximations): NaN and Inf still propagate to the instability checks.
+#: reciprocal approximations): NaN and Inf still propagate to the instability checks. The
+#: Johnson-Cook callees keep their own flags (fastmath off: ``robobore.material.johnson_cook``),
+#: so the material law has the same digits here as in the 2D engine.
 # a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
 hex_element_py = make_hex_element(jc_return, jc_damage_increment)
 hex_element = njit(cache=False, fastmath={"contract", "reassoc", "arcp", "nsz"})(hex_element_py)
