@@ -27,7 +27,10 @@ quad_element_groups_apart_2d_paired.txt``), and called once per task of 256 elem
 loop compiled apart, the ``prange`` over the tasks) at 0.83-0.85
 (``quad_element_chunked_2d_paired.txt``). Reading the groups by field name inside an inlined
 per-node function keeps the writes but costs about 3 % in the thermal contact pass
-(``tool_heat_node_groups_2d_paired.txt``).
+(``tool_heat_node_groups_2d_paired.txt``). The arrays a per-item function only reads, and its
+scalars, may reach it in plain tuples built at the call, in the body, from the flat locals,
+and unpacked at the top of the function; the arrays it writes stay flat parameters
+(:func:`robobore.cutting.fe.physics.thermal2d.tool_heat_node_py`).
 
 Shapes: ``n`` nodes, ``e`` quads.
 """
