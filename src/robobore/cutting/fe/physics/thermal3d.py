@@ -205,10 +205,11 @@ def make_tool_heat_node3(hex_face_corner, face_free3, face_area3):
         CSR node-to-element lists ``ptr`` (n + 1,), ``nel``, ``ncorner``, ``alive`` (e,),
         ``enbr`` (e, 6) the face neighbours, ``pairs`` (n, 2) the node pairs of node
         splitting, ``vol0`` (e,) initial volumes [m^3]) and ``fields`` = (``cf`` (n, 4) the
-        contact forces [N], ``fric`` (n,) the cumulative frictional work [J], ``temp`` (e,)
-        [K]); writes ``theat`` (n, 3) only. ``heat`` = (volumetric heat capacity ``rcp``
-        [J/(m^3 K)], contact conductance ``hc`` [W/(m^2 K)], share ``eta`` of the frictional
-        heat into the workpiece, insert temperature ``t_tool`` [K], time ``dt_th`` [s]).
+        contact forces [N] in ``cf[:, 0:3]``, ``fric`` (n,) the cumulative frictional work [J],
+        ``temp`` (e,) [K]); writes ``theat`` (n, 3) only. ``heat`` = (volumetric heat capacity
+        ``rcp`` [J/(m^3 K)], contact conductance ``hc`` [W/(m^2 K)], share ``eta`` of the
+        frictional heat into the workpiece, insert temperature ``t_tool`` [K], time ``dt_th``
+        [s]).
         """
         conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0 = mesh
         cf, fric, temp = fields
