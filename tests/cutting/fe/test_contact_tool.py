@@ -60,25 +60,25 @@ def test_tool_gap_is_a_distance(px, py, r):
 def test_contact_law_coulomb_and_cap():
     m, dt = 1e-6, 1e-8
     # sliding fast: friction = mu * Fn, opposite to the sliding velocity
-    fx, fy, fn, ft, fd = P.contact_force(-1e-8, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt,
-                                         0.0, 0.0, 0.0)
+    fx, fy, fn, ft, fd = P.contact_force(-1e-8, (0.0, 1.0), (1.0, 0.0), (0.0, 0.0), m, 1e-5, dt,
+                                         (0.2, 1e30, 0.1, 0.0))
     assert fd == 0.0
     assert fn == pytest.approx(0.1 * m / dt**2 * 1e-8)
     assert ft == pytest.approx(0.2 * fn) and fy == pytest.approx(fn)
     # tangent t = (-ny, nx) = (-1, 0); vt = -1 (sliding along +x) -> friction along t positive
     assert fx == pytest.approx(-0.2 * fn)
     # shear cap: tau * length below mu * Fn
-    _, _, fn2, ft2, _ = P.contact_force(-1e-8, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e5, 0.1, dt,
-                                        0.0, 0.0, 0.0)
+    _, _, fn2, ft2, _ = P.contact_force(-1e-8, (0.0, 1.0), (1.0, 0.0), (0.0, 0.0), m, 1e-5, dt,
+                                        (0.2, 1e5, 0.1, 0.0))
     assert 1e5 * 1e-5 < 0.2 * fn2
     assert abs(ft2) == pytest.approx(1e5 * 1e-5)
     # sticking: small slip velocity -> force stopping it in one step
-    _, _, _, ft3, _ = P.contact_force(-1e-8, 0.0, 1.0, 1e-9, 0.0, m, 1e-5, 0.2, 1e30, 0.1,
-                                      dt, 0.0, 0.0, 0.0)
+    _, _, _, ft3, _ = P.contact_force(-1e-8, (0.0, 1.0), (1e-9, 0.0), (0.0, 0.0), m, 1e-5, dt,
+                                      (0.2, 1e30, 0.1, 0.0))
     assert abs(ft3) == pytest.approx(m * 1e-9 / dt)
     # no contact
-    assert P.contact_force(1e-9, 0.0, 1.0, 1.0, 0.0, m, 1e-5, 0.2, 1e30, 0.1, dt, 0.3, 0.0,
-                           0.0) == (0.0, 0.0, 0.0, 0.0, 0.0)
+    assert P.contact_force(1e-9, (0.0, 1.0), (1.0, 0.0), (0.0, 0.0), m, 1e-5, dt,
+                           (0.2, 1e30, 0.1, 0.3)) == (0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 def test_contact_law_return_mapping_on_the_trial_velocity():
@@ -89,21 +89,21 @@ def test_contact_law_return_mapping_on_the_trial_velocity():
     m, dt, mu, pf = 1e-6, 1e-8, 0.2, 0.1
     fn = pf * m / dt**2 * 1e-8
     # at rest, pushed along +x (= -t) by 0.5 mu Fn: static friction balances it exactly
-    fx, _, _, ft, _ = P.contact_force(-1e-8, 0.0, 1.0, 0.0, 0.0, m, 1e-5, mu, 1e30, pf, dt,
-                                      0.0, 0.5 * mu * fn, 123.0)
+    fx, _, _, ft, _ = P.contact_force(-1e-8, (0.0, 1.0), (0.0, 0.0), (0.5 * mu * fn, 123.0), m,
+                                      1e-5, dt, (mu, 1e30, pf, 0.0))
     assert fx == pytest.approx(-0.5 * mu * fn) and abs(ft) == pytest.approx(0.5 * mu * fn)
     # pushed by 3 mu Fn: slides, friction mu Fn against the push
-    fx, _, _, ft, _ = P.contact_force(-1e-8, 0.0, 1.0, 0.0, 0.0, m, 1e-5, mu, 1e30, pf, dt,
-                                      0.0, 3 * mu * fn, 0.0)
+    fx, _, _, ft, _ = P.contact_force(-1e-8, (0.0, 1.0), (0.0, 0.0), (3 * mu * fn, 0.0), m, 1e-5,
+                                      dt, (mu, 1e30, pf, 0.0))
     assert fx == pytest.approx(-mu * fn)
     # sliding slowly (m v / dt = 0.1 mu Fn) and pushed on by 2 mu Fn: Coulomb, not m v / dt
     v = 0.1 * mu * fn * dt / m
-    fx, *_ = P.contact_force(-1e-8, 0.0, 1.0, v, 0.0, m, 1e-5, mu, 1e30, pf, dt, 0.0,
-                             2 * mu * fn, 0.0)
+    fx, *_ = P.contact_force(-1e-8, (0.0, 1.0), (v, 0.0), (2 * mu * fn, 0.0), m, 1e-5, dt,
+                             (mu, 1e30, pf, 0.0))
     assert fx == pytest.approx(-mu * fn)
     # the push's normal part does not enter the friction
-    _, _, fn2, ft2, _ = P.contact_force(-1e-8, 0.0, 1.0, 0.0, 0.0, m, 1e-5, mu, 1e30, pf, dt,
-                                        0.0, 0.0, -5 * fn)
+    _, _, fn2, ft2, _ = P.contact_force(-1e-8, (0.0, 1.0), (0.0, 0.0), (0.0, -5 * fn), m, 1e-5, dt,
+                                        (mu, 1e30, pf, 0.0))
     assert fn2 == pytest.approx(fn) and ft2 == 0.0
 
 
@@ -114,13 +114,13 @@ def test_contact_damping():
     k = pf * m / dt**2
     c = 2 * z * (k * m) ** 0.5
     # approaching along -n at 0.01 m/s: the damping adds c * 0.01 to the penalty force
-    _, fy, fn, _, fd = P.contact_force(-1e-8, 0.0, 1.0, 0.0, -0.01, m, 1e-5, 0.0, 1e30, pf, dt,
-                                       z, 0.0, 0.0)
+    _, fy, fn, _, fd = P.contact_force(-1e-8, (0.0, 1.0), (0.0, -0.01), (0.0, 0.0), m, 1e-5, dt,
+                                       (0.0, 1e30, pf, z))
     assert fd == pytest.approx(c * 0.01, rel=1e-12)
     assert fn == pytest.approx(k * 1e-8 + c * 0.01, rel=1e-12) and fy == pytest.approx(fn)
     # leaving at 10 m/s: the damping would pull harder than the spring pushes -> fn = 0
-    _, _, fn2, _, fd2 = P.contact_force(-1e-8, 0.0, 1.0, 0.0, 10.0, m, 1e-5, 0.0, 1e30, pf, dt,
-                                        z, 0.0, 0.0)
+    _, _, fn2, _, fd2 = P.contact_force(-1e-8, (0.0, 1.0), (0.0, 10.0), (0.0, 0.0), m, 1e-5, dt,
+                                        (0.0, 1e30, pf, z))
     assert fn2 == 0.0 and fd2 == pytest.approx(-k * 1e-8)
 
 

@@ -33,35 +33,40 @@ def test_contact_force3_hand_calculation():
     """Normal penalty F = pf m / dt^2 (-g); sliding capped by mu Fn, opposite to sliding;
     a 2D-plane case equals the 2D law."""
     m, dt, pf, mu = 2e-9, 1e-8, 0.1, 0.3
-    fx, fy, fz, fn, ft, *_ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 5.0, 0.0, 0.0, m, 1.0, mu,
-                                                  1e30, pf, dt, 0.0, 0.0, 0.0, 0.0)
+    fx, fy, fz, fn, ft, *_ = scalar3d.contact_force3_py(-1e-7, (0, 1, 0), (5.0, 0.0, 0.0),
+                                                        (0.0, 0.0, 0.0), m, 1.0, dt,
+                                                        (mu, 1e30, pf, 0.0))
     assert fn == pytest.approx(pf * m / dt**2 * 1e-7)
     assert fy == pytest.approx(fn)
     assert ft == pytest.approx(mu * fn)  # m v / dt = 1 N > mu Fn = 0.06 N
     assert fx == pytest.approx(-mu * fn) and fz == 0.0
     # stick: small sliding velocity -> the force that stops it in one step
-    *_, ft2, tx, ty, tz, _ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 0.0, 0.0, 1e-3, m, 1.0, mu,
-                                                  1e30, pf, dt, 0.0, 0.0, 0.0, 0.0)
+    *_, ft2, tx, ty, tz, _ = scalar3d.contact_force3_py(-1e-7, (0, 1, 0), (0.0, 0.0, 1e-3),
+                                                        (0.0, 0.0, 0.0), m, 1.0, dt,
+                                                        (mu, 1e30, pf, 0.0))
     assert ft2 == pytest.approx(m * 1e-3 / dt) and tz == pytest.approx(1.0)
     # shear cap
-    *_, ft3, _, _, _, _ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 5.0, 0.0, 0.0, m, 1e-12, mu,
-                                               1e9, pf, dt, 0.0, 0.0, 0.0, 0.0)
+    *_, ft3, _, _, _, _ = scalar3d.contact_force3_py(-1e-7, (0, 1, 0), (5.0, 0.0, 0.0),
+                                                     (0.0, 0.0, 0.0), m, 1e-12, dt,
+                                                     (mu, 1e9, pf, 0.0))
     assert ft3 == pytest.approx(1e9 * 1e-12)
     # 2D equivalence in the x-y plane
-    f2 = contact_force_py(-1e-7, 0.6, 0.8, 0.3, -0.2, m, 1.0, mu, 1e30, pf, dt, 0.0, 0.0, 0.0)
-    f3 = scalar3d.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt,
-                              0.0, 0.0, 0.0, 0.0)
+    f2 = contact_force_py(-1e-7, (0.6, 0.8), (0.3, -0.2), (0.0, 0.0), m, 1.0, dt,
+                          (mu, 1e30, pf, 0.0))
+    f3 = scalar3d.contact_force3_py(-1e-7, (0.6, 0.8, 0.0), (0.3, -0.2, 0.0), (0.0, 0.0, 0.0), m,
+                                    1.0, dt, (mu, 1e30, pf, 0.0))
     assert f3[0] == pytest.approx(f2[0]) and f3[1] == pytest.approx(f2[1]) and f3[2] == 0.0
     # return mapping on the trial velocity, as in 2D: the element forces' tangential part
     # enters the stick force (static friction balances a push below mu Fn)
     fn = pf * m / dt**2 * 1e-7
     push = (0.0, 0.4 * mu * fn, 0.3 * mu * fn)  # y is normal: only z is tangential
-    *_, ft4, tx, ty, tz, _ = scalar3d.contact_force3_py(-1e-7, 0, 1, 0, 0.0, 0.0, 0.0, m, 1.0, mu,
-                                                  1e30, pf, dt, 0.0, *push)
+    *_, ft4, tx, ty, tz, _ = scalar3d.contact_force3_py(-1e-7, (0, 1, 0), (0.0, 0.0, 0.0), push, m,
+                                                        1.0, dt, (mu, 1e30, pf, 0.0))
     assert ft4 == pytest.approx(0.3 * mu * fn) and tz == pytest.approx(1.0)
-    g2 = contact_force_py(-1e-7, 0.6, 0.8, 0.3, -0.2, m, 1.0, mu, 1e30, pf, dt, 0.0, 0.5, -0.7)
-    g3 = scalar3d.contact_force3_py(-1e-7, 0.6, 0.8, 0.0, 0.3, -0.2, 0.0, m, 1.0, mu, 1e30, pf, dt,
-                              0.0, 0.5, -0.7, 0.0)
+    g2 = contact_force_py(-1e-7, (0.6, 0.8), (0.3, -0.2), (0.5, -0.7), m, 1.0, dt,
+                          (mu, 1e30, pf, 0.0))
+    g3 = scalar3d.contact_force3_py(-1e-7, (0.6, 0.8, 0.0), (0.3, -0.2, 0.0), (0.5, -0.7, 0.0), m,
+                                    1.0, dt, (mu, 1e30, pf, 0.0))
     assert g3[0] == pytest.approx(g2[0]) and g3[1] == pytest.approx(g2[1])
 
 
@@ -74,23 +79,23 @@ def test_contact_force3_damping_is_the_2d_law():
     k = pf * m / dt**2
     c = 2 * z * (k * m) ** 0.5
     for vr in ((0.3, -0.2), (-0.05, -0.01), (0.0, 10.0)):
-        f2 = contact_force_py(-1e-8, 0.6, 0.8, vr[0], vr[1], m, 1.0, mu, 1e30, pf, dt, z,
-                              0.5, -0.7)
-        f3 = scalar3d.contact_force3_py(-1e-8, 0.6, 0.8, 0.0, vr[0], vr[1], 0.0, m, 1.0, mu,
-                                        1e30, pf, dt, z, 0.5, -0.7, 0.0)
+        f2 = contact_force_py(-1e-8, (0.6, 0.8), (vr[0], vr[1]), (0.5, -0.7), m, 1.0, dt,
+                              (mu, 1e30, pf, z))
+        f3 = scalar3d.contact_force3_py(-1e-8, (0.6, 0.8, 0.0), (vr[0], vr[1], 0.0),
+                                        (0.5, -0.7, 0.0), m, 1.0, dt, (mu, 1e30, pf, z))
         assert f3[0] == pytest.approx(f2[0], rel=1e-12) and f3[1] == pytest.approx(f2[1],
                                                                                    rel=1e-12)
         assert f3[3] == pytest.approx(f2[2], rel=1e-12) and f3[8] == pytest.approx(f2[4],
                                                                                    rel=1e-12)
         assert f3[3] >= 0.0
     # approaching along -y at 0.01 m/s (and sliding in z): fd = c * 0.01 exactly
-    f = scalar3d.contact_force3_py(-1e-8, 0.0, 1.0, 0.0, 0.0, -0.01, 0.2, m, 1.0, mu, 1e30, pf,
-                                   dt, z, 0.0, 0.0, 0.0)
+    f = scalar3d.contact_force3_py(-1e-8, (0.0, 1.0, 0.0), (0.0, -0.01, 0.2), (0.0, 0.0, 0.0), m,
+                                   1.0, dt, (mu, 1e30, pf, z))
     assert f[8] == pytest.approx(c * 0.01, rel=1e-12)
     assert f[3] == pytest.approx(k * 1e-8 + c * 0.01, rel=1e-12)
     # leaving at 10 m/s: no adhesion
-    f = scalar3d.contact_force3_py(-1e-8, 0.0, 1.0, 0.0, 0.0, 10.0, 0.0, m, 1.0, mu, 1e30, pf,
-                                   dt, z, 0.0, 0.0, 0.0)
+    f = scalar3d.contact_force3_py(-1e-8, (0.0, 1.0, 0.0), (0.0, 10.0, 0.0), (0.0, 0.0, 0.0), m,
+                                   1.0, dt, (mu, 1e30, pf, z))
     assert f[3] == 0.0 and f[8] == pytest.approx(-k * 1e-8)
 
 

@@ -166,18 +166,24 @@ def make_contact_force3(normal_force):
     """:func:`contact_force3_py` with its callees ``normal_force`` given (the CPU's
     compiled functions here, a GPU engine's device functions in its port)."""
 
-    def contact_force3_py(gap, nx, ny, nz, vrx, vry, vrz, mass, trib_area, mu, tau_max, pen_factor,
-                          dt, damping, fox, foy, foz):
+    def contact_force3_py(gap, normal, vr, fo, mass, trib_area, dt, law):
         """Contact force on a node touching the rigid insert [N] (3D form of the 2D law).
+
+        ``gap`` the signed gap [m] (< 0: penetration), ``normal`` = ``(nx, ny, nz)`` the
+        insert's outward unit normal, ``vr`` = ``(vrx, vry, vrz)`` the node's velocity relative
+        to the tool [m/s], ``fo`` = ``(fox, foy, foz)`` the node's element forces this step
+        [N], ``mass`` the node's (scaled) mass [kg], ``trib_area`` its tributary contact area
+        [m^2], ``dt`` the time step [s], ``law`` = ``(mu, tau_max, pen_factor, damping)``: the
+        Coulomb coefficient, the shear-stress cap [Pa], the penalty factor and the fraction of
+        critical damping (all but ``tau_max`` dimensionless), as
+        :func:`tool_contact.contact_force_py`.
 
         Normal: :func:`tool_contact.normal_force_py` (penalty plus viscous damping on the
         relative normal velocity, kept >= 0), as :func:`tool_contact.contact_force_py`.
         Tangential: the same return mapping on the trial sliding velocity (the tangential part
-        of ``v_r + dt fo / mass``, ``fo`` = ``(fox, foy, foz)`` the node's element forces this
-        step [N]): the force that stops it in one step,
-        limited by Coulomb ``mu Fn`` and by the shear cap ``tau_max * trib_area`` (the node's
-        tributary contact area [m^2]), opposite to the trial sliding direction. ``(vrx, vry,
-        vrz)`` node velocity relative to the tool [m/s].
+        of ``v_r + dt fo / mass``): the force that stops it in one step, limited by Coulomb
+        ``mu Fn`` and by the shear cap ``tau_max * trib_area``, opposite to the trial sliding
+        direction.
 
         Returns ``(fx, fy, fz, fn, ft, tx, ty, tz, fd)``: force, normal magnitude, tangential
         magnitude, the unit sliding direction (zero vector when not sliding) and the damping part
@@ -185,6 +191,10 @@ def make_contact_force3(normal_force):
         """
         if gap >= 0.0:
             return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        nx, ny, nz = normal
+        vrx, vry, vrz = vr
+        fox, foy, foz = fo
+        mu, tau_max, pen_factor, damping = law
         fn, fd = normal_force(gap, vrx * nx + vry * ny + vrz * nz, mass, pen_factor, dt, damping)
         wx = vrx + dt * fox / mass
         wy = vry + dt * foy / mass
@@ -342,9 +352,9 @@ def make_hex_node(insert_gap3, contact_force3, friction_at3):
                     cf[n, 3] = vs
                     mu = friction_at3(prm, vs)
                 fcx, fcy, fcz, fn, ft, tx, ty, tz, fd = contact_force3(
-                    gap, gnx, gny, gnz, vrx, vry, vrz, m, trib, mu, prm[P_TAU], prm[P_PEN],
-                    dt, prm[P_CDAMP], 0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy,
-                    0.0 if (fb & 4) else fz)
+                    gap, (gnx, gny, gnz), (vrx, vry, vrz),
+                    (0.0 if (fb & 1) else fx, 0.0 if (fb & 2) else fy, 0.0 if (fb & 4) else fz),
+                    m, trib, dt, (mu, prm[P_TAU], prm[P_PEN], prm[P_CDAMP]))
                 vt0 = vrx * tx + vry * ty + vrz * tz
                 if fd != 0.0:
                     vn0 = vrx * gnx + vry * gny + vrz * gnz

@@ -109,9 +109,18 @@ def parting_edge_py(i, ppair, x, y, alive, tied, temp, tbuf, kcond, rcp, dt_th):
     temp[eb] -= q / (rcp * ab)
 
 
-def tool_heat_node_py(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
-                      temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th):
+def tool_heat_node_py(n, mesh, fields, fheat, tcq, heat):
     """Heat [J/m] node ``n`` exchanges with the tool since the last call, into ``tcq[n]``.
+
+    Reads ``mesh`` = (``conn`` (e, 4) corners, ``x``, ``y`` (n,) positions [m], the CSR
+    node-to-element lists ``ptr`` (n + 1,), ``nel``, ``ncorner``, ``alive`` (e,), ``enbr``
+    (e, 4) the edge neighbours) and ``fields`` = (``cfx``, ``cfy`` (n,) the contact forces
+    [N/m], ``fric`` (n,) the cumulative frictional work [J/m], ``temp`` (e,) [K], ``tbuf`` the
+    centroids and areas of :func:`conduct`); writes ``fheat`` (n,) (the frictional work
+    already turned into heat [J/m]) and ``tcq`` (n, 2) only: a parallel pass's writes go to
+    arrays it holds directly (:mod:`robobore.cutting.fe.engine.groups2d`).
+    ``heat`` = (rho c_p ``rcp`` [J/(m^3 K)], conductance ``hc`` [W/(m^2 K)], heat fraction
+    ``eta``, tool temperature ``t_tool`` [K], time ``dt_th`` [s]).
 
     The node takes ``eta`` of the frictional dissipation booked on it since the last call
     (``fric - fheat``; the rest heats the tool). A node in contact (non-zero contact force)
@@ -122,6 +131,9 @@ def tool_heat_node_py(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, f
     (stability, as in :func:`quad_conduct_py`). ``tcq[n]`` = (heat, area of the node's live
     elements). Needs the areas in ``tbuf[:, 2]``.
     """
+    conn, x, y, ptr, nel, ncorner, alive, enbr = mesh
+    cfx, cfy, fric, temp, tbuf = fields
+    rcp, hc, eta, t_tool, dt_th = heat
     q = eta * (fric[n] - fheat[n])
     fheat[n] = fric[n]
     touching = hc > 0.0 and (cfx[n] != 0.0 or cfy[n] != 0.0)
@@ -201,8 +213,8 @@ def tool_heat(nodes, quads, qs, contact, enbr, fheat, tbuf, tcq, rcp, interface)
     (the element state: its row ``temp``), ``contact`` (Contact2: ``cfx``, ``cfy``,
     ``fric``); ``enbr`` (e, 4) the edge neighbours, ``fheat`` (n,) the frictional work
     already turned into heat [J/m], ``tbuf`` the centroids and areas of :func:`conduct`,
-    ``tcq`` (e,) work, ``rcp`` rho c_p [J/(m^3 K)]; ``interface`` = (conductance hc [W/(m^2 K)], heat fraction eta, tool
-    temperature [K], time ``dt_th`` [s]).
+    ``tcq`` (n, 2) work, ``rcp`` rho c_p [J/(m^3 K)]; ``interface`` = (conductance hc
+    [W/(m^2 K)], heat fraction eta, tool temperature [K], time ``dt_th`` [s]).
     """
     # the prange bodies read flat locals, one bound per statement (engine.groups2d)
     x = nodes.x
@@ -221,7 +233,8 @@ def tool_heat(nodes, quads, qs, contact, enbr, fheat, tbuf, tcq, rcp, interface)
     t_tool = interface[2]
     dt_th = interface[3]
     for n in prange(x.shape[0]):
-        tool_heat_node(n, conn, x, y, ptr, nel, ncorner, alive, enbr, cfx, cfy, fric, fheat,
-                       temp, tbuf, tcq, rcp, hc, eta, t_tool, dt_th)
+        # the read-only arrays and the scalars in tuples built here, in the body
+        tool_heat_node(n, (conn, x, y, ptr, nel, ncorner, alive, enbr),
+                       (cfx, cfy, fric, temp, tbuf), fheat, tcq, (rcp, hc, eta, t_tool, dt_th))
     for e in prange(conn.shape[0]):
         tool_heat_elem(e, conn, alive, temp, tcq, rcp)

@@ -130,12 +130,20 @@ def make_hex_conduct3(face_tied3, face_area3):
     """:func:`hex_conduct3_py` with its callees ``face_tied3``, ``face_area3`` given (the
     CPU's compiled functions here, a GPU engine's device functions in its port)."""
 
-    def hex_conduct3_py(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th):
+    def hex_conduct3_py(e, mesh, temp, tbuf, conduction):
         """New temperature of hexahedron ``e`` into ``tbuf[e, 3]`` (second pass of conduction).
+
+        Reads ``mesh`` = (``conn`` (e, 8) corners, ``x``, ``y``, ``z`` (n,) positions [m],
+        ``alive`` (e,), ``enbr`` (e, 6) the face neighbours, ``pairs`` (n, 2) the node pairs
+        of node splitting, ``vol0`` (e,) initial volumes [m^3]) and ``temp`` (e,) [K]; writes
+        ``tbuf`` (e, 4) only. ``conduction`` = (conductivity ``kcond`` [W/(m K)], volumetric
+        heat capacity ``rcp`` [J/(m^3 K)], time ``dt_th`` [s]).
 
         Needs the centroids ``tbuf[:, 0:3]`` of every element; reads ``temp`` only, so all
         elements can run at once. See the module docstring.
         """
+        conn, x, y, z, alive, enbr, pairs, vol0 = mesh
+        kcond, rcp, dt_th = conduction
         tbuf[e, 3] = temp[e]
         ve = vol0[e]
         if alive[e] != 1 or ve <= 0.0:
@@ -188,11 +196,24 @@ def make_tool_heat_node3(hex_face_corner, face_free3, face_area3):
     ``face_area3`` given (the CPU's compiled functions here, a GPU engine's device
     functions in its port)"""
 
-    def tool_heat_node3_py(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf, fric,
-                           temp, theat, rcp, hc, eta, t_tool, dt_th):
+    def tool_heat_node3_py(n, mesh, fields, theat, heat):
         """Heat [J] node ``n`` exchanges with the insert since the last pass, into
         ``theat[n, 1]``, and the volume of its live elements into ``theat[n, 2]``; ``theat[n, 0]``
-        holds the frictional dissipation already turned into heat. See the module docstring."""
+        holds the frictional dissipation already turned into heat. See the module docstring.
+
+        Reads ``mesh`` = (``conn`` (e, 8) corners, ``x``, ``y``, ``z`` (n,) positions [m], the
+        CSR node-to-element lists ``ptr`` (n + 1,), ``nel``, ``ncorner``, ``alive`` (e,),
+        ``enbr`` (e, 6) the face neighbours, ``pairs`` (n, 2) the node pairs of node
+        splitting, ``vol0`` (e,) initial volumes [m^3]) and ``fields`` = (``cf`` (n, 4) the
+        contact forces [N] in ``cf[:, 0:3]``, ``fric`` (n,) the cumulative frictional work [J],
+        ``temp`` (e,) [K]); writes ``theat`` (n, 3) only. ``heat`` = (volumetric heat capacity
+        ``rcp`` [J/(m^3 K)], contact conductance ``hc`` [W/(m^2 K)], share ``eta`` of the
+        frictional heat into the workpiece, insert temperature ``t_tool`` [K], time ``dt_th``
+        [s]).
+        """
+        conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0 = mesh
+        cf, fric, temp = fields
+        rcp, hc, eta, t_tool, dt_th = heat
         q = eta * (fric[n] - theat[n, 0])
         theat[n, 0] = fric[n]
         touching = hc > 0.0 and (cf[n, 0] != 0.0 or cf[n, 1] != 0.0 or cf[n, 2] != 0.0)
@@ -315,7 +336,9 @@ def conduct3(nodes, cells, elems, contact, tbuf, kcond, rcp, dt_th):
     for e in prange(ne):
         hex_centroid3(e, conn, x, y, z, tbuf)
     for e in prange(ne):
-        hex_conduct3(e, conn, x, y, z, alive, enbr, pairs, vol0, temp, tbuf, kcond, rcp, dt_th)
+        # the read-only arrays and the scalars in tuples built here, in the body
+        hex_conduct3(e, (conn, x, y, z, alive, enbr, pairs, vol0), temp, tbuf,
+                     (kcond, rcp, dt_th))
     for e in prange(ne):
         temp[e] = tbuf[e, 3]
 
@@ -344,8 +367,9 @@ def tool_heat3(nodes, ncorner, cells, elems, contact, theat, rcp, hc, eta, t_too
     fric = contact.fric
     pairs = contact.pairs
     for n in prange(x.shape[0]):
-        tool_heat_node3(n, conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0, cf,
-                        fric, temp, theat, rcp, hc, eta, t_tool, dt_th)
+        # the read-only arrays and the scalars in tuples built here, in the body
+        tool_heat_node3(n, (conn, x, y, z, ptr, nel, ncorner, alive, enbr, pairs, vol0),
+                        (cf, fric, temp), theat, (rcp, hc, eta, t_tool, dt_th))
     for e in prange(conn.shape[0]):
         tool_heat_elem3(e, conn, alive, temp, theat, rcp)
 

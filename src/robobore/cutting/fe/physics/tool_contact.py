@@ -104,9 +104,16 @@ def make_contact_force(normal_force):
     """:func:`contact_force_py` with its callees ``normal_force`` given (the CPU's compiled
     functions here, a GPU engine's device functions in its port)."""
 
-    def contact_force_py(gap, nx, ny, vrx, vry, mass, trib_len, mu, tau_max, pen_factor, dt,
-                         damping, fox, foy):
+    def contact_force_py(gap, normal, vr, fo, mass, trib_len, dt, law):
         """Contact force on a node touching the rigid tool [N per m of width].
+
+        ``gap`` the signed gap [m] (< 0: penetration), ``normal`` = ``(nx, ny)`` the tool's
+        outward unit normal, ``vr`` = ``(vrx, vry)`` the node's velocity relative to the tool
+        [m/s], ``fo`` = ``(fox, foy)`` the node's other forces this step (its element forces)
+        [N/m], ``mass`` the node's (scaled) mass [kg/m], ``trib_len`` its tributary contact
+        length [m], ``dt`` the time step [s], ``law`` = ``(mu, tau_max, pen_factor, damping)``:
+        the Coulomb coefficient, the shear-stress cap [Pa], the penalty factor and the
+        fraction of critical damping (all but ``tau_max`` dimensionless).
 
         Normal: penalty ``Fn = pen_factor * mass / dt**2 * (-gap)`` (mass-proportional penalty,
         stable for ``pen_factor`` << 1 and independent of mass scaling: penetration under a force
@@ -120,14 +127,17 @@ def make_contact_force(normal_force):
         ``tau_max * trib_len`` (the node's tributary contact length), opposite to ``vt*``.
         (Stopping only the start-of-step velocity instead would let the element forces
         re-accelerate the node every step: a viscous interface ``mass v / dt ~ rho c v`` that
-        undercuts Coulomb wherever the contact pressure is high.) (vrx, vry) is the node's
-        velocity relative to the tool [m/s]; mass the node's (scaled) mass [kg/m].
+        undercuts Coulomb wherever the contact pressure is high.)
 
         Returns ``(fx, fy, fn, ft, fd)`` with fn >= 0 the normal force, ft the signed tangential
         component along t = (-ny, nx) and fd the damping part of fn. Zero for gap >= 0.
         """
         if gap >= 0.0:
             return 0.0, 0.0, 0.0, 0.0, 0.0
+        nx, ny = normal
+        vrx, vry = vr
+        fox, foy = fo
+        mu, tau_max, pen_factor, damping = law
         fn, fd = normal_force(gap, vrx * nx + vry * ny, mass, pen_factor, dt, damping)
         tx = -ny
         ty = nx

@@ -179,8 +179,8 @@ def make_quad_node(tool_gap, contact_force, friction_at):
                 vs = vslip[n] + a * (abs(vt0) - vslip[n])
                 vslip[n] = vs
                 mu = friction_at(prm, vs)
-            fcx, fcy, fn, ft, fd = contact_force(gap, gnx, gny, vrx, vry, m, trib, mu, tau, pf,
-                                                 dt, prm[P_CDAMP], fx, fy)
+            fcx, fcy, fn, ft, fd = contact_force(gap, (gnx, gny), (vrx, vry), (fx, fy), m, trib,
+                                                 dt, (mu, tau, pf, prm[P_CDAMP]))
             vn0 = vrx * gnx + vry * gny
             pen[n] = share * 0.5 * (fn - fd) * (-gap)
         cfx[n] = share * fcx

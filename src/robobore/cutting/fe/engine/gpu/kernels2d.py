@@ -132,9 +132,10 @@ def kernels2(phases: Phases):
     @cuda.jit(device=True)
     def theat_item(n, a):
         mat, prm = a.mat, a.prm
-        thnode(n, a.conn, a.x, a.y, a.ptr, a.nel, a.ncorner, a.alive, a.enbr, a.cfx,
-               a.cfy, a.fric, a.fheat, a.qs[QS_TEMP], a.tbuf, a.tcq, mat[RHO] * mat[CP],
-               prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC])
+        # the tuples of the CPU's tool_heat (physics.thermal2d.tool_heat_node_py)
+        thnode(n, (a.conn, a.x, a.y, a.ptr, a.nel, a.ncorner, a.alive, a.enbr),
+               (a.cfx, a.cfy, a.fric, a.qs[QS_TEMP], a.tbuf), a.fheat, a.tcq,
+               (mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], prm[P_COND_ACC]))
 
     # the persistent kernel's phases (engine.gpu.persistent), on the state RunState
 

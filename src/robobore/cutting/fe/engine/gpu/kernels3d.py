@@ -145,15 +145,17 @@ def kernels3(conduction: bool):
     @cuda.jit(device=True)
     def conduct_item(e, a, dt_th):
         mat = a.mat
-        conduct3(e, a.conn, a.x, a.y, a.z, a.alive, a.enbr, a.pairs, a.vol0, a.temp, a.tbuf,
-                 mat[KCOND], mat[RHO] * mat[CP], dt_th)
+        # the tuples of the CPU's conduct3 (physics.thermal3d.hex_conduct3_py)
+        conduct3(e, (a.conn, a.x, a.y, a.z, a.alive, a.enbr, a.pairs, a.vol0), a.temp, a.tbuf,
+                 (mat[KCOND], mat[RHO] * mat[CP], dt_th))
 
     @cuda.jit(device=True)
     def heat_node_item(n, a, dt_th):
         mat, prm = a.mat, a.prm
-        heat_node3(n, a.conn, a.x, a.y, a.z, a.ptr, a.nel, a.ncorner, a.alive, a.enbr,
-                   a.pairs, a.vol0, a.cf, a.fric, a.temp, a.theat, mat[RHO] * mat[CP],
-                   prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th)
+        # the tuples of the CPU's tool_heat3 (physics.thermal3d.tool_heat_node3_py)
+        heat_node3(n, (a.conn, a.x, a.y, a.z, a.ptr, a.nel, a.ncorner, a.alive, a.enbr,
+                       a.pairs, a.vol0), (a.cf, a.fric, a.temp), a.theat,
+                   (mat[RHO] * mat[CP], prm[P_HC], prm[P_FHEAT], prm[P_TTOOL], dt_th))
 
     # the persistent kernel's phases (engine.gpu.persistent), on the state RunState3
 
