@@ -23,8 +23,8 @@ of same-typed arrays (``a, b, c, d = g.a, g.b, g.c, g.d`` packs one; ``a, b, c =
 loop then reads correctly and writes nothing. The parallel passes therefore take the groups
 and bind their arrays one statement each; the per-element and per-node functions the body
 inlines take the arrays they write one by one, and the arrays they only read in plain tuples
-built at the call from those locals (``quad_element(e, (conn, layer, area0, x, y, vx, vy),
-alive, qs, ...)``, unpacked at the top of the function), which costs nothing measurable
+built at the call from those locals (``quad_element(e, (conn, layer, area0, x, y, vx, vy,
+mat, prm), alive, qs, ...)``, unpacked at the top of the function), which costs nothing measurable
 (``benchmarks/measured/fe_before_after/``; ``tests/cutting/fe/test_groups2d.py`` checks that
 a parallel pass so written writes every array). A per-element function that takes the groups
 and is compiled apart (``njit`` without ``inline="always"``, called from the body with the
