@@ -107,9 +107,9 @@ def test_parallel_passes_write_what_the_scalar_code_writes():
     ref, par = _moving_state(), _moving_state()
     dt = 1e-9
     for e in range(ref.conn.shape[0]):
-        quad_element_py(e, (ref.conn, ref.layer, ref.area0, ref.x, ref.y, ref.vx, ref.vy,
-                            ref.mat, ref.prm), ref.alive, ref.qs, ref.ie, ref.hge, ref.fex,
-                        ref.fey, ref.dte, ref.plast, ref.rate, (dt, layout.ERODE_NONE))
+        quad_element_py(e, ref.conn, ref.layer, ref.area0, ref.x, ref.y, ref.vx, ref.vy,
+                        ref.alive, ref.qs, ref.ie, ref.hge, ref.fex, ref.fey, ref.dte, ref.plast,
+                        ref.rate, ref.mat, ref.prm, dt, layout.ERODE_NONE)
     element_update(*groups2d.groups_of(par)[:4], par.mat, par.prm, dt, layout.ERODE_NONE)
     kin = (par.prm[layout.P_TCX], par.prm[layout.P_TCY], 0.0, 0.0)
     for n in range(ref.x.shape[0]):

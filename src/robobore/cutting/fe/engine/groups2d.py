@@ -23,10 +23,13 @@ of same-typed arrays (``a, b, c, d = g.a, g.b, g.c, g.d`` packs one; ``a, b, c =
 loop then reads correctly and writes nothing. The parallel passes therefore take the groups
 and bind their arrays one statement each; the per-element and per-node functions the body
 inlines take the arrays they write one by one, and the arrays they only read in plain tuples
-built at the call from those locals (``quad_element(e, (conn, layer, area0, x, y, vx, vy,
-mat, prm), alive, qs, ...)``, unpacked at the top of the function), which costs nothing measurable
-(``benchmarks/measured/fe_before_after/``; ``tests/cutting/fe/test_groups2d.py`` checks that
-a parallel pass so written writes every array). A per-element function that takes the groups
+built at the call from those locals (``tool_heat_node(n, (conn, x, y, ...), ...)``,
+unpacked at the top of the function), which costs nothing measurable in the small ones
+(``benchmarks/bench_rezone3d.py``); the large per-element updates (``quad_element_py``,
+``quad_bbar_py``) take every argument flat, as the tuples cost them 1-2 %
+(``benchmarks/measured/fe_before_after/qs_tuples_2d_paired.txt``).
+``tests/cutting/fe/test_groups2d.py`` checks that a parallel pass so written writes every
+array. A per-element function that takes the groups
 and is compiled apart (``njit`` without ``inline="always"``, called from the body with the
 groups) keeps the writes, but runs the 2D contract case at 0.62-0.63 of the inlined flat form
 (paired, one thread: ``benchmarks/measured/fe_before_after/

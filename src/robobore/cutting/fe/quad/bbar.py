@@ -48,7 +48,8 @@ from robobore.cutting.fe.quad.element import (
 from robobore.material import johnson_cook as jc
 
 
-def quad_bbar_py(e, inputs, alive, qs, gps, ie, fex, fey, dte, plast, rate, step):
+def quad_bbar_py(e, conn, layer, area0, x, y, vx, vy, alive, qs, gps, ie, fex, fey, dte, plast,
+                 rate, mat, prm, dt, erosion):
     """Fully integrated quad ``e`` with mean-dilatation B-bar (scalar code, allocates nothing).
 
     Four Gauss points (2x2) each carry their own deviatoric stress and plastic strain
@@ -61,7 +62,7 @@ def quad_bbar_py(e, inputs, alive, qs, gps, ie, fex, fey, dte, plast, rate, step
     damage stay one per element (Gauss-point plastic work and damage increments are
     area-weighted); the rows ``sdx``, ``sdy``, ``sdz``, ``sdxy``, ``eps_p`` of the element
     state ``qs`` and ``rate`` receive the area-weighted Gauss-point means (for the outputs,
-    conduction and erosion). ``inputs`` and ``step`` as in
+    conduction and erosion). The other arguments as in
     :func:`robobore.cutting.fe.quad.element.make_quad_element`'s ``quad_element_py``.
 
     Internal force ``f_I = sum_k detJ_k B_k^T sigma_k`` with ``sigma_k = s_k - p``: for a
@@ -69,8 +70,6 @@ def quad_bbar_py(e, inputs, alive, qs, gps, ie, fex, fey, dte, plast, rate, step
     ``sum_k detJ_k Bbar_k^T sigma_k`` (Belytschko, Liu, Moran 2000, sec. 8.5). Stable step,
     bulk viscosity and erosion as :func:`quad_element_py`; returns ``(dte, inverted)``.
     """
-    conn, layer, area0, x, y, vx, vy, mat, prm = inputs
-    dt, erosion = step
     if alive[e] != 1:
         quad_retire(e, fex, fey, dte)
         return 1e30, False
@@ -277,8 +276,8 @@ def element_update_bbar(nodes, quads, qs, out, gps, mat, prm, dt, erosion):
     dtmin = 1e30
     bad = -1
     for e in prange(ne):
-        d, inv = quad_bbar(e, (conn, layer, area0, x, y, vx, vy, mat, prm), alive, qs, gps, ie,
-                           fex, fey, dte, plast, rate, (dt, erosion))
+        d, inv = quad_bbar(e, conn, layer, area0, x, y, vx, vy, alive, qs, gps, ie, fex, fey,
+                           dte, plast, rate, mat, prm, dt, erosion)
         dtmin = min(dtmin, d)
         if inv:
             bad = max(bad, e)

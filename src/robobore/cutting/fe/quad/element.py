@@ -167,15 +167,18 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
     ``quad_step``, ``damage_erosion`` given (the CPU's compiled functions here, a GPU
     engine's device functions in its port)"""
 
-    def quad_element_py(e, inputs, alive, qs, ie, hge, fex, fey, dte, plast, rate, step):
+    def quad_element_py(e, conn, layer, area0, x, y, vx, vy, alive, qs, ie, hge, fex, fey, dte,
+                        plast, rate, mat, prm, dt, erosion):
         """Stress update and nodal forces of quad ``e`` (one element, scalar code).
 
-        Reads ``inputs`` = ``(conn, layer, area0, x, y, vx, vy, mat, prm)`` (the arrays of
-        :data:`~robobore.cutting.fe.engine.groups2d.Quads2` but ``alive``, the nodes'
-        positions [m] and velocities [m/s], the material and parameter vectors) and ``step`` =
-        ``(dt, erosion)`` (the step [s], the erosion mode); updates the element state ``qs``
+        Reads the quads' corners, layer flags and reference areas, the nodes' positions [m]
+        and velocities [m/s], the material and parameter vectors, the step ``dt`` [s] and the
+        erosion mode; updates the element state ``qs``
         (:data:`~robobore.cutting.fe.engine.groups2d.QS_FIELDS` rows), ``alive`` and the
-        outputs of :data:`~robobore.cutting.fe.engine.groups2d.QuadOut2` at ``e``.
+        outputs of :data:`~robobore.cutting.fe.engine.groups2d.QuadOut2` at ``e``. The
+        arguments come one by one: the same function reading its read-only arrays from
+        tuples built at the call ran the element pass about 1-2 % slower
+        (``benchmarks/measured/fe_before_after/qs_tuples_2d_paired.txt``).
 
         The whole per-element update of :func:`element_update`: kinematics at the new
         configuration, Jaumann rotation, elastic trial, Johnson-Cook radial return, adiabatic
@@ -189,8 +192,6 @@ def make_quad_element(radial_return, jc_damage_increment, quad_retire, quad_area
         Returns ``(dte, inverted)``: the element's stable step [s] (1e30 when it is not alive or
         was just eroded by distortion) and whether it just turned inside out (``alive`` = -2).
         """
-        conn, layer, area0, x, y, vx, vy, mat, prm = inputs
-        dt, erosion = step
         if alive[e] != 1:
             quad_retire(e, fex, fey, dte)
             return 1e30, False
@@ -361,8 +362,8 @@ def element_update(nodes, quads, qs, out, mat, prm, dt, erosion):
     dtmin = 1e30
     bad = -1
     for e in prange(ne):
-        d, inv = quad_element(e, (conn, layer, area0, x, y, vx, vy, mat, prm), alive, qs, ie,
-                              hge, fex, fey, dte, plast, rate, (dt, erosion))
+        d, inv = quad_element(e, conn, layer, area0, x, y, vx, vy, alive, qs, ie, hge, fex,
+                              fey, dte, plast, rate, mat, prm, dt, erosion)
         dtmin = min(dtmin, d)
         if inv:
             bad = max(bad, e)

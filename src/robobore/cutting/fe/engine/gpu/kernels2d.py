@@ -240,8 +240,8 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def elem_phase(e, a, dt, red):
-        d, inv = elem(e, (a.conn, a.layer, a.area0, a.x, a.y, a.vx, a.vy, a.mat, a.prm), a.alive,
-                      a.qs, a.ie, a.hge, a.fex, a.fey, a.dte, a.plast, a.rate, (dt, a.erosion))
+        d, inv = elem(e, a.conn, a.layer, a.area0, a.x, a.y, a.vx, a.vy, a.alive, a.qs, a.ie,
+                      a.hge, a.fex, a.fey, a.dte, a.plast, a.rate, a.mat, a.prm, dt, a.erosion)
         cuda.atomic.min(red, R_DTMIN, d)
         if inv:
             cuda.atomic.max(red, R_BAD, float(e))
