@@ -35,6 +35,11 @@ from robobore.errors import ConfigError
 from robobore.material import Material
 
 
+def _qs_row(k: int, doc: str) -> property:
+    """A read-only attribute: row ``k`` of the element state ``qs`` (a view)."""
+    return property(lambda st: st.qs[k], doc=doc)
+
+
 @dataclass
 class FEState:
     """All arrays of an explicit model (SI, per unit width). Shapes: nodes (n,), elements (e,).
@@ -163,55 +168,16 @@ class FEState:
     phases: Phases = field(default_factory=Phases)
 
     # the rows of ``qs`` by name: views, written in place (``st.temp[:] = ...``)
-    @property
-    def sdx(self) -> np.ndarray:
-        """deviatoric stress xx (e,) [Pa]"""
-        return self.qs[QS_SDX]
-
-    @property
-    def sdy(self) -> np.ndarray:
-        """deviatoric stress yy (e,) [Pa]"""
-        return self.qs[QS_SDY]
-
-    @property
-    def sdz(self) -> np.ndarray:
-        """deviatoric stress zz (e,) [Pa]"""
-        return self.qs[QS_SDZ]
-
-    @property
-    def sdxy(self) -> np.ndarray:
-        """deviatoric stress xy (e,) [Pa]"""
-        return self.qs[QS_SDXY]
-
-    @property
-    def pres(self) -> np.ndarray:
-        """pressure (e,) [Pa]"""
-        return self.qs[QS_PRES]
-
-    @property
-    def eps_p(self) -> np.ndarray:
-        """equivalent plastic strain (e,)"""
-        return self.qs[QS_EPS_P]
-
-    @property
-    def temp(self) -> np.ndarray:
-        """temperature (e,) [K]"""
-        return self.qs[QS_TEMP]
-
-    @property
-    def dmg(self) -> np.ndarray:
-        """Johnson-Cook damage (e,)"""
-        return self.qs[QS_DMG]
-
-    @property
-    def qhx(self) -> np.ndarray:
-        """stored hourglass force x (e,) [N/m]"""
-        return self.qs[QS_QHX]
-
-    @property
-    def qhy(self) -> np.ndarray:
-        """stored hourglass force y (e,) [N/m]"""
-        return self.qs[QS_QHY]
+    sdx = _qs_row(QS_SDX, "deviatoric stress xx (e,) [Pa]")
+    sdy = _qs_row(QS_SDY, "deviatoric stress yy (e,) [Pa]")
+    sdz = _qs_row(QS_SDZ, "deviatoric stress zz (e,) [Pa]")
+    sdxy = _qs_row(QS_SDXY, "deviatoric stress xy (e,) [Pa]")
+    pres = _qs_row(QS_PRES, "pressure (e,) [Pa]")
+    eps_p = _qs_row(QS_EPS_P, "equivalent plastic strain (e,)")
+    temp = _qs_row(QS_TEMP, "temperature (e,) [K]")
+    dmg = _qs_row(QS_DMG, "Johnson-Cook damage (e,)")
+    qhx = _qs_row(QS_QHX, "stored hourglass force x (e,) [N/m]")
+    qhy = _qs_row(QS_QHY, "stored hourglass force y (e,) [N/m]")
 
     def kernel_args(self) -> tuple:
         return (self.x, self.y, self.vx, self.vy, self.mass, self.fixed, self.ptr, self.nel,
