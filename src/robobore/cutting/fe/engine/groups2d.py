@@ -25,9 +25,9 @@ and bind their arrays one statement each; the per-element and per-node functions
 inlines take the arrays they write one by one, and the arrays they only read in plain tuples
 built at the call from those locals (``tool_heat_node(n, (conn, x, y, ...), ...)``,
 unpacked at the top of the function), which costs nothing measurable in the small ones
-(``benchmarks/bench_rezone3d.py``); the large per-element updates (``quad_element_py``,
-``quad_bbar_py``) take every argument flat, as the tuples cost them 1-2 %
-(``benchmarks/measured/fe_before_after/qs_tuples_2d_paired.txt``).
+(``benchmarks/bench_rezone3d.py``); the large element and node updates (``quad_element_py``,
+``quad_bbar_py``, ``quad_node_py``) take every argument flat, as the tuples cost the element
+update 1-2 % (``benchmarks/measured/fe_before_after/qs_tuples_2d_paired.txt``).
 ``tests/cutting/fe/test_groups2d.py`` checks that a parallel pass so written writes every
 array. A per-element function that takes the groups
 and is compiled apart (``njit`` without ``inline="always"``, called from the body with the
