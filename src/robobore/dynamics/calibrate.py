@@ -560,7 +560,9 @@ def fit(problem: CalibrationProblem, with_pd: bool = False,
     H = 0.5 * (H + H.T)
     lam, U = np.linalg.eigh(H)
     prior_prec = np.linalg.eigvalsh(np.linalg.inv(problem.prior_cov(with_pd)))
-    lam = np.maximum(lam, float(prior_prec.min()) * 1e-3)  # no direction wider than its prior
+    # a direction the likelihood leaves flat or concave keeps a precision of a thousandth of
+    # the smallest prior precision: at most 32 times the widest prior standard deviation
+    lam = np.maximum(lam, float(prior_prec.min()) * 1e-3)
     cov = (U / lam) @ U.T
     ll = problem.log_likelihood(pred, theta)
     bic = -2.0 * ll + p * math.log(max(problem.n_data, 1))
