@@ -141,13 +141,13 @@ def kernels2(phases: Phases):
 
     @cuda.jit(device=True)
     def node_phase(n, a, kv, dt, red):
-        cx, cy, tvx, tvy = kv
+        tool_cx, tool_cy, tool_vx, tool_vy = kv
         cfx, cfy = a.cfx, a.cfy
         fcx, fcy, touched = node(n, a.x, a.y, a.vx, a.vy, a.mass, a.fixed,
                                  a.ptr, a.nel, a.ncorner, a.alive, a.area0,
                                  a.fex, a.fey, cfx, cfy, a.fric, a.pen,
-                                 a.ndead, a.ero_ke, a.nwork, cx, cy, tvx, tvy,
-                                 a.prm, dt, a.twin, a.tied, a.vslip)
+                                 a.ndead, a.ero_ke, a.nwork, tool_cx, tool_cy, tool_vx,
+                                 tool_vy, a.prm, dt, a.twin, a.tied, a.vslip)
         if touched:
             cuda.atomic.add(red, R_NC, 1.0)  # a count: exact in any order
         return cfx[n] != 0.0 or cfy[n] != 0.0
