@@ -77,13 +77,14 @@ def main() -> int:
         return 2
     disp.get_current_device = lambda: types.SimpleNamespace(compute_capability=cc)
 
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.chunk_loop import Phases
     from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
     from robobore.cutting.fe.engine.gpu import backend3d as gpu
     from robobore.cutting.fe.hex import layout3d
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
     from robobore.cutting.fe.models.orthogonal import setup_orthogonal
     from robobore.cutting.fe.quad import node_contact
     from robobore.io.config import load_toml

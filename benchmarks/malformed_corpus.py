@@ -658,7 +658,8 @@ def npz_cases(workdir: Path) -> list[Case]:
 
     sys.path.insert(0, str(ROOT / "src"))
     from robobore.modal.example import example_path
-    from robobore.modal.frf import FRFData, estimate_frf
+    from robobore.modal.frf import estimate_frf
+    from robobore.modal.frf_data import FRFData
     from robobore.modal.io import load_input
 
     d = load_input(example_path())
