@@ -49,8 +49,9 @@ def _load() -> str:
 
 
 def speed(n_elements: int, steps: int, frame: str | None = None) -> dict:
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.engine import kernels3d as K3
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")
@@ -105,11 +106,8 @@ def speed(n_elements: int, steps: int, frame: str | None = None) -> dict:
 def paper(sizes: list[float], cut_mm: float, ms: float, coefficients: str | None,
           friction: str | None = None, separation: str | None = None,
           support: bool = True, frame: str | None = None) -> dict:
-    from robobore.cutting.fe.models.boring3d import (
-        compare_with_mechanistic,
-        parse_boring_config,
-        simulate_boring,
-    )
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
+    from robobore.cutting.fe.models.boring3d import compare_with_mechanistic, simulate_boring
     from robobore.io.config import load_toml
 
     base = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

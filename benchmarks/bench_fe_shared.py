@@ -72,8 +72,9 @@ def run_2d(length_mm: float, adaptive: bool) -> tuple[float, dict]:
 
 
 def run_3d(n_steps: int, element_um: float, adaptive: bool) -> tuple[float, dict]:
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.engine.state3d import advance3
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(ROOT / "examples" / "fe_boring_paper.toml")

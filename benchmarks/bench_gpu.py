@@ -71,7 +71,7 @@ def env() -> dict:
         out["numba_cuda"] = getattr(numba_cuda, "__version__", "?")
     except Exception as e:  # pragma: no cover - depends on the machine
         out["numba_cuda"] = f"not importable: {e}"
-    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
+    from robobore.cutting.fe.engine.gpu.shared import cuda_available
 
     out["cuda_available"] = cuda_available()
     if out["cuda_available"]:
@@ -214,8 +214,9 @@ def _speed_row(st0, n_elements: int, advance, advance_gpu, diff, gpu_steps: int,
 
 def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int,
             use_gpu: bool, profile: bool) -> dict:
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.engine.state3d import advance3
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
 
     advance3_gpu = None
     if use_gpu:
@@ -234,11 +235,8 @@ def speed3d(sizes: list[float], gpu_steps: int, cpu_steps: int, cpu_threads: int
 
 def paper3d(sizes: list[float], devices: list[str], cut_mm: float, ms: float,
             coefficients: str | None) -> dict:
-    from robobore.cutting.fe.models.boring3d import (
-        compare_with_mechanistic,
-        parse_boring_config,
-        simulate_boring,
-    )
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
+    from robobore.cutting.fe.models.boring3d import compare_with_mechanistic, simulate_boring
 
     res = {"runs": []}
     for le in sizes:

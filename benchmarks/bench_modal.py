@@ -26,7 +26,8 @@ import warnings
 
 import numpy as np
 
-from robobore.modal.frf import FRFData, estimate_frf
+from robobore.modal.frf import estimate_frf
+from robobore.modal.frf_data import FRFData
 from robobore.modal.identify import identify_modes
 from robobore.modal.plscf import plscf
 from robobore.modal.stabilization import select_poles, stabilisation

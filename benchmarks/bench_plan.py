@@ -27,7 +27,8 @@ import numpy as np
 
 from robobore.plan.chatter import critical_depth_range
 from robobore.plan.posture import plan_posture
-from robobore.robot.kinematics import fk, get_robot
+from robobore.robot.description import get_robot
+from robobore.robot.kinematics import fk
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "plan_paper_bore.toml"
@@ -94,7 +95,7 @@ def main() -> None:
     # the same with link bending (lower arm and forearm as beams: 12 coordinates)
     from dataclasses import replace
 
-    from robobore.plan.model import LinkBending
+    from robobore.plan.bending import LinkBending
 
     mb = replace(model, link_bending=(LinkBending(2, (1 / 5.7e7, 1 / 7.2e7)),
                                       LinkBending(4, (1 / 1.6e7, 1 / 1.6e7))))

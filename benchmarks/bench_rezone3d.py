@@ -40,7 +40,8 @@ def main() -> None:
         P_RN,
         P_TOOL,
     )
-    from robobore.cutting.fe.mesh.toolframe3d import ToolFrame3DSizes, build_toolframe3d_mesh
+    from robobore.cutting.fe.mesh.toolframe3d import build_toolframe3d_mesh
+    from robobore.cutting.fe.mesh.toolframe3d_layout import ToolFrame3DSizes
     from robobore.cutting.geometry import BoringInsert
 
     insert = BoringInsert(nose_radius_m=0.4e-3, approach_angle_deg=90.0,

@@ -19,8 +19,9 @@ from robobore.robot.campaign import (
     simulate_campaign,
     simulate_clean,
 )
+from robobore.robot.description import get_robot
 from robobore.robot.identify import identify_batch, identify_joint_stiffness
-from robobore.robot.kinematics import fk_jacobian, get_robot
+from robobore.robot.kinematics import fk_jacobian
 
 
 def numpy_fk_jacobian(robot, q, tcp):

@@ -33,9 +33,10 @@ sys.path.insert(0, str(ROOT / "src"))
 
 from robobore.cutting import geometry as G  # noqa: E402
 from robobore.cutting.coefficient_files import load_coefficients  # noqa: E402
+from robobore.cutting.fe.config.boring3d import parse_boring_config  # noqa: E402
 from robobore.cutting.fe.engine.state3d import advance3  # noqa: E402
 from robobore.cutting.fe.hex.scalar3d import T_GZ, T_UZ  # noqa: E402
-from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring  # noqa: E402
+from robobore.cutting.fe.models.boring3d import setup_boring  # noqa: E402
 from robobore.cutting.forces import boring_forces  # noqa: E402
 from robobore.io.config import load_toml  # noqa: E402
 from robobore.io.results import atomic_write_bytes  # noqa: E402

@@ -43,11 +43,8 @@ def main() -> None:
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
 
-    from robobore.cutting.fe.models.boring3d import (
-        parse_boring_config,
-        setup_boring,
-        simulate_boring,
-    )
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
+    from robobore.cutting.fe.models.boring3d import setup_boring, simulate_boring
     from robobore.io.config import load_toml
 
     d = load_toml(a.config)

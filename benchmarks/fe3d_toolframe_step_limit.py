@@ -38,11 +38,12 @@ def main() -> None:
     ap.add_argument("--json", default=None)
     a = ap.parse_args()
 
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.engine import kernels3d as K3
     from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.state3d import advance3
     from robobore.cutting.fe.hex import scalar3d
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(a.config)

@@ -77,13 +77,16 @@ def main() -> int:
         return 2
     disp.get_current_device = lambda: types.SimpleNamespace(compute_capability=cc)
 
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.config.orthogonal import load_fe_config
     from robobore.cutting.fe.engine import layout
     from robobore.cutting.fe.engine.chunk_loop import Phases
     from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
     from robobore.cutting.fe.engine.gpu import backend3d as gpu
+    from robobore.cutting.fe.engine.gpu import kernels3d as gpu_k3
+    from robobore.cutting.fe.engine.gpu import runstate2d
     from robobore.cutting.fe.hex import layout3d
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
     from robobore.cutting.fe.models.orthogonal import setup_orthogonal
     from robobore.cutting.fe.quad import node_contact
     from robobore.io.config import load_toml
@@ -108,9 +111,9 @@ def main() -> int:
     cases = {
     }
     # the 3D persistent kernel with and without the heat phase
-    run3 = [1, gpu.RunState3(*[np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS],
+    run3 = [1, gpu_k3.RunState3(*[np.ascontiguousarray(getattr(st3, n)) for n in gpu._RUN_ARGS],
                              int(st3.prm[layout3d.P_EROSION])),
-            np.zeros(gpu.N_RED)] + chunk_arrays(st3.x.shape[0])
+            np.zeros(gpu_k3.N_RED)] + chunk_arrays(st3.x.shape[0])
     for conduction in (True, False):
         name = f"3D k_run ({'conduction' if conduction else 'adiabatic'})"
         cases[name] = (gpu._kernels(conduction)[-1], run3)
@@ -119,14 +122,14 @@ def main() -> int:
     k3 = gpu._kernels(True)
     for kern in tuple(k3[:5]) + tuple(k3[5]):
         names = inspect.signature(kern.py_func).parameters
-        args = [np.zeros(gpu.N_RED) if n == "red" else run3[1] for n in names]
+        args = [np.zeros(gpu_k3.N_RED) if n == "red" else run3[1] for n in names]
         cases[f"3D {kern.py_func.__name__}"] = (kern, args)
     # the 2D persistent kernel of each GPU model choice (the tool frame and conduction, each
     # on or off), compiled for the tool-frame state's argument types
-    run2 = [1, gpu2d.RunState(*[np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS],
+    run2 = [1, runstate2d.RunState(*[np.ascontiguousarray(getattr(st2, n)) for n in gpu2d._ARRAYS],
                               int(st2.prm[layout.P_EROSION]), 1, 1,
                               int(st2.prm[layout.P_RZ_EVERY])),
-            np.zeros(gpu2d.N_RED)] + chunk_arrays(st2.x.shape[0])
+            np.zeros(runstate2d.N_RED)] + chunk_arrays(st2.x.shape[0])
     for tool_frame in (True, False):
         for conduction in (True, False):
             ph = Phases("q4r", tool_frame, conduction)
@@ -137,7 +140,7 @@ def main() -> int:
     # on the state ``a`` and, where it takes them, the reductions ``red``
     for kern in tuple(k2[:-2]) + tuple(k2[-1]):
         names = inspect.signature(kern.py_func).parameters
-        args = [np.zeros(gpu2d.N_RED) if n == "red" else run2[1] for n in names]
+        args = [np.zeros(runstate2d.N_RED) if n == "red" else run2[1] for n in names]
         cases[f"2D {kern.py_func.__name__}"] = (kern, args)
     ptxas = _ptxas()
     rc = 0

@@ -66,7 +66,7 @@ from robobore.io.config import dump_toml  # noqa: E402
 #: parse-only drivers (commands that would run FE simulations or the whole paper study)
 PARSE = {
     "fe": "from robobore.cutting.fe.config.orthogonal import load_fe_config as f",
-    "fe_boring": "from robobore.cutting.fe.models.boring3d import load_boring_config as f",
+    "fe_boring": "from robobore.cutting.fe.config.boring3d import load_boring_config as f",
     "calibration": "from robobore.cutting.calibration_config import load_calibration_config as f",
     "paper": "from robobore.study.paper_config import load_paper_config as f",
     "material": "from robobore.material import load_material as f",
@@ -658,7 +658,8 @@ def npz_cases(workdir: Path) -> list[Case]:
 
     sys.path.insert(0, str(ROOT / "src"))
     from robobore.modal.example import example_path
-    from robobore.modal.frf import FRFData, estimate_frf
+    from robobore.modal.frf import estimate_frf
+    from robobore.modal.frf_data import FRFData
     from robobore.modal.io import load_input
 
     d = load_input(example_path())

@@ -24,10 +24,10 @@ import time
 from pathlib import Path
 
 from robobore.cutting import calibrate as cal
-from robobore.cutting.fe.models.validate import (
+from robobore.cutting.fe.models.validate import read_measured
+from robobore.cutting.fe.models.validation_record import (
     bundled_validation_path,
     load_validation_record,
-    read_measured,
 )
 from robobore.io.config import load_toml
 

@@ -39,7 +39,7 @@ def _fe(p: Path):
 
 
 def _fe_boring(p: Path):
-    from robobore.cutting.fe.models.boring3d import load_boring_config
+    from robobore.cutting.fe.config.boring3d import load_boring_config
 
     load_boring_config(p)
 
@@ -69,7 +69,7 @@ def _material(p: Path):
 
 
 def _robot(p: Path):
-    from robobore.robot.kinematics import load_robot_file
+    from robobore.robot.description import load_robot_file
 
     load_robot_file(p)
 

@@ -66,7 +66,7 @@ def test_bundled_config_passes_the_identity_checks(path):
 
 @pytest.mark.parametrize("path", sorted((EX / "robots").glob("*.toml")), ids=lambda p: p.name)
 def test_example_robot_loads(path):
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import get_robot
 
     assert get_robot(str(path)).links
 

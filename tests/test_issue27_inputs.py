@@ -17,8 +17,8 @@ from typer.testing import CliRunner
 from robobore.cli import app
 from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
+from robobore.cutting.fe.config.boring3d import parse_boring_config
 from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
-from robobore.cutting.fe.models.boring3d import parse_boring_config
 from robobore.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -247,9 +247,9 @@ def test_fe_meshes_refused_at_parse_time(tmp_path):
     import re
     import tomllib
 
+    from robobore.cutting.fe.config.boring3d import load_boring_config, parse_boring_config
     from robobore.cutting.fe.config.orthogonal import load_fe_config, parse_config
     from robobore.cutting.fe.mesh.memory import fe2d_elements, fe3d_elements
-    from robobore.cutting.fe.models.boring3d import load_boring_config, parse_boring_config
 
     for f in sorted(EX.glob("fe_orthogonal*.toml")):
         assert fe2d_elements(load_fe_config(f)) < 1e5

@@ -359,7 +359,7 @@ def test_fe_orthogonal_material_file_is_config_relative(tmp_path, monkeypatch):
 
 
 def test_fe_boring_material_file_is_config_relative(tmp_path, monkeypatch):
-    from robobore.cutting.fe.models.boring3d import load_boring_config
+    from robobore.cutting.fe.config.boring3d import load_boring_config
 
     cfgdir = _fe_material_case(tmp_path, monkeypatch)
     text = (EX / "fe_boring_paper.toml").read_text()
@@ -552,7 +552,7 @@ def test_paper_band_and_corrupt_stored_coefficients(tmp_path):
 
 
 def test_robot_file_lengths_in_mm_refused(tmp_path):
-    from robobore.robot.kinematics import load_robot_file
+    from robobore.robot.description import load_robot_file
 
     src = ROOT / "src" / "robobore" / "robot" / "library" / "irb6600-175-2.55.toml"
     text = src.read_text()
@@ -612,7 +612,7 @@ def test_option_names_pick_the_range_of_their_unit():
 
 
 def test_robot_link_centre_of_mass_and_inertia_in_mm_refused(tmp_path):
-    from robobore.robot.kinematics import load_robot_file
+    from robobore.robot.description import load_robot_file
 
     src = (Path(__file__).resolve().parents[1] / "src/robobore/robot/library/"
            "irb6600-175-2.55.toml").read_text()

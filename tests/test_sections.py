@@ -128,7 +128,7 @@ def test_one_strict_base_model():
                     isinstance(b, ast.Name) and b.id == "BaseModel" for b in node.bases):
                 found.append(f"{rel}:{node.lineno} {node.name}")
     assert not found, found
-    from robobore.cutting.fe.config.solver import Strict
+    from robobore.io.sections import StrictModel as Strict
 
     assert Strict is sections.StrictModel
 

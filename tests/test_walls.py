@@ -13,6 +13,15 @@
   functions (``TYPE_CHECKING`` imports, annotations only, are left out). ``errors`` and ``io``
   import no stage; the command-line modules and ``api`` form the top layer. A module in no
   stage of the table fails, so that a new package is placed in it.
+- No re-export hub: a name taken from a robobore module (``from robobore.a import name`` or
+  ``a.name`` where ``a`` is a module bound by an import) is one that module defines (``def``,
+  ``class``, assignment), not one it imports; a module imports no robobore name that it does
+  not use itself, and its ``__all__`` lists only names it defines. :data:`PUBLIC_HUBS` names
+  the package ``__init__`` files that gather names for the users of the package (``from
+  robobore.material import Material``), with the reason; robobore's own modules import from
+  the defining module even there. A package that loads its names on first use (an
+  ``_EXPORTS`` table of name -> submodule, ``robobore.robot``, ``robobore.modal``) names the
+  submodule that defines each.
 
 Every failure names ``file:line`` of the offending import or attribute. ``EXEMPT`` lists the
 packages not yet held to the private-name and cycle rules, by name, so that each can be
@@ -34,6 +43,16 @@ ROOT_PACKAGE = "robobore"
 EXEMPT: tuple[str, ...] = ()
 
 CLI_LAYER = ("robobore.cli", "robobore.clitools")
+
+#: package ``__init__`` files that import names only to offer them to the package's users, with
+#: the reason; they may hold names they do not use (robobore's modules do not import through
+#: them)
+PUBLIC_HUBS: dict[str, str] = {
+    "robobore.material": "the material API of docs/api.md and the examples: Material, "
+                         "load_material, bundled_materials",
+    "robobore.io": "the file helpers of the package's edges: load_toml, validate_model, "
+                   "atomic writes, write_json, write_netcdf",
+}
 
 #: the layers of the package, lowest first: (layer, stages), each stage (name, the dotted
 #: module prefixes it holds). A module belongs to the stage of its longest matching prefix
@@ -327,6 +346,124 @@ def layer_violations(files: dict[str, Path] | None = None) -> list[str]:
     return sorted(set(bad))
 
 
+def defined_names(tree: ast.Module) -> set[str]:
+    """The names a module binds at module level by ``def``, ``class`` or assignment (also
+    inside module-level ``if``/``try``/``for``/``with``), not by an import."""
+    out: set[str] = set()
+
+    def bind(target: ast.AST) -> None:
+        out.update(n.id for n in ast.walk(target) if isinstance(n, ast.Name))
+
+    def visit(body: list[ast.stmt]) -> None:
+        for s in body:
+            if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                out.add(s.name)
+            elif isinstance(s, ast.Assign):
+                for t in s.targets:
+                    bind(t)
+            elif isinstance(s, ast.AnnAssign | ast.AugAssign):
+                bind(s.target)
+            elif isinstance(s, ast.For | ast.AsyncFor):
+                bind(s.target)
+                visit(s.body + s.orelse)
+            elif isinstance(s, ast.With | ast.AsyncWith):
+                for item in s.items:
+                    if item.optional_vars is not None:
+                        bind(item.optional_vars)
+                visit(s.body)
+            elif isinstance(s, ast.If):
+                visit(s.body + s.orelse)
+            elif isinstance(s, ast.Try):
+                visit(s.body + s.orelse + s.finalbody + [x for h in s.handlers for x in h.body])
+
+    visit(tree.body)
+    return out
+
+
+def reexport_violations(files: dict[str, Path] | None = None) -> list[str]:
+    """Names taken from a robobore module that does not define them (``from robobore.a import
+    name``, ``a.name`` on a module bound by an import), robobore names a module imports at
+    module level without using them and names its ``__all__`` lists without defining them (a
+    re-export), outside :data:`PUBLIC_HUBS`; each naming ``file:line``."""
+    files = files if files is not None else module_files()
+    trees = {m: ast.parse(p.read_text(encoding="utf-8"), filename=str(p))
+             for m, p in files.items()}
+    defs = {m: defined_names(t) for m, t in trees.items()}
+    bad = []
+    for mod, tree in trees.items():
+        rel = _rel(files[mod])
+        bound: dict[str, str] = {}  # local name -> robobore module it is bound to
+        top_names: dict[str, tuple[int, str]] = {}  # name imported at module level -> (line, from)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                for a in node.names:
+                    if a.name.split(".")[0] == ROOT_PACKAGE:
+                        bound[a.asname or ROOT_PACKAGE] = a.name if a.asname else ROOT_PACKAGE
+            elif isinstance(node, ast.ImportFrom):
+                base = _resolve_from(mod, node, files)
+                if base.split(".")[0] != ROOT_PACKAGE or base not in files:
+                    continue
+                for a in node.names:
+                    if f"{base}.{a.name}" in files:
+                        bound[a.asname or a.name] = f"{base}.{a.name}"
+                        continue
+                    if a.name not in defs[base]:
+                        bad.append(f"{rel}:{node.lineno}: {mod} imports {a.name} from {base}, "
+                                   "which does not define it")
+                    if node in tree.body:
+                        top_names[a.asname or a.name] = (node.lineno, base)
+        used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute):
+                target = _dotted(node.value, bound)
+                if (target is not None and target in files and target != mod
+                        and f"{target}.{node.attr}" not in files
+                        and node.attr not in defs[target]):
+                    bad.append(f"{rel}:{node.lineno}: {mod} uses {target}.{node.attr}, "
+                               "which that module does not define")
+        if mod not in PUBLIC_HUBS:
+            for node in tree.body:
+                if (isinstance(node, ast.Assign) and len(node.targets) == 1
+                        and getattr(node.targets[0], "id", None) == "__all__"):
+                    for elt in getattr(node.value, "elts", []):
+                        name = getattr(elt, "value", None)
+                        if isinstance(name, str) and name not in defs[mod] and (
+                                f"{mod}.{name}" not in files):
+                            bad.append(f"{rel}:{node.lineno}: {mod} lists {name} in __all__ "
+                                       "without defining it")
+            for name, (line, base) in sorted(top_names.items()):
+                if name not in used:
+                    bad.append(f"{rel}:{line}: {mod} imports {name} from {base} without using "
+                               "it (a re-export)")
+    return sorted(set(bad))
+
+
+def lazy_export_violations(files: dict[str, Path] | None = None) -> list[str]:
+    """Entries of a package's ``_EXPORTS`` table (name -> submodule, read by its
+    ``__getattr__``) whose submodule does not define the name."""
+    files = files if files is not None else module_files()
+    bad = []
+    for mod, path in files.items():
+        if path.name != "__init__.py":
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        for node in tree.body:
+            if (isinstance(node, ast.Assign) and len(node.targets) == 1
+                    and getattr(node.targets[0], "id", None) == "_EXPORTS"
+                    and isinstance(node.value, ast.Dict)):
+                for k, v in zip(node.value.keys, node.value.values, strict=True):
+                    name, sub = getattr(k, "value", None), f"{mod}.{getattr(v, 'value', '')}"
+                    if sub not in files:
+                        bad.append(f"{_rel(path)}:{k.lineno}: {mod}._EXPORTS[{name!r}] names "
+                                   f"{sub}, no module of the package")
+                        continue
+                    sub_tree = ast.parse(files[sub].read_text(encoding="utf-8"))
+                    if name not in defined_names(sub_tree):
+                        bad.append(f"{_rel(path)}:{k.lineno}: {mod}._EXPORTS[{name!r}] names "
+                                   f"{sub}, which does not define it")
+    return bad
+
+
 def module_sizes(files: dict[str, Path] | None = None) -> dict[str, int]:
     files = files if files is not None else module_files()
     return {m: len(p.read_text(encoding="utf-8").splitlines()) for m, p in files.items()}
@@ -426,6 +563,50 @@ def test_the_scanners_see_a_planted_violation(tmp_path):
     assert len(cyc) == 1 and "a/x.py:1" in cyc[0] and "a/y.py:1" in cyc[0]
 
 
+def test_no_reexport_hub():
+    """Every importer takes a name from the module that defines it; no module passes on
+    names it imports (:data:`PUBLIC_HUBS` aside)."""
+    bad = reexport_violations() + lazy_export_violations()
+    assert not bad, "import each name from the module that defines it (no re-export hubs):\n" \
+        + "\n".join(bad)
+
+
+def test_the_reexport_check_sees_a_planted_reexport(tmp_path):
+    """A name imported from a module that only imports it (from-import and attribute) and the
+    unused import that passes it on are reported; a name from its defining module, a name a
+    module imports and uses, and a public hub's gathered names are not."""
+    pkg = tmp_path / ROOT_PACKAGE
+    (pkg / "a").mkdir(parents=True)
+    (pkg / "material").mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "material" / "__init__.py").write_text("from robobore.material.lib import M\n")
+    (pkg / "material" / "lib.py").write_text("class M:\n    pass\n")
+    (pkg / "a" / "__init__.py").write_text("")
+    (pkg / "a" / "core.py").write_text("def f():\n    pass\n\n\nX = 1\n")
+    (pkg / "a" / "hub.py").write_text("from robobore.a.core import X, f\n\n\n"
+                                      "def g():\n    return f()\n")
+    (pkg / "a" / "user.py").write_text("from robobore.a import hub\nfrom robobore.a.core import f\n"
+                                       "from robobore.a.hub import X, g\n"
+                                       "from robobore.material.lib import M\n\n"
+                                       "Y = hub.f, X, f, g, M\n")
+    bad = reexport_violations(module_files(tmp_path))
+    assert len(bad) == 3, bad
+    text = "\n".join(bad)
+    assert "a/hub.py:1: robobore.a.hub imports X from robobore.a.core without using it" in text
+    assert "a/user.py:3: robobore.a.user imports X from robobore.a.hub, which does not define " \
+        "it" in text
+    assert "a/user.py:6: robobore.a.user uses robobore.a.hub.f, which that module does not " \
+        "define" in text
+    assert "material" not in text
+    (pkg / "a" / "__init__.py").write_text('_EXPORTS = {"f": "core", "X": "hub", "Z": "gone"}\n')
+    lazy = lazy_export_violations(module_files(tmp_path))
+    assert len(lazy) == 2, lazy
+    assert lazy[0].endswith("robobore/a/__init__.py:1: robobore.a._EXPORTS['X'] names "
+                            "robobore.a.hub, which does not define it")
+    assert lazy[1].endswith("robobore/a/__init__.py:1: robobore.a._EXPORTS['Z'] names "
+                            "robobore.a.gone, no module of the package")
+
+
 def _exempt_text() -> str:
     return ", ".join(EXEMPT) if EXEMPT else "the exempt packages (none)"
 
@@ -455,6 +636,11 @@ def main() -> None:
     lay = layer_violations(files)
     print(f"imports against the layer order: {len(lay)}")
     for b in lay:
+        print("  " + b)
+    rex = reexport_violations(files) + lazy_export_violations(files)
+    print(f"re-exports (names taken from a module that does not define them, imports passed "
+          f"on unused): {len(rex)}")
+    for b in rex:
         print("  " + b)
     sizes = module_sizes(files)
     big = sorted(((n, m) for m, n in sizes.items() if n > 600), reverse=True)

@@ -127,7 +127,7 @@ def load_campaign(path: str | Path | None = None, robot: Any = DEFAULT_ROBOT):
     """Read a laser-tracker stiffness campaign CSV (None: the bundled SYNTHETIC one),
     validated against ``robot`` (library name, robot TOML path or ``Robot``)."""
     from robobore.robot.campaign_io import read_campaign
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import get_robot
 
     path = _path_arg(path, "path")
     return read_campaign(bundled_campaign_path() if path is None else path,
@@ -142,8 +142,8 @@ def identify_joint_stiffness(campaign: Any = None, robot: Any = DEFAULT_ROBOT, *
     directional stiffness [N/m] at the campaign's first posture in ``frame``). ``sigma_m``:
     known tracker noise [m] (None: estimated)."""
     from robobore.robot.campaign import Campaign
+    from robobore.robot.description import get_robot
     from robobore.robot.identify import identify_joint_stiffness as _identify
-    from robobore.robot.kinematics import get_robot
 
     rb = get_robot(robot)
     sigma_m = _number_arg(sigma_m, "sigma_m", "m (1-sigma tracker noise per coordinate)")
@@ -173,8 +173,7 @@ def _robot_arg(robot: Any, joint_stiffness: Any, name: str = "joint_stiffness"):
     import warnings
 
     from robobore.io.identity import check_robot
-    from robobore.robot.description import Robot, robot_of_identity
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import Robot, get_robot, robot_of_identity
     from robobore.robot.stiffness import JointStiffness
 
     ident = _identity_of(joint_stiffness)
@@ -303,7 +302,8 @@ def frf(records: Any, *, estimator: str = "H1", exp_window_tau_s: float | None =
     """FRFs ``(n_outputs, n_inputs, n_f)`` of hammer records (H1/H2/Hv, averaged over the
     hits, force window; double-hit, overload and leakage checks warn) -> ``FRFData``. An
     ``FRFData`` is returned as it is."""
-    from robobore.modal.frf import FRFData, HammerRecords, estimate_frf
+    from robobore.modal.frf import HammerRecords, estimate_frf
+    from robobore.modal.frf_data import FRFData
 
     if isinstance(records, FRFData):
         return records

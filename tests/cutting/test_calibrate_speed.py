@@ -22,10 +22,10 @@ from robobore.cutting import calibration_config as calcfg
 from robobore.cutting import calibration_runs as calruns
 from robobore.cutting.coefficient_files import load_coefficients
 from robobore.cutting.coefficient_sets import DUCOBU_FILE
-from robobore.cutting.fe.models.validate import (
+from robobore.cutting.fe.models.validate import read_measured
+from robobore.cutting.fe.models.validation_record import (
     bundled_validation_path,
     load_validation_record,
-    read_measured,
 )
 from robobore.io.config import load_toml
 

@@ -16,12 +16,14 @@ from robobore.cli import app
 from robobore.cutting.coefficient_sets import ti64_coefficients
 from robobore.cutting.geometry import BoringInsert
 from robobore.dynamics.process import boring_process, single_point_process
-from robobore.dynamics.stability import (
+from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_HI_M,
     critical_depth_semidiscretization,
+    monodromy_spectral_radius,
+)
+from robobore.dynamics.stability import (
     lobes_frequency_domain,
     lobes_semidiscretization,
-    monodromy_spectral_radius,
     sdof_absolute_limit,
     sdof_pocket_speeds,
 )

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from robobore.dynamics.process import single_point_process
+from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
 from robobore.dynamics.stability import (
-    critical_depth_semidiscretization,
     lobes_frequency_domain,
     lobes_semidiscretization,
     mode_coupling,

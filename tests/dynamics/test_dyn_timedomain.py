@@ -11,11 +11,11 @@ from robobore.cutting.forces import CuttingCoefficients, boring_forces
 from robobore.cutting.geometry import BoringInsert
 from robobore.dynamics.chatter import classify
 from robobore.dynamics.process import boring_process
+from robobore.dynamics.semidiscretization import monodromy_spectral_radius
 from robobore.dynamics.stability import (
     lobes_frequency_domain,
     mode_coupling,
     mode_coupling_limit,
-    monodromy_spectral_radius,
     sdof_pocket_speeds,
 )
 from robobore.dynamics.structure import ToolPointStructure
@@ -263,7 +263,7 @@ def test_rotating_bar_semidiscretization_vs_time_domain():
     where the static deflection is a negligible part of the depth: the semi-discretised
     (Floquet) critical depth separates decaying (0.9 x) from growing (1.1 x) simulations."""
     from robobore.cutting.coefficient_sets import ti64_coefficients
-    from robobore.dynamics.stability import critical_depth_semidiscretization
+    from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
 
     st = ToolPointStructure.from_modes([
         {"frequency_Hz": 180.0, "damping_ratio": 0.02, "stiffness_N_per_m": 2.0e7,
@@ -290,7 +290,7 @@ def test_robot_boring_semidiscretization_vs_time_domain(speed):
     from pathlib import Path
 
     from robobore.dynamics.config import build_process, build_structure, load_dynamics_config
-    from robobore.dynamics.stability import critical_depth_semidiscretization
+    from robobore.dynamics.semidiscretization import critical_depth_semidiscretization
 
     ex = Path(__file__).resolve().parents[2] / "examples" / "boring_paper.toml"
     cfg, _ = load_dynamics_config(ex)

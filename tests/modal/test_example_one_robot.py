@@ -14,7 +14,7 @@ import pytest
 
 from robobore.modal.virtual import robot_boring_truth, tool_point_compliance, truth_table
 from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
-from robobore.robot.kinematics import get_robot
+from robobore.robot.description import get_robot
 from robobore.robot.stiffness import directional_stiffness_xyz
 from robobore.study import paper as pp
 from robobore.study import paper_config as pc

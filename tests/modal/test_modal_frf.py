@@ -12,15 +12,13 @@ from hypothesis import strategies as st
 from robobore.errors import DataError, InputError
 from robobore.modal.frf import (
     DoubleHitWarning,
-    FRFData,
     HammerRecords,
     LeakageWarning,
-    check_frequencies,
     check_hit,
-    convert_frf,
     estimate_frf,
     exponential_window,
 )
+from robobore.modal.frf_data import FRFData, check_frequencies, convert_frf
 from robobore.modal.identify import identify_modes
 from robobore.modal.virtual import ModalTruth, robot_boring_truth, simulate_hammer_test
 

@@ -18,7 +18,8 @@ import pytest
 from robobore.errors import IdentificationError, InputError
 from robobore.io.results import dumps_json
 from robobore.modal.cmif import cmif
-from robobore.modal.frf import FRFData, estimate_frf
+from robobore.modal.frf import estimate_frf
+from robobore.modal.frf_data import FRFData
 from robobore.modal.identify import ModalResult, identify_modes
 from robobore.modal.lsfd import lsfd, mpc, normalise_shape
 from robobore.modal.plscf import plscf

@@ -13,7 +13,8 @@ from typer.testing import CliRunner
 from robobore.cli import app
 from robobore.errors import DataError
 from robobore.modal.example import example_path
-from robobore.modal.frf import FRFData, HammerRecords, estimate_frf
+from robobore.modal.frf import HammerRecords, estimate_frf
+from robobore.modal.frf_data import FRFData
 from robobore.modal.io import (
     _write_sets,
     default_dofs,

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from robobore.errors import InputError
-from robobore.modal.frf import FRFData
+from robobore.modal.frf_data import FRFData
 from robobore.modal.plscf import _blocks, normal_equation_lags, plscf
 from robobore.modal.stabilization import mac
 from robobore.modal.virtual import ModalTruth, robot_boring_truth

@@ -96,7 +96,7 @@ def test_rank_point_without_matching_dofs_is_the_most_compliant_output(dofs):
     """Measured FRFs (5 % complex noise on the SYNTHETIC tool point) without driving-point
     DOFs: the modes are ranked at the tip (the most compliant output) or at the DOF whose
     direction sign differs, and the three tip-dominant modes come back."""
-    from robobore.modal.frf import FRFData
+    from robobore.modal.frf_data import FRFData
 
     truth = tool_point_truth()
     f = np.arange(0.0, 5000.0, 2.0)

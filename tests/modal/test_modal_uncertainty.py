@@ -79,7 +79,7 @@ def test_json_round_trip_and_frf_input_uses_the_residual_bootstrap():
 def test_frf_only_intervals_cover_the_truth_in_90_to_99_percent():
     """200 SYNTHETIC FRF sets (the two-mode structure's exact accelerance, 0.125 Hz lines,
     complex white noise 2 % of each FRF's mean magnitude): bootstrap of the residuals."""
-    from robobore.modal.frf import FRFData
+    from robobore.modal.frf_data import FRFData
 
     truth = two_modes()
     f = np.arange(0.0, 64.0, 0.125)

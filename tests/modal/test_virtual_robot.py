@@ -25,7 +25,8 @@ from robobore.modal.identify import identify_modes
 from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, simulate_hammer_test
 from robobore.plan.virtual_hammer import robot_truth, sample_rate_for, static_stiffness
 from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD as K_IRB
-from robobore.robot.kinematics import fk_jacobian, get_robot
+from robobore.robot.description import get_robot
+from robobore.robot.kinematics import fk_jacobian
 from robobore.robot.stiffness import compliance_matrix, process_frame
 
 runner = CliRunner()

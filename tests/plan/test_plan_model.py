@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 from robobore.errors import InputError
-from robobore.plan.model import PoseModel, ToolBody, calibrate
-from robobore.robot.kinematics import LinkInertia, Robot, fk, get_robot
+from robobore.plan.inertia import ToolBody
+from robobore.plan.model import PoseModel, calibrate
+from robobore.robot.description import LinkInertia, Robot, get_robot
+from robobore.robot.kinematics import fk
 
 PAPER_Q = np.radians([-48.38, 54.82, 6.86, -54.16, 107.43, -21.95])
 K6 = np.array([3.0e6, 4.0e6, 2.6e6, 4.7e5, 4.5e5, 2.6e5])

@@ -20,7 +20,8 @@ from robobore.errors import ConfigError, DataError, InputError
 from robobore.io.records import json_mismatches
 from robobore.io.results import to_jsonable
 from robobore.plan.posture import plan_posture
-from robobore.robot.kinematics import fk, get_robot
+from robobore.robot.description import get_robot
+from robobore.robot.kinematics import fk
 
 runner = CliRunner()
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "plan_paper_bore.toml"

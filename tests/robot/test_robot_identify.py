@@ -19,8 +19,9 @@ from robobore.robot.campaign import (
     simulate_campaign,
     simulate_clean,
 )
+from robobore.robot.description import get_robot
 from robobore.robot.identify import identify_batch, identify_joint_stiffness, kabsch, screw_map
-from robobore.robot.kinematics import fk_jacobian, get_robot, rotation_vector
+from robobore.robot.kinematics import fk_jacobian, rotation_vector
 from robobore.robot.stiffness import directional_stiffness_xyz, process_frame
 
 ROBOT = "irb6600-175-2.55"

@@ -11,15 +11,17 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from robobore.errors import ConfigError, InputError
-from robobore.robot.kinematics import (
+from robobore.robot.description import (
     available_robots,
     check_joint_limits,
+    get_robot,
+    load_robot_file,
+)
+from robobore.robot.kinematics import (
     fk,
     fk_jacobian,
-    get_robot,
     jacobian,
     jacobian_derivative,
-    load_robot_file,
     rotation_vector,
 )
 

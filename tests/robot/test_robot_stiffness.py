@@ -8,7 +8,8 @@ import pytest
 from robobore.errors import IdentificationError, InputError, NumericalError
 from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD as K_TRUE
 from robobore.robot.campaign import deflect
-from robobore.robot.kinematics import fk, fk_jacobian, get_robot, rotation_vector
+from robobore.robot.description import get_robot
+from robobore.robot.kinematics import fk, fk_jacobian, rotation_vector
 from robobore.robot.stiffness import (
     JointStiffness,
     cartesian_stiffness,

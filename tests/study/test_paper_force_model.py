@@ -11,7 +11,10 @@ import re
 
 import pytest
 
-from robobore.cutting.fe.models.validate import bundled_validation_path, load_validation_record
+from robobore.cutting.fe.models.validation_record import (
+    bundled_validation_path,
+    load_validation_record,
+)
 from robobore.errors import DataError
 from robobore.study import paper_config as pc
 from robobore.study.paper_report import force_model_fe_text, force_model_validation
@@ -33,14 +36,14 @@ def _tables(html: str) -> list[str]:
 
 def test_bundled_record_is_the_nine_point_validation_of_the_default_model():
     rec = load_validation_record(bundled_validation_path())
-    assert len(rec["points"]) == 9
-    assert rec["config"].endswith("fe_orthogonal.toml")
-    hv = {(p["uncut_chip_thickness_um"], p["cutting_speed_m_per_min"]) for p in rec["points"]}
+    assert len(rec.points) == 9
+    assert rec.config.endswith("fe_orthogonal.toml")
+    hv = {(p.uncut_chip_thickness_um, p.cutting_speed_m_per_min) for p in rec.points}
     assert hv == {(h, v) for h in (40.0, 60.0, 80.0) for v in (5.0, 10.0, 30.0)}
-    for p in rec["points"]:  # every error is simulated / measured - 1 of the stored values
-        m = p["measured"]["cutting_force_N_per_mm"]
-        assert p["relative_error"]["cutting_force"] == pytest.approx(
-            p["cutting_force_N_per_mm"] / m - 1, rel=1e-9)
+    for p in rec.points:  # every error is simulated / measured - 1 of the stored values
+        m = p.measured.cutting_force_N_per_mm
+        assert p.relative_error.cutting_force == pytest.approx(
+            p.cutting_force_N_per_mm / m - 1, rel=1e-9)
 
 
 def test_section_names_the_model_lists_departures_and_shows_nine_rows():
@@ -59,7 +62,7 @@ def test_section_names_the_model_lists_departures_and_shows_nine_rows():
                 "Ff sim [N/mm]", "Ff err [%]", "chip ratio sim"):
         assert col in table
     rec = load_validation_record(bundled_validation_path())
-    mx = rec["summary"]["max_abs_error"]["cutting_force"]
+    mx = rec.summary.max_abs_error.cutting_force
     assert f"Fc {100 * mx:.1f} / " in html
     assert "not an independent validation" in html and "fe validate" in html
 

@@ -43,7 +43,7 @@ import time
 from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -54,6 +54,9 @@ from robobore.cutting.calibration_config import (
 )
 from robobore.cutting.calibration_runs import run_grid
 from robobore.errors import ConfigError, NumericalError
+
+if TYPE_CHECKING:
+    from robobore.cutting.fe.models.validation_record import ValidationRecord
 
 
 def fit_edge_model(h_m: np.ndarray, force_N_per_m: np.ndarray) -> dict[str, float]:
@@ -326,21 +329,29 @@ def _error_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def validation_calibration(record: dict[str, Any], fe_config: dict[str, Any],
+def validation_calibration(record: ValidationRecord, fe_config: dict[str, Any],
                            source: str | None = None
                            ) -> tuple[CalibrationConfig, list[dict[str, Any]]]:
     """The FE points of a validation record as a calibration: (config, records).
 
-    ``record``: the ``--json`` output of ``robobore fe validate``
-    (:func:`robobore.cutting.fe.models.validate.load_validation_record`); ``fe_config``: the FE
+    ``record``: the ``--json`` output of ``robobore fe validate`` as
+    :func:`robobore.cutting.fe.models.validation_record.load_validation_record` reads it (a
+    point without a finite simulated force is an error); ``fe_config``: the FE
     config mapping it ran (its ``[tool]`` is the insert, its ``[material]`` the material).
     The grid is the record's chip thicknesses x speeds (every combination must be in the
     record); the records carry the simulated forces (N/m) as :func:`run_grid` gives them, so
     :func:`calibrate` and :func:`mechanistic_check` fit them without running the FE.
     """
-    pts = {(float(p["uncut_chip_thickness_um"]), float(p["cutting_speed_m_per_min"])):
-           (float(p["cutting_force_N_per_mm"]), float(p["feed_force_N_per_mm"]))
-           for p in record["points"]}
+    for i, p in enumerate(record.points):
+        for name, v in (("cutting_force_N_per_mm", p.cutting_force_N_per_mm),
+                        ("feed_force_N_per_mm", p.feed_force_N_per_mm)):
+            if v is None:
+                raise ConfigError("validation point without a simulated force", file=source,
+                                  row=i, field=f"points[{i}].{name}", value=v,
+                                  expected="a finite force per mm of width [N/mm]")
+    pts = {(float(p.uncut_chip_thickness_um), float(p.cutting_speed_m_per_min)):
+           (float(p.cutting_force_N_per_mm), float(p.feed_force_N_per_mm))
+           for p in record.points}
     hs = sorted({h for h, _ in pts})
     vs = sorted({v for _, v in pts})
     missing = [f"{h:g}:{v:g}" for h in hs for v in vs if (h, v) not in pts]

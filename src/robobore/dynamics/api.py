@@ -320,5 +320,4 @@ def critical_depth_at(config: str | Path | dict[str, Any] | DynamicsConfig, spee
                          interrupted_below_mm=below * 1e3)
 
 
-__all__ = ["run_boring", "lobes", "critical_depth_at", "UNDECIDED_MAX_FACTOR", "BoringResult",
-           "LobesResult", "CriticalDepth"]
+__all__ = ["run_boring", "lobes", "critical_depth_at", "UNDECIDED_MAX_FACTOR"]

@@ -32,12 +32,7 @@ import numpy as np
 from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_HI_M,
-    auto_steps,
     chatter_free_windows,
-    critical_depth_semidiscretization,
-    deflected_depth_weights,
-    depth_scan_grid,
-    monodromy_spectral_radius,
 )
 from robobore.dynamics.structure import ToolPointStructure
 from robobore.dynamics.zero_order import (
@@ -310,10 +305,6 @@ def sdof_pocket_speeds(f_n: float, zeta: float, n_inserts: int, lobes: int) -> n
     return 60 * wc / (n_inserts * (eps + 2 * np.pi * k))
 
 
-__all__ = ["LobeResult", "DEPTH_SCAN_HI_M", "depth_scan_grid", "frequency_grid",
-           "oriented_eigenvalues", "lobe_branches",
-           "lobes_frequency_domain", "lobe_curves", "monodromy_spectral_radius",
-           "critical_depth_semidiscretization", "lobes_semidiscretization", "auto_steps",
-           "deflected_depth_weights",
-           "ModeCoupling",
-           "mode_coupling", "mode_coupling_limit", "sdof_absolute_limit", "sdof_pocket_speeds"]
+__all__ = ["LobeResult", "lobes_frequency_domain", "lobe_curves", "lobes_semidiscretization",
+           "ModeCoupling", "mode_coupling", "mode_coupling_limit", "sdof_absolute_limit",
+           "sdof_pocket_speeds"]

@@ -12,7 +12,8 @@ from __future__ import annotations
 from typing import Any
 
 _EXPORTS = {
-    "FRFData": "frf", "HammerRecords": "frf", "estimate_frf": "frf", "convert_frf": "frf",
+    "FRFData": "frf_data", "HammerRecords": "frf", "estimate_frf": "frf",
+    "convert_frf": "frf_data",
     "cmif": "cmif", "CMIF": "cmif", "plscf": "plscf", "PLSCFResult": "plscf",
     "stabilisation": "stabilization", "select_poles": "stabilization", "mac": "stabilization",
     "lsfd": "lsfd", "mpc": "lsfd", "identify_modes": "identify", "ModalResult": "identify",

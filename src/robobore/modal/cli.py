@@ -122,13 +122,8 @@ def modes_cmd(
     from robobore.io.outputs import check_output_dir, check_output_file
     from robobore.io.results import write_json
     from robobore.modal.example import EXAMPLE_BAND_HZ, example_path
-    from robobore.modal.frf import (
-        FRF_TYPES,
-        DoubleHitWarning,
-        FRFData,
-        LeakageWarning,
-        estimate_frf,
-    )
+    from robobore.modal.frf import DoubleHitWarning, LeakageWarning, estimate_frf
+    from robobore.modal.frf_data import FRF_TYPES, FRFData
     from robobore.modal.identify import identify_modes
     from robobore.modal.io import load_input
 
@@ -247,7 +242,7 @@ def _test_identity(path: Path, robot: str | None, joints_deg: str | None,
     out["source"] = str(path)
     out["synthetic"] = synthetic if synthetic is not None else out.get("synthetic")
     if robot is not None:
-        from robobore.robot.kinematics import get_robot
+        from robobore.robot.description import get_robot
 
         rb = get_robot(robot)
         check_robot(ident, str(tp), rb.name, rb.description_hash(), "--robot",
@@ -492,7 +487,7 @@ def _robot_truth(robot: str | None, robot_file: Path | None, joints_deg: str | N
     when one is missing or bad)."""
     from robobore.errors import ConfigError, IdentificationError, InputError
     from robobore.plan.virtual_hammer import robot_truth
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import get_robot
 
     if example:
         raise ConfigError("--example regenerates the bundled test", field="--robot",
@@ -546,7 +541,7 @@ def _robot_truth(robot: str | None, robot_file: Path | None, joints_deg: str | N
 
 def get_robot_for_identity(robot: str | None, robot_file: Path | None) -> Any:
     """The robot named by ``--robot`` or ``--robot-file``."""
-    from robobore.robot.kinematics import get_robot, load_robot_file
+    from robobore.robot.description import get_robot, load_robot_file
 
     return load_robot_file(robot_file) if robot_file is not None else get_robot(
         robot or "irb6600-175-2.55", field="--robot")
@@ -557,7 +552,7 @@ def _virtual_identity(rb: Any = None, q_deg: Any = None, tcp: Any = None) -> dic
     example robot at the example posture)."""
     from robobore.io.identity import make_identity
     from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, EXAMPLE_ROBOT, EXAMPLE_TCP_M
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import get_robot
 
     rb = get_robot(EXAMPLE_ROBOT) if rb is None else rb
     return make_identity("hammer test", robot=rb.name, robot_hash=rb.description_hash(),
@@ -571,7 +566,7 @@ def _virtual_truth(robot: str | None, robot_file: Path | None, joint_stiffness: 
                    joints_deg: str | None, tcp_m: str | None):
     """The truth model and identity of a virtual hammer test (options checked here)."""
     from robobore.modal.virtual import EXAMPLE_POSTURE_DEG, EXAMPLE_TCP_M, robot_boring_truth
-    from robobore.robot.kinematics import check_joint_limits, get_robot, load_robot_file
+    from robobore.robot.description import check_joint_limits, get_robot, load_robot_file
 
     if robot is None and robot_file is None and joint_stiffness is None and \
             joints_deg is None and tcp_m is None:

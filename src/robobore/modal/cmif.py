@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from robobore.modal.frf import FRFData
+from robobore.modal.frf_data import FRFData
 
 
 @dataclass(frozen=True)

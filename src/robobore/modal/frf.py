@@ -43,14 +43,8 @@ import numpy as np
 
 from robobore.errors import DataError, InputError
 from robobore.modal.frf_data import (
-    FRF_TYPES,
-    FRF_UNITS,
     RESPONSE_QUANTITIES,
     FRFData,
-    check_frequencies,
-    check_frf_array,
-    check_frf_type,
-    convert_frf,
 )
 
 
@@ -462,9 +456,15 @@ def combine_hits(est: FRFEstimate, weights: np.ndarray) -> FRFData:
 
 
 __all__ = [
-    "FRF_TYPES", "FRF_UNITS", "FRFData", "HammerRecords", "HitCheck", "FRFEstimate",
-    "DoubleHitWarning", "LeakageWarning", "record_decay_ratio", "estimate_frf", "convert_frf",
+    "HammerRecords",
+    "HitCheck",
+    "FRFEstimate",
+    "DoubleHitWarning",
+    "LeakageWarning",
+    "record_decay_ratio",
+    "estimate_frf",
     "combine_hits",
-    "check_hit", "force_window",
-    "exponential_window", "check_frequencies", "check_frf_array", "check_frf_type",
+    "check_hit",
+    "force_window",
+    "exponential_window",
 ]

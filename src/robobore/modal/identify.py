@@ -24,7 +24,8 @@ import numpy as np
 
 from robobore.errors import IdentificationError, InputError
 from robobore.modal.cmif import CMIF, cmif
-from robobore.modal.frf import FRFData, FRFEstimate, HammerRecords
+from robobore.modal.frf import FRFEstimate, HammerRecords
+from robobore.modal.frf_data import FRFData
 from robobore.modal.lsfd import LSFDResult, lsfd, modal_peak_compliance, mpc, normalise_shape
 from robobore.modal.plscf import PLSCFResult, plscf
 from robobore.modal.stabilization import (

@@ -31,7 +31,8 @@ import numpy as np
 from robobore.errors import DataError
 from robobore.io.ranges import check_array, check_value
 from robobore.io.results import atomic_write_bytes
-from robobore.modal.frf import FRFData, HammerRecords, check_frf_type
+from robobore.modal.frf import HammerRecords
+from robobore.modal.frf_data import FRFData, check_frf_type
 
 SPEC_FORCE = 13
 SPEC_BY_QUANTITY = {"acceleration": 12, "velocity": 11, "displacement": 8}

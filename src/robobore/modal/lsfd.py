@@ -22,8 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robobore.errors import IdentificationError
-from robobore.modal.frf import FRFData
-from robobore.modal.frf_data import FRF_POWER
+from robobore.modal.frf_data import FRF_POWER, FRFData
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robobore.modal.frf import FRF_UNITS
+from robobore.modal.frf_data import FRF_UNITS
 from robobore.modal.identify import ModalAnalysis
 
 _MARKERS = {0: ("o", "0.7", "new"), 1: ("x", "tab:orange", "f"), 2: ("d", "tab:blue", "f+d"),

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import IdentificationError, InputError
-from robobore.modal.frf import FRFData
+from robobore.modal.frf_data import FRFData
 
 
 @contextmanager

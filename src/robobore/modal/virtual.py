@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import InputError
-from robobore.modal.frf import FRFData, HammerRecords
+from robobore.modal.frf import HammerRecords
+from robobore.modal.frf_data import FRFData
 
 TIP_WIDTH_S = {"soft": 8e-3, "medium": 4e-3, "hard": 1.5e-3}
 
@@ -184,7 +185,8 @@ def tool_point_compliance(joint_stiffness_Nm_per_rad: Any = None,
     directional stiffness of :func:`robobore.robot.stiffness.directional_stiffness_xyz`.
     """
     from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
-    from robobore.robot.kinematics import fk_jacobian, get_robot
+    from robobore.robot.description import get_robot
+    from robobore.robot.kinematics import fk_jacobian
     from robobore.robot.stiffness import compliance_matrix, process_frame
 
     k = (IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD if joint_stiffness_Nm_per_rad is None

@@ -19,7 +19,8 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import InputError
-from robobore.robot.kinematics import Robot, fk_jacobian
+from robobore.robot.description import Robot
+from robobore.robot.kinematics import fk_jacobian
 
 
 @dataclass(frozen=True)

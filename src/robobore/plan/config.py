@@ -281,7 +281,7 @@ def load_plan_config(path: str | Path, x_hint: Any = None) -> PlanInputs:
         raise ConfigError("wrong number of joint angles", file=f,
                           field="identification.posture_deg", value=list(qm),
                           expected=f"{robot.n_joints} angles in deg")
-    from robobore.robot.kinematics import check_joint_limits
+    from robobore.robot.description import check_joint_limits
 
     check_joint_limits(robot, np.radians(qm), file=f)
     synthetic = bool(sdata.get("synthetic", False)) or bool(mdata.get("synthetic", False))
@@ -327,8 +327,7 @@ def _plan_robot(cfg: PlanConfig, raw: dict[str, Any], p: Path) -> tuple[Any, lis
     stiffness file (else the modes file) was identified for, said in a note; the default
     robot when neither the config nor the files name one."""
     from robobore.io.identity import read_identity
-    from robobore.robot.description import robot_of_identity
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import get_robot, robot_of_identity
 
     f = str(p)
     if not _names_robot(raw):

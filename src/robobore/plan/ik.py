@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from robobore.robot.kinematics import Robot
+from robobore.robot.description import Robot
 
 N_BRANCHES = 8
 

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.errors import ConfigError, InputError
-from robobore.robot.kinematics import Robot
+from robobore.robot.description import Robot
 
 
 @dataclass(frozen=True)

@@ -60,7 +60,8 @@ from robobore.plan.bending import (
     redundancy,
 )
 from robobore.plan.inertia import ToolBody, link_arrays, mass_matrix, merge_tool
-from robobore.robot.kinematics import Robot, fk_jacobian
+from robobore.robot.description import Robot
+from robobore.robot.kinematics import fk_jacobian
 from robobore.robot.stiffness import process_frame
 
 
@@ -471,5 +472,5 @@ def calibrate(model: PoseModel, q_meas_rad: Any, frequency_Hz: Any, damping_rati
                        pm2.damping_ratio[0, sel], f0_all[sel], tuple(pick))
 
 
-__all__ = ["ToolBody", "PoseModel", "PostureModes", "Calibration", "calibrate", "LinkBending",
-           "boring_frames", "fit_joint_damping", "fit_proportional_damping"]
+__all__ = ["PoseModel", "PostureModes", "Calibration", "calibrate", "boring_frames",
+           "fit_joint_damping", "fit_proportional_damping"]

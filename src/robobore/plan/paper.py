@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import RoboboreError
-from robobore.plan.model import ToolBody
+from robobore.plan.inertia import ToolBody
 
 #: ASSUMED end effector for the paper's cell: electro-spindle + boring bar, 60 kg, centre of
 #: mass 0.15 m along the flange z axis (solid cylinder 0.2 m diameter, 0.4 m long).
@@ -37,7 +37,8 @@ def paper_posture_plan(cfg: Any, cfg_path: Path, stiff: dict[str, Any], modes: d
     from robobore.cutting.coefficient_files import inline_coefficients
     from robobore.plan.config import PlanConfig, PlanInputs
     from robobore.plan.posture import run_plan, workspace_map
-    from robobore.robot.kinematics import fk, get_robot
+    from robobore.robot.description import get_robot
+    from robobore.robot.kinematics import fk
 
     t0 = time.perf_counter()
     try:

@@ -141,7 +141,8 @@ def run_plan(inp: PlanInputs, *, progress_factory: Any = None,
 
     from robobore.dynamics.semidiscretization import chatter_free_window
     from robobore.dynamics.stability import lobes_semidiscretization
-    from robobore.plan.model import PoseModel, ToolBody, calibrate
+    from robobore.plan.inertia import ToolBody
+    from robobore.plan.model import PoseModel, calibrate
     from robobore.robot.kinematics import fk
 
     t0 = time.perf_counter() if t0 is None else t0
@@ -417,4 +418,4 @@ def workspace_map(result: PostureResult, progress: Any = None) -> dict[str, Any]
             "criterion": inp.cfg.plan.criterion, "rotation_step_deg": ws.rotation_step_deg}
 
 
-__all__ = ["plan_posture", "run_plan", "results_dataset", "workspace_map", "PostureResult"]
+__all__ = ["plan_posture", "run_plan", "results_dataset", "workspace_map"]

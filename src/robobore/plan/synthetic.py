@@ -36,8 +36,10 @@ from typing import Any
 
 import numpy as np
 
-from robobore.plan.model import PoseModel, ToolBody
-from robobore.robot.kinematics import Robot, get_robot, rotation_vector
+from robobore.plan.inertia import ToolBody
+from robobore.plan.model import PoseModel
+from robobore.robot.description import Robot, get_robot
+from robobore.robot.kinematics import rotation_vector
 
 TRUTH_JOINT_K = np.array([3.2e6, 4.2e6, 2.5e6, 4.8e5, 4.4e5, 2.6e5])
 TRUTH_JOINT_C = np.array([3000.0, 3500.0, 900.0, 150.0, 80.0, 30.0])
@@ -323,7 +325,8 @@ def run_validation(n_heldout: int = 24, f_max_Hz: float = 60.0,
     sensitivity case). ``link_bending``: the planner's model also has the lower arm and the
     forearm as Euler-Bernoulli beams (:class:`robobore.plan.bending.LinkBending`), their
     compliances identified with the joint compliances from the same campaign."""
-    from robobore.plan.model import LinkBending, calibrate
+    from robobore.plan.bending import LinkBending
+    from robobore.plan.model import calibrate
 
     robot = get_robot("irb6600-175-2.55")
     truth = TruthRobot(robot, bend_scale=bend_scale)

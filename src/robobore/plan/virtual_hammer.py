@@ -35,9 +35,10 @@ def robot_truth(robot: Any, joints_deg: Any, joint_stiffness_Nm_per_rad: Any, *,
     """The modal truth of ``robot`` (name, TOML path or Robot) at ``joints_deg`` with the joint
     stiffness (N m/rad) -> ``(ModalTruth, info)``; ``info`` holds the robot, the posture, the
     robot's directional stiffness (N/m) and the modes' frequencies."""
-    from robobore.plan.model import PoseModel
     from robobore.plan.inertia import ToolBody
-    from robobore.robot.kinematics import fk_jacobian, get_robot
+    from robobore.plan.model import PoseModel
+    from robobore.robot.description import get_robot
+    from robobore.robot.kinematics import fk_jacobian
 
     rb = get_robot(robot)
     q = np.asarray(joints_deg, float).ravel()

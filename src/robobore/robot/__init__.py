@@ -20,13 +20,13 @@ import importlib
 from typing import Any
 
 _EXPORTS = {
-    "Robot": "kinematics",
-    "get_robot": "kinematics",
-    "available_robots": "kinematics",
+    "Robot": "description",
+    "get_robot": "description",
+    "available_robots": "description",
     "fk": "kinematics",
     "jacobian": "kinematics",
     "fk_jacobian": "kinematics",
-    "check_joint_limits": "kinematics",
+    "check_joint_limits": "description",
     "JointStiffness": "stiffness",
     "directional_stiffness_xyz": "stiffness",
     "stiffness_at": "stiffness",

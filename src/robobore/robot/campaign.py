@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import ConfigError, InputError
-from robobore.robot.kinematics import check_joint_limits, fk, fk_jacobian, get_robot
+from robobore.robot.description import check_joint_limits, get_robot
+from robobore.robot.kinematics import fk, fk_jacobian
 
 #: Ground truth used for the bundled synthetic IRB 6600 campaign and the tests, N m/rad.
 #: ASSUMPTION, not a measurement of any real robot: values of the order published for

@@ -197,7 +197,7 @@ def read_campaign(path: str | Path, robot=None) -> Campaign:
     truth = read_truth(p)
     if truth is not None and robot is not None:
         from robobore.io.identity import check_robot
-        from robobore.robot.kinematics import get_robot
+        from robobore.robot.description import get_robot
 
         rb = get_robot(robot)
         check_robot({"robot": truth.get("robot"), "robot_hash": truth.get("robot_hash")},
@@ -294,7 +294,7 @@ def validate_campaign(c: Campaign, robot=None) -> None:
                         expected=f"a largest force of at least {MIN_PEAK_FORCE_N:g} N "
                         "(stiffness campaigns load 100 .. 5000 N)")
     if robot is not None:
-        from robobore.robot.kinematics import check_joint_limits, get_robot
+        from robobore.robot.description import check_joint_limits, get_robot
 
         rb = get_robot(robot)
         for i in range(c.n_rows):

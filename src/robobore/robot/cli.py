@@ -46,7 +46,7 @@ FRAME_OPT = typer.Option(
 
 def _robot(robot: str | None, robot_file: Path | None, default: str | None = DEFAULT_ROBOT):
     from robobore.errors import ConfigError
-    from robobore.robot.kinematics import get_robot, load_robot_file
+    from robobore.robot.description import get_robot, load_robot_file
 
     if robot_file is not None:
         return load_robot_file(robot_file)
@@ -81,7 +81,7 @@ def _q(robot, joints_deg: str, warn: list[str] | None = None):
     import numpy as np
 
     from robobore.io.ranges import radians_hint
-    from robobore.robot.kinematics import check_joint_limits
+    from robobore.robot.description import check_joint_limits
 
     vals = parse_floats(joints_deg, robot.n_joints, "--joints-deg", "deg")
     hint = radians_hint(vals, "--joints-deg")
@@ -120,7 +120,7 @@ def _matrix_table(title: str, M, row_labels, col_labels):
 @handle_errors
 def list_cmd(as_json: bool = JSON_OPTION) -> None:
     """List the robots in the library (built-in and ROBOBORE_ROBOT_PATH folders)."""
-    from robobore.robot.kinematics import available_robots, load_robot_file
+    from robobore.robot.description import available_robots, load_robot_file
 
     out = {}
     for name, path in available_robots().items():

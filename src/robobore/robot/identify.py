@@ -41,7 +41,8 @@ from scipy import optimize, stats
 from robobore.errors import IdentificationError, InputError
 from robobore.robot.campaign import Campaign
 from robobore.robot.campaign_io import validate_campaign
-from robobore.robot.kinematics import check_joint_limits, fk_jacobian, get_robot, rotation_vector
+from robobore.robot.description import check_joint_limits, get_robot
+from robobore.robot.kinematics import fk_jacobian, rotation_vector
 from robobore.robot.stiffness import JointStiffness, process_frame
 
 STRUCTURAL_ZERO = 1e-8  # column norm relative to the largest: "no excitation"

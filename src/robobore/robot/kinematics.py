@@ -27,14 +27,7 @@ import numpy as np
 from numba import njit, prange
 
 from robobore.errors import InputError
-from robobore.robot.description import (
-    LinkInertia,
-    Robot,
-    available_robots,
-    check_joint_limits,
-    get_robot,
-    load_robot_file,
-)
+from robobore.robot.description import Robot
 
 # --- kernels --------------------------------------------------------------------------------
 
@@ -272,12 +265,6 @@ def rotation_vector(R: np.ndarray) -> np.ndarray:
 
 
 __all__ = [
-    "Robot",
-    "LinkInertia",
-    "available_robots",
-    "get_robot",
-    "load_robot_file",
-    "check_joint_limits",
     "fk",
     "jacobian",
     "fk_jacobian",

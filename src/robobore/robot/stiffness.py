@@ -39,7 +39,8 @@ from typing import Any
 import numpy as np
 
 from robobore.errors import ConfigError, IdentificationError, InputError, NumericalError
-from robobore.robot.kinematics import Robot, fk_jacobian, get_robot, jacobian_derivative
+from robobore.robot.description import Robot, get_robot
+from robobore.robot.kinematics import fk_jacobian, jacobian_derivative
 
 FRAMES = ("tool", "base", "boring")
 #: a feed axis within this angle of the vertical (deg) is a vertical bore: the boring

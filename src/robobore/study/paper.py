@@ -70,8 +70,8 @@ def _resolve(base: Path, name: str | None) -> Path | None:
 def identify_stiffness(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
     """Joint stiffness from the campaign + directional stiffness at the configured posture."""
     from robobore.robot.campaign_io import read_campaign
+    from robobore.robot.description import get_robot
     from robobore.robot.identify import identify_joint_stiffness
-    from robobore.robot.kinematics import get_robot
     from robobore.robot.stiffness import directional_stiffness_xyz
 
     robot = get_robot(cfg.robot.name)
@@ -101,7 +101,8 @@ def identify_modes(cfg: PaperConfig, cfg_path: Path) -> dict[str, Any]:
     under ``"analysis"`` the :class:`~robobore.modal.identify.ModalAnalysis` (not JSON: the
     report draws its stabilisation diagram and FRF fit)."""
     from robobore.modal.example import example_path
-    from robobore.modal.frf import FRFData, estimate_frf
+    from robobore.modal.frf import estimate_frf
+    from robobore.modal.frf_data import FRFData
     from robobore.modal.identify import identify_modes as _identify
     from robobore.modal.io import load_input
 

@@ -145,7 +145,10 @@ def force_model_validation(rep: Report, coeffs: dict[str, Any],
     of the default model (``robobore/data/fe_validation``) when the calibration ran the
     validated physics on its material; otherwise a note that no validation applies."""
     from robobore.cutting.calibration_config import VALIDATION_DOMAIN
-    from robobore.cutting.fe.models.validate import bundled_validation_path, load_validation_record
+    from robobore.cutting.fe.models.validation_record import (
+        bundled_validation_path,
+        load_validation_record,
+    )
 
     m = coeffs.get("fe_model") if isinstance(coeffs.get("fe_model"), dict) else {}
     mat = coeffs.get("material")
@@ -162,32 +165,32 @@ def force_model_validation(rep: Report, coeffs: dict[str, Any],
         return
     val = load_validation_record(path)
     rows = []
-    for pt in val["points"]:
-        ms, er = pt["measured"], pt["relative_error"]
-        rows.append({"h [um]": pt["uncut_chip_thickness_um"],
-                     "vc [m/min]": pt["cutting_speed_m_per_min"],
-                     "Fc meas [N/mm]": ms.get("cutting_force_N_per_mm"),
-                     "Fc sim [N/mm]": pt["cutting_force_N_per_mm"],
-                     "Fc err [%]": _pct(er.get("cutting_force")),
-                     "Ff meas [N/mm]": ms.get("feed_force_N_per_mm"),
-                     "Ff sim [N/mm]": pt["feed_force_N_per_mm"],
-                     "Ff err [%]": _pct(er.get("feed_force")),
-                     "chip ratio meas": ms.get("chip_ratio"),
-                     "chip ratio sim": pt["chip_ratio"],
-                     "chip ratio err [%]": _pct(er.get("chip_ratio"))})
+    for pt in val.points:
+        ms, er = pt.measured, pt.relative_error
+        rows.append({"h [um]": pt.uncut_chip_thickness_um,
+                     "vc [m/min]": pt.cutting_speed_m_per_min,
+                     "Fc meas [N/mm]": ms.cutting_force_N_per_mm,
+                     "Fc sim [N/mm]": pt.cutting_force_N_per_mm,
+                     "Fc err [%]": _pct(er.cutting_force),
+                     "Ff meas [N/mm]": ms.feed_force_N_per_mm,
+                     "Ff sim [N/mm]": pt.feed_force_N_per_mm,
+                     "Ff err [%]": _pct(er.feed_force),
+                     "chip ratio meas": ms.chip_ratio,
+                     "chip ratio sim": pt.chip_ratio,
+                     "chip ratio err [%]": _pct(er.chip_ratio)})
     rep.add_table(rows, caption="Validation of the FE model against measured orthogonal "
                   "forces (err = simulated / measured - 1)", float_fmt="{:.4g}")
-    s = val["summary"]
+    mx_, mn_ = val.summary.max_abs_error, val.summary.mean_abs_error
     parts = []
-    for key, label in (("cutting_force", "Fc"), ("feed_force", "Ff"),
-                       ("chip_ratio", "chip ratio")):
-        mx, mn = s["max_abs_error"].get(key), s["mean_abs_error"].get(key)
+    for label, mx, mn in (("Fc", mx_.cutting_force, mn_.cutting_force),
+                          ("Ff", mx_.feed_force, mn_.feed_force),
+                          ("chip ratio", mx_.chip_ratio, mn_.chip_ratio)):
         if mx is not None and mn is not None:
             parts.append(f"{label} {100 * mx:.1f} / {100 * mn:.1f} %")
     rep.add_text("Max / mean |error| over the points: " + ", ".join(parts) + ".")
     rep.add_text(f"Source: {path.name} (robobore/data/fe_validation), the --json output of "
-                 f"robobore fe validate {val.get('config')} --measured "
-                 f"{Path(str(val.get('measured_file'))).name} (the engine's default model at "
+                 f"robobore fe validate {val.config} --measured "
+                 f"{Path(str(val.measured_file)).name} (the engine's default model at "
                  "its validated configuration). Its two CALIBRATED choices (friction law "
                  "rech2013_calibrated, the hardening hold) were chosen on these same points, "
                  "so the table shows how far the calibration reaches, not an independent "

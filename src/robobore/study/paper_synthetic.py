@@ -23,7 +23,7 @@ def truth_robot_model(cfg: PaperConfig) -> dict[str, Any]:
     """The 'real' robot of the SYNTHETIC measurements (documented ground truth)."""
     from robobore.modal.virtual import robot_boring_truth
     from robobore.robot.campaign import IRB6600_ASSUMED_JOINT_STIFFNESS_NM_PER_RAD
-    from robobore.robot.kinematics import get_robot
+    from robobore.robot.description import get_robot
     from robobore.robot.stiffness import directional_stiffness_xyz
 
     robot = get_robot(cfg.robot.name)

@@ -20,7 +20,8 @@ from typer.testing import CliRunner
 
 from robobore.cli import app
 from robobore.cutting.fe.engine.gpu import backend2d as gpu2d
-from robobore.cutting.fe.engine.gpu import backend3d as gpu
+from robobore.cutting.fe.engine.gpu.runstate2d import N_RED, RunState
+from robobore.cutting.fe.engine.gpu.shared import cuda_available
 from robobore.errors import ConfigError
 
 EXAMPLE = Path(__file__).parents[3] / "examples" / "fe_orthogonal.toml"
@@ -164,7 +165,7 @@ SCRIPT_TF = PRELUDE + textwrap.dedent("""
 
 def test_gpu2d_module_imports_and_reports_cleanly():
     assert callable(gpu2d.advance_gpu)
-    if not gpu.cuda_available():
+    if not cuda_available():
         from robobore.cutting.fe.config.orthogonal import load_fe_config
         from robobore.cutting.fe.models.orthogonal import simulate_orthogonal
 
@@ -179,7 +180,7 @@ def test_bbar_is_refused_on_the_gpu():
 
 
 def test_cli_device_gpu_fails_cleanly_without_gpu(tmp_path):
-    if gpu.cuda_available():
+    if cuda_available():
         pytest.skip("a GPU is usable here")
     r = CliRunner().invoke(app, ["fe", "orthogonal", str(EXAMPLE), "--json", "--device", "gpu"])
     assert r.exit_code == 2
@@ -321,8 +322,8 @@ def test_persistent_kernel_parameters_fit_in_cuda_limit():
     st = setup_orthogonal(parse_config(d)).state
     # k_run(n_steps, state (the arrays, then erosion, cond_every, theat, rz_every), red, cflag,
     # clist); the state, a namedtuple, passes as its elements' fields
-    state = gpu2d.RunState(*[getattr(st, k) for k in gpu2d._ARRAYS], 0, 0, 0, 0)
-    total = (arg(0) + arg(state) + arg(np.zeros(gpu2d.N_RED)) + arg(np.zeros(1, np.int32))
+    state = RunState(*[getattr(st, k) for k in gpu2d._ARRAYS], 0, 0, 0, 0)
+    total = (arg(0) + arg(state) + arg(np.zeros(N_RED)) + arg(np.zeros(1, np.int32))
              + arg(np.zeros(1, np.int64)))
     assert arg(state) == sum(arg(v) for v in state)
     assert arg(np.zeros(3)) == 56 and arg(np.zeros((3, 2))) == 72  # the model counted

@@ -103,8 +103,9 @@ def test_2d_default_model_gives_the_same_digits_on_any_thread_count():
 
 @needs_threads
 def test_3d_boring_model_gives_the_same_digits_on_any_thread_count():
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.cutting.fe.engine.state3d import advance3
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.models.boring3d import setup_boring
 
     d = {"cut": {"depth_of_cut_mm": 0.05, "feed_mm_per_rev": 0.15, "speed_rpm": 300.0,
                  "cut_length_mm": 0.02},

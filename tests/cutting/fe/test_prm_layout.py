@@ -51,7 +51,7 @@ def test_fields_tile_the_vector_and_bind_the_constants(layout, users):
 def test_table_fields_take_their_size():
     assert L.P_MUTAB_MU - L.P_MUTAB_V == L.MU_TABLE_MAX
     assert L.P_SLIP_TAU - L.P_MUTAB_MU == L.MU_TABLE_MAX
-    assert L3.P_MUTAB_MU - L3.P_MUTAB_V == L3.MU_TABLE_MAX
+    assert L3.P_MUTAB_MU - L3.P_MUTAB_V == L.MU_TABLE_MAX
 
 
 @pytest.mark.parametrize("fields, word", [

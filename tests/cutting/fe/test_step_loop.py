@@ -28,7 +28,8 @@ def _state2():
 
 
 def _state3():
-    from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
+    from robobore.cutting.fe.models.boring3d import setup_boring
     from robobore.io.config import load_toml
 
     d = load_toml(EX / "fe_boring_paper.toml")

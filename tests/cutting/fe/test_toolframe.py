@@ -14,16 +14,8 @@ import math
 import numpy as np
 import pytest
 
-from robobore.cutting.fe.ale.rezone import (
-    BF_OPEN,
-    BF_VIRGIN,
-    TF_CHAIN,
-    TF_INTERIOR,
-    TF_LINE,
-    TF_RIGID,
-    rezone,
-    swept_py,
-)
+from robobore.cutting.fe.ale.remap import BF_OPEN, BF_VIRGIN, swept_py
+from robobore.cutting.fe.ale.rezone import TF_CHAIN, TF_INTERIOR, TF_LINE, TF_RIGID, rezone
 from robobore.cutting.fe.ale.toolframe import build_toolframe_mesh
 from robobore.cutting.fe.config.orthogonal import parse_config
 from robobore.cutting.fe.engine import layout
@@ -179,7 +171,7 @@ def test_tool_frame_config_errors(patch, field):
 def test_tool_frame_on_gpu_needs_a_gpu():
     """The tool-frame model runs on the GPU (the simulator test in
     test_fe2d_gpu.py); without a usable GPU --device gpu stops with the clear error."""
-    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
+    from robobore.cutting.fe.engine.gpu.shared import cuda_available
     from robobore.cutting.fe.models.orthogonal import check_device
 
     cfg = parse_config({"tool": {"rake_deg": 15, "clearance_deg": 2, "edge_radius_um": 20},

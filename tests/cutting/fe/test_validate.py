@@ -18,7 +18,18 @@ from typer.testing import CliRunner
 
 from robobore.cli import app
 from robobore.cutting.fe.models import validate as V
-from robobore.cutting.fe.models.results import PerQuantity
+from robobore.cutting.fe.models.results import (
+    MeasuredValues,
+    PerQuantity,
+    ValidationPoint,
+    ValidationSummary,
+)
+from robobore.cutting.fe.models.validation_record import (
+    _KINDS,
+    ValidationRecord,
+    bundled_validation_path,
+    load_validation_record,
+)
 from robobore.errors import ConfigError, DataError
 
 TINY = """\
@@ -187,6 +198,12 @@ def test_cli_json_contract_and_resume(tmp_path):
         assert s["mean_abs_error"][q] == pytest.approx(sum(errs) / len(errs))
     assert (tmp_path / "png" / "fe_validation.png").is_file()
     assert len(list(out.glob("*.json"))) == 3
+    # the --json output read back as a record: typed, and to_dict() is that JSON, key order too
+    (tmp_path / "rec.json").write_text(r.stdout)
+    rec = load_validation_record(tmp_path / "rec.json")
+    assert rec.measured_file == str(m) and rec.identity["kind"] == "fe validate"
+    assert rec.files == {"png_validation": str(tmp_path / "png" / "fe_validation.png")}
+    assert json.dumps(rec.to_dict()) == json.dumps(res)
     # a rerun reuses every stored point: same numbers
     r2 = CliRunner().invoke(app, args[:-2])
     res2 = json.loads(r2.stdout)
@@ -260,3 +277,68 @@ def test_points_option_runs_a_prediction(tmp_path):
     assert d["summary"] == {"max_abs_error": none, "mean_abs_error": none,
                             "n_measured": {"cutting_force": 0, "feed_force": 0,
                                            "chip_ratio": 0}}
+
+
+def test_bundled_record_reads_back_typed_and_exactly():
+    """The bundled record as a ValidationRecord: typed points and summary; ``to_dict()`` is the
+    file's JSON, key for key and in order."""
+    path = bundled_validation_path()
+    raw = json.loads(path.read_text(encoding="utf-8"))
+    rec = load_validation_record(path)
+    assert isinstance(rec, ValidationRecord) and len(rec.points) == 9
+    assert all(isinstance(p, ValidationPoint) for p in rec.points)
+    assert isinstance(rec.summary, ValidationSummary)
+    assert isinstance(rec.points[0].measured, MeasuredValues)
+    assert rec.points[0].measured.cutting_force_N_per_mm == \
+        raw["points"][0]["measured"]["cutting_force_N_per_mm"]
+    assert rec.summary.n_measured.cutting_force == 9
+    assert rec.measured_file == raw["measured_file"] and rec.identity is None
+    assert json.dumps(rec.to_dict()) == json.dumps(raw)
+    d = rec.to_dict()
+    d["points"][0]["measured"]["chip_ratio"] = -1.0  # a copy: the record is not changed
+    assert rec.to_dict() == raw
+
+
+def test_the_record_reader_knows_every_field_of_the_contract():
+    """The reader's table of keys is the fields of the result types (a new field is read)."""
+    from dataclasses import fields
+
+    for cls, kinds in _KINDS.items():
+        assert list(kinds) == [f.name for f in fields(cls)], cls
+
+
+def _bad_record(tmp_path, change):
+    raw = json.loads(bundled_validation_path().read_text(encoding="utf-8"))
+    change(raw)
+    f = tmp_path / "rec.json"
+    f.write_text(json.dumps(raw))
+    with pytest.raises(DataError) as e:
+        load_validation_record(f)
+    assert e.value.file == str(f)
+    return e.value
+
+
+def test_bad_validation_records_name_file_key_and_value(tmp_path):
+    e = _bad_record(tmp_path, lambda r: r["points"][2].pop("reused"))
+    assert "lacks a key" in e.message and e.field == "points[2].reused" and e.row == 2
+    e = _bad_record(tmp_path, lambda r: r["points"][1]["measured"].update(extra=1.0))
+    assert "unknown key" in e.message and e.field == "points[1].measured.extra"
+    e = _bad_record(tmp_path, lambda r: r["points"][0].update(cutting_force_N_per_mm="105"))
+    assert e.field == "points[0].cutting_force_N_per_mm" and e.value == "105"
+    assert "a number or null" in e.expected
+    e = _bad_record(tmp_path, lambda r: r["points"][0].update(uncut_chip_thickness_um=None))
+    assert e.field == "points[0].uncut_chip_thickness_um" and e.expected == "a number"
+    e = _bad_record(tmp_path, lambda r: r["points"][0].update(reused=1))
+    assert e.field == "points[0].reused" and e.expected == "true or false"
+    e = _bad_record(tmp_path, lambda r: r["summary"]["n_measured"].pop("chip_ratio"))
+    assert e.field == "summary.n_measured.chip_ratio"
+    e = _bad_record(tmp_path, lambda r: r.pop("device"))
+    assert "lacks a key" in e.message and e.field == "device"
+    e = _bad_record(tmp_path, lambda r: r.update(measured_file=None))
+    assert e.field == "measured_file" and e.expected == "a string"
+    e = _bad_record(tmp_path, lambda r: r.update(files={"png_validation": 3}))
+    assert e.field == "files.png_validation"
+    e = _bad_record(tmp_path, lambda r: r.update(note="hand-edited"))
+    assert "unknown key" in e.message and e.field == "note"
+    e = _bad_record(tmp_path, lambda r: r.update(points=[]))
+    assert "no validation points" in e.message and e.field == "points"

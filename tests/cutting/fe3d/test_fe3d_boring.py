@@ -16,7 +16,8 @@ import typer
 from typer.testing import CliRunner
 
 from robobore.cutting.fe.cli_boring import register_boring
-from robobore.cutting.fe.models.boring3d import build_boring_mesh, parse_boring_config
+from robobore.cutting.fe.config.boring3d import parse_boring_config
+from robobore.cutting.fe.mesh.boring3d import build_boring_mesh
 from robobore.cutting.geometry import BoringInsert, chip_area
 from robobore.errors import ConfigError
 
@@ -150,7 +151,7 @@ def test_tiny_run_physics(tiny_run):
 
 
 def test_gpu_request_without_gpu_is_a_clear_error(tiny_run):
-    from robobore.cutting.fe.engine.gpu.backend3d import cuda_available
+    from robobore.cutting.fe.engine.gpu.shared import cuda_available
 
     if cuda_available():
         pytest.skip("a CUDA device is present: the no-GPU error path does not apply")

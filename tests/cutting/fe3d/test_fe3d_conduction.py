@@ -11,15 +11,11 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.ale.groups3d import groups3_of
-from robobore.cutting.fe.engine.state3d import (
-    advance3,
-    box_mesh,
-    energy_error,
-    make_state3,
-    split_node_layer,
-)
+from robobore.cutting.fe.config.boring3d import parse_boring_config
+from robobore.cutting.fe.engine.chunk_driver import energy_error
+from robobore.cutting.fe.engine.state3d import advance3, box_mesh, make_state3, split_node_layer
 from robobore.cutting.fe.hex import layout3d
-from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+from robobore.cutting.fe.models.boring3d import setup_boring
 from robobore.cutting.fe.physics.thermal3d import (
     conduct3,
     face_neighbours,

@@ -12,13 +12,13 @@ import math
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.config.boring3d import parse_boring_config
 from robobore.cutting.fe.config.contact import ContactSection
 from robobore.cutting.fe.config.engine_settings import apply_friction_settings
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state2d import default_prm
 from robobore.cutting.fe.engine.state3d import box_mesh, default_prm3, make_state3
 from robobore.cutting.fe.hex import layout3d, scalar3d
-from robobore.cutting.fe.models.boring3d import parse_boring_config
 from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
 from robobore.material import load_material

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from robobore.cutting.fe.engine.gpu import backend3d as gpu
+from robobore.cutting.fe.engine.gpu.shared import cuda_available, require_gpu
 from robobore.errors import ConfigError
 
 #: the GPU benchmark script; its ``small3d`` builds the simulator test's state
@@ -84,10 +85,10 @@ SCRIPT = textwrap.dedent("""
 
 
 def test_gpu_module_imports_and_reports_cleanly():
-    assert isinstance(gpu.cuda_available(), bool)
-    if not gpu.cuda_available():
+    assert isinstance(cuda_available(), bool)
+    if not cuda_available():
         with pytest.raises(ConfigError, match="no usable NVIDIA GPU"):
-            gpu.require_gpu()
+            require_gpu()
 
 
 def _simulator_usable() -> bool:

@@ -13,15 +13,12 @@ import math
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.config.boring3d import parse_boring_config
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state3d import advance3, box_mesh, default_prm3, make_state3
 from robobore.cutting.fe.hex import layout3d, scalar3d
-from robobore.cutting.fe.models.boring3d import (
-    build_boring_mesh,
-    parse_boring_config,
-    parting_surface,
-    setup_boring,
-)
+from robobore.cutting.fe.mesh.boring3d import build_boring_mesh, parting_surface
+from robobore.cutting.fe.models.boring3d import setup_boring
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
 from robobore.material import load_material

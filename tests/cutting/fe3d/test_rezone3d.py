@@ -51,12 +51,12 @@ from robobore.cutting.fe.hex.layout3d import (
 from robobore.cutting.fe.hex.scalar3d import insert_gap3_py
 from robobore.cutting.fe.mesh.toolframe3d import (
     FK_SIDE,
-    ToolFrame3DSizes,
     build_toolframe3d_mesh,
     extrude_toolframe_mesh,
     reference_blocks,
-    slice_map,
 )
+from robobore.cutting.fe.mesh.toolframe3d_layout import ToolFrame3DSizes
+from robobore.cutting.fe.mesh.toolframe3d_section import slice_map
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
 from robobore.cutting.geometry import BoringInsert
 

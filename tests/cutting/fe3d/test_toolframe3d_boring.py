@@ -12,16 +12,14 @@ import numpy as np
 import pytest
 
 from robobore.cutting.fe.ale.remap3d import VEL_TAYLOR
+from robobore.cutting.fe.config.boring3d import parse_boring_config
 from robobore.cutting.fe.config.spec import ToolFrame
 from robobore.cutting.fe.engine import kernels3d as K3
-from robobore.cutting.fe.engine.state3d import advance3, energy_error
+from robobore.cutting.fe.engine.chunk_driver import energy_error
+from robobore.cutting.fe.engine.state3d import advance3
 from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.mesh.toolframe3d import FK_SIDE
-from robobore.cutting.fe.models.boring3d import (
-    parse_boring_config,
-    setup_boring,
-    simulate_boring,
-)
+from robobore.cutting.fe.models.boring3d import setup_boring, simulate_boring
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml
 

@@ -10,11 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robobore.cutting.fe.config.boring3d import parse_boring_config
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.state3d import advance3, element_steps3
 from robobore.cutting.fe.hex import layout3d
-from robobore.cutting.fe.models.boring3d import parse_boring_config, setup_boring
+from robobore.cutting.fe.models.boring3d import setup_boring
 from robobore.cutting.fe.models.toolframe3d import thin_element_factors, tip_section_step
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml

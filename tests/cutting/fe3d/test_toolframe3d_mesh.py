@@ -27,8 +27,10 @@ from robobore.cutting.fe.mesh.toolframe3d import (
     FK_OUTFLOW,
     FK_SIDE,
     FK_TOOL,
-    ToolFrame3DSizes,
     build_toolframe3d_mesh,
+)
+from robobore.cutting.fe.mesh.toolframe3d_layout import ToolFrame3DSizes
+from robobore.cutting.fe.mesh.toolframe3d_section import (
     clamp_area,
     s_of_y,
     section_coords,
@@ -246,7 +248,7 @@ def test_memory_estimate_of_a_tool_frame_config(monkeypatch):
     a section."""
     import robobore.cutting.fe.mesh.memory as memory
     import robobore.cutting.fe.mesh.toolframe3d_layout as layout
-    from robobore.cutting.fe.models.boring3d import parse_boring_config
+    from robobore.cutting.fe.config.boring3d import parse_boring_config
     from robobore.errors import ConfigError
     from robobore.io.config import load_toml
 

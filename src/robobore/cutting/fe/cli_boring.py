@@ -101,9 +101,9 @@ def boring_cmd(
 
 @handle_errors
 def run_boring_cli(config, as_json, vtk, device, coefficients) -> None:
+    from robobore.cutting.fe.config.boring3d import load_boring_config
     from robobore.cutting.fe.models.boring3d import (
         compare_with_mechanistic,
-        load_boring_config,
         simulate_boring,
         write_vtk,
     )

@@ -35,21 +35,11 @@ import math
 from numba import njit, prange
 
 from robobore.cutting.fe.ale.remap import (
-    BF_CLOSED,
-    BF_OPEN,
-    BF_VIRGIN,
-    N_RZ_FIELDS,
     rz_flux,
-    rz_flux_py,
     rz_node_mass,
-    rz_node_mass_py,
     rz_velocity,
-    rz_velocity_py,
     rz_write,
-    rz_write_py,
-    swept_py,
 )
-from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.physics.tool_contact import tool_gap
 
 #: tool-frame node classes (``acls[:, 0]``): interior, rigid (inflow face, bottom), on a
@@ -368,18 +358,4 @@ __all__ = [
     "tf_interior",
     "toolframe_targets",
     "rezone",
-    "edge_neighbours",
-    "N_RZ_FIELDS",
-    "BF_CLOSED",
-    "BF_VIRGIN",
-    "BF_OPEN",
-    "swept_py",
-    "rz_flux_py",
-    "rz_velocity_py",
-    "rz_write_py",
-    "rz_node_mass_py",
-    "rz_flux",
-    "rz_velocity",
-    "rz_write",
-    "rz_node_mass",
 ]

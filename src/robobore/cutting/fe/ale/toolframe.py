@@ -55,15 +55,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robobore.cutting.fe.ale.rezone import (
-    BF_OPEN,
-    BF_VIRGIN,
-    TF_CHAIN,
-    TF_FACE,
-    TF_INTERIOR,
-    TF_LINE,
-    TF_RIGID,
-)
+from robobore.cutting.fe.ale.remap import BF_OPEN, BF_VIRGIN
+from robobore.cutting.fe.ale.rezone import TF_CHAIN, TF_FACE, TF_INTERIOR, TF_LINE, TF_RIGID
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.mesh.orthogonal import MeshSizes
 from robobore.cutting.fe.models.output import ChipGeometry, point_polyline_distance, shear_angle_deg

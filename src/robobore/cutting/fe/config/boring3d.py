@@ -15,12 +15,12 @@ from pydantic import Field, field_validator, model_validator
 from robobore.cutting.fe.config.contact import ContactSection as ContactSection2D
 from robobore.cutting.fe.config.frame import Frame
 from robobore.cutting.fe.config.orthogonal import MaterialSection, ParameterSetConfig
-from robobore.cutting.fe.config.solver import SolverSettings, Strict
+from robobore.cutting.fe.config.solver import SolverSettings
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
-from robobore.material import load_material
-from robobore.material.library import resolve_material_name
+from robobore.io.sections import StrictModel as Strict
+from robobore.material.library import load_material, resolve_material_name
 
 __all__ = ["InsertSection", "CutSection", "ContactSection", "MeshSection", "SolverSection",
            "ToolSupportSection", "BoringFEConfig", "parse_boring_config", "load_boring_config"]

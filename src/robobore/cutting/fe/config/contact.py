@@ -11,8 +11,8 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, PrivateAttr, field_validator, model_validator
 
-from robobore.cutting.fe.config.solver import Strict
 from robobore.cutting.fe.engine.layout import MU_TABLE_MAX
+from robobore.io.sections import StrictModel as Strict
 from robobore.material.friction import CALIBRATED_LAW, friction_law, friction_laws
 
 __all__ = ["ContactSection", "FRICTION_TABLE_VC_M_MIN", "FRICTION_TABLE_MU"]

@@ -16,7 +16,7 @@ import numpy as np
 
 from robobore.cutting.fe.config.spec import write_friction, write_thermal
 from robobore.cutting.fe.config.spec_build import friction_spec, thermal_spec
-from robobore.material import Material
+from robobore.material.library import Material
 
 
 def apply_numerics(p: np.ndarray, s: Any, layout: Any) -> np.ndarray:

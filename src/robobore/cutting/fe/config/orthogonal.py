@@ -23,9 +23,10 @@ from pydantic import (
 
 from robobore.cutting.fe.config.contact import ContactSection
 from robobore.cutting.fe.config.frame import Frame
-from robobore.cutting.fe.config.solver import SolverSettings, Strict
+from robobore.cutting.fe.config.solver import SolverSettings
 from robobore.errors import ConfigError
 from robobore.io.config import load_toml, validate_model
+from robobore.io.sections import StrictModel as Strict
 from robobore.material.friction import (
     A_PRIORI_LAW,
     CALIBRATED_LAW,

@@ -13,7 +13,7 @@ from pydantic import Field
 
 from robobore.io.sections import StrictModel as Strict
 
-__all__ = ["Strict", "SolverSettings"]
+__all__ = ["SolverSettings"]
 
 
 class SolverSettings(Strict):

@@ -32,7 +32,7 @@ from robobore.cutting.fe.config.spec import (
     WorkpieceFrame3D,
 )
 from robobore.errors import ConfigError
-from robobore.material import Material
+from robobore.material.library import Material
 
 __all__ = ["build_spec", "build_boring_spec", "friction_spec", "thermal_spec", "MODEL_KEYS",
            "BORING_MODEL_KEYS"]

@@ -6,7 +6,7 @@ Reuses the 2D engine's scalar physics unchanged: the Johnson-Cook return mapping
 the insert edge) and the spring-damper step
 (:func:`robobore.cutting.fe.physics.tool_contact.tool_support_step`). The 3D state layout and scalar
 functions (``_py`` original + ``njit``, device-ready) are
-:mod:`robobore.cutting.fe.hex.scalar3d`, re-exported here; this module holds the parallel loops
+:mod:`robobore.cutting.fe.hex.scalar3d`'s, which this module calls; it holds the parallel loops
 (elements, nodes), the energy sums, the contact-force total, the conduction pass, the step
 phases and the chunk loops :func:`run_chunk3` (the step loop of
 :mod:`robobore.cutting.fe.engine.step_loop` with those phases; workpiece frame) and

@@ -17,6 +17,7 @@ from robobore.cutting.fe.ale.stencils import edge_neighbours
 from robobore.cutting.fe.engine import layout
 from robobore.cutting.fe.engine.chunk_loop import Phases
 from robobore.cutting.fe.engine.groups2d import (
+    N_QS,
     QS_DMG,
     QS_EPS_P,
     QS_PRES,
@@ -27,12 +28,11 @@ from robobore.cutting.fe.engine.groups2d import (
     QS_SDY,
     QS_SDZ,
     QS_TEMP,
-    N_QS,
     groups_of,
 )
 from robobore.cutting.fe.quad import element as q_element
 from robobore.errors import ConfigError
-from robobore.material import Material
+from robobore.material.library import Material
 
 
 def _qs_row(k: int, doc: str) -> property:

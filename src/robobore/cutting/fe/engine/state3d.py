@@ -19,16 +19,16 @@ from robobore.cutting.fe.ale.groups3d import groups3_of
 from robobore.cutting.fe.ale.remap3d import N_RZ3
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine import layout
-from robobore.cutting.fe.engine.chunk_driver import drive_chunks, energy_error
+from robobore.cutting.fe.engine.chunk_driver import drive_chunks
 from robobore.cutting.fe.engine.threads import ThreadGovernor
 from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.physics.thermal3d import face_neighbours
 from robobore.errors import ConfigError
-from robobore.material import Material
 from robobore.material.johnson_cook import RHO as MAT_RHO
+from robobore.material.library import Material
 
-__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "element_steps3",
-           "advance3", "energy_error", "hex_volumes", "split_node_layer"]
+__all__ = ["FEState3", "default_prm3", "make_state3", "init_forces3", "element_steps3", "advance3",
+           "hex_volumes", "split_node_layer"]
 
 #: node sign pattern of the reference hexahedron (VTK order), shape (8, 3)
 HEX_SIGNS = np.array([(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),

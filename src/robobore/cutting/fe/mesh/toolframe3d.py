@@ -120,19 +120,14 @@ from robobore.cutting.fe.mesh.toolframe3d_section import (
     SectionPlan,
     clamp_area,
     s_of_y,
-    section_coords,
     section_nodes,
-    section_plan,
     slice_map,
-    uncut_thickness,
 )
 from robobore.cutting.geometry import BoringInsert, chip_area
 
-__all__ = ["ToolFrame3DSizes", "SectionPlan", "ToolFrameMesh3D", "FK_INTERIOR", "FK_INFLOW",
-           "FK_OUTFLOW", "FK_TOOL", "FK_FREE", "FK_BOTTOM", "FK_SIDE", "FK_CHIP_SIDE",
-           "section_plan", "section_nodes", "slice_map", "section_coords", "s_of_y",
-           "uncut_thickness", "clamp_area", "build_toolframe3d_mesh", "extrude_toolframe_mesh",
-           "tip_slice_nodes", "reference_blocks"]
+__all__ = ["ToolFrameMesh3D", "FK_INTERIOR", "FK_INFLOW", "FK_OUTFLOW", "FK_TOOL", "FK_FREE",
+           "FK_BOTTOM", "FK_SIDE", "FK_CHIP_SIDE", "build_toolframe3d_mesh",
+           "extrude_toolframe_mesh", "tip_slice_nodes", "reference_blocks"]
 
 #: kind of a hexahedron face: shared by two elements, inflow face (virgin material enters),
 #: outflow face (machined-surface side back face, chip top face), on the insert (rake face

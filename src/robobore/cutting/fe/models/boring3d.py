@@ -42,17 +42,12 @@ from typing import Any
 
 import numpy as np
 
-from robobore.cutting.fe.config.boring3d import (
-    BoringFEConfig,
-    load_boring_config,
-    parse_boring_config,
-)
+from robobore.cutting.fe.config.boring3d import BoringFEConfig
 from robobore.cutting.fe.engine import layout
-from robobore.cutting.fe.engine.chunk_driver import energy_check
-from robobore.cutting.fe.engine.state3d import FEState3, energy_error
+from robobore.cutting.fe.engine.chunk_driver import energy_check, energy_error
+from robobore.cutting.fe.engine.state3d import FEState3
 from robobore.cutting.fe.hex import layout3d, scalar3d
-from robobore.cutting.fe.mesh.boring3d import BoringMesh, build_boring_mesh, parting_surface
-from robobore.cutting.fe.models.boring_setup import BoringSetup, boring_prm, check_support_step
+from robobore.cutting.fe.models.boring_setup import BoringSetup
 from robobore.cutting.fe.models.choose import choose_boring
 from robobore.cutting.fe.models.results import (
     XYZ,
@@ -65,10 +60,8 @@ from robobore.cutting.fe.models.results import (
 )
 from robobore.cutting.geometry import chip_area
 
-__all__ = ["BoringFEConfig", "load_boring_config", "parse_boring_config", "BoringMesh",
-           "build_boring_mesh", "parting_surface", "BoringSetup", "setup_boring", "simulate_boring",
-           "BoringFEResult", "compare_with_mechanistic", "write_vtk", "boring_prm",
-           "check_support_step", "check_boring_device"]
+__all__ = ["setup_boring", "simulate_boring", "BoringFEResult", "compare_with_mechanistic",
+           "write_vtk", "check_boring_device"]
 
 
 def setup_boring(cfg: BoringFEConfig, source: str | None = None) -> BoringSetup:

@@ -21,7 +21,7 @@ from robobore.cutting.fe.hex import layout3d
 from robobore.cutting.fe.mesh.boring3d import build_boring_mesh
 from robobore.cutting.geometry import BoringInsert
 from robobore.errors import ConfigError
-from robobore.material import Material, load_material
+from robobore.material.library import Material, load_material
 
 __all__ = ["BoringSetup", "boring_prm", "check_support_step", "setup_boring_workpiece"]
 

@@ -170,7 +170,7 @@ def choose_orthogonal(cfg: FEConfig, device: str = "cpu",
     check_device(device, source)
     if device == "gpu":
         from robobore.cutting.fe.engine.gpu.backend2d import check_gpu_supported
-        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
+        from robobore.cutting.fe.engine.gpu.shared import require_gpu
 
         check_gpu_supported(cfg.solver.element, source)
         require_gpu()
@@ -303,7 +303,7 @@ def choose_boring(cfg: BoringFEConfig, device: str = "cpu",
                 expected='cpu, or set [mesh] frame = "workpiece" in the config for the GPU '
                          "(the workpiece-frame model: radial and feed forces 22-38 % low at "
                          "the paper's condition, docs/fe3d.md)")
-        from robobore.cutting.fe.engine.gpu.backend3d import require_gpu
+        from robobore.cutting.fe.engine.gpu.shared import require_gpu
 
         require_gpu()
     cls = Boring3DTool if tool else Boring3DWork

@@ -29,7 +29,7 @@ from robobore.cutting.fe.engine.state2d import (
 from robobore.cutting.fe.mesh.orthogonal import CuttingMesh, build_edge_refined_mesh, build_mesh
 from robobore.cutting.fe.models.choose import choose_orthogonal
 from robobore.errors import ConfigError
-from robobore.material import Material, load_material
+from robobore.material.library import Material, load_material
 
 
 @dataclass

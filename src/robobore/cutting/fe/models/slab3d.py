@@ -49,7 +49,7 @@ from robobore.cutting.fe.hex import layout3d, scalar3d
 from robobore.cutting.fe.models.choose import choose_orthogonal
 from robobore.cutting.fe.models.results import SlabSummary
 from robobore.errors import ConfigError
-from robobore.material import load_material
+from robobore.material.library import load_material
 
 __all__ = ["SlabSetup", "setup_slab3", "simulate_slab3", "setup_slab3_toolframe",
            "simulate_slab3_toolframe"]

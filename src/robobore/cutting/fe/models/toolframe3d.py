@@ -39,16 +39,12 @@ from robobore.cutting.fe.config.spec_build import build_boring_spec
 from robobore.cutting.fe.engine import kernels3d as K3
 from robobore.cutting.fe.engine.state3d import FEState3, element_steps3, make_state3
 from robobore.cutting.fe.hex import layout3d, scalar3d
-from robobore.cutting.fe.mesh.toolframe3d import (
-    FK_SIDE,
-    ToolFrame3DSizes,
-    ToolFrameMesh3D,
-    build_toolframe3d_mesh,
-)
+from robobore.cutting.fe.mesh.toolframe3d import FK_SIDE, ToolFrameMesh3D, build_toolframe3d_mesh
+from robobore.cutting.fe.mesh.toolframe3d_layout import ToolFrame3DSizes
 from robobore.cutting.fe.models.boring_setup import BoringSetup, boring_prm, check_support_step
 from robobore.cutting.fe.models.results import ToolFrameMeshSummary
 from robobore.errors import ConfigError
-from robobore.material import Material, load_material
+from robobore.material.library import Material, load_material
 
 __all__ = ["toolframe_fixed", "attach_toolframe", "thin_element_factors", "tip_section_step",
            "setup_boring_toolframe", "toolframe_mesh_summary"]

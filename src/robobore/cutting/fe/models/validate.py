@@ -205,7 +205,14 @@ def parse_points(text: str) -> list[tuple[float, float]]:
 
 
 def point_config(base: dict[str, Any], h_um: float, vc_m_per_min: float) -> dict[str, Any]:
-    """The base config dict with only the uncut chip thickness and cutting speed replaced."""
+    """The base config dict with only the uncut chip thickness and cutting speed replaced.
+
+    A dict, not a typed result: it is the config as the TOML file gives it (the sections of
+    ``robobore fe orthogonal``'s contract), the input of
+    :func:`robobore.cutting.fe.config.orthogonal.parse_config` here and, through
+    :func:`robobore.cutting.calibration_config.fe_config_dict`, the FE config of a calibration
+    grid point, whose mapping is the key of the cached FE results
+    (:func:`robobore.cutting.calibration_runs.fe_cache_inputs`)."""
     d = copy.deepcopy(base)
     cut = d.get("cut")
     if not isinstance(cut, dict):
@@ -373,45 +380,5 @@ def _summarize(rows: list[ValidationPoint]) -> ValidationSummary:
     return ValidationSummary(**{k: PerQuantity(**v) for k, v in out.items()})
 
 
-#: the bundled validation record of the default model: the ``--json`` output of
-#: ``robobore fe validate examples/fe_orthogonal.toml --measured
-#: ../shared/data/ti64_orthogonal_cutting_forces.json`` (robobore/data/fe_validation/README.md)
-BUNDLED_RECORD = "tc4_default_model.json"
-_POINT_KEYS = ("uncut_chip_thickness_um", "cutting_speed_m_per_min", "cutting_force_N_per_mm",
-               "feed_force_N_per_mm", "chip_ratio", "relative_error", "measured")
-
-
-def bundled_validation_path() -> Path:
-    """Path of the bundled validation record of the default FE model (TC4)."""
-    from importlib import resources
-
-    return Path(str(resources.files("robobore") / "data" / "fe_validation" / BUNDLED_RECORD))
-
-
-def load_validation_record(path: str | Path) -> dict[str, Any]:
-    """A validation record (the ``--json`` output of ``robobore fe validate``), checked:
-    ``points`` (each with the contract keys and ``measured``) and ``summary``; a missing or
-    malformed record is a :class:`DataError` naming the file and key."""
-    f = str(path)
-    data = load_json(Path(path), "FE validation record", "the --json output of robobore fe "
-                     "validate", kind=dict, error=DataError)
-    pts = data.get("points")
-    if not isinstance(pts, list) or not pts:
-        raise DataError("no validation points", file=f, field="points", value=pts,
-                        expected="a non-empty list of points (robobore fe validate --json)")
-    for i, pt in enumerate(pts):
-        miss = [k for k in _POINT_KEYS if not isinstance(pt, dict) or k not in pt]
-        if miss:
-            raise DataError("validation point lacks a key", file=f, row=i,
-                            field=f"points[{i}].{miss[0]}",
-                            expected=f"the keys {list(_POINT_KEYS)}")
-    summ = data.get("summary")
-    if not isinstance(summ, dict) or not {"max_abs_error", "mean_abs_error"} <= set(summ):
-        raise DataError("no summary", file=f, field="summary", value=summ,
-                        expected="{max_abs_error, mean_abs_error} per quantity")
-    return data
-
-
 __all__ = ["MeasuredPoint", "read_measured", "parse_points", "point_config", "run_validation",
-           "QUANTITIES", "BUNDLED_RECORD", "bundled_validation_path",
-           "load_validation_record"]
+           "QUANTITIES"]

@@ -1,9 +1,9 @@
-"""Scalar physics of the FE cutting engine, in one module (shared by the CPU and GPU engines).
+"""The tool and its contact in the FE cutting engine (shared by the CPU and GPU engines); the
+Johnson-Cook flow stress, failure strain, damage increment and radial return the engines use
+are :mod:`robobore.material.johnson_cook`'s.
 
 Plain-Python originals (suffix ``_py``) and their ``numba.njit(cache=True)`` versions:
 
-* Johnson-Cook flow stress, failure strain, damage increment and radial return -- re-exported
-  from :mod:`robobore.material.johnson_cook`;
 * :func:`tool_face_py` -- the face of the tool (rake, edge arc, flank) closest to a point;
 * :func:`tool_gap_py` -- signed distance of a point to the analytic rigid tool (rake face,
   edge-radius arc, flank with clearance) and the outward normal;
@@ -23,17 +23,6 @@ from __future__ import annotations
 import math
 
 from numba import njit
-
-from robobore.material.johnson_cook import (  # noqa: F401  (re-exports)
-    jc_damage_increment,
-    jc_damage_increment_py,
-    jc_failure_strain,
-    jc_failure_strain_py,
-    jc_flow_stress,
-    jc_flow_stress_py,
-    radial_return,
-    radial_return_py,
-)
 
 #: faces of the analytic tool (:func:`tool_face_py`)
 FACE_RAKE, FACE_EDGE, FACE_FLANK = 0, 1, 2

@@ -33,10 +33,6 @@ from robobore.cutting.fe.engine.layout import (
     P_DT_ERODE,
     P_MS,
 )
-from robobore.cutting.fe.physics.tool_contact import (
-    jc_damage_increment,
-    radial_return,
-)
 from robobore.cutting.fe.quad.element import (
     damage_erosion,
     quad_area_corners,
@@ -46,6 +42,7 @@ from robobore.cutting.fe.quad.element import (
     quad_step,
 )
 from robobore.material import johnson_cook as jc
+from robobore.material.johnson_cook import jc_damage_increment, radial_return
 
 
 def quad_bbar_py(e, conn, layer, area0, x, y, vx, vy, alive, qs, gps, ie, fex, fey, dte, plast,

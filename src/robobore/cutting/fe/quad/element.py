@@ -53,12 +53,9 @@ from robobore.cutting.fe.engine.layout import (
     P_TCX,
     P_TCY,
 )
-from robobore.cutting.fe.physics.tool_contact import (
-    jc_damage_increment,
-    radial_return,
-    tool_gap,
-)
+from robobore.cutting.fe.physics.tool_contact import tool_gap
 from robobore.material import johnson_cook as jc
+from robobore.material.johnson_cook import jc_damage_increment, radial_return
 
 
 def quad_area_corners_py(x1, x2, x3, x4, y1, y2, y3, y4):

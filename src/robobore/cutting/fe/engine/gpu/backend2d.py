@@ -25,7 +25,7 @@ bar and the energy check).
 
 
 Optional: needs an NVIDIA GPU and numba's CUDA target (``pip install robobore[gpu]``).
-Importing this module needs neither; :func:`robobore.cutting.fe.engine.gpu.backend3d.require_gpu`
+Importing this module needs neither; :func:`robobore.cutting.fe.engine.gpu.shared.require_gpu`
 raises a clear :class:`robobore.errors.ConfigError` when no GPU is usable. Correctness is tested on
 the CPU with numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) against the CPU engine. The
 workpiece-frame model is timed on an H100 (docs/fe.md, "GPU path"); the tool-frame model is
@@ -67,7 +67,7 @@ from robobore.cutting.fe.engine.gpu.shared import GpuEngine, blocks, drive_gpu, 
 from robobore.cutting.fe.quad import node_contact
 from robobore.errors import ConfigError
 
-__all__ = ["advance_gpu", "check_gpu_supported", "N_RED"]
+__all__ = ["advance_gpu", "check_gpu_supported"]
 
 _THREADS = 128
 #: the kernels (benchmarks/gpu_compile_check.py compiles them)

@@ -35,26 +35,15 @@ from collections.abc import Callable
 
 from robobore.cutting.fe.engine.gpu.kernels3d import N_RED, RUN_ARRAYS, RunState3, kernels3
 from robobore.cutting.fe.engine.gpu.shared import (
-    MAX_BLOCK,
     THREADS,
     GpuEngine,
-    bind_cuda,
     blocks,
-    chunk_list_py,
     cooperative,
-    cuda_available,
     drive_gpu,
-    jc_device_functions,
-    persistent_run,
-    profile_ticker,
     require_gpu,
-    simulator_enabled,
 )
 
-__all__ = ["cuda_available", "require_gpu", "advance3_gpu", "simulator_enabled", "N_RED",
-           # shared with the 2D GPU engine (robobore.cutting.fe.engine.gpu.backend2d)
-           "MAX_BLOCK", "bind_cuda", "chunk_list_py", "jc_device_functions", "persistent_run",
-           "profile_ticker"]
+__all__ = ["advance3_gpu"]
 
 _THREADS = THREADS
 #: the kernels (benchmarks/gpu_compile_check.py compiles the persistent one, the last)

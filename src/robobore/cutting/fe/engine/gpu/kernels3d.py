@@ -27,8 +27,7 @@ from robobore.cutting.fe.engine.gpu.persistent import (
 )
 from robobore.cutting.fe.engine.gpu.shared import bind_cuda, jc_device_functions
 
-__all__ = ["kernels3", "RUN_ARRAYS", "RunState3", "R_DTMIN", "R_BAD", "R_FX", "R_FY", "R_FZ",
-           "R_NC", "N_RED"]
+__all__ = ["kernels3", "RUN_ARRAYS", "RunState3", "R_FX", "R_FY", "R_FZ", "R_NC", "N_RED"]
 
 # reduction slots on the device (engine.gpu.persistent's R_DTMIN, R_BAD, then the four sums of
 # its contact-force total: the force and the number of contact nodes)
