@@ -496,9 +496,9 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     to the spindle (:func:`attributable`).
 
     The spindle frequency is refined order by order: the lines attributable to the harmonics
-    of ``f0`` fix it (least squares of ``f = k f0``), its standard error ``s_f0 = s / sqrt(sum
-    k^2)`` (``s`` the lines' scatter about their harmonics, at least :data:`FINE_LINE_BINS`
-    bins) places the higher harmonics to ``k s_f0``, which attributes lines of higher order,
+    of ``f0`` (its first :data:`LOW_HARMONICS` where two or more are lines) fix it (least squares of ``f = k f0``), its standard error ``s_f0 = s / sqrt(sum
+    k^2)`` (``s`` the lines' scatter about their harmonics, 1.4826 times their median
+    absolute deviation, at least :data:`FINE_LINE_BINS` bins) places the higher harmonics to ``k s_f0``, which attributes lines of higher order,
     and so on while the set grows. A line is the harmonic ``k`` when within
     :data:`FINE_SIGMAS` ``sqrt(s^2 + (k s_f0)^2)`` of ``k f0`` (at least 0.75 bin) and that
     band is attributable. Returns ``(bands (centre, half-width), lines, f0 refined, s_f0)``;
@@ -519,6 +519,8 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     k = np.round(freqs / f0)
     tol = _line_tol(freqs, df)
     use = (k >= 1) & (np.abs(freqs - k * f0) <= tol) & attributable(tol, f0)
+    if int(np.sum(use & (k <= LOW_HARMONICS))) >= 2:  # start from the first harmonics
+        use &= k <= LOW_HARMONICS
     fr, s_f0 = f0, math.nan
     for _ in range(20):
         if int(use.sum()) < 2:
@@ -528,7 +530,8 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
         if abs(f_new / f0 - 1.0) > SPEED_TOLERANCE:
             break
         fr = f_new
-        s_line = max(FINE_LINE_BINS * df, float(np.sqrt(np.mean((freqs[use] - ku * fr) ** 2))))
+        s_line = max(FINE_LINE_BINS * df,  # robust scatter: a stray line does not widen it
+                     1.4826 * float(np.median(np.abs(freqs[use] - ku * fr))))
         s_f0 = s_line / float(np.sqrt(np.sum(ku * ku)))
         k = np.round(freqs / fr)
         tol = np.maximum(0.75 * df, FINE_SIGMAS * np.sqrt(s_line ** 2 + (k * s_f0) ** 2))
