@@ -729,10 +729,9 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     growth_db = None
     ch_idx = int(np.bincount(best_ch).argmax())
     if chatter:
-        # the developed chatter: the chattering windows of the record's last third (else
-        # all from the onset on), at their median peak frequency
-        late = [i for i in range(best, nw) if flag[i] and t0[i] >= t0[-1] * 2.0 / 3.0]
-        ref = float(np.median(pk_hz[late])) if late else float(pk_hz[best])
+        # the developed chatter: the line of the record's last chattering window (a growing
+        # vibration can move from one lobe's frequency to another's as it grows)
+        ref = float(pk_hz[max(i for i in range(best, nw) if flag[i])])
         use = [i for i in range(best, nw) if flag[i]
                and abs(pk_hz[i] - ref) <= max(3 * df, 0.02 * ref)]
         ch_idx = int(np.bincount(best_ch[use]).argmax())
