@@ -31,23 +31,61 @@ signal's level and units:
    too: mains (50 and 60 Hz families, each detected by its fundamental line, then every
    multiple up to the 20th present as a line weaker than the fundamental: mains distortion
    decays with the order) and any lines given.
-3. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
+
+   **High harmonic orders** (low spindle speeds: at 300 r/min a chatter line at 2 kHz lies at
+   order 400). A line is attributed to the spindle only where that is better than chance
+   (:func:`attributable`): its harmonic band ``2 tol`` covers at most :data:`CHANCE_MAX` of
+   the harmonic spacing (the chance ``2 tol / f0`` that :func:`comb_score` subtracts; a band
+   that covers most of the spacing holds the harmonic and nearly any line beside it). The
+   harmonics are then placed on the record-length spectrum (resolution ``1 / T``,
+   :func:`fine_harmonic_bands`): the spindle frequency refined there on the first
+   harmonics, then order by order, each harmonic ``k`` placed to ``k s_f0`` (the refined
+   frequency's standard error), a line the harmonic when within three standard errors. The
+   harmonics so placed at orders the windows cannot attribute are excluded in every window
+   (as wide as their skirts on that spectrum, two window bins at least); a line that a window
+   attributes to a harmonic is the spindle's only when the strongest line of the
+   record-length spectrum in its band is a harmonic there (a chatter line beside a harmonic
+   that the window does not resolve stays a candidate). Schmitz's once-per-revolution
+   criterion is the same test in time: a forced line keeps its phase to the rotation from
+   revolution to revolution, a chatter line precesses, and over the record that is a
+   frequency off ``k f0`` by more than about ``1 / T``.
+3. **Windows.** :data:`DEFAULT_WINDOW_S` or :data:`WINDOW_REVS` revolutions, the longer, and
+   at most a third of the record (five windows at 50 % overlap), but where the record shows
+   spindle harmonics no fewer than :data:`MIN_WINDOW_REVS` revolutions (harmonics 8 bins
+   apart: a band of +-2 bins covers half the spacing); a record too short for
+   :data:`PERSIST_WINDOWS` such windows is refused (:func:`window_length`).
+4. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
    modes when modes are given) and its energy above the local spectral floor (the median of
    the remaining spectrum within +-5 % of its frequency) as a share of the window's energy.
    The window chatters when that share is at least :data:`SHARE_LIMIT` and the peak stands
    :data:`PROMINENCE_DB` above the floor: a narrow line, not a broadband resonance hump.
-4. **Persistence.** The record chatters when :data:`PERSIST_WINDOWS` consecutive windows
+5. **Persistence.** The record chatters when :data:`PERSIST_WINDOWS` consecutive windows
    chatter at the same frequency (within 2 %): self-excited vibration persists once it has
    grown; one window of an impact or a transient does not make chatter. Onset: the start of
    the first such run.
-5. **Chatter frequency.** The peak of the averaged spectrum of the chattering windows, refined
-   by quadratic interpolation of the log power over the three bins round the maximum (the
-   error is a few hundredths of a bin with the Hann window).
+6. **Chatter frequency.** The line of the last chattering window (the developed chatter: a
+   growing vibration can move from one lobe's frequency to another's), on the averaged
+   spectrum of the chattering windows at that line (within 2 %), refined by quadratic
+   interpolation of the log power over the three bins round the maximum (the error is a few
+   hundredths of a bin with the Hann window).
 
 Limits: a chatter line that falls on a spindle harmonic or a mains multiple (within the
 band widths) cannot be told from it and is missed; a spindle speed that drifts by more than
 +-0.5 % from the record's mean widens the harmonics past their bands; a lightly damped mode
-driven by broadband noise looks like a line.
+driven by broadband noise looks like a line. A harmonic of order ``k`` can be placed only
+with the spindle frequency known to better than about ``1 / (2 k)`` relative: from the
+record's own first harmonics; a given speed (+-1.5 %) is not that precise, and a forced
+line at a high order where the record shows no first harmonics is not excluded (it can be
+called chatter when it holds a fifth of the energy 20 dB above the floor).
+
+References: Y. Altintas, P. K. Chan, In-process detection and suppression of machine tool
+chatter, Precision Engineering 14 (1992); T. L. Schmitz, K. Medicus, B. Dutterer, Exploring
+once-per-revolution audio signal variance as a chatter indicator, Machining Science and
+Technology 6 (2002); T. L. Schmitz, Chatter recognition by a statistical evaluation of the
+synchronously sampled audio signal, J. Sound Vib. 262 (2003); E. Kuljanic, G. Totis, M.
+Sortino, Development of an intelligent multisensor chatter detection system in milling,
+MSSP 23 (2009); M. Lamraoui et al., Indicators for monitoring chatter in milling based on
+instantaneous angular speeds, MSSP 44 (2014).
 """
 
 from __future__ import annotations
