@@ -534,14 +534,15 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     to the spindle (:func:`attributable`).
 
     The spindle frequency is refined order by order: the lines attributable to the harmonics
-    of ``f0`` (its first :data:`LOW_HARMONICS` where two or more are lines) fix it (least squares of ``f = k f0``), its standard error ``s_f0 = s / sqrt(sum
-    k^2)`` (``s`` the lines' scatter about their harmonics, 1.4826 times their median
-    absolute deviation, at least :data:`FINE_LINE_BINS` bins) places the higher harmonics to ``k s_f0``, which attributes lines of higher order,
-    and so on while the set grows. A line is the harmonic ``k`` when within
-    :data:`FINE_SIGMAS` ``sqrt(s^2 + (k s_f0)^2)`` of ``k f0`` (at least 0.75 bin) and that
-    band is attributable. Returns ``(bands (centre, half-width), lines, f0 refined, s_f0)``;
-    the bands are the high-order harmonics only (the windows attribute the others, checked
-    against ``lines``)."""
+    of ``f0`` (its first :data:`LOW_HARMONICS`, where two or more are lines) fix it (least
+    squares of ``f = k f0``); its standard error ``s_f0 = s / sqrt(sum k^2)`` (``s`` the
+    lines' scatter about their harmonics, 1.4826 times their median absolute deviation, at
+    least :data:`FINE_LINE_BINS` bins) places the higher harmonics to ``k s_f0``, which
+    attributes lines of higher order, and so on while the set grows. A line is the harmonic
+    ``k`` when within :data:`FINE_SIGMAS` ``sqrt(s^2 + (k s_f0)^2)`` of ``k f0`` (at least
+    0.75 bin) and that band is attributable. Returns ``(bands (centre, half-width), lines, f0
+    refined, s_f0)``; the bands are the high-order harmonics only (the windows attribute the
+    others, checked against ``lines``)."""
     df = f[1] - f[0]
     freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
     for ln in exclude:
