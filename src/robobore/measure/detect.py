@@ -53,7 +53,8 @@ signal's level and units:
    at most a third of the record (five windows at 50 % overlap), but where the record shows
    spindle harmonics no fewer than :data:`MIN_WINDOW_REVS` revolutions (harmonics 8 bins
    apart: a band of +-2 bins covers half the spacing); a record too short for
-   :data:`PERSIST_WINDOWS` such windows is refused (:func:`window_length`).
+   :data:`PERSIST_WINDOWS` such windows gets :data:`PERSIST_WINDOWS` shorter ones, the
+   harmonics then placed on the record-length spectrum only (:func:`window_length`).
 4. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
    modes when modes are given) and its energy above the local spectral floor (the median of
    the remaining spectrum within +-5 % of its frequency) as a share of the window's energy.
@@ -642,9 +643,10 @@ def window_length(record: Record, s: DetectSettings, f0: float | None, n_matched
     """Window length [s]: ``--window-s``, else :data:`DEFAULT_WINDOW_S` or
     :data:`WINDOW_REVS` revolutions, the longer, shortened to a third of the record (five
     windows at 50 % overlap: the persistence test can start after an onset) but, where the
-    record shows spindle harmonics, to no fewer than :data:`MIN_WINDOW_REVS` revolutions.
-    A record that then holds fewer than :data:`PERSIST_WINDOWS` windows cannot tell chatter
-    from the spindle harmonics and is refused (:class:`DataError`)."""
+    record shows spindle harmonics, to no fewer than :data:`MIN_WINDOW_REVS` revolutions;
+    a record too short for :data:`PERSIST_WINDOWS` such windows gets :data:`PERSIST_WINDOWS`
+    shorter ones (the harmonics are then placed on the record-length spectrum only, and the
+    verdict's reasons say so)."""
     dur = record.duration_s
     if s.window_s is not None:
         return min(float(s.window_s), dur)
@@ -655,13 +657,9 @@ def window_length(record: Record, s: DetectSettings, f0: float | None, n_matched
         return win
     least = MIN_WINDOW_REVS / f0 if n_matched > 0 else min(DEFAULT_WINDOW_S, win)
     win = max(dur / 3.0, least)
-    need = int(s.persist_windows)
+    need = max(1, int(s.persist_windows))
     if n_matched > 0 and win * (need + 1) / 2.0 > dur * (1 + 1e-9):
-        raise DataError("record too short to tell chatter from the spindle harmonics",
-                        file=record.source, field="duration_s", value=round(dur, 6),
-                        expected=f"at least {least * (need + 1) / 2.0:.4g} s: {need} windows "
-                        f"of {MIN_WINDOW_REVS:g} revolutions at 50 % overlap at "
-                        f"{60.0 * f0:.5g} r/min (a longer record, or --window-s)")
+        return 2.0 * dur / (need + 1)
     return min(win, dur)
 
 
@@ -804,6 +802,13 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     windows = tuple(wins)
     if f0 is None:
         reasons.append("spindle harmonics not found: only fixed lines excluded")
+    elif n_matched > 0 and s.window_s is None and nwin / fs * f0 < MIN_WINDOW_REVS - 1e-9:
+        reasons.append(f"short record ({record.duration_s:.4g} s, {record.duration_s * f0:.3g} "
+                       f"revolutions): windows of {nwin / fs * f0:.3g} revolutions (fewer than "
+                       f"{MIN_WINDOW_REVS:g}) do not resolve the spindle harmonics; they are "
+                       f"placed on the record-length spectrum only ({2 * MIN_WINDOW_REVS:g} "
+                       f"revolutions, {2 * MIN_WINDOW_REVS / f0:.3g} s, resolve them in "
+                       "the windows)")
     use_w = [i for i in range(nw) if flag[i]] if chatter else list(range(nw))
     mode = None
     if s.modes_Hz and fc is not None:
