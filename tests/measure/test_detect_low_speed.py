@@ -101,3 +101,22 @@ def test_record_too_short_for_resolved_windows_keeps_persistence_windows():
         if chatter:
             assert d.chatter_frequency_Hz == pytest.approx(fc, rel=2e-3)
         assert any("short record" in r and "16 revolutions" in r for r in d.reasons)
+
+
+def test_interruption_draws_leave_the_rest_of_the_record():
+    """The interruption has its own generator: without it a low-speed record is the record
+    of the same seed and speed range; with it the other draws are the same (the signals
+    differ: the forced lines, and the mains and noise levels relative to the RMS)."""
+    from robobore.measure.synthetic import simulated_record
+
+    kw = {k: v for k, v in LOW_SPEED.items() if k != "interruption_probability"}
+    seen = set()
+    for seed in range(5000, 5012):
+        a = simulated_record(seed, **LOW_SPEED)
+        b = simulated_record(seed, interruption_probability=0.0, **kw)
+        assert {k: v for k, v in a.truth.items() if k != "interruption"} == \
+            {k: v for k, v in b.truth.items() if k != "interruption"}
+        same = np.array_equal(a.signals, b.signals)
+        assert same == (a.truth["interruption"] is None)
+        seen.add(same)
+    assert seen == {True, False}

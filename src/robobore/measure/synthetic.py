@@ -38,8 +38,9 @@ band; through the mode's receptance they put forced lines at high harmonic order
 mode, the lines a detector must not take for chatter. The pulse train is built over one
 revolution of the simulation's grid (exactly periodic), superposed on the simulated
 acceleration like the runout response (the regenerative simulation, and so the label, does
-not see it). These draws come from ``numpy.random.default_rng((seed, 1))``, so the rest of a
-record is the record of the same seed without the interruption.
+not see it). These draws come from ``numpy.random.default_rng((seed, 1))``, so a record's other
+draws are those of the same seed without the interruption (its mains and sensor-noise levels,
+set relative to the record's RMS, follow the added lines).
 """
 
 from __future__ import annotations
