@@ -6,8 +6,10 @@ confusion table of chatter detection on N SYNTHETIC records of the time-domain s
 2. ``--accuracy N [--seed S]``: records ``S .. S + N - 1``, labelled by the simulation's verdict
    (robobore.dynamics.chatter.classify): confusion table, share right, chatter-frequency error
    against the simulation's chatter frequency (target: >= 98 % right, within 2 %).
+   ``--low-speed``: the records of the low-speed regime (robobore.measure.synthetic.LOW_SPEED:
+   150-1000 r/min, 8 s, half of them with a once-per-revolution interruption of the cut).
 
-Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_measure.py [--accuracy 200]
+Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_measure.py [--accuracy 200] [--low-speed]
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import time
 import numpy as np
 
 from robobore.measure.detect import DetectSettings, detect_chatter
-from robobore.measure.synthetic import simulated_record
+from robobore.measure.synthetic import LOW_SPEED, simulated_record
 
 
 def best_of(fn, repeat=5):
@@ -48,13 +50,13 @@ def speed() -> None:
               f"({rec.n_channels * rec.n_samples / dt / 1e6:.1f} M samples/s; target < 1 s)")
 
 
-def accuracy(n: int, seed: int) -> None:
+def accuracy(n: int, seed: int, **kw) -> None:
     for given in (False, True):
         conf = {"chatter, detected": 0, "chatter, missed": 0, "stable, called chatter": 0,
                 "stable, right": 0}
         ferr, bad = [], []
         for s in range(seed, seed + n):
-            r = simulated_record(s)
+            r = simulated_record(s, **kw)
             tr = r.truth
             d = detect_chatter(r, DetectSettings(speed_rpm=tr["speed_rpm"] if given else None,
                                                  n_inserts=tr["n_inserts"]))
@@ -65,11 +67,11 @@ def accuracy(n: int, seed: int) -> None:
             else:
                 conf["stable, called chatter" if d.chatter else "stable, right"] += 1
             if d.chatter != tr["chatter"]:
-                bad.append(s)
+                bad.append(s if not kw else f"{s} ({tr['speed_rpm']:.0f} r/min)")
         right = (conf["chatter, detected"] + conf["stable, right"]) / n
         fe = np.array(ferr)
         print(f"\nspeed {'given' if given else 'not given'}: {n} records (seeds {seed}.."
-              f"{seed + n - 1}), right {100 * right:.1f} %")
+              f"{seed + n - 1}{', low-speed regime' if kw else ''}), right {100 * right:.1f} %")
         print(f"  {'':16s}{'detected chatter':>18s}{'detected stable':>18s}")
         print(f"  {'truth chatter':16s}{conf['chatter, detected']:>18d}"
               f"{conf['chatter, missed']:>18d}")
@@ -85,9 +87,12 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--accuracy", type=int, default=0)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--low-speed", action="store_true")
+    ap.add_argument("--no-speed-run", action="store_true", help="skip the timing")
     a = ap.parse_args()
     print(f"NUMBA_NUM_THREADS={os.environ.get('NUMBA_NUM_THREADS', '(default)')}, "
           f"load {os.getloadavg()[0]:.2f}")
-    speed()
+    if not a.no_speed_run:
+        speed()
     if a.accuracy:
-        accuracy(a.accuracy, a.seed)
+        accuracy(a.accuracy, a.seed, **(LOW_SPEED if a.low_speed else {}))

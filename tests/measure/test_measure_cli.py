@@ -62,3 +62,16 @@ def test_detect_chatter_with_modes_file(tmp_path):
     m.write_text(json.dumps({"modes": [{"frequency_Hz": "abc"}]}))
     r = runner.invoke(app, ["detect", "chatter", str(p), "--modes-file", str(m)])
     assert r.exit_code == 2 and "frequency_Hz" in r.output
+
+
+def test_synthetic_low_speed_record_and_its_verdict(tmp_path):
+    p = tmp_path / "low.csv"
+    r = runner.invoke(app, ["measure", "synthetic", str(p), "--seed", "5003", "--low-speed",
+                            "--json"])
+    assert r.exit_code == 0, r.output
+    truth = json.loads(r.stdout)["truth"]
+    assert 150.0 <= truth["speed_rpm"] <= 1000.0 and truth["speed_range_rpm"] == [150.0, 1000.0]
+    r = runner.invoke(app, ["detect", "chatter", str(p), "--json", "--speed-rpm",
+                            str(truth["speed_rpm"])])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["chatter"] == truth["chatter"]

@@ -193,9 +193,14 @@ def measure_synthetic_cmd(
                              "accelerometer record of the time-domain simulation, labelled by "
                              "its verdict) or force (a dynamometer record of a boring cut)."),
     seed: int = typer.Option(0, "--seed", help="Random seed (the record's ground truth)."),
-    duration_s: float = typer.Option(3.0, "--duration-s", help="Length [s] of the cut "
-                                     "(0.5 .. 60; a force record adds 1 s of air before and "
-                                     "after)."),
+    duration_s: float | None = typer.Option(None, "--duration-s", help="Length [s] of the "
+                                            "cut (0.5 .. 60; default 3, 8 with --low-speed; "
+                                            "a force record adds 1 s of air before and "
+                                            "after)."),
+    low_speed: bool = typer.Option(False, "--low-speed", help="Vibration: the low-speed "
+                                   "regime (150-1000 r/min, half of the seeds a cut "
+                                   "interrupted once per revolution; "
+                                   "robobore.measure.synthetic.LOW_SPEED)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Write a SYNTHETIC record with its ground truth (to try `detect chatter` and
@@ -203,16 +208,22 @@ def measure_synthetic_cmd(
     from robobore.io.outputs import check_output_file
 
     check_output_file(out, "OUT", "the record")
+    if duration_s is None:
+        duration_s = 8.0 if low_speed else 3.0
     if not 0.5 <= duration_s <= 60.0:
         raise ConfigError("duration out of range", field="--duration-s", value=duration_s,
                           expected="0.5 .. 60 s")
     if kind == "vibration":
         from robobore.measure.records import write_record_csv
-        from robobore.measure.synthetic import simulated_record
+        from robobore.measure.synthetic import LOW_SPEED, simulated_record
 
-        rec = simulated_record(seed, duration_s=duration_s)
+        kw = {k: v for k, v in LOW_SPEED.items() if k != "duration_s"} if low_speed else {}
+        rec = simulated_record(seed, duration_s=duration_s, **kw)
         write_record_csv(rec, out)
     elif kind == "force":
+        if low_speed:
+            raise ConfigError("--low-speed is for vibration records", field="--low-speed",
+                              value=True, expected="--kind vibration")
         from robobore.measure.cut import synthetic_force_record, write_dynoware_ascii
 
         rec = synthetic_force_record(duration_s=duration_s + 2.0, seed=seed)  # + 1 s of air

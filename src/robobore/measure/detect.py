@@ -31,23 +31,62 @@ signal's level and units:
    too: mains (50 and 60 Hz families, each detected by its fundamental line, then every
    multiple up to the 20th present as a line weaker than the fundamental: mains distortion
    decays with the order) and any lines given.
-3. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
+
+   **High harmonic orders** (low spindle speeds: at 300 r/min a chatter line at 2 kHz lies at
+   order 400). A line is attributed to the spindle only where that is better than chance
+   (:func:`attributable`): its harmonic band ``2 tol`` covers at most :data:`CHANCE_MAX` of
+   the harmonic spacing (the chance ``2 tol / f0`` that :func:`comb_score` subtracts; a band
+   that covers most of the spacing holds the harmonic and nearly any line beside it). The
+   harmonics are then placed on the record-length spectrum (resolution ``1 / T``,
+   :func:`fine_harmonic_bands`): the spindle frequency refined there on the first
+   harmonics, then order by order, each harmonic ``k`` placed to ``k s_f0`` (the refined
+   frequency's standard error), a line the harmonic when within three standard errors. The
+   harmonics so placed at orders the windows cannot attribute are excluded in every window
+   (as wide as their skirts on that spectrum, two window bins at least); a line that a window
+   attributes to a harmonic is the spindle's only when the strongest line of the
+   record-length spectrum in its band is a harmonic there (a chatter line beside a harmonic
+   that the window does not resolve stays a candidate). Schmitz's once-per-revolution
+   criterion is the same test in time: a forced line keeps its phase to the rotation from
+   revolution to revolution, a chatter line precesses, and over the record that is a
+   frequency off ``k f0`` by more than about ``1 / T``.
+3. **Windows.** :data:`DEFAULT_WINDOW_S` or :data:`WINDOW_REVS` revolutions, the longer, and
+   at most a third of the record (five windows at 50 % overlap), but where the record shows
+   spindle harmonics no fewer than :data:`MIN_WINDOW_REVS` revolutions (harmonics 8 bins
+   apart: a band of +-2 bins covers half the spacing); a record too short for
+   :data:`PERSIST_WINDOWS` such windows gets :data:`PERSIST_WINDOWS` shorter ones, the
+   harmonics then placed on the record-length spectrum only (:func:`window_length`).
+4. **Chatter in a window.** The largest remaining peak (inside the bands of the structural
    modes when modes are given) and its energy above the local spectral floor (the median of
    the remaining spectrum within +-5 % of its frequency) as a share of the window's energy.
    The window chatters when that share is at least :data:`SHARE_LIMIT` and the peak stands
    :data:`PROMINENCE_DB` above the floor: a narrow line, not a broadband resonance hump.
-4. **Persistence.** The record chatters when :data:`PERSIST_WINDOWS` consecutive windows
+5. **Persistence.** The record chatters when :data:`PERSIST_WINDOWS` consecutive windows
    chatter at the same frequency (within 2 %): self-excited vibration persists once it has
    grown; one window of an impact or a transient does not make chatter. Onset: the start of
    the first such run.
-5. **Chatter frequency.** The peak of the averaged spectrum of the chattering windows, refined
-   by quadratic interpolation of the log power over the three bins round the maximum (the
-   error is a few hundredths of a bin with the Hann window).
+6. **Chatter frequency.** The line of the last chattering window (the developed chatter: a
+   growing vibration can move from one lobe's frequency to another's), on the averaged
+   spectrum of the chattering windows at that line (within 2 %), refined by quadratic
+   interpolation of the log power over the three bins round the maximum (the error is a few
+   hundredths of a bin with the Hann window).
 
 Limits: a chatter line that falls on a spindle harmonic or a mains multiple (within the
 band widths) cannot be told from it and is missed; a spindle speed that drifts by more than
 +-0.5 % from the record's mean widens the harmonics past their bands; a lightly damped mode
-driven by broadband noise looks like a line.
+driven by broadband noise looks like a line. A harmonic of order ``k`` can be placed only
+with the spindle frequency known to better than about ``1 / (2 k)`` relative: from the
+record's own first harmonics; a given speed (+-1.5 %) is not that precise, and a forced
+line at a high order where the record shows no first harmonics is not excluded (it can be
+called chatter when it holds a fifth of the energy 20 dB above the floor).
+
+References: Y. Altintas, P. K. Chan, In-process detection and suppression of machine tool
+chatter, Precision Engineering 14 (1992); T. L. Schmitz, K. Medicus, B. Dutterer, Exploring
+once-per-revolution audio signal variance as a chatter indicator, Machining Science and
+Technology 6 (2002); T. L. Schmitz, Chatter recognition by a statistical evaluation of the
+synchronously sampled audio signal, J. Sound Vib. 262 (2003); E. Kuljanic, G. Totis, M.
+Sortino, Development of an intelligent multisensor chatter detection system in milling,
+MSSP 23 (2009); M. Lamraoui et al., Indicators for monitoring chatter in milling based on
+instantaneous angular speeds, MSSP 44 (2014).
 """
 
 from __future__ import annotations
@@ -97,8 +136,24 @@ MAINS_MAX_ORDER = 20
 #: Mains families looked for as fixed lines [Hz].
 MAINS_HZ = (50.0, 60.0)
 #: Shortest default window [s] (2 Hz resolution: a resonance hump of 1 % damping at 500 Hz
-#: spans 5 bins, a chatter line about 1.5); longer when 16 revolutions need more.
+#: spans 5 bins, a chatter line about 1.5); longer when :data:`WINDOW_REVS` need more.
 DEFAULT_WINDOW_S = 0.5
+#: Revolutions in a default window (the harmonics 16 bins apart).
+WINDOW_REVS = 16.0
+#: Fewest revolutions in a window where the record shows spindle harmonics: the harmonics are
+#: then 8 bins apart and a band of +-:data:`LINE_BINS` bins covers half their spacing (the
+#: most at which attributing a line to the spindle is better than chance, :data:`CHANCE_MAX`).
+MIN_WINDOW_REVS = 4.0 * LINE_BINS
+#: A line is attributed to the spindle only where its harmonic band ``2 tol`` covers at most
+#: this share of the harmonic spacing ``f0``: a band that covers more holds the harmonic and
+#: nearly any line beside it, and the frequency cannot tell them apart.
+CHANCE_MAX = 0.5
+#: Line-position error of a clean line on the Hann spectrum after the parabolic refinement, in
+#: bins (the least error assumed for a line on the record-length spectrum).
+FINE_LINE_BINS = 0.1
+#: A line on the record-length spectrum is the harmonic when within this many standard
+#: errors of ``k f0``.
+FINE_SIGMAS = 3.0
 
 
 @dataclass(frozen=True)
@@ -407,18 +462,23 @@ def harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
     tol = _line_tol(freqs, df)
     k = np.round(freqs / f0)
-    on = (k >= 1) & (np.abs(freqs - k * f0) <= tol)
+    on = (k >= 1) & (np.abs(freqs - k * f0) <= tol) & attributable(tol, f0)
     for ln in exclude:
         on &= np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)
     return [(float(c), line_extent(f, P, float(c))) for c in freqs[on]]
 
 
 def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
-                          exclude: list[float]) -> list[tuple[float, float]]:
+                          exclude: list[float], fine: FineLines | None = None
+                          ) -> list[tuple[float, float]]:
     """:func:`harmonic_bands` of one window, the spindle frequency re-refined in it within
     +-:data:`WINDOW_SPEED_TOLERANCE` of the record's ``f0`` (a speed that wanders over the
     record is nearly constant over one window) when that aligns at least
-    :data:`WINDOW_REALIGN_LINES` more of the window's lines with the harmonics."""
+    :data:`WINDOW_REALIGN_LINES` more of the window's lines with the harmonics. Only lines
+    that :func:`attributable` allows; with ``fine`` (the lines of the record-length spectrum,
+    :func:`fine_harmonic_bands`), a line whose band holds a stronger line of the record-length
+    spectrum that is not a harmonic there is that line's (a chatter line beside a harmonic
+    that the window does not resolve), not the spindle's."""
     df = f[1] - f[0]
     freqs, prom = spectral_lines(f, P, max(1, int(f_lo / df)))
     if freqs.size == 0:
@@ -440,18 +500,105 @@ def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
         f2 = _refine_f0(grid[j], freqs, w, mj)
         fi = f2 if abs(f2 / f0 - 1) <= WINDOW_SPEED_TOLERANCE else grid[j]
     _, m = comb_score(fi, freqs, w, tol)
+    m &= attributable(tol, fi)
+    if fine is not None and fine.freqs.size:
+        for i in np.flatnonzero(m):
+            near = np.abs(fine.freqs - freqs[i]) <= tol[i]
+            if near.any():
+                j = np.flatnonzero(near)[np.argmax(fine.power[near])]
+                m[i] = bool(fine.harmonic[j])
     return [(float(c), line_extent(f, P, float(c))) for c in freqs[m]]
 
 
-def exclusion_mask(f: np.ndarray, bands: list[tuple[float, float]], f_lo: float
-                   ) -> np.ndarray:
+@dataclass(frozen=True)
+class FineLines:
+    """The lines of the record-length spectrum: frequency [Hz], power (normalised), whether
+    each is a spindle harmonic there (:func:`fine_harmonic_bands`)."""
+
+    freqs: np.ndarray
+    power: np.ndarray
+    harmonic: np.ndarray
+
+
+def attributable(tol: np.ndarray, f0: float) -> np.ndarray:
+    """Where a line can be attributed to the spindle by its frequency: its harmonic band
+    ``2 tol`` covers at most :data:`CHANCE_MAX` of the harmonic spacing ``f0`` (the chance
+    that a line beside the harmonic falls in it; :func:`comb_score` subtracts the same)."""
+    return 2.0 * np.asarray(tol) <= CHANCE_MAX * f0
+
+
+def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
+                        exclude: list[float], coarse_df: float
+                        ) -> tuple[list[tuple[float, float]], FineLines, float, float]:
+    """Harmonics placed on the record-length spectrum ``(f, P)`` at the orders where the
+    windows' tolerance (:func:`_line_tol` at resolution ``coarse_df``) cannot attribute a line
+    to the spindle (:func:`attributable`).
+
+    The spindle frequency is refined order by order: the lines attributable to the harmonics
+    of ``f0`` (its first :data:`LOW_HARMONICS`, where two or more are lines) fix it (least
+    squares of ``f = k f0``); its standard error ``s_f0 = s / sqrt(sum k^2)`` (``s`` the
+    lines' scatter about their harmonics, 1.4826 times their median absolute deviation, at
+    least :data:`FINE_LINE_BINS` bins) places the higher harmonics to ``k s_f0``, which
+    attributes lines of higher order, and so on while the set grows. A line is the harmonic
+    ``k`` when within :data:`FINE_SIGMAS` ``sqrt(s^2 + (k s_f0)^2)`` of ``k f0`` (at least
+    0.75 bin) and that band is attributable. Returns ``(bands (centre, half-width), lines, f0
+    refined, s_f0)``; the bands are the high-order harmonics only (the windows attribute the
+    others, checked against ``lines``)."""
+    df = f[1] - f[0]
+    freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
+    for ln in exclude:
+        freqs = freqs[np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)]
+    power = np.interp(freqs, f, P)
+    none = FineLines(freqs, power, np.zeros(freqs.size, dtype=bool))
+    if freqs.size < 2:
+        return [], none, f0, math.nan
+    # the record's f0 re-refined on this spectrum's low harmonics (as a given speed is)
+    f_start, _, n_low = find_spindle(f, P, 60.0 * f0, f_lo, 0.95 * f[-1], exclude)
+    if n_low > 0:
+        f0 = float(f_start)
+    k = np.round(freqs / f0)
+    tol = _line_tol(freqs, df)
+    use = (k >= 1) & (np.abs(freqs - k * f0) <= tol) & attributable(tol, f0)
+    if int(np.sum(use & (k <= LOW_HARMONICS))) >= 2:  # start from the first harmonics
+        use &= k <= LOW_HARMONICS
+    fr, s_f0 = f0, math.nan
+    for _ in range(20):
+        if int(use.sum()) < 2:
+            break
+        ku = np.round(freqs[use] / fr)
+        f_new = float(np.sum(ku * freqs[use]) / np.sum(ku * ku))
+        if abs(f_new / f0 - 1.0) > SPEED_TOLERANCE:
+            break
+        fr = f_new
+        s_line = max(FINE_LINE_BINS * df,  # robust scatter: a stray line does not widen it
+                     1.4826 * float(np.median(np.abs(freqs[use] - ku * fr))))
+        s_f0 = s_line / float(np.sqrt(np.sum(ku * ku)))
+        k = np.round(freqs / fr)
+        tol = np.maximum(0.75 * df, FINE_SIGMAS * np.sqrt(s_line ** 2 + (k * s_f0) ** 2))
+        new = (k >= 1) & (np.abs(freqs - k * fr) <= tol) & attributable(tol, fr)
+        if np.array_equal(new, use) or int(new.sum()) < 2:
+            break
+        use = new
+    if not math.isfinite(s_f0):
+        return [], none, f0, s_f0
+    coarse = ~attributable(_line_tol(freqs, coarse_df), fr)
+    bands = [(float(c), line_extent(f, P, float(c))) for c in freqs[use & coarse]]
+    return bands, FineLines(freqs, power, use.copy()), fr, s_f0
+
+
+def exclusion_mask(f: np.ndarray, bands: list[tuple[float, float]], f_lo: float,
+                   fine_bands: list[tuple[float, float]] = ()) -> np.ndarray:
     """True where a frequency bin is excluded: below ``f_lo``, within a band ``(centre,
     half-width)`` (widened to :data:`LINE_BINS` bins and :data:`LINE_REL_WIDTH` of the
-    frequency at least), or in the anti-alias roll-off (the top 5 % below Nyquist)."""
+    frequency at least), within a band of ``fine_bands`` (harmonics placed on the
+    record-length spectrum, :func:`fine_harmonic_bands`: widened to :data:`LINE_BINS` bins
+    only), or in the anti-alias roll-off (the top 5 % below Nyquist)."""
     df = f[1] - f[0]
     mask = f < f_lo
     for c, hw in bands:
         mask |= np.abs(f - c) <= max(hw, LINE_BINS * df, LINE_REL_WIDTH * c)
+    for c, hw in fine_bands:
+        mask |= np.abs(f - c) <= max(hw, LINE_BINS * df)
     mask[-max(1, int(0.05 * f.size)):] = True
     return mask
 
@@ -489,6 +636,31 @@ def _window_measures(f: np.ndarray, P: np.ndarray, excl: np.ndarray, allowed: np
         share[i] = float(np.clip(seg - floor, 0.0, None).sum() / tot[i])
         prom[i] = 10 * math.log10(row[k] / floor) if floor > 0 else 300.0
     return {"nonharmonic": nonh, "peak": pk, "share": share, "prominence": prom}
+
+
+def window_length(record: Record, s: DetectSettings, f0: float | None, n_matched: int
+                  ) -> float:
+    """Window length [s]: ``--window-s``, else :data:`DEFAULT_WINDOW_S` or
+    :data:`WINDOW_REVS` revolutions, the longer, shortened to a third of the record (five
+    windows at 50 % overlap: the persistence test can start after an onset) but, where the
+    record shows spindle harmonics, to no fewer than :data:`MIN_WINDOW_REVS` revolutions;
+    a record too short for :data:`PERSIST_WINDOWS` such windows gets :data:`PERSIST_WINDOWS`
+    shorter ones (the harmonics are then placed on the record-length spectrum only, and the
+    verdict's reasons say so)."""
+    dur = record.duration_s
+    if s.window_s is not None:
+        return min(float(s.window_s), dur)
+    if f0 is None:
+        return min(DEFAULT_WINDOW_S, dur)
+    win = max(DEFAULT_WINDOW_S, WINDOW_REVS / f0)
+    if win <= dur / 3.0:
+        return win
+    least = MIN_WINDOW_REVS / f0 if n_matched > 0 else min(DEFAULT_WINDOW_S, win)
+    win = max(dur / 3.0, least)
+    need = max(1, int(s.persist_windows))
+    if n_matched > 0 and win * (need + 1) / 2.0 > dur * (1 + 1e-9):
+        return 2.0 * dur / (need + 1)
+    return min(win, dur)
 
 
 def detect_chatter(record: Record, settings: DetectSettings | None = None,
@@ -529,23 +701,29 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     if progress is not None:
         progress(0.3)
     # --- windows
-    if s.window_s is not None:
-        win_s = float(s.window_s)
-    elif f0 is not None:
-        win_s = max(DEFAULT_WINDOW_S, 16.0 / f0)
-    else:
-        win_s = DEFAULT_WINDOW_S
-    win_s = min(win_s, record.duration_s)
+    win_s = window_length(record, s, f0, n_matched)
     nwin = max(16, int(round(win_s * fs)))
     f, t0, P = window_spectra(x, fs, nwin, max(1, nwin // 2))
     df = f[1] - f[0]
     f_lo = max(4.0 * df, 0.5 * f0 if f0 else 0.0)
+    # high harmonic orders, where the windows' bands cannot attribute a line to the spindle:
+    # the harmonics placed on the record-length spectrum (fine resolution)
+    fine: list[tuple[float, float]] = []
+    fine_lines = None
+    if n_matched > 0:
+        fF, _, PF = window_spectra(x, fs, n, n)
+        PF = PF[:, 0, :] / (PF[:, 0, fF >= f_lo].sum(axis=1, keepdims=True) + 1e-300)
+        fine, fine_lines, _, s_f0 = fine_harmonic_bands(fF, PF.mean(axis=0), f0, f_lo, lines,
+                                                        df)
+        if not math.isfinite(s_f0):  # no harmonics placed there: the windows' bands stand
+            fine_lines = None
     Pall = P / (P[:, :, f >= f_lo].sum(axis=2, keepdims=True) + 1e-300)
     Pall = Pall.mean(axis=0)  # (n_win, n_f): the channels' normalised spectra
     excl = np.empty((t0.size, f.size), dtype=bool)
     for i in range(t0.size):
-        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines) if n_matched > 0 else [])
-        excl[i] = exclusion_mask(f, wb + fixed_bands, f_lo)
+        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines, fine_lines)
+              if n_matched > 0 else [])
+        excl[i] = exclusion_mask(f, wb + fixed_bands, f_lo, fine)
     allowed = np.ones(f.size, dtype=bool)
     if s.modes_Hz:
         reach = 1.5 * f0 if f0 else 0.0
@@ -588,10 +766,9 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     growth_db = None
     ch_idx = int(np.bincount(best_ch).argmax())
     if chatter:
-        # the developed chatter: the chattering windows of the record's last third (else
-        # all from the onset on), at their median peak frequency
-        late = [i for i in range(best, nw) if flag[i] and t0[i] >= t0[-1] * 2.0 / 3.0]
-        ref = float(np.median(pk_hz[late])) if late else float(pk_hz[best])
+        # the developed chatter: the line of the record's last chattering window (a growing
+        # vibration can move from one lobe's frequency to another's as it grows)
+        ref = float(pk_hz[max(i for i in range(best, nw) if flag[i])])
         use = [i for i in range(best, nw) if flag[i]
                and abs(pk_hz[i] - ref) <= max(3 * df, 0.02 * ref)]
         ch_idx = int(np.bincount(best_ch[use]).argmax())
@@ -625,6 +802,13 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     windows = tuple(wins)
     if f0 is None:
         reasons.append("spindle harmonics not found: only fixed lines excluded")
+    elif n_matched > 0 and s.window_s is None and nwin / fs * f0 < MIN_WINDOW_REVS - 1e-9:
+        reasons.append(f"short record ({record.duration_s:.4g} s, {record.duration_s * f0:.3g} "
+                       f"revolutions): windows of {nwin / fs * f0:.3g} revolutions (fewer than "
+                       f"{MIN_WINDOW_REVS:g}) do not resolve the spindle harmonics; they are "
+                       f"placed on the record-length spectrum only ({2 * MIN_WINDOW_REVS:g} "
+                       f"revolutions, {2 * MIN_WINDOW_REVS / f0:.3g} s, resolve them in "
+                       "the windows)")
     use_w = [i for i in range(nw) if flag[i]] if chatter else list(range(nw))
     mode = None
     if s.modes_Hz and fc is not None:
@@ -652,6 +836,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
 
 __all__ = ["DetectSettings", "ChatterDetection", "detect_chatter", "window_spectra",
            "spectral_lines", "find_spindle", "fixed_lines", "harmonic_bands",
-           "window_harmonic_bands", "line_extent",
+           "window_harmonic_bands", "line_extent", "attributable", "fine_harmonic_bands",
+           "window_length",
            "exclusion_mask", "comb_score",
            "SHARE_LIMIT", "PROMINENCE_DB", "PERSIST_WINDOWS", "SPEED_TOLERANCE", "MAINS_HZ"]

@@ -22,7 +22,25 @@ decimated), plus
 * white sensor noise at a signal-to-noise ratio of 20-40 dB;
 * an offset and a random gain ``10^U(-3, 3)`` (the detector must not care).
 
-Every random draw comes from ``numpy.random.default_rng(seed)``.
+Every random draw comes from ``numpy.random.default_rng(seed)``; the default records are
+spindle speeds of 1000-8000 r/min (``speed_range_rpm``).
+
+**Low-speed regime** (:data:`LOW_SPEED`: ``labelled_set(n, seed, **LOW_SPEED)``): turning
+and boring cells and laboratory tests at 150-1000 r/min (spindle 2.5-17 Hz), 8 s records
+(20-130 revolutions), where a chatter line near the mode lies at rotation-harmonic order
+30-1000. With ``interruption_probability`` p, a record's cut is, with probability p,
+interrupted once per revolution (a flat, a cross hole or a hard spot round the bore): the chip
+force along the mode changes by a fraction ``q ~ U(0.05, 1)`` of its mean (1: the chip
+vanishes) over an arc of
+``U(2, 10)`` degrees. That rectangular pulse train has force harmonics
+``2 q F sin(pi k d) / (pi k)`` (``d`` the arc's share of the revolution) up to the record's
+band; through the mode's receptance they put forced lines at high harmonic orders round the
+mode, the lines a detector must not take for chatter. The pulse train is built over one
+revolution of the simulation's grid (exactly periodic), superposed on the simulated
+acceleration like the runout response (the regenerative simulation, and so the label, does
+not see it). These draws come from ``numpy.random.default_rng((seed, 1))``, so a record's other
+draws are those of the same seed without the interruption (its mains and sensor-noise levels,
+set relative to the record's RMS, follow the added lines).
 """
 
 from __future__ import annotations
@@ -32,10 +50,16 @@ from typing import Any
 
 import numpy as np
 
+from robobore.errors import InputError
 from robobore.measure.records import Record, make_record
 
 #: The simulation runs at this multiple of the record's sample rate.
 OVERSAMPLE = 8
+#: Spindle speeds of the default records [r/min].
+DEFAULT_SPEED_RANGE_RPM = (1000.0, 8000.0)
+#: The low-speed regime (module docstring): keyword arguments of :func:`simulated_record`.
+LOW_SPEED: dict[str, Any] = {"speed_range_rpm": (150.0, 1000.0), "duration_s": 8.0,
+                             "interruption_probability": 0.5}
 
 
 def _mode_acc_response(f: np.ndarray, fn: float, zeta: float, k: float) -> np.ndarray:
@@ -45,12 +69,36 @@ def _mode_acc_response(f: np.ndarray, fn: float, zeta: float, k: float) -> np.nd
     return -(w ** 2) / (k * (1 - r ** 2 + 2j * zeta * r))
 
 
+def _interruption_response(force: float, duty: float, phase: float, Ns: int, fsim: float,
+                           n: int, fn: float, zeta: float, k: float) -> np.ndarray:
+    """Acceleration [m/s^2] at the record's rate (``fsim / OVERSAMPLE``), ``n`` samples, of
+    the mode driven by a force pulse of ``force`` [N] lasting ``duty`` of each revolution
+    (``Ns`` simulation steps), starting at ``phase`` of the revolution: its harmonics up to
+    0.45 of the record's rate, each through the receptance, summed over one revolution of the
+    simulation grid (an inverse FFT, exactly periodic) and repeated."""
+    f1 = fsim / Ns
+    kk = np.arange(1, Ns // 2)
+    kk = kk[kk * f1 < 0.45 * fsim / OVERSAMPLE]
+    # complex Fourier coefficients of a rectangular pulse train of height ``force``
+    c = force * np.sin(np.pi * kk * duty) / (np.pi * kk) * np.exp(
+        -1j * np.pi * kk * duty - 2j * np.pi * kk * phase)
+    spec = np.zeros(Ns // 2 + 1, dtype=complex)
+    spec[kk] = c * _mode_acc_response(kk * f1, fn, zeta, k) * Ns
+    one = np.fft.irfft(spec, Ns)
+    reps = int(math.ceil(n * OVERSAMPLE / Ns)) + 1
+    return np.tile(one, reps)[::OVERSAMPLE][:n]
+
+
 def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: float = 3.0,
-                     n_channels: int = 1) -> Record:
+                     n_channels: int = 1,
+                     speed_range_rpm: tuple[float, float] = DEFAULT_SPEED_RANGE_RPM,
+                     interruption_probability: float = 0.0) -> Record:
     """One SYNTHETIC labelled record (module docstring); ``truth`` holds the label and the
     drawn parameters. With ``n_channels`` 3 the record has the accelerometer's three axes
     (the other two see the mode through 5-20 % cross-axis sensitivity, with their own
-    noise)."""
+    noise). ``speed_range_rpm``: the range the spindle speed is drawn from;
+    ``interruption_probability``: the chance of a once-per-revolution interruption of the
+    cut (module docstring, low-speed regime)."""
     from scipy import signal
 
     from robobore.dynamics import stability
@@ -59,6 +107,14 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
     from robobore.dynamics.structure import ToolPointStructure
     from robobore.dynamics.timedomain import SimulationSettings, simulate
 
+    n_lo, n_hi = (float(v) for v in speed_range_rpm)
+    if not (math.isfinite(n_lo) and math.isfinite(n_hi) and 10.0 <= n_lo < n_hi <= 100000.0):
+        raise InputError("spindle speed range out of range", field="speed_range_rpm",
+                         value=speed_range_rpm, expected="10 <= low < high <= 100000 r/min")
+    p_int = float(interruption_probability)
+    if not 0.0 <= p_int <= 1.0:
+        raise InputError("interruption probability out of range",
+                         field="interruption_probability", value=p_int, expected="0 .. 1")
     rng = np.random.default_rng(seed)
     fs = float(sample_rate_Hz)
     fn = float(rng.uniform(500.0, min(2500.0, 0.3 * fs)))
@@ -73,7 +129,7 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
     u = np.array([math.cos(beta), math.sin(beta), 0.0])
     pr = single_point_process(K, u, [1.0, 0.0, 0.0], feed, n_inserts=N)
     fsim = OVERSAMPLE * fs
-    lo_ns, hi_ns = math.ceil(60 * fsim / 8000.0 / N), math.floor(60 * fsim / 1000.0 / N)
+    lo_ns, hi_ns = math.ceil(60 * fsim / n_hi / N), math.floor(60 * fsim / n_lo / N)
     Ns = N * int(rng.integers(lo_ns, hi_ns + 1))
     speed = 60.0 * fsim / Ns
     crit = float(stability.lobes_frequency_domain(st, pr, np.array([speed])).critical_depth_m[0])
@@ -109,6 +165,16 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
         H = _mode_acc_response(np.array([fj]), fn, zeta, kst)[0]
         forced += np.abs(H) * gain_x * 0.3 * K * depth * (feed / N) / j * np.cos(
             2 * np.pi * fj * t + rng.uniform(0, 2 * np.pi))
+    interruption = None
+    if p_int > 0.0:  # own generator: the record's other draws stay those of its seed
+        rng2 = np.random.default_rng((seed, 1))
+        if rng2.random() < p_int:
+            q = float(rng2.uniform(0.05, 1.0))
+            arc = float(rng2.uniform(2.0, 10.0))
+            forced += _interruption_response(q * gain_x * K * depth * (feed / N), arc / 360.0,
+                                             float(rng2.uniform(0.0, 1.0)), Ns, fsim, n,
+                                             fn, zeta, kst)
+            interruption = {"force_fraction": q, "arc_deg": arc}
     # broadband cutting-force noise through the mode (frequency-domain filtering)
     fnoise = 0.02 * K * depth * (feed / N) * rng.standard_normal(n)
     Fw = np.fft.rfft(fnoise)
@@ -138,6 +204,7 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
         "critical_depth_mm": crit * 1e3, "depth_over_critical": factor,
         "vibration_growth": v.vibration_growth, "mains_Hz": mains, "snr_dB": snr_db,
         "gain": gain, "seed": seed, "generator": "robobore.measure.synthetic.simulated_record",
+        "speed_range_rpm": [n_lo, n_hi], "interruption": interruption,
     }
     return make_record(X, fs, names, ["" for _ in names],
                        source=f"<SYNTHETIC record seed {seed}>", kind="SYNTHETIC", truth=truth)
@@ -148,4 +215,5 @@ def labelled_set(n: int, seed: int = 0, **kw: Any) -> list[Record]:
     return [simulated_record(seed + i, **kw) for i in range(n)]
 
 
-__all__ = ["simulated_record", "labelled_set", "OVERSAMPLE"]
+__all__ = ["simulated_record", "labelled_set", "OVERSAMPLE", "LOW_SPEED",
+           "DEFAULT_SPEED_RANGE_RPM"]
