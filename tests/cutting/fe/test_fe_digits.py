@@ -1,7 +1,8 @@
 """The FE engines' results to 1e-9, stored: the default validation configuration, the contract
 config, the tool-support example and the 3D paper condition (on the workpiece frame at mass
 scaling 100: the tool frame's digits differ by about 1e-5 between a process that compiles the
-engine and one that loads it from numba's cache, docs/fe3d.md, tool-frame "Limits"), each on a short cut.
+engine and one that loads it from numba's cache, docs/fe3d.md, tool-frame "Limits"), each on a
+short cut.
 
 The engines are deterministic (the same digits on any thread count and chunk size,
 tests/cutting/fe/test_fe_threads.py), so any change to the code that is meant to keep the
