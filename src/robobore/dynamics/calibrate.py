@@ -558,12 +558,14 @@ def fit(problem: CalibrationProblem, with_pd: bool = False,
 
     H = _hessian(neg_final, theta)
     H = 0.5 * (H + H.T)
-    lam, U = np.linalg.eigh(H)
-    prior_prec = np.linalg.eigvalsh(np.linalg.inv(problem.prior_cov(with_pd)))
-    # a direction the likelihood leaves flat or concave keeps a precision of a thousandth of
-    # the smallest prior precision: at most 32 times the widest prior standard deviation
-    lam = np.maximum(lam, float(prior_prec.min()) * 1e-3)
-    cov = (U / lam) @ U.T
+    # posterior precision = the likelihood's curvature + the prior's precision; a direction the
+    # linearised likelihood leaves flat or curved the wrong way keeps its prior precision, so
+    # no direction is wider than the prior (the likelihood's negative eigenvalues clipped at 0)
+    P = np.linalg.inv(problem.prior_cov(with_pd))
+    lam, U = np.linalg.eigh(H - P)
+    Hl = (U * np.maximum(lam, 0.0)) @ U.T
+    cov = np.linalg.inv(Hl + P)
+    cov = 0.5 * (cov + cov.T)
     ll = problem.log_likelihood(pred, theta)
     bic = -2.0 * ll + p * math.log(max(problem.n_data, 1))
     return Fit(problem.names(with_pd), theta, cov, ll, problem.log_prior(theta), bic, it, pred)
