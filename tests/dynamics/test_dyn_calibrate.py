@@ -173,6 +173,38 @@ def test_modal_band_collapses_to_nominal_and_widens_with_the_intervals(example):
 
 
 # --------------------------------------------------------------------------- calibration
+def test_posterior_cov_is_never_wider_than_the_prior(example):
+    """The Laplace covariance: inv(Hessian) where the likelihood's curvature is positive
+    semi-definite; along a direction the likelihood curves the wrong way, the prior's variance
+    (inv(Hessian) there would be wider than the prior, or not a covariance at all)."""
+    from robobore.dynamics.calibrate import Observation, build_problem, posterior_cov
+
+    cfg, _, _ = example
+    prior = build_problem(cfg, [Observation(1, 1000.0, 1e-3, False)]).prior_cov(False)
+    P = np.linalg.inv(prior)
+    lp, Up = np.linalg.eigh(prior)
+    rng = np.random.default_rng(7)
+    B = rng.normal(size=(P.shape[0], 3))
+    H = P + B @ B.T  # the likelihood adds curvature of rank 3
+    np.testing.assert_allclose(posterior_cov(H, prior), np.linalg.inv(H), rtol=1e-9,
+                               atol=1e-12)
+    # the likelihood curves the wrong way (-0.5 x the prior precision) along the prior's widest
+    # axis and adds curvature along the others: inv(H) would be twice the prior's variance there
+    d = 1.0 / lp + np.linspace(0.0, 50.0, lp.size)
+    d[-1] = 0.5 / lp[-1]
+    H2 = (Up * d) @ Up.T
+    u = Up[:, -1]
+    assert u @ np.linalg.inv(H2) @ u == pytest.approx(2.0 * lp[-1])
+    cov = posterior_cov(H2, prior)
+    assert u @ cov @ u == pytest.approx(lp[-1], rel=1e-9)
+    assert np.linalg.eigvalsh(prior - cov).min() >= -1e-12 * lp[-1]
+    np.testing.assert_allclose(np.linalg.eigvalsh(cov),
+                               np.sort(np.append(1.0 / d[:-1], lp[-1])), rtol=1e-9)
+    # a likelihood curved the wrong way in every direction leaves the prior
+    np.testing.assert_allclose(posterior_cov(P - np.eye(P.shape[0]), prior), prior,
+                               rtol=1e-9, atol=1e-12)
+
+
 def test_synthetic_validation_one_seed(example):
     """SYNTHETIC truth (damping x0.6, x stiffness x1.3), 12 cuts, 10 % label noise: the
     corrected lobes are nearer the truth than the uncorrected ones at held-out speeds and

@@ -318,9 +318,9 @@ def test_critical_depth_does_not_depend_on_what_ran_before():
 
 
 def test_a_structure_whose_nominal_cut_map_overflows_gives_a_limit_not_an_error():
-    """A band secant far along a wide posterior axis (SYNTHETIC sequential seed 8: x stiffness
-    x e^-12, x damping x e^-17) meets a structure whose one-revolution map of the nominal cut
-    overflows at a deep trial depth: no steady orbit, and the search goes on."""
+    """A structure far from any robot (x stiffness x e^-12, x damping x e^-17) whose
+    one-revolution map of the nominal cut overflows at a deep trial depth: no steady orbit,
+    and the search goes on."""
     from robobore.dynamics.calibrate import Observation, build_problem
     from robobore.dynamics.config import load_dynamics_config
     from robobore.dynamics.semidiscretization import critical_depth_semidiscretization

@@ -38,7 +38,10 @@ Theory, Inference, and Learning Algorithms*, ch. 27; Bishop 2006, *Pattern Recog
 Machine Learning*, section 4.4) on the log factors, with the predictions linearised about the
 current estimate and re-linearised until the estimate stops moving (Gauss-Newton iteration of
 the iterated extended Kalman filter, Bell & Cathey 1993), the first linearisations with a
-wider verdict spread (:data:`SPREAD_SCHEDULE`). Priors: Gaussian in the log factors, centred on
+wider verdict spread (:data:`SPREAD_SCHEDULE`). Covariance: the inverse of the likelihood's
+curvature at the estimate (the last linearised posterior's Hessian less the prior precision,
+negative eigenvalues clipped at 0) plus the prior precision, so no direction is wider than the
+prior. Priors: Gaussian in the log factors, centred on
 1, correlated within the damping and within the stiffness group (:class:`LikelihoodSettings`).
 Process damping
 (``c = C a / v``, Altintas, Eynian & Onozuka 2008, added to the units' damping as the
@@ -506,6 +509,21 @@ PD_ITERATIONS = 2
 SPREAD_SCHEDULE = (0.8, 0.3)
 
 
+def posterior_cov(hessian: np.ndarray, prior_cov: np.ndarray) -> np.ndarray:
+    """Laplace covariance from the Hessian of the negative log posterior at the estimate.
+
+    The posterior precision is the likelihood's curvature (``hessian`` less the prior
+    precision, its negative eigenvalues clipped at 0) plus the prior precision: a direction the
+    linearised likelihood leaves flat, or curves the wrong way, keeps its prior precision, so no
+    direction is wider than the prior (``prior_cov - cov`` is positive semi-definite); where the
+    likelihood's curvature is positive semi-definite the result is ``inv(hessian)``."""
+    H = 0.5 * (hessian + hessian.T)
+    P = np.linalg.inv(prior_cov)
+    lam, U = np.linalg.eigh(H - P)
+    cov = np.linalg.inv((U * np.maximum(lam, 0.0)) @ U.T + P)
+    return 0.5 * (cov + cov.T)
+
+
 def fit(problem: CalibrationProblem, with_pd: bool = False,
         start: np.ndarray | None = None, progress: Callable[[int], None] | None = None,
         max_iterations: int | None = None, continuation: bool = True) -> Fit:
@@ -558,12 +576,7 @@ def fit(problem: CalibrationProblem, with_pd: bool = False,
 
     H = _hessian(neg_final, theta)
     H = 0.5 * (H + H.T)
-    lam, U = np.linalg.eigh(H)
-    prior_prec = np.linalg.eigvalsh(np.linalg.inv(problem.prior_cov(with_pd)))
-    # a direction the likelihood leaves flat or concave keeps a precision of a thousandth of
-    # the smallest prior precision: at most 32 times the widest prior standard deviation
-    lam = np.maximum(lam, float(prior_prec.min()) * 1e-3)
-    cov = (U / lam) @ U.T
+    cov = posterior_cov(H, problem.prior_cov(with_pd))
     ll = problem.log_likelihood(pred, theta)
     bic = -2.0 * ll + p * math.log(max(problem.n_data, 1))
     return Fit(problem.names(with_pd), theta, cov, ll, problem.log_prior(theta), bic, it, pred)
