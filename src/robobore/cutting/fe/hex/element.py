@@ -449,10 +449,12 @@ def make_hex_element(jc_return, jc_damage_increment):
     return hex_element_py
 
 
-#: CPU version. ``fastmath`` without the no-NaN/no-Inf flags (FMA contraction, reassociation,
-#: reciprocal approximations): NaN and Inf still propagate to the instability checks. The
-#: Johnson-Cook callees keep their own flags (fastmath off: ``robobore.material.johnson_cook``),
+#: CPU version. ``fastmath`` with FMA contraction only: reassociation, reciprocal
+#: approximations or no-signed-zeros make the code numba loads from its cache compute other
+#: last bits than the code it compiles in the process (a tool-frame run then differs by about
+#: 1e-5 between the two: docs/fe3d.md); contraction alone gives one set of digits either way.
+#: The Johnson-Cook callees keep their own flags (fastmath off: ``robobore.material.johnson_cook``),
 #: so the material law has the same digits here as in the 2D engine.
 # a closure over compiled functions: numba keys no cache on it (its callers' caches hold it)
 hex_element_py = make_hex_element(jc_return, jc_damage_increment)
-hex_element = njit(cache=False, fastmath={"contract", "reassoc", "arcp", "nsz"})(hex_element_py)
+hex_element = njit(cache=False, fastmath={"contract"})(hex_element_py)
