@@ -41,6 +41,18 @@ from robobore.dynamics.config import load_dynamics_config
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def print_figures(w, wu, we, c, ec, eu) -> None:
+    """The validation's figures over the seeds: per-seed shares within 10 % of the truth
+    (corrected ``w``, uncorrected ``wu``, the band's forecast ``we``), coverage ``c`` and
+    median errors (corrected ``ec``, uncorrected ``eu``), each an array over the seeds."""
+    print(f"  corrected within 10 % of the truth: {w.mean():.1%} of speeds "
+          f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}; "
+          f"the band's own forecast: {we.mean():.1%}")
+    print(f"  90 % band covers the truth: {c.mean():.1%} (seeds: min {c.min():.0%})")
+    print(f"  median relative error: corrected {np.median(ec):.3f}, uncorrected "
+          f"{np.median(eu):.3f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
@@ -121,12 +133,7 @@ def run_config(cfg, args, amp: bool, freq: bool = False) -> list[dict]:
     t = np.array([r.seconds for r in runs])
     cpu = np.array([r.cpu_seconds for r in runs])
     print(f"{label} ({args.design} design), over {len(runs)} seeds x 24 held-out speeds:")
-    print(f"  corrected within 10 % of the truth: {w.mean():.1%} of speeds "
-          f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}; "
-          f"the band's own forecast: {we.mean():.1%}")
-    print(f"  90 % band covers the truth: {c.mean():.1%} (seeds: min {c.min():.0%})")
-    print(f"  median relative error: corrected {np.median(ec):.3f}, uncorrected "
-          f"{np.median(eu):.3f}")
+    print_figures(w, wu, we, c, ec, eu)
     print(f"  calibrate (12 observations, band at 24 speeds): wall {np.median(t):.1f} s median "
           f"(max {t.max():.1f}), CPU {np.median(cpu):.1f} s median; "
           f"{len(runs) / t.sum() * 60:.2f} calibrations per minute")

@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from bench_calibrate import print_figures
 
 
 def main() -> None:
@@ -54,12 +55,7 @@ def main() -> None:
     wall = np.array([r["seconds"] + r.get("design_seconds", 0.0) for r in sel])
     cpu = np.array([r["cpu_seconds"] + r.get("design_cpu_seconds", 0.0) for r in sel])
     print(f"over {len(sel)} seeds x 24 held-out speeds:")
-    print(f"  corrected within 10 % of the truth: {w.mean():.1%} of speeds "
-          f"(seeds: min {w.min():.0%}, median {np.median(w):.0%}); uncorrected: {wu.mean():.1%}; "
-          f"the band's own forecast: {we.mean():.1%}")
-    print(f"  90 % band covers the truth: {c.mean():.1%} (seeds: min {c.min():.0%})")
-    print(f"  median relative error: corrected {np.median(ec):.3f}, uncorrected "
-          f"{np.median(eu):.3f}")
+    print_figures(w, wu, we, c, ec, eu)
     print(f"  per seed (final calibration + design): CPU {np.median(cpu):.1f} s median "
           f"(max {cpu.max():.1f}), wall {np.median(wall):.1f} s median (max {wall.max():.1f})")
 
