@@ -574,9 +574,7 @@ def fit(problem: CalibrationProblem, with_pd: bool = False,
     def neg_final(t: np.ndarray) -> float:
         return -(problem.log_likelihood(p0 + J @ (t - t0), t) + problem.log_prior(t))
 
-    H = _hessian(neg_final, theta)
-    H = 0.5 * (H + H.T)
-    cov = posterior_cov(H, problem.prior_cov(with_pd))
+    cov = posterior_cov(_hessian(neg_final, theta), problem.prior_cov(with_pd))
     ll = problem.log_likelihood(pred, theta)
     bic = -2.0 * ll + p * math.log(max(problem.n_data, 1))
     return Fit(problem.names(with_pd), theta, cov, ll, problem.log_prior(theta), bic, it, pred)

@@ -529,7 +529,7 @@ def attributable(tol: np.ndarray, f0: float) -> np.ndarray:
 
 def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
                         exclude: list[float], coarse_df: float
-                        ) -> tuple[list[tuple[float, float]], FineLines, float, float]:
+                        ) -> tuple[list[tuple[float, float]], FineLines, float]:
     """Harmonics placed on the record-length spectrum ``(f, P)`` at the orders where the
     windows' tolerance (:func:`_line_tol` at resolution ``coarse_df``) cannot attribute a line
     to the spindle (:func:`attributable`).
@@ -541,8 +541,8 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     least :data:`FINE_LINE_BINS` bins) places the higher harmonics to ``k s_f0``, which
     attributes lines of higher order, and so on while the set grows. A line is the harmonic
     ``k`` when within :data:`FINE_SIGMAS` ``sqrt(s^2 + (k s_f0)^2)`` of ``k f0`` (at least
-    0.75 bin) and that band is attributable. Returns ``(bands (centre, half-width), lines, f0
-    refined, s_f0)``; the bands are the high-order harmonics only (the windows attribute the
+    0.75 bin) and that band is attributable. Returns ``(bands (centre, half-width), lines,
+    s_f0)``; the bands are the high-order harmonics only (the windows attribute the
     others, checked against ``lines``)."""
     df = f[1] - f[0]
     freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
@@ -551,7 +551,7 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     power = np.interp(freqs, f, P)
     none = FineLines(freqs, power, np.zeros(freqs.size, dtype=bool))
     if freqs.size < 2:
-        return [], none, f0, math.nan
+        return [], none, math.nan
     # the record's f0 re-refined on this spectrum's low harmonics (as a given speed is)
     f_start, _, n_low = find_spindle(f, P, 60.0 * f0, f_lo, 0.95 * f[-1], exclude)
     if n_low > 0:
@@ -580,10 +580,10 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
             break
         use = new
     if not math.isfinite(s_f0):
-        return [], none, f0, s_f0
+        return [], none, s_f0
     coarse = ~attributable(_line_tol(freqs, coarse_df), fr)
     bands = [(float(c), line_extent(f, P, float(c))) for c in freqs[use & coarse]]
-    return bands, FineLines(freqs, power, use.copy()), fr, s_f0
+    return bands, FineLines(freqs, power, use.copy()), s_f0
 
 
 def exclusion_mask(f: np.ndarray, bands: list[tuple[float, float]], f_lo: float,
@@ -713,8 +713,8 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     if n_matched > 0:
         fF, _, PF = window_spectra(x, fs, n, n)
         PF = PF[:, 0, :] / (PF[:, 0, fF >= f_lo].sum(axis=1, keepdims=True) + 1e-300)
-        fine, fine_lines, _, s_f0 = fine_harmonic_bands(fF, PF.mean(axis=0), f0, f_lo, lines,
-                                                        df)
+        fine, fine_lines, s_f0 = fine_harmonic_bands(fF, PF.mean(axis=0), f0, f_lo, lines,
+                                                     df)
         if not math.isfinite(s_f0):  # no harmonics placed there: the windows' bands stand
             fine_lines = None
     Pall = P / (P[:, :, f >= f_lo].sum(axis=2, keepdims=True) + 1e-300)
