@@ -300,11 +300,21 @@ def test_bundled_record_reads_back_typed_and_exactly():
 
 
 def test_the_record_reader_knows_every_field_of_the_contract():
-    """The reader's table of keys is the fields of the result types (a new field is read)."""
+    """The reader's kinds come from the result types' fields, in their order; a field of a
+    type the reader cannot check is refused when the module loads, not read unchecked."""
     from dataclasses import fields
+
+    from robobore.cutting.fe.models.results import PerQuantity, ValidationPoint
+    from robobore.cutting.fe.models.validation_record import _kind
 
     for cls, kinds in _KINDS.items():
         assert list(kinds) == [f.name for f in fields(cls)], cls
+    vp = _KINDS[ValidationPoint]
+    assert (vp["uncut_chip_thickness_um"], vp["chip_ratio"], vp["reused"], vp["file"],
+            vp["relative_error"]) == ("num", "num?", "bool", "str?", PerQuantity)
+    assert _kind(float | int | None) == "num?"
+    with pytest.raises(TypeError, match="no record kind"):
+        _kind(list[float])
 
 
 def _bad_record(tmp_path, change):

@@ -6,9 +6,10 @@
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, is_dataclass
 from pathlib import Path
-from typing import Any
+from types import UnionType
+from typing import Any, Union, get_args, get_origin, get_type_hints
 
 from robobore.cutting.fe.models.results import (
     MeasuredValues,
@@ -54,20 +55,25 @@ class ValidationRecord(ValidationResult):
         return copy.deepcopy(super().to_dict())
 
 
-#: the value each key of a record's tables holds: a kind ("num", "bool", "str"; "?": may be
-#: null) or the table's type
+def _kind(tp: Any) -> str | type:
+    """The kind a field of type ``tp`` holds in the record: its table's type (a result
+    dataclass), or "num" (float, int), "bool", "str", with "?" where it may be null."""
+    if is_dataclass(tp):
+        return tp
+    args = set(get_args(tp)) if get_origin(tp) in (Union, UnionType) else {tp}
+    base = args - {type(None)}
+    kind = ("num" if base <= {float, int} and base else "bool" if base == {bool}
+            else "str" if base == {str} else None)
+    if kind is None:
+        raise TypeError(f"no record kind for the field type {tp!r}")
+    return kind + ("?" if type(None) in args else "")
+
+
+#: the value each key of a record's tables holds, from the result types' fields (in their
+#: order): a kind ("num", "bool", "str"; "?": may be null) or the table's type
 _KINDS: dict[type, dict[str, Any]] = {
-    PerQuantity: dict.fromkeys(("cutting_force", "feed_force", "chip_ratio"), "num?"),
-    MeasuredValues: dict.fromkeys(("cutting_force_N_per_mm", "feed_force_N_per_mm",
-                                   "chip_ratio"), "num?"),
-    ValidationPoint: {"uncut_chip_thickness_um": "num", "cutting_speed_m_per_min": "num",
-                      "cutting_force_N_per_mm": "num?", "feed_force_N_per_mm": "num?",
-                      "chip_ratio": "num?", "relative_error": PerQuantity,
-                      "measured": MeasuredValues, "energy_error": "num?", "wall_time_s": "num?",
-                      "element_updates_per_s": "num?", "reused": "bool", "file": "str?"},
-    ValidationSummary: dict.fromkeys(("max_abs_error", "mean_abs_error", "n_measured"),
-                                     PerQuantity),
-}
+    cls: {f.name: _kind(get_type_hints(cls)[f.name]) for f in fields(cls)}
+    for cls in (PerQuantity, MeasuredValues, ValidationPoint, ValidationSummary)}
 _EXPECT = {"num": "a number", "bool": "true or false", "str": "a string"}
 
 
