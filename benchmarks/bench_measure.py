@@ -8,8 +8,11 @@ confusion table of chatter detection on N SYNTHETIC records of the time-domain s
    against the simulation's chatter frequency (target: >= 98 % right, within 2 %).
    ``--low-speed``: the records of the low-speed regime (robobore.measure.synthetic.LOW_SPEED:
    150-1000 r/min, 8 s, half of them with a once-per-revolution interruption of the cut).
+   ``--speed-wander W``: the spindle speed wanders with a relative standard deviation W
+   (robobore.measure.synthetic, "Speed wander").
 
 Run: NUMBA_NUM_THREADS=1 python benchmarks/bench_measure.py [--accuracy 200] [--low-speed]
+[--speed-wander 0.003]
 """
 
 from __future__ import annotations
@@ -67,11 +70,15 @@ def accuracy(n: int, seed: int, **kw) -> None:
             else:
                 conf["stable, called chatter" if d.chatter else "stable, right"] += 1
             if d.chatter != tr["chatter"]:
-                bad.append(s if not kw else f"{s} ({tr['speed_rpm']:.0f} r/min)")
+                bad.append(s if "speed_range_rpm" not in kw
+                           else f"{s} ({tr['speed_rpm']:.0f} r/min)")
         right = (conf["chatter, detected"] + conf["stable, right"]) / n
         fe = np.array(ferr)
+        regime = ", low-speed regime" if "speed_range_rpm" in kw else ""
+        if kw.get("speed_wander"):
+            regime += f", speed wander {kw['speed_wander']:g}"
         print(f"\nspeed {'given' if given else 'not given'}: {n} records (seeds {seed}.."
-              f"{seed + n - 1}{', low-speed regime' if kw else ''}), right {100 * right:.1f} %")
+              f"{seed + n - 1}{regime}), right {100 * right:.1f} %")
         print(f"  {'':16s}{'detected chatter':>18s}{'detected stable':>18s}")
         print(f"  {'truth chatter':16s}{conf['chatter, detected']:>18d}"
               f"{conf['chatter, missed']:>18d}")
@@ -88,6 +95,7 @@ if __name__ == "__main__":
     ap.add_argument("--accuracy", type=int, default=0)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--low-speed", action="store_true")
+    ap.add_argument("--speed-wander", type=float, default=0.0)
     ap.add_argument("--no-speed-run", action="store_true", help="skip the timing")
     a = ap.parse_args()
     print(f"NUMBA_NUM_THREADS={os.environ.get('NUMBA_NUM_THREADS', '(default)')}, "
@@ -95,4 +103,7 @@ if __name__ == "__main__":
     if not a.no_speed_run:
         speed()
     if a.accuracy:
-        accuracy(a.accuracy, a.seed, **(LOW_SPEED if a.low_speed else {}))
+        kw = dict(LOW_SPEED) if a.low_speed else {}
+        if a.speed_wander:
+            kw["speed_wander"] = a.speed_wander
+        accuracy(a.accuracy, a.seed, **kw)

@@ -107,6 +107,7 @@ def detect_chatter_cmd(
                 ("spindle frequency (Hz)", r["spindle_frequency_Hz"]),
                 ("spindle speed (r/min)", r["speed_rpm"]),
                 ("spindle speed from", r["speed_source"]),
+                ("spindle speed spread over the windows (%)", 100.0 * r["speed_spread"]),
                 ("energy share away from harmonics and fixed lines",
                  r["nonharmonic_energy_share"]),
                 ("chatter peak energy share (median)", r["chatter_energy_share"]),
@@ -201,6 +202,10 @@ def measure_synthetic_cmd(
                                    "regime (150-1000 r/min, half of the seeds a cut "
                                    "interrupted once per revolution; "
                                    "robobore.measure.synthetic.LOW_SPEED)."),
+    speed_wander: float = typer.Option(0.0, "--speed-wander", help="Vibration: standard "
+                                       "deviation of the spindle speed's relative wander "
+                                       "(0 .. 0.05; e.g. 0.003 for 0.3 %; default 0, a "
+                                       "steady speed)."),
     as_json: bool = JSON_OPTION,
 ) -> None:
     """Write a SYNTHETIC record with its ground truth (to try `detect chatter` and
@@ -218,12 +223,16 @@ def measure_synthetic_cmd(
         from robobore.measure.synthetic import LOW_SPEED, simulated_record
 
         kw = {k: v for k, v in LOW_SPEED.items() if k != "duration_s"} if low_speed else {}
-        rec = simulated_record(seed, duration_s=duration_s, **kw)
+        rec = simulated_record(seed, duration_s=duration_s, speed_wander=speed_wander, **kw)
         write_record_csv(rec, out)
     elif kind == "force":
         if low_speed:
             raise ConfigError("--low-speed is for vibration records", field="--low-speed",
                               value=True, expected="--kind vibration")
+        if speed_wander:
+            raise ConfigError("--speed-wander is for vibration records",
+                              field="--speed-wander", value=speed_wander,
+                              expected="--kind vibration")
         from robobore.measure.cut import synthetic_force_record, write_dynoware_ascii
 
         rec = synthetic_force_record(duration_s=duration_s + 2.0, seed=seed)  # + 1 s of air

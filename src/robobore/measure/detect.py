@@ -27,8 +27,11 @@ signal's level and units:
    line (a saturated chatter vibration has harmonics of its own; a sub-multiple of it does not
    make a spindle). In each window only the harmonics it shows as lines are excluded, as
    wide as their skirts (:func:`line_extent`), the spindle frequency re-refined in the window
-   (:func:`window_harmonic_bands`). Fixed lines that do not move with the speed are excluded
-   too: mains (50 and 60 Hz families, each detected by its fundamental line, then every
+   (:func:`window_harmonic_bands`). A speed that wanders moves harmonic ``k`` by ``k``
+   times its relative change: the record's speed spread (:func:`speed_spread`, the scatter of
+   the windows' own spindle frequencies) widens each harmonic's band to its wandering range
+   where that band stays attributable (below). Fixed lines that do not move with the speed
+   are excluded too: mains (50 and 60 Hz families, each detected by its fundamental line, then every
    multiple up to the 20th present as a line weaker than the fundamental: mains distortion
    decays with the order) and any lines given.
 
@@ -71,8 +74,9 @@ signal's level and units:
    hundredths of a bin with the Hann window).
 
 Limits: a chatter line that falls on a spindle harmonic or a mains multiple (within the
-band widths) cannot be told from it and is missed; a spindle speed that drifts by more than
-+-0.5 % from the record's mean widens the harmonics past their bands; a lightly damped mode
+band widths) cannot be told from it and is missed; a spindle speed that wanders by more than
+about 0.5 % (standard deviation) leaves the windows' search, and its harmonics above order 10
+or so smear past their bands; a lightly damped mode
 driven by broadband noise looks like a line. A harmonic of order ``k`` can be placed only
 with the spindle frequency known to better than about ``1 / (2 k)`` relative: from the
 record's own first harmonics; a given speed (+-1.5 %) is not that precise, and a forced
@@ -154,6 +158,10 @@ FINE_LINE_BINS = 0.1
 #: A line on the record-length spectrum is the harmonic when within this many standard
 #: errors of ``k f0``.
 FINE_SIGMAS = 3.0
+#: Fewest windows with their own spindle frequency for the record's speed spread.
+SPREAD_MIN_WINDOWS = 3
+#: Half-width of a wandering harmonic, in standard deviations of the spindle frequency.
+SPREAD_SIGMAS = 3.0
 
 
 @dataclass(frozen=True)
@@ -212,6 +220,7 @@ class ChatterDetection:
     spindle_frequency_Hz: float | None
     speed_rpm: float | None
     speed_source: str
+    speed_spread: float
     n_inserts: int
     nonharmonic_energy_share: float
     chatter_energy_share: float
@@ -232,7 +241,9 @@ class ChatterDetection:
         ``nonharmonic_share``, ``prominence_dB``; with chatter ``chatter_line_dB``: the
         chatter line's power relative to its largest), ``chatter_growth_dB`` (that largest
         over the first window's), the spindle frequency used and where it came from, the
-        energy shares, the fixed lines excluded, the record and settings."""
+        energy shares, the fixed lines excluded, ``speed_spread`` (the spindle frequency's
+        relative standard deviation over the windows, :func:`speed_spread`; 0 for a steady
+        speed or where the windows do not show it), the record and settings."""
         d = {k: v for k, v in self.__dict__.items() if k != "spectrogram"}
         d["windows"] = list(self.windows)
         d["reasons"] = list(self.reasons)
@@ -469,8 +480,8 @@ def harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
 
 
 def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
-                          exclude: list[float], fine: FineLines | None = None
-                          ) -> list[tuple[float, float]]:
+                          exclude: list[float], fine: FineLines | None = None,
+                          spread: float = 0.0) -> list[tuple[float, float]]:
     """:func:`harmonic_bands` of one window, the spindle frequency re-refined in it within
     +-:data:`WINDOW_SPEED_TOLERANCE` of the record's ``f0`` (a speed that wanders over the
     record is nearly constant over one window) when that aligns at least
@@ -478,7 +489,14 @@ def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     that :func:`attributable` allows; with ``fine`` (the lines of the record-length spectrum,
     :func:`fine_harmonic_bands`), a line whose band holds a stronger line of the record-length
     spectrum that is not a harmonic there is that line's (a chatter line beside a harmonic
-    that the window does not resolve), not the spindle's."""
+    that the window does not resolve), not the spindle's.
+
+    ``spread``: the spindle frequency's relative standard deviation over the record
+    (:func:`speed_spread`). A harmonic ``k`` then wanders over ``k f0 (1 +- 3 spread)``
+    (:data:`SPREAD_SIGMAS`): a line within that of ``k f0`` is matched to it, and the whole
+    range is excluded, at the orders where that band is attributable (:func:`_spread_tol`);
+    such a band is not checked against ``fine`` (a line within a harmonic's wandering range
+    cannot be told from it, on either spectrum)."""
     df = f[1] - f[0]
     freqs, prom = spectral_lines(f, P, max(1, int(f_lo / df)))
     if freqs.size == 0:
@@ -487,7 +505,8 @@ def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
         keep = np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)
         freqs, prom = freqs[keep], prom[keep]
     w = np.minimum(np.log10(np.maximum(prom, 1.0)), 3.0)
-    tol = _line_tol(freqs, df)
+    steady = _line_tol(freqs, df)
+    tol = _spread_tol(steady, SPREAD_SIGMAS * spread * freqs, f0)
     fi = f0
     _, m0 = comb_score(f0, freqs, w, tol)
     grid = f0 * (1 + np.linspace(-WINDOW_SPEED_TOLERANCE, WINDOW_SPEED_TOLERANCE, 81))
@@ -502,12 +521,88 @@ def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     _, m = comb_score(fi, freqs, w, tol)
     m &= attributable(tol, fi)
     if fine is not None and fine.freqs.size:
-        for i in np.flatnonzero(m):
+        # a band widened to the harmonic's wandering range is not checked: the harmonic is
+        # smeared over that range on the record-length spectrum too
+        for i in np.flatnonzero(m & (tol <= steady)):
             near = np.abs(fine.freqs - freqs[i]) <= tol[i]
             if near.any():
                 j = np.flatnonzero(near)[np.argmax(fine.power[near])]
                 m[i] = bool(fine.harmonic[j])
-    return [(float(c), line_extent(f, P, float(c))) for c in freqs[m]]
+    bands = []
+    for c in freqs[m]:
+        hw = line_extent(f, P, float(c))
+        if spread > 0.0:  # the harmonic's whole wandering range, where attributable
+            kf = float(np.round(c / fi)) * fi
+            wander = abs(c - kf) + SPREAD_SIGMAS * spread * kf
+            if attributable(np.array([wander]), fi)[0]:
+                hw = max(hw, wander)
+        bands.append((float(c), hw))
+    return bands
+
+
+def _spread_tol(tol: np.ndarray, wander: np.ndarray, f0: float) -> np.ndarray:
+    """A harmonic band widened by the speed's wander where the widened band is still
+    attributable (:func:`attributable`); beyond that order the band stays ``tol``, as for a
+    steady speed (a band over half the spacing cannot tell the harmonic from a line beside
+    it, wandering or not)."""
+    wide = np.maximum(tol, wander)
+    return np.where(attributable(wide, f0), wide, tol)
+
+
+def window_spindle(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
+                   exclude: list[float]) -> tuple[float, float] | None:
+    """One window's own spindle frequency and its standard error [Hz]: least squares of
+    ``f = k f_w`` on the window's lines at its first :data:`LOW_HARMONICS` harmonics, ``f_w``
+    searched within +-:data:`WINDOW_SPEED_TOLERANCE` of the record's ``f0`` (the value that
+    matches the most such lines, the nearest ``f0`` among equals). None where fewer than three
+    harmonics are lines. The standard error is the lines' scatter about their harmonics (at
+    least :data:`FINE_LINE_BINS` bins) over ``sqrt(sum k^2)``."""
+    df = f[1] - f[0]
+    freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
+    for ln in exclude:
+        freqs = freqs[np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)]
+    freqs = freqs[freqs <= (LOW_HARMONICS + 0.5) * f0 * (1 + WINDOW_SPEED_TOLERANCE)]
+    if freqs.size < 3:
+        return None
+    tol = _line_tol(freqs, df)
+
+    def matched(g: float) -> np.ndarray:
+        k = np.round(freqs / g)
+        return (k >= 1) & (k <= LOW_HARMONICS) & (np.abs(freqs - k * g) <= tol)
+
+    grid = f0 * (1 + np.linspace(-WINDOW_SPEED_TOLERANCE, WINDOW_SPEED_TOLERANCE, 81))
+    counts = [int(matched(g).sum()) for g in grid]
+    j = max(range(grid.size), key=lambda i: (counts[i], -abs(grid[i] - f0)))
+    m = matched(grid[j])
+    k = np.round(freqs[m] / grid[j])
+    if len(set(k.tolist())) < 3:
+        return None
+    fw = float(np.sum(k * freqs[m]) / np.sum(k * k))
+    if abs(fw / f0 - 1.0) > WINDOW_SPEED_TOLERANCE:
+        return None
+    res = freqs[m] - k * fw
+    s = max(FINE_LINE_BINS * df, float(np.sqrt(np.sum(res ** 2) / max(1, res.size - 1))))
+    return fw, s / float(np.sqrt(np.sum(k * k)))
+
+
+def speed_spread(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
+                 exclude: list[float]) -> float:
+    """Relative standard deviation of the spindle frequency over the record, from the
+    windows' own spindle frequencies (:func:`window_spindle`; ``P``: (n_win, n_f)): their
+    robust scatter (1.4826 times the median absolute deviation) less their typical
+    standard error, in quadrature; 0 where fewer than :data:`SPREAD_MIN_WINDOWS` windows, or
+    fewer than half of them, give one (the forced lines of a cut are in every window; a comb
+    that only some windows show is not a spindle to measure). A spindle whose speed wanders
+    (a belt, the drive's regulation under the cutting load) moves every harmonic ``k`` by
+    ``k`` times its relative change."""
+    est = [window_spindle(f, P[i], f0, f_lo, exclude) for i in range(P.shape[0])]
+    est = [e for e in est if e is not None]
+    if len(est) < max(SPREAD_MIN_WINDOWS, 0.5 * P.shape[0]):
+        return 0.0
+    r = np.array([e[0] for e in est]) / f0
+    se = np.array([e[1] for e in est]) / f0
+    sd = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    return float(np.sqrt(max(0.0, sd ** 2 - float(np.median(se ** 2)))))
 
 
 @dataclass(frozen=True)
@@ -528,7 +623,7 @@ def attributable(tol: np.ndarray, f0: float) -> np.ndarray:
 
 
 def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
-                        exclude: list[float], coarse_df: float
+                        exclude: list[float], coarse_df: float, spread: float = 0.0
                         ) -> tuple[list[tuple[float, float]], FineLines, float]:
     """Harmonics placed on the record-length spectrum ``(f, P)`` at the orders where the
     windows' tolerance (:func:`_line_tol` at resolution ``coarse_df``) cannot attribute a line
@@ -541,8 +636,12 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     least :data:`FINE_LINE_BINS` bins) places the higher harmonics to ``k s_f0``, which
     attributes lines of higher order, and so on while the set grows. A line is the harmonic
     ``k`` when within :data:`FINE_SIGMAS` ``sqrt(s^2 + (k s_f0)^2)`` of ``k f0`` (at least
-    0.75 bin) and that band is attributable. Returns ``(bands (centre, half-width), lines,
-    s_f0)``; the bands are the high-order harmonics only (the windows attribute the
+    0.75 bin) and that band is attributable. ``spread`` (the spindle frequency's relative
+    standard deviation over the record, :func:`speed_spread`) widens the band to the
+    harmonic's wandering range ``3 k f0 spread`` (:data:`SPREAD_SIGMAS`) where that stays
+    attributable (:func:`_spread_tol`), as in the windows: a wandering harmonic is smeared over
+    that range, its strongest bin anywhere in it. Returns ``(bands (centre, half-width),
+    lines, s_f0)``; the bands are the high-order harmonics only (the windows attribute the
     others, checked against ``lines``)."""
     df = f[1] - f[0]
     freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
@@ -575,6 +674,7 @@ def fine_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
         s_f0 = s_line / float(np.sqrt(np.sum(ku * ku)))
         k = np.round(freqs / fr)
         tol = np.maximum(0.75 * df, FINE_SIGMAS * np.sqrt(s_line ** 2 + (k * s_f0) ** 2))
+        tol = _spread_tol(tol, SPREAD_SIGMAS * spread * k * fr, fr)
         new = (k >= 1) & (np.abs(freqs - k * fr) <= tol) & attributable(tol, fr)
         if np.array_equal(new, use) or int(new.sum()) < 2:
             break
@@ -706,6 +806,10 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     f, t0, P = window_spectra(x, fs, nwin, max(1, nwin // 2))
     df = f[1] - f[0]
     f_lo = max(4.0 * df, 0.5 * f0 if f0 else 0.0)
+    Pall = P / (P[:, :, f >= f_lo].sum(axis=2, keepdims=True) + 1e-300)
+    Pall = Pall.mean(axis=0)  # (n_win, n_f): the channels' normalised spectra
+    # how far the speed wanders over the record (each harmonic k moves k times as far)
+    spread = speed_spread(f, Pall, f0, f_lo, lines) if n_matched > 0 else 0.0
     # high harmonic orders, where the windows' bands cannot attribute a line to the spindle:
     # the harmonics placed on the record-length spectrum (fine resolution)
     fine: list[tuple[float, float]] = []
@@ -714,14 +818,12 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
         fF, _, PF = window_spectra(x, fs, n, n)
         PF = PF[:, 0, :] / (PF[:, 0, fF >= f_lo].sum(axis=1, keepdims=True) + 1e-300)
         fine, fine_lines, s_f0 = fine_harmonic_bands(fF, PF.mean(axis=0), f0, f_lo, lines,
-                                                     df)
+                                                     df, spread)
         if not math.isfinite(s_f0):  # no harmonics placed there: the windows' bands stand
             fine_lines = None
-    Pall = P / (P[:, :, f >= f_lo].sum(axis=2, keepdims=True) + 1e-300)
-    Pall = Pall.mean(axis=0)  # (n_win, n_f): the channels' normalised spectra
     excl = np.empty((t0.size, f.size), dtype=bool)
     for i in range(t0.size):
-        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines, fine_lines)
+        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines, fine_lines, spread)
               if n_matched > 0 else [])
         excl[i] = exclusion_mask(f, wb + fixed_bands, f_lo, fine)
     allowed = np.ones(f.size, dtype=bool)
@@ -817,7 +919,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
         chatter=chatter, chatter_frequency_Hz=fc, onset_s=onset,
         channel=record.channels[ch_idx],
         spindle_frequency_Hz=f0, speed_rpm=None if f0 is None else 60.0 * f0,
-        speed_source=f0_src, n_inserts=int(s.n_inserts),
+        speed_source=f0_src, speed_spread=spread, n_inserts=int(s.n_inserts),
         nonharmonic_energy_share=float(np.mean(nonh)),
         chatter_energy_share=float(np.median(share[use_w])) if use_w else 0.0,
         peak_prominence_dB=float(np.median(prom[use_w])) if use_w else 0.0,
@@ -837,6 +939,7 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
 __all__ = ["DetectSettings", "ChatterDetection", "detect_chatter", "window_spectra",
            "spectral_lines", "find_spindle", "fixed_lines", "harmonic_bands",
            "window_harmonic_bands", "line_extent", "attributable", "fine_harmonic_bands",
+           "window_spindle", "speed_spread",
            "window_length",
            "exclusion_mask", "comb_score",
            "SHARE_LIMIT", "PROMINENCE_DB", "PERSIST_WINDOWS", "SPEED_TOLERANCE", "MAINS_HZ"]

@@ -22,6 +22,16 @@ decimated), plus
 * white sensor noise at a signal-to-noise ratio of 20-40 dB;
 * an offset and a random gain ``10^U(-3, 3)`` (the detector must not care).
 
+**Speed wander** (``speed_wander`` W > 0): the spindle's speed is ``n (1 + eps(t))``, ``eps``
+the sum of three sinusoids of ``U(0.1, 2)`` Hz and random phases scaled to a standard
+deviation W (a belt drive, or the drive's regulation under the cutting load). The lines that
+turn with the spindle (runout, insert passing, the interruption) follow its angle: each
+harmonic ``k`` moves by ``k`` times the relative change. The regenerative simulation, and so
+the label, runs at the constant speed (the wander changes the delay by ``eps``, a
+negligible change of the lobes at a few per mille). These draws come from
+``numpy.random.default_rng((seed, 2))``; with W = 0 the record is that of the steady speed,
+bit for bit.
+
 Every random draw comes from ``numpy.random.default_rng(seed)``; the default records are
 spindle speeds of 1000-8000 r/min (``speed_range_rpm``).
 
@@ -70,12 +80,16 @@ def _mode_acc_response(f: np.ndarray, fn: float, zeta: float, k: float) -> np.nd
 
 
 def _interruption_response(force: float, duty: float, phase: float, Ns: int, fsim: float,
-                           n: int, fn: float, zeta: float, k: float) -> np.ndarray:
+                           n: int, fn: float, zeta: float, k: float,
+                           angle_t: np.ndarray | None = None) -> np.ndarray:
     """Acceleration [m/s^2] at the record's rate (``fsim / OVERSAMPLE``), ``n`` samples, of
     the mode driven by a force pulse of ``force`` [N] lasting ``duty`` of each revolution
     (``Ns`` simulation steps), starting at ``phase`` of the revolution: its harmonics up to
     0.45 of the record's rate, each through the receptance, summed over one revolution of the
-    simulation grid (an inverse FFT, exactly periodic) and repeated."""
+    simulation grid (an inverse FFT, exactly periodic) and repeated. ``angle_t``: the
+    spindle's angle at each sample as the time [s] it would take at the nominal speed (a
+    wandering speed); the revolution's waveform is then read there, linearly interpolated on
+    the simulation grid."""
     f1 = fsim / Ns
     kk = np.arange(1, Ns // 2)
     kk = kk[kk * f1 < 0.45 * fsim / OVERSAMPLE]
@@ -85,6 +99,9 @@ def _interruption_response(force: float, duty: float, phase: float, Ns: int, fsi
     spec = np.zeros(Ns // 2 + 1, dtype=complex)
     spec[kk] = c * _mode_acc_response(kk * f1, fn, zeta, k) * Ns
     one = np.fft.irfft(spec, Ns)
+    if angle_t is not None:
+        pos = np.mod(angle_t * fsim, Ns)
+        return np.interp(pos, np.arange(Ns + 1), np.append(one, one[0]))
     reps = int(math.ceil(n * OVERSAMPLE / Ns)) + 1
     return np.tile(one, reps)[::OVERSAMPLE][:n]
 
@@ -92,13 +109,15 @@ def _interruption_response(force: float, duty: float, phase: float, Ns: int, fsi
 def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: float = 3.0,
                      n_channels: int = 1,
                      speed_range_rpm: tuple[float, float] = DEFAULT_SPEED_RANGE_RPM,
-                     interruption_probability: float = 0.0) -> Record:
+                     interruption_probability: float = 0.0,
+                     speed_wander: float = 0.0) -> Record:
     """One SYNTHETIC labelled record (module docstring); ``truth`` holds the label and the
     drawn parameters. With ``n_channels`` 3 the record has the accelerometer's three axes
     (the other two see the mode through 5-20 % cross-axis sensitivity, with their own
     noise). ``speed_range_rpm``: the range the spindle speed is drawn from;
     ``interruption_probability``: the chance of a once-per-revolution interruption of the
-    cut (module docstring, low-speed regime)."""
+    cut (module docstring, low-speed regime); ``speed_wander``: the standard deviation of
+    the spindle speed's relative wander (module docstring)."""
     from scipy import signal
 
     from robobore.dynamics import stability
@@ -115,6 +134,10 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
     if not 0.0 <= p_int <= 1.0:
         raise InputError("interruption probability out of range",
                          field="interruption_probability", value=p_int, expected="0 .. 1")
+    wander = float(speed_wander)
+    if not (math.isfinite(wander) and 0.0 <= wander <= 0.05):
+        raise InputError("speed wander out of range", field="speed_wander", value=wander,
+                         expected="0 .. 0.05 (a relative standard deviation of the speed)")
     rng = np.random.default_rng(seed)
     fs = float(sample_rate_Hz)
     fn = float(rng.uniform(500.0, min(2500.0, 0.3 * fs)))
@@ -146,6 +169,14 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
     n = int(round(duration_s * fs))
     clean = np.pad(clean, (0, max(0, n - clean.size)), mode="edge")[:n]
     t = np.arange(n) / fs
+    angle_t = t  # the spindle's angle, as the time it takes at the nominal speed [s]
+    if wander > 0.0:  # own generator: the record's other draws stay those of its seed
+        rng3 = np.random.default_rng((seed, 2))
+        fw = rng3.uniform(0.1, 2.0, 3)
+        pw = rng3.uniform(0.0, 2 * np.pi, 3)
+        eps = wander * math.sqrt(2.0 / 3.0) * np.sin(
+            2 * np.pi * fw[:, None] * t[None, :] + pw[:, None]).sum(axis=0)
+        angle_t = t + np.concatenate(([0.0], np.cumsum(0.5 * (eps[1:] + eps[:-1])))) / fs
     f1 = speed / 60.0
     # forced response to runout and insert passing
     e = rng.uniform(2e-6, 10e-6)
@@ -157,14 +188,14 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
             break
         H = _mode_acc_response(np.array([fk]), fn, zeta, kst)[0]
         forced += np.abs(H) * gain_x * K * depth * e / kk * np.cos(
-            2 * np.pi * fk * t + rng.uniform(0, 2 * np.pi))
+            2 * np.pi * fk * angle_t + rng.uniform(0, 2 * np.pi))
     for j in range(1, 5):
         fj = j * N * f1
         if fj >= 0.45 * fs:
             break
         H = _mode_acc_response(np.array([fj]), fn, zeta, kst)[0]
         forced += np.abs(H) * gain_x * 0.3 * K * depth * (feed / N) / j * np.cos(
-            2 * np.pi * fj * t + rng.uniform(0, 2 * np.pi))
+            2 * np.pi * fj * angle_t + rng.uniform(0, 2 * np.pi))
     interruption = None
     if p_int > 0.0:  # own generator: the record's other draws stay those of its seed
         rng2 = np.random.default_rng((seed, 1))
@@ -173,7 +204,8 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
             arc = float(rng2.uniform(2.0, 10.0))
             forced += _interruption_response(q * gain_x * K * depth * (feed / N), arc / 360.0,
                                              float(rng2.uniform(0.0, 1.0)), Ns, fsim, n,
-                                             fn, zeta, kst)
+                                             fn, zeta, kst,
+                                             angle_t if wander > 0.0 else None)
             interruption = {"force_fraction": q, "arc_deg": arc}
     # broadband cutting-force noise through the mode (frequency-domain filtering)
     fnoise = 0.02 * K * depth * (feed / N) * rng.standard_normal(n)
@@ -205,6 +237,7 @@ def simulated_record(seed: int, sample_rate_Hz: float = 10000.0, duration_s: flo
         "vibration_growth": v.vibration_growth, "mains_Hz": mains, "snr_dB": snr_db,
         "gain": gain, "seed": seed, "generator": "robobore.measure.synthetic.simulated_record",
         "speed_range_rpm": [n_lo, n_hi], "interruption": interruption,
+        "speed_wander": wander,
     }
     return make_record(X, fs, names, ["" for _ in names],
                        source=f"<SYNTHETIC record seed {seed}>", kind="SYNTHETIC", truth=truth)
