@@ -79,3 +79,49 @@ def test_dynoware_semicolon_decimal_comma(tmp_path):
     rec = read_cut_record(p)
     assert rec.channels == ("Fx", "Fy", "Fz") and rec.sample_rate_Hz == pytest.approx(2000)
     assert rec.signals[2].mean() == pytest.approx(30.0)
+
+
+def _write(path, header, rows):
+    path.write_text(header + "".join(rows), encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("layout", ["quoted", "r_index", "pandas_index", "decimal_comma",
+                                    "trailing_separator", "tab_quoted"])
+def test_csv_as_data_frames_and_spreadsheets_write_it(tmp_path, layout):
+    """The same record written as R (``write.csv``: quoted header, quoted row names),
+    pandas (``to_csv`` with its index), a comma-decimal spreadsheet (``;``) and exports
+    with a trailing separator: read as one ``acc`` channel at the same rate."""
+    x = _signal()
+    t = np.arange(x.size) / FS
+    rows = {
+        "quoted": ('"time_s","acc"\n', [f'"{a:.7f}","{b:.9g}"\n' for a, b in zip(t, x)]),
+        "r_index": ('"","time_s","acc"\n',
+                    [f'"{i + 1}",{a:.7f},{b:.9g}\n' for i, (a, b) in enumerate(zip(t, x))]),
+        "pandas_index": (",time_s,acc\n",
+                         [f"{i},{a:.7f},{b:.9g}\n" for i, (a, b) in enumerate(zip(t, x))]),
+        "decimal_comma": ("time_s;acc\n",
+                          [f"{a:.7f};{b:.9g}\n".replace(".", ",") for a, b in zip(t, x)]),
+        "trailing_separator": ("time_s,acc,\n", [f"{a:.7f},{b:.9g},\n" for a, b in zip(t, x)]),
+        "tab_quoted": ('"time_s"\t"acc"\n', [f"{a:.7f}\t{b:.9g}\n" for a, b in zip(t, x)]),
+    }[layout]
+    rec = read_record(_write(tmp_path / f"{layout}.csv", *rows))
+    assert rec.channels == ("acc",)
+    assert rec.sample_rate_Hz == pytest.approx(FS, rel=1e-9)
+    np.testing.assert_allclose(rec.signals[0], x, rtol=1e-8, atol=1e-8)
+    _check(rec)
+
+
+def test_csv_unnamed_signal_column_is_kept_and_bad_quoted_cell_named(tmp_path):
+    x = _signal()
+    t = np.arange(x.size) / FS
+    rec = read_record(_write(tmp_path / "u.csv", "time_s,\n",
+                             [f"{a:.7f},{b:.9g}\n" for a, b in zip(t, x)]))
+    assert rec.channels == ("column 2",)  # not a row index: its values do not count 0, 1, ..
+    rows = [f'"{a:.7f}","{b:.9g}"\n' for a, b in zip(t, x)]
+    rows[41] = f'"{t[41]:.7f}","1.2.3"\n'
+    from robobore.errors import DataError
+
+    with pytest.raises(DataError) as e:
+        read_record(_write(tmp_path / "bad.csv", '"time_s","acc"\n', rows))
+    assert e.value.row == 42 and e.value.field == "acc" and "1.2.3" in str(e.value)

@@ -6,7 +6,11 @@ A :class:`Record` holds ``signals`` of shape ``(n_channels, n_samples)`` sampled
 
 * **CSV** (``.csv``, ``.txt``): a header line of column names, then one row per sample; a
   ``time_s`` column (seconds; also ``time [s]``, ``Time [s]``, ``t_s``) or a sample rate given
-  by the caller; every other column is a signal channel. Lines starting with ``#`` are comments.
+  by the caller; every other column is a signal channel, but for a data frame's row index (an
+  unnamed or ``index`` column counting 0, 1, 2 ... or 1, 2, 3 ..., as pandas and R write
+  it). Separators ``,``, ``;`` or tab; quoted cells; with ``;`` or tab a decimal comma; a
+  trailing separator on every line (an empty last column) is ignored. Lines starting with
+  ``#`` are comments.
 * **NPZ**: 1-D arrays of equal length, one per channel, plus ``time_s`` (1-D) or
   ``sample_rate_Hz`` (a scalar); or one 2-D ``signals`` array ``(n_channels, n_samples)``
   with ``channels`` (names) and ``sample_rate_Hz``.
@@ -25,6 +29,7 @@ was expected.
 
 from __future__ import annotations
 
+import csv
 import math
 import re
 from dataclasses import dataclass, field
@@ -239,7 +244,9 @@ def read_csv_table(path: Path, what: str = "a record CSV", skip_lines: int = 0,
                 delim = ";" if ln.count(";") > ln.count(",") else ","
                 if delim == "," and "," not in ln and "\t" in ln:
                     delim = "\t"
-                header = [h.strip() for h in ln.split(delim)]
+                # CSV quoting ("time_s","acc", as R and spreadsheets write it) is read
+                header = [h.strip() for h in next(csv.reader([ln.rstrip("\r\n")],
+                                                            delimiter=delim))]
             else:
                 fh.readline()
                 line_no += 1
@@ -248,6 +255,15 @@ def read_csv_table(path: Path, what: str = "a record CSV", skip_lines: int = 0,
             start = fh.tell()
             probe = [fh.readline() for _ in range(200)]
             probe = [x for x in probe if x]
+            rows = [x.rstrip("\r\n") for x in probe
+                    if x.strip() and not x.lstrip().startswith("#")]
+            usecols = None
+            if len(header) > 1 and header[-1] == "" and rows and all(
+                    r.endswith(delim) for r in rows):  # a trailing delimiter on every line
+                header = header[:-1]
+                usecols = range(len(header))
+            # a decimal comma (a ';' or tab separated export of a comma-decimal locale)
+            comma = delim in (";", "\t") and any("," in r for r in rows)
             per_line = max(1.0, sum(len(x.encode()) for x in probe) / max(1, len(probe)))
             rows_est = size / per_line
             from robobore.io.memory import check_memory
@@ -259,12 +275,14 @@ def read_csv_table(path: Path, what: str = "a record CSV", skip_lines: int = 0,
             fh.seek(start)
             try:
                 data = np.loadtxt(fh, delimiter=None if delim == " " else delim,
-                                  comments="#", dtype=float, ndmin=2)
+                                  comments="#", dtype=float, ndmin=2, quotechar='"',
+                                  usecols=usecols,
+                                  converters=_comma_float if comma else None)
             except ValueError:
                 data = None
             if data is None or data.shape[1] != len(header) or data.shape[0] == 0:
                 fh.seek(start)
-                _locate_bad_row(fh, header, src, delim)
+                _locate_bad_row(fh, header, src, delim, comma)
                 raise DataError("no data rows", file=src, expected="one row per sample")
     except UnicodeDecodeError as exc:
         raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=src,
@@ -272,21 +290,31 @@ def read_csv_table(path: Path, what: str = "a record CSV", skip_lines: int = 0,
     return header, data, header_line
 
 
-def _locate_bad_row(lines: Any, header: list[str], source: str, delim: str | None) -> None:
+def _comma_float(cell: str) -> float:
+    """A number written with a decimal comma (``"0,125"``)."""
+    return float(cell.replace(",", "."))
+
+
+def _locate_bad_row(lines: Any, header: list[str], source: str, delim: str | None,
+                    comma: bool = False) -> None:
     """Raise the error of the first bad data row of ``lines`` (an iterable of text lines);
-    rows are counted from 1 after the header, blank and comment lines included."""
+    rows are counted from 1 after the header, blank and comment lines included. Cells may be
+    quoted; ``comma``: numbers written with a decimal comma."""
     n = 0
     for ln in lines:
         n += 1
         if not ln.strip() or ln.lstrip().startswith("#"):
             continue
-        cells = ln.rstrip("\r\n").split(delim) if delim else ln.split()
+        text = ln.rstrip("\r\n")
+        cells = next(csv.reader([text], delimiter=delim)) if delim else text.split()
+        if len(cells) == len(header) + 1 and header and cells[-1].strip() == "":
+            cells = cells[:-1]  # the trailing delimiter dropped with the empty column
         if len(cells) != len(header):
             raise DataError(f"row has {len(cells)} cells, the header has {len(header)}",
                             file=source, row=n, expected=f"{len(header)} cells")
         for h, c in zip(header, cells, strict=True):
             try:
-                float(c)
+                _comma_float(c) if comma else float(c)
             except ValueError:
                 raise DataError("not a number", file=source, row=n, field=h,
                                 value=c.strip(), expected="a number") from None
@@ -320,7 +348,7 @@ def _read_csv(path: Path, sample_rate_Hz: float | None) -> Record:
         raise DataError("both a time column and a sample rate", file=src,
                         field="--sample-rate-hz", value=sample_rate_Hz,
                         expected="one of them (the time column is read)")
-    cols = [i for i in range(len(header)) if i != ti]
+    cols = [i for i in range(len(header)) if i != ti and not _row_index(header[i], data[:, i])]
     if not cols:
         raise DataError("no signal column", file=src, expected="one or more signal columns "
                         "besides the time")
@@ -336,6 +364,17 @@ def _read_csv(path: Path, sample_rate_Hz: float | None) -> Record:
     else:
         fs, t0 = float(sample_rate_Hz), 0.0
     return make_record(x, fs, names, units, src, t0)
+
+
+#: Headers of the row-index column a data frame writes (pandas ``to_csv``, R ``write.csv``).
+INDEX_COLUMNS = ("", "index", "unnamed: 0")
+
+
+def _row_index(name: str, values: np.ndarray) -> bool:
+    """Whether a CSV column is a data frame's row index, not a signal: an unnamed (or
+    ``index``) column counting 0, 1, 2 ... or 1, 2, 3 ..."""
+    return (name.strip().lower() in INDEX_COLUMNS and values.size > 1
+            and values[0] in (0.0, 1.0) and bool(np.all(np.diff(values) == 1.0)))
 
 
 def _read_npz(path: Path, sample_rate_Hz: float | None) -> Record:
