@@ -60,3 +60,19 @@ def test_chatter_in_the_forces_is_reported():
     x[:2] += 100.0 * np.sin(2 * np.pi * 187.3 * t) * on
     q = cut_quantities(make_record(x, rec.sample_rate_Hz, rec.channels, rec.units), 300.0)
     assert q["chatter"] and q["chatter_frequency_Hz"] == pytest.approx(187.3, rel=2e-3)
+
+
+def test_time_column_in_ms_is_read_in_s(tmp_path):
+    """A time column declared in ms (the header's unit) is read in s, by the record and the
+    cut readers alike (one definition of the time column)."""
+    from robobore.measure.records import read_record
+
+    rec = synthetic_force_record(noise_N=0.0)
+    t_ms = np.arange(rec.n_samples) / rec.sample_rate_Hz * 1e3
+    p = tmp_path / "cut_ms.csv"
+    np.savetxt(p, np.column_stack([t_ms, rec.signals[0], rec.signals[1], rec.signals[2]]),
+               delimiter=",", header="Time (ms),Fx [N],Fy [N],Fz [N]", comments="")
+    cut = read_cut_record(p)
+    assert cut.sample_rate_Hz == pytest.approx(rec.sample_rate_Hz, rel=1e-9)
+    assert read_record(p).sample_rate_Hz == pytest.approx(rec.sample_rate_Hz, rel=1e-9)
+    assert read_record(p).channels == ("Fx", "Fy", "Fz")

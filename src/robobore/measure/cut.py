@@ -53,6 +53,7 @@ from robobore.measure.records import (
     read_csv_table,
     sample_rate_from_time,
     split_unit,
+    time_column,
 )
 
 FORCE_UNITS = {"n": 1.0, "kn": 1e3, "dan": 10.0, "lbf": 4.4482216152605}
@@ -90,14 +91,10 @@ def _column(col: str, source: str) -> tuple[str, str, float] | None:
     return None
 
 
-def _is_time(col: str) -> bool:
-    name, unit = split_unit(col)
-    return name.lower() in ("time", "time_s", "t_s", "t") and unit.lower() in ("", "s")
-
-
 def _from_table(header: list[str], data: np.ndarray, source: str, header_line: int,
                 sample_rate_Hz: float | None, dynoware: bool) -> Record:
-    ti = next((i for i, h in enumerate(header) if _is_time(h)), None)
+    tc = time_column(header)
+    ti, t_scale = tc if tc is not None else (None, 1.0)
     cols: dict[str, tuple[int, float]] = {}
     for i, h in enumerate(header):
         if i == ti:
@@ -124,7 +121,7 @@ def _from_table(header: list[str], data: np.ndarray, source: str, header_line: i
     x = np.vstack([data[:, cols[a][0]] * cols[a][1] for a in order])
     units = ["N" if a.startswith("F") else "m" for a in order]
     if ti is not None:
-        fs, t0 = sample_rate_from_time(data[:, ti], source, header[ti])
+        fs, t0 = sample_rate_from_time(data[:, ti] * t_scale, source, header[ti])
     elif sample_rate_Hz is not None:
         fs, t0 = float(sample_rate_Hz), 0.0
     else:
@@ -137,7 +134,7 @@ def _dynoware_header(lines: list[str]) -> int | None:
     """Index of a DynoWare column line (a time column and an ``Fx``-like column)."""
     for i, ln in enumerate(lines[:200]):
         cells = [c.strip() for c in re.split(r"[\t;,]", ln) if c.strip()]
-        if len(cells) >= 2 and _is_time(cells[0]) and any(
+        if len(cells) >= 2 and time_column(cells[:1]) is not None and any(
                 split_unit(c)[0].lower().startswith("f") for c in cells[1:]):
             if i > 0 and any(":" in x or "\t" in x for x in lines[:i]):
                 return i

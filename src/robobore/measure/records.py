@@ -5,7 +5,8 @@ A :class:`Record` holds ``signals`` of shape ``(n_channels, n_samples)`` sampled
 (:func:`read_record`) take:
 
 * **CSV** (``.csv``, ``.txt``): a header line of column names, then one row per sample; a
-  ``time_s`` column (seconds; also ``time [s]``, ``Time [s]``, ``t_s``) or a sample rate given
+  ``time_s`` column (seconds; also ``t_s``, ``time`` or ``t`` with its unit, ``Time [s]``,
+  ``time (ms)``, ``t [us]``: read in s) or a sample rate given
   by the caller; every other column is a signal channel, but for a data frame's row index (an
   unnamed or ``index`` column counting 0, 1, 2 ... or 1, 2, 3 ..., as pandas and R write
   it). Separators ``,``, ``;`` or tab; quoted cells; with ``;`` or tab a decimal comma; a
@@ -51,8 +52,6 @@ GRID_TOLERANCE = 0.25
 #: A cutting record sampled slower than this (Hz) shows neither chatter nor the revolutions
 #: (a time column in ms read as s gives 1000 x slower rates)
 MIN_RECORD_RATE_HZ = 100.0
-#: Names of the time column of a CSV record (matched case-insensitively).
-TIME_COLUMNS = ("time_s", "time [s]", "t_s", "time")
 
 
 @dataclass(frozen=True)
@@ -192,11 +191,21 @@ def guard_size(path: Path, bytes_per_file_byte: float, what: str) -> None:
                  "the record's length (split it into shorter files)", file=str(path))
 
 
-def _time_column(header: list[str]) -> int | None:
-    low = [h.strip().lower() for h in header]
-    for name in TIME_COLUMNS:
-        if name in low:
-            return low.index(name)
+#: Time units a CSV header may declare (``time [ms]``), in s.
+TIME_UNITS_S = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+
+
+def time_column(header: list[str]) -> tuple[int, float] | None:
+    """The time column of a table's header and the factor of its unit to s, or None: the
+    first column named ``time_s`` or ``t_s`` (unit s or none), or ``time`` or ``t`` (unit
+    none or one of :data:`TIME_UNITS_S`: ``Time [s]``, ``time (ms)``: 1e-3)."""
+    for i, h in enumerate(header):
+        name, unit = split_unit(h)
+        name = name.lower()
+        if name in ("time_s", "t_s") and unit in ("", "s"):
+            return i, 1.0
+        if name in ("time", "t") and (unit == "" or unit in TIME_UNITS_S):
+            return i, TIME_UNITS_S.get(unit, 1.0)
     return None
 
 
@@ -340,7 +349,8 @@ def parse_rows(body: list[str], header: list[str], source: str, header_line: int
 def _read_csv(path: Path, sample_rate_Hz: float | None) -> Record:
     header, data, _ = read_csv_table(path)
     src = str(path)
-    ti = _time_column(header)
+    tc = time_column(header)
+    ti, t_scale = tc if tc is not None else (None, 1.0)
     if ti is None and sample_rate_Hz is None:
         raise DataError("no time column and no sample rate", file=src, field="time_s",
                         expected="a 'time_s' column in s, or --sample-rate-hz")
@@ -360,7 +370,7 @@ def _read_csv(path: Path, sample_rate_Hz: float | None) -> Record:
     x = data[:, cols].T
     check_samples(x, tuple(names), src)
     if ti is not None:
-        fs, t0 = sample_rate_from_time(data[:, ti], src, header[ti])
+        fs, t0 = sample_rate_from_time(data[:, ti] * t_scale, src, header[ti])
     else:
         fs, t0 = float(sample_rate_Hz), 0.0
     return make_record(x, fs, names, units, src, t0)
@@ -546,6 +556,6 @@ def write_record_csv(record: Record, path: str | Path, digits: int = 9) -> Path:
 
 
 __all__ = ["Record", "make_record", "read_record", "read_csv_table", "parse_rows",
-           "sample_rate_from_time", "check_samples", "split_unit", "guard_size",
-           "write_record_csv", "MIN_SAMPLES", "STEP_TOLERANCE", "GRID_TOLERANCE", "TIME_COLUMNS",
+           "sample_rate_from_time", "time_column", "check_samples", "split_unit", "guard_size",
+           "write_record_csv", "MIN_SAMPLES", "STEP_TOLERANCE", "GRID_TOLERANCE", "TIME_UNITS_S",
            "SYNTHETIC_MARK", "with_synthetic_mark"]
