@@ -125,3 +125,20 @@ def test_csv_unnamed_signal_column_is_kept_and_bad_quoted_cell_named(tmp_path):
     with pytest.raises(DataError) as e:
         read_record(_write(tmp_path / "bad.csv", '"time_s","acc"\n', rows))
     assert e.value.row == 42 and e.value.field == "acc" and "1.2.3" in str(e.value)
+
+
+def test_times_written_with_few_decimals(tmp_path):
+    """25.6 kHz with the times written to 1e-5 s (steps of 3.9e-5 s off by up to 26 %): read
+    at the rate the times say; a missing sample is still refused."""
+    from robobore.errors import DataError
+
+    fs = 25600.0
+    x = np.sin(2 * np.pi * 987.0 * np.arange(int(fs)) / fs)
+    t = np.arange(x.size) / fs
+    rows = [f"{a:.5f},{b:.9g}\n" for a, b in zip(t, x)]
+    rec = read_record(_write(tmp_path / "q.csv", "time_s,acc\n", rows))
+    assert rec.sample_rate_Hz == pytest.approx(fs, rel=1e-6)
+    del rows[5000]
+    with pytest.raises(DataError, match="not uniformly sampled") as e:
+        read_record(_write(tmp_path / "gap.csv", "time_s,acc\n", rows))
+    assert e.value.row == 5001

@@ -21,7 +21,8 @@ A :class:`Record` holds ``signals`` of shape ``(n_channels, n_samples)`` sampled
 
 Every reader checks the record before it is used: a time column that decreases or is not
 uniform (a step more than 20 % off the median step, or a time more than a quarter step off
-the uniform grid: a missing sample), non-finite samples,
+the uniform grid: a missing sample; times written with few decimals may be off by half their
+last digit, a step by one), non-finite samples,
 fewer than :data:`MIN_SAMPLES` samples, or a file whose parsed size would not fit in memory
 (estimated from the file size before reading) are refused with a
 :class:`~robobore.errors.DataError` naming the file, the row or column, the value and what
@@ -139,6 +140,16 @@ def check_samples(x: np.ndarray, channels: tuple[str, ...], source: str,
                         expected="a finite number in every row (fill or cut the gap)")
 
 
+def _time_quantum(t: np.ndarray) -> float:
+    """The resolution the times were written with: the largest ``10^-d`` (``d`` = 0 .. 12) of
+    which every time is a multiple (to a thousandth of it), 0 where none is."""
+    for d in range(13):
+        v = t * 10.0 ** d
+        if np.all(np.abs(v - np.round(v)) < 1e-3):
+            return 10.0 ** -d
+    return 0.0
+
+
 def sample_rate_from_time(t: np.ndarray, source: str, column: str = "time_s",
                           first_row: int = 1) -> tuple[float, float]:
     """``(sample_rate_Hz, t0_s)`` of a time column; refuses a decreasing, repeated or
@@ -159,12 +170,18 @@ def sample_rate_from_time(t: np.ndarray, source: str, column: str = "time_s",
                         "(samples in time order, each once)")
     dt = (t[-1] - t[0]) / (t.size - 1)
     med = float(np.median(d))
+    dev = np.abs(t - (t[0] + dt * np.arange(t.size)))
     step_bad = np.abs(d - med) > STEP_TOLERANCE * med
-    grid_bad = np.abs(t - (t[0] + dt * np.arange(t.size))) > GRID_TOLERANCE * dt
+    grid_bad = dev > GRID_TOLERANCE * dt
+    if step_bad.any() or grid_bad.any():
+        # times written with few decimals: each within half a printed digit of the grid
+        q = _time_quantum(t)
+        step_bad = np.abs(d - med) > max(STEP_TOLERANCE * med, 1.01 * q)
+        grid_bad = dev > max(GRID_TOLERANCE * dt, 0.51 * q)
     if step_bad.any() or grid_bad.any():
         i1 = int(np.argmax(step_bad)) + 1 if step_bad.any() else t.size
         i2 = int(np.argmax(grid_bad)) if grid_bad.any() else t.size
-        i = max(1, min(i1, i2))
+        i = max(1, i1 if step_bad.any() else i2)  # a gap or a repeat is a bad step there
         raise DataError("time is not uniformly sampled", file=source, row=i + first_row,
                         field=column, value=float(t[i]),
                         expected=f"steps of {med:.6g} s (each within "
