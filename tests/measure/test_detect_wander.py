@@ -18,8 +18,8 @@ from robobore.measure.records import make_record
 from robobore.measure.synthetic import simulated_record
 
 WANDER = 0.003
-#: Stable records (default regime) that the detector called chatter at this wander when
-#: it took the speed as steady (its bands one line wide about each harmonic).
+#: Stable records (default regime) that bands for a steady speed (one line wide about each
+#: harmonic, spread 0) call chatter at this wander.
 STABLE_SEEDS = (5, 29, 71, 112, 175, 195)
 
 
