@@ -61,6 +61,17 @@ def test_wandering_stable_records_are_stable(given):
     assert wrong == []
 
 
+def test_steady_bands_call_the_wandering_stable_records_chatter(monkeypatch):
+    """The records above are a case for the spread: with it held at 0 (bands for a steady
+    speed) they are called chatter."""
+    import robobore.measure.detect as detect
+
+    monkeypatch.setattr(detect, "speed_spread", lambda *a: 0.0)
+    called = [s for s in STABLE_SEEDS
+              if detect.detect_chatter(simulated_record(s, speed_wander=WANDER)).chatter]
+    assert called == list(STABLE_SEEDS)
+
+
 def test_wandering_chatter_records_still_chatter():
     n, ferr = 0, []
     for s in range(40):
