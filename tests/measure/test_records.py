@@ -142,3 +142,15 @@ def test_times_written_with_few_decimals(tmp_path):
     with pytest.raises(DataError, match="not uniformly sampled") as e:
         read_record(_write(tmp_path / "gap.csv", "time_s,acc\n", rows))
     assert e.value.row == 5001
+
+
+def test_a_row_with_an_extra_cell_is_named(tmp_path):
+    from robobore.errors import DataError
+
+    x = _signal()
+    t = np.arange(x.size) / FS
+    rows = [f"{a:.7f},{b:.9g}\n" for a, b in zip(t, x)]
+    rows[9] = rows[9].rstrip("\n") + ",\n"
+    with pytest.raises(DataError, match="row has 3 cells") as e:
+        read_record(_write(tmp_path / "x.csv", "time_s,acc\n", rows))
+    assert e.value.row == 10

@@ -308,7 +308,7 @@ def read_csv_table(path: Path, what: str = "a record CSV", skip_lines: int = 0,
                 data = None
             if data is None or data.shape[1] != len(header) or data.shape[0] == 0:
                 fh.seek(start)
-                _locate_bad_row(fh, header, src, delim, comma)
+                _locate_bad_row(fh, header, src, delim, comma, usecols is not None)
                 raise DataError("no data rows", file=src, expected="one row per sample")
     except UnicodeDecodeError as exc:
         raise DataError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=src,
@@ -322,10 +322,11 @@ def _comma_float(cell: str) -> float:
 
 
 def _locate_bad_row(lines: Any, header: list[str], source: str, delim: str | None,
-                    comma: bool = False) -> None:
+                    comma: bool = False, trailing: bool = False) -> None:
     """Raise the error of the first bad data row of ``lines`` (an iterable of text lines);
     rows are counted from 1 after the header, blank and comment lines included. Cells may be
-    quoted; ``comma``: numbers written with a decimal comma."""
+    quoted; ``comma``: numbers written with a decimal comma; ``trailing``: every line ends
+    with a separator (its empty last cell is not a column)."""
     n = 0
     for ln in lines:
         n += 1
@@ -333,8 +334,8 @@ def _locate_bad_row(lines: Any, header: list[str], source: str, delim: str | Non
             continue
         text = ln.rstrip("\r\n")
         cells = next(csv.reader([text], delimiter=delim)) if delim else text.split()
-        if len(cells) == len(header) + 1 and header and cells[-1].strip() == "":
-            cells = cells[:-1]  # the trailing delimiter dropped with the empty column
+        if trailing and len(cells) == len(header) + 1 and cells[-1].strip() == "":
+            cells = cells[:-1]
         if len(cells) != len(header):
             raise DataError(f"row has {len(cells)} cells, the header has {len(header)}",
                             file=source, row=n, expected=f"{len(header)} cells")
