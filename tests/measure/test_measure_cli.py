@@ -75,3 +75,14 @@ def test_synthetic_low_speed_record_and_its_verdict(tmp_path):
                             str(truth["speed_rpm"])])
     assert r.exit_code == 0, r.output
     assert json.loads(r.stdout)["chatter"] == truth["chatter"]
+
+
+def test_detect_chatter_sends_a_dynoware_export_to_measure_cut(tmp_path):
+    """A rotating bar's forces on a fixed dynamometer turn once per revolution (one line,
+    no harmonics): `measure cut` finds the speed from them and judges the cut; `detect
+    chatter` names that command instead of a verdict of its own."""
+    p = write_dynoware_ascii(synthetic_force_record(), tmp_path / "cut.txt")
+    r = runner.invoke(app, ["detect", "chatter", str(p)])
+    assert r.exit_code != 0 and "measure cut" in r.output and "DynoWare" in r.output
+    r = runner.invoke(app, ["measure", "cut", str(p), "--json"])
+    assert r.exit_code == 0, r.output

@@ -18,7 +18,7 @@ from robobore.clitools import (
     parse_floats,
     stdout,
 )
-from robobore.errors import ConfigError
+from robobore.errors import ConfigError, DataError
 
 
 def _modes_Hz(path: Path | None) -> tuple[float, ...]:
@@ -56,7 +56,8 @@ def _modes_Hz(path: Path | None) -> tuple[float, ...]:
 @handle_errors
 def detect_chatter_cmd(
     file: Path = typer.Argument(..., help="Record: CSV (time_s + signal columns), NPZ, "
-                                          "UFF 58 time records (.uff/.unv) or WAV."),
+                                          "UFF 58 time records (.uff/.unv) or WAV (a "
+                                          "DynoWare force export: `measure cut`)."),
     speed_rpm: float | None = typer.Option(None, "--speed-rpm", help="Spindle speed [r/min] "
                                            "(refined within +-1.5 %; estimated from the "
                                            "record's harmonics when not given)."),
@@ -76,6 +77,7 @@ def detect_chatter_cmd(
 ) -> None:
     """Chatter in a measured vibration, sound or force record: verdict, onset, frequency."""
     from robobore.io.outputs import check_output_dir
+    from robobore.measure.cut import is_dynoware
     from robobore.measure.detect import DetectSettings, detect_chatter
     from robobore.measure.records import read_record
 
@@ -84,6 +86,11 @@ def detect_chatter_cmd(
     lines = tuple(parse_floats(fixed_lines_hz, None, "--fixed-lines-hz", "Hz")
                   ) if fixed_lines_hz else ()
     with fraction_progress("chatter detection", not as_json) as prog:
+        if is_dynoware(file):  # its verdict is measure cut's: on the cut, at its speed
+            raise DataError("a DynoWare force export", file=str(file),
+                            expected="`robobore measure cut FILE`: the record's chatter "
+                            "verdict on the cutting part, at the speed found from the forces "
+                            "(detect chatter reads CSV, NPZ, UFF 58 and WAV records)")
         rec = read_record(file, sample_rate_hz)
         if channel is not None:
             rec = rec.channel(channel)

@@ -141,6 +141,30 @@ def _dynoware_header(lines: list[str]) -> int | None:
     return None
 
 
+def _head_lines(p: Path) -> tuple[list[str], str]:
+    """The first 200 lines of a text file and the encoding they were read in (UTF-8, else
+    ANSI: DynoWare writes ANSI text)."""
+    head: list[str] = []
+    enc = "utf-8-sig"
+    for enc in ("utf-8-sig", "latin-1"):
+        try:
+            with p.open("r", encoding=enc, newline="") as fh:
+                head = [fh.readline().rstrip("\r\n") for _ in range(200)]
+            break
+        except UnicodeDecodeError:
+            continue
+    return head, enc
+
+
+def is_dynoware(path: str | Path) -> bool:
+    """Whether a file is a DynoWare ASCII export (a header block of ``key: value`` lines,
+    then a time column and force columns)."""
+    p = Path(path)
+    if not p.is_file() or p.suffix.lower() not in (".csv", ".txt", ".asc", ".dat"):
+        return False
+    return _dynoware_header(_head_lines(p)[0]) is not None
+
+
 def read_cut_record(path: str | Path, sample_rate_Hz: float | None = None) -> Record:
     """Read a force and/or displacement record (module docstring); SI units."""
     p = Path(path)
@@ -166,15 +190,7 @@ def read_cut_record(path: str | Path, sample_rate_Hz: float | None = None) -> Re
     if ext not in (".csv", ".txt", ".asc", ".dat"):
         raise DataError("unknown record format", file=src, value=ext,
                         expected=".csv, .txt, .asc, .dat (DynoWare ASCII) or .npz")
-    head: list[str] = []
-    enc = "utf-8-sig"
-    for enc in ("utf-8-sig", "latin-1"):  # DynoWare writes ANSI text
-        try:
-            with p.open("r", encoding=enc, newline="") as fh:
-                head = [fh.readline().rstrip("\r\n") for _ in range(200)]
-            break
-        except UnicodeDecodeError:
-            continue
+    head, enc = _head_lines(p)
     hi = _dynoware_header(head)
     if hi is not None:
         hdr_line = head[hi]
