@@ -481,7 +481,9 @@ def harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
 
 def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
                           exclude: list[float], fine: FineLines | None = None,
-                          spread: float = 0.0) -> list[tuple[float, float]]:
+                          spread: float = 0.0,
+                          lines: tuple[np.ndarray, np.ndarray] | None = None
+                          ) -> list[tuple[float, float]]:
     """:func:`harmonic_bands` of one window, the spindle frequency re-refined in it within
     +-:data:`WINDOW_SPEED_TOLERANCE` of the record's ``f0`` (a speed that wanders over the
     record is nearly constant over one window) when that aligns at least
@@ -496,9 +498,10 @@ def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     (:data:`SPREAD_SIGMAS`): a line within that of ``k f0`` is matched to it, and the whole
     range is excluded, at the orders where that band is attributable (:func:`_spread_tol`);
     such a band is not checked against ``fine`` (a line within a harmonic's wandering range
-    cannot be told from it, on either spectrum)."""
+    cannot be told from it, on either spectrum). ``lines``: the window's
+    :func:`spectral_lines` above ``f_lo``, where the caller has them."""
     df = f[1] - f[0]
-    freqs, prom = spectral_lines(f, P, max(1, int(f_lo / df)))
+    freqs, prom = lines if lines is not None else spectral_lines(f, P, max(1, int(f_lo / df)))
     if freqs.size == 0:
         return []
     for ln in exclude:
@@ -534,7 +537,7 @@ def window_harmonic_bands(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
         if spread > 0.0:  # the harmonic's whole wandering range, where attributable
             kf = float(np.round(c / fi)) * fi
             wander = abs(c - kf) + SPREAD_SIGMAS * spread * kf
-            if attributable(np.array([wander]), fi)[0]:
+            if attributable(wander, fi):
                 hw = max(hw, wander)
         bands.append((float(c), hw))
     return bands
@@ -550,15 +553,18 @@ def _spread_tol(tol: np.ndarray, wander: np.ndarray, f0: float) -> np.ndarray:
 
 
 def window_spindle(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
-                   exclude: list[float]) -> tuple[float, float] | None:
+                   exclude: list[float],
+                   lines: tuple[np.ndarray, np.ndarray] | None = None
+                   ) -> tuple[float, float] | None:
     """One window's own spindle frequency and its standard error [Hz]: least squares of
     ``f = k f_w`` on the window's lines at its first :data:`LOW_HARMONICS` harmonics, ``f_w``
     searched within +-:data:`WINDOW_SPEED_TOLERANCE` of the record's ``f0`` (the value that
     matches the most such lines, the nearest ``f0`` among equals). None where fewer than three
     harmonics are lines. The standard error is the lines' scatter about their harmonics (at
-    least :data:`FINE_LINE_BINS` bins) over ``sqrt(sum k^2)``."""
+    least :data:`FINE_LINE_BINS` bins) over ``sqrt(sum k^2)``. ``lines``: as in
+    :func:`window_harmonic_bands`."""
     df = f[1] - f[0]
-    freqs, _ = spectral_lines(f, P, max(1, int(f_lo / df)))
+    freqs = (lines if lines is not None else spectral_lines(f, P, max(1, int(f_lo / df))))[0]
     for ln in exclude:
         freqs = freqs[np.abs(freqs - ln) > max(2.0 * df, LINE_REL_WIDTH * ln)]
     freqs = freqs[freqs <= (LOW_HARMONICS + 0.5) * f0 * (1 + WINDOW_SPEED_TOLERANCE)]
@@ -577,7 +583,7 @@ def window_spindle(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     k = np.round(freqs[m] / grid[j])
     if len(set(k.tolist())) < 3:
         return None
-    fw = float(np.sum(k * freqs[m]) / np.sum(k * k))
+    fw = _refine_f0(grid[j], freqs, np.ones(freqs.size), m)
     if abs(fw / f0 - 1.0) > WINDOW_SPEED_TOLERANCE:
         return None
     res = freqs[m] - k * fw
@@ -586,7 +592,8 @@ def window_spindle(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
 
 
 def speed_spread(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
-                 exclude: list[float]) -> float:
+                 exclude: list[float],
+                 lines: list[tuple[np.ndarray, np.ndarray]] | None = None) -> float:
     """Relative standard deviation of the spindle frequency over the record, from the
     windows' own spindle frequencies (:func:`window_spindle`; ``P``: (n_win, n_f)): their
     robust scatter (1.4826 times the median absolute deviation) less their typical
@@ -594,8 +601,9 @@ def speed_spread(f: np.ndarray, P: np.ndarray, f0: float, f_lo: float,
     fewer than half of them, give one (the forced lines of a cut are in every window; a comb
     that only some windows show is not a spindle to measure). A spindle whose speed wanders
     (a belt, the drive's regulation under the cutting load) moves every harmonic ``k`` by
-    ``k`` times its relative change."""
-    est = [window_spindle(f, P[i], f0, f_lo, exclude) for i in range(P.shape[0])]
+    ``k`` times its relative change. ``lines``: each window's :func:`spectral_lines`."""
+    est = [window_spindle(f, P[i], f0, f_lo, exclude, None if lines is None else lines[i])
+           for i in range(P.shape[0])]
     est = [e for e in est if e is not None]
     if len(est) < max(SPREAD_MIN_WINDOWS, 0.5 * P.shape[0]):
         return 0.0
@@ -809,7 +817,10 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
     Pall = P / (P[:, :, f >= f_lo].sum(axis=2, keepdims=True) + 1e-300)
     Pall = Pall.mean(axis=0)  # (n_win, n_f): the channels' normalised spectra
     # how far the speed wanders over the record (each harmonic k moves k times as far)
-    spread = speed_spread(f, Pall, f0, f_lo, lines) if n_matched > 0 else 0.0
+    # each window's lines, found once for its speed and its harmonic bands
+    wlines = ([spectral_lines(f, Pall[i], max(1, int(f_lo / df))) for i in range(t0.size)]
+              if n_matched > 0 else None)
+    spread = speed_spread(f, Pall, f0, f_lo, lines, wlines) if n_matched > 0 else 0.0
     # high harmonic orders, where the windows' bands cannot attribute a line to the spindle:
     # the harmonics placed on the record-length spectrum (fine resolution)
     fine: list[tuple[float, float]] = []
@@ -823,8 +834,8 @@ def detect_chatter(record: Record, settings: DetectSettings | None = None,
             fine_lines = None
     excl = np.empty((t0.size, f.size), dtype=bool)
     for i in range(t0.size):
-        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines, fine_lines, spread)
-              if n_matched > 0 else [])
+        wb = (window_harmonic_bands(f, Pall[i], f0, f_lo, lines, fine_lines, spread,
+                                    wlines[i]) if n_matched > 0 else [])
         excl[i] = exclusion_mask(f, wb + fixed_bands, f_lo, fine)
     allowed = np.ones(f.size, dtype=bool)
     if s.modes_Hz:
