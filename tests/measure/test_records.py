@@ -154,3 +154,12 @@ def test_a_row_with_an_extra_cell_is_named(tmp_path):
     with pytest.raises(DataError, match="row has 3 cells") as e:
         read_record(_write(tmp_path / "x.csv", "time_s,acc\n", rows))
     assert e.value.row == 10
+
+
+def test_time_in_an_unknown_unit_is_refused(tmp_path):
+    from robobore.errors import DataError
+
+    rows = [f"{i / 60.0 / FS:.9f},{v:.9g}\n" for i, v in enumerate(_signal())]
+    with pytest.raises(DataError, match="unknown time unit") as e:
+        read_record(_write(tmp_path / "min.csv", "time [min],acc\n", rows), sample_rate_Hz=FS)
+    assert e.value.field == "time [min]" and e.value.value == "min"

@@ -93,7 +93,7 @@ def _column(col: str, source: str) -> tuple[str, str, float] | None:
 
 def _from_table(header: list[str], data: np.ndarray, source: str, header_line: int,
                 sample_rate_Hz: float | None, dynoware: bool) -> Record:
-    tc = time_column(header)
+    tc = time_column(header, source)
     ti, t_scale = tc if tc is not None else (None, 1.0)
     cols: dict[str, tuple[int, float]] = {}
     for i, h in enumerate(header):

@@ -212,10 +212,12 @@ def guard_size(path: Path, bytes_per_file_byte: float, what: str) -> None:
 TIME_UNITS_S = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 
 
-def time_column(header: list[str]) -> tuple[int, float] | None:
+def time_column(header: list[str], source: str | None = None) -> tuple[int, float] | None:
     """The time column of a table's header and the factor of its unit to s, or None: the
     first column named ``time_s`` or ``t_s`` (unit s or none), or ``time`` or ``t`` (unit
-    none or one of :data:`TIME_UNITS_S`: ``Time [s]``, ``time (ms)``: 1e-3)."""
+    none or one of :data:`TIME_UNITS_S`: ``Time [s]``, ``time (ms)``: 1e-3). With ``source``
+    (the file), a ``time`` column in another unit (``time [min]``) is a :class:`DataError`,
+    not a signal."""
     for i, h in enumerate(header):
         name, unit = split_unit(h)
         name = name.lower()
@@ -223,6 +225,9 @@ def time_column(header: list[str]) -> tuple[int, float] | None:
             return i, 1.0
         if name in ("time", "t") and (unit == "" or unit in TIME_UNITS_S):
             return i, TIME_UNITS_S.get(unit, 1.0)
+        if name == "time" and source is not None:
+            raise DataError("unknown time unit", file=source, field=h, value=unit,
+                            expected=f"a time in {', '.join(TIME_UNITS_S)}")
     return None
 
 
@@ -367,7 +372,7 @@ def parse_rows(body: list[str], header: list[str], source: str, header_line: int
 def _read_csv(path: Path, sample_rate_Hz: float | None) -> Record:
     header, data, _ = read_csv_table(path)
     src = str(path)
-    tc = time_column(header)
+    tc = time_column(header, src)
     ti, t_scale = tc if tc is not None else (None, 1.0)
     if ti is None and sample_rate_Hz is None:
         raise DataError("no time column and no sample rate", file=src, field="time_s",
