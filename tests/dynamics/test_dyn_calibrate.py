@@ -318,6 +318,16 @@ def test_calibrate_cli_writes_a_model_lobes_accept(tmp_path, example):
                     + text[text.index("[insert]"):])
     b = critical_depth_at(toml, 1200.0)
     assert b.critical_depth_mm is not None and a.critical_depth_mm is not None
+    # one answer: the corrected model file gives, through the lobes' own path, the chatter
+    # limits the calibration reports as its band's median (no process damping here, so the
+    # file holds the whole corrected model): the critical depth, or where the cut has no
+    # chatter-free depth the depth up to which it is interrupted (the linear limit); each is
+    # a bracketing search to 1e-3. The band's speeds include 1066.7 r/min, where the steady
+    # cut of this robot is interrupted at vanishing depth (chatter_limit).
+    for n, p50 in zip(d["band"]["speed_rpm"], d["band"]["critical_depth_p50_mm"], strict=True):
+        c = critical_depth_at(toml, float(n))
+        lim = c.critical_depth_mm if c.critical_depth_mm != 0.0 else c.interrupted_below_mm
+        assert lim is not None and abs(lim / p50 - 1.0) <= 2e-3, (n, lim, p50)
 
 
 def test_calibrate_cli_without_observations_is_a_clear_error(tmp_path):
@@ -368,3 +378,36 @@ def test_chatter_frequency_prediction_is_finite_where_the_monodromy_overflows(ex
                         lambda *a, **k: (complex("nan"), math.nan, -1))
     pred = pb.predictions(np.zeros(6))
     assert np.all(np.isfinite(pred)) and pred[1] == pytest.approx(17.0 + half)
+
+
+def test_band_limits_are_the_lobes_chatter_limits(example):
+    """The band, the calibration and the SYNTHETIC truth place the chatter limit where the
+    lobes do: at 1050 r/min the example robot's steady cut is interrupted at vanishing depth,
+    the linear limit is 0 there, and the lobes' limit is the first crossing above the
+    interruption; at 1000 r/min the cut is interrupted up to the linear limit itself (no
+    chatter-free depth), the chatter limit is that depth; elsewhere it is the linear limit."""
+    from robobore.dynamics.band import critical_depths
+    from robobore.dynamics.semidiscretization import (
+        chatter_free_window,
+        chatter_limit,
+        critical_depth_semidiscretization,
+    )
+
+    _, st, pr = example
+    assert critical_depth_semidiscretization(st, pr, 1050.0) == 0.0
+    speeds = np.array([400.0, 1000.0, 1050.0, 2200.0])
+    band = critical_depths(st, pr, speeds)
+    for n, b in zip(speeds, band, strict=True):
+        below, ac = chatter_free_window(st, pr, float(n))
+        lobes = ac if ac > 0.0 else below
+        assert lobes > 1e-4  # a real limit, not the scan's floor (5 um)
+        assert chatter_limit(st, pr, float(n)) == pytest.approx(lobes, rel=2e-3)
+        assert b == pytest.approx(lobes, rel=2e-3), n
+
+
+def test_bundled_cuts_are_the_generators(example, tmp_path):
+    """examples/boring_paper_cuts.csv is what write_example_observations makes (seed 0)."""
+    from robobore.dynamics.calibrate_synthetic import write_example_observations
+
+    out = write_example_observations(tmp_path / "cuts.csv", EXAMPLE, 0)
+    assert Path(out).read_text() == (ROOT / "examples" / "boring_paper_cuts.csv").read_text()

@@ -15,9 +15,10 @@ JCGM 100:2008 section 5.1, with a secant on the scale of the spread rather than 
 ``g(n)`` is then taken as Gaussian: the critical depth's quantiles are
 ``exp(g0 +- 1.645 sd)`` and the probability of chatter at depth ``a`` is
 ``Phi((ln a - g0) / sd)``. A zero covariance gives the nominal lobes and a step at them.
-Critical depths are the linear limit of
-:func:`~robobore.dynamics.semidiscretization.critical_depth_semidiscretization` (a speed stable
-up to the top of the depth scan counts as the top, one unstable at the bottom as the bottom).
+Critical depths are the lobes' chatter limit,
+:func:`~robobore.dynamics.semidiscretization.chatter_limit` (the linear limit, above the
+interruption where the steady cut is interrupted at vanishing depth; a speed stable up to the
+top of the depth scan counts as the top, one unstable at the bottom as the bottom).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from robobore.dynamics.process import CuttingProcess
 from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_DECADES,
     DEPTH_SCAN_HI_M,
-    critical_depth_semidiscretization,
+    chatter_limit,
 )
 from robobore.dynamics.structure import ToolPointStructure
 
@@ -52,7 +53,8 @@ def clipped(a: np.ndarray | float) -> np.ndarray:
 
 def critical_depths(structure: ToolPointStructure, process: CuttingProcess,
                     speeds: np.ndarray, guess: np.ndarray | None = None) -> np.ndarray:
-    """Linear critical depth [m] at each speed (clipped, :func:`clipped`). ``guess`` (m, one a
+    """Chatter limit [m] (:func:`~robobore.dynamics.semidiscretization.chatter_limit`) at each
+    speed (clipped, :func:`clipped`). ``guess`` (m, one a
     speed, e.g. the nominal model's): each search continues from it; without it, from the
     previous speed's limit."""
     speeds = np.asarray(speeds, float)
@@ -61,8 +63,7 @@ def critical_depths(structure: ToolPointStructure, process: CuttingProcess,
     for i, n in enumerate(speeds):
         g = prev if guess is None else float(guess[i])
         g = g if g is not None and DEPTH_FLOOR_M < g < DEPTH_SCAN_HI_M else None
-        out[i] = float(clipped(critical_depth_semidiscretization(structure, process, float(n),
-                                                                  guess_m=g)))
+        out[i] = float(clipped(chatter_limit(structure, process, float(n), guess_m=g)))
         prev = out[i]
     return out
 

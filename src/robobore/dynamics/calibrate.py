@@ -9,7 +9,9 @@ stiffness), and, where the data need it, a process-damping coefficient.
 Likelihood (one term per observation):
 
 * verdict: ``P(chatter) = eps + (1 - 2 eps) Phi(ln(a / a_crit(n)) / s)``, ``a_crit`` the
-  semi-discretisation linear limit at the cut's speed (and feed), ``eps`` the label-noise rate,
+  lobes' chatter limit at the cut's speed (and feed): the semi-discretisation linear limit,
+  above the interruption where the steady cut is interrupted at vanishing depth
+  (:func:`~robobore.dynamics.semidiscretization.chatter_limit`), ``eps`` the label-noise rate,
   ``s`` the spread of the verdict about the limit (:class:`LikelihoodSettings`);
 * chatter frequency (chatter cuts): Gaussian about the frequency of the semi-discretisation's
   critical Floquet multiplier at the cut's speed and depth
@@ -74,7 +76,7 @@ from robobore.dynamics.band import (
 )
 from robobore.dynamics.semidiscretization import (
     DEPTH_SCAN_HI_M,
-    critical_depth_semidiscretization,
+    chatter_limit,
     critical_multiplier,
 )
 from robobore.dynamics.structure import ToolPointStructure
@@ -332,8 +334,7 @@ class CalibrationProblem:
             st = self.structure_at(theta, o.depth_m, o.speed_rpm)
             gm = None if guess is None else math.exp(guess[i])
             gm = gm if gm is not None and DEPTH_FLOOR_M < gm < DEPTH_SCAN_HI_M else None
-            a = critical_depth_semidiscretization(st, self.processes[o.feed_mm_per_rev],
-                                                  o.speed_rpm, guess_m=gm)
+            a = chatter_limit(st, self.processes[o.feed_mm_per_rev], o.speed_rpm, guess_m=gm)
             g[i] = math.log(float(clipped(a)))
         extra = []
         for o in obs:
@@ -716,8 +717,7 @@ def band_curve(problem: CalibrationProblem, with_pd: bool, speeds: np.ndarray,
             for i, n in enumerate(speeds):
                 st = problem.structure_at(theta, float(a[i]), float(n))
                 g = float(a[i]) if DEPTH_FLOOR_M < a[i] < DEPTH_SCAN_HI_M else None
-                a[i] = float(clipped(critical_depth_semidiscretization(st, pr, float(n),
-                                                                       guess_m=g)))
+                a[i] = float(clipped(chatter_limit(st, pr, float(n), guess_m=g)))
         return a
 
     return curve

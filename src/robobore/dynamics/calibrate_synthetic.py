@@ -8,8 +8,9 @@ robot of ``examples/boring_paper.toml``) with every direction's damping ratio x0
 Design of the cuts (:func:`synthetic_observations`): 12 speeds, one drawn uniformly in each of
 12 equal slices of the speed range (stratified: the cuts spread over the lobes); at each speed
 a depth ``a_truth(n) exp(u)``, ``u`` uniform in +-0.3 (the test cuts of an engineer who
-brackets the limit within a factor 1.35 either side); the label is the truth's verdict (chatter
-above its semi-discretisation linear limit) flipped with probability 0.1 (label noise).
+brackets the limit within a factor 1.35 either side); the label is the truth's verdict
+(chatter above its chatter limit, :func:`~robobore.dynamics.semidiscretization.chatter_limit`)
+flipped with probability 0.1 (label noise).
 Held-out speeds: 24 speeds drawn uniformly over the range with the same seed.
 
 Sequential design (:func:`sequential_observations`, ``design="sequential"``): the first

@@ -364,6 +364,29 @@ def chatter_free_window(structure: ToolPointStructure, process: CuttingProcess,
     return _window(structure, process, speed_rpm, guess_m, None, **kwargs)[:2]
 
 
+def chatter_limit(structure: ToolPointStructure, process: CuttingProcess, speed_rpm: float,
+                  guess_m: float | None = None) -> float:
+    """The depth [m] above which the cut chatters at one speed, as the lobes
+    (:func:`chatter_free_windows`) place it: the linear limit of
+    :func:`critical_depth_semidiscretization` (``guess_m`` as there), except where the
+    spectral radius is at or above 1 at vanishing depth because the steady cut is
+    interrupted there: then the first crossing above the depth up to which the cut stays
+    interrupted, or that depth where the cut is unstable as soon as it is in the material
+    (:func:`_above_interruption`, as :func:`chatter_free_window` does). ``inf``: stable up to
+    the scan's top (the top itself where the cut is interrupted up to it); 0: unstable in the
+    material at vanishing depth. Below this depth the cut does not chatter; whether it is
+    chatter-free or interrupted by the forced vibration there is
+    :func:`chatter_free_window`'s answer. This is the limit that the chatter verdicts of
+    observed cuts are compared with (:mod:`robobore.dynamics.calibrate`) and that the lobes'
+    band spreads (:mod:`robobore.dynamics.band`)."""
+    a_c = critical_depth_semidiscretization(structure, process, speed_rpm, guess_m=guess_m)
+    if a_c != 0.0:
+        return a_c
+    below, a_c = _above_interruption(structure, process, speed_rpm, DEPTH_SCAN_HI_M, 0, 1e-3,
+                                     True, True, DEPTH_SCAN_DECADES, DEPTH_SCAN_RATIO)
+    return a_c if a_c > 0.0 else below
+
+
 def _window(structure, process, speed_rpm, guess_m, slope, depth_hi_m=DEPTH_SCAN_HI_M,
             steps=0, tol=1e-3, include_process_stiffness=True, about_deflected=True,
             decades=DEPTH_SCAN_DECADES, ratio=DEPTH_SCAN_RATIO):
@@ -1338,7 +1361,7 @@ def critical_multiplier(structure: ToolPointStructure, process: CuttingProcess,
 __all__ = ["DEPTH_SCAN_HI_M", "DEPTH_SCAN_DECADES", "DEPTH_SCAN_RATIO", "DENSE_EIG_MAX",
            "blas_thread_limit", "depth_scan_grid", "auto_steps", "deflected_depth_weights",
            "monodromy_spectral_radius", "critical_depth_semidiscretization",
-           "interrupted_below",
+           "interrupted_below", "chatter_limit",
            "chatter_free_window", "chatter_free_windows", "CONTINUATION_STEP",
            "CONTINUATION_SLOPE", "CONTINUATION_MAX_STEP", "CONTINUATION_SECANT_STEPS",
            "RICHARDSON_MIN_STEPS", "DEFLECTION_SAMPLES", "critical_multiplier"]
