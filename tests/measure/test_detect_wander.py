@@ -106,3 +106,12 @@ def test_cli_synthetic_speed_wander(tmp_path):
     r = runner.invoke(app, ["measure", "synthetic", str(tmp_path / "f.txt"), "--kind", "force",
                             "--speed-wander", "0.003"])
     assert r.exit_code == 2 and "--speed-wander" in r.output
+
+
+def test_cli_speed_wander_out_of_range_names_the_option(tmp_path):
+    """0.3 for 0.3 % (a percent slip by 100) is refused naming the option and its range."""
+    r = CliRunner().invoke(app, ["measure", "synthetic", str(tmp_path / "w.csv"),
+                                 "--speed-wander", "0.3"])
+    assert r.exit_code == 2
+    assert "--speed-wander" in r.output and "0 .. 0.05" in r.output
+    assert not (tmp_path / "w.csv").exists()

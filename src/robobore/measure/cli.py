@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -225,6 +226,11 @@ def measure_synthetic_cmd(
     if not 0.5 <= duration_s <= 60.0:
         raise ConfigError("duration out of range", field="--duration-s", value=duration_s,
                           expected="0.5 .. 60 s")
+    if not (math.isfinite(speed_wander) and 0.0 <= speed_wander <= 0.05):
+        raise ConfigError("speed wander out of range", field="--speed-wander",
+                          value=speed_wander,
+                          expected="0 .. 0.05 (a relative standard deviation of the speed; "
+                                   "0.003 for 0.3 %)")
     if kind == "vibration":
         from robobore.measure.records import write_record_csv
         from robobore.measure.synthetic import LOW_SPEED, simulated_record
