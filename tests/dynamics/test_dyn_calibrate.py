@@ -354,6 +354,13 @@ def test_lobes_band_option_draws_the_modal_band(tmp_path):
                                             "critical_depth_p95_mm"))
     assert np.all(lo <= med) and np.all(med <= hi) and np.any(hi > lo)
     assert (tmp_path / "lobes_band.png").stat().st_size > 0
+    # one answer: the band's median is the lobes' chatter limit of the nominal model
+    from robobore.dynamics.api import critical_depth_at
+
+    for n, m in zip(b["speed_rpm"], med, strict=True):
+        c = critical_depth_at(toml, float(n))
+        lim = c.critical_depth_mm if c.critical_depth_mm != 0.0 else c.interrupted_below_mm
+        assert lim is not None and abs(lim / m - 1.0) <= 2e-3, (n, lim, m)
     r = runner.invoke(app, ["lobes", str(EXAMPLE), "--band"])
     assert r.exit_code == 2 and "equivalent.uncertainty" in r.output
 
