@@ -86,3 +86,16 @@ def test_every_image_of_the_docs_is_in_the_site(site):
                 problems.append(f"{html.relative_to(site)}: <img src={src!r}> points at nothing")
     assert not problems, "\n".join(problems)
     assert n >= 8  # every figure of docs/figures is shown by a guide, two on the home page
+
+
+def test_home_page_commands_are_the_readmes():
+    """docs/index.md shows the README's two commands (the ones CI runs), word for word."""
+
+    def blocks(text: str) -> list[str]:
+        return [b.strip() for b in re.findall(r"```bash\n(.*?)```", text, re.S)]
+
+    readme = (ROOT / "README.md").read_text()
+    ci = []
+    for marker in ("<!-- ci:main -->", "<!-- ci:test -->"):
+        ci.append(blocks(readme[readme.index(marker):])[0])
+    assert blocks((ROOT / "docs" / "index.md").read_text())[:2] == ci
