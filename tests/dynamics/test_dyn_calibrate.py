@@ -418,3 +418,18 @@ def test_bundled_cuts_are_the_generators(example, tmp_path):
 
     out = write_example_observations(tmp_path / "cuts.csv", EXAMPLE, 0)
     assert Path(out).read_text() == (ROOT / "examples" / "boring_paper_cuts.csv").read_text()
+
+
+def test_feed_amplitude_prediction_is_the_planners(example):
+    """One answer: the feed amplitude the likelihood compares a stable cut with is the
+    planner's steady feed amplitude (held to the time domain's in tests/plan), at speeds on and
+    off the lobes' peaks."""
+    from robobore.dynamics.calibrate import Observation, build_problem
+    from robobore.plan.scoring import steady_feed_amplitude
+
+    cfg = example[0]
+    for n, a in ((500.0, 0.5e-3), (1000.0, 1e-3), (2600.0, 0.3e-3)):
+        o = Observation(1, n, a, False, feed_amplitude_m=1e-6)
+        pb = build_problem(cfg, [o])
+        assert pb.feed_amplitude(np.zeros(6), o) == pytest.approx(
+            steady_feed_amplitude(pb.structure, pb.process, a, n), rel=1e-9)
