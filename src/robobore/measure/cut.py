@@ -145,7 +145,6 @@ def _head_lines(p: Path) -> tuple[list[str], str]:
     """The first 200 lines of a text file and the encoding they were read in (UTF-8, else
     ANSI: DynoWare writes ANSI text)."""
     head: list[str] = []
-    enc = "utf-8-sig"
     for enc in ("utf-8-sig", "latin-1"):
         try:
             with p.open("r", encoding=enc, newline="") as fh:

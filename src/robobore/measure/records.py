@@ -179,9 +179,8 @@ def sample_rate_from_time(t: np.ndarray, source: str, column: str = "time_s",
         step_bad = np.abs(d - med) > max(STEP_TOLERANCE * med, 1.01 * q)
         grid_bad = dev > max(GRID_TOLERANCE * dt, 0.51 * q)
     if step_bad.any() or grid_bad.any():
-        i1 = int(np.argmax(step_bad)) + 1 if step_bad.any() else t.size
-        i2 = int(np.argmax(grid_bad)) if grid_bad.any() else t.size
-        i = max(1, i1 if step_bad.any() else i2)  # a gap or a repeat is a bad step there
+        # a gap or a repeat is a bad step there, else the first time off the grid
+        i = max(1, int(np.argmax(step_bad)) + 1 if step_bad.any() else int(np.argmax(grid_bad)))
         raise DataError("time is not uniformly sampled", file=source, row=i + first_row,
                         field=column, value=float(t[i]),
                         expected=f"steps of {med:.6g} s (each within "
